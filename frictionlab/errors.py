@@ -1,0 +1,37 @@
+"""Error types. Every message is one line that names the file, field or parameter at fault."""
+
+
+class FrictionLabError(Exception):
+    """Base class: a user-facing error whose message is one complete line."""
+
+
+class UnitError(FrictionLabError):
+    """A quantity or unit string that cannot be read or has the wrong dimension."""
+
+
+class DatasetError(FrictionLabError):
+    """A dataset file (CSV or TOML) that is missing, malformed or inconsistent."""
+
+
+class RegistryError(FrictionLabError):
+    """An unknown law name, or two laws registered under one name."""
+
+
+class LawError(FrictionLabError):
+    """A law plugin that is malformed or returns an unusable force."""
+
+
+class ParameterError(FrictionLabError):
+    """A law or scene parameter that is unknown, out of bounds or of the wrong unit."""
+
+
+class SceneError(FrictionLabError):
+    """A scene that cannot supply what a law or an effect asks for."""
+
+
+class SolverError(FrictionLabError):
+    """An unknown solver, or a solver that does not apply to this law and scene."""
+
+
+class OutputError(FrictionLabError):
+    """An output path that exists or cannot be written."""

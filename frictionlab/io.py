@@ -1,0 +1,54 @@
+"""Writing outputs whole or not at all."""
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from contextlib import contextmanager
+from pathlib import Path
+
+from .errors import OutputError
+
+
+def atomic_write_text(path, text: str) -> None:
+    """Write ``text`` to ``path`` through a temporary file in the same folder, then rename."""
+    path = Path(path)
+    if not path.parent.exists():
+        raise OutputError(f"{path}: folder {path.parent} does not exist")
+    try:
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot write: {exc.strerror or exc}") from None
+
+
+@contextmanager
+def atomic_dir(path, force: bool = False):
+    """Yield a temporary folder beside ``path``; move it into place only if the block succeeds.
+
+    An existing ``path`` is refused unless ``force``, in which case it is replaced at the end.
+    """
+    path = Path(path)
+    if path.exists() and not force:
+        raise OutputError(f"{path}: output folder exists; choose another --out or pass --force")
+    parent = path.parent if str(path.parent) else Path(".")
+    if not parent.exists():
+        raise OutputError(f"{path}: parent folder {parent} does not exist")
+    try:
+        tmp = Path(tempfile.mkdtemp(dir=parent, prefix=f".{path.name}.", suffix=".tmp"))
+    except OSError as exc:
+        raise OutputError(f"{path}: cannot write in {parent}: {exc.strerror or exc}") from None
+    try:
+        yield tmp
+        if path.exists():
+            old = parent / f".{path.name}.old"
+            shutil.rmtree(old, ignore_errors=True)
+            os.replace(path, old)
+            os.replace(tmp, path)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(tmp, path)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)

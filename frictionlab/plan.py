@@ -1,0 +1,156 @@
+"""The plan: the state vector and right-hand side a scene and a law actually need, and nothing else.
+
+State components (each only when called for):
+  v      body tangential velocity [m/s]                 always
+  omega  spin [rad/s], theta rotation angle [rad]       effect 'spin' or 'slip-coupling'
+  x      sliding length [m]                             area model 'growth' and the law uses A or dA/dt
+  xi     tangential spring deflection [m]               effect 'compliance'
+
+Slip u is v, or v - r omega with 'slip-coupling'; with 'compliance' it is the slip of a
+massless contact patch, found from  F(u) = k xi + c (w - u),  w the rigid contact-point velocity.
+"""
+from __future__ import annotations
+
+import math
+
+import attrs
+import numpy as np
+from scipy.optimize import brentq
+
+from .errors import SceneError
+from .law import QUANTITIES, Contact, FrictionLaw
+from .scene import G, GrowthArea, HertzNormal, Scene
+
+
+@attrs.frozen(eq=False)
+class Plan:
+    scene: Scene
+    law: FrictionLaw
+    states: tuple[str, ...]
+    coupled: bool
+    needs_area: bool
+    needs_normal: bool
+
+    # -- constants ----------------------------------------------------------------
+    @property
+    def drive(self) -> float:
+        """Tangential acceleration of the body from gravity along the incline [m/s^2]."""
+        s = self.scene
+        return G * math.sin(s.incline) if "gravity" in s.effects else 0.0
+
+    @property
+    def kappa(self) -> float:
+        """d(slip)/dt per unit friction force [1/kg]: 1/m, plus r^2/I with slip coupling."""
+        s = self.scene
+        return 1.0 / s.mass + (s.radius**2 / s.inertia if self.coupled else 0.0)
+
+    @property
+    def has_spin(self) -> bool:
+        return "omega" in self.states
+
+    def index(self, name: str) -> int:
+        return self.states.index(name)
+
+    def initial_state(self) -> np.ndarray:
+        s = self.scene
+        values = {"v": s.u0 + (s.radius * s.omega0 if self.coupled else 0.0), "omega": s.omega0, "theta": 0.0,
+                  "x": 0.0, "xi": 0.0}
+        return np.array([values[k] for k in self.states], dtype=float)
+
+    # -- contact quantities ----------------------------------------------------------
+    def rigid_slip(self, y: np.ndarray) -> np.ndarray:
+        """Velocity of the body's contact point relative to the surface [m/s]."""
+        v = y[0]
+        return v - self.scene.radius * y[self.index("omega")] if self.coupled else v
+
+    def contact(self, t, y, u) -> Contact:
+        """The contact quantities the law requires, and only those, at times t for states y."""
+        s = self.scene
+        A = dAdt = N = None
+        if self.needs_area or isinstance(s.normal, HertzNormal) and self.needs_normal:
+            x = y[self.index("x")] if "x" in self.states else None
+            A, dAdt = s.area(t, x, u)
+        if self.needs_normal:
+            N = s.normal(t, A)
+        req = self.law.requires
+        return Contact(t=np.asarray(t, dtype=float), u=np.asarray(u, dtype=float),
+                       N=N if "N" in req else None, A=A if "A" in req else None, dAdt=dAdt if "dAdt" in req else None)
+
+    def force(self, p, t, y, u) -> tuple[np.ndarray, Contact]:
+        c = self.contact(t, y, u)
+        return self.law.evaluate(p, c), c
+
+    def patch_slip(self, p, t, y) -> float:
+        """Slip of the compliant contact patch: the root of F(u) + c u = k xi + c w (scalar state)."""
+        k, c = self.scene.compliance.stiffness, self.scene.compliance.damping
+        w = float(self.rigid_slip(y))
+        target = k * y[self.index("xi")] + c * w
+
+        def g(u):
+            f, _ = self.force(p, np.array([t]), y[:, None], np.array([u]))
+            return f[0] + c * u - target
+
+        tiny = 1e-12 * max(abs(w), abs(target) / c, 1e-300)
+        lo, hi = g(-tiny), g(tiny)
+        if lo <= 0.0 <= hi:
+            return 0.0
+        bound = target / c
+        a, b = (0.0, bound) if hi < 0 else (bound, 0.0)
+        ga, gb = g(a), g(b)
+        if ga * gb > 0:  # law not monotone: widen once, then give up clearly
+            a, b = (0.0, 2 * bound + math.copysign(tiny, bound)) if hi < 0 else (2 * bound - tiny, 0.0)
+            if g(a) * g(b) > 0:
+                raise SceneError(f"law '{self.law.name}': no contact-patch slip balances the tangential spring at t = {t:g} s")
+        return brentq(g, a, b, xtol=1e-15 * max(abs(bound), 1e-300), rtol=4 * np.finfo(float).eps)
+
+    def slip(self, p, t, y) -> float:
+        if "xi" in self.states:
+            return self.patch_slip(p, t, y)
+        return self.rigid_slip(y)
+
+    def rates(self, t, y, F, u) -> np.ndarray:
+        """Time derivatives of the state for friction force F and slip u (works on batches)."""
+        s = self.scene
+        out = []
+        for name in self.states:
+            if name == "v":
+                out.append(self.drive - F / s.mass)
+            elif name == "omega":
+                out.append(F * s.radius / s.inertia)
+            elif name == "theta":
+                out.append(y[self.index("omega")])
+            elif name == "x":
+                out.append(np.abs(u))
+            elif name == "xi":
+                out.append(self.rigid_slip(y) - u)
+        return np.array(out)
+
+
+def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan:
+    """Assemble the plan for ``law`` on ``scene``; error if the scene cannot supply what the law needs."""
+    missing = set(law.requires) - scene.supplies()
+    if missing:
+        hint = {"N": "add a [scene.normal] model (half-sine, hertz, column or weight)",
+                "A": "add a [scene.area] model (half-sine, constant, growth or column)",
+                "dAdt": "add a [scene.area] model (half-sine, constant, growth or column)"}
+        what = ", ".join(f"{q} ({QUANTITIES[q].split(' [')[0]})" for q in sorted(missing))
+        raise SceneError(f"law '{law.name}' needs {what}, which {scene_name} cannot supply: "
+                         + "; ".join(sorted({hint[q] for q in missing if q in hint})))
+    effects = scene.effects
+    coupled = "slip-coupling" in effects
+    spin = "spin" in effects or coupled
+    if spin and scene.radius is None:
+        raise SceneError(f"{scene_name}: effect 'spin' needs scene.radius")
+    needs_area = bool({"A", "dAdt"} & set(law.requires))
+    needs_normal = "N" in law.requires
+    states = ["v"]
+    if spin:
+        states += ["omega", "theta"]
+    if needs_area and isinstance(scene.area, GrowthArea):
+        states.append("x")
+    if "compliance" in effects:
+        if scene.compliance is None or not scene.compliance.damping > 0:
+            raise SceneError(f"{scene_name}: effect 'compliance' needs a positive stiffness and damping")
+        states.append("xi")
+    return Plan(scene=scene, law=law, states=tuple(states), coupled=coupled, needs_area=needs_area,
+                needs_normal=needs_normal)

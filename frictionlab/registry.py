@@ -1,0 +1,179 @@
+"""The law registry: entry-point plugins loaded lazily and cached, plus run-time registration.
+
+Built-in and third-party laws arrive the same way, through the ``frictionlab.laws``
+entry-point group. ``register_law`` adds one at run time. A plugin that fails to import
+is skipped with a warning naming it; two laws under one name is an error naming both.
+"""
+from __future__ import annotations
+
+import inspect
+import warnings
+from importlib.metadata import entry_points
+
+import numpy as np
+
+from .errors import FrictionLabError, LawError, RegistryError
+from .law import QUANTITIES, Contact, FrictionLaw
+
+GROUP = "frictionlab.laws"
+
+
+class PluginWarning(UserWarning):
+    """A law plugin was skipped."""
+
+
+_laws: dict[str, FrictionLaw] = {}
+_sources: dict[str, str] = {}
+_runtime: list[tuple[FrictionLaw, str]] = []
+_loaded = False
+
+
+def _as_law(obj, source: str) -> FrictionLaw:
+    law = obj() if inspect.isclass(obj) else obj
+    if not isinstance(law, FrictionLaw):
+        raise LawError(f"law plugin {source}: {obj!r} is not a frictionlab.FrictionLaw")
+    validate_law(law, source)
+    return law
+
+
+def validate_law(law: FrictionLaw, source: str) -> None:
+    """Check a law's declaration and probe its force once with its defaults."""
+    for attr in ("name", "formula", "citation", "params", "requires"):
+        if not hasattr(law, attr):
+            raise LawError(f"law plugin {source}: missing class attribute '{attr}'")
+    if not isinstance(law.name, str) or not law.name or any(ch.isspace() for ch in law.name):
+        raise LawError(f"law plugin {source}: name must be a non-empty word, got {law.name!r}")
+    unknown = set(law.requires) - set(QUANTITIES)
+    if unknown:
+        raise LawError(
+            f"law '{law.name}' ({source}): requires unknown quantities {sorted(unknown)}; known: {', '.join(QUANTITIES)}"
+        )
+    if "u" not in law.requires:
+        raise LawError(f"law '{law.name}' ({source}): every law must require the slip velocity 'u'")
+    n = 5
+    probe = Contact(
+        t=np.linspace(0.0, 1e-3, n),
+        u=np.array([1.0, 0.5, 1e-3, 2.0, 3.0]),
+        N=np.full(n, 10.0) if "N" in law.requires else None,
+        A=np.full(n, 1e-4) if "A" in law.requires else None,
+        dAdt=np.zeros(n) if "dAdt" in law.requires else None,
+    )
+    p = law.defaults()
+    f_pos = law.evaluate(p, probe)
+    f_neg = law.evaluate(p, attrs_replace(probe, u=-probe.u))
+    if np.any(f_pos < 0) or np.any(f_neg > 0):
+        raise LawError(
+            f"law '{law.name}' ({source}): force() does not oppose slip at its defaults; "
+            "frictionlab's convention is F > 0 for u > 0 (m dv/dt = drive - F)"
+        )
+
+
+def attrs_replace(c: Contact, **kw) -> Contact:
+    import attrs
+
+    return attrs.evolve(c, **kw)
+
+
+def _add(law: FrictionLaw, source: str) -> None:
+    if law.name in _laws:
+        raise RegistryError(f"law name '{law.name}' is registered twice: by {_sources[law.name]} and by {source}")
+    _laws[law.name] = law
+    _sources[law.name] = source
+
+
+def _load() -> None:
+    global _loaded
+    if _loaded:
+        return
+    _laws.clear()
+    _sources.clear()
+    seen = set()
+    try:
+        for ep in entry_points(group=GROUP):
+            dist = getattr(ep, "dist", None)
+            dist_name = f"{dist.metadata['Name']} {dist.version}" if dist is not None else "unknown distribution"
+            key = (ep.name, ep.value, dist_name)
+            if key in seen:  # the same distribution found twice on sys.path
+                continue
+            seen.add(key)
+            source = f"entry point '{ep.name} = {ep.value}' of {dist_name}"
+            try:
+                law = _as_law(ep.load(), source)
+            except FrictionLabError as exc:
+                warnings.warn(f"frictionlab: skipped law plugin: {exc}", PluginWarning, stacklevel=3)
+                continue
+            except Exception as exc:
+                warnings.warn(
+                    f"frictionlab: skipped law plugin {source}: import failed: {type(exc).__name__}: {exc}",
+                    PluginWarning,
+                    stacklevel=3,
+                )
+                continue
+            _add(law, source)
+        for law, source in _runtime:
+            _add(law, source)
+    except RegistryError:
+        _laws.clear()
+        _sources.clear()
+        raise
+    _loaded = True
+
+
+def register_law(obj=None, *, replace: bool = False):
+    """Register a law class or instance at run time; usable as a class decorator.
+
+    ``replace=True`` swaps out a law of the same name registered earlier at run time.
+    """
+
+    def _register(o):
+        source = f"run-time registration of {getattr(o, '__module__', '?')}.{getattr(o, '__qualname__', type(o).__name__)}"
+        law = _as_law(o, source)
+        _load()
+        if replace and law.name in _laws and _sources[law.name].startswith("run-time"):
+            unregister_law(law.name)
+        _add(law, source)
+        _runtime.append((law, source))
+        return o
+
+    return _register if obj is None else _register(obj)
+
+
+def unregister_law(name: str) -> None:
+    """Remove a law registered at run time (entry-point laws stay)."""
+    _load()
+    if name not in _laws:
+        raise RegistryError(f"unknown law '{name}'")
+    if not _sources[name].startswith("run-time"):
+        raise RegistryError(f"law '{name}' comes from {_sources[name]}; only run-time laws can be removed")
+    del _laws[name]
+    del _sources[name]
+    _runtime[:] = [(law, s) for law, s in _runtime if law.name != name]
+
+
+def get_law(name: str | FrictionLaw) -> FrictionLaw:
+    """The registered law called ``name`` (a law instance is returned as is)."""
+    if isinstance(name, FrictionLaw):
+        return name
+    _load()
+    try:
+        return _laws[name]
+    except KeyError:
+        raise RegistryError(f"unknown law '{name}'; registered laws: {', '.join(sorted(_laws))}") from None
+
+
+def available_laws() -> dict[str, FrictionLaw]:
+    """All registered laws by name, in registration order."""
+    _load()
+    return dict(_laws)
+
+
+def law_source(name: str) -> str:
+    _load()
+    return _sources[get_law(name).name]
+
+
+def reload_registry() -> None:
+    """Forget the cached entry points and read them again (run-time laws are kept)."""
+    global _loaded
+    _loaded = False
+    _load()

@@ -1,0 +1,310 @@
+"""Scenes: a body, a contact history (area and normal-force models), a drive and named effects.
+
+A scene is pure data in SI floats. It comes from a dataset's ``[scene]`` TOML table
+(``Scene.from_spec``) or is built in Python. What to integrate is decided later by the
+plan (``frictionlab.plan``), from the scene's effects and the law's requirements.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+import attrs
+import numpy as np
+
+from .errors import SceneError, UnitError
+from .units import to_si
+
+G = 9.80665  # standard gravity [m/s^2]
+
+KINDS = ("impact", "incline", "impact-outcome")
+
+#: Effects a scene may switch on in its ``effects`` list.
+EFFECTS = {
+    "spin": "integrate spin omega and rotation angle theta from the friction torque (needs radius)",
+    "slip-coupling": "contact-point slip u = v - r omega (rigid sphere) instead of u = v",
+    "compliance": "linear tangential spring and damper at the contact (Maw, Barber and Fawcett 1976)",
+    "gravity": "gravity along an incline, m g sin(alpha), with N = m g cos(alpha)",
+}
+
+
+# --- contact-area models ------------------------------------------------------------
+@attrs.frozen
+class HalfSineArea:
+    """A(t) = peak sin(pi t / contact_time) for 0 <= t <= contact_time, else 0. Eq (1) of the paper."""
+
+    peak: float  # [m^2]
+    contact_time: float  # [s]
+
+    def __call__(self, t, x=None, speed=None):
+        t = np.asarray(t, dtype=float)
+        phi = math.pi / self.contact_time
+        inside = (t >= 0) & (t <= self.contact_time)
+        return np.where(inside, self.peak * np.sin(phi * t), 0.0), np.where(inside, self.peak * phi * np.cos(phi * t), 0.0)
+
+
+@attrs.frozen
+class ConstantArea:
+    """A constant contact area [m^2]."""
+
+    area: float
+
+    def __call__(self, t, x=None, speed=None):
+        t = np.asarray(t, dtype=float)
+        return np.full(t.shape, self.area), np.zeros(t.shape)
+
+
+@attrs.frozen
+class GrowthArea:
+    """Wear growth with sliding length x: A = initial + rate * x [m^2, m^2/m]; dA/dt = rate * |slip|."""
+
+    initial: float
+    rate: float
+
+    def __call__(self, t, x=None, speed=None):
+        x = np.zeros(np.shape(t)) if x is None else np.asarray(x, dtype=float)
+        speed = np.zeros(np.shape(t)) if speed is None else np.abs(speed)
+        return self.initial + self.rate * x, self.rate * speed
+
+
+@attrs.frozen(eq=False)
+class TableArea:
+    """A measured area column, smoothed by a spline whose derivative gives dA/dt.
+
+    The smoothing spline's roughness penalty is chosen by generalized cross-validation,
+    so measurement noise does not blow up the derivative.
+    """
+
+    t: np.ndarray
+    A: np.ndarray
+    spline: object = attrs.field(init=False, repr=False)
+
+    def __attrs_post_init__(self):
+        from scipy.interpolate import make_smoothing_spline
+
+        object.__setattr__(self, "spline", make_smoothing_spline(self.t, self.A))
+
+    def __call__(self, t, x=None, speed=None):
+        t = np.clip(np.asarray(t, dtype=float), self.t[0], self.t[-1])
+        return np.maximum(self.spline(t), 0.0), self.spline.derivative()(t)
+
+
+# --- normal-force models ------------------------------------------------------------
+@attrs.frozen
+class HalfSineNormal:
+    """N(t) = peak sin(pi t / contact_time), impulse = 2 peak contact_time / pi = m v_n (1 + e)."""
+
+    impulse: float  # [N s]
+    contact_time: float  # [s]
+
+    @property
+    def peak(self) -> float:
+        return self.impulse * math.pi / (2.0 * self.contact_time)
+
+    def __call__(self, t, A=None):
+        t = np.asarray(t, dtype=float)
+        phi = math.pi / self.contact_time
+        inside = (t >= 0) & (t <= self.contact_time)
+        return np.where(inside, self.peak * np.sin(phi * t), 0.0)
+
+
+@attrs.frozen
+class HertzNormal:
+    """Hertz-type N = coefficient * A^(3/2) [N/m^3]; for a sphere k = 4 E* / (3 pi^1.5 R)."""
+
+    coefficient: float
+
+    def __call__(self, t, A=None):
+        return self.coefficient * np.maximum(A, 0.0) ** 1.5
+
+
+@attrs.frozen(eq=False)
+class TableNormal:
+    """A measured normal-force column, linearly interpolated [N]."""
+
+    t: np.ndarray
+    N: np.ndarray
+
+    def __call__(self, t, A=None):
+        return np.interp(t, self.t, self.N)
+
+
+@attrs.frozen
+class WeightNormal:
+    """N = m g cos(alpha) on an incline [N]."""
+
+    value: float
+
+    def __call__(self, t, A=None):
+        return np.full(np.shape(t), self.value)
+
+
+@attrs.frozen
+class Compliance:
+    """Linear tangential spring [N/m] and damper [N s/m] between the body and a massless contact patch.
+
+    The damper must be positive: it makes the patch slip well defined for every law.
+    """
+
+    stiffness: float
+    damping: float
+
+
+@attrs.frozen
+class Scene:
+    """Everything about an experiment except the friction law; SI floats throughout."""
+
+    kind: str
+    mass: float  # [kg]
+    u0: float  # initial tangential velocity of the body [m/s]
+    duration: float  # simulated time span [s]
+    radius: float | None = None  # [m]
+    inertia_factor: float = 0.4  # I = inertia_factor * m r^2
+    omega0: float = 0.0  # [rad/s]
+    incline: float | None = None  # [rad]
+    area: object | None = None
+    normal: object | None = None
+    compliance: Compliance | None = None
+    effects: frozenset = frozenset()
+
+    @property
+    def inertia(self) -> float:
+        if self.radius is None:
+            raise SceneError("scene has no radius, so no moment of inertia")
+        return self.inertia_factor * self.mass * self.radius**2
+
+    def supplies(self) -> set[str]:
+        """Contact quantities this scene can provide to a law."""
+        q = {"u", "t"}
+        if self.area is not None:
+            q |= {"A", "dAdt"}
+        if self.normal is not None:
+            q.add("N")
+        return q
+
+    def with_(self, **changes) -> "Scene":
+        return attrs.evolve(self, **changes)
+
+    # -- construction from a TOML [scene] table -------------------------------------
+    @classmethod
+    def from_spec(cls, spec: Mapping, kind: str, where: str, columns: Mapping[str, np.ndarray] | None = None,
+                  t: np.ndarray | None = None) -> "Scene":
+        """Build a scene from a ``[scene]`` table; ``where`` prefixes error messages (file name)."""
+        columns = columns or {}
+        known = {"mass", "radius", "inertia_factor", "u0", "omega0", "duration", "incline", "effects",
+                 "area", "normal", "compliance", "impact_speed", "incidence", "restitution"}
+        extra = set(spec) - known
+        if extra:
+            raise SceneError(f"{where}: [scene] has unknown key(s) {sorted(extra)}; known: {', '.join(sorted(known))}")
+
+        def q(key, unit, table=spec, prefix="scene", required=True, positive=True, default=None):
+            if key not in table:
+                if required:
+                    raise SceneError(f"{where}: [{prefix}] is missing '{key}'")
+                return default
+            value = to_si(table[key], unit, f"{where}: {prefix}.{key}")
+            if positive and not value > 0:
+                raise SceneError(f"{where}: {prefix}.{key} must be positive, got {table[key]!r}")
+            return value
+
+        effects = spec.get("effects", [])
+        if not isinstance(effects, list) or not all(isinstance(e, str) for e in effects):
+            raise SceneError(f"{where}: scene.effects must be a list of names")
+        bad = [e for e in effects if e not in EFFECTS]
+        if bad:
+            raise SceneError(f"{where}: scene.effects: unknown effect(s) {bad}; known: {', '.join(EFFECTS)}")
+        effects = frozenset(effects)
+
+        mass = q("mass", "kg")
+        radius = q("radius", "m", required="spin" in effects or "slip-coupling" in effects)
+        incline = q("incline", "rad", required=kind == "incline")
+        if incline is not None and not (0 < incline < math.pi / 2):
+            raise SceneError(f"{where}: scene.incline must be between 0 and 90 deg, got {spec['incline']!r}")
+        if kind == "incline":
+            effects |= {"gravity"}
+        inertia_factor = q("inertia_factor", "", default=0.4, required=False)
+        u0 = q("u0", "m/s", required=kind != "impact-outcome", positive=False, default=0.0)
+        omega0 = q("omega0", "rad/s", required=False, positive=False, default=0.0)
+
+        area = _area_from_spec(spec.get("area"), where, q, columns, t)
+        contact_time = getattr(area, "contact_time", None)
+        normal = _normal_from_spec(spec.get("normal"), where, q, columns, t, mass, contact_time, spec, incline)
+        if "gravity" in effects and normal is None:
+            normal = WeightNormal(mass * G * math.cos(incline))
+        compliance = None
+        if "compliance" in spec:
+            c = spec["compliance"]
+            compliance = Compliance(q("stiffness", "N/m", c, "scene.compliance"),
+                                    q("damping", "N*s/m", c, "scene.compliance"))
+            effects |= {"compliance"}
+        elif "compliance" in effects:
+            raise SceneError(f"{where}: effect 'compliance' needs a [scene.compliance] table with 'stiffness'")
+
+        duration = q("duration", "s", required=False)
+        if duration is None:
+            if contact_time is not None and kind == "impact":
+                duration = contact_time
+            elif t is not None and len(t) and t[-1] > 0:
+                duration = float(t[-1])
+            elif kind != "impact-outcome":
+                raise SceneError(f"{where}: [scene] needs 'duration' (no contact time or time column to take it from)")
+            else:
+                duration = 0.0
+        return cls(kind=kind, mass=mass, u0=u0, duration=duration, radius=radius, inertia_factor=inertia_factor,
+                   omega0=omega0, incline=incline, area=area, normal=normal, compliance=compliance, effects=effects)
+
+
+def _column(columns, name, where, prefix):
+    if name not in columns:
+        raise SceneError(f"{where}: {prefix}.column = {name!r} is not a column of the CSV (has: {', '.join(columns)})")
+    return columns[name]
+
+
+def _area_from_spec(a, where, q, columns, t):
+    if a is None:
+        return None
+    p = "scene.area"
+    model = a.get("model")
+    if model == "half-sine":
+        return HalfSineArea(q("peak", "m^2", a, p), q("contact_time", "s", a, p))
+    if model == "constant":
+        return ConstantArea(q("area", "m^2", a, p))
+    if model == "growth":
+        return GrowthArea(q("initial", "m^2", a, p), q("rate", "m^2/m", a, p, positive=False))
+    if model == "column":
+        A = _column(columns, a.get("column", "A"), where, p)
+        if np.any(A < 0):
+            raise SceneError(f"{where}: area column has negative values")
+        return TableArea(t, A)
+    raise SceneError(f"{where}: {p}.model must be one of half-sine, constant, growth, column; got {model!r}")
+
+
+def _normal_from_spec(n, where, q, columns, t, mass, contact_time, spec, incline):
+    if n is None:
+        return None
+    p = "scene.normal"
+    model = n.get("model")
+    if model == "half-sine":
+        tc = q("contact_time", "s", n, p, required=contact_time is None, default=contact_time)
+        if "impulse" in n:
+            impulse = q("impulse", "N*s", n, p)
+        else:
+            vn = q("normal_speed", "m/s", n, p)
+            e = q("restitution", "", n, p, positive=False)
+            if not 0 <= e <= 1:
+                raise SceneError(f"{where}: {p}.restitution must be in [0, 1], got {e}")
+            impulse = mass * vn * (1 + e)
+        return HalfSineNormal(impulse, tc)
+    if model == "hertz":
+        if "coefficient" in n:
+            return HertzNormal(q("coefficient", "N/m^3", n, p))
+        modulus = q("modulus", "Pa", n, p)
+        radius = q("radius", "m", n, p)
+        return HertzNormal(4.0 * modulus / (3.0 * math.pi**1.5 * radius))
+    if model == "column":
+        return TableNormal(t, _column(columns, n.get("column", "N"), where, p))
+    if model == "weight":
+        if incline is None:
+            raise SceneError(f"{where}: {p}.model = 'weight' needs scene.incline")
+        return WeightNormal(mass * G * math.cos(incline))
+    raise SceneError(f"{where}: {p}.model must be one of half-sine, hertz, column, weight; got {model!r}")

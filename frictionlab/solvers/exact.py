@@ -1,0 +1,205 @@
+"""Closed-form solutions, for laws whose ``form`` is known and scenes that admit one.
+
+AreaSlipForm, F = k A u:
+  half-sine area, no drive (the paper's impact, eq (6)):  u = u0 exp(-b (1 - cos phi t)),
+      b = kappa k A0 / phi (kappa = 1/m, or 1/m + r^2/I with slip coupling); the integral of u
+      is a Bessel series, int_0^t exp(b cos phi s - b) ds = ive(0,b) t + 2 sum_k ive(k,b) sin(k phi t)/(k phi).
+  constant area, constant drive a (incline):  u = u_inf + (u0 - u_inf) exp(-t/tau),
+      tau = 1/(kappa k A), u_inf = a tau.
+NormalAreaRateForm, F = s (a N + c dA/dt) while slip keeps its sign s:
+  u = u_s + drive (t - t_s) - kappa s [a (IN(t) - IN(t_s)) + c (A(t) - A(t_s))], IN = int N dt,
+  for half-sine or constant (weight) N and half-sine or constant A; slip reaching zero is
+  located by root finding and handed to the stick logic.
+In every case the friction impulse J(t) = int F dt and its integral K(t) give the states:
+  v = v_s + drive dt - J/m,  omega = omega_s + r J / I,  theta = theta_s + omega_s dt + r K / I.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.optimize import brentq
+from scipy.special import ive
+
+from ..errors import SolverError
+from ..law import AreaSlipForm, NormalAreaRateForm
+from ..scene import ConstantArea, HalfSineArea, HalfSineNormal, WeightNormal
+
+SCAN = 4096  # grid points scanned for the first zero of slip
+
+
+def check(plan, p) -> None:
+    """Raise SolverError unless a closed form exists for this law and scene."""
+    _form_and_reason(plan, p)
+
+
+def _form_and_reason(plan, p):
+    law, s = plan.law, plan.scene
+    form = law.form(p)
+    name = f"law '{law.name}'"
+    if form is None:
+        raise SolverError(f"exact: {name} declares no closed form; use --solver ode")
+    if "xi" in plan.states:
+        raise SolverError("exact: no closed form with tangential compliance; use --solver ode")
+    if isinstance(form, AreaSlipForm):
+        if isinstance(s.area, HalfSineArea) and plan.drive == 0.0:
+            return form
+        if isinstance(s.area, ConstantArea):
+            return form
+        raise SolverError(f"exact: {name} has a closed form only with a half-sine area and no drive, "
+                          f"or a constant area; this scene has {type(s.area).__name__} and drive {plan.drive:g} m/s^2")
+    if isinstance(form, NormalAreaRateForm):
+        if not isinstance(s.normal, (HalfSineNormal, WeightNormal)):
+            raise SolverError(f"exact: {name} needs a half-sine or weight normal force; this scene has "
+                              f"{type(s.normal).__name__}")
+        if form.c != 0.0 and not isinstance(s.area, (HalfSineArea, ConstantArea)):
+            raise SolverError(f"exact: {name} needs a half-sine or constant area; this scene has {type(s.area).__name__}")
+        return form
+    raise SolverError(f"exact: {name} returned an unknown form {form!r}")
+
+
+def make_slide():
+    def slide(plan, p, t0, y0, direction, t_out):
+        form = _form_and_reason(plan, p)
+        t_out = np.asarray(t_out, dtype=float)
+        if isinstance(form, AreaSlipForm):
+            (J, K), t_stop = _area_slip(plan, form.k, t0, y0, t_out), None
+        else:
+            J, K, t_stop = _normal_area_rate(plan, form, t0, y0, direction, t_out)
+        keep = t_out <= t_stop if t_stop is not None else np.ones(t_out.shape, dtype=bool)
+        Y = _states(plan, t0, y0, t_out[keep], J[keep], K[keep])
+        y_stop = None
+        if t_stop is not None:
+            Js, Ks = _normal_area_rate(plan, form, t0, y0, direction, np.array([t_stop]), find_stop=False)[:2]
+            y_stop = _states(plan, t0, y0, np.array([t_stop]), Js, Ks)[:, 0]
+        return Y, t_stop, y_stop, {"nfev": 0}
+
+    return slide
+
+
+def _states(plan, t0, y0, t, J, K):
+    s = plan.scene
+    dt = t - t0
+    out = []
+    for i, name in enumerate(plan.states):
+        if name == "v":
+            out.append(y0[i] + plan.drive * dt - J / s.mass)
+        elif name == "omega":
+            out.append(y0[i] + s.radius * J / s.inertia)
+        elif name == "theta":
+            out.append(y0[i] + y0[plan.index("omega")] * dt + s.radius * K / s.inertia)
+        else:  # pragma: no cover - guarded by check()
+            raise SolverError(f"exact: state '{name}' has no closed form")
+    return np.array(out)
+
+
+# --- F = k A u ------------------------------------------------------------------------
+def bessel_integral(b: float, phi: float, t: np.ndarray) -> np.ndarray:
+    """int_0^t exp(b cos(phi s) - b) ds for 0 <= t <= pi/phi, to machine precision."""
+    kmax = int(math.ceil(math.sqrt(2.0 * max(b, 1.0) * 45.0))) + 20
+    k = np.arange(1, kmax + 1)
+    w = ive(k, b)  # I_k(b) exp(-b), decays fast once k^2 > 2b
+    w = w[w > 1e-300]
+    k = k[: w.size]
+    out = ive(0, b) * t
+    for chunk in range(0, k.size, 256):
+        kk, ww = k[chunk: chunk + 256], w[chunk: chunk + 256]
+        out = out + 2.0 * np.sum(ww[:, None] * np.sin(np.outer(kk, phi * t)) / (kk[:, None] * phi), axis=0)
+    return out
+
+
+def _area_slip(plan, k, t0, y0, t):
+    s = plan.scene
+    u0 = float(plan.rigid_slip(y0))
+    kappa = plan.kappa
+    if isinstance(s.area, ConstantArea):
+        rate = kappa * k * s.area.area
+        dt = t - t0
+        x = rate * dt
+        # e1 = (1 - exp(-x)) / rate and e2 = int_0^dt e1, written to stay exact for tiny x
+        with np.errstate(divide="ignore", invalid="ignore"):
+            g1 = np.where(x > 1e-8, -np.expm1(-x) / np.where(x > 0, x, 1.0), 1.0 - x / 2.0 + x * x / 6.0)
+            g2 = np.where(x > 1e-5, (x + np.expm1(-x)) / np.where(x > 0, x * x, 1.0), 0.5 - x / 6.0 + x * x / 24.0)
+        a = plan.drive
+        u = u0 * np.exp(-x) + a * dt * g1
+        int_u = u0 * dt * g1 + a * dt * dt * g2
+        J = (a * dt - (u - u0)) / kappa
+        K = (a * dt * dt / 2.0 - (int_u - u0 * dt)) / kappa
+        return J, K
+    if t0 != 0.0:
+        raise SolverError("exact: the half-sine closed form starts at first contact only")
+    tc = s.area.contact_time
+    phi = math.pi / tc
+    b = kappa * k * s.area.peak / phi
+    tau = np.minimum(t, tc)
+    u = u0 * np.exp(-2.0 * b * np.sin(phi * tau / 2.0) ** 2)
+    int_u = u0 * bessel_integral(b, phi, tau)
+    u_end = u0 * math.exp(-2.0 * b)
+    int_u = int_u + u_end * np.maximum(t - tc, 0.0)
+    J = (u0 - u) / kappa
+    K = (u0 * t - int_u) / kappa
+    return J, K
+
+
+# --- F = s (a N + c dA/dt) --------------------------------------------------------------
+def _normal_integrals(normal, t):
+    """IN = int_0^t N, IIN = int_0^t IN, for half-sine or constant N."""
+    if isinstance(normal, WeightNormal):
+        return normal.value * t, normal.value * t * t / 2.0
+    tc = normal.contact_time
+    phi = math.pi / tc
+    tau = np.minimum(t, tc)
+    Np = normal.peak
+    IN = Np / phi * (1.0 - np.cos(phi * tau))
+    IIN = Np / phi * (tau - np.sin(phi * tau) / phi) + (2.0 * Np / phi) * np.maximum(t - tc, 0.0)
+    return IN, IIN
+
+
+def _area_integrals(area, t):
+    """A(t) and int_0^t A, for half-sine or constant A (zeros without an area model)."""
+    if area is None:
+        return np.zeros_like(t), np.zeros_like(t)
+    if isinstance(area, ConstantArea):
+        return np.full_like(t, area.area), area.area * t
+    tc = area.contact_time
+    phi = math.pi / tc
+    tau = np.minimum(t, tc)
+    A = np.where(t <= tc, area.peak * np.sin(phi * tau), 0.0)
+    return A, area.peak / phi * (1.0 - np.cos(phi * tau))
+
+
+def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
+    s = plan.scene
+    sgn = direction if direction != 0 else 1.0
+    area = s.area if form.c != 0.0 else None
+
+    def JK(tt):
+        IN, IIN = _normal_integrals(s.normal, tt)
+        IN0, IIN0 = _normal_integrals(s.normal, np.array([t0]))
+        A, IA = _area_integrals(area, tt)
+        A0, IA0 = _area_integrals(area, np.array([t0]))
+        dt = tt - t0
+        J = sgn * (form.a * (IN - IN0) + form.c * (A - A0))
+        K = sgn * (form.a * (IIN - IIN0 - IN0 * dt) + form.c * (IA - IA0 - A0 * dt))
+        return J, K
+
+    J, K = JK(t)
+    if not find_stop or t.size == 0:
+        return J, K, None
+    u_s = float(plan.rigid_slip(y0))
+
+    def slip(tt):
+        return u_s + plan.drive * (tt - t0) - plan.kappa * JK(np.atleast_1d(tt))[0]
+
+    T = float(t[-1])
+    grid = np.unique(np.concatenate([np.linspace(t0, T, SCAN), t]))
+    g = sgn * slip(grid)
+    bad = np.nonzero(g[1:] <= 0.0)[0]
+    if bad.size == 0:
+        return J, K, None
+    i = int(bad[0]) + 1
+    if g[i] == 0.0:
+        return J, K, float(grid[i])
+    t_stop = brentq(lambda x: sgn * slip(x)[0], grid[i - 1], grid[i], xtol=1e-15 * max(T, 1e-300),
+                    rtol=4 * np.finfo(float).eps)
+    return J, K, float(t_stop)

@@ -1,0 +1,81 @@
+"""Numerical integration with scipy's solve_ivp, on a scaled problem, with zero slip as an event.
+
+Time is scaled by the simulated span and each state by its typical size, so that one pair of
+tolerances means the same thing for a 1 ns and a 1 s contact, for 1e-12 and 1 m^2 areas.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from ..errors import SolverError
+
+METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+
+
+def state_scales(plan, T: float) -> np.ndarray:
+    s = plan.scene
+    V = max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * (s.radius or 0.0), 1e-300)
+    if V == 1e-300:
+        V = 1.0
+    r = s.radius or 1.0
+    size = {"v": V, "omega": V / r, "theta": V * T / r, "x": V * T, "xi": V * T}
+    return np.array([size[k] for k in plan.states])
+
+
+def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = None):
+    """A sliding-phase function for ``segments.run`` using solve_ivp ``method``."""
+    if method not in METHODS:
+        raise SolverError(f"unknown ODE method {method!r}; choose one of {', '.join(METHODS)}")
+    if not (0 < rtol < 1):
+        raise SolverError(f"rtol must be in (0, 1), got {rtol}")
+    atol = rtol if atol is None else atol
+
+    def slide(plan, p, t0, y0, direction, t_out):
+        if len(t_out) == 0 or t_out[-1] <= t0:
+            return np.repeat(np.asarray(y0, dtype=float)[:, None], len(t_out), axis=1), None, None, {"nfev": 0}
+        T = float(t_out[-1])
+        scale = state_scales(plan, T)
+        tscale = T
+        compliant = "xi" in plan.states
+
+        def f(s, z):
+            t = s * tscale
+            y = z * scale
+            u = plan.slip(p, t, y)
+            F, _ = plan.force(p, np.asarray(t), y, np.asarray(u))
+            return plan.rates(t, y, F, u) * tscale / scale
+
+        events = None
+        if not compliant and direction != 0:
+            def zero_slip(s, z):
+                return float(plan.rigid_slip(z * scale)) / scale[0]
+
+            zero_slip.terminal = True
+            zero_slip.direction = -direction
+            events = [zero_slip]
+        s_eval = np.clip(np.asarray(t_out, dtype=float) / tscale, t0 / tscale, T / tscale)
+        try:
+            sol = solve_ivp(f, (t0 / tscale, T / tscale), np.asarray(y0, dtype=float) / scale, method=method,
+                            t_eval=s_eval, rtol=rtol, atol=atol, events=events)
+        except Exception as exc:  # a law raising inside the integrator
+            from ..errors import FrictionLabError
+
+            if isinstance(exc, FrictionLabError):
+                raise
+            raise SolverError(f"ode:{method}: integration failed for law '{plan.law.name}': {exc}") from exc
+        if sol.status == -1:
+            raise SolverError(f"ode:{method}: integration failed for law '{plan.law.name}': {sol.message}")
+        Y = sol.y * scale[:, None]
+        t_stop = y_stop = None
+        if events is not None and sol.t_events[0].size:
+            t_stop = float(sol.t_events[0][0]) * tscale
+            y_stop = sol.y_events[0][0] * scale
+            Y = Y[:, np.asarray(t_out) <= t_stop][:, : Y.shape[1]]
+        info = {"nfev": int(sol.nfev), "njev": int(sol.njev), "nlu": int(sol.nlu), "method": method,
+                "rtol": rtol, "atol": atol}
+        return Y, t_stop, y_stop, info
+
+    return slide
+
+

@@ -1,0 +1,105 @@
+"""Drive a solution through sliding and stuck phases; each solver supplies the sliding phase.
+
+A sliding-phase function has the signature
+    slide(plan, p, t0, y0, direction, t_out) -> (Y_out, t_stop, y_stop, info)
+where Y_out holds the states at the times t_out (all >= t0, only those reached), t_stop is
+the time slip reached zero (None if it did not before t_out[-1] or the end), y_stop the state there.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import SolverError
+from ..trajectory import Trajectory
+from . import stick
+
+MAX_SEGMENTS = 200
+
+
+def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
+    t_eval = np.asarray(t_eval, dtype=float)
+    n, T = t_eval.size, float(t_eval[-1])
+    Y = np.empty((len(plan.states), n))
+    F = np.empty(n)
+    sliding = np.zeros(n, dtype=bool)
+    done = np.zeros(n, dtype=bool)
+    t0, y0 = 0.0, plan.initial_state()
+    info: dict = {"nfev": 0, "segments": 0}
+    stick_time = None
+    compliant = "xi" in plan.states
+    u_start = float(plan.rigid_slip(y0))
+    direction = float(np.sign(u_start))
+    if compliant or u_start != 0.0:
+        phase = "slide"
+    else:
+        tb = stick.breakaway(plan, p, 0.0, max(T, 0.0), y0, 0.0)
+        phase = "slide" if tb == 0.0 else "stuck"
+        direction = stick.hold_direction(plan, 0.0)
+    last_direction = direction or 1.0
+    while True:
+        info["segments"] += 1
+        if info["segments"] > MAX_SEGMENTS:
+            raise SolverError(f"{solver_name}: slip changed between sliding and sticking more than "
+                              f"{MAX_SEGMENTS} times (chatter); the law is not suited to this scene")
+        todo = (~done) & (t_eval >= t0)
+        if phase == "slide":
+            Ys, t_stop, y_stop, seg = slide(plan, p, t0, y0, direction, t_eval[todo])
+            for k, v in seg.items():
+                info[k] = info.get(k, 0) + v if isinstance(v, (int, float)) and k in ("nfev", "njev", "nlu") else v
+            idx = np.nonzero(todo)[0][: Ys.shape[1]]
+            Y[:, idx] = Ys
+            sliding[idx] = True
+            done[idx] = True
+            if t_stop is None or t_stop >= T:
+                break
+            stick_time = t_stop if stick_time is None else stick_time
+            last_direction = direction
+            t0, y0 = t_stop, _zero_slip(plan, y_stop)
+            phase = "stuck"
+        else:
+            tb = stick.breakaway(plan, p, t0, T, y0, last_direction)
+            end = T if tb is None else tb
+            sel = todo & (t_eval <= end)
+            idx = np.nonzero(sel)[0]
+            Y[:, idx], F[idx] = stick.stuck_states(plan, t_eval[idx], t0, y0)
+            done[idx] = True
+            if tb is None:
+                break
+            ys, _ = stick.stuck_states(plan, np.array([tb]), t0, y0)
+            t0, y0 = tb, ys[:, 0]
+            direction = stick.hold_direction(plan, last_direction)
+            phase = "slide"
+    if not done.all():
+        raise SolverError(f"{solver_name}: solution ended at t = {t0:g} s before the last requested time {T:g} s")
+    u = np.empty(n)
+    if compliant:
+        for i in np.nonzero(sliding)[0]:
+            u[i] = plan.patch_slip(p, t_eval[i], Y[:, i])
+    else:
+        u[:] = plan.rigid_slip(Y)
+    u[~sliding] = 0.0
+    c = plan.contact(t_eval, Y, u)
+    if sliding.any():
+        F[sliding] = plan.law.evaluate(p, _subset(c, sliding))
+    A = c.A if c.A is not None else (plan.scene.area(t_eval, None, u)[0] if plan.needs_area else None)
+    omega = Y[plan.index("omega")] if plan.has_spin else np.zeros(n)
+    theta = Y[plan.index("theta")] if plan.has_spin else np.zeros(n)
+    for name, arr in (("u", u), ("v", Y[0]), ("omega", omega), ("theta", theta), ("force", F)):
+        if not np.all(np.isfinite(arr)):
+            raise SolverError(f"{solver_name}: {name} became NaN or infinite for law '{plan.law.name}' with {dict(p)}")
+    return Trajectory(t=t_eval, u=u, v=Y[0].copy(), omega=omega, theta=theta, force=F, A=A, N=c.N,
+                      solver=solver_name, law=plan.law.name, stick_time=stick_time, info=info)
+
+
+def _subset(c, mask):
+    import attrs
+
+    return attrs.evolve(c, **{k: (getattr(c, k)[mask] if getattr(c, k) is not None else None)
+                              for k in ("t", "u", "N", "A", "dAdt")})
+
+
+def _zero_slip(plan, y):
+    """Set slip to exactly zero at a stick event."""
+    y = np.array(y, dtype=float)
+    y[0] = plan.scene.radius * y[plan.index("omega")] if plan.coupled else 0.0
+    return y
