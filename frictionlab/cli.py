@@ -1,0 +1,61 @@
+"""The ``frictionlab`` command. Each subcommand lives in ``frictionlab/commands/<name>.py`` and
+exposes ``add_parser(subparsers)`` (which sets ``func``) and its run function.
+
+Errors are one line on stderr and exit status 2; ``--debug`` shows the traceback.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+import warnings
+
+from .errors import FrictionLabError
+
+COMMANDS = ("laws", "datasets", "simulate", "fit", "compare", "bench")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="frictionlab", description="Compare friction laws against impact and sliding data.")
+    parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in COMMANDS:
+        try:
+            module = importlib.import_module(f"frictionlab.commands.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name == f"frictionlab.commands.{name}":
+                continue  # not built yet
+            raise
+        module.add_parser(sub)
+    return parser
+
+
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:  # argparse already printed its one-line usage error
+        return int(exc.code or 0) if exc.code in (0, None) else 2
+    if not getattr(args, "func", None):
+        parser.print_help()
+        return 2
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("default")
+            warnings.formatwarning = lambda m, c, *a, **k: f"warning: {m}\n"
+            return int(args.func(args) or 0)
+    except FrictionLabError as exc:
+        if args.debug:
+            raise
+        print(f"frictionlab: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("frictionlab: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,32 @@
+"""``frictionlab laws``: list the registered laws with parameters, units, bounds and needs."""
+from __future__ import annotations
+
+from ..law import QUANTITIES
+from ..registry import available_laws, law_source
+from ..table import render
+
+
+def add_parser(sub):
+    p = sub.add_parser("laws", help="list the registered friction laws")
+    p.add_argument("--brief", action="store_true", help="one line per law")
+    p.set_defaults(func=run)
+
+
+def run(args) -> int:
+    laws = available_laws()
+    if args.brief:
+        print(render([{"law": n, "formula": law.formula, "requires": ", ".join(sorted(law.requires)),
+                       "parameters": ", ".join(law.param_names)} for n, law in laws.items()]))
+        return 0
+    for name, law in laws.items():
+        print(f"{name}: {law.formula}")
+        print(f"  requires: {', '.join(f'{q} ({QUANTITIES[q]})' for q in sorted(law.requires))}")
+        print(f"  citation: {law.citation}")
+        print(f"  source:   {law_source(name)}")
+        rows = [{"parameter": s.name, "unit": s.unit or "-", "default": s.default, "lower": s.lower, "upper": s.upper,
+                 "scale": s.scale, "description": s.description} for s in law.params]
+        print("    " + render(rows).replace("\n", "\n    "))
+        for a, b in law.ratio_only:
+            print(f"  note: {a} and {b} enter only as {a}/{b}; fix one to identify the other")
+        print()
+    return 0
