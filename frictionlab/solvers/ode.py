@@ -14,13 +14,13 @@ METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 
 
 def state_scales(plan, T: float) -> np.ndarray:
+    """Typical size of each state; shape (n_states,), or (n_states, n) for a batch view with array fields."""
     s = plan.scene
-    V = max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * (s.radius or 0.0), 1e-300)
-    if V == 1e-300:
-        V = 1.0
-    r = s.radius or 1.0
+    r = 1.0 if s.radius is None else s.radius
+    V = np.maximum(np.maximum(np.abs(s.u0), np.abs(plan.drive) * T), np.abs(s.omega0) * (0.0 if s.radius is None else r))
+    V = np.where(V > 1e-300, V, 1.0)
     size = {"v": V, "omega": V / r, "theta": V * T / r, "x": V * T, "xi": V * T}
-    return np.array([size[k] for k in plan.states])
+    return np.array(np.broadcast_arrays(*[size[k] for k in plan.states]), dtype=float)
 
 
 def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = None):
@@ -71,7 +71,7 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
         if events is not None and sol.t_events[0].size:
             t_stop = float(sol.t_events[0][0]) * tscale
             y_stop = sol.y_events[0][0] * scale
-            Y = Y[:, np.asarray(t_out) <= t_stop][:, : Y.shape[1]]
+            Y = Y[:, : int(np.count_nonzero(np.asarray(t_out) <= t_stop))]  # solve_ivp already cut t_eval at the event
         info = {"nfev": int(sol.nfev), "njev": int(sol.njev), "nlu": int(sol.nlu), "method": method,
                 "rtol": rtol, "atol": atol}
         return Y, t_stop, y_stop, info
