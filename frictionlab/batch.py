@@ -325,7 +325,7 @@ def _breakaway(law, batch, p, ids, ts, ys, t_end, last_dir):
     pc = _take_params(p, ids, column=True)
     need = np.broadcast_to(stick.needed_force(plan), (ids.size, 1))[:, 0]
     hold = np.where(need != 0, np.sign(need), np.where(last_dir != 0, np.sign(last_dir), 1.0))
-    tiny = hold * 1e-12 * np.maximum(np.abs(np.broadcast_to(view.u0, (ids.size, 1))[:, 0]), 1e-3)
+    tiny = hold * np.broadcast_to(stick.vanishing_slip(plan), (ids.size, 1))[:, 0]
     y3 = ys[:, :, None]
 
     def margin(tt):
@@ -347,7 +347,7 @@ def _breakaway(law, batch, p, ids, ts, ys, t_end, last_dir):
 
         def g(tt):
             f, _ = sub_plan.force(sub_p, tt[:, None], ys[:, ref, None], tiny[ref, None])
-            return -(hold[ref] * f[:, 0] - np.abs(need[ref]))
+            return hold[ref] * f[:, 0] - np.abs(need[ref])
 
         lo = grid[ref, first[ref] - 1]
         hi = grid[ref, first[ref]]
@@ -395,8 +395,10 @@ def _run_rk(law, batch, p, T, method, rtol, atol):
             tb, hold, need = _breakaway(law, batch, p, stuck_ids, t0[stuck_ids], y0[:, stuck_ids], t_end[stuck_ids],
                                         last_dir[stuck_ids])
             end = np.where(np.isnan(tb), t_end[stuck_ids], tb)
-            _fill_stuck(law, batch, stuck_ids, t0[stuck_ids], y0[:, stuck_ids], t0[stuck_ids], end, T, Y, done,
-                        stuck_mask)
+            held = ~(tb == t0[stuck_ids])  # breakaway at once: the sliding phase owns the outputs at t0
+            if held.any():
+                h_ids = stuck_ids[held]
+                _fill_stuck(law, batch, h_ids, t0[h_ids], y0[:, h_ids], t0[h_ids], end[held], T, Y, done, stuck_mask)
             go = ~np.isnan(tb) & (tb < t_end[stuck_ids])
             ids = stuck_ids[go]
             if ids.size:
@@ -452,11 +454,12 @@ def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rt
         plan = _plan(law, batch.view(g_ids))
         pv = _take_params(p, g_ids)
         tsc, ssc = span[k], sc[:, k]
+        dirs = direction[g_ids]
 
         def rhs(s, z):
             t = s * tsc
             y = z * ssc
-            u = plan.rigid_slip(y)
+            u = stick.branch_slip(plan, plan.rigid_slip(y), dirs)
             F, _ = plan.force(pv, t, y, u)
             return plan.rates(t, y, F, u) * tsc / ssc
 
@@ -474,7 +477,15 @@ def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rt
 
     s_out = T[ids] / span[:, None]
     return vecrk.integrate(make_rhs, t0[ids] / span, y0[:, ids] / sc, 1.0, s_out, method=method, rtol=rtol,
-                           atol=atol, make_event=make_event)
+                           atol=atol, make_event=make_event, breaks=_breaks(batch, ids, span))
+
+
+def _breaks(batch, ids, span):
+    """End of contact of half-sine area and normal-force models, in units of each scene's span."""
+    view = batch.view(ids)
+    cols = [np.broadcast_to(np.asarray(m.contact_time, dtype=float), ids.shape) / span
+            for m in (view.area, view.normal) if hasattr(m, "contact_time")]
+    return np.column_stack(cols) if cols else None
 
 
 # --- the vectorized closed forms -------------------------------------------------------------

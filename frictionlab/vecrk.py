@@ -45,13 +45,15 @@ def _rms(x):
 
 
 def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: float = 1e-8, atol: float | None = None,
-              make_event=None) -> Result:
+              make_event=None, breaks=None) -> Result:
     """Integrate n problems y' = f(t, y) from t0 (n,) with y0 (d, n) to t_end (n,).
 
     make_rhs(idx) returns rhs(t, y) for the problems ``idx`` (t (k,), y (d, k) -> (d, k)); it is
     called once whenever the set of unfinished problems changes. t_out (n, m) holds each
     problem's increasing output times (entries outside [t0, t_end] are never filled).
     make_event(idx), if given, returns g(t, y) -> (k,); a problem stops where g crosses to <= 0.
+    breaks (n, nb), if given, are times where f has a kink or jump (e.g. the end of contact): no step
+    crosses one, so a short forcing window before it cannot be stepped over.
     """
     if method not in METHODS:
         raise SolverError(f"batch: unknown method {method!r}; choose one of {', '.join(METHODS)}")
@@ -86,6 +88,8 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
     nfev[active] += 1
     g_old = g(t[active], y[:, active]) if g else None
     h = _initial_step(rhs, t[active], y[:, active], f, t_end[active] - t[active], cls.order, rtol, atol)
+    if breaks is not None:  # a first step that would cross a break is sized to reach it
+        h = np.minimum(h, np.where(breaks[active] > t[active, None], breaks[active] - t[active, None], np.inf).min(axis=1))
     nfev[active] += 1
     F = np.empty((d, n))
     F[:, active] = f
@@ -102,6 +106,10 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
             raise SolverError(f"batch {method}: more than {MAX_ITERATIONS} steps; the problem is stiff or singular")
         ta, ya, fa = t[active], y[:, active], F[:, active]
         ha = np.minimum(H[active], t_end[active] - ta)
+        if breaks is not None:
+            b = breaks[active]
+            ahead = np.where(b > ta[:, None] * (1 + 4 * np.finfo(float).eps), b, np.inf).min(axis=1)
+            ha = np.minimum(ha, ahead - ta)
         min_step = 10.0 * np.abs(np.nextafter(ta, np.inf) - ta)
         if np.any(ha < min_step):
             bad = active[np.argmax(ha < min_step)]

@@ -181,7 +181,7 @@ def _area_integrals(area, t):
 def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     s = plan.scene
     sgn = direction if direction != 0 else 1.0
-    area = s.area if form.c != 0.0 else None
+    area = s.area if np.any(np.asarray(form.c) != 0.0) else None
 
     def JK(tt):
         IN, IIN = _normal_integrals(s.normal, tt)

@@ -9,6 +9,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from ..errors import SolverError
+from . import stick
 
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 
@@ -43,6 +44,8 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
             t = s * tscale
             y = z * scale
             u = plan.slip(p, t, y)
+            if not compliant and direction != 0:
+                u = stick.branch_slip(plan, u, direction)
             F, _ = plan.force(p, np.asarray(t), y, np.asarray(u))
             return plan.rates(t, y, F, u) * tscale / scale
 
