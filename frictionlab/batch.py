@@ -32,7 +32,7 @@ from . import vecrk
 from .errors import ParameterError, SceneError, SolverError
 from .plan import Plan, make_plan
 from .registry import get_law
-from .scene import Scene
+from .scene import HalfSineNormal, HertzNormal, Scene, WeightNormal
 from .solvers import exact, stick
 from .solvers.ode import state_scales
 from .trajectory import Trajectory
@@ -40,6 +40,7 @@ from .trajectory import Trajectory
 SOLVERS = ("auto", "exact") + vecrk.METHODS
 SCAN = 1024  # uniform points scanned for the first zero of slip when it is not provably monotone
 MAX_SEGMENTS = 200
+_NONNEGATIVE_N = (HalfSineNormal, HertzNormal, WeightNormal)
 _TOP = ("mass", "u0", "duration", "radius", "inertia_factor", "omega0", "incline")
 
 
@@ -325,6 +326,9 @@ def _breakaway(law, batch, p, ids, ts, ys, t_end, last_dir):
     pc = _take_params(p, ids, column=True)
     need = np.broadcast_to(stick.needed_force(plan), (ids.size, 1))[:, 0]
     hold = np.where(need != 0, np.sign(need), np.where(last_dir != 0, np.sign(last_dir), 1.0))
+    known = _known_capacity(law, plan, pc, ids.size, ts, need)
+    if known is not None:
+        return known, hold, need
     tiny = hold * np.broadcast_to(stick.vanishing_slip(plan), (ids.size, 1))[:, 0]
     y3 = ys[:, :, None]
 
@@ -537,30 +541,54 @@ def _run_exact(law, batch, p, T):
     return out, {"nfev": 0, "scalar_fallback": int(fallback.sum())}
 
 
+def _known_capacity(law, plan, pc, k, ts, need):
+    """Breakaway times without a scan, when the law's form makes them obvious, else None.
+
+    Under F = s (a N + c dA/dt) the holding capacity is a N + c dA/dt. With c = 0, a >= 0 and a
+    normal-force model that is never negative, the capacity a N >= 0 holds a scene that needs no
+    force (no drive: the rolling sphere) for ever, and a constant N needs one comparison.
+    """
+    form = law.form(pc)
+    if not isinstance(form, exact.NormalAreaRateForm) or not isinstance(plan.scene.normal, _NONNEGATIVE_N):
+        return None
+    if not (np.all(np.asarray(form.c) == 0.0) and np.all(np.asarray(form.a) >= 0.0)):
+        return None
+    if np.all(need == 0.0):
+        return np.full(k, np.nan)
+    if isinstance(plan.scene.normal, WeightNormal):
+        cap = np.broadcast_to(form.a * plan.scene.normal.value, (k, 1))[:, 0]
+        return np.where(cap < np.abs(need), ts, np.nan)
+    return None
+
+
 def _exact_stop(law, batch, p, plan, form, y0, u_s, sgn, T):
     """First time each scene's slip reaches zero under F = s (a N + c dA/dt), NaN if it does not."""
     nsc = T.shape[0]
     t_end = T[:, -1]
 
-    def g_of(ids, tt):  # sgn * slip at times tt (k, q) for scenes ids
+    def make_g(ids):  # sgn * slip at times tt (k, q) for scenes ids (None: all)
         sub = plan if ids is None else _plan(law, batch.view(ids, column=True))
         f = form if ids is None else law.form(_take_params(p, ids, column=True))
         s = sgn[:, None] if ids is None else sgn[ids, None]
         us = u_s[:, None] if ids is None else u_s[ids, None]
         y0s = y0 if ids is None else y0[:, ids]
-        J1 = exact._normal_area_rate(sub, f, 0.0, y0s, 1.0, tt, find_stop=False)[0]
-        return s * (us + sub.drive * tt) - sub.kappa * J1
+
+        def g(tt):
+            J1 = exact._normal_area_rate(sub, f, 0.0, y0s, 1.0, tt, find_stop=False)[0]
+            return s * (us + sub.drive * tt) - sub.kappa * J1
+
+        return g
 
     c_zero = np.all(np.asarray(form.c) == 0.0)
     monotone = c_zero and (isinstance(batch.template.normal, exact.WeightNormal)
                            or np.all(sgn * np.broadcast_to(plan.drive, (nsc, 1))[:, 0] <= 0.0))
     if monotone:
-        g_end = g_of(None, t_end[:, None])[:, 0]
+        g_end = make_g(None)(t_end[:, None])[:, 0]
         ids = np.nonzero(g_end <= 0.0)[0]
         lo, hi = np.zeros(ids.size), t_end[ids]
     else:
         grid = t_end[:, None] * np.linspace(0.0, 1.0, SCAN)[None, :]
-        gg = g_of(None, grid)
+        gg = make_g(None)(grid)
         bad = gg[:, 1:] <= 0.0
         anyb = bad.any(axis=1)
         ids = np.nonzero(anyb)[0]
@@ -568,7 +596,8 @@ def _exact_stop(law, batch, p, plan, form, y0, u_s, sgn, T):
         lo, hi = grid[ids, first - 1], grid[ids, first]
     ts = np.full(nsc, np.nan)
     if ids.size:
-        ts[ids] = _bisect(lambda x: g_of(ids, x[:, None])[:, 0], lo, hi, 1e-15 * np.maximum(t_end[ids], 1e-300))
+        g = make_g(ids)
+        ts[ids] = _bisect(lambda x: g(x[:, None])[:, 0], lo, hi, 1e-15 * np.maximum(t_end[ids], 1e-300))
         ts[ids[ts[ids] >= t_end[ids]]] = np.nan
     return ts
 

@@ -210,18 +210,22 @@ class _Dense:
     def __init__(self, kind, t_old, h, y_old, coef):
         self.kind, self.t_old, self.h, self.y_old, self.coef = kind, t_old, h, y_old, coef
 
-    def __call__(self, x, rows):
+    def subset(self, rows) -> "_Dense":
+        """The dense output of rows only (so repeated calls need no gathering)."""
+        return _Dense(self.kind, self.t_old[rows], self.h[rows], self.y_old[:, rows], self.coef[:, :, rows])
+
+    def __call__(self, x, rows=slice(None)):
         """States at fractions x (k,) of the step for subset rows (k,) -> (d, k)."""
-        c = self.coef[:, :, rows]
+        coef = self.coef
         if self.kind == "RK45":  # y_old + h * sum_j Q_j x^(j+1)
-            acc = np.zeros_like(c[0])
-            for q in c[::-1]:
-                acc = (acc + q) * x
+            acc = coef[-1][:, rows] * x
+            for j in range(coef.shape[0] - 2, -1, -1):
+                acc = (acc + coef[j][:, rows]) * x
             return self.y_old[:, rows] + self.h[rows] * acc
-        acc = np.zeros_like(c[0])  # DOP853: nested x, (1 - x) products
-        for i, q in enumerate(c[::-1]):
-            acc = acc + q
-            acc = acc * (x if i % 2 == 0 else 1.0 - x)
+        acc = coef[-1][:, rows] * x  # DOP853: nested x, (1 - x) products
+        one_minus = 1.0 - x
+        for i, j in enumerate(range(coef.shape[0] - 2, -1, -1), start=1):
+            acc = (acc + coef[j][:, rows]) * (x if i % 2 == 0 else one_minus)
         return self.y_old[:, rows] + acc
 
 
@@ -274,14 +278,32 @@ def _fill_dense(Y, reached, ptr, t_out, idx, pos, t_stop, dense):
 
 
 def _locate(make_event, idx, dense, rows, t_old, h):
-    """Bisection on the dense output for the first g <= 0 in each step; returns (t_stop, y_stop)."""
+    """First g <= 0 in each step, on the dense output: Illinois regula falsi on the bracket (bisection
+    after 30 rounds); returns (t_stop, y_stop) with t_stop on the g <= 0 side, bracket <= 4 eps."""
     g = make_event(idx)
+    dense = dense.subset(rows)
+    rows = slice(None)
     lo, hi = np.zeros(idx.size), np.ones(idx.size)
-    for _ in range(BISECTIONS):
-        mid = 0.5 * (lo + hi)
-        below = g(t_old + mid * h, dense(mid, rows)) <= 0.0
-        hi = np.where(below, mid, hi)
-        lo = np.where(below, lo, mid)
-        if np.all(hi - lo <= 4 * np.finfo(float).eps):
+    glo = g(t_old, dense(lo, rows))
+    ghi = g(t_old + h, dense(hi, rows))
+    eps = 4 * np.finfo(float).eps
+    side = np.zeros(idx.size)
+    for it in range(BISECTIONS + 40):
+        open_ = (hi - lo > eps) & (ghi != 0.0)
+        if not open_.any():
             break
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mid = (lo * ghi - hi * glo) / (ghi - glo)
+        bad = ~np.isfinite(mid) | (mid <= lo) | (mid >= hi) | (it >= 30)  # bisection if it stalls
+        mid = np.where(bad, 0.5 * (lo + hi), mid)
+        mid = np.where(open_, mid, hi)
+        gm = g(t_old + mid * h, dense(mid, rows))
+        below = (gm <= 0.0) & open_
+        above = ~below & open_
+        hi, ghi = np.where(below, mid, hi), np.where(below, gm, ghi)
+        lo, glo = np.where(above, mid, lo), np.where(above, gm, glo)
+        # Illinois: halve the stale end's value when the same side moves twice
+        glo = np.where(below & (side < 0), glo * 0.5, glo)
+        ghi = np.where(above & (side > 0), ghi * 0.5, ghi)
+        side = np.where(below, -1.0, np.where(above, 1.0, side))
     return t_old + hi * h, dense(hi, rows)
