@@ -361,14 +361,18 @@ def _breakaway(law, batch, p, ids, ts, ys, t_end, last_dir):
 
 def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask):
     """Stuck-phase states (``solvers.stick.stuck_states``) at outputs in [t_from, t_to] not yet filled."""
-    plan = _plan(law, batch.view(ids, column=True))
+    assert Y.flags.c_contiguous and done.flags.c_contiguous  # written through flat views
     Ts = T[ids]
-    Ys, _ = stick.stuck_states(plan, Ts, ts[:, None], ys[:, :, None])
     sel = (Ts >= t_from[:, None]) & (Ts <= t_to[:, None]) & ~done[ids]
     r, c = np.nonzero(sel)
-    Y[:, ids[r], c] = np.broadcast_to(Ys, (Y.shape[0],) + Ts.shape)[:, r, c]
-    done[ids[r], c] = True
-    stuck_mask[ids[r], c] = True
+    if r.size == 0:
+        return
+    plan = _plan(law, batch.view(ids[r]))
+    Ys, _ = stick.stuck_states(plan, Ts[r, c], ts[r], ys[:, r])
+    flat = ids[r] * T.shape[1] + c
+    Y.reshape(Y.shape[0], -1)[:, flat] = Ys
+    done.reshape(-1)[flat] = True
+    stuck_mask.reshape(-1)[flat] = True
 
 
 # --- the vectorized Runge-Kutta path ----------------------------------------------------------
@@ -423,10 +427,14 @@ def _run_rk(law, batch, p, T, method, rtol, atol):
         res = _slide_rk(law, batch, p, slide_ids, t0, y0, direction, T, t_end, scale, method, rtol, atol)
         iterations += res.iterations
         nfev[slide_ids] += res.nfev
-        Yr = res.Y * scale[:, slide_ids, None]
-        r, c = np.nonzero(res.reached & ~done[slide_ids])
-        Y[:, slide_ids[r], c] = Yr[:, r, c]
-        done[slide_ids[r], c] = True
+        new = res.reached & ~done[slide_ids]
+        if slide_ids.size == nsc:  # every scene slides (the usual first phase): no gathering
+            np.copyto(Y, res.Y * scale[:, :, None], where=new[None])
+            done |= new
+        else:
+            r, c = np.nonzero(new)
+            Y[:, slide_ids[r], c] = res.Y[:, r, c] * scale[:, slide_ids[r]]
+            done[slide_ids[r], c] = True
         ev = np.nonzero(~np.isnan(res.t_event))[0]
         ids = slide_ids[ev]
         ts = res.t_event[ev] * t_end[ids]
