@@ -297,25 +297,24 @@ def _finish(law, batch, p, T, Y, sliding, need):
     N = c.N
     omega = Y[plan.index("omega")] if plan.has_spin else np.zeros_like(u)
     theta = Y[plan.index("theta")] if plan.has_spin else np.zeros_like(u)
-    for name, arr in (("u", u), ("v", Y[0]), ("omega", omega), ("theta", theta), ("force", F)):
-        if not np.all(np.isfinite(arr)):
-            i = int(np.argmax(~np.all(np.isfinite(arr), axis=1)))
+    for name, arr in (("states", Y), ("force", F)):
+        if not np.isfinite(arr).all():
+            bad = ~np.isfinite(arr) if arr.ndim == 2 else ~np.isfinite(arr).all(axis=0)
+            i = int(np.argmax(bad.any(axis=1)))
             raise SolverError(f"batch: {name} became NaN or infinite for law '{law.name}' in scene {i}")
-    return {"u": u, "v": np.array(Y[0]), "omega": np.array(omega), "theta": np.array(theta), "force": F,
-            "A": None if A is None else np.broadcast_to(A, u.shape).copy(),
-            "N": None if N is None else np.broadcast_to(N, u.shape).copy()}
+
+    def full(a):
+        return None if a is None else (a if np.shape(a) == u.shape else np.broadcast_to(a, u.shape).copy())
+
+    return {"u": u, "v": Y[0], "omega": omega, "theta": theta, "force": F, "A": full(A), "N": full(N)}
 
 
-def _bisect(fn, lo, hi, tol):
-    """First root of a per-scene sign change: fn(t (k,)) <= 0 at hi, > 0 at lo; returns hi side."""
-    for _ in range(vecrk.BISECTIONS + 10):
-        if np.all(hi - lo <= tol):
-            break
-        mid = 0.5 * (lo + hi)
-        below = fn(mid) <= 0.0
-        hi = np.where(below, mid, hi)
-        lo = np.where(below, lo, mid)
-    return hi
+def _root(make_fn, lo, hi, tol, gtol=0.0):
+    """First root of a per-scene sign change, fn > 0 at lo and <= 0 at hi; returns the hi side.
+
+    make_fn(rows) gives fn for scenes rows (positions in lo/hi), see ``vecrk.illinois``."""
+    fn = make_fn(np.arange(np.size(lo)))
+    return vecrk.illinois(make_fn, lo, hi, fn(lo), fn(hi), tol, gtol)
 
 
 # --- stuck phases ----------------------------------------------------------------------------
@@ -345,17 +344,21 @@ def _breakaway(law, batch, p, ids, ts, ys, t_end, last_dir):
     tb[anyb & (first == 0)] = ts[anyb & (first == 0)]
     ref = np.nonzero(anyb & (first > 0))[0]
     if ref.size:
-        sub_view = batch.view(ids[ref], column=True)
-        sub_plan = _plan(law, sub_view)
-        sub_p = _take_params(p, ids[ref], column=True)
 
-        def g(tt):
-            f, _ = sub_plan.force(sub_p, tt[:, None], ys[:, ref, None], tiny[ref, None])
-            return hold[ref] * f[:, 0] - np.abs(need[ref])
+        def make_fn(rows):
+            r = ref[rows]
+            plan_r = _plan(law, batch.view(ids[r], column=True))
+            p_r = _take_params(p, ids[r], column=True)
+
+            def fn(tt):
+                f, _ = plan_r.force(p_r, tt[:, None], ys[:, r, None], tiny[r, None])
+                return hold[r] * f[:, 0] - np.abs(need[r])
+
+            return fn
 
         lo = grid[ref, first[ref] - 1]
         hi = grid[ref, first[ref]]
-        tb[ref] = _bisect(g, lo, hi, 1e-15 * np.maximum(t_end[ref], 1e-300))
+        tb[ref] = _root(make_fn, lo, hi, 1e-15 * np.maximum(t_end[ref], 1e-300))
     return tb, hold, need
 
 
@@ -524,23 +527,19 @@ def _run_exact(law, batch, p, T):
         Y = exact._states(plan, 0.0, y0, T, sgn * J1, sgn * K1)
         ts = _exact_stop(law, batch, p, plan, form, y0, u_s[:, 0], sgn[:, 0], T)
         hit = ~np.isnan(ts) & ~fallback
-        if hit.any():
+        if hit.any():  # stuck states after the stick time, on the whole grid (cheaper than gathering)
+            stick_time[hit] = ts[hit]
+            tcol = np.where(hit, ts, 0.0)[:, None]
+            Js, Ks, _ = exact._normal_area_rate(plan, form, 0.0, y0, 1.0, tcol, find_stop=False)
+            ys = exact._states(plan, 0.0, y0, tcol, sgn * Js, sgn * Ks)[:, :, 0]
+            ys = _zero_slip(_plan(law, batch.view()), ys)
             ids = np.nonzero(hit)[0]
-            stick_time[ids] = ts[ids]
-            sub = _plan(law, batch.view(ids, column=True))
-            sub_form = law.form(_take_params(p, ids, column=True))
-            tcol = ts[ids][:, None]
-            Js, Ks, _ = exact._normal_area_rate(sub, sub_form, 0.0, y0[:, ids], 1.0, tcol, find_stop=False)
-            ys = exact._states(sub, 0.0, y0[:, ids], tcol, sgn[ids] * Js, sgn[ids] * Ks)[:, :, 0]
-            ys = _zero_slip(sub, ys)
             t_end = T[ids, -1]
-            tb, _, _ = _breakaway(law, batch, p, ids, ts[ids], ys, t_end, sgn[ids, 0])
+            tb, _, _ = _breakaway(law, batch, p, ids, ts[ids], ys[:, ids], t_end, sgn[ids, 0])
             fallback[ids[~np.isnan(tb) & (tb < t_end)]] = True
-            done = T[ids] <= tcol
-            Y[:, ids] = np.where(done[None], Y[:, ids], np.nan)
-            done_full = np.zeros((nsc, m), dtype=bool)
-            done_full[ids] = done
-            _fill_stuck(law, batch, ids, ts[ids], ys, ts[ids], t_end, T, Y, done_full, stuck_mask)
+            stuck_mask = T > np.where(hit, ts, np.inf)[:, None]
+            Ys, _ = stick.stuck_states(plan, T, tcol, ys[:, :, None])
+            np.copyto(Y, Ys, where=stuck_mask[None])
     need = stick.needed_force(plan)
     out = _finish(law, batch, p, T, np.nan_to_num(Y) if fallback.any() else Y, ~stuck_mask, need)
     for i in np.nonzero(fallback)[0]:
@@ -604,8 +603,12 @@ def _exact_stop(law, batch, p, plan, form, y0, u_s, sgn, T):
         lo, hi = grid[ids, first - 1], grid[ids, first]
     ts = np.full(nsc, np.nan)
     if ids.size:
-        g = make_g(ids)
-        ts[ids] = _bisect(lambda x: g(x[:, None])[:, 0], lo, hi, 1e-15 * np.maximum(t_end[ids], 1e-300))
+        def make_fn(rows):
+            g = make_g(ids[rows])
+            return lambda x: g(x[:, None])[:, 0]
+
+        noise = 8 * np.finfo(float).eps * np.abs(u_s[ids])  # slip is u_s minus terms of its size
+        ts[ids] = _root(make_fn, lo, hi, 1e-15 * np.maximum(t_end[ids], 1e-300), noise)
         ts[ids[ts[ids] >= t_end[ids]]] = np.nan
     return ts
 

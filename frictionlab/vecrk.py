@@ -317,33 +317,69 @@ def _fill_dense(Y, reached, ptr, t_out, idx, pos, t_stop, dense, shared=None):
     ptr[idx] = np.maximum(ptr[idx], stop)
 
 
-def _locate(make_event, idx, dense, rows, t_old, h):
-    """First g <= 0 in each step, on the dense output: Illinois regula falsi on the bracket (bisection
-    after 30 rounds); returns (t_stop, y_stop) with t_stop on the g <= 0 side, bracket <= 4 eps."""
-    g = make_event(idx)
-    dense = dense.subset(rows)
-    rows = None
-    lo, hi = np.zeros(idx.size), np.ones(idx.size)
-    glo = g(t_old, dense(lo, rows))
-    ghi = g(t_old + h, dense(hi, rows))
-    eps = 4 * np.finfo(float).eps
-    side = np.zeros(idx.size)
+def illinois(make_fn, lo, hi, glo, ghi, tol, gtol=0.0):
+    """Per problem, the first point where fn <= 0 in brackets [lo, hi] with fn(lo) > 0 >= fn(hi).
+
+    make_fn(rows) returns fn for the problems ``rows`` (it is rebuilt on the unfinished problems
+    whenever half of them have converged). Regula falsi with the Anderson-Bjorck correction and
+    the bracket kept; a bisection step wherever the secant leaves the bracket or the last three
+    steps did not halve it. Returns the fn <= 0 end once the bracket is within tol, or once |fn|
+    there is within gtol (the rounding noise of fn: no finer answer is meaningful).
+    """
+    n = np.size(lo)
+    out = np.array(hi, dtype=float)
+    cur = np.arange(n)
+    lo, hi, glo, ghi = (np.array(a, dtype=float) for a in (lo, hi, glo, ghi))
+    tol = np.broadcast_to(np.asarray(tol, dtype=float), (n,))
+    gtol = np.broadcast_to(np.asarray(gtol, dtype=float), (n,))
+    side = np.zeros(n)
+    widths = [np.full(n, np.inf)] * 3
+    fn = make_fn(cur)
     for it in range(BISECTIONS + 40):
-        open_ = (hi - lo > eps) & (ghi != 0.0)
+        open_ = (hi - lo > tol) & (np.abs(ghi) > gtol)
+        out[cur] = hi
         if not open_.any():
             break
+        if open_.sum() <= cur.size // 2:  # drop the converged problems
+            cur = cur[open_]
+            lo, hi, glo, ghi, tol, gtol, side = (a[open_] for a in (lo, hi, glo, ghi, tol, gtol, side))
+            widths = [w[open_] for w in widths]
+            open_ = open_[open_]
+            fn = make_fn(cur)
         with np.errstate(invalid="ignore", divide="ignore"):
             mid = (lo * ghi - hi * glo) / (ghi - glo)
-        bad = ~np.isfinite(mid) | (mid <= lo) | (mid >= hi) | (it >= 30)  # bisection if it stalls
+        slow = (hi - lo) > 0.5 * widths[0]
+        widths = widths[1:] + [hi - lo]
+        bad = ~np.isfinite(mid) | (mid <= lo) | (mid >= hi) | slow | (it >= 30)
         mid = np.where(bad, 0.5 * (lo + hi), mid)
         mid = np.where(open_, mid, hi)
-        gm = g(t_old + mid * h, dense(mid, rows))
+        gm = fn(mid)
         below = (gm <= 0.0) & open_
         above = ~below & open_
+        # the same end moved twice: scale the stale end's value (Anderson-Bjorck, m = 1 - g_new/g_replaced)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            m_hi = np.where(below, 1.0 - gm / ghi, 0.5)
+            m_lo = np.where(above, 1.0 - gm / glo, 0.5)
+        m_hi = np.where(m_hi > 0, m_hi, 0.5)
+        m_lo = np.where(m_lo > 0, m_lo, 0.5)
         hi, ghi = np.where(below, mid, hi), np.where(below, gm, ghi)
         lo, glo = np.where(above, mid, lo), np.where(above, gm, glo)
-        # Illinois: halve the stale end's value when the same side moves twice
-        glo = np.where(below & (side < 0), glo * 0.5, glo)
-        ghi = np.where(above & (side > 0), ghi * 0.5, ghi)
+        glo = np.where(below & (side < 0), glo * m_hi, glo)
+        ghi = np.where(above & (side > 0), ghi * m_lo, ghi)
         side = np.where(below, -1.0, np.where(above, 1.0, side))
-    return t_old + hi * h, dense(hi, rows)
+    return out
+
+
+def _locate(make_event, idx, dense, rows, t_old, h):
+    """First g <= 0 within each step, on the dense output; returns (t_stop, y_stop)."""
+    dense = dense.subset(rows)
+
+    def make_fn(sub):
+        g, dn, t0, hh = make_event(idx[sub]), dense.subset(sub), t_old[sub], h[sub]
+        return lambda x: g(t0 + x * hh, dn(x))
+
+    eps = np.finfo(float).eps
+    fn = make_fn(np.arange(idx.size))
+    lo, hi = np.zeros(idx.size), np.ones(idx.size)
+    x = illinois(make_fn, lo, hi, fn(lo), fn(hi), 4 * eps, 8 * eps)  # g is slip / its scale
+    return t_old + x * h, dense(x)
