@@ -62,3 +62,15 @@ def fmt_value(value: float, err: float | None, unit_: str) -> str:
     if err is None:
         return f"{fmt(value)}{u}"
     return f"{fmt(value)} ± {fmt(err, 2)}{u}"
+
+
+#: SI unit -> (display unit, factor, threshold): shown in the display unit when |value| < threshold.
+_SMALL = {"m": ("um", 1e6, 1e-3), "m^2": ("mm^2", 1e6, 1e-2), "s": ("us", 1e6, 2e-3)}
+
+
+def param_text(value: float, err: float | None, unit_: str) -> str:
+    """A parameter with its error for a table, small lengths, areas and times in um, mm^2, us."""
+    if unit_ in _SMALL and value is not None and abs(value) < _SMALL[unit_][2]:
+        name, f, _ = _SMALL[unit_]
+        return fmt_value(value * f, None if err is None else err * f, name)
+    return fmt_value(value, err, unit_)

@@ -98,10 +98,13 @@ def _shape(t: np.ndarray, y: np.ndarray) -> tuple[bool, str]:
     return False, "rises throughout (no fall after a peak)"
 
 
-def _cross(law: str, other: FitResult, solver: str) -> CrossFit:
+def _cross(own: FitResult, other: FitResult) -> CrossFit:
+    """Refit ``own``'s law to ``other``'s best-fit curve, starting from ``own``'s best parameters."""
     d = other.per_dataset[0]
     tg = Target(d.target.dataset, d.target.observable, d.model.copy(), d.target.sigma, f"best fit of {other.law}")
-    r = fit(law, tg, solver=solver)
+    start = {k: p.value for k, p in own.params.items() if p.kind == "law" and p.vary}
+    law = own.law
+    r = fit(law, tg, solver=own.per_dataset[0].solver, initial=start, scan=0, n_starts=1)
     if not r.ok:
         return CrossFit(law, other.law, r.status)
     mine = r.per_dataset[0]
@@ -158,7 +161,7 @@ def analyze_equivalence(fw: FitResult, fa: FitResult, cross: bool = True) -> Equ
     impulse = {WEAR: float(np.trapezoid(Fw, t)), AREA_RATE: float(np.trapezoid(Fa, t))}
     crosses = ()
     if cross:
-        crosses = (_cross(AREA_RATE, fw, fa.per_dataset[0].solver), _cross(WEAR, fa, fw.per_dataset[0].solver))
+        crosses = (_cross(fa, fw), _cross(fw, fa))
     falls = {}
     shape = {}
     for f in (fw, fa):
