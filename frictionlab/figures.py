@@ -115,19 +115,19 @@ def ranking_figure(rows) -> bytes:
     from matplotlib.colors import LogNorm
 
     datasets = list(dict.fromkeys(r.dataset for r in rows))
-    cands = sorted({r.candidate for r in rows})
+    row_of = lambda r: r.law + (" [series]" if r.solver == "series" else "")  # noqa: E731
+    cands = sorted({row_of(r) for r in rows})
     M = np.full((len(cands), len(datasets)), np.nan)
     text = [["" for _ in datasets] for _ in cands]
     for r in rows:
-        i, j = cands.index(r.candidate), datasets.index(r.dataset)
+        i, j = cands.index(row_of(r)), datasets.index(r.dataset)
         if r.rank is not None:
             M[i, j] = r.delta_aic
-            text[i][j] = f"#{r.rank}\n{r.delta_aic:.3g}"
+            text[i][j] = f"#{r.rank}\n{r.delta_aic:.1f}" + ("" if r.solver in ("exact", "series") else f"\n{r.solver}")
         else:
             text[i][j] = r.status
     fig, ax = plt.subplots(figsize=(1.25 * len(datasets) + 3.2, 0.55 * len(cands) + 1.8))
-    cmap = plt.get_cmap("viridis_r").copy()
-    cmap.set_bad("0.9")
+    cmap = plt.get_cmap("viridis_r").with_extremes(bad="0.9")
     im = ax.imshow(np.where(np.isnan(M), np.nan, M + 1.0), cmap=cmap, aspect="auto",
                    norm=LogNorm(vmin=1.0, vmax=max(10.0, np.nanmax(M + 1.0) if np.isfinite(M).any() else 10.0)))
     for i in range(len(cands)):
@@ -138,7 +138,7 @@ def ranking_figure(rows) -> bytes:
     ax.set_yticks(range(len(cands)), cands, fontsize=8)
     cb = fig.colorbar(im, ax=ax, shrink=0.85)
     cb.set_label("ΔAIC + 1 (log scale; 1 = best)")
-    ax.set_title("Ranking: rank and ΔAIC of each law [solver] per dataset")
+    ax.set_title("Ranking per dataset: #rank and ΔAIC (solver exact unless named)")
     return _png(fig)
 
 
@@ -163,8 +163,9 @@ def derivation_figure(dataset, derived: dict, noisy: dict, sigma_theta: float, s
                 continue
             ax.plot(t * tf, d.theta_fit * af, color=colors.get(name), lw=1.5, label=f"{name} fit")
             axw.plot(t * tf, d.omega * df, color=colors.get(name), lw=1.5, label=f"omega from {name}")
-            axw.fill_between(t * tf, (d.omega - d.sigma) * df, (d.omega + d.sigma) * df, color=colors.get(name),
-                             alpha=0.15)
+            if col == 1:  # the column as given is noise-free: a band would only show the stated sigma
+                axw.fill_between(t * tf, (d.omega - d.sigma) * df, (d.omega + d.sigma) * df,
+                                 color=colors.get(name), alpha=0.15)
         if "omega" in dataset.columns:
             axw.plot(t * tf, dataset.columns["omega"] * df, "k.", ms=4, label="omega column")
         ax.set_title(title, fontsize=10)
@@ -181,7 +182,8 @@ def derivation_figure(dataset, derived: dict, noisy: dict, sigma_theta: float, s
             lo = min(float(np.min(ref)), min(float(np.percentile(f, 2)) for f in finite)) - 0.15 * span
             hi = max(float(np.max(ref)), max(float(np.percentile(f, 98)) for f in finite)) + 0.15 * span
             axw.set_ylim(lo, hi)
-    fig.suptitle(f"{dataset.name}: spin derived from rotation angle (shaded: ±1σ passed on from theta)", fontsize=11)
+    fig.suptitle(f"{dataset.name}: spin derived from rotation angle (shaded: ±1σ each route passes on from θ noise)",
+                 fontsize=11)
     fig.tight_layout()
     return _png(fig)
 

@@ -23,7 +23,6 @@ import warnings
 from collections.abc import Callable, Mapping, Sequence
 
 import attrs
-import lmfit
 import numpy as np
 
 from .dataset import Dataset, load_dataset
@@ -311,7 +310,8 @@ class FitResult:
 
     def summary(self) -> str:
         """A few lines for the terminal."""
-        head = f"{self.law} [{self.solver}] on {', '.join(self.datasets)}: {self.status}"
+        on = ", ".join(d.target.label for d in self.per_dataset) if self.per_dataset else ", ".join(self.datasets)
+        head = f"{self.law} [{self.solver}] on {on}: {self.status}"
         if not self.ok:
             return f"{head}: {self.reason}"
         s = self.stats
@@ -452,7 +452,7 @@ class _Model:
         return np.concatenate(out)
 
 
-def _si(params: lmfit.Parameters, slots) -> dict[str, float]:
+def _si(params, slots) -> dict[str, float]:
     return {s.pname: params[s.pname].value * s.scale for s in slots}
 
 
@@ -514,6 +514,8 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     n_starts: Levenberg-Marquardt runs from the best distinct grid points (the lowest chi2 wins);
     at most two when one model evaluation takes longer than SLOW_EVAL (ODE solvers).
     """
+    import lmfit  # slow to import: only when fitting
+
     law = get_law(law)
     started = time.perf_counter()
     items = datasets if isinstance(datasets, (list, tuple)) else [datasets]
@@ -661,6 +663,13 @@ def _series_notes(law, per) -> list[str]:
             if b > B_ACCURATE:
                 notes.append(f"series on '{d.name}' at b = {b:.3g}: the first-order expansion (eq 7) is accurate "
                              f"only for b << 1 (below about {B_ACCURATE})")
+            if b > 0.5:
+                t_rev = math.acos(-(1 - b) / b) * s.area.contact_time / math.pi
+                notes.append(f"series on '{d.name}': with b = {b:.3g} > 0.5 the truncated slip u0 (1 - b + b cos phi t) "
+                             f"changes sign at t = {t_rev * 1e6:.0f} us (u(t_c) = u0 (1 - 2b) < 0), so the series "
+                             "force reverses there, while the exact slip u0 exp(-b (1 - cos phi t)) never does. The series "
+                             "spin falls exactly while its slip is negative: its rise-then-fall comes from the "
+                             "truncation, not from the law")
     return notes
 
 

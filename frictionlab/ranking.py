@@ -79,8 +79,7 @@ def _rank(rows: list[RankRow], tie: float) -> list[RankRow]:
         tied = tuple(o.candidate for o in ok if o is not r and abs(o.aic - r.aic) <= tie)
         out.append(attrs.evolve(r, delta_aic=r.aic - best, akaike_weight=weights[id(r)] / total, rank=rank,
                                 status="tied" if tied else "ok", tied_with=tied))
-    return sorted(out, key=lambda r: (r.rank is None, r.rank or 0, r.aic if math.isfinite(r.aic) else math.inf,
-                                      r.law, r.solver))
+    return sorted(out, key=lambda r: (r.rank is None, r.rank or 0, r.law, r.solver))
 
 
 def fit_row(f: FitResult) -> RankRow:

@@ -158,6 +158,10 @@ PROVENANCE_WORDS = {
 }
 
 
+def _fixed(x, digits: int) -> str:
+    return "" if x is None or not math.isfinite(x) else f"{x:.{digits}f}"
+
+
 def _candidate_table(rows, observable: str) -> tuple[list[str], list[list]]:
     uname, uf = unit(observable)
     headers = ["rank", "law [solver]", "n", "k", f"RMSE [{uname}]", "reduced χ²", "AIC", "AICc", "BIC", "ΔAIC",
@@ -168,7 +172,7 @@ def _candidate_table(rows, observable: str) -> tuple[list[str], list[list]]:
             (f": {r.reason}" if r.reason else "")
         out.append([r.rank or "–", r.candidate, r.n_points or "", r.n_params if r.rank else "",
                     fmt(r.rmse * uf) if math.isfinite(r.rmse) else "", fmt(r.redchi), fmt(r.aic), fmt(r.aicc),
-                    fmt(r.bic), fmt(r.delta_aic), fmt(r.akaike_weight, 3), status])
+                    fmt(r.bic), _fixed(r.delta_aic, 2), _fixed(r.akaike_weight, 3), status])
     return headers, out
 
 
@@ -176,7 +180,7 @@ def _group_table(rows) -> tuple[list[str], list[list]]:
     headers = ["group", "rank", "law [solver]", "n", "k", "reduced χ²", "ΣAIC", "ΣAICc", "ΣBIC", "ΔAIC",
                "Akaike weight", "status"]
     out = [[r.dataset, r.rank or "–", r.candidate, r.n_points or "", r.n_params if r.rank else "", fmt(r.redchi),
-            fmt(r.aic), fmt(r.aicc), fmt(r.bic), fmt(r.delta_aic), fmt(r.akaike_weight, 3),
+            fmt(r.aic), fmt(r.aicc), fmt(r.bic), _fixed(r.delta_aic, 2), _fixed(r.akaike_weight, 3),
             r.status + (f": {r.reason}" if r.reason else "")] for r in rows]
     return headers, out
 
@@ -237,9 +241,11 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
                          + (" shared by a tie" if len(best) > 1 else "") + ")")
         else:
             items.append(f"**{d.name}**: no law could be fitted")
-    for r in c.groups:
-        if r.rank == 1:
-            items.append(f"**{r.dataset}**: best {r.candidate} (summed AIC over the group)")
+    for g in dict.fromkeys(r.dataset for r in c.groups):
+        best = [r.candidate for r in c.groups if r.dataset == g and r.rank == 1]
+        if best:
+            items.append(f"**{g}**: best " + " = ".join(best) + " (summed AIC over the group"
+                         + ("; a tie" if len(best) > 1 else "") + ")")
     doc.items(items)
     if c.equivalence:
         doc.p("Equivalence of λAu and μN + μη′dA/dt: " + "; ".join(
