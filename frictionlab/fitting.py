@@ -45,7 +45,7 @@ SCENE_QUANTITIES = {
 CORRELATION_LIMIT = 0.95
 PENALTY = 1e4  # weighted residual per point when the model cannot be evaluated
 FIT_RTOL = 1e-10  # ODE tolerance during fits: finite-difference Jacobians need a smooth model
-SLOW_EVAL = 5e-3  # s per model evaluation above which at most two starts are refined
+ODE_STARTS = 2  # at most this many starts are refined when a dataset needs the (costlier) ODE solver
 FTOL = 1e-6  # relative chi-square and step tolerances of Levenberg-Marquardt
 
 
@@ -512,7 +512,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     initial: start values (SI). observable / derive: what to fit (see make_target).
     scan: number of grid points scored before Levenberg-Marquardt (0: start from the defaults);
     n_starts: Levenberg-Marquardt runs from the best distinct grid points (the lowest chi2 wins);
-    at most two when one model evaluation takes longer than SLOW_EVAL (ODE solvers).
+    at most ODE_STARTS when a dataset is solved by 'ode' (deterministic, never timing-dependent).
     """
     import lmfit  # slow to import: only when fitting
 
@@ -569,14 +569,13 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         if varying and scan:
             fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
             scored = []
-            t_scan = time.perf_counter()
             for cand in _start_grid(varying, np.random.default_rng(0), scan):
                 vals = {**fixed_part, **cand}
                 r = model.residual({s.pname: vals[s.pname] * s.scale for s in slots})
                 scored.append((float(r @ r), len(scored), cand))
             scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins
-            per_eval = (time.perf_counter() - t_scan) / len(scored)
-            starts = _distinct(scored, n_starts if per_eval < SLOW_EVAL else min(n_starts, 2))
+            slow = any(x.startswith("ode") for x in solvers)
+            starts = _distinct(scored, min(n_starts, ODE_STARTS) if slow else n_starts)
         if varying:
             best_res = None
             for start in starts:
