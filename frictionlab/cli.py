@@ -18,6 +18,8 @@ COMMANDS = ("laws", "datasets", "simulate", "fit", "compare", "bench")
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="frictionlab", description="Compare friction laws against impact and sliding data.")
     parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    parser.add_argument("--load", metavar="FILE.py", action="append", default=[],
+                        help="import a Python file first (laws it registers with @register_law become available)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMANDS:
         try:
@@ -30,6 +32,27 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+
+
+def load_file(path: str) -> None:
+    """Import a user's Python file by path (for laws registered at run time)."""
+    import importlib.util
+    from pathlib import Path
+
+    from .errors import RegistryError
+
+    p = Path(path)
+    if not p.is_file():
+        raise RegistryError(f"--load {path}: no such file")
+    spec = importlib.util.spec_from_file_location(f"frictionlab_user_{p.stem}", p)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    try:
+        spec.loader.exec_module(module)
+    except FrictionLabError:
+        raise
+    except Exception as exc:
+        raise RegistryError(f"--load {path}: import failed: {type(exc).__name__}: {exc}") from exc
 
 
 def main(argv=None) -> int:
@@ -46,6 +69,8 @@ def main(argv=None) -> int:
         with warnings.catch_warnings():
             warnings.simplefilter("default")
             warnings.formatwarning = lambda m, c, *a, **k: f"warning: {m}\n"
+            for path in args.load:
+                load_file(path)
             return int(args.func(args) or 0)
     except FrictionLabError as exc:
         if args.debug:

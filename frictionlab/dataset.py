@@ -147,14 +147,17 @@ def from_meta(meta: dict, path: Path) -> Dataset:
         si = COLUMN_SI.get(col)
         if si is None:
             raise DatasetError(f"{path}: column '{col}' is not a known quantity ({', '.join(COLUMN_SI)})")
-        columns[col] = raw[col] * unit_factor(unit, si, f"{path}: columns.{col}")
+        try:
+            columns[col] = raw[col] * unit_factor(unit, si, f"{path}: columns.{col}")
+        except FrictionLabError as exc:
+            raise DatasetError(str(exc)) from None
     if "t" in columns:
         t = columns["t"]
         bad = np.nonzero(np.diff(t) <= 0)[0]
         if bad.size:
             i = int(bad[0])
-            raise DatasetError(f"{csv}: column 't' must increase strictly; row {i + 3} ({raw['t'][i + 1]!r}) "
-                               f"does not exceed row {i + 2} ({raw['t'][i]!r})")
+            raise DatasetError(f"{csv}: column 't' must increase strictly; line {_line_of_row(csv, i + 1)} "
+                               f"({raw['t'][i + 1]!r}) does not exceed the line before ({raw['t'][i]!r})")
     for col in ("A", "N"):
         if col in columns and np.any(columns[col] < 0):
             raise DatasetError(f"{csv}: column '{col}' has negative values")
@@ -244,6 +247,14 @@ def read_csv(csv: Path) -> dict[str, np.ndarray]:
         bad = np.nonzero(~np.isfinite(values))[0]
         if bad.size:
             i = int(bad[0])
-            raise DatasetError(f"{csv}: column '{col}' row {i + 2}: {df[col].iloc[i]!r} is not a finite number")
+            raise DatasetError(f"{csv}: column '{col}' line {_line_of_row(csv, i)}: {df[col].iloc[i]!r} "
+                               "is not a finite number")
         out[str(col).strip()] = values
     return out
+
+
+def _line_of_row(csv: Path, row: int) -> int:
+    """1-based line number in the file of data row ``row`` (0-based, after header and comments)."""
+    lines = Path(csv).read_text(encoding="utf-8", errors="replace").splitlines()
+    data = [i for i, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")]
+    return data[row + 1] + 1 if row + 1 < len(data) else len(lines)
