@@ -217,7 +217,7 @@ class Scene:
 
         mass = q("mass", "kg")
         radius = q("radius", "m", required="spin" in effects or "slip-coupling" in effects)
-        incline = q("incline", "rad", required=kind == "incline")
+        incline = q("incline", "rad", required=kind == "incline", positive=False)
         if incline is not None and not (0 < incline < math.pi / 2):
             raise SceneError(f"{where}: scene.incline must be between 0 and 90 deg, got {spec['incline']!r}")
         if kind == "incline":
