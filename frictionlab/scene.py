@@ -167,6 +167,13 @@ class Scene:
     compliance: Compliance | None = None
     effects: frozenset = frozenset()
 
+    def __attrs_post_init__(self):
+        if "gravity" in self.effects:
+            if self.incline is None:
+                raise SceneError("effect 'gravity' needs scene.incline")
+            if self.normal is None:  # a block on an incline is pressed on by its weight
+                object.__setattr__(self, "normal", WeightNormal(self.mass * G * math.cos(self.incline)))
+
     @property
     def inertia(self) -> float:
         if self.radius is None:
@@ -235,8 +242,6 @@ class Scene:
         area = _area_from_spec(spec.get("area"), where, q, columns, t)
         contact_time = getattr(area, "contact_time", None)
         normal = _normal_from_spec(spec.get("normal"), where, q, columns, t, mass, contact_time, spec, incline)
-        if "gravity" in effects and normal is None:
-            normal = WeightNormal(mass * G * math.cos(incline))
         compliance = None
         if "compliance" in spec:
             c = spec["compliance"]

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..scene import G, ConstantArea, GrowthArea, Scene, WeightNormal
+from ..scene import ConstantArea, GrowthArea, Scene
 from ..solvers import simulate
 from .write import write_pair
 
@@ -57,7 +57,6 @@ def _oil(out_dir, a_mm2, seed):
     t = np.round(np.arange(0.0, c["t_end"] + c["dt"] / 2, c["dt"]), 10)
     scene = Scene(kind="incline", mass=c["mass"], u0=0.0, duration=c["t_end"], incline=alpha,
                   area=ConstantArea(a_mm2 * 1e-6), effects=frozenset({"gravity"}))
-    scene = scene.with_(normal=WeightNormal(c["mass"] * G * math.cos(alpha)))
     traj = simulate("couette", scene, {"eta": c["eta"], "h": c["h"]}, solver="exact", t=t)
     v = _noisy(traj.v, c["noise"], seed)
     name = f"incline-oil-a{a_mm2}"
@@ -95,7 +94,6 @@ def _dry(out_dir, d_mm, a0_mm2, seed):
     rate = c["rate_mm2_per_m"] * 1e-6
     scene = Scene(kind="incline", mass=mass, u0=0.0, duration=c["t_end"], incline=alpha,
                   area=GrowthArea(a0_mm2 * 1e-6, rate), effects=frozenset({"gravity"}))
-    scene = scene.with_(normal=WeightNormal(mass * G * math.cos(alpha)))
     traj = simulate("wear", scene, {"lam": c["lam"]}, solver="ode:DOP853", t=t, rtol=1e-12)
     v = _noisy(traj.v, c["noise"], seed)
     name = f"incline-dry-d{d_mm:g}".replace(".", "p")

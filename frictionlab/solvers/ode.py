@@ -47,6 +47,8 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
             t = s * tscale
             y = z * scale
             u = plan.slip(p, t, y)
+            if u == 0.0 and direction != 0:  # sliding resumes from rest: the law acts in the slip direction
+                u = direction * 1e-300
             F, _ = plan.force(p, np.asarray(t), y, np.asarray(u))
             return plan.rates(t, y, F, u) * tscale / scale
 
@@ -75,7 +77,6 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
         if events is not None and sol.t_events[0].size:
             t_stop = float(sol.t_events[0][0]) * tscale
             y_stop = sol.y_events[0][0] * scale
-            Y = Y[:, sol.t * tscale <= t_stop]  # solve_ivp stopped at the event: only the times reached
         info = {"nfev": int(sol.nfev), "njev": int(sol.njev), "nlu": int(sol.nlu), "method": method,
                 "rtol": rtol, "atol": atol}
         return Y, t_stop, y_stop, info
