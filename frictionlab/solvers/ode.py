@@ -14,6 +14,9 @@ from ..errors import SolverError
 
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 
+#: Slip, relative to its scale, by which the zero-slip event waits past zero (see zero_slip).
+SLIP_MARGIN = 1e-12
+
 
 def state_scales(plan, T: float) -> np.ndarray:
     s = plan.scene
@@ -55,7 +58,9 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
         events = None
         if not compliant and direction != 0:
             def zero_slip(s, z):
-                return float(plan.rigid_slip(z * scale)) / scale[0]
+                # fires once slip has passed zero by a hair (SLIP_MARGIN of its scale), so that
+                # round-off at a restart from rest (slip exactly 0) is not taken for a new stop
+                return float(plan.rigid_slip(z * scale)) / scale[0] + direction * SLIP_MARGIN
 
             zero_slip.terminal = True
             zero_slip.direction = -direction
