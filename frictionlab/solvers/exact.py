@@ -26,6 +26,7 @@ from ..law import AreaSlipForm, NormalAreaRateForm
 from ..scene import ConstantArea, HalfSineArea, HalfSineNormal, WeightNormal
 
 SCAN = 4096  # grid points scanned for the first zero of slip
+SLIP_MARGIN = 1e-12  # slip, relative to its scale, by which a stop must pass zero (as in ode.zero_slip)
 
 
 def check(plan, p) -> None:
@@ -202,14 +203,18 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
         return u_s + plan.drive * (tt - t0) - plan.kappa * JK(np.atleast_1d(tt))[0]
 
     T = float(t[-1])
+    # slip must pass zero by a hair (as in the ode solver's event): at a restart from rest,
+    # round-off in the slip an ulp after t0 is not a new stop
+    s = plan.scene
+    margin = SLIP_MARGIN * max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * (s.radius or 0.0), 1e-300)
     grid = np.unique(np.concatenate([np.linspace(t0, T, SCAN), t]))
-    g = sgn * slip(grid)
+    g = sgn * slip(grid) + margin
     bad = np.nonzero(g[1:] <= 0.0)[0]
     if bad.size == 0:
         return J, K, None
     i = int(bad[0]) + 1
     if g[i] == 0.0:
         return J, K, float(grid[i])
-    t_stop = brentq(lambda x: sgn * slip(x)[0], grid[i - 1], grid[i], xtol=1e-15 * max(T, 1e-300),
+    t_stop = brentq(lambda x: sgn * slip(x)[0] + margin, grid[i - 1], grid[i], xtol=1e-15 * max(T, 1e-300),
                     rtol=4 * np.finfo(float).eps)
     return J, K, float(t_stop)

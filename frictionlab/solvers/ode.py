@@ -5,6 +5,8 @@ tolerances means the same thing for a 1 ns and a 1 s contact, for 1e-12 and 1 m^
 """
 from __future__ import annotations
 
+import numbers
+
 import numpy as np
 from scipy.integrate import solve_ivp
 
@@ -12,6 +14,9 @@ from ..errors import SolverError
 from . import stick
 
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+
+#: Slip, relative to its scale, by which the zero-slip event waits past zero (see zero_slip).
+SLIP_MARGIN = 1e-12
 
 
 def state_scales(plan, T: float) -> np.ndarray:
@@ -28,9 +33,11 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
     """A sliding-phase function for ``segments.run`` using solve_ivp ``method``."""
     if method not in METHODS:
         raise SolverError(f"unknown ODE method {method!r}; choose one of {', '.join(METHODS)}")
-    if not (0 < rtol < 1):
-        raise SolverError(f"rtol must be in (0, 1), got {rtol}")
+    if isinstance(rtol, bool) or not isinstance(rtol, numbers.Real) or not (0 < rtol < 1):
+        raise SolverError(f"rtol must be a number in (0, 1), got {rtol!r}")
     atol = rtol if atol is None else atol
+    if isinstance(atol, bool) or not isinstance(atol, numbers.Real) or not (0 < atol < float("inf")):
+        raise SolverError(f"atol must be a positive number, got {atol!r}")
 
     def slide(plan, p, t0, y0, direction, t_out):
         if len(t_out) == 0 or t_out[-1] <= t0:
@@ -52,7 +59,9 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
         events = None
         if not compliant and direction != 0:
             def zero_slip(s, z):
-                return float(plan.rigid_slip(z * scale)) / scale[0]
+                # fires once slip has passed zero by a hair (SLIP_MARGIN of its scale), so that
+                # round-off at a restart from rest (slip exactly 0) is not taken for a new stop
+                return float(plan.rigid_slip(z * scale)) / scale[0] + direction * SLIP_MARGIN
 
             zero_slip.terminal = True
             zero_slip.direction = -direction
@@ -74,7 +83,6 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
         if events is not None and sol.t_events[0].size:
             t_stop = float(sol.t_events[0][0]) * tscale
             y_stop = sol.y_events[0][0] * scale
-            Y = Y[:, : int(np.count_nonzero(np.asarray(t_out) <= t_stop))]  # solve_ivp already cut t_eval at the event
         info = {"nfev": int(sol.nfev), "njev": int(sol.njev), "nlu": int(sol.nlu), "method": method,
                 "rtol": rtol, "atol": atol}
         return Y, t_stop, y_stop, info

@@ -1,0 +1,1 @@
+"""Built-in datasets (CSV + TOML pairs), installed as ``frictionlab.data``. See README: Datasets."""
