@@ -141,6 +141,11 @@ class SceneBatch:
             top["normal"] = attrs.evolve(s.normal, **normal)
         return attrs.evolve(s, **top) if top else s
 
+    def subset(self, idx) -> "SceneBatch":
+        """The scenes ``idx`` (an index array or slice) as a batch of their own."""
+        idx = np.arange(self.n)[idx]
+        return SceneBatch(self.template, {k: v[idx] for k, v in self.values.items()}, int(idx.size))
+
     def __len__(self) -> int:
         return self.n
 
@@ -258,6 +263,42 @@ def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol:
         out, info = _run_rk(law, batch, p, T, solver, rtol, atol)
     info.update({"rtol": rtol, "atol": rtol if atol is None else atol} if solver != "exact" else {})
     return BatchResult(t=tgrid, solver=solver, law=law.name, info=info, **out)
+
+
+def simulate_sweep(law, scenes, params=None, t=None, solver: str = "auto", rtol: float = 1e-8,
+                   atol: float | None = None, n: int = 201, executor=None, chunk: int = 5000) -> BatchResult:
+    """``simulate_batch`` in chunks of ``chunk`` scenes, dispatched on ``executor`` (as in
+    ``frictionlab.bootstrap``: None runs here; a concurrent.futures executor or a dask.distributed
+    Client spreads the chunks). Results are concatenated in scene order and equal the one-call result.
+    """
+    law = get_law(law)
+    batch = scenes if isinstance(scenes, SceneBatch) else SceneBatch.from_scenes(scenes)
+    p = batch_params(law, params, batch.n)
+    tgrid = _time_grid(batch, t, n)
+    chunk = max(1, int(chunk))
+    jobs = []
+    for start in range(0, batch.n, chunk):
+        sl = slice(start, min(start + chunk, batch.n))
+        args = (law.name, batch.subset(sl), _take_params(p, sl), tgrid if tgrid.ndim == 1 else tgrid[sl], solver, rtol,
+                atol, n)
+        jobs.append(args)
+    if executor is None:
+        parts = [simulate_batch(*a) for a in jobs]
+    else:
+        parts = [f.result() for f in [executor.submit(simulate_batch, *a) for a in jobs]]
+    return _concat(parts, tgrid)
+
+
+def _concat(parts, tgrid) -> BatchResult:
+    def cat(name):
+        arrs = [getattr(r, name) for r in parts]
+        return None if any(a is None for a in arrs) else np.concatenate(arrs, axis=0)
+
+    info = {"chunks": len(parts), "solver_per_chunk": [r.solver for r in parts],
+            "nfev": int(sum(r.info.get("nfev", 0) for r in parts))}
+    return BatchResult(t=tgrid, u=cat("u"), v=cat("v"), omega=cat("omega"), theta=cat("theta"), force=cat("force"),
+                       stick_time=cat("stick_time"), A=cat("A"), N=cat("N"), solver=parts[0].solver, law=parts[0].law,
+                       info=info)
 
 
 def _time_grid(batch, t, n):

@@ -184,8 +184,15 @@ def measure_case(name, law, params, scene, rtols, repeats, batch_size, n_t=201, 
     return rows, meta
 
 
-def run_bench(quick: bool = False, progress=None) -> dict:
-    """Measure every scene kind; returns {'env', 'settings', 'cases': {name: {title, law, params, meta}}, 'rows'}."""
+#: The cost at the level users care about: fits at each tolerance (``frictionlab.fitcost``).
+FIT_CASES = (("impact-golf-v28", ("wear", "area-rate", "coulomb")), ("incline-dry-d10", ("wear", "couette", "coulomb")))
+FIT_METHODS, QUICK_FIT_METHODS = ("LSODA", "DOP853"), ("LSODA",)
+FIT_RTOLS, QUICK_FIT_RTOLS = (1e-3, 1e-5, 1e-7, 1e-10), (1e-3, 1e-7)
+
+
+def run_bench(quick: bool = False, progress=None, fits: bool = True) -> dict:
+    """Measure every scene kind (and, with ``fits``, the fit-tolerance study); returns
+    {'env', 'settings', 'cases': {name: {title, law, params, meta}}, 'rows', 'fit_rows'}."""
     rtols = QUICK_RTOLS if quick else RTOLS
     repeats = 3 if quick else 7
     batch_size = 20 if quick else 200
@@ -199,7 +206,14 @@ def run_bench(quick: bool = False, progress=None) -> dict:
     settings = {"rtols": list(rtols), "atol": "equal to rtol, on the scaled problem", "repeats": repeats,
                 "min_loop_s": MIN_LOOP, "quick": quick, "clock": "time.process_time (CPU seconds of this process)",
                 "load_average_at_start": list(os.getloadavg()) if hasattr(os, "getloadavg") else None}
-    return {"env": env, "settings": settings, "cases": info, "rows": all_rows}
+    fit_rows = []
+    if fits:
+        from .fitcost import fit_tolerance_study
+
+        for dataset, laws in FIT_CASES:
+            fit_rows += fit_tolerance_study(laws, dataset, QUICK_FIT_METHODS if quick else FIT_METHODS,
+                                            QUICK_FIT_RTOLS if quick else FIT_RTOLS, progress=progress)
+    return {"env": env, "settings": settings, "cases": info, "rows": all_rows, "fit_rows": fit_rows}
 
 
 # --- writing --------------------------------------------------------------------------------------------
@@ -303,7 +317,21 @@ def write_bench(out, result, force: bool = False) -> list[str]:
             w.writeheader()
             for r in result["rows"]:
                 w.writerow({k: ("" if r[k] is None else r[k]) for k in fields})
-        (tmp / "workprecision.md").write_text(markdown(result) + "\n", encoding="utf-8")
+        md = markdown(result)
+        if result.get("fit_rows"):
+            from . import fitcost
+
+            fit_fields = list(result["fit_rows"][0])
+            with open(tmp / "fit_tolerance.csv", "w", newline="", encoding="utf-8") as fh:
+                w = csv.DictWriter(fh, fieldnames=fit_fields)
+                w.writeheader()
+                for r in result["fit_rows"]:
+                    w.writerow({k: ("" if r[k] is None else r[k]) for k in fit_fields})
+            md += "\n## What the tolerance does to a fit\n\n"
+            for ds in dict.fromkeys(r["dataset"] for r in result["fit_rows"]):
+                md += f"### {ds}\n\n" + fitcost.markdown([r for r in result["fit_rows"] if r["dataset"] == ds]) + "\n\n"
+            written.append("fit_tolerance.csv")
+        (tmp / "workprecision.md").write_text(md + "\n", encoding="utf-8")
         meta = {k: result[k] for k in ("env", "settings")}
         meta["cases"] = {k: {**v, "meta": {**v["meta"]}} for k, v in result["cases"].items()}
         (tmp / "environment.json").write_text(json.dumps(meta, indent=2, default=str) + "\n", encoding="utf-8")

@@ -157,3 +157,19 @@ def test_errors_are_one_line():
         simulate_batch("coulomb", [oblique(30, 0.5)], solver="Radau")
     with pytest.raises(FrictionLabError, match="needs"):
         simulate_batch("wear", [incline(0.1)], solver="DOP853")
+
+
+def test_sweep_in_chunks_on_an_executor_equals_one_call():
+    from concurrent.futures import ThreadPoolExecutor
+
+    from frictionlab.batch import simulate_sweep
+
+    rng = np.random.default_rng(3)
+    batch = SceneBatch.sweep(oblique(40.0, 0.5), {"u0": rng.uniform(2, 30, 11)})
+    mu = rng.uniform(0.1, 0.5, 11)
+    one = simulate_batch("coulomb", batch, {"mu": mu}, solver="DOP853", n=41)
+    with ThreadPoolExecutor(2) as ex:
+        swept = simulate_sweep("coulomb", batch, {"mu": mu}, solver="DOP853", n=41, executor=ex, chunk=4)
+    assert swept.info["chunks"] == 3
+    for name in ("u", "v", "omega", "theta", "force", "stick_time"):
+        assert np.array_equal(getattr(swept, name), getattr(one, name), equal_nan=True)

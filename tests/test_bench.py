@@ -16,6 +16,8 @@ def tiny(monkeypatch):
     monkeypatch.setattr(bench, "BATCH_METHODS", ("DOP853",))
     monkeypatch.setattr(bench, "MIN_LOOP", 0.0)
     monkeypatch.setattr(bench, "CHECK_RTOL", 1e-8)
+    monkeypatch.setattr(bench, "FIT_CASES", (("incline-oil-a100", ("couette", "coulomb")),))
+    monkeypatch.setattr(bench, "QUICK_FIT_RTOLS", (1e-4,))
     real = bench.measure_case
 
     def fast(name, law, params, scene, rtols, repeats, batch_size, n_t=201, progress=None):
@@ -62,7 +64,10 @@ def test_bench_command_writes_whole_folder(tiny, tmp_path, capsys):
     assert any(r["method"] == "batch:DOP853" for r in rows)
     assert all(math.isfinite(float(r["time_median_s"])) for r in rows if r["status"] == "ok")
     md = (out / "workprecision.md").read_text()
-    assert "Hardware:" in md and "numpy" in md
+    assert "Hardware:" in md and "numpy" in md and "What the tolerance does to a fit" in md
+    fits = list(csv.DictReader(open(out / "fit_tolerance.csv")))
+    assert {r["solver"] for r in fits} == {"exact", "ode:LSODA"} and {r["law"] for r in fits} == {"couette", "coulomb"}
+    assert all(r["ranking_as_reference"] == "True" for r in fits)
     # existing folder: refused before measuring, one line, exit 2
     assert main(["bench", "--out", str(out), "--quick"]) == 2
     assert "exists" in capsys.readouterr().err
@@ -77,5 +82,18 @@ def test_failed_run_leaves_no_folder(tiny, tmp_path, monkeypatch):
         raise bench.FrictionLabError("disk full")
 
     monkeypatch.setattr(bench, "plot_case", boom)
-    assert main(["bench", "--out", str(out), "--quick"]) == 2
+    assert main(["bench", "--out", str(out), "--quick", "--no-fits"]) == 2
     assert not out.exists() and not list(tmp_path.iterdir())
+
+
+def test_fit_tolerance_study_rows():
+    from frictionlab.fitcost import fit_tolerance_study, markdown
+
+    rows = fit_tolerance_study(["couette"], "incline-oil-a100", methods=("LSODA",), rtols=(1e-3, 1e-8))
+    assert [r["solver"] for r in rows] == ["exact", "ode:LSODA", "ode:LSODA"]
+    assert rows[0]["shift_in_stderr"] == 0.0 and abs(rows[2]["shift_in_stderr"]) < 1e-2
+    assert all(r["fit_time_s"] > 0 and r["rank"] == 1 for r in rows)
+    assert "| couette | exact |" in markdown(rows)
+    from frictionlab import fitting
+
+    assert fitting.FIT_RTOL == 1e-10  # restored after the study
