@@ -221,6 +221,16 @@ def numba_closed_form(batch, params, t_bare, bare):
     print(f"  numba-compiled loop of the same closed form: {t_nb:.3f} s (bare numpy / numba = {t_bare / t_nb:.2f}x)")
 
 
+def scaling(args, rng):
+    """Per-scene cost of the numpy batch against batch size: the interpreter overhead is paid per
+    step of the whole batch, so it vanishes per scene as the batch grows."""
+    print("\n[scaling] batch DOP853 on coulomb-roll, per-scene CPU time by batch size")
+    for n in (10, 100, 1000, args.n):
+        b, p = coulomb_family(n, rng)
+        t, _ = median_time(lambda: simulate_batch("coulomb", b, p, solver="DOP853", rtol=args.rtol, n=NT), args.repeats)
+        print(f"  n = {n:>6}: {t / n * 1e6:9.1f} us/scene")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=10_000, help="scenes per family")
@@ -243,6 +253,7 @@ def main(argv=None):
     rk_vs_loop("wear-paper", "wear", wb, wp, args, rng)
     exact_vs_bare("coulomb-roll", "coulomb", cb, cp, bare_coulomb, args, rng)
     exact_vs_bare("wear-paper", "wear", wb, wp, bare_wear, args, rng)
+    scaling(args, rng)
 
 
 if __name__ == "__main__":

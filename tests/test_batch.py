@@ -173,3 +173,18 @@ def test_sweep_in_chunks_on_an_executor_equals_one_call():
     assert swept.info["chunks"] == 3
     for name in ("u", "v", "omega", "theta", "force", "stick_time"):
         assert np.array_equal(getattr(swept, name), getattr(one, name), equal_nan=True)
+
+
+@pytest.mark.slow
+def test_benchmark_script_runs(capsys):
+    """benchmarks/bench_batch.py end to end on a small problem (slow: deselected by default)."""
+    import importlib.util
+    import pathlib
+
+    path = pathlib.Path(__file__).resolve().parents[1] / "benchmarks" / "bench_batch.py"
+    spec = importlib.util.spec_from_file_location("bench_batch", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    mod.main(["--n", "300", "--sample", "10", "--repeats", "1", "--no-numba"])
+    out = capsys.readouterr().out
+    assert out.count("RATIO loop/batch") == 4 and out.count("RATIO batch/bare") == 2
