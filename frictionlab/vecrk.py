@@ -35,11 +35,6 @@ class Result:
     iterations: int
 
 
-def _tableau(method):
-    cls = {"RK45": RK45, "DOP853": DOP853}[method]
-    return cls
-
-
 def _rms(x):
     return np.sqrt(np.mean(x * x, axis=0))
 
@@ -66,7 +61,7 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
     """
     if method not in METHODS:
         raise SolverError(f"batch: unknown method {method!r}; choose one of {', '.join(METHODS)}")
-    cls = _tableau(method)
+    cls = {"RK45": RK45, "DOP853": DOP853}[method]
     atol = rtol if atol is None else atol
     t0 = np.asarray(t0, dtype=float)
     y = np.array(y0, dtype=float)
@@ -84,7 +79,7 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
     ptr = (t_out < t0[:, None]).sum(axis=1)
     t = t0.copy()
     active = np.nonzero(t < t_end)[0]
-    _fill_at_start(Y, reached, ptr, t_out, t, y, active, n)
+    _fill_at_start(Y, reached, ptr, t_out, t, y)
     if active.size == 0:
         return Result(Y, reached, t_event, y_event, nfev, 0)
 
@@ -276,7 +271,7 @@ def _dense(cls, rhs, K, t_old, h, y_old, y_new, f_new):
     return _Dense("DOP853", t_old, h, y_old, Fc)
 
 
-def _fill_at_start(Y, reached, ptr, t_out, t, y, idx, n):
+def _fill_at_start(Y, reached, ptr, t_out, t, y):
     """Outputs requested exactly at each problem's start time take its initial state."""
     m = t_out.shape[1]
     rows = np.nonzero((ptr < m))[0]
@@ -317,7 +312,7 @@ def _fill_dense(Y, reached, ptr, t_out, idx, pos, t_stop, dense, shared=None):
     ptr[idx] = np.maximum(ptr[idx], stop)
 
 
-def illinois(make_fn, lo, hi, glo, ghi, tol, gtol=0.0):
+def root_bracketed(make_fn, lo, hi, glo, ghi, tol, gtol=0.0):
     """Per problem, the first point where fn <= 0 in brackets [lo, hi] with fn(lo) > 0 >= fn(hi).
 
     make_fn(rows) returns fn for the problems ``rows`` (it is rebuilt on the unfinished problems
@@ -381,5 +376,5 @@ def _locate(make_event, idx, dense, rows, t_old, h):
     eps = np.finfo(float).eps
     fn = make_fn(np.arange(idx.size))
     lo, hi = np.zeros(idx.size), np.ones(idx.size)
-    x = illinois(make_fn, lo, hi, fn(lo), fn(hi), 4 * eps, 8 * eps)  # g is slip / its scale
+    x = root_bracketed(make_fn, lo, hi, fn(lo), fn(hi), 4 * eps, 8 * eps)  # g is slip / its scale
     return t_old + x * h, dense(x)
