@@ -71,7 +71,6 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
     m = t_out.shape[1]
     shared = t_out[0] if np.all(t_out == t_out[:1]) else None
     Y = np.full((d, n, m), np.nan)
-    reached = np.zeros((n, m), dtype=bool)
     t_event = np.full(n, np.nan)
     y_event = np.full((d, n), np.nan)
     nfev = np.zeros(n, dtype=np.int64)
@@ -79,9 +78,10 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
     ptr = (t_out < t0[:, None]).sum(axis=1)
     t = t0.copy()
     active = np.nonzero(t < t_end)[0]
-    _fill_at_start(Y, reached, ptr, t_out, t, y)
+    ptr0 = ptr.copy()  # outputs are filled contiguously from here: reached is [ptr0, ptr) at the end
+    _fill_at_start(Y, ptr, t_out, t, y)
     if active.size == 0:
-        return Result(Y, reached, t_event, y_event, nfev, 0)
+        return Result(Y, _reached(ptr0, ptr, m), t_event, y_event, nfev, 0)
 
     order = cls.error_estimator_order
     exponent = -1.0 / (order + 1)
@@ -161,7 +161,7 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
                 t_event[ia[je]] = ts
                 y_event[:, ia[je]] = ys
             jd = np.nonzero(needs_dense)[0]
-            _fill_dense(Y, reached, ptr, t_out, ia[jd], acc[jd], t_stop_acc[jd], dense, shared)
+            _fill_dense(Y, ptr, t_out, ia[jd], acc[jd], t_stop_acc[jd], dense, shared)
         t[ia] = t_new[acc]
         y[:, ia] = y_new[:, acc]
         F[:, ia] = f_new[:, acc]
@@ -173,7 +173,12 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
             if active.size:
                 rhs = make_rhs(active)
                 g = make_event(active) if make_event else None
-    return Result(Y, reached, t_event, y_event, nfev, iterations)
+    return Result(Y, _reached(ptr0, ptr, m), t_event, y_event, nfev, iterations)
+
+
+def _reached(ptr0, ptr, m):
+    k = np.arange(m)[None, :]
+    return (k >= ptr0[:, None]) & (k < ptr[:, None])
 
 
 def _error_norm(cls, K, h, scale):
@@ -271,7 +276,7 @@ def _dense(cls, rhs, K, t_old, h, y_old, y_new, f_new):
     return _Dense("DOP853", t_old, h, y_old, Fc)
 
 
-def _fill_at_start(Y, reached, ptr, t_out, t, y):
+def _fill_at_start(Y, ptr, t_out, t, y):
     """Outputs requested exactly at each problem's start time take its initial state."""
     m = t_out.shape[1]
     rows = np.nonzero((ptr < m))[0]
@@ -280,13 +285,13 @@ def _fill_at_start(Y, reached, ptr, t_out, t, y):
     at = t_out[rows, ptr[rows]] == t[rows]
     r = rows[at]
     Y[:, r, ptr[r]] = y[:, r]
-    reached[r, ptr[r]] = True
     ptr[r] += 1
 
 
-def _fill_dense(Y, reached, ptr, t_out, idx, pos, t_stop, dense, shared=None):
+def _fill_dense(Y, ptr, t_out, idx, pos, t_stop, dense, shared=None):
     """Fill every output t_out[i, ptr_i:] <= t_stop_i of problems idx (rows pos of the dense output)."""
     start = ptr[idx]
+    m = t_out.shape[1]
     if shared is not None:  # one grid for all problems: count with searchsorted, no (k, m) mask
         stop = np.maximum(np.searchsorted(shared, t_stop, side="right"), start)
         counts = stop - start
@@ -294,10 +299,9 @@ def _fill_dense(Y, reached, ptr, t_out, idx, pos, t_stop, dense, shared=None):
         if total == 0:
             return
         rows = np.repeat(np.arange(idx.size), counts)
-        cols = start[rows] + np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+        cols = np.arange(total) + np.repeat(start - (np.cumsum(counts) - counts), counts)
         tq = shared[cols]
     else:
-        m = t_out.shape[1]
         within = (np.arange(m)[None, :] >= start[:, None]) & (t_out[idx] <= t_stop[:, None])
         rows, cols = np.nonzero(within)
         if rows.size == 0:
@@ -306,9 +310,7 @@ def _fill_dense(Y, reached, ptr, t_out, idx, pos, t_stop, dense, shared=None):
         tq = t_out[idx[rows], cols]
     p = pos[rows]
     x = (tq - dense.t_old[p]) / dense.h[p]
-    flat = idx[rows] * t_out.shape[1] + cols  # Y and reached are C-contiguous (d, n, m) and (n, m)
-    Y.reshape(Y.shape[0], -1)[:, flat] = dense(x, p)
-    reached.reshape(-1)[flat] = True
+    Y.reshape(Y.shape[0], -1)[:, idx[rows] * m + cols] = dense(x, p)  # Y is C-contiguous (d, n, m)
     ptr[idx] = np.maximum(ptr[idx], stop)
 
 
