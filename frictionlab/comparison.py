@@ -170,6 +170,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
         eq_results, done = _run(tasks, _equivalence_task, jobs, progress, done, total,
                                 lambda t: f"equivalence on {t[0].datasets[0]} [{t[0].solver}]")
     order = {d.name: i for i, d in enumerate(dss)}
+    eq_results.sort(key=lambda e: (order[e.dataset], family(e.solver) == "series"))
     fits.sort(key=lambda f: (order[f.datasets[0]], law_names.index(f.law), family(f.solver) == "series"))
     ranking = rank_fits(fits)
     kinds = {d.name: d.kind for d in dss}

@@ -26,8 +26,8 @@
                  force_correlation, force_distance, impulse_Ns{}, aic{}, redchi{}, shape{}, fitted{},
                  cross[{law, to, status, rms, rms_sigma, params}],
                  decomposition{b, u0, c_area, c_area_rate, mu, eta_prime, r2} | null}],
-    derivations{dataset: {method: {rms_vs_omega_column, omega_peak, omega_end, median_sigma,
-                                   noisy_rms_vs_omega_column}}}
+    derivations{dataset: {method: {rms_vs_omega_column, omega_peak, omega_end, noisy_rms_vs_omega_column,
+                                   noisy_omega_peak, noisy_omega_end, noisy_median_sigma}}}
   All numbers SI (rad/s, s, m, N) unless the key says otherwise; non-finite numbers are null.
 """
 from __future__ import annotations
@@ -37,6 +37,7 @@ import datetime as _dt
 import html
 import json
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -204,7 +205,7 @@ def _derivation_stats(ds, given, noisy) -> dict:
     for m, d in given.items():
         rms = lambda x: float(np.sqrt(np.mean((x - ref) ** 2))) if ref is not None else math.nan  # noqa: E731
         out[m] = {"rms_vs_omega_column": rms(d.omega), "omega_peak": float(np.max(d.omega)),
-                  "omega_end": float(d.omega[-1]), "median_sigma": float(np.median(d.sigma)),
+                  "omega_end": float(d.omega[-1]), "noisy_median_sigma": float(np.median(noisy[m].sigma)),
                   "noisy_rms_vs_omega_column": rms(noisy[m].omega), "noisy_omega_peak": float(np.max(noisy[m].omega)),
                   "noisy_omega_end": float(noisy[m].omega[-1])}
     return out
@@ -246,6 +247,17 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
         if best:
             items.append(f"**{g}**: best " + " = ".join(best) + " (summed AIC over the group"
                          + ("; a tie" if len(best) > 1 else "") + ")")
+    for d in fitted:
+        for law in c.laws:
+            ser = next((r for r in c.ranking if r.dataset == d.name and r.law == law and r.solver == "series"
+                        and r.rank), None)
+            full = next((r for r in c.ranking if r.dataset == d.name and r.law == law and r.solver != "series"
+                         and r.rank), None)
+            if ser and full and abs(ser.aic - full.aic) > 2:
+                better = "better" if ser.aic < full.aic else "worse"
+                items.append(f"**{d.name}**: the paper's truncated series of {law} fits {better} than the {full.solver} "
+                             f"solution of the same law (ΔAIC {abs(ser.aic - full.aic):.1f}): the approximation, not "
+                             "the law, makes that difference (see the notes under Fits)")
     doc.items(items)
     if c.equivalence:
         doc.p("Equivalence of λAu and μN + μη′dA/dt: " + "; ".join(
@@ -302,8 +314,13 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
         for f in fits:
             if not f.ok:
                 continue
+            ratio_keys = {k for pair in f.identifiability.ratio_only for k in pair}
             for p in f.params.values():
                 role = "fitted" if p.vary else (p.fixed_by or "held")
+                if p.vary and p.kind == "law" and p.key in ratio_keys:
+                    role = "arbitrary: only the ratio is determined"
+                elif p.vary and p.stderr is None:
+                    role = f"fitted; no error bar: {f.identifiability.missing_stderr.get(p.name, 'see warnings')}"
                 prow.append([f"{f.law} [{f.solver}]", p.name, param_text(p.value, p.stderr if p.vary or
                                                                          p.kind == "derived" else None, p.unit),
                              role])
@@ -344,11 +361,15 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
             doc.fig(name, f"{d.name}: ω derived from θ by poly9 and spline, without and with simulated noise.")
             uname, uf = unit("omega")
             doc.table(["route", f"RMS vs ω column [{uname}]", f"peak [{uname}]", f"end [{uname}]",
-                       f"median ±1σ [{uname}]", f"with noise: RMS vs ω column [{uname}]",
-                       f"with noise: peak [{uname}]", f"with noise: end [{uname}]"],
+                       f"with noise: RMS vs ω column [{uname}]", f"with noise: peak [{uname}]",
+                       f"with noise: end [{uname}]", f"with noise: median ±1σ passed on [{uname}]"],
                       [[m, fmt(s["rms_vs_omega_column"] * uf), fmt(s["omega_peak"] * uf), fmt(s["omega_end"] * uf),
-                        fmt(s["median_sigma"] * uf), fmt(s["noisy_rms_vs_omega_column"] * uf),
-                        fmt(s["noisy_omega_peak"] * uf), fmt(s["noisy_omega_end"] * uf)] for m, s in stats.items()])
+                        fmt(s["noisy_rms_vs_omega_column"] * uf), fmt(s["noisy_omega_peak"] * uf),
+                        fmt(s["noisy_omega_end"] * uf), fmt(s["noisy_median_sigma"] * uf)] for m, s in stats.items()])
+            ref = d.reported
+            if ref:
+                doc.p("Reported in the paper for this impact: " + ", ".join(f"{k} = {v}" for k, v in ref.items()
+                                                                           if "omega" in k or k == "t_peak") + ".")
 
     # identifiability roll-up
     doc.h(2, "Identifiability warnings")
@@ -406,7 +427,9 @@ def _equivalence_section(doc: Doc, figs: dict, c: Comparison):
         fws = [c.fit_for(d.name, WEAR, e.solver) for e in mine]
         name = f"equivalence-{d.name}.png"
         figs[name] = figures.equivalence_figure(d, fws, fa, [e.decomposition for e in mine])
-        doc.fig(name, f"{d.name}: friction force of the wear and area-rate fits, and the paper's decomposition.")
+        doc.fig(name, f"{d.name}: friction force of the wear and area-rate fits"
+                + (", and the paper's decomposition of each wear fit with its projection onto μN + μη′dA/dt."
+                   if any(e.decomposition for e in mine) else "."))
 
 
 def _method_section(doc: Doc, c: Comparison):
@@ -519,6 +542,9 @@ def write_report(c: Comparison, out, force: bool = False) -> Path:
     """Write the report folder ``out`` whole or not at all; refuse an existing folder unless force."""
     out = Path(out)
     with atomic_dir(out, force=force) as tmp:
+        umask = os.umask(0)
+        os.umask(umask)
+        tmp.chmod(0o777 & ~umask)  # mkdtemp makes it private; the report is meant to be read
         doc, figs, deriv = build(c)
         (tmp / "figures").mkdir()
         for name, data in figs.items():
