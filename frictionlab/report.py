@@ -307,9 +307,10 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
             name = f"fit-{d.name}.png"
             figs[name] = figures.fit_figure(d, fits, rows)
             doc.fig(name, f"{d.name}: data ({d.provenance.kind}) with each law's best fit, and residuals.")
-            name = f"force-{d.name}.png"
-            figs[name] = figures.force_figure(d, fits)
-            doc.fig(name, f"{d.name}: friction force of each best fit.")
+            if "t" in d.columns:
+                name = f"force-{d.name}.png"
+                figs[name] = figures.force_figure(d, fits)
+                doc.fig(name, f"{d.name}: friction force of each best fit.")
         prow = []
         for f in fits:
             if not f.ok:
