@@ -621,14 +621,17 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         notes.append(f"{model.failures} of {model.nfev} evaluations could not be solved and were penalized "
                      f"(last: {model.last_error})")
     notes += _series_notes(law, per)
-    presults = _param_results(slots, best_params, targets, structure,
-                              _jacobian_errors(slots, values, J, structure, stats.redchi))
+    jac = _jacobian_errors(slots, values, J, structure, stats.redchi)
+    presults = _param_results(slots, best_params, targets, structure, jac)
     correl = {}
-    for s in varying:
-        for other, r in (best_params[s.pname].correl or {}).items():
-            o = next(x for x in slots if x.pname == other)
-            if s.display < o.display:
-                correl[(s.display, o.display)] = float(r)
+    if structure["ratios"] or structure["no_effect"]:  # lmfit's covariance is degenerate: use the identifiable part
+        correl = jac.get("correl", {})
+    else:
+        for s in varying:
+            for other, r in (best_params[s.pname].correl or {}).items():
+                o = next(x for x in slots if x.pname == other)
+                if s.display < o.display:
+                    correl[(s.display, o.display)] = float(r)
     ident = _verdict(structure, presults, correl)
     return FitResult(law=law.name, solver=solver_label, datasets=names, status=status, reason=reason,
                      params=presults, correlations=correl, stats=stats, identifiability=ident,
@@ -718,7 +721,8 @@ def _in_ratio(s, structure) -> bool:
 def _jacobian_errors(slots, values, J, structure, redchi) -> dict:
     """Standard errors [SI] from the Jacobian of the identifiable directions, scaled by the reduced
     chi-square as lmfit's are: free parameters that have an effect and are not in a ratio-only pair,
-    plus each such pair as its ratio. Returns {display: err} and {'ratio label': (value, err, unit, slot)}."""
+    plus each such pair as its ratio. Returns {"errors": {display: err}, "derived": {label: (value, err,
+    unit, slot)}, "correl": {(a, b): r}}."""
     cols, entries = [], []
     for k, s in enumerate(s for s in slots if s.vary):
         if s.display in structure["no_effect"]:
@@ -742,6 +746,7 @@ def _jacobian_errors(slots, values, J, structure, redchi) -> dict:
         An = A / np.maximum(np.linalg.norm(A, axis=0), 1e-300)
         if np.linalg.matrix_rank(An, tol=1e-8) == A.shape[1]:
             cov = np.linalg.inv(A.T @ A) * redchi
+    correl = {}
     for i, (name, conv, extra) in enumerate(entries):
         err = float(np.sqrt(max(cov[i, i], 0.0))) * conv if cov is not None else None
         if extra is None:
@@ -749,19 +754,26 @@ def _jacobian_errors(slots, values, J, structure, redchi) -> dict:
                 errors[name] = err
         else:
             derived[name] = (extra[0], err, extra[1], extra[2])
-    return {"errors": errors, "derived": derived}
+        if cov is not None:
+            for j in range(i + 1, len(entries)):
+                denom = math.sqrt(max(cov[i, i] * cov[j, j], 1e-300))
+                a, b = sorted((name, entries[j][0]))
+                correl[(a, b)] = float(cov[i, j] / denom)
+    return {"errors": errors, "derived": derived, "correl": correl}
 
 
 def _param_results(slots, best, targets, structure, jac) -> dict[str, ParamResult]:
     """ParamResults in SI: lmfit's error bars; none where the data cannot give one (ratio-only,
-    no effect); the Jacobian's where lmfit gave none. Ratio-only pairs add their ratio ('derived')."""
+    no effect); the Jacobian's over the identifiable directions where lmfit gave none or where a
+    degeneracy makes its covariance unreliable. Ratio-only pairs add their ratio ('derived')."""
     out = {}
+    degenerate = bool(structure["ratios"] or structure["no_effect"])  # lmfit's covariance is then unreliable
     for s in slots:
         p = best[s.pname]
         err = p.stderr * s.scale if (s.vary and p.stderr is not None and np.isfinite(p.stderr)) else None
         if s.display in structure["no_effect"] or (s.vary and _in_ratio(s, structure)):
             err = None
-        elif err is None and s.vary:
+        elif s.vary and (err is None or degenerate):
             err = jac["errors"].get(s.display)
         out[s.display] = ParamResult(s.display, s.key, s.kind, p.value * s.scale, err, s.unit, s.vary, s.value,
                                      s.lower, s.upper, tuple(targets[i].name for i in s.targets), s.fixed_by)
