@@ -498,6 +498,36 @@ def _distinct(scored: list[tuple], n: int) -> list[dict]:
     return out
 
 
+def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: int, max_nfev):
+    """Score a grid of starts, refine the best distinct ones with Levenberg-Marquardt, keep the lowest
+    chi-square. Returns (parameters, success, message)."""
+    varying = [s for s in slots if s.vary]
+    if not varying:
+        return params, True, "nothing to fit: every parameter is held"
+    starts = [{s.pname: params[s.pname].value for s in varying}]
+    if scan:
+        fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
+        scored = []
+        for cand in _start_grid(varying, np.random.default_rng(0), scan):
+            vals = {**fixed_part, **cand}
+            r = model.residual({s.pname: vals[s.pname] * s.scale for s in slots})
+            scored.append((float(r @ r), len(scored), cand))
+        scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins
+        slow = any(x.startswith("ode") for x in solvers)
+        starts = _distinct(scored, min(n_starts, ODE_STARTS) if slow else n_starts)
+    best = None
+    for start in starts:
+        trial = params.copy()
+        for k, v in start.items():
+            trial[k].set(value=v)
+        mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), trial, scale_covar=True,
+                               max_nfev=max_nfev or 200 * (len(varying) + 1))
+        r = mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
+        if best is None or (r.success, -r.chisqr) > (best.success, -best.chisqr):
+            best = r
+    return best.params, bool(best.success), str(best.message)
+
+
 def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[float]] | None = None,
         fixed: Mapping[str, float] | None = None, local: Sequence[str] = (),
         initial: Mapping[str, float] | None = None, observable: str | None = None, derive: str | None = None,
@@ -561,36 +591,8 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     solver_label = solver if solver != "auto" else "+".join(dict.fromkeys(solvers))
     n_points = sum(t.y.size for t in targets)
 
-    def residual(ps):
-        return model.residual(_si(ps, slots))
-
     try:
-        starts = [{s.pname: params[s.pname].value for s in varying}]
-        if varying and scan:
-            fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
-            scored = []
-            for cand in _start_grid(varying, np.random.default_rng(0), scan):
-                vals = {**fixed_part, **cand}
-                r = model.residual({s.pname: vals[s.pname] * s.scale for s in slots})
-                scored.append((float(r @ r), len(scored), cand))
-            scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins
-            slow = any(x.startswith("ode") for x in solvers)
-            starts = _distinct(scored, min(n_starts, ODE_STARTS) if slow else n_starts)
-        if varying:
-            best_res = None
-            for start in starts:
-                trial = params.copy()
-                for k, v in start.items():
-                    trial[k].set(value=v)
-                mini = lmfit.Minimizer(residual, trial, scale_covar=True,
-                                       max_nfev=max_nfev or 200 * (len(varying) + 1))
-                r = mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
-                if best_res is None or (r.success, -r.chisqr) > (best_res.success, -best_res.chisqr):
-                    best_res = r
-            res = best_res
-            best_params, success, message = res.params, bool(res.success), str(res.message)
-        else:
-            best_params, success, message, res = params, True, "nothing to fit: every parameter is held", None
+        best_params, success, message = _search(lmfit, model, params, slots, solvers, scan, n_starts, max_nfev)
         values = _si(best_params, slots)
         models = model.models(values)
     except SkipDataset as exc:
