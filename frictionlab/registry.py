@@ -60,8 +60,13 @@ def validate_law(law: FrictionLaw, source: str) -> None:
         dAdt=np.zeros(n) if "dAdt" in law.requires else None,
     )
     p = law.defaults()
-    f_pos = law.evaluate(p, probe)
-    f_neg = law.evaluate(p, attrs_replace(probe, u=-probe.u))
+    try:
+        f_pos = law.evaluate(p, probe)
+        f_neg = law.evaluate(p, attrs_replace(probe, u=-probe.u))
+    except FrictionLabError as exc:  # name the plugin, not only the law
+        msg = str(exc)
+        prefix = f"law '{law.name}': "
+        raise LawError(f"law '{law.name}' ({source}): {msg[len(prefix):] if msg.startswith(prefix) else msg}") from None
     if np.any(f_pos < 0) or np.any(f_neg > 0):
         raise LawError(
             f"law '{law.name}' ({source}): force() does not oppose slip at its defaults; "

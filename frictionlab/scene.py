@@ -224,15 +224,21 @@ class Scene:
 
         mass = q("mass", "kg")
         radius = q("radius", "m", required="spin" in effects or "slip-coupling" in effects)
-        incline = q("incline", "rad", required=kind == "incline")
+        incline = q("incline", "rad", required=kind == "incline", positive=False)
         if incline is not None and not (0 < incline < math.pi / 2):
             raise SceneError(f"{where}: scene.incline must be between 0 and 90 deg, got {spec['incline']!r}")
         if kind == "incline":
             effects |= {"gravity"}
         inertia_factor = q("inertia_factor", "", default=0.4, required=False)
+        if not inertia_factor <= 1.0:
+            raise SceneError(f"{where}: scene.inertia_factor = {inertia_factor:g}: I = f m r^2 needs f <= 1 "
+                             "(0.4 for a solid sphere, 2/3 for a thin shell)")
         u0 = q("u0", "m/s", required=kind != "impact-outcome", positive=False, default=0.0)
         omega0 = q("omega0", "rad/s", required=False, positive=False, default=0.0)
 
+        for key in ("area", "normal", "compliance"):
+            if key in spec and not isinstance(spec[key], Mapping):
+                raise SceneError(f"{where}: scene.{key} must be a table, got {type(spec[key]).__name__} {spec[key]!r}")
         area = _area_from_spec(spec.get("area"), where, q, columns, t)
         contact_time = getattr(area, "contact_time", None)
         normal = _normal_from_spec(spec.get("normal"), where, q, columns, t, mass, contact_time, spec, incline)
@@ -259,9 +265,11 @@ class Scene:
                    omega0=omega0, incline=incline, area=area, normal=normal, compliance=compliance, effects=effects)
 
 
-def _column(columns, name, where, prefix):
+def _column(columns, name, where, prefix, quantity):
+    if name != quantity:
+        raise SceneError(f"{where}: {prefix}.column = {name!r}: the column must be the {quantity!r} column")
     if name not in columns:
-        raise SceneError(f"{where}: {prefix}.column = {name!r} is not a column of the CSV (has: {', '.join(columns)})")
+        raise SceneError(f"{where}: {prefix}.column = {name!r} is not a column of the CSV (has: {', '.join(map(str, columns))})")
     return columns[name]
 
 
@@ -277,7 +285,7 @@ def _area_from_spec(a, where, q, columns, t):
     if model == "growth":
         return GrowthArea(q("initial", "m^2", a, p), q("rate", "m^2/m", a, p, positive=False))
     if model == "column":
-        A = _column(columns, a.get("column", "A"), where, p)
+        A = _column(columns, a.get("column", "A"), where, p, "A")
         if np.any(A < 0):
             raise SceneError(f"{where}: area column has negative values")
         return TableArea(t, A)
@@ -307,7 +315,7 @@ def _normal_from_spec(n, where, q, columns, t, mass, contact_time, spec, incline
         radius = q("radius", "m", n, p)
         return HertzNormal(4.0 * modulus / (3.0 * math.pi**1.5 * radius))
     if model == "column":
-        return TableNormal(t, _column(columns, n.get("column", "N"), where, p))
+        return TableNormal(t, _column(columns, n.get("column", "N"), where, p, "N"))
     if model == "weight":
         if incline is None:
             raise SceneError(f"{where}: {p}.model = 'weight' needs scene.incline")

@@ -77,8 +77,13 @@ def _rebuild(args) -> int:
             return 1
         print(f"{len(written)} generated files equal the committed ones in {builtin_dir()}")
         return 0
+    from ..errors import OutputError
+
     out = args.out or builtin_dir()
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"{out}: cannot create the output folder: {exc.strerror or exc}") from None
     with tempfile.TemporaryDirectory(dir=out) as tmp:
         written = rebuild(Path(tmp))
         for p in written:  # all generated first, then moved: no half-rebuilt folder

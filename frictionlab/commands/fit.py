@@ -4,7 +4,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from ..errors import ParameterError
+from ..errors import ParameterError, SolverError
 from ..fitting import SCENE_QUANTITIES, fit
 from ..registry import get_law
 from ..units import to_si
@@ -66,6 +66,8 @@ def run(args) -> int:
     law = get_law(args.law)
     result = fit(law, args.datasets, solver=args.solver, free=parse_free(args.free), fixed=parse_fix(law, args.fix),
                  local=args.local, observable=args.observable, derive=args.derive)
+    if result.status == "skipped":  # asked for explicitly, an inapplicable solver is an error, not a skip
+        raise SolverError(result.reason)
     print(result.summary())
     if args.json:
         from ..io import atomic_write_text

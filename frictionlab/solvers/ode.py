@@ -5,31 +5,39 @@ tolerances means the same thing for a 1 ns and a 1 s contact, for 1e-12 and 1 m^
 """
 from __future__ import annotations
 
+import numbers
+
 import numpy as np
 from scipy.integrate import solve_ivp
 
 from ..errors import SolverError
+from . import stick
 
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 
+#: Slip, relative to its scale, by which the zero-slip event waits past zero (see zero_slip).
+SLIP_MARGIN = 1e-12
+
 
 def state_scales(plan, T: float) -> np.ndarray:
+    """Typical size of each state; shape (n_states,), or (n_states, n) for a batch view with array fields."""
     s = plan.scene
-    V = max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * (s.radius or 0.0), 1e-300)
-    if V == 1e-300:
-        V = 1.0
-    r = s.radius or 1.0
+    r = 1.0 if s.radius is None else s.radius
+    V = np.maximum(np.maximum(np.abs(s.u0), np.abs(plan.drive) * T), np.abs(s.omega0) * (0.0 if s.radius is None else r))
+    V = np.where(V > 1e-300, V, 1.0)
     size = {"v": V, "omega": V / r, "theta": V * T / r, "x": V * T, "xi": V * T}
-    return np.array([size[k] for k in plan.states])
+    return np.array(np.broadcast_arrays(*[size[k] for k in plan.states]), dtype=float)
 
 
 def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = None):
     """A sliding-phase function for ``segments.run`` using solve_ivp ``method``."""
     if method not in METHODS:
         raise SolverError(f"unknown ODE method {method!r}; choose one of {', '.join(METHODS)}")
-    if not (0 < rtol < 1):
-        raise SolverError(f"rtol must be in (0, 1), got {rtol}")
+    if isinstance(rtol, bool) or not isinstance(rtol, numbers.Real) or not (0 < rtol < 1):
+        raise SolverError(f"rtol must be a number in (0, 1), got {rtol!r}")
     atol = rtol if atol is None else atol
+    if isinstance(atol, bool) or not isinstance(atol, numbers.Real) or not (0 < atol < float("inf")):
+        raise SolverError(f"atol must be a positive number, got {atol!r}")
 
     def slide(plan, p, t0, y0, direction, t_out):
         if len(t_out) == 0 or t_out[-1] <= t0:
@@ -43,15 +51,17 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
             t = s * tscale
             y = z * scale
             u = plan.slip(p, t, y)
-            if u == 0.0 and direction != 0:  # sliding resumes from rest: the law acts in the slip direction
-                u = direction * 1e-300
+            if not compliant and direction != 0:
+                u = stick.branch_slip(plan, u, direction)
             F, _ = plan.force(p, np.asarray(t), y, np.asarray(u))
             return plan.rates(t, y, F, u) * tscale / scale
 
         events = None
         if not compliant and direction != 0:
             def zero_slip(s, z):
-                return float(plan.rigid_slip(z * scale)) / scale[0]
+                # fires once slip has passed zero by a hair (SLIP_MARGIN of its scale), so that
+                # round-off at a restart from rest (slip exactly 0) is not taken for a new stop
+                return float(plan.rigid_slip(z * scale)) / scale[0] + direction * SLIP_MARGIN
 
             zero_slip.terminal = True
             zero_slip.direction = -direction
