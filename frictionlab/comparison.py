@@ -143,6 +143,11 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     upper) in SI (see fitting.SCENE_QUANTITIES); jobs: worker processes; progress(done, total, label).
     """
     started = time.perf_counter()
+    from .solvers import parse_solver
+
+    for s in solvers or ():
+        if s != "auto":
+            parse_solver(s)  # an unknown solver is an input error, before any work
     law_names = tuple(get_law(n).name for n in (laws or available_laws()))
     dss = tuple(load_dataset(d) for d in (datasets if datasets is not None else builtin_names()))
     if not dss:
