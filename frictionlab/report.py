@@ -211,6 +211,40 @@ def _derivation_stats(ds, given, noisy) -> dict:
     return out
 
 
+def _truth_check(d, c: Comparison) -> str:
+    """For data generated with a known law: where that law ranks and how far its fit lands from the truth."""
+    from .errors import FrictionLabError
+    from .registry import get_law
+    from .units import to_si
+
+    truth = dict(d.provenance.truth or {})
+    law = truth.pop("law", None)
+    if not law or law not in c.laws:
+        return ""
+    rows = [r for r in c.ranking if r.dataset == d.name and r.law == law and r.rank]
+    parts = []
+    for r in rows:
+        f = c.fit_for(d.name, law, r.solver)
+        found = []
+        for name, text in truth.items():
+            p = f.params.get(name) if f else None
+            if p is None or not p.vary:
+                continue
+            try:
+                value = to_si(text, get_law(law).spec(name).unit, f"{d.name}: provenance.truth.{name}")
+            except FrictionLabError:
+                continue
+            dev = f" ({(p.value - value) / p.stderr:+.1f}σ)" if p.stderr else ""
+            found.append(f"{name}: true {param_text(value, None, p.unit)}, fitted "
+                         f"{param_text(p.value, p.stderr, p.unit)}{dev}")
+        parts.append(f"{law} [{r.solver}] ranks #{r.rank}" + (f" ({r.status} with {', '.join(r.tied_with)})"
+                                                              if r.tied_with else "")
+                     + ("; " + "; ".join(found) if found else ""))
+    if not parts:
+        return ""
+    return f"**Known truth:** generated with {law}. " + ". ".join(parts) + "."
+
+
 def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
     """The document, its figures (name -> PNG bytes) and the derivation statistics."""
     doc, figs, deriv_stats = Doc(), {}, {}
@@ -303,6 +337,9 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
         doc.h(3, d.name)
         if d.description:
             doc.p(d.description)
+        check = _truth_check(d, c)
+        if check:
+            doc.p(check)
         if any(f.ok for f in fits):
             name = f"fit-{d.name}.png"
             figs[name] = figures.fit_figure(d, fits, rows)

@@ -71,6 +71,8 @@ def run(args) -> int:
                          equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar)
     finally:
         bar.close()
+    if bar.active:
+        print("writing the report ...", file=sys.stderr, flush=True)
     out = write_report(result, args.out, force=args.force)
     ok = sum(f.ok for f in result.fits)
     print(f"compared {len(result.laws)} laws on {len(result.fitted_datasets)} datasets: {ok} fits, "
