@@ -40,6 +40,9 @@ def test_report_folder_contents(report_dir):
     assert "SYNTHETIC" in md and "not measured" in md  # never presented as measured
     assert "1/(φA0)" in md and "φ/A0" in md  # the paper's misprinted factor is named
     assert "equivalent" in md
+    # the generating law and parameters are checked in the report itself
+    assert "**Known truth:** generated with area-rate. area-rate [exact] ranks #1" in md
+    assert "eta_prime: true 8000 N s/m^2, fitted" in md
 
 
 def test_html_is_self_contained(report_dir):
