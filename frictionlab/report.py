@@ -245,6 +245,27 @@ def _truth_check(d, c: Comparison) -> str:
     return f"**Known truth:** generated with {law}. " + ". ".join(parts) + "."
 
 
+def _reported_check(d, c: Comparison) -> str:
+    """Law parameters the source reports for this dataset, beside every fit of a law that has them."""
+    from .errors import FrictionLabError
+    from .registry import get_law
+    from .units import to_si
+
+    parts = []
+    for name, text in (d.reported or {}).items():
+        for f in c.fits_on(d.name):
+            p = f.params.get(name)
+            if not f.ok or p is None or p.kind != "law" or not p.vary:
+                continue
+            try:
+                value = to_si(text, get_law(f.law).spec(name).unit, f"{d.name}: reported.{name}")
+            except FrictionLabError:
+                continue
+            parts.append(f"{name} reported {param_text(value, None, p.unit)}, fitted by {f.law} [{f.solver}] "
+                         f"{param_text(p.value, p.stderr, p.unit)}")
+    return ("**Reported by the source:** " + "; ".join(parts) + ".") if parts else ""
+
+
 def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
     """The document, its figures (name -> PNG bytes) and the derivation statistics."""
     doc, figs, deriv_stats = Doc(), {}, {}
@@ -337,9 +358,9 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
         doc.h(3, d.name)
         if d.description:
             doc.p(d.description)
-        check = _truth_check(d, c)
-        if check:
-            doc.p(check)
+        for check in (_truth_check(d, c), _reported_check(d, c)):
+            if check:
+                doc.p(check)
         if any(f.ok for f in fits):
             name = f"fit-{d.name}.png"
             figs[name] = figures.fit_figure(d, fits, rows)
