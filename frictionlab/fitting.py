@@ -27,10 +27,14 @@ import numpy as np
 
 from .errors import DatasetError, FrictionLabError, ParameterError, SolverError
 from .identifiability import Identifiability, find_structure, in_ratio, jacobian, jacobian_errors, make_verdict
-from .predict import (PREDICTORS, SCENE_QUANTITIES, SkipDataset, Target, applicable_solvers,  # noqa: F401
+from .predict import (PREDICTORS, SCENE_QUANTITIES, SkipDataset, Target, applicable_solvers,
                       auto_solver, get_scene_quantity, make_target, predict, register_predictor, set_scene_quantity)
 from .registry import get_law
 from .scene import Scene
+
+__all__ = ["DatasetFit", "FitResult", "ParamResult", "PREDICTORS", "SCENE_QUANTITIES", "SkipDataset", "Stats", "Target",
+           "applicable_solvers", "auto_solver", "fit", "get_scene_quantity", "make_target", "predict",
+           "register_predictor", "set_scene_quantity"]
 
 PENALTY = 1e4  # weighted residual per point when the model cannot be evaluated
 ODE_STARTS = 2  # at most this many starts are refined when a dataset needs the (costlier) ODE solver
