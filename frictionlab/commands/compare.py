@@ -75,7 +75,8 @@ def run(args) -> int:
         print("writing the report ...", file=sys.stderr, flush=True)
     out = write_report(result, args.out, force=args.force)
     ok = sum(f.ok for f in result.fits)
-    print(f"compared {len(result.laws)} laws on {len(result.fitted_datasets)} datasets: {ok} fits, "
+    n_laws, n_data = len(result.laws), len(result.fitted_datasets)
+    print(f"compared {n_laws} law{'s' * (n_laws != 1)} on {n_data} dataset{'s' * (n_data != 1)}: {ok} fits, "
           f"{sum(f.status == 'failed' for f in result.fits)} failed, {sum(f.status == 'skipped' for f in result.fits)} "
           f"skipped, {len(result.equivalence)} equivalence tests, in {result.wall_time:.1f} s")
     print(f"report: {out / 'report.html'} (also report.md, ranking.csv, results.json, figures/)")
