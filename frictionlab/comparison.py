@@ -93,8 +93,11 @@ def candidates(law, dataset: Dataset, solvers: Sequence[str] | None) -> list[tup
 
 
 def _fit_task(args) -> FitResult:
-    law, dataset, solver = args
-    return fit(law, dataset, solver=solver)
+    law, dataset, solver, free = args
+    try:
+        return fit(law, dataset, solver=solver, free=free)
+    except FrictionLabError as exc:  # e.g. a freed scene quantity this scene does not have
+        return FitResult(law=law, solver=solver, datasets=(dataset.name,), status="skipped", reason=str(exc))
 
 
 def _equivalence_task(args) -> EquivalenceResult:
@@ -130,14 +133,21 @@ def _run(tasks, fn, jobs, progress, done, total, label):
 
 
 def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None, solvers: Sequence[str] | None = None,
-            *, equivalence: bool = True, jobs: int = 1, progress: Progress | None = None) -> Comparison:
+            *, free: dict | None = None, equivalence: bool = True, jobs: int = 1,
+            progress: Progress | None = None) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
 
     laws: registered names (default all); datasets: built-in names, TOML paths or Datasets
     (default every built-in); solvers: None for the default choice, or a list of 'exact',
-    'series', 'ode[:METHOD]', 'auto'; jobs: worker processes; progress(done, total, label).
+    'series', 'ode[:METHOD]', 'auto'; free: scene quantities fitted per dataset, name -> (lower,
+    upper) in SI (see fitting.SCENE_QUANTITIES); jobs: worker processes; progress(done, total, label).
     """
     started = time.perf_counter()
+    from .solvers import parse_solver
+
+    for s in solvers or ():
+        if s != "auto":
+            parse_solver(s)  # an unknown solver is an input error, before any work
     law_names = tuple(get_law(n).name for n in (laws or available_laws()))
     dss = tuple(load_dataset(d) for d in (datasets if datasets is not None else builtin_names()))
     if not dss:
@@ -155,7 +165,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                 if why:
                     fits.append(FitResult(law=law, solver=solver, datasets=(ds.name,), status="skipped", reason=why))
                 else:
-                    plan.append((law, ds, solver))
+                    plan.append((law, ds, solver, dict(free or {})))
     # slow (ode) fits first, so that workers finish together
     plan.sort(key=lambda x: not x[2].startswith("ode"))
     eq_pairs = _equivalence_pairs(law_names, plan) if equivalence else []
@@ -170,6 +180,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
         eq_results, done = _run(tasks, _equivalence_task, jobs, progress, done, total,
                                 lambda t: f"equivalence on {t[0].datasets[0]} [{t[0].solver}]")
     order = {d.name: i for i, d in enumerate(dss)}
+    eq_results.sort(key=lambda e: (order[e.dataset], family(e.solver) == "series"))
     fits.sort(key=lambda f: (order[f.datasets[0]], law_names.index(f.law), family(f.solver) == "series"))
     ranking = rank_fits(fits)
     kinds = {d.name: d.kind for d in dss}
@@ -178,7 +189,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                       equivalence=tuple(eq_results), skipped_datasets=skipped_ds,
                       wall_time=time.perf_counter() - started, versions=versions(),
                       settings={"solvers": list(solvers) if solvers else "default", "jobs": jobs,
-                                "equivalence": equivalence})
+                                "equivalence": equivalence, "free": {k: list(v) for k, v in (free or {}).items()}})
 
 
 def _equivalence_pairs(law_names, plan) -> list[tuple[str, str, str]]:
@@ -186,10 +197,10 @@ def _equivalence_pairs(law_names, plan) -> list[tuple[str, str, str]]:
     if WEAR not in law_names or AREA_RATE not in law_names:
         return []
     out = []
-    for law, ds, solver in plan:
+    for law, ds, solver, _ in plan:
         if law != WEAR:
             continue
-        ar = [s for (lw, d, s) in plan if lw == AREA_RATE and d.name == ds.name]
+        ar = [s for (lw, d, s, _) in plan if lw == AREA_RATE and d.name == ds.name]
         if ar:
             out.append((ds.name, solver, ar[0]))
     return out

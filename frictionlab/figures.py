@@ -44,34 +44,51 @@ def _label(f, rows) -> str:
     return f"{f.law} [{f.solver}]{extra}"
 
 
+def _x_axis(dataset, obs):
+    """(x values [display], label, time factor or None): time if the dataset has it, else its first
+    other column (rows of an impact-outcome set, e.g. incidence), else the row number."""
+    if "t" in dataset.columns:
+        t = dataset.t
+        tname, tf = time_unit(float(t[-1]))
+        return t * tf, f"time [{tname}]", tf
+    for name, values in dataset.columns.items():
+        if name != obs:
+            uname, uf = unit(name)
+            return values * uf, f"{NAMES.get(name, name)} [{uname}]", None
+    return np.arange(len(dataset), dtype=float), "row", None
+
+
 def fit_figure(dataset, fits, rows) -> bytes:
     """Data with every law's best fit (top) and residuals model - data with the ±1 sigma band (bottom)."""
     plt = _plt()
     ok = [f for f in fits if f.ok]
-    obs = ok[0].per_dataset[0].target.observable if ok else dataset.observable
+    target = ok[0].per_dataset[0].target if ok else None
+    obs = target.observable if ok else dataset.observable
     uname, uf = unit(obs)
-    t = dataset.t
-    tname, tf = time_unit(float(t[-1]))
+    x, xlabel, tf = _x_axis(dataset, obs)
+    order = np.argsort(x, kind="stable")
     fig, (ax, axr) = plt.subplots(2, 1, figsize=(7.6, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 1.6]})
-    y = dataset.columns[obs]
-    sigma = ok[0].per_dataset[0].target.sigma if ok else np.full(t.shape, dataset.noise.get(obs, np.nan))
+    y = target.y if ok else dataset.columns[obs]
+    sigma = target.sigma if ok else np.full(x.shape, dataset.noise.get(obs, np.nan))
     kind = dataset.provenance.kind
-    ax.errorbar(t * tf, y * uf, yerr=sigma * uf, fmt="o", ms=3.2, color="black", ecolor="0.7", elinewidth=0.8,
-                label=f"data ({kind})", zorder=1)
+    ax.errorbar(x, y * uf, yerr=sigma * uf, fmt="o", ms=3.2, color="black", ecolor="0.7", elinewidth=0.8,
+                label=f"data ({kind})" + (f", {target.derivation}" if ok and target.derivation else ""), zorder=1)
     for i, f in enumerate(ok):
         d = f.per_dataset[0]
         style = _style(f.law, f.solver, i)
-        tr = d.trajectory(f.law, np.linspace(float(t[0]), float(t[-1]), 400)) if d.target.t is not None else None
+        tr = None
+        if tf is not None:
+            tr = d.trajectory(f.law, np.linspace(float(dataset.t[0]), float(dataset.t[-1]), 400))
         if tr is not None:
             ax.plot(tr.t * tf, tr[obs] * uf, label=_label(f, rows), zorder=3, **style)
         else:
-            ax.plot(t * tf, d.model * uf, label=_label(f, rows), zorder=3, **style)
-        axr.plot(t * tf, d.residual * uf, marker=".", ms=3, **style)
-    axr.fill_between(t * tf, -sigma * uf, sigma * uf, color="0.85", label="±1σ noise", zorder=0)
+            ax.plot(x[order], d.model[order] * uf, label=_label(f, rows), zorder=3, **style)
+        axr.plot(x[order], d.residual[order] * uf, marker=".", ms=3, **style)
+    axr.fill_between(x[order], -sigma[order] * uf, sigma[order] * uf, color="0.85", label="±1σ noise", zorder=0)
     axr.axhline(0, color="0.3", lw=0.8)
     ax.set_ylabel(f"{NAMES.get(obs, obs)} [{uname}]")
     axr.set_ylabel(f"model − data [{uname}]")
-    axr.set_xlabel(f"time [{tname}]")
+    axr.set_xlabel(xlabel)
     ax.set_title(f"{dataset.name}: fits of every law" + ("" if kind == "measured" else f"  ({kind} data)"))
     ax.legend(fontsize=8, loc="best", framealpha=0.9)
     axr.legend(fontsize=8, loc="best")

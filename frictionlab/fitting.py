@@ -20,181 +20,25 @@ import math
 import re
 import time
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 
 import attrs
 import numpy as np
 
-from .dataset import Dataset, load_dataset
 from .errors import DatasetError, FrictionLabError, ParameterError, SolverError
-from .law import FrictionLaw
+from .identifiability import Identifiability, find_structure, in_ratio, jacobian, jacobian_errors, make_verdict
+from .predict import (PREDICTORS, SCENE_QUANTITIES, SkipDataset, Target, applicable_solvers,
+                      auto_solver, get_scene_quantity, make_target, predict, register_predictor, set_scene_quantity)
 from .registry import get_law
 from .scene import Scene
 
-#: Trajectory series that a time-series observable reads.
-SERIES = {"omega": "omega", "theta": "theta", "v": "v", "u": "u"}
+__all__ = ["DatasetFit", "FitResult", "ParamResult", "PREDICTORS", "SCENE_QUANTITIES", "SkipDataset", "Stats", "Target",
+           "applicable_solvers", "auto_solver", "fit", "get_scene_quantity", "make_target", "predict",
+           "register_predictor", "set_scene_quantity"]
 
-#: Scene quantities that can be freed, with their SI unit (dotted names reach into sub-models).
-SCENE_QUANTITIES = {
-    "u0": "m/s", "omega0": "rad/s", "mass": "kg", "radius": "m", "incline": "rad",
-    "area.peak": "m^2", "area.contact_time": "s", "area.area": "m^2", "area.initial": "m^2", "area.rate": "m^2/m",
-    "normal.impulse": "N*s", "normal.contact_time": "s", "normal.value": "N", "normal.coefficient": "N/m^3",
-    "compliance.stiffness": "N/m", "compliance.damping": "N*s/m",
-}
-
-CORRELATION_LIMIT = 0.95
 PENALTY = 1e4  # weighted residual per point when the model cannot be evaluated
-FIT_RTOL = 1e-10  # ODE tolerance during fits: finite-difference Jacobians need a smooth model
 ODE_STARTS = 2  # at most this many starts are refined when a dataset needs the (costlier) ODE solver
 FTOL = 1e-6  # relative chi-square and step tolerances of Levenberg-Marquardt
-
-
-class SkipDataset(FrictionLabError):
-    """A dataset this law or solver cannot predict (reported as 'skipped', not 'failed')."""
-
-
-# --- targets: what is fitted -------------------------------------------------------------
-@attrs.frozen(eq=False)
-class Target:
-    """One fitted series: the dataset, the observable, its values y and 1-sigma per point (SI)."""
-
-    dataset: Dataset
-    observable: str
-    y: np.ndarray
-    sigma: np.ndarray
-    derivation: str = ""  # "" or how y was derived (e.g. omega from theta by poly9)
-
-    @property
-    def name(self) -> str:
-        return self.dataset.name
-
-    @property
-    def t(self) -> np.ndarray | None:
-        return self.dataset.columns.get("t")
-
-    @property
-    def label(self) -> str:
-        return f"{self.name} ({self.observable}{', ' + self.derivation if self.derivation else ''})"
-
-
-def make_target(dataset, observable: str | None = None, derive: str | None = None) -> Target:
-    """The series to fit from ``dataset``: its observable, another column, or omega derived from theta.
-
-    derive: None, 'poly9' or 'spline' (then observable is omega, computed from the theta column).
-    """
-    ds = load_dataset(dataset)
-    if ds.kind == "contact-area":
-        raise SkipDataset(f"dataset '{ds.name}' is a contact-area series: supporting data, not fitted")
-    obs = observable or ds.observable
-    if derive:
-        from .derive import derive_omega
-
-        if "theta" not in ds.columns:
-            raise DatasetError(f"dataset '{ds.name}': deriving omega needs a 'theta' column")
-        d = derive_omega(ds.t, ds.columns["theta"], derive, ds.noise.get("theta"))
-        return Target(ds, "omega", d.omega, d.sigma, f"omega from theta by {derive}")
-    if obs not in ds.columns:
-        raise DatasetError(f"dataset '{ds.name}': no column '{obs}' to fit (has: {', '.join(ds.columns)})")
-    if obs in ds.noise:
-        sigma = np.full(len(ds), ds.noise[obs])
-    else:
-        raise DatasetError(f"dataset '{ds.name}': [noise] gives no estimate for '{obs}'; add e.g. {obs} = '...'")
-    return Target(ds, obs, ds.columns[obs], sigma)
-
-
-# --- predictions: one function per dataset kind -------------------------------------------
-Predictor = Callable[[FrictionLaw, Target, Scene, Mapping[str, float], str], np.ndarray]
-PREDICTORS: dict[str, Predictor] = {}
-
-
-def register_predictor(kind: str, fn: Predictor) -> None:
-    """Make dataset ``kind`` fittable: fn(law, target, scene, params, solver) -> model of target.y (SI)."""
-    PREDICTORS[kind] = fn
-
-
-def _predict_series(law, target, scene, params, solver):
-    from .solvers import simulate
-
-    if target.observable not in SERIES:
-        raise SkipDataset(f"dataset '{target.name}': observable '{target.observable}' is not a simulated series "
-                          f"({', '.join(SERIES)})")
-    tr = simulate(law, scene, params, solver=solver, t=target.t, rtol=FIT_RTOL)
-    return tr[SERIES[target.observable]]
-
-
-register_predictor("impact", _predict_series)
-register_predictor("incline", _predict_series)
-
-
-def predict(law, target: Target, params: Mapping[str, float], solver: str = "exact",
-            scene: Scene | None = None) -> np.ndarray:
-    """The law's prediction of ``target.y`` (SI) for law parameters ``params`` (SI), on ``scene``
-    (default: the dataset's). Raises SkipDataset for a kind nobody can predict yet."""
-    law = get_law(law)
-    kind = target.dataset.kind
-    if kind not in PREDICTORS:
-        raise SkipDataset(f"no predictor for dataset kind '{kind}' (dataset '{target.name}'); "
-                          f"known: {', '.join(PREDICTORS)}")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # series accuracy warnings are recorded in the result instead
-        return np.asarray(PREDICTORS[kind](law, target, scene or target.dataset.scene, params, solver), dtype=float)
-
-
-def applicable_solvers(law, scene: Scene) -> dict[str, str | None]:
-    """For 'exact', 'series' and 'ode': None if it applies to ``law`` on ``scene``, else why not."""
-    from .plan import make_plan
-    from .solvers import exact, series
-
-    law = get_law(law)
-    try:
-        plan = make_plan(scene, law)
-    except FrictionLabError as exc:
-        return {name: str(exc) for name in ("exact", "series", "ode")}
-    out = {"ode": None}
-    for name, module in (("exact", exact), ("series", series)):
-        try:
-            for p in (law.defaults(), _generic_params(law)):  # forms may degenerate at defaults (eta' = 0)
-                module.check(plan, p)
-            out[name] = None
-        except FrictionLabError as exc:
-            out[name] = str(exc)
-    return out
-
-
-def _generic_params(law) -> dict[str, float]:
-    p = {}
-    for s in law.params:
-        v = s.default + s.scale
-        p[s.name] = v if v <= s.upper else s.default - s.scale
-    return p
-
-
-def auto_solver(law, scene: Scene) -> str:
-    """'exact' where a closed form exists for this law and scene, else 'ode'."""
-    return "exact" if applicable_solvers(law, scene)["exact"] is None else "ode"
-
-
-def set_scene_quantity(scene: Scene, name: str, value: float) -> Scene:
-    """A copy of ``scene`` with the (dotted) quantity ``name`` set to ``value`` (SI)."""
-    head, _, tail = name.partition(".")
-    if not tail:
-        return attrs.evolve(scene, **{head: float(value)})
-    sub = getattr(scene, head)
-    return attrs.evolve(scene, **{head: attrs.evolve(sub, **{tail: float(value)})})
-
-
-def get_scene_quantity(scene: Scene, name: str) -> float:
-    if name not in SCENE_QUANTITIES:
-        raise ParameterError(f"scene quantity '{name}' cannot be freed; choose from {', '.join(SCENE_QUANTITIES)}")
-    obj = scene
-    for part in name.split("."):
-        if obj is None or not hasattr(obj, part):
-            raise ParameterError(f"scene quantity '{name}': this scene has no {part!r}"
-                                 + (f" ({type(obj).__name__})" if obj is not None else ""))
-        obj = getattr(obj, part)
-    if not isinstance(obj, (int, float)):
-        raise ParameterError(f"scene quantity '{name}' is not a number on this scene")
-    return float(obj)
 
 
 # --- results -------------------------------------------------------------------------------
@@ -231,17 +75,6 @@ class Stats:
     aic: float
     aicc: float
     bic: float
-
-
-@attrs.frozen
-class Identifiability:
-    verdict: str
-    warnings: tuple[str, ...] = ()
-    at_bounds: tuple[str, ...] = ()
-    missing_stderr: dict = attrs.field(factory=dict)  # name -> reason
-    high_correlations: tuple[tuple[str, str, float], ...] = ()
-    ratio_only: tuple[tuple[str, str], ...] = ()
-    no_effect: tuple[str, ...] = ()
 
 
 @attrs.frozen(eq=False)
@@ -498,6 +331,36 @@ def _distinct(scored: list[tuple], n: int) -> list[dict]:
     return out
 
 
+def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: int, max_nfev):
+    """Score a grid of starts, refine the best distinct ones with Levenberg-Marquardt, keep the lowest
+    chi-square. Returns (parameters, success, message)."""
+    varying = [s for s in slots if s.vary]
+    if not varying:
+        return params, True, "nothing to fit: every parameter is held"
+    starts = [{s.pname: params[s.pname].value for s in varying}]
+    if scan:
+        fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
+        scored = []
+        for cand in _start_grid(varying, np.random.default_rng(0), scan):
+            vals = {**fixed_part, **cand}
+            r = model.residual({s.pname: vals[s.pname] * s.scale for s in slots})
+            scored.append((float(r @ r), len(scored), cand))
+        scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins
+        slow = any(x.startswith("ode") for x in solvers)
+        starts = _distinct(scored, min(n_starts, ODE_STARTS) if slow else n_starts)
+    best = None
+    for start in starts:
+        trial = params.copy()
+        for k, v in start.items():
+            trial[k].set(value=v)
+        mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), trial, scale_covar=True,
+                               max_nfev=max_nfev or 200 * (len(varying) + 1))
+        r = mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
+        if best is None or (r.success, -r.chisqr) > (best.success, -best.chisqr):
+            best = r
+    return best.params, bool(best.success), str(best.message)
+
+
 def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[float]] | None = None,
         fixed: Mapping[str, float] | None = None, local: Sequence[str] = (),
         initial: Mapping[str, float] | None = None, observable: str | None = None, derive: str | None = None,
@@ -561,36 +424,8 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     solver_label = solver if solver != "auto" else "+".join(dict.fromkeys(solvers))
     n_points = sum(t.y.size for t in targets)
 
-    def residual(ps):
-        return model.residual(_si(ps, slots))
-
     try:
-        starts = [{s.pname: params[s.pname].value for s in varying}]
-        if varying and scan:
-            fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
-            scored = []
-            for cand in _start_grid(varying, np.random.default_rng(0), scan):
-                vals = {**fixed_part, **cand}
-                r = model.residual({s.pname: vals[s.pname] * s.scale for s in slots})
-                scored.append((float(r @ r), len(scored), cand))
-            scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins
-            slow = any(x.startswith("ode") for x in solvers)
-            starts = _distinct(scored, min(n_starts, ODE_STARTS) if slow else n_starts)
-        if varying:
-            best_res = None
-            for start in starts:
-                trial = params.copy()
-                for k, v in start.items():
-                    trial[k].set(value=v)
-                mini = lmfit.Minimizer(residual, trial, scale_covar=True,
-                                       max_nfev=max_nfev or 200 * (len(varying) + 1))
-                r = mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
-                if best_res is None or (r.success, -r.chisqr) > (best_res.success, -best_res.chisqr):
-                    best_res = r
-            res = best_res
-            best_params, success, message = res.params, bool(res.success), str(res.message)
-        else:
-            best_params, success, message, res = params, True, "nothing to fit: every parameter is held", None
+        best_params, success, message = _search(lmfit, model, params, slots, solvers, scan, n_starts, max_nfev)
         values = _si(best_params, slots)
         models = model.models(values)
     except SkipDataset as exc:
@@ -606,8 +441,8 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         per.append(DatasetFit(tg, solver_i, p, scene, m, float(r @ r), float(np.sqrt(np.mean(r**2))),
                               float(np.sum((r / tg.sigma) ** 2))))
     chisqr = sum(d.chisqr for d in per)
-    J = _jacobian(model, slots, values)
-    structure = _structure(law, slots, values, J)
+    J = jacobian(model, slots, values)
+    structure = find_structure(law, slots, values, J)
     stats = _stats(n_points, structure["k_eff"], len(varying), chisqr, per)
     status, reason = "ok", ""
     if not all(np.all(np.isfinite(d.model)) for d in per):
@@ -621,15 +456,18 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         notes.append(f"{model.failures} of {model.nfev} evaluations could not be solved and were penalized "
                      f"(last: {model.last_error})")
     notes += _series_notes(law, per)
-    presults = _param_results(slots, best_params, targets, structure,
-                              _jacobian_errors(slots, values, J, structure, stats.redchi))
+    jac = jacobian_errors(slots, values, J, structure, stats.redchi)
+    presults = _param_results(slots, best_params, targets, structure, jac)
     correl = {}
-    for s in varying:
-        for other, r in (best_params[s.pname].correl or {}).items():
-            o = next(x for x in slots if x.pname == other)
-            if s.display < o.display:
-                correl[(s.display, o.display)] = float(r)
-    ident = _verdict(structure, presults, correl)
+    if structure["ratios"] or structure["no_effect"]:  # lmfit's covariance is degenerate: use the identifiable part
+        correl = jac.get("correl", {})
+    else:
+        for s in varying:
+            for other, r in (best_params[s.pname].correl or {}).items():
+                o = next(x for x in slots if x.pname == other)
+                if s.display < o.display:
+                    correl[(s.display, o.display)] = float(r)
+    ident = make_verdict(structure, presults, correl)
     return FitResult(law=law.name, solver=solver_label, datasets=names, status=status, reason=reason,
                      params=presults, correlations=correl, stats=stats, identifiability=ident,
                      per_dataset=tuple(per), nfev=model.nfev, wall_time=time.perf_counter() - started,
@@ -672,96 +510,18 @@ def _series_notes(law, per) -> list[str]:
     return notes
 
 
-def _jacobian(model: _Model, slots, values) -> np.ndarray:
-    """Central-difference Jacobian of the weighted residual in scaled units of the free parameters."""
-    cols = []
-    for s in (s for s in slots if s.vary):
-        x = values[s.pname] / s.scale
-        h = 1e-4 * max(abs(x), 1e-2)
-        lo, hi = dict(values), dict(values)
-        lo[s.pname] = (x - h) * s.scale
-        hi[s.pname] = (x + h) * s.scale
-        cols.append((model.residual(hi) - model.residual(lo)) / (2 * h))
-    return np.array(cols).T if cols else np.zeros((0, 0))
-
-
-def _structure(law, slots, values, J) -> dict:
-    """What the data can determine: free parameters at (or running into) a bound, ratio-only pairs
-    that are both free, parameters with no effect, and the number of identifiable directions
-    (rank of the column-normalized Jacobian)."""
-    varying = [s for s in slots if s.vary]
-    at_bounds = tuple(s.display for s in varying
-                      if any(math.isfinite(b) and abs(values[s.pname] - b) <= 2e-3 * max(abs(b) * 1e-3, s.scale)
-                             for b in (s.lower, s.upper)))
-    ratios = []
-    for a, b in law.ratio_only:
-        for sa in (s for s in varying if s.kind == "law" and s.key == a):
-            sb = [s for s in varying if s.kind == "law" and s.key == b and set(s.targets) & set(sa.targets)]
-            if sb and (a, b) not in ratios:
-                ratios.append((a, b))
-    norms = np.linalg.norm(J, axis=0) if J.size else np.zeros(len(varying))
-    top = norms.max() if norms.size else 0.0
-    effect = norms > 1e-9 * max(top, 1e-300)
-    no_effect = tuple(s.display for s, e in zip(varying, effect) if not e)
-    k_eff = 0
-    if effect.any():
-        sv = np.linalg.svd(J[:, effect] / norms[effect], compute_uv=False)
-        k_eff = int(np.sum(sv > 1e-6 * sv[0]))
-    return {"at_bounds": at_bounds, "ratios": tuple(ratios), "no_effect": no_effect, "k_eff": k_eff,
-            "n_free": len(varying)}
-
-
-def _in_ratio(s, structure) -> bool:
-    return s.kind == "law" and any(s.key in pair for pair in structure["ratios"])
-
-
-def _jacobian_errors(slots, values, J, structure, redchi) -> dict:
-    """Standard errors [SI] from the Jacobian of the identifiable directions, scaled by the reduced
-    chi-square as lmfit's are: free parameters that have an effect and are not in a ratio-only pair,
-    plus each such pair as its ratio. Returns {display: err} and {'ratio label': (value, err, unit, slot)}."""
-    cols, entries = [], []
-    for k, s in enumerate(s for s in slots if s.vary):
-        if s.display in structure["no_effect"]:
-            continue
-        if not _in_ratio(s, structure):
-            cols.append(J[:, k])
-            entries.append((s.display, s.scale, None))
-            continue
-        pair = next(pr for pr in structure["ratios"] if s.key in pr)
-        if s.key != pair[0]:
-            continue
-        b = next(x for x in slots if x.kind == "law" and x.key == pair[1] and set(x.targets) & set(s.targets))
-        cols.append(J[:, k] * values[b.pname] / s.scale)  # d res / d(a/b) = J_a b / scale_a
-        label = f"{pair[0]}/{pair[1]}" + s.display[len(s.key):]
-        unit = f"{s.unit}/{b.unit}" if b.unit else s.unit
-        entries.append((label, 1.0, (values[s.pname] / values[b.pname], unit, s)))
-    errors, derived = {}, {}
-    cov = None
-    if cols and np.isfinite(redchi):
-        A = np.array(cols).T
-        An = A / np.maximum(np.linalg.norm(A, axis=0), 1e-300)
-        if np.linalg.matrix_rank(An, tol=1e-8) == A.shape[1]:
-            cov = np.linalg.inv(A.T @ A) * redchi
-    for i, (name, conv, extra) in enumerate(entries):
-        err = float(np.sqrt(max(cov[i, i], 0.0))) * conv if cov is not None else None
-        if extra is None:
-            if err is not None:
-                errors[name] = err
-        else:
-            derived[name] = (extra[0], err, extra[1], extra[2])
-    return {"errors": errors, "derived": derived}
-
-
 def _param_results(slots, best, targets, structure, jac) -> dict[str, ParamResult]:
     """ParamResults in SI: lmfit's error bars; none where the data cannot give one (ratio-only,
-    no effect); the Jacobian's where lmfit gave none. Ratio-only pairs add their ratio ('derived')."""
+    no effect); the Jacobian's over the identifiable directions where lmfit gave none or where a
+    degeneracy makes its covariance unreliable. Ratio-only pairs add their ratio ('derived')."""
     out = {}
+    degenerate = bool(structure["ratios"] or structure["no_effect"])  # lmfit's covariance is then unreliable
     for s in slots:
         p = best[s.pname]
         err = p.stderr * s.scale if (s.vary and p.stderr is not None and np.isfinite(p.stderr)) else None
-        if s.display in structure["no_effect"] or (s.vary and _in_ratio(s, structure)):
+        if s.display in structure["no_effect"] or (s.vary and in_ratio(s, structure)):
             err = None
-        elif err is None and s.vary:
+        elif s.vary and (err is None or degenerate):
             err = jac["errors"].get(s.display)
         out[s.display] = ParamResult(s.display, s.key, s.kind, p.value * s.scale, err, s.unit, s.vary, s.value,
                                      s.lower, s.upper, tuple(targets[i].name for i in s.targets), s.fixed_by)
@@ -772,42 +532,3 @@ def _param_results(slots, best, targets, structure, jac) -> dict[str, ParamResul
     return out
 
 
-def _verdict(structure, presults, correl) -> Identifiability:
-    """Warnings a reader can act on, and a one-line verdict."""
-    if not structure["n_free"]:
-        return Identifiability("nothing fitted: every parameter is held")
-    warn, missing = [], {}
-    for name in structure["at_bounds"]:
-        warn.append(f"{name} is at (or running into) a bound of its allowed range")
-        missing[name] = "at a bound, where the error is not defined"
-    for a, b in structure["ratios"]:
-        warn.append(f"{a} and {b} enter only as {a}/{b}: their separate values mean nothing and get no error "
-                    f"bars; fix one (a dataset's [fixed] table) to determine the other; {a}/{b} is reported")
-    for name in structure["no_effect"]:
-        warn.append(f"{name} has no effect on the prediction near the best fit (a term multiplied by dA/dt = 0, "
-                    "or a body stuck throughout)")
-    ratio_keys = {k for pair in structure["ratios"] for k in pair}
-    for p in presults.values():
-        if not p.vary or p.stderr is not None:
-            continue
-        if p.name in structure["no_effect"]:
-            missing.setdefault(p.name, "has no effect on the prediction")
-        elif p.kind == "law" and p.key in ratio_keys:
-            missing.setdefault(p.name, "enters only through a ratio")
-        else:
-            missing.setdefault(p.name, "the covariance matrix is singular: parameters not separately determined")
-            warn.append(f"{p.name} has no error bar: {missing[p.name]}")
-    high = []
-    for (a, b), r in correl.items():
-        ka, kb = presults[a].key, presults[b].key
-        if abs(r) > CORRELATION_LIMIT and not (ka in ratio_keys and kb in ratio_keys):
-            high.append((a, b, r))
-            warn.append(f"{a} and {b} are correlated (r = {r:+.3f}): the data determine a combination of them "
-                        "better than either")
-    problems = [label for label, flag in (("parameter at a bound", structure["at_bounds"]),
-                                          ("ratio-only pair", structure["ratios"]),
-                                          ("parameter without effect", structure["no_effect"]),
-                                          ("strong correlation", high), ("missing error bars", missing)) if flag]
-    verdict = "identifiable" if not problems else "not fully identifiable: " + ", ".join(problems)
-    return Identifiability(verdict, tuple(warn), structure["at_bounds"], missing, tuple(high), structure["ratios"],
-                           structure["no_effect"])

@@ -24,10 +24,10 @@
     ranking[row], groups[row] (row: the ranking.csv columns plus reason, tied_with),
     equivalence[{dataset, solver, area_rate_solver, status, verdict, explanation, reason, checks{},
                  force_correlation, force_distance, impulse_Ns{}, aic{}, redchi{}, shape{}, fitted{},
-                 cross[{law, to, status, rms, rms_sigma, params}],
+                 cross[{law, to, status, rms, rms_sigma, dchi2, params}],
                  decomposition{b, u0, c_area, c_area_rate, mu, eta_prime, r2} | null}],
-    derivations{dataset: {method: {rms_vs_omega_column, omega_peak, omega_end, median_sigma,
-                                   noisy_rms_vs_omega_column}}}
+    derivations{dataset: {method: {rms_vs_omega_column, omega_peak, omega_end, noisy_rms_vs_omega_column,
+                                   noisy_omega_peak, noisy_omega_end, noisy_median_sigma}}}
   All numbers SI (rad/s, s, m, N) unless the key says otherwise; non-finite numbers are null.
 """
 from __future__ import annotations
@@ -37,6 +37,7 @@ import datetime as _dt
 import html
 import json
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -204,10 +205,65 @@ def _derivation_stats(ds, given, noisy) -> dict:
     for m, d in given.items():
         rms = lambda x: float(np.sqrt(np.mean((x - ref) ** 2))) if ref is not None else math.nan  # noqa: E731
         out[m] = {"rms_vs_omega_column": rms(d.omega), "omega_peak": float(np.max(d.omega)),
-                  "omega_end": float(d.omega[-1]), "median_sigma": float(np.median(d.sigma)),
+                  "omega_end": float(d.omega[-1]), "noisy_median_sigma": float(np.median(noisy[m].sigma)),
                   "noisy_rms_vs_omega_column": rms(noisy[m].omega), "noisy_omega_peak": float(np.max(noisy[m].omega)),
                   "noisy_omega_end": float(noisy[m].omega[-1])}
     return out
+
+
+def _truth_check(d, c: Comparison) -> str:
+    """For data generated with a known law: where that law ranks and how far its fit lands from the truth."""
+    from .errors import FrictionLabError
+    from .registry import get_law
+    from .units import to_si
+
+    truth = dict(d.provenance.truth or {})
+    law = truth.pop("law", None)
+    if not law or law not in c.laws:
+        return ""
+    rows = [r for r in c.ranking if r.dataset == d.name and r.law == law and r.rank]
+    parts = []
+    for r in rows:
+        f = c.fit_for(d.name, law, r.solver)
+        found = []
+        for name, text in truth.items():
+            p = f.params.get(name) if f else None
+            if p is None or not p.vary:
+                continue
+            try:
+                value = to_si(text, get_law(law).spec(name).unit, f"{d.name}: provenance.truth.{name}")
+            except FrictionLabError:
+                continue
+            dev = f" ({(p.value - value) / p.stderr:+.1f}σ)" if p.stderr else ""
+            found.append(f"{name}: true {param_text(value, None, p.unit)}, fitted "
+                         f"{param_text(p.value, p.stderr, p.unit)}{dev}")
+        parts.append(f"{law} [{r.solver}] ranks #{r.rank}" + (f" ({r.status} with {', '.join(r.tied_with)})"
+                                                              if r.tied_with else "")
+                     + ("; " + "; ".join(found) if found else ""))
+    if not parts:
+        return ""
+    return f"**Known truth:** generated with {law}. " + ". ".join(parts) + "."
+
+
+def _reported_check(d, c: Comparison) -> str:
+    """Law parameters the source reports for this dataset, beside every fit of a law that has them."""
+    from .errors import FrictionLabError
+    from .registry import get_law
+    from .units import to_si
+
+    parts = []
+    for name, text in (d.reported or {}).items():
+        for f in c.fits_on(d.name):
+            p = f.params.get(name)
+            if not f.ok or p is None or p.kind != "law" or not p.vary:
+                continue
+            try:
+                value = to_si(text, get_law(f.law).spec(name).unit, f"{d.name}: reported.{name}")
+            except FrictionLabError:
+                continue
+            parts.append(f"{name} reported {param_text(value, None, p.unit)}, fitted by {f.law} [{f.solver}] "
+                         f"{param_text(p.value, p.stderr, p.unit)}")
+    return ("**Reported by the source:** " + "; ".join(parts) + ".") if parts else ""
 
 
 def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
@@ -246,6 +302,17 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
         if best:
             items.append(f"**{g}**: best " + " = ".join(best) + " (summed AIC over the group"
                          + ("; a tie" if len(best) > 1 else "") + ")")
+    for d in fitted:
+        for law in c.laws:
+            ser = next((r for r in c.ranking if r.dataset == d.name and r.law == law and r.solver == "series"
+                        and r.rank), None)
+            full = next((r for r in c.ranking if r.dataset == d.name and r.law == law and r.solver != "series"
+                         and r.rank), None)
+            if ser and full and abs(ser.aic - full.aic) > 2:
+                better = "better" if ser.aic < full.aic else "worse"
+                items.append(f"**{d.name}**: the paper's truncated series of {law} fits {better} than the {full.solver} "
+                             f"solution of the same law (ΔAIC {abs(ser.aic - full.aic):.1f}): the approximation, not "
+                             "the law, makes that difference (see the notes under Fits)")
     doc.items(items)
     if c.equivalence:
         doc.p("Equivalence of λAu and μN + μη′dA/dt: " + "; ".join(
@@ -291,19 +358,28 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
         doc.h(3, d.name)
         if d.description:
             doc.p(d.description)
+        for check in (_truth_check(d, c), _reported_check(d, c)):
+            if check:
+                doc.p(check)
         if any(f.ok for f in fits):
             name = f"fit-{d.name}.png"
             figs[name] = figures.fit_figure(d, fits, rows)
             doc.fig(name, f"{d.name}: data ({d.provenance.kind}) with each law's best fit, and residuals.")
-            name = f"force-{d.name}.png"
-            figs[name] = figures.force_figure(d, fits)
-            doc.fig(name, f"{d.name}: friction force of each best fit.")
+            if "t" in d.columns:
+                name = f"force-{d.name}.png"
+                figs[name] = figures.force_figure(d, fits)
+                doc.fig(name, f"{d.name}: friction force of each best fit.")
         prow = []
         for f in fits:
             if not f.ok:
                 continue
+            ratio_keys = {k for pair in f.identifiability.ratio_only for k in pair}
             for p in f.params.values():
                 role = "fitted" if p.vary else (p.fixed_by or "held")
+                if p.vary and p.kind == "law" and p.key in ratio_keys:
+                    role = "arbitrary: only the ratio is determined"
+                elif p.vary and p.stderr is None:
+                    role = f"fitted; no error bar: {f.identifiability.missing_stderr.get(p.name, 'see warnings')}"
                 prow.append([f"{f.law} [{f.solver}]", p.name, param_text(p.value, p.stderr if p.vary or
                                                                          p.kind == "derived" else None, p.unit),
                              role])
@@ -344,11 +420,15 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
             doc.fig(name, f"{d.name}: ω derived from θ by poly9 and spline, without and with simulated noise.")
             uname, uf = unit("omega")
             doc.table(["route", f"RMS vs ω column [{uname}]", f"peak [{uname}]", f"end [{uname}]",
-                       f"median ±1σ [{uname}]", f"with noise: RMS vs ω column [{uname}]",
-                       f"with noise: peak [{uname}]", f"with noise: end [{uname}]"],
+                       f"with noise: RMS vs ω column [{uname}]", f"with noise: peak [{uname}]",
+                       f"with noise: end [{uname}]", f"with noise: median ±1σ passed on [{uname}]"],
                       [[m, fmt(s["rms_vs_omega_column"] * uf), fmt(s["omega_peak"] * uf), fmt(s["omega_end"] * uf),
-                        fmt(s["median_sigma"] * uf), fmt(s["noisy_rms_vs_omega_column"] * uf),
-                        fmt(s["noisy_omega_peak"] * uf), fmt(s["noisy_omega_end"] * uf)] for m, s in stats.items()])
+                        fmt(s["noisy_rms_vs_omega_column"] * uf), fmt(s["noisy_omega_peak"] * uf),
+                        fmt(s["noisy_omega_end"] * uf), fmt(s["noisy_median_sigma"] * uf)] for m, s in stats.items()])
+            ref = d.reported
+            if ref:
+                doc.p("Reported in the paper for this impact: " + ", ".join(f"{k} = {v}" for k, v in ref.items()
+                                                                           if "omega" in k or k == "t_peak") + ".")
 
     # identifiability roll-up
     doc.h(2, "Identifiability warnings")
@@ -371,10 +451,11 @@ def _equivalence_section(doc: Doc, figs: dict, c: Comparison):
           "F ≈ λu0(1 − b)A + (λu0b/(φA0)) A dA/dt. The paper prints the second factor as φ/A0 (from "
           "'cos φt = (φ/A0) dA/dt'); differentiating A = A0 sin φt gives cos φt = (dA/dt)/(φA0), so the factor is "
           "1/(φA0), as used here. Per dataset and wear solver: both laws' best fits; each law refitted to the other's "
-          "best curve (misfit in noise σ, RMS); the correlation r and normalized RMS distance d of the two force "
+          "best curve, with the misfit Δχ² = Σ((refit − curve)/σ)², the penalty that law would pay on noisy data "
+          "generated by the other; the correlation r and normalized RMS distance d of the two force "
           "histories; and, on the half-sine impact, the decomposition of the wear fit projected by least squares "
           "onto μN + μη′dA/dt, compared with the fitted area-rate μ and η′. Verdict: **equivalent at this noise** if "
-          "both refits come within 1σ; else **qualitatively similar** if the curves have the same shape (both fall "
+          "both refits stay within Δχ² ≤ 2 (the scale of one AIC parameter); else **qualitatively similar** if the curves have the same shape (both fall "
           "after their peak, or neither does), r ≥ 0.8 and the implied μ, η′ are within a factor 2 of the fitted "
           "ones; else **not equivalent**, with the failed checks named.")
     if not c.equivalence:
@@ -389,12 +470,12 @@ def _equivalence_section(doc: Doc, figs: dict, c: Comparison):
         dec = e.decomposition
         rows.append([e.dataset, e.solver, e.area_rate_solver, e.verdict, fmt(e.force_correlation, 3),
                      fmt(e.force_distance, 3),
-                     fmt(cr[AREA_RATE].rms_sigma, 3) if AREA_RATE in cr else "",
-                     fmt(cr[WEAR].rms_sigma, 3) if WEAR in cr else "",
+                     fmt(cr[AREA_RATE].dchi2, 3) if AREA_RATE in cr else "",
+                     fmt(cr[WEAR].dchi2, 3) if WEAR in cr else "",
                      f"μ {fmt(dec.mu, 3)}, η′ {fmt(dec.eta_prime, 3)}" if dec else "n/a",
                      f"μ {fmt(e.fitted[AREA_RATE].get('mu'), 3)}, η′ {fmt(e.fitted[AREA_RATE].get('eta_prime'), 3)}"])
     doc.table(["dataset", "wear solver", "area-rate solver", "verdict", "force r", "force d",
-               "area-rate → wear curve [σ]", "wear → area-rate curve [σ]", "implied by decomposition",
+               "area-rate refit to wear curve, Δχ²", "wear refit to area-rate curve, Δχ²", "implied by decomposition",
                "fitted area-rate"], rows)
     doc.items([f"**{e.dataset} [wear {e.solver}] — {e.verdict}**: {e.explanation}" for e in c.equivalence
                if e.status == "ok"])
@@ -406,7 +487,9 @@ def _equivalence_section(doc: Doc, figs: dict, c: Comparison):
         fws = [c.fit_for(d.name, WEAR, e.solver) for e in mine]
         name = f"equivalence-{d.name}.png"
         figs[name] = figures.equivalence_figure(d, fws, fa, [e.decomposition for e in mine])
-        doc.fig(name, f"{d.name}: friction force of the wear and area-rate fits, and the paper's decomposition.")
+        doc.fig(name, f"{d.name}: friction force of the wear and area-rate fits"
+                + (", and the paper's decomposition of each wear fit with its projection onto μN + μη′dA/dt."
+                   if any(e.decomposition for e in mine) else "."))
 
 
 def _method_section(doc: Doc, c: Comparison):
@@ -491,7 +574,7 @@ def _equivalence_json(e) -> dict:
             "verdict": e.verdict, "explanation": e.explanation, "reason": e.reason, "checks": e.checks,
             "force_correlation": e.force_correlation, "force_distance": e.force_distance, "impulse_Ns": e.impulse,
             "aic": e.aic, "redchi": e.redchi, "shape": e.shape, "fitted": e.fitted,
-            "cross": [{"law": x.law, "to": x.to, "status": x.status, "rms": x.rms, "rms_sigma": x.rms_sigma,
+            "cross": [{"law": x.law, "to": x.to, "status": x.status, "rms": x.rms, "rms_sigma": x.rms_sigma, "dchi2": x.dchi2,
                        "params": x.params} for x in e.cross],
             "decomposition": None if d is None else {"b": d.b, "u0": d.u0, "c_area": d.c_area,
                                                       "c_area_rate": d.c_area_rate, "mu": d.mu,
@@ -519,6 +602,9 @@ def write_report(c: Comparison, out, force: bool = False) -> Path:
     """Write the report folder ``out`` whole or not at all; refuse an existing folder unless force."""
     out = Path(out)
     with atomic_dir(out, force=force) as tmp:
+        umask = os.umask(0)
+        os.umask(umask)
+        tmp.chmod(0o777 & ~umask)  # mkdtemp makes it private; the report is meant to be read
         doc, figs, deriv = build(c)
         (tmp / "figures").mkdir()
         for name, data in figs.items():

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 
-from frictionlab import Dataset, Scene, simulate
+from frictionlab import Dataset, Scene, get_law, simulate
 from frictionlab.dataset import Provenance
 from frictionlab.scene import ConstantArea, HalfSineArea, HalfSineNormal
 
@@ -47,7 +47,8 @@ def synthetic(law: str, params: dict, scene: Scene | None = None, *, n: int = 26
     return Dataset(name=name or f"synthetic-{law}", kind=scene.kind, observable=observable, path=None, columns=cols,
                    units=units, noise=noise, scene=scene, fixed=dict(fixed or {}),
                    provenance=Provenance(kind="synthetic", source="tests", command="tests/_fit_helpers.py",
-                                         seed=seed, truth={"law": law, **{k: str(v) for k, v in params.items()}}))
+                                         seed=seed, truth={"law": law, **{k: f"{v} {get_law(law).spec(k).unit}".strip()
+                                                                          for k, v in params.items()}}))
 
 
 TRUTH = {

@@ -42,7 +42,8 @@ def test_series_wear_and_area_rate_are_similar_but_exact_wear_is_not():
     assert series.force_correlation > exact.force_correlation
     for e in (exact, series):
         assert {c.law for c in e.cross} == {"wear", "area-rate"}
-        assert all(c.status == "ok" and c.rms_sigma > 1.0 for c in e.cross)  # 1% noise tells them apart
+        assert all(c.status == "ok" and c.dchi2 > 2.0 for c in e.cross)  # 1% noise tells them apart
+        assert all(c.dchi2 == pytest.approx(26 * c.rms_sigma**2) for c in e.cross)
         assert e.decomposition is not None
         assert str(round(e.force_correlation, 3)) in e.explanation
 
@@ -59,7 +60,8 @@ def test_verdict_follows_the_noise_level():
         assert e.decomposition is None  # no half-sine area on an incline
     assert verdicts["noisy"].verdict == "equivalent at this noise"
     assert verdicts["clean"].verdict == "not equivalent"
-    assert all(c.rms_sigma > 1 for c in verdicts["clean"].cross)
+    assert all(c.dchi2 > 2 for c in verdicts["clean"].cross)
+    assert all(c.dchi2 <= 2 for c in verdicts["noisy"].cross)
 
 
 def test_failed_or_skipped_fit_skips_the_analysis():

@@ -211,3 +211,18 @@ def test_bad_input_is_a_one_line_error_naming_the_field():
         fit("wear", ds, solver="magic")
     with pytest.raises(DatasetError, match="column"):
         fit("wear", ds, observable="v")
+
+
+def test_degenerate_fit_takes_errors_and_correlations_from_the_identifiable_part():
+    """couette with eta, h and u0 free is wear with lambda and u0 free: same errors, no spurious r = 1."""
+    ds = synthetic("wear", {"lam": 1.2e6}, impact_scene(u0=12.0), truth_scene=impact_scene(u0=10.0))
+    free = {"u0": (5.0, 14.0)}
+    c = fit("couette", ds, solver="exact", free=free)
+    w = fit("wear", ds, solver="exact", free=free)
+    assert c.ok and w.ok
+    assert c.stderr("u0") == pytest.approx(w.stderr("u0"), rel=0.05)
+    assert c.stderr("eta/h") == pytest.approx(w.stderr("lam"), rel=0.05)
+    assert c.correlations[("eta/h", "u0")] == pytest.approx(w.correlations[("lam", "u0")], abs=0.02)
+    # the one strong correlation is the real one (lambda with u0), not eta or h with anything
+    assert [(a, b) for a, b, _ in c.identifiability.high_correlations] == [("eta/h", "u0")]
+    assert [(a, b) for a, b, _ in w.identifiability.high_correlations] == [("lam", "u0")]

@@ -76,3 +76,11 @@ def test_known_truth_on_an_incline_and_coulomb_cannot_level_off():
     assert by["couette"].rank == 1 == by["wear"].rank
     assert by["coulomb"].delta_aic > 50  # constant acceleration cannot approach a terminal speed
     assert by["area-rate"].rank == by["coulomb"].rank  # dA/dt = 0: area-rate is Coulomb here
+
+
+def test_parallel_comparison_gives_the_same_results():
+    ds = synthetic("wear", TRUTH["wear"], seed=8, n=16)
+    one = compare(laws=["wear", "coulomb"], datasets=[ds], jobs=1)
+    two = compare(laws=["wear", "coulomb"], datasets=[ds], jobs=2)
+    assert [(r.candidate, r.rank) for r in one.ranking] == [(r.candidate, r.rank) for r in two.ranking]
+    assert [r.aic for r in one.ranking] == pytest.approx([r.aic for r in two.ranking], rel=1e-12)

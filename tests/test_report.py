@@ -40,6 +40,9 @@ def test_report_folder_contents(report_dir):
     assert "SYNTHETIC" in md and "not measured" in md  # never presented as measured
     assert "1/(φA0)" in md and "φ/A0" in md  # the paper's misprinted factor is named
     assert "equivalent" in md
+    # the generating law and parameters are checked in the report itself
+    assert "**Known truth:** generated with area-rate. area-rate [exact] ranks #1" in md
+    assert "eta_prime: true 8000 N s/m^2, fitted" in md
 
 
 def test_html_is_self_contained(report_dir):
@@ -168,3 +171,39 @@ def test_progress_bar_draws_only_on_a_terminal():
         bar.close()
     assert "3/10" in tty.getvalue() and tty.getvalue().startswith("\r[######")
     assert pipe.getvalue() == ""
+
+
+def test_a_new_dataset_kind_plugs_in_through_one_predictor(tmp_path, monkeypatch):
+    """Rows are impacts (no time column): a predictor registered for the kind is all compare and
+    the report need; without it the dataset is skipped with the reason."""
+    import attrs
+
+    from frictionlab import fitting, simulate
+    from frictionlab.dataset import Dataset
+
+    base = synthetic("wear", {"lam": 1.2e6})
+    speeds = np.array([8.0, 10.0, 12.0, 14.0, 16.0])
+
+    def final_spins(law, scene, params, solver, u0s):
+        return np.array([simulate(law, attrs.evolve(scene, u0=u), params, solver=solver,
+                                  t=np.array([0.0, scene.duration])).omega[-1] for u in u0s])
+
+    def predict_outcome(law, target, scene, params, solver):
+        return final_spins(law, scene, params, solver, target.dataset.columns["speed"])
+
+    truth = final_spins("wear", base.scene, {"lam": 1.2e6}, "exact", speeds)
+    rng = np.random.default_rng(2)
+    ds = Dataset(name="outcomes", kind="impact-outcome", observable="rebound_spin", path=None,
+                 columns={"speed": speeds, "rebound_spin": truth + rng.normal(0, 5.0, speeds.size)},
+                 units={"speed": "m/s", "rebound_spin": "rad/s"}, noise={"rebound_spin": 5.0},
+                 scene=attrs.evolve(base.scene, kind="impact-outcome"), fixed={}, provenance=base.provenance)
+    skipped = compare(laws=["wear"], datasets=[ds], equivalence=False)
+    assert "outcomes" in skipped.skipped_datasets and "predictor" in skipped.skipped_datasets["outcomes"]
+
+    monkeypatch.setitem(fitting.PREDICTORS, "impact-outcome", predict_outcome)
+    c = compare(laws=["wear", "coulomb"], datasets=[ds])
+    f = c.fit_for("outcomes", "wear", "exact")
+    assert f.ok and abs(f.value("lam") - 1.2e6) < 3 * f.stderr("lam")
+    out = write_report(c, tmp_path / "rep")
+    assert (out / "figures" / "fit-outcomes.png").exists()
+    assert not (out / "figures" / "force-outcomes.png").exists()  # no time series, no force history

@@ -20,6 +20,8 @@ def add_parser(sub):
     p.add_argument("--solver", action="append", metavar="SOLVER",
                    help="exact, series, ode[:METHOD] or auto; repeat for several (default: exact where a closed "
                         "form exists else ode, plus series where it applies)")
+    p.add_argument("--free", action="append", default=[], metavar="NAME=LO:HI",
+                   help="fit a scene quantity per dataset within bounds, with units, e.g. u0='5 m/s:31 m/s'")
     p.add_argument("--out", type=Path, default=Path("report"), help="report folder (default: ./report)")
     p.add_argument("--force", action="store_true", help="replace an existing report folder")
     p.add_argument("--jobs", type=int, default=min(os.cpu_count() or 1, 4),
@@ -55,21 +57,26 @@ class ProgressBar:
 def run(args) -> int:
     from ..comparison import compare
     from ..report import write_report
+    from .fit import parse_free
 
     if args.out.exists() and not args.force:  # fail before the work, not after it
         raise OutputError(f"{args.out}: output folder exists; choose another --out or pass --force")
     if args.jobs < 1:
         raise OutputError(f"--jobs must be at least 1, got {args.jobs}")
+    free = parse_free(args.free)
     laws = [x.strip() for x in args.laws.split(",") if x.strip()] if args.laws else None
     bar = ProgressBar()
     try:
-        result = compare(laws=laws, datasets=args.data, solvers=args.solver,
+        result = compare(laws=laws, datasets=args.data, solvers=args.solver, free=free,
                          equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar)
     finally:
         bar.close()
+    if bar.active:
+        print("writing the report ...", file=sys.stderr, flush=True)
     out = write_report(result, args.out, force=args.force)
     ok = sum(f.ok for f in result.fits)
-    print(f"compared {len(result.laws)} laws on {len(result.fitted_datasets)} datasets: {ok} fits, "
+    n_laws, n_data = len(result.laws), len(result.fitted_datasets)
+    print(f"compared {n_laws} law{'s' * (n_laws != 1)} on {n_data} dataset{'s' * (n_data != 1)}: {ok} fits, "
           f"{sum(f.status == 'failed' for f in result.fits)} failed, {sum(f.status == 'skipped' for f in result.fits)} "
           f"skipped, {len(result.equivalence)} equivalence tests, in {result.wall_time:.1f} s")
     print(f"report: {out / 'report.html'} (also report.md, ranking.csv, results.json, figures/)")
