@@ -7,9 +7,9 @@ the reference error bar, CPU time of the fit, AIC, the rank among the laws at th
 whether the ranking equals the reference ranking. The reference is the closed-form fit where
 every law has one, else the tightest tolerance of the first method.
 
-Hook: ``fitting.fit`` takes no tolerance argument yet; it reads ``fitting.FIT_RTOL`` when it
-solves an ODE, so the study sets that module constant for the duration of each fit (in this
-process only; not thread-safe). When ``fit`` grows an ``rtol`` argument, ``_fit`` is the one
+Hook: ``fitting.fit`` takes no tolerance argument yet; its predictions read ``predict.FIT_RTOL``
+when they solve an ODE, so the study sets that module constant for the duration of each fit (in
+this process only; not thread-safe). When ``fit`` grows an ``rtol`` argument, ``_fit`` is the one
 place to change.
 """
 from __future__ import annotations
@@ -25,14 +25,15 @@ DEFAULT_RTOLS = (1e-3, 1e-5, 1e-7, 1e-10)
 
 @contextmanager
 def _fit_rtol(rtol):
-    from . import fitting
+    import importlib
 
-    old = fitting.FIT_RTOL
-    fitting.FIT_RTOL = rtol
+    predict = importlib.import_module("frictionlab.predict")  # the package exports a function of that name
+    old = predict.FIT_RTOL
+    predict.FIT_RTOL = rtol
     try:
         yield
     finally:
-        fitting.FIT_RTOL = old
+        predict.FIT_RTOL = old
 
 
 def _fit(law, dataset, solver, rtol):
@@ -52,7 +53,7 @@ def _ranking(fits: dict) -> tuple[str, ...]:
 def fit_tolerance_study(laws, dataset, methods=("LSODA", "DOP853"), rtols=DEFAULT_RTOLS, progress=None) -> list[dict]:
     """Rows (one per law, solver, rtol, parameter): see the module docstring; SI units."""
     from .dataset import load_dataset
-    from .fitting import applicable_solvers
+    from .predict import applicable_solvers
 
     ds = load_dataset(dataset)
     runs = []  # (solver, rtol)
