@@ -188,3 +188,26 @@ def test_benchmark_script_runs(capsys):
     mod.main(["--n", "300", "--sample", "10", "--repeats", "1", "--no-numba"])
     out = capsys.readouterr().out
     assert out.count("RATIO loop/batch") == 4 and out.count("RATIO batch/bare") == 2
+
+
+def test_shared_table_model_is_allowed_different_tables_are_not():
+    from frictionlab.scene import TableNormal
+
+    tc = 450e-6
+    tt = np.linspace(0, tc, 50)
+    table = TableNormal(tt, 3000.0 * np.sin(np.pi * tt / tc))
+    scenes = [Scene(kind="impact", mass=M, u0=u0, duration=tc, radius=R, normal=table,
+                    effects=frozenset({"slip-coupling"})) for u0 in (3.0, 8.0)]
+    br = simulate_batch("coulomb", scenes, {"mu": 0.3}, solver="auto", n=41)
+    assert br.solver == "DOP853"
+    tr = fl.simulate("coulomb", scenes[1], {"mu": 0.3}, solver="ode:DOP853", t=br.t, rtol=1e-10)
+    assert np.allclose(br.u[1], tr.u, atol=1e-6 * 8.0)
+    other = attrs_evolve(scenes[1], normal=TableNormal(tt, 2.0 * table.N))
+    with pytest.raises(SceneError, match="normal.t|normal.N"):
+        SceneBatch.from_scenes([scenes[0], other])
+
+
+def attrs_evolve(obj, **kw):
+    import attrs
+
+    return attrs.evolve(obj, **kw)
