@@ -13,13 +13,29 @@ from ..errors import SolverError
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 
 
-def state_scales(plan, T: float) -> np.ndarray:
+def state_scales(plan, p, t0: float, T: float, y0, direction: float) -> np.ndarray:
+    """Typical size of each state over [t0, T], so that tolerances act relative to it.
+
+    Velocities scale with the largest of the initial slip, the drive over the span and the
+    initial spin speed. Spin and angle scale with the friction impulse the law can deliver,
+    J ~ min(F_probe (T - t0), (V + |drive| T) / kappa), F_probe being the law's largest force
+    at slip V over the span: with a weak law (b = 1e-6) spin is tiny, and scaling it by V/r
+    would leave it to the absolute tolerance alone.
+    """
     s = plan.scene
-    V = max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * (s.radius or 0.0), 1e-300)
-    if V == 1e-300:
-        V = 1.0
     r = s.radius or 1.0
-    size = {"v": V, "omega": V / r, "theta": V * T / r, "x": V * T, "xi": V * T}
+    V = max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * r, abs(float(plan.rigid_slip(y0))))
+    V = V if V > 0 and np.isfinite(V) else 1.0
+    span = max(T - t0, T * 1e-12, 1e-300)
+    size = {"v": V, "x": V * span, "xi": V * span}
+    if plan.has_spin:
+        tt = np.linspace(t0, T, 33)
+        yy = np.repeat(np.asarray(y0, dtype=float)[:, None], tt.size, axis=1)
+        F, _ = plan.force(p, tt, yy, np.full(tt.size, (direction or 1.0) * V))
+        J = min(float(np.max(np.abs(F))) * span, (V + abs(plan.drive) * span) / plan.kappa)
+        w = max(r * J / s.inertia, abs(s.omega0), 1e-12 * V / r)
+        size["omega"] = w
+        size["theta"] = max(w * span, abs(float(y0[plan.index("theta")])) , 1e-300)
     return np.array([size[k] for k in plan.states])
 
 
@@ -35,14 +51,19 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
         if len(t_out) == 0 or t_out[-1] <= t0:
             return np.repeat(np.asarray(y0, dtype=float)[:, None], len(t_out), axis=1), None, None, {"nfev": 0}
         T = float(t_out[-1])
-        scale = state_scales(plan, T)
+        scale = state_scales(plan, p, t0, T, y0, direction)
         tscale = T
         compliant = "xi" in plan.states
+
+        hold = not compliant and direction != 0
+        tiny = np.finfo(float).tiny
 
         def f(s, z):
             t = s * tscale
             y = z * scale
             u = plan.slip(p, t, y)
+            if hold:  # keep the sliding mode of this phase: extend the law continuously past zero slip
+                u = direction * max(direction * float(u), tiny)
             F, _ = plan.force(p, np.asarray(t), y, np.asarray(u))
             return plan.rates(t, y, F, u) * tscale / scale
 
@@ -71,7 +92,8 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
         if events is not None and sol.t_events[0].size:
             t_stop = float(sol.t_events[0][0]) * tscale
             y_stop = sol.y_events[0][0] * scale
-            Y = Y[:, np.asarray(t_out) <= t_stop][:, : Y.shape[1]]
+            # solve_ivp returns only the t_eval points before the terminal event
+            Y = Y[:, : int(np.count_nonzero(np.asarray(t_out) <= t_stop))]
         info = {"nfev": int(sol.nfev), "njev": int(sol.njev), "nlu": int(sol.nlu), "method": method,
                 "rtol": rtol, "atol": atol}
         return Y, t_stop, y_stop, info
