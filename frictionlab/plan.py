@@ -63,13 +63,17 @@ class Plan:
         v = y[0]
         return v - self.scene.radius * y[self.index("omega")] if self.coupled else v
 
+    def area(self, t, y, u) -> tuple[np.ndarray, np.ndarray]:
+        """Contact area [m^2] and its rate [m^2/s] at times t for states y and slip u."""
+        x = y[self.index("x")] if "x" in self.states else None
+        return self.scene.area(t, x, u)
+
     def contact(self, t, y, u) -> Contact:
         """The contact quantities the law requires, and only those, at times t for states y."""
         s = self.scene
         A = dAdt = N = None
-        if self.needs_area or isinstance(s.normal, HertzNormal) and self.needs_normal:
-            x = y[self.index("x")] if "x" in self.states else None
-            A, dAdt = s.area(t, x, u)
+        if self.needs_area:
+            A, dAdt = self.area(t, y, u)
         if self.needs_normal:
             N = s.normal(t, A)
         req = self.law.requires
@@ -141,8 +145,13 @@ def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan
     spin = "spin" in effects or coupled
     if spin and scene.radius is None:
         raise SceneError(f"{scene_name}: effect 'spin' needs scene.radius")
-    needs_area = bool({"A", "dAdt"} & set(law.requires))
     needs_normal = "N" in law.requires
+    hertz = needs_normal and isinstance(scene.normal, HertzNormal)
+    if hertz and scene.area is None:
+        raise SceneError(f"law '{law.name}' needs N (normal force), which {scene_name} computes from the contact "
+                         "area (Hertz model) but has no [scene.area] model")
+    # the area is evaluated when the law reads A or dA/dt, or when a Hertz normal force reads A
+    needs_area = bool({"A", "dAdt"} & set(law.requires)) or hertz
     states = ["v"]
     if spin:
         states += ["omega", "theta"]

@@ -69,24 +69,41 @@ class GrowthArea:
 
 @attrs.frozen(eq=False)
 class TableArea:
-    """A measured area column, smoothed by a spline whose derivative gives dA/dt.
+    """A measured area column [m^2] at times t [s], smoothed by a spline whose derivative gives dA/dt.
 
-    The smoothing spline's roughness penalty is chosen by generalized cross-validation,
-    so measurement noise does not blow up the derivative.
+    The smoothing spline's roughness penalty is chosen by generalized cross-validation on the
+    data scaled to order one (time to [0, 1], area to its peak): in SI units (1e-4 s, 1e-4 m^2)
+    the criterion is ill-posed and scipy returns a nearly straight line. Outside the measured
+    span the area holds its end value and dA/dt is zero.
     """
 
     t: np.ndarray
     A: np.ndarray
     spline: object = attrs.field(init=False, repr=False)
+    slope: object = attrs.field(init=False, repr=False)
 
     def __attrs_post_init__(self):
         from scipy.interpolate import make_smoothing_spline
 
-        object.__setattr__(self, "spline", make_smoothing_spline(self.t, self.A))
+        t, A = np.asarray(self.t, dtype=float), np.asarray(self.A, dtype=float)
+        if t.ndim != 1 or t.shape != A.shape or t.size < 5:
+            raise SceneError(f"area column: need at least 5 (t, A) samples of equal length, got {t.size} and {A.size}")
+        if np.any(np.diff(t) <= 0) or not (np.all(np.isfinite(t)) and np.all(np.isfinite(A))):
+            raise SceneError("area column: times must increase strictly and values be finite")
+        if np.any(A < 0):
+            raise SceneError("area column: negative contact area")
+        span = t[-1] - t[0]
+        peak = float(np.max(A)) or 1.0
+        unit = make_smoothing_spline((t - t[0]) / span, A / peak)
+        object.__setattr__(self, "spline", lambda tt: peak * unit((tt - t[0]) / span))
+        slope = unit.derivative()
+        object.__setattr__(self, "slope", lambda tt: (peak / span) * slope((tt - t[0]) / span))
 
     def __call__(self, t, x=None, speed=None):
-        t = np.clip(np.asarray(t, dtype=float), self.t[0], self.t[-1])
-        return np.maximum(self.spline(t), 0.0), self.spline.derivative()(t)
+        t = np.asarray(t, dtype=float)
+        inside = (t >= self.t[0]) & (t <= self.t[-1])
+        tc = np.clip(t, self.t[0], self.t[-1])
+        return np.maximum(self.spline(tc), 0.0), np.where(inside, self.slope(tc), 0.0)
 
 
 # --- normal-force models ------------------------------------------------------------
@@ -156,7 +173,7 @@ class Scene:
 
     kind: str
     mass: float  # [kg]
-    u0: float  # initial tangential velocity of the body [m/s]
+    u0: float  # initial slip at the contact [m/s] (body velocity minus r omega0 with slip coupling)
     duration: float  # simulated time span [s]
     radius: float | None = None  # [m]
     inertia_factor: float = 0.4  # I = inertia_factor * m r^2
@@ -229,6 +246,7 @@ class Scene:
         area = _area_from_spec(spec.get("area"), where, q, columns, t)
         contact_time = getattr(area, "contact_time", None)
         normal = _normal_from_spec(spec.get("normal"), where, q, columns, t, mass, contact_time, spec, incline)
+        contact_time = contact_time if contact_time is not None else getattr(normal, "contact_time", None)
         if "gravity" in effects and normal is None:
             normal = WeightNormal(mass * G * math.cos(incline))
         compliance = None
@@ -238,7 +256,7 @@ class Scene:
                                     q("damping", "N*s/m", c, "scene.compliance"))
             effects |= {"compliance"}
         elif "compliance" in effects:
-            raise SceneError(f"{where}: effect 'compliance' needs a [scene.compliance] table with 'stiffness'")
+            raise SceneError(f"{where}: effect 'compliance' needs a [scene.compliance] table with 'stiffness' and 'damping'")
 
         duration = q("duration", "s", required=False)
         if duration is None:
@@ -255,6 +273,8 @@ class Scene:
 
 
 def _column(columns, name, where, prefix):
+    if "t" not in columns:
+        raise SceneError(f"{where}: {prefix}.model = 'column' needs the time column 't'")
     if name not in columns:
         raise SceneError(f"{where}: {prefix}.column = {name!r} is not a column of the CSV (has: {', '.join(columns)})")
     return columns[name]
@@ -275,7 +295,10 @@ def _area_from_spec(a, where, q, columns, t):
         A = _column(columns, a.get("column", "A"), where, p)
         if np.any(A < 0):
             raise SceneError(f"{where}: area column has negative values")
-        return TableArea(t, A)
+        try:
+            return TableArea(t, A)
+        except SceneError as exc:
+            raise SceneError(f"{where}: {p}: {exc}") from None
     raise SceneError(f"{where}: {p}.model must be one of half-sine, constant, growth, column; got {model!r}")
 
 

@@ -81,7 +81,7 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
     c = plan.contact(t_eval, Y, u)
     if sliding.any():
         F[sliding] = plan.law.evaluate(p, _subset(c, sliding))
-    A = c.A if c.A is not None else (plan.scene.area(t_eval, None, u)[0] if plan.needs_area else None)
+    A = c.A if c.A is not None else (plan.area(t_eval, Y, u)[0] if plan.needs_area else None)
     omega = Y[plan.index("omega")] if plan.has_spin else np.zeros(n)
     theta = Y[plan.index("theta")] if plan.has_spin else np.zeros(n)
     for name, arr in (("u", u), ("v", Y[0]), ("omega", omega), ("theta", theta), ("force", F)):
