@@ -16,26 +16,35 @@ METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 def state_scales(plan, p, t0: float, T: float, y0, direction: float) -> np.ndarray:
     """Typical size of each state over [t0, T], so that tolerances act relative to it.
 
-    Velocities scale with the largest of the initial slip, the drive over the span and the
-    initial spin speed. Spin and angle scale with the friction impulse the law can deliver,
-    J ~ min(F_probe (T - t0), (V + |drive| T) / kappa), F_probe being the law's largest force
-    at slip V over the span: with a weak law (b = 1e-6) spin is tiny, and scaling it by V/r
-    would leave it to the absolute tolerance alone.
+    Velocities scale with the largest of the initial slip and body speed, and the speed the
+    drive can reach: |drive| (T - t0), or less where the law's force at that speed exceeds
+    the drive (a lubricated block levels off at u_inf << g T). Spin and angle scale with the
+    friction impulse the law can deliver, J ~ min(F (T - t0), (V + |drive| T) / kappa), F the
+    law's largest force at slip V over the span: with a weak law (b = 1e-6) spin is tiny, and
+    scaling it by V / r would leave it to the absolute tolerance alone.
     """
     s = plan.scene
     r = s.radius or 1.0
-    V = max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * r, abs(float(plan.rigid_slip(y0))))
-    V = V if V > 0 and np.isfinite(V) else 1.0
     span = max(T - t0, T * 1e-12, 1e-300)
+    tt = np.linspace(t0, T, 33)
+    yy = np.repeat(np.asarray(y0, dtype=float)[:, None], tt.size, axis=1)
+
+    def largest_force(u):
+        F, _ = plan.force(p, tt, yy, np.full(tt.size, u))
+        return float(np.max(np.abs(F)))
+
+    V = max(abs(s.u0), abs(float(y0[0])), abs(float(plan.rigid_slip(y0))), abs(s.omega0) * r)
+    if plan.drive != 0.0:
+        reach = abs(plan.drive) * span
+        F = largest_force(np.sign(plan.drive) * reach)
+        V = max(V, reach * min(1.0, s.mass * abs(plan.drive) / F) if F > 0 else reach)
+    V = V if V > 0 and np.isfinite(V) else 1.0
     size = {"v": V, "x": V * span, "xi": V * span}
     if plan.has_spin:
-        tt = np.linspace(t0, T, 33)
-        yy = np.repeat(np.asarray(y0, dtype=float)[:, None], tt.size, axis=1)
-        F, _ = plan.force(p, tt, yy, np.full(tt.size, (direction or 1.0) * V))
-        J = min(float(np.max(np.abs(F))) * span, (V + abs(plan.drive) * span) / plan.kappa)
+        J = min(largest_force((direction or 1.0) * V) * span, (V + abs(plan.drive) * span) / plan.kappa)
         w = max(r * J / s.inertia, abs(s.omega0), 1e-12 * V / r)
         size["omega"] = w
-        size["theta"] = max(w * span, abs(float(y0[plan.index("theta")])) , 1e-300)
+        size["theta"] = max(w * span, abs(float(y0[plan.index("theta")])), 1e-300)
     return np.array([size[k] for k in plan.states])
 
 

@@ -1,0 +1,1 @@
+"""Built-in datasets (CSV + TOML sidecars), installed as ``frictionlab.data``."""
