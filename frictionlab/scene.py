@@ -28,13 +28,34 @@ EFFECTS = {
 }
 
 
+# --- validation of Python-built models: no NaN or negative size slips through ----------
+def _number(test, words):
+    def check(instance, attribute, value):
+        ok = isinstance(value, (int, float, np.floating, np.integer)) and not isinstance(value, bool)
+        if not ok or not math.isfinite(value) or not test(value):
+            raise SceneError(f"{type(instance).__name__}.{attribute.name} must be {words}, got {value!r}")
+    return check
+
+
+_positive = _number(lambda v: v > 0, "a positive finite number")
+_nonnegative = _number(lambda v: v >= 0, "a finite number >= 0")
+_finite = _number(lambda v: True, "a finite number")
+
+
+def _optional(check):
+    def optional(instance, attribute, value):
+        if value is not None:
+            check(instance, attribute, value)
+    return optional
+
+
 # --- contact-area models ------------------------------------------------------------
 @attrs.frozen
 class HalfSineArea:
     """A(t) = peak sin(pi t / contact_time) for 0 <= t <= contact_time, else 0. Eq (1) of the paper."""
 
-    peak: float  # [m^2]
-    contact_time: float  # [s]
+    peak: float = attrs.field(validator=_nonnegative)  # [m^2]
+    contact_time: float = attrs.field(validator=_positive)  # [s]
 
     def __call__(self, t, x=None, speed=None):
         t = np.asarray(t, dtype=float)
@@ -47,7 +68,7 @@ class HalfSineArea:
 class ConstantArea:
     """A constant contact area [m^2]."""
 
-    area: float
+    area: float = attrs.field(validator=_nonnegative)
 
     def __call__(self, t, x=None, speed=None):
         t = np.asarray(t, dtype=float)
@@ -58,8 +79,8 @@ class ConstantArea:
 class GrowthArea:
     """Wear growth with sliding length x: A = initial + rate * x [m^2, m^2/m]; dA/dt = rate * |slip|."""
 
-    initial: float
-    rate: float
+    initial: float = attrs.field(validator=_nonnegative)
+    rate: float = attrs.field(validator=_nonnegative)
 
     def __call__(self, t, x=None, speed=None):
         x = np.zeros(np.shape(t)) if x is None else np.asarray(x, dtype=float)
@@ -111,8 +132,8 @@ class TableArea:
 class HalfSineNormal:
     """N(t) = peak sin(pi t / contact_time), impulse = 2 peak contact_time / pi = m v_n (1 + e)."""
 
-    impulse: float  # [N s]
-    contact_time: float  # [s]
+    impulse: float = attrs.field(validator=_nonnegative)  # [N s]
+    contact_time: float = attrs.field(validator=_positive)  # [s]
 
     @property
     def peak(self) -> float:
@@ -129,7 +150,7 @@ class HalfSineNormal:
 class HertzNormal:
     """Hertz-type N = coefficient * A^(3/2) [N/m^3]; for a sphere k = 4 E* / (3 pi^1.5 R)."""
 
-    coefficient: float
+    coefficient: float = attrs.field(validator=_nonnegative)
 
     def __call__(self, t, A=None):
         return self.coefficient * np.maximum(A, 0.0) ** 1.5
@@ -150,7 +171,7 @@ class TableNormal:
 class WeightNormal:
     """N = m g cos(alpha) on an incline [N]."""
 
-    value: float
+    value: float = attrs.field(validator=_nonnegative)
 
     def __call__(self, t, A=None):
         return np.full(np.shape(t), self.value)
@@ -163,8 +184,8 @@ class Compliance:
     The damper must be positive: it makes the patch slip well defined for every law.
     """
 
-    stiffness: float
-    damping: float
+    stiffness: float = attrs.field(validator=_positive)
+    damping: float = attrs.field(validator=_positive)
 
 
 @attrs.frozen
@@ -172,17 +193,32 @@ class Scene:
     """Everything about an experiment except the friction law; SI floats throughout."""
 
     kind: str
-    mass: float  # [kg]
-    u0: float  # initial slip at the contact [m/s] (body velocity minus r omega0 with slip coupling)
-    duration: float  # simulated time span [s]
-    radius: float | None = None  # [m]
-    inertia_factor: float = 0.4  # I = inertia_factor * m r^2
-    omega0: float = 0.0  # [rad/s]
+    mass: float = attrs.field(validator=_positive)  # [kg]
+    u0: float = attrs.field(validator=_finite)  # initial slip at the contact [m/s] (body velocity minus r omega0 with slip coupling)
+    duration: float = attrs.field(validator=_nonnegative)  # simulated time span [s]
+    radius: float | None = attrs.field(default=None, validator=_optional(_positive))  # [m]
+    inertia_factor: float = attrs.field(default=0.4, validator=_positive)  # I = inertia_factor * m r^2
+    omega0: float = attrs.field(default=0.0, validator=_finite)  # [rad/s]
     incline: float | None = None  # [rad]
     area: object | None = None
     normal: object | None = None
     compliance: Compliance | None = None
-    effects: frozenset = frozenset()
+    effects: frozenset = attrs.field(default=frozenset(), converter=frozenset)
+
+    def __attrs_post_init__(self):
+        if self.kind not in KINDS:
+            raise SceneError(f"Scene.kind must be one of {', '.join(KINDS)}, got {self.kind!r}")
+        unknown = sorted(set(self.effects) - set(EFFECTS))
+        if unknown:
+            raise SceneError(f"Scene.effects: unknown effect(s) {unknown}; known: {', '.join(EFFECTS)}")
+        if self.incline is not None:
+            _finite(self, attrs.fields(Scene).incline, self.incline)
+            if not 0 < self.incline < math.pi / 2:
+                raise SceneError(f"Scene.incline must be between 0 and pi/2 rad, got {self.incline!r}")
+        if "gravity" in self.effects and self.incline is None:
+            raise SceneError("Scene: effect 'gravity' needs an incline angle")
+        if {"spin", "slip-coupling"} & set(self.effects) and self.radius is None:
+            raise SceneError("Scene: effects 'spin' and 'slip-coupling' need a radius")
 
     @property
     def inertia(self) -> float:
@@ -268,8 +304,12 @@ class Scene:
                 raise SceneError(f"{where}: [scene] needs 'duration' (no contact time or time column to take it from)")
             else:
                 duration = 0.0
-        return cls(kind=kind, mass=mass, u0=u0, duration=duration, radius=radius, inertia_factor=inertia_factor,
-                   omega0=omega0, incline=incline, area=area, normal=normal, compliance=compliance, effects=effects)
+        try:
+            return cls(kind=kind, mass=mass, u0=u0, duration=duration, radius=radius, inertia_factor=inertia_factor,
+                       omega0=omega0, incline=incline, area=area, normal=normal, compliance=compliance,
+                       effects=effects)
+        except SceneError as exc:
+            raise SceneError(f"{where}: {exc}") from None
 
 
 def _column(columns, name, where, prefix):
