@@ -70,10 +70,13 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
         def f(s, z):
             t = s * tscale
             y = z * scale
-            u = plan.slip(p, t, y)
-            if hold:  # keep the sliding mode of this phase: extend the law continuously past zero slip
-                u = direction * max(direction * float(u), tiny)
-            F, _ = plan.force(p, np.asarray(t), y, np.asarray(u))
+            if compliant:
+                F, u = plan.patch_force(p, t, y)
+            else:
+                u = plan.rigid_slip(y)
+                if hold:  # keep the sliding mode of this phase: extend the law continuously past zero slip
+                    u = direction * max(direction * float(u), tiny)
+                F, _ = plan.force(p, np.asarray(t), y, np.asarray(u))
             return plan.rates(t, y, F, u) * tscale / scale
 
         events = None

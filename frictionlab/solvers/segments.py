@@ -75,9 +75,9 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
     if not done.all():
         raise SolverError(f"{solver_name}: solution ended at t = {t0:g} s before the last requested time {T:g} s")
     u = np.empty(n)
-    if compliant:
+    if compliant:  # the force on the body is the spring's and damper's, also while the patch sticks
         for i in np.nonzero(sliding)[0]:
-            u[i] = plan.patch_slip(p, t_eval[i], Y[:, i])
+            F[i], u[i] = plan.patch_force(p, t_eval[i], Y[:, i])
     else:
         u[:] = plan.rigid_slip(Y)
         # within a sliding phase slip keeps its sign: rounding (1e-15 m/s) must not flip it
@@ -85,7 +85,7 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
         u[held] = dirs[held] * np.maximum(dirs[held] * u[held], 0.0)
     u[~sliding] = 0.0
     c = plan.contact(t_eval, Y, u)
-    if sliding.any():
+    if sliding.any() and not compliant:
         F[sliding] = plan.law.evaluate(p, _subset(c, sliding))
     A = c.A if c.A is not None else (plan.area(t_eval, Y, u)[0] if plan.needs_area else None)
     omega = Y[plan.index("omega")] if plan.has_spin else np.zeros(n)
