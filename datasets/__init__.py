@@ -1,1 +1,1 @@
-"""Built-in datasets (CSV + TOML sidecars), installed as ``frictionlab.data``."""
+"""Built-in datasets (CSV + TOML pairs), installed as ``frictionlab.data``. See README: Datasets."""

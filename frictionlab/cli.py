@@ -15,9 +15,23 @@ from .errors import FrictionLabError
 COMMANDS = ("laws", "datasets", "simulate", "fit", "compare", "bench")
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with a one-line usage error (no usage block), exit status 2."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {one_line(message)} (see '{self.prog} --help')\n")
+
+
+def one_line(text) -> str:
+    """A message on one line: newlines inside (a file name, a column name) become spaces."""
+    return " ".join(str(text).split("\n")).replace("\r", " ")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="frictionlab", description="Compare friction laws against impact and sliding data.")
+    parser = _Parser(prog="frictionlab", description="Compare friction laws against impact and sliding data.")
     parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    parser.add_argument("--load", metavar="FILE.py", action="append", default=[],
+                        help="import a Python file first (laws it registers with @register_law become available)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMANDS:
         try:
@@ -32,9 +46,37 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 
+def load_file(path: str) -> None:
+    """Import a user's Python file by path (for laws registered at run time)."""
+    import importlib.util
+    from pathlib import Path
+
+    from .errors import RegistryError
+
+    p = Path(path)
+    if not p.is_file():
+        raise RegistryError(f"--load {path}: no such file")
+    spec = importlib.util.spec_from_file_location(f"frictionlab_user_{p.stem}", p)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    try:
+        spec.loader.exec_module(module)
+    except FrictionLabError:
+        raise
+    except Exception as exc:
+        raise RegistryError(f"--load {path}: import failed: {type(exc).__name__}: {exc}") from exc
+
+
 def main(argv=None) -> int:
-    parser = build_parser()
     argv = sys.argv[1:] if argv is None else list(argv)
+    try:
+        parser = build_parser()
+    except Exception as exc:  # a command module that fails to import
+        if "--debug" in argv:
+            raise
+        print(f"frictionlab: internal error: {type(exc).__name__}: {one_line(exc)} "
+              "(rerun with --debug for the traceback)", file=sys.stderr)
+        return 1
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # argparse already printed its one-line usage error
@@ -42,19 +84,36 @@ def main(argv=None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    formatwarning = warnings.formatwarning
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("default")
-            warnings.formatwarning = lambda m, c, *a, **k: f"warning: {m}\n"
+            warnings.formatwarning = lambda m, c, *a, **k: f"warning: {one_line(m)}\n"
+            for path in args.load:
+                load_file(path)
             return int(args.func(args) or 0)
     except FrictionLabError as exc:
         if args.debug:
             raise
-        print(f"frictionlab: error: {exc}", file=sys.stderr)
+        print(f"frictionlab: error: {one_line(exc)}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # the file system refused (permissions, a full disk): the user's to fix
+        if args.debug:
+            raise
+        where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+        print(f"frictionlab: error: {where}{one_line(exc.strerror or exc)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("frictionlab: interrupted", file=sys.stderr)
         return 130
+    except Exception as exc:  # a bug, not bad input: say so in one line, exit 1
+        if args.debug:
+            raise
+        print(f"frictionlab: internal error: {type(exc).__name__}: {one_line(exc)} "
+              "(a bug in frictionlab or a plugin; rerun with --debug for the traceback)", file=sys.stderr)
+        return 1
+    finally:
+        warnings.formatwarning = formatwarning
 
 
 if __name__ == "__main__":  # pragma: no cover

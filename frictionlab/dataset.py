@@ -118,8 +118,17 @@ def _req(meta, key, path, typ=str):
     if key not in meta:
         raise DatasetError(f"{path}: missing required key '{key}'")
     if not isinstance(meta[key], typ):
-        raise DatasetError(f"{path}: '{key}' must be a {typ.__name__ if isinstance(typ, type) else 'table'}")
+        what = {str: "string", dict: "table"}.get(typ, typ.__name__)
+        raise DatasetError(f"{path}: '{key}' must be a {what}, got {type(meta[key]).__name__}")
     return meta[key]
+
+
+def _table(meta, key, path, where=None):
+    """An optional TOML table: {} when absent, an error when present but not a table."""
+    value = meta.get(key, {})
+    if not isinstance(value, dict):
+        raise DatasetError(f"{path}: {where or key} must be a table, got {type(value).__name__} {value!r}")
+    return value
 
 
 def from_meta(meta: dict, path: Path) -> Dataset:
@@ -129,6 +138,8 @@ def from_meta(meta: dict, path: Path) -> Dataset:
     if kind not in DATA_KINDS:
         raise DatasetError(f"{path}: kind = {kind!r}, expected one of {', '.join(DATA_KINDS)}")
     observable = _req(meta, "observable", path)
+    if observable == "t":
+        raise DatasetError(f"{path}: observable = 't': the time column cannot be the observable")
     units = _req(meta, "columns", path, dict)
     for col, u in units.items():
         if not isinstance(u, str):
@@ -143,24 +154,30 @@ def from_meta(meta: dict, path: Path) -> Dataset:
     columns = {}
     for col, unit in units.items():
         if col not in raw:
-            raise DatasetError(f"{csv}: missing column '{col}' declared in {path.name} (has: {', '.join(raw)})")
+            raise DatasetError(f"{csv}: missing column '{col}' declared in {path.name} (has: {_names(raw)})")
         si = COLUMN_SI.get(col)
         if si is None:
             raise DatasetError(f"{path}: column '{col}' is not a known quantity ({', '.join(COLUMN_SI)})")
-        columns[col] = raw[col] * unit_factor(unit, si, f"{path}: columns.{col}")
+        try:
+            columns[col] = raw[col] * unit_factor(unit, si, f"{path}: columns.{col}")
+        except FrictionLabError as exc:
+            raise DatasetError(str(exc)) from None
     if "t" in columns:
         t = columns["t"]
         bad = np.nonzero(np.diff(t) <= 0)[0]
         if bad.size:
             i = int(bad[0])
-            raise DatasetError(f"{csv}: column 't' must increase strictly; row {i + 3} ({raw['t'][i + 1]!r}) "
-                               f"does not exceed row {i + 2} ({raw['t'][i]!r})")
+            raise DatasetError(f"{csv}: column 't' must increase strictly; line {_line_of_row(csv, i + 1)} "
+                               f"({raw['t'][i + 1]:g}) does not exceed the line before ({raw['t'][i]:g})")
+        if kind != "contact-area" and t[0] < 0:
+            raise DatasetError(f"{csv}: column 't' line {_line_of_row(csv, 0)}: time {raw['t'][0]:g} is negative; "
+                               "times count from first contact (or release) at t = 0")
     for col in ("A", "N"):
         if col in columns and np.any(columns[col] < 0):
             raise DatasetError(f"{csv}: column '{col}' has negative values")
 
-    noise_spec = meta.get("noise", {})
-    if not isinstance(noise_spec, dict) or observable not in noise_spec:
+    noise_spec = _table(meta, "noise", path, "[noise]")
+    if observable not in noise_spec:
         raise DatasetError(f"{path}: [noise] must give the noise of the observable, e.g. {observable} = '100 rpm'")
     noise = {}
     for col, value in noise_spec.items():
@@ -180,25 +197,53 @@ def from_meta(meta: dict, path: Path) -> Dataset:
             scene = Scene.from_spec(spec, kind, str(path), columns, columns.get("t"))
         except FrictionLabError as exc:
             raise DatasetError(str(exc)) from None
+        _check_observable(scene, observable, path)
 
     fixed, fixed_units = {}, {}
-    for key, value in meta.get("fixed", {}).items():
+    for key, value in _table(meta, "fixed", path, "[fixed]").items():
         from .registry import available_laws
 
-        units_of = {s.name: s.unit for law in available_laws().values() for s in law.params}
-        if key not in units_of:
+        specs = [(law.name, s) for law in available_laws().values() for s in law.params if s.name == key]
+        if not specs:
             raise DatasetError(f"{path}: fixed.{key} is not a parameter of any registered law")
-        fixed[key] = _quantity(value, units_of[key], f"{path}: fixed.{key}")
-        fixed_units[key] = units_of[key]
+        unit = specs[0][1].unit
+        fixed[key] = _quantity(value, unit, f"{path}: fixed.{key}")
+        fixed_units[key] = unit
+        for law_name, spec in specs:
+            if spec.unit == unit and not spec.lower <= fixed[key] <= spec.upper:
+                raise DatasetError(f"{path}: fixed.{key} = {value!r} is outside the bounds of law '{law_name}' "
+                                   f"[{spec.lower:g}, {spec.upper:g}] {spec.unit}".rstrip())
 
     extra = set(meta) - {"name", "kind", "observable", "columns", "noise", "scene", "fixed", "provenance",
                          "reported", "description"}
     if extra:
         raise DatasetError(f"{path}: unknown top-level key(s) {sorted(extra)}")
+    reported = _table(meta, "reported", path, "[reported]")
+    if not isinstance(meta.get("description", ""), str):
+        raise DatasetError(f"{path}: 'description' must be a string")
     return Dataset(name=name, kind=kind, observable=observable, path=path, columns=columns, units=dict(units),
                    noise=noise, scene=scene, fixed=fixed, provenance=provenance,
-                   description=meta.get("description", ""), reported=meta.get("reported", {}),
+                   description=meta.get("description", ""), reported=reported,
                    fixed_units=fixed_units)
+
+
+#: Trajectory series each observable needs, and what in a scene provides it.
+def _check_observable(scene: Scene, observable: str, path) -> None:
+    """A dataset whose observable its own scene cannot produce would be fitted against zeros."""
+    if scene.kind not in ("impact", "incline"):
+        return
+    if observable in ("omega", "theta") and not ({"spin", "slip-coupling"} & scene.effects):
+        raise DatasetError(f"{path}: observable {observable!r} needs the scene to integrate spin; "
+                           "add \"spin\" to scene.effects (and a scene.radius)")
+    if observable == "A" and scene.area is None:
+        raise DatasetError(f"{path}: observable 'A' needs a [scene.area] model")
+    if observable == "N" and scene.normal is None:
+        raise DatasetError(f"{path}: observable 'N' needs a [scene.normal] model")
+
+
+def _names(columns) -> str:
+    """Column names for a one-line message (repr when a name holds odd characters)."""
+    return ", ".join(c if c.isprintable() and "," not in c else repr(c) for c in columns)
 
 
 def _quantity(value, si, where):
@@ -220,30 +265,89 @@ def _provenance(p, path) -> Provenance:
         raise DatasetError(f"{path}: provenance.source must name where the data come from")
     if kind in ("reconstructed", "synthetic") and not p.get("command"):
         raise DatasetError(f"{path}: provenance.command must give the command that regenerates {kind} data")
+    for key in ("method", "command"):
+        if not isinstance(p.get(key, ""), str):
+            raise DatasetError(f"{path}: provenance.{key} must be a string")
+    seed = p.get("seed")
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int)):
+        raise DatasetError(f"{path}: provenance.seed must be an integer, got {seed!r}")
+    if not isinstance(p.get("truth", {}), dict):
+        raise DatasetError(f"{path}: provenance.truth must be a table")
     return Provenance(kind=kind, source=p["source"], method=p.get("method", ""), command=p.get("command", ""),
                       seed=p.get("seed"), truth=p.get("truth", {}))
 
 
 def read_csv(csv: Path) -> dict[str, np.ndarray]:
     """Read a numeric CSV with a header row into float arrays; one-line errors on bad content."""
+    import warnings
+
     import pandas as pd
 
     try:
-        df = pd.read_csv(csv, comment="#", skipinitialspace=True)
+        with warnings.catch_warnings():
+            # more fields in every row than in the header: pandas would shift the columns silently
+            warnings.simplefilter("error", pd.errors.ParserWarning)
+            df = pd.read_csv(csv, comment="#", skipinitialspace=True, index_col=False, dtype=str,
+                             keep_default_na=False)
     except FileNotFoundError:
         raise DatasetError(f"{csv}: no such file") from None
+    except IsADirectoryError:
+        raise DatasetError(f"{csv}: is a folder, not a CSV file") from None
     except pd.errors.EmptyDataError:
         raise DatasetError(f"{csv}: file is empty") from None
-    except (pd.errors.ParserError, UnicodeDecodeError, ValueError) as exc:
-        raise DatasetError(f"{csv}: CSV does not parse: {str(exc).splitlines()[0]}") from None
+    except pd.errors.ParserWarning:
+        raise DatasetError(f"{csv}: CSV does not parse: data rows have more fields than the header") from None
+    except (pd.errors.ParserError, UnicodeError, ValueError, OSError) as exc:
+        first = (str(exc).splitlines() or [type(exc).__name__])[0]
+        raise DatasetError(f"{csv}: CSV does not parse: {first}") from None
+    names = [str(c).strip() for c in df.columns]
+    header = _header_names(csv)
+    for i, name in enumerate(header if header is not None else names):
+        if not name:
+            raise DatasetError(f"{csv}: header column {i + 1} has no name (a stray comma?)")
+        if any(sep in name for sep in (";", "\t")):
+            raise DatasetError(f"{csv}: header {name!r} looks ;- or tab-separated; write comma-separated values")
+    if header is not None:
+        dup = sorted({n for n in header if header.count(n) > 1})
+        if dup:
+            raise DatasetError(f"{csv}: column {dup[0]!r} appears more than once in the header")
     if len(df) == 0:
         raise DatasetError(f"{csv}: no data rows")
     out = {}
-    for col in df.columns:
-        values = pd.to_numeric(df[col], errors="coerce").to_numpy(dtype=float)
+    for col, name in zip(df.columns, names):
+        text = df[col]
+        values = np.array([_number(x) for x in text], dtype=float)
         bad = np.nonzero(~np.isfinite(values))[0]
         if bad.size:
             i = int(bad[0])
-            raise DatasetError(f"{csv}: column '{col}' row {i + 2}: {df[col].iloc[i]!r} is not a finite number")
-        out[str(col).strip()] = values
+            raise DatasetError(f"{csv}: column {name!r} line {_line_of_row(csv, i)}: {text.iloc[i]!r} "
+                               "is not a finite number")
+        out[name] = values
     return out
+
+
+def _number(text) -> float:
+    """A CSV cell as a float (correctly rounded, like Python's float), NaN if it is not a number."""
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def _header_names(csv: Path) -> list[str] | None:
+    """Column names as written in the header line (pandas renames duplicates), or None if unreadable."""
+    import csv as csvmod
+
+    try:
+        with open(csv, encoding="utf-8-sig", newline="") as fh:
+            rows = (r for r in csvmod.reader(line for line in fh if line.strip() and not line.lstrip().startswith("#")))
+            return [c.strip() for c in next(rows)]
+    except (OSError, UnicodeError, csvmod.Error, StopIteration):
+        return None
+
+
+def _line_of_row(csv: Path, row: int) -> int:
+    """1-based line number in the file of data row ``row`` (0-based, after header and comments)."""
+    lines = Path(csv).read_text(encoding="utf-8", errors="replace").splitlines()
+    data = [i for i, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")]
+    return data[row + 1] + 1 if row + 1 < len(data) else len(lines)

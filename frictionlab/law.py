@@ -111,7 +111,11 @@ class FrictionLaw:
         p = self.defaults()
         for name, value in (values or {}).items():
             s = self.spec(name)
-            v = float(value)
+            try:
+                v = float(value)
+            except (TypeError, ValueError):
+                raise ParameterError(f"law '{self.name}': {name} = {value!r} is not a number "
+                                     f"(SI value in {s.unit or 'plain units'})") from None
             if not (math.isfinite(v) and s.lower <= v <= s.upper):
                 raise ParameterError(
                     f"law '{self.name}': {name} = {value!r} {s.unit} is outside its bounds [{s.lower:g}, {s.upper:g}]"

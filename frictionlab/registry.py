@@ -26,6 +26,7 @@ _laws: dict[str, FrictionLaw] = {}
 _sources: dict[str, str] = {}
 _runtime: list[tuple[FrictionLaw, str]] = []
 _loaded = False
+_loading = False
 
 
 def _as_law(obj, source: str) -> FrictionLaw:
@@ -59,8 +60,13 @@ def validate_law(law: FrictionLaw, source: str) -> None:
         dAdt=np.zeros(n) if "dAdt" in law.requires else None,
     )
     p = law.defaults()
-    f_pos = law.evaluate(p, probe)
-    f_neg = law.evaluate(p, attrs_replace(probe, u=-probe.u))
+    try:
+        f_pos = law.evaluate(p, probe)
+        f_neg = law.evaluate(p, attrs_replace(probe, u=-probe.u))
+    except FrictionLabError as exc:  # name the plugin, not only the law
+        msg = str(exc)
+        prefix = f"law '{law.name}': "
+        raise LawError(f"law '{law.name}' ({source}): {msg[len(prefix):] if msg.startswith(prefix) else msg}") from None
     if np.any(f_pos < 0) or np.any(f_neg > 0):
         raise LawError(
             f"law '{law.name}' ({source}): force() does not oppose slip at its defaults; "
@@ -75,6 +81,8 @@ def attrs_replace(c: Contact, **kw) -> Contact:
 
 
 def _add(law: FrictionLaw, source: str) -> None:
+    if law.name in _laws and type(_laws[law.name]) is type(law):
+        return  # the same class reached twice (a decorator in a module an entry point also names)
     if law.name in _laws:
         raise RegistryError(f"law name '{law.name}' is registered twice: by {_sources[law.name]} and by {source}")
     _laws[law.name] = law
@@ -82,9 +90,10 @@ def _add(law: FrictionLaw, source: str) -> None:
 
 
 def _load() -> None:
-    global _loaded
-    if _loaded:
+    global _loaded, _loading
+    if _loaded or _loading:
         return
+    _loading = True
     _laws.clear()
     _sources.clear()
     seen = set()
@@ -116,6 +125,8 @@ def _load() -> None:
         _laws.clear()
         _sources.clear()
         raise
+    finally:
+        _loading = False
     _loaded = True
 
 
@@ -128,14 +139,21 @@ def register_law(obj=None, *, replace: bool = False):
     def _register(o):
         source = f"run-time registration of {getattr(o, '__module__', '?')}.{getattr(o, '__qualname__', type(o).__name__)}"
         law = _as_law(o, source)
-        _load()
-        if replace and law.name in _laws and _sources[law.name].startswith("run-time"):
-            unregister_law(law.name)
-        _add(law, source)
-        _runtime.append((law, source))
+        _runtime_add(law, source, replace)
         return o
 
     return _register if obj is None else _register(obj)
+
+
+def _runtime_add(law: FrictionLaw, source: str, replace: bool) -> None:
+    if _loading:  # a plugin module registering itself while entry points load: added after them
+        _runtime.append((law, source))
+        return
+    _load()
+    if replace and law.name in _laws and _sources[law.name].startswith("run-time"):
+        unregister_law(law.name)
+    _add(law, source)
+    _runtime.append((law, source))
 
 
 def unregister_law(name: str) -> None:

@@ -31,8 +31,10 @@ EFFECTS = {
 # --- validation of Python-built models: no NaN or negative size slips through ----------
 def _number(test, words):
     def check(instance, attribute, value):
-        ok = isinstance(value, (int, float, np.floating, np.integer)) and not isinstance(value, bool)
-        if not ok or not math.isfinite(value) or not test(value):
+        # a batch view (frictionlab.batch) puts arrays over scenes in these fields: check every element
+        v = None if isinstance(value, (bool, np.bool_)) else np.asarray(value)
+        ok = v is not None and v.dtype.kind in "fi"
+        if not ok or not np.all(np.isfinite(v)) or not np.all(test(v)):
             raise SceneError(f"{type(instance).__name__}.{attribute.name} must be {words}, got {value!r}")
     return check
 
@@ -213,12 +215,15 @@ class Scene:
             raise SceneError(f"Scene.effects: unknown effect(s) {unknown}; known: {', '.join(EFFECTS)}")
         if self.incline is not None:
             _finite(self, attrs.fields(Scene).incline, self.incline)
-            if not 0 < self.incline < math.pi / 2:
+            if not np.all((0 < np.asarray(self.incline)) & (np.asarray(self.incline) < math.pi / 2)):
                 raise SceneError(f"Scene.incline must be between 0 and pi/2 rad, got {self.incline!r}")
-        if "gravity" in self.effects and self.incline is None:
-            raise SceneError("Scene: effect 'gravity' needs an incline angle")
         if {"spin", "slip-coupling"} & set(self.effects) and self.radius is None:
             raise SceneError("Scene: effects 'spin' and 'slip-coupling' need a radius")
+        if "gravity" in self.effects:
+            if self.incline is None:
+                raise SceneError("effect 'gravity' needs scene.incline")
+            if self.normal is None:  # a block on an incline is pressed on by its weight
+                object.__setattr__(self, "normal", WeightNormal(self.mass * G * np.cos(self.incline)))
 
     @property
     def inertia(self) -> float:
@@ -270,21 +275,25 @@ class Scene:
 
         mass = q("mass", "kg")
         radius = q("radius", "m", required="spin" in effects or "slip-coupling" in effects)
-        incline = q("incline", "rad", required=kind == "incline")
+        incline = q("incline", "rad", required=kind == "incline", positive=False)
         if incline is not None and not (0 < incline < math.pi / 2):
             raise SceneError(f"{where}: scene.incline must be between 0 and 90 deg, got {spec['incline']!r}")
         if kind == "incline":
             effects |= {"gravity"}
         inertia_factor = q("inertia_factor", "", default=0.4, required=False)
+        if not inertia_factor <= 1.0:
+            raise SceneError(f"{where}: scene.inertia_factor = {inertia_factor:g}: I = f m r^2 needs f <= 1 "
+                             "(0.4 for a solid sphere, 2/3 for a thin shell)")
         u0 = q("u0", "m/s", required=kind != "impact-outcome", positive=False, default=0.0)
         omega0 = q("omega0", "rad/s", required=False, positive=False, default=0.0)
 
+        for key in ("area", "normal", "compliance"):
+            if key in spec and not isinstance(spec[key], Mapping):
+                raise SceneError(f"{where}: scene.{key} must be a table, got {type(spec[key]).__name__} {spec[key]!r}")
         area = _area_from_spec(spec.get("area"), where, q, columns, t)
         contact_time = getattr(area, "contact_time", None)
         normal = _normal_from_spec(spec.get("normal"), where, q, columns, t, mass, contact_time, spec, incline)
         contact_time = contact_time if contact_time is not None else getattr(normal, "contact_time", None)
-        if "gravity" in effects and normal is None:
-            normal = WeightNormal(mass * G * math.cos(incline))
         compliance = None
         if "compliance" in spec:
             c = spec["compliance"]
@@ -312,11 +321,13 @@ class Scene:
             raise SceneError(f"{where}: {exc}") from None
 
 
-def _column(columns, name, where, prefix):
+def _column(columns, name, where, prefix, quantity):
     if "t" not in columns:
         raise SceneError(f"{where}: {prefix}.model = 'column' needs the time column 't'")
+    if name != quantity:
+        raise SceneError(f"{where}: {prefix}.column = {name!r}: the column must be the {quantity!r} column")
     if name not in columns:
-        raise SceneError(f"{where}: {prefix}.column = {name!r} is not a column of the CSV (has: {', '.join(columns)})")
+        raise SceneError(f"{where}: {prefix}.column = {name!r} is not a column of the CSV (has: {', '.join(map(str, columns))})")
     return columns[name]
 
 
@@ -332,7 +343,7 @@ def _area_from_spec(a, where, q, columns, t):
     if model == "growth":
         return GrowthArea(q("initial", "m^2", a, p), q("rate", "m^2/m", a, p, positive=False))
     if model == "column":
-        A = _column(columns, a.get("column", "A"), where, p)
+        A = _column(columns, a.get("column", "A"), where, p, "A")
         if np.any(A < 0):
             raise SceneError(f"{where}: area column has negative values")
         try:
@@ -365,7 +376,7 @@ def _normal_from_spec(n, where, q, columns, t, mass, contact_time, spec, incline
         radius = q("radius", "m", n, p)
         return HertzNormal(4.0 * modulus / (3.0 * math.pi**1.5 * radius))
     if model == "column":
-        return TableNormal(t, _column(columns, n.get("column", "N"), where, p))
+        return TableNormal(t, _column(columns, n.get("column", "N"), where, p, "N"))
     if model == "weight":
         if incline is None:
             raise SceneError(f"{where}: {p}.model = 'weight' needs scene.incline")

@@ -48,7 +48,11 @@ def unit_factor(unit: str, si_unit: str, where: str) -> float:
         raise UnitError(
             f"{where}: unit {unit!r} is {_dim(q)}, expected {_dim(target)} (like {si_unit or 'a plain number'!r})"
         )
-    return float(q.to(target.units).magnitude)
+    _check_angle(q, target, repr(unit), si_unit, where)
+    factor = float(q.to(target.units).magnitude)
+    if not (math.isfinite(factor) and factor > 0):
+        raise UnitError(f"{where}: unit {unit!r} does not convert to {si_unit or 'a plain number'!r}")
+    return factor
 
 
 def to_si(value, si_unit: str, where: str) -> float:
@@ -80,12 +84,33 @@ def to_si(value, si_unit: str, where: str) -> float:
                 if si_unit
                 else f"{where}: {value!r} should be a plain number"
             )
+        _check_angle(q, target, repr(value), si_unit, where)
         out = float(q.to(target.units).magnitude)
     else:
         raise UnitError(f"{where}: expected a quantity string like '1 {si_unit}', got {type(value).__name__}")
     if not math.isfinite(out):
         raise UnitError(f"{where}: {value!r} is not finite")
     return out
+
+
+def _angle_power(q) -> float:
+    """Power of the radian in a quantity's root units (pint counts angles as dimensionless)."""
+    _, root = _registry().get_root_units(q.units)
+    return dict(root._units).get("radian", 0)
+
+
+def _check_angle(q, target, shown: str, si_unit: str, where: str) -> None:
+    """Angles are dimensionless to pint, so 1 Hz would convert to 1 rad/s and 30 deg to 0.52:
+    refuse a value whose angle part differs from the target's (a factor 2 pi or 57 goes unseen)."""
+    given, wanted = _angle_power(q), _angle_power(target)
+    if given == wanted:
+        return
+    if wanted and si_unit == "rad/s":
+        raise UnitError(f"{where}: {shown} has no angle unit; write it like 'rad/s', 'rpm' or 'deg/s' "
+                        "(Hz and 1/s are ambiguous: read as rad/s they are off by 2 pi)")
+    if wanted:
+        raise UnitError(f"{where}: {shown} has no angle unit; write it like 'rad' or 'deg'")
+    raise UnitError(f"{where}: {shown} is an angle, expected {_dim(target)} (like {si_unit or 'a plain number'!r})")
 
 
 def _dim(q) -> str:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..dataset import Dataset
-from ..errors import SolverError
+from ..errors import SceneError, SolverError
 from ..plan import make_plan
 from ..registry import get_law
 from ..scene import Scene
@@ -46,6 +46,9 @@ def simulate(law, scene, params=None, solver: str = "ode", t=None, rtol: float =
     if isinstance(scene, Dataset):
         name = f"dataset '{scene.name}'"
         fixed = {k: v for k, v in scene.fixed.items() if k in law.param_names}
+        if scene.scene is None:
+            raise SceneError(f"dataset '{scene.name}' ({scene.kind}) has no [scene] to simulate; "
+                             "it is a supporting series, not a motion to fit")
         if t is None:
             t = scene.t
         scene = scene.scene

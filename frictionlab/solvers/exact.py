@@ -26,6 +26,7 @@ from ..law import AreaSlipForm, NormalAreaRateForm
 from ..scene import ConstantArea, HalfSineArea, HalfSineNormal, WeightNormal
 
 SCAN = 4096  # grid points scanned for the first zero of slip
+SLIP_MARGIN = 1e-12  # slip, relative to its scale, by which a stop must pass zero (as in ode.zero_slip)
 
 
 def check(plan, p) -> None:
@@ -97,43 +98,67 @@ def _states(plan, t0, y0, t, J, K):
 B_LAPLACE = 500.0  # above this b the integral of exp(-2 b sin^2) is summed as a Laplace-type series
 
 
-def bessel_integral(b: float, phi: float, t: np.ndarray) -> np.ndarray:
+def bessel_integral(b, phi, t) -> np.ndarray:
     """int_0^t exp(b cos(phi s) - b) ds for 0 <= t <= pi/phi, to machine precision.
 
-    b <= 500: the Bessel (Jacobi-Anger) series ive(0,b) t + 2 sum_k ive(k,b) sin(k phi t) / (k phi).
-    b > 500: with x = sin(phi s / 2) the integral is (2/phi) int_0^X exp(-2 b x^2) / sqrt(1 - x^2) dx;
-    the integrand is below exp(-b/2) for x > 1/2, so X is capped there and 1/sqrt(1 - x^2) is
-    expanded, sum_n C(2n,n)/4^n x^(2n), each term an incomplete gamma function; the terms fall
-    like (1/(4b))^n. (The Bessel series would need ~sqrt(90 b) terms and loses accuracy.)
+    b [-], phi [1/s] and t [s] broadcast against each other (a batch passes (n, 1) columns
+    and an (n, m) grid).
+    b <= 500: the Bessel (Jacobi-Anger) series ive(0,b) t + 2 sum_k ive(k,b) sin(k phi t) / (k phi);
+    the sines come from the recurrence sin((k+1)x) = 2 cos(x) sin(kx) - sin((k-1)x); terms stop
+    once 2 I_k(b) e^-b / k falls below 1e-17 I_0(b) e^-b for every b.
+    b > 500: the series would need ~sqrt(90 b) terms (6e6 at b = 4.5e11) and loses accuracy;
+    instead see ``_laplace_integral``.
     """
-    t = np.asarray(t, dtype=float)
-    if b > B_LAPLACE:
-        from scipy.special import gamma, gammainc
+    b, phi, t = (np.asarray(v, dtype=float) for v in (b, phi, t))
+    big = b > B_LAPLACE
+    if not np.any(big):
+        return _bessel_series(b, phi, t)
+    if np.all(big):
+        return _laplace_integral(b, phi, t)
+    return np.where(big, _laplace_integral(np.where(big, b, 2 * B_LAPLACE), phi, t),
+                    _bessel_series(np.where(big, 0.0, b), phi, t))
 
-        X = np.minimum(np.sin(phi * t / 2.0), 0.5)
-        z = 2.0 * b * X * X
-        out = np.zeros_like(t)
-        c = 1.0
-        for n in range(12):
-            a = n + 0.5
-            out = out + c * 0.5 * (2.0 * b) ** (-a) * gamma(a) * gammainc(a, z)
-            c *= (2 * n + 1) / (2 * n + 2)
-        return (2.0 / phi) * out
-    kmax = int(math.ceil(math.sqrt(2.0 * max(b, 1.0) * 45.0))) + 20
-    k = np.arange(1, kmax + 1)
-    w = ive(k, b)  # I_k(b) exp(-b), decays fast once k^2 > 2b
-    w = w[w > 1e-300]
-    k = k[: w.size]
-    out = ive(0, b) * t
-    for chunk in range(0, k.size, 256):
-        kk, ww = k[chunk: chunk + 256], w[chunk: chunk + 256]
-        out = out + 2.0 * np.sum(ww[:, None] * np.sin(np.outer(kk, phi * t)) / (kk[:, None] * phi), axis=0)
+
+def _bessel_series(b, phi, t):
+    kmax = int(math.ceil(math.sqrt(2.0 * max(float(np.max(b, initial=0.0)), 1.0) * 45.0))) + 20
+    w0 = ive(0, b)
+    x = phi * t
+    out = w0 * t
+    two_cos = 2.0 * np.cos(x)
+    s_prev, s_k = np.zeros_like(x), np.sin(x)
+    for k in range(1, kmax + 1):
+        w = ive(k, b)
+        out = out + (2.0 * w / (k * phi)) * s_k
+        if np.all(2.0 * w <= 1e-17 * k * w0):
+            break
+        s_prev, s_k = s_k, two_cos * s_k - s_prev
+    return out
+
+
+def _laplace_integral(b, phi, t):
+    """The same integral for large b: with x = sin(phi s / 2) it is (2/phi) int_0^X exp(-2 b x^2) / sqrt(1 - x^2) dx.
+
+    The integrand is below exp(-b/2) for x > 1/2, so X is capped there and 1/sqrt(1 - x^2) is
+    expanded, sum_n C(2n,n)/4^n x^(2n); each term is an incomplete gamma function and the terms
+    fall like (1/(4b))^n.
+    """
+    from scipy.special import gamma, gammainc
+
+    X = np.minimum(np.sin(phi * t / 2.0), 0.5)
+    z = 2.0 * b * X * X
+    out = np.zeros(np.broadcast(b, z).shape)
+    c = 1.0
+    for n in range(12):
+        a = n + 0.5
+        out = out + c * 0.5 * (2.0 * b) ** (-a) * gamma(a) * gammainc(a, z)
+        c *= (2 * n + 1) / (2 * n + 2)
+    return (2.0 / phi) * out
     return out
 
 
 def _area_slip(plan, k, t0, y0, t):
     s = plan.scene
-    u0 = float(plan.rigid_slip(y0))
+    u0 = plan.rigid_slip(y0)
     kappa = plan.kappa
     if isinstance(s.area, ConstantArea):
         rate = kappa * k * s.area.area
@@ -157,7 +182,7 @@ def _area_slip(plan, k, t0, y0, t):
     tau = np.minimum(t, tc)
     u = u0 * np.exp(-2.0 * b * np.sin(phi * tau / 2.0) ** 2)
     int_u = u0 * bessel_integral(b, phi, tau)
-    u_end = u0 * math.exp(-2.0 * b)
+    u_end = u0 * np.exp(-2.0 * b)
     int_u = int_u + u_end * np.maximum(t - tc, 0.0)
     J = (u0 - u) / kappa
     K = (u0 * t - int_u) / kappa
@@ -194,7 +219,7 @@ def _area_integrals(area, t):
 def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     s = plan.scene
     sgn = direction if direction != 0 else 1.0
-    area = s.area if form.c != 0.0 else None
+    area = s.area if np.any(np.asarray(form.c) != 0.0) else None
 
     def JK(tt):
         IN, IIN = _normal_integrals(s.normal, tt)
@@ -215,14 +240,25 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
         return u_s + plan.drive * (tt - t0) - plan.kappa * JK(np.atleast_1d(tt))[0]
 
     T = float(t[-1])
+    # slip must pass zero by a hair (as in the ode solver's event): at a restart from rest,
+    # round-off in the slip an ulp after t0 is not a new stop
+    s = plan.scene
+    margin = SLIP_MARGIN * max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * (s.radius or 0.0), 1e-300)
     grid = np.unique(np.concatenate([np.linspace(t0, T, SCAN), t]))
-    g = sgn * slip(grid)
+    g = sgn * slip(grid) + margin
     bad = np.nonzero(g[1:] <= 0.0)[0]
     if bad.size == 0:
         return J, K, None
     i = int(bad[0]) + 1
-    if g[i] == 0.0:
-        return J, K, float(grid[i])
-    t_stop = brentq(lambda x: sgn * slip(x)[0], grid[i - 1], grid[i], xtol=1e-15 * max(T, 1e-300),
-                    rtol=4 * np.finfo(float).eps)
-    return J, K, float(t_stop)
+    xtol, rtol = 1e-15 * max(T, 1e-300), 4 * np.finfo(float).eps
+    t_margin = float(grid[i]) if g[i] == 0.0 else brentq(lambda x: sgn * slip(x)[0] + margin, grid[i - 1], grid[i],
+                                                         xtol=xtol, rtol=rtol)
+    # the margin only detects the stop; the stop itself is where slip is zero, found from the
+    # last time slip was strictly of the phase's sign (the closed form is exact, keep it so)
+    ahead = np.nonzero(sgn * slip(grid[:i]) > 0.0)[0]
+    if ahead.size == 0:
+        return J, K, t_margin
+    lo = float(grid[int(ahead[-1])])
+    if sgn * slip(t_margin)[0] >= 0.0:
+        return J, K, t_margin
+    return J, K, float(brentq(lambda x: sgn * slip(x)[0], lo, t_margin, xtol=xtol, rtol=rtol))

@@ -5,16 +5,32 @@ tolerances means the same thing for a 1 ns and a 1 s contact, for 1e-12 and 1 m^
 """
 from __future__ import annotations
 
+import numbers
+
 import numpy as np
 from scipy.integrate import solve_ivp
 
 from ..errors import SolverError
+from . import stick
 
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 
+#: Slip, relative to its scale, by which the zero-slip event waits past zero (see zero_slip).
+SLIP_MARGIN = 1e-12
 
-def state_scales(plan, p, t0: float, T: float, y0, direction: float) -> np.ndarray:
-    """Typical size of each state over [t0, T], so that tolerances act relative to it.
+
+def state_scales(plan, T: float) -> np.ndarray:
+    """Typical size of each state; shape (n_states,), or (n_states, n) for a batch view with array fields."""
+    s = plan.scene
+    r = 1.0 if s.radius is None else s.radius
+    V = np.maximum(np.maximum(np.abs(s.u0), np.abs(plan.drive) * T), np.abs(s.omega0) * (0.0 if s.radius is None else r))
+    V = np.where(V > 1e-300, V, 1.0)
+    size = {"v": V, "omega": V / r, "theta": V * T / r, "x": V * T, "xi": V * T}
+    return np.array(np.broadcast_arrays(*[size[k] for k in plan.states]), dtype=float)
+
+
+def phase_scales(plan, p, t0: float, T: float, y0, direction: float) -> np.ndarray:
+    """Typical size of each state over a sliding phase [t0, T], so that tolerances act relative to it.
 
     Velocities scale with the largest of the initial slip and body speed, and the speed the
     drive can reach: |drive| (T - t0), or less where the law's force at that speed exceeds
@@ -52,20 +68,20 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
     """A sliding-phase function for ``segments.run`` using solve_ivp ``method``."""
     if method not in METHODS:
         raise SolverError(f"unknown ODE method {method!r}; choose one of {', '.join(METHODS)}")
-    if not (0 < rtol < 1):
-        raise SolverError(f"rtol must be in (0, 1), got {rtol}")
+    if isinstance(rtol, bool) or not isinstance(rtol, numbers.Real) or not (0 < rtol < 1):
+        raise SolverError(f"rtol must be a number in (0, 1), got {rtol!r}")
     atol = rtol if atol is None else atol
+    if isinstance(atol, bool) or not isinstance(atol, numbers.Real) or not (0 < atol < float("inf")):
+        raise SolverError(f"atol must be a positive number, got {atol!r}")
 
     def slide(plan, p, t0, y0, direction, t_out):
         if len(t_out) == 0 or t_out[-1] <= t0:
             return np.repeat(np.asarray(y0, dtype=float)[:, None], len(t_out), axis=1), None, None, {"nfev": 0}
         T = float(t_out[-1])
-        scale = state_scales(plan, p, t0, T, y0, direction)
+        scale = phase_scales(plan, p, t0, T, y0, direction)
         tscale = T
         compliant = "xi" in plan.states
 
-        hold = not compliant and direction != 0
-        tiny = np.finfo(float).tiny
 
         def f(s, z):
             t = s * tscale
@@ -74,15 +90,17 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
                 F, u = plan.patch_force(p, t, y)
             else:
                 u = plan.rigid_slip(y)
-                if hold:  # keep the sliding mode of this phase: extend the law continuously past zero slip
-                    u = direction * max(direction * float(u), tiny)
+                if direction != 0:
+                    u = stick.branch_slip(plan, u, direction)
                 F, _ = plan.force(p, np.asarray(t), y, np.asarray(u))
             return plan.rates(t, y, F, u) * tscale / scale
 
         events = None
         if not compliant and direction != 0:
             def zero_slip(s, z):
-                return float(plan.rigid_slip(z * scale)) / scale[0]
+                # fires once slip has passed zero by a hair (SLIP_MARGIN of its scale), so that
+                # round-off at a restart from rest (slip exactly 0) is not taken for a new stop
+                return float(plan.rigid_slip(z * scale)) / scale[0] + direction * SLIP_MARGIN
 
             zero_slip.terminal = True
             zero_slip.direction = -direction
@@ -104,8 +122,6 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
         if events is not None and sol.t_events[0].size:
             t_stop = float(sol.t_events[0][0]) * tscale
             y_stop = sol.y_events[0][0] * scale
-            # solve_ivp returns only the t_eval points before the terminal event
-            Y = Y[:, : int(np.count_nonzero(np.asarray(t_out) <= t_stop))]
         info = {"nfev": int(sol.nfev), "njev": int(sol.njev), "nlu": int(sol.nlu), "method": method,
                 "rtol": rtol, "atol": atol}
         return Y, t_stop, y_stop, info

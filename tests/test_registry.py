@@ -1,0 +1,186 @@
+"""The law registry: entry points (built-in and third-party), run-time registration, errors."""
+import re
+import sys
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import frictionlab as fl
+from frictionlab import registry
+from frictionlab.errors import LawError, RegistryError
+from frictionlab.law import Contact
+
+README = Path(__file__).resolve().parents[1] / "README.md"
+
+
+def test_builtin_laws_come_from_entry_points():
+    laws = fl.available_laws()
+    assert {"coulomb", "area-rate", "wear", "couette"} <= set(laws)
+    for name in ("coulomb", "area-rate", "wear", "couette"):
+        assert registry.law_source(name).startswith(f"entry point '{name} = frictionlab.laws.")
+    assert "laws" not in sys.modules  # the folder is installed as frictionlab.laws only
+
+
+@pytest.mark.parametrize("name, params, needs", [
+    ("coulomb", ["mu"], {"u", "N"}),
+    ("area-rate", ["mu", "eta_prime"], {"u", "N", "dAdt"}),
+    ("wear", ["lam"], {"u", "A"}),
+    ("couette", ["eta", "h"], {"u", "A"}),
+])
+def test_builtin_declarations(name, params, needs):
+    law = fl.get_law(name)
+    assert list(law.param_names) == params
+    assert set(law.requires) == needs
+
+
+def test_builtin_forces_by_hand():
+    c = Contact(t=np.zeros(3), u=np.array([2.0, -1.0, 0.0]), N=np.array([10.0, 10.0, 10.0]),
+                A=np.array([1e-4, 2e-4, 1e-4]), dAdt=np.array([0.5, -0.5, 0.0]))
+    assert np.allclose(fl.get_law("coulomb").force({"mu": 0.3}, c), [3.0, -3.0, 0.0])
+    assert np.allclose(fl.get_law("area-rate").force({"mu": 0.3, "eta_prime": 4.0}, c),
+                       [0.3 * (10 + 2.0), -0.3 * (10 - 2.0), 0.0])
+    assert np.allclose(fl.get_law("wear").force({"lam": 1e6}, c), [200.0, -200.0, 0.0])
+    assert np.allclose(fl.get_law("couette").force({"eta": 0.1, "h": 1e-6}, c), [20.0, -20.0, 0.0])
+
+
+def test_unknown_law_lists_the_registered_ones():
+    with pytest.raises(RegistryError, match=r"unknown law 'nope'; registered laws: .*wear"):
+        fl.get_law("nope")
+
+
+def _law_class(name="tmp-law", sign=1.0):
+    class TmpLaw(fl.FrictionLaw):
+        formula = "F = k u"
+        citation = "test"
+        params = (fl.ParamSpec("k", "N s/m", 1.0, 0.0, 10.0, 1.0, "viscous coefficient"),)
+        requires = frozenset({"u"})
+
+        def force(self, p, c):
+            return sign * p["k"] * c.u
+
+    TmpLaw.name = name
+    return TmpLaw
+
+
+def test_runtime_registration_and_duplicate_names_both_sources():
+    cls = _law_class("tmp-runtime")
+    fl.register_law(cls)
+    try:
+        assert fl.get_law("tmp-runtime").force({"k": 2.0}, Contact(t=np.zeros(1), u=np.ones(1)))[0] == 2.0
+        with pytest.raises(RegistryError, match=r"'wear' is registered twice: by entry point 'wear = .*run-time"):
+            fl.register_law(_law_class("wear"))
+    finally:
+        fl.unregister_law("tmp-runtime")
+    assert "tmp-runtime" not in fl.available_laws()
+
+
+def test_law_with_wrong_sign_is_rejected_naming_it():
+    with pytest.raises(LawError, match=r"law 'backwards' .* does not oppose slip"):
+        fl.register_law(_law_class("backwards", sign=-1.0))
+
+
+def _write_dist(root: Path, dist: str, module_code: str, entry_points: str):
+    pkg = root / dist.replace("-", "_")
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text(textwrap.dedent(module_code))
+    info = root / f"{dist.replace('-', '_')}-0.1.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {dist}\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text("[frictionlab.laws]\n" + textwrap.dedent(entry_points))
+
+
+THIRD_PARTY = """
+    import numpy as np
+    from frictionlab import FrictionLaw, ParamSpec
+
+    class Viscous(FrictionLaw):
+        name = "viscous-third-party"
+        formula = "F = c u"
+        citation = "a third-party package"
+        params = (ParamSpec("c", "N s/m", 2.0, 0.0, 100.0, 1.0, "viscous coefficient"),)
+        requires = frozenset({"u"})
+
+        def force(self, p, c):
+            return p["c"] * c.u
+"""
+
+
+@pytest.fixture
+def third_party(tmp_path, monkeypatch):
+    _write_dist(tmp_path, "viscous-law", THIRD_PARTY, "viscous-third-party = viscous_law:Viscous\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    registry.reload_registry()
+    yield tmp_path
+    monkeypatch.undo()
+    registry.reload_registry()
+
+
+def test_third_party_entry_point_registers_and_evaluates(third_party):
+    law = fl.get_law("viscous-third-party")
+    assert "viscous-law 0.1" in registry.law_source("viscous-third-party")
+    f = law.force({"c": 3.0}, Contact(t=np.zeros(2), u=np.array([1.0, -2.0])))
+    assert np.allclose(f, [3.0, -6.0])
+    scene = fl.Scene(kind="incline", mass=1.0, u0=1.0, duration=1.0)
+    traj = fl.simulate(law, scene, {"c": 3.0}, solver="ode", t=np.linspace(0, 1, 5))
+    assert np.allclose(traj.v, np.exp(-3.0 * traj.t), rtol=1e-7)
+
+
+def test_third_party_law_in_cli_listing(third_party, run_cli):
+    out = run_cli("laws", env={"PYTHONPATH": str(third_party)})
+    assert out.returncode == 0, out.stderr
+    assert "viscous-third-party: F = c u" in out.stdout
+    assert "viscous-law 0.1" in out.stdout
+
+
+def test_broken_plugin_warns_and_registry_still_works(tmp_path, monkeypatch):
+    _write_dist(tmp_path, "broken-law", "raise ImportError('missing dependency foo')\n", "broken = broken_law:X\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    try:
+        with pytest.warns(registry.PluginWarning, match=r"broken = broken_law:X.*missing dependency foo"):
+            registry.reload_registry()
+        assert "wear" in fl.available_laws()
+    finally:
+        monkeypatch.undo()
+        registry.reload_registry()
+
+
+def test_two_plugins_with_one_name_is_an_error_naming_both(tmp_path, monkeypatch):
+    _write_dist(tmp_path, "dup-one", THIRD_PARTY, "viscous-third-party = dup_one:Viscous\n")
+    _write_dist(tmp_path, "dup-two", THIRD_PARTY.replace("Viscous", "Viscous2"),
+                "viscous-third-party = dup_two:Viscous2\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    try:
+        with pytest.raises(RegistryError, match=r"registered twice: by entry point .*dup-(one|two) 0.1 and by .*dup-"):
+            registry.reload_registry()
+    finally:
+        monkeypatch.undo()
+        registry.reload_registry()
+
+
+def _readme_law_code() -> str:
+    text = README.read_text()
+    block = re.search(r"```python\n(import numpy as np\n\nfrom frictionlab import FrictionLaw.*?)```", text, re.S)
+    assert block, "README has no law example"
+    return block.group(1)
+
+
+def test_readme_law_example_runs_as_written(tmp_path, run_cli):
+    code = _readme_law_code()
+    assert len(code.splitlines()) <= 35
+    (tmp_path / "my_laws.py").write_text(code)
+    out = run_cli("--load", tmp_path / "my_laws.py", "laws", "--brief")
+    assert out.returncode == 0, out.stderr
+    assert "stribeck" in out.stdout
+    namespace = {}
+    exec(compile(code, "my_laws.py", "exec"), namespace)
+    try:
+        law = fl.get_law("stribeck")
+        scene = fl.Scene(kind="incline", mass=0.1, u0=1.0, duration=0.05, normal=fl.scene.WeightNormal(1.0))
+        traj = fl.simulate("stribeck", scene, solver="ode", t=np.linspace(0, 0.05, 6))
+        # mu between mu_k and mu_s, so the block decelerates at between 0.2 and 0.4 N / 0.1 kg
+        assert 1.0 - 4.0 * 0.05 <= traj.v[-1] <= 1.0 - 2.0 * 0.05
+        assert law.citation.startswith("R. Stribeck")
+    finally:
+        fl.unregister_law("stribeck")
