@@ -50,7 +50,10 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
             t = s * tscale
             y = z * scale
             u = plan.slip(p, t, y)
-            if u == 0.0 and direction != 0:  # sliding resumes from rest: the law acts in the slip direction
+            if not compliant and u * direction <= 0.0 and direction != 0:
+                # within a sliding phase the law sees slip in the phase's direction, also at rest
+                # (restart) and just past zero: as in the closed forms, the right-hand side stays
+                # smooth through the stop, and the zero-slip event ends the phase there
                 u = direction * 1e-300
             F, _ = plan.force(p, np.asarray(t), y, np.asarray(u))
             return plan.rates(t, y, F, u) * tscale / scale
