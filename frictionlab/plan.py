@@ -34,9 +34,9 @@ class Plan:
     # -- constants ----------------------------------------------------------------
     @property
     def drive(self) -> float:
-        """Tangential acceleration of the body from gravity along the incline [m/s^2]."""
+        """Tangential acceleration of the body from gravity along the incline [m/s^2] (an array for a batch view)."""
         s = self.scene
-        return G * math.sin(s.incline) if "gravity" in s.effects else 0.0
+        return G * np.sin(s.incline) if "gravity" in s.effects else 0.0
 
     @property
     def kappa(self) -> float:
@@ -55,7 +55,7 @@ class Plan:
         s = self.scene
         values = {"v": s.u0 + (s.radius * s.omega0 if self.coupled else 0.0), "omega": s.omega0, "theta": 0.0,
                   "x": 0.0, "xi": 0.0}
-        return np.array([values[k] for k in self.states], dtype=float)
+        return np.array(np.broadcast_arrays(*[values[k] for k in self.states]), dtype=float)
 
     # -- contact quantities ----------------------------------------------------------
     def rigid_slip(self, y: np.ndarray) -> np.ndarray:

@@ -95,23 +95,33 @@ def _states(plan, t0, y0, t, J, K):
 
 
 # --- F = k A u ------------------------------------------------------------------------
-def bessel_integral(b: float, phi: float, t: np.ndarray) -> np.ndarray:
-    """int_0^t exp(b cos(phi s) - b) ds for 0 <= t <= pi/phi, to machine precision."""
-    kmax = int(math.ceil(math.sqrt(2.0 * max(b, 1.0) * 45.0))) + 20
-    k = np.arange(1, kmax + 1)
-    w = ive(k, b)  # I_k(b) exp(-b), decays fast once k^2 > 2b
-    w = w[w > 1e-300]
-    k = k[: w.size]
-    out = ive(0, b) * t
-    for chunk in range(0, k.size, 256):
-        kk, ww = k[chunk: chunk + 256], w[chunk: chunk + 256]
-        out = out + 2.0 * np.sum(ww[:, None] * np.sin(np.outer(kk, phi * t)) / (kk[:, None] * phi), axis=0)
+def bessel_integral(b, phi, t) -> np.ndarray:
+    """int_0^t exp(b cos(phi s) - b) ds for 0 <= t <= pi/phi, to machine precision.
+
+    b [-], phi [1/s] and t [s] broadcast against each other (a batch passes (n, 1) columns
+    and an (n, m) grid). The sines sin(k phi t) come from the three-term recurrence
+    sin((k+1)x) = 2 cos(x) sin(kx) - sin((k-1)x); terms stop once 2 I_k(b) e^-b / k falls
+    below 1e-17 I_0(b) e^-b for every b (the series converges like (b/2)^k / k!).
+    """
+    b, phi, t = (np.asarray(v, dtype=float) for v in (b, phi, t))
+    kmax = int(math.ceil(math.sqrt(2.0 * max(float(np.max(b, initial=0.0)), 1.0) * 45.0))) + 20
+    w0 = ive(0, b)
+    x = phi * t
+    out = w0 * t
+    two_cos = 2.0 * np.cos(x)
+    s_prev, s_k = np.zeros_like(x), np.sin(x)
+    for k in range(1, kmax + 1):
+        w = ive(k, b)
+        out = out + (2.0 * w / (k * phi)) * s_k
+        if np.all(2.0 * w <= 1e-17 * k * w0):
+            break
+        s_prev, s_k = s_k, two_cos * s_k - s_prev
     return out
 
 
 def _area_slip(plan, k, t0, y0, t):
     s = plan.scene
-    u0 = float(plan.rigid_slip(y0))
+    u0 = plan.rigid_slip(y0)
     kappa = plan.kappa
     if isinstance(s.area, ConstantArea):
         rate = kappa * k * s.area.area
@@ -135,7 +145,7 @@ def _area_slip(plan, k, t0, y0, t):
     tau = np.minimum(t, tc)
     u = u0 * np.exp(-2.0 * b * np.sin(phi * tau / 2.0) ** 2)
     int_u = u0 * bessel_integral(b, phi, tau)
-    u_end = u0 * math.exp(-2.0 * b)
+    u_end = u0 * np.exp(-2.0 * b)
     int_u = int_u + u_end * np.maximum(t - tc, 0.0)
     J = (u0 - u) / kappa
     K = (u0 * t - int_u) / kappa
@@ -172,7 +182,7 @@ def _area_integrals(area, t):
 def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     s = plan.scene
     sgn = direction if direction != 0 else 1.0
-    area = s.area if form.c != 0.0 else None
+    area = s.area if np.any(np.asarray(form.c) != 0.0) else None
 
     def JK(tt):
         IN, IIN = _normal_integrals(s.normal, tt)

@@ -11,6 +11,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from ..errors import SolverError
+from . import stick
 
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 
@@ -19,13 +20,13 @@ SLIP_MARGIN = 1e-12
 
 
 def state_scales(plan, T: float) -> np.ndarray:
+    """Typical size of each state; shape (n_states,), or (n_states, n) for a batch view with array fields."""
     s = plan.scene
-    V = max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * (s.radius or 0.0), 1e-300)
-    if V == 1e-300:
-        V = 1.0
-    r = s.radius or 1.0
+    r = 1.0 if s.radius is None else s.radius
+    V = np.maximum(np.maximum(np.abs(s.u0), np.abs(plan.drive) * T), np.abs(s.omega0) * (0.0 if s.radius is None else r))
+    V = np.where(V > 1e-300, V, 1.0)
     size = {"v": V, "omega": V / r, "theta": V * T / r, "x": V * T, "xi": V * T}
-    return np.array([size[k] for k in plan.states])
+    return np.array(np.broadcast_arrays(*[size[k] for k in plan.states]), dtype=float)
 
 
 def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = None):
@@ -50,11 +51,8 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
             t = s * tscale
             y = z * scale
             u = plan.slip(p, t, y)
-            if not compliant and u * direction <= 0.0 and direction != 0:
-                # within a sliding phase the law sees slip in the phase's direction, also at rest
-                # (restart) and just past zero: as in the closed forms, the right-hand side stays
-                # smooth through the stop, and the zero-slip event ends the phase there
-                u = direction * 1e-300
+            if not compliant and direction != 0:
+                u = stick.branch_slip(plan, u, direction)
             F, _ = plan.force(p, np.asarray(t), y, np.asarray(u))
             return plan.rates(t, y, F, u) * tscale / scale
 

@@ -18,10 +18,23 @@ def needed_force(plan) -> float:
     return plan.drive / plan.kappa
 
 
+def vanishing_slip(plan):
+    """The small slip magnitude [m/s] at which a law's force 'at zero slip' is evaluated."""
+    return 1e-12 * np.maximum(np.abs(plan.scene.u0), 1e-3)
+
+
+def branch_slip(plan, u, direction):
+    """Slip the law sees during a sliding phase in ``direction``: a Runge-Kutta stage that overshoots
+    zero slip sees vanishing slip on the phase's side, so the phase's force law continues smoothly and
+    the zero-slip event ends the phase. (Letting the force flip there makes slip chatter about zero,
+    a sliding mode, and the integrator crawl towards an event that never comes.)"""
+    return np.where(direction * u > 0, u, direction * vanishing_slip(plan))
+
+
 def capacity(plan, p, t, y, direction: float) -> np.ndarray:
     """The law's force at vanishing slip in ``direction`` (+1 or -1), at times t for stuck state y."""
     t = np.atleast_1d(np.asarray(t, dtype=float))
-    tiny = direction * 1e-12 * max(abs(plan.scene.u0), 1e-3)
+    tiny = direction * vanishing_slip(plan)
     yy = np.repeat(np.asarray(y, dtype=float)[:, None], t.size, axis=1)
     f, _ = plan.force(p, t, yy, np.full(t.size, tiny))
     return direction * f

@@ -1,0 +1,614 @@
+"""Many scenes at once: vectorized closed forms and a vectorized Runge-Kutta engine, with stick per scene.
+
+``simulate_batch(law, scenes, params, t, solver, rtol)`` returns a ``BatchResult`` of (n_scenes, n_t)
+arrays. Scenes in one batch share their structure (kind, effects, area and normal-force model
+types) and differ in numbers; a ``SceneBatch`` holds them column-wise, so a sweep of a million
+scenes never builds a million Scene objects.
+
+The physics is not written twice: a batch "view" is an ordinary Scene whose numeric fields are
+arrays, and the ordinary Plan, law force, closed-form helpers (``solvers.exact``) and stuck-phase
+formulas (``solvers.stick``) evaluate it elementwise. Laws must therefore broadcast their
+parameters (every built-in law does: its force is arithmetic on the parameter values).
+
+Solvers:
+  'exact'   the closed forms of ``solvers.exact`` over the whole batch; stick located per scene by
+            vectorized bisection. A scene that breaks away after sticking (rare: it needs a law whose
+            holding capacity drops below the drive) is re-run alone with the scalar exact solver.
+  'RK45', 'DOP853'  ``frictionlab.vecrk``: scipy's tableaus, per-scene adaptive steps, dense output,
+            zero slip located per scene; stuck phases and breakaway handled per scene.
+  'auto'    'exact' where the law and scene admit a closed form, else 'DOP853'.
+Tolerances act on the same scaled problem as ``solvers.ode`` (time by the span, states by
+``ode.state_scales``), so rtol means what it means for ``simulate(..., solver='ode:...')``.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+
+import attrs
+import numpy as np
+
+from . import vecrk
+from .errors import ParameterError, SceneError, SolverError
+from .plan import Plan, make_plan
+from .registry import get_law
+from .scene import HalfSineNormal, HertzNormal, Scene, WeightNormal
+from .solvers import exact, stick
+from .solvers.ode import state_scales
+from .trajectory import Trajectory
+
+SOLVERS = ("auto", "exact") + vecrk.METHODS
+SCAN = 1024  # uniform points scanned for the first zero of slip when it is not provably monotone
+MAX_SEGMENTS = 200
+_NONNEGATIVE_N = (HalfSineNormal, HertzNormal, WeightNormal)
+_TOP = ("mass", "u0", "duration", "radius", "inertia_factor", "omega0", "incline")
+
+
+# --- scenes, column-wise -------------------------------------------------------------------
+def _is_number(x) -> bool:
+    return isinstance(x, (int, float, np.floating, np.integer)) and not isinstance(x, bool)
+
+
+def _structure(scene: Scene):
+    return (scene.kind, scene.effects, type(scene.area), type(scene.normal), scene.compliance is None,
+            scene.radius is None, scene.incline is None)
+
+
+def _model_fields(model):
+    return [] if model is None else [f.name for f in attrs.fields(type(model)) if f.init]
+
+
+@attrs.frozen(eq=False)
+class SceneBatch:
+    """n scenes of one structure: a template Scene plus per-scene values of its numeric fields.
+
+    ``values`` maps a field path ('mass', 'u0', 'area.peak', 'normal.impulse', ...) to an (n,)
+    array in SI; fields not listed take the template's value for every scene.
+    """
+
+    template: Scene
+    values: dict
+    n: int
+
+    @classmethod
+    def from_scenes(cls, scenes: Sequence[Scene]) -> "SceneBatch":
+        scenes = list(scenes)
+        if not scenes:
+            raise SceneError("batch: no scenes given")
+        first = scenes[0]
+        key = _structure(first)
+        for i, s in enumerate(scenes):
+            if not isinstance(s, Scene):
+                raise SceneError(f"batch: item {i} is a {type(s).__name__}, not a Scene")
+            if _structure(s) != key:
+                raise SceneError(f"batch: scene {i} differs in structure (kind, effects or area/normal model) from "
+                                 "scene 0; simulate scenes of one structure per batch")
+        values = {}
+        paths = [(name, None) for name in _TOP]
+        paths += [("area", f) for f in _model_fields(first.area)] + [("normal", f) for f in _model_fields(first.normal)]
+        for top, field in paths:
+            if field is None:
+                col = [getattr(s, top) for s in scenes]
+                path = top
+            else:
+                col = [getattr(getattr(s, top), field) for s in scenes]
+                path = f"{top}.{field}"
+            ref = col[0]
+            if _is_number(ref):
+                arr = np.array(col, dtype=float)
+                if np.any(arr != arr[0]):
+                    values[path] = arr
+            elif any(c is not ref for c in col[1:]):
+                raise SceneError(f"batch: scenes differ in {path}, which cannot be vectorized; "
+                                 "share one model object or simulate them one by one")
+        return cls(first, values, len(scenes))
+
+    @classmethod
+    def sweep(cls, template: Scene, values: Mapping[str, np.ndarray]) -> "SceneBatch":
+        """A batch from a template and arrays for some of its numeric fields (all of one length)."""
+        arrays = {k: np.asarray(v, dtype=float).ravel() for k, v in values.items()}
+        sizes = {a.size for a in arrays.values()}
+        if len(sizes) != 1:
+            raise SceneError(f"batch: sweep arrays differ in length ({sorted(sizes)})")
+        known = set(_TOP) | {f"area.{f}" for f in _model_fields(template.area)} | {
+            f"normal.{f}" for f in _model_fields(template.normal)}
+        bad = sorted(set(arrays) - known)
+        if bad:
+            raise SceneError(f"batch: unknown scene field(s) {bad}; known: {', '.join(sorted(known))}")
+        return cls(template, arrays, sizes.pop())
+
+    def view(self, idx=None, column: bool = False) -> Scene:
+        """A Scene whose varying fields are arrays over scenes ``idx`` (shape (k,), or (k, 1) with column)."""
+        def take(a):
+            a = a if idx is None else a[idx]
+            return a[:, None] if column else a
+
+        return self._with({path: take(a) for path, a in self.values.items()})
+
+    def scene(self, i: int) -> Scene:
+        """Scene i as an ordinary Scene of floats."""
+        return self._with({path: float(a[i]) for path, a in self.values.items()})
+
+    def _with(self, values) -> Scene:
+        top, area, normal = {}, {}, {}
+        for path, a in values.items():
+            head, _, field = path.partition(".")
+            {"area": area, "normal": normal}.get(head, top)[field or head] = a
+        s = self.template
+        if area:
+            top["area"] = attrs.evolve(s.area, **area)
+        if normal:
+            top["normal"] = attrs.evolve(s.normal, **normal)
+        return attrs.evolve(s, **top) if top else s
+
+    def __len__(self) -> int:
+        return self.n
+
+
+# --- parameters ------------------------------------------------------------------------------
+def batch_params(law, params, n: int) -> dict:
+    """Law parameters for n scenes: name -> float (shared) or (n,) array, checked against bounds.
+
+    ``params`` is None (defaults), a mapping of name -> scalar or (n,) array, or a sequence of n mappings.
+    """
+    if params is None:
+        params = {}
+    if not isinstance(params, Mapping):
+        rows = list(params)
+        if len(rows) != n:
+            raise ParameterError(f"batch: {len(rows)} parameter sets for {n} scenes")
+        names = set().union(*[set(r) for r in rows]) if rows else set()
+        params = {k: np.array([r.get(k, law.spec(k).default) for r in rows], dtype=float) for k in names}
+    out = {}
+    for spec in law.params:
+        v = params.get(spec.name, spec.default)
+        a = np.asarray(v, dtype=float)
+        if a.ndim == 0:
+            a = float(a)
+        elif a.shape != (n,):
+            raise ParameterError(f"batch: parameter {spec.name} has shape {a.shape}, expected ({n},) or a scalar")
+        bad = ~(np.isfinite(a) & (a >= spec.lower) & (a <= spec.upper))
+        if np.any(bad):
+            i = int(np.argmax(np.atleast_1d(bad)))
+            val = np.atleast_1d(a)[i]
+            raise ParameterError(f"law '{law.name}': {spec.name} = {val!r} {spec.unit} (scene {i}) is outside its bounds "
+                                 f"[{spec.lower:g}, {spec.upper:g}]")
+        out[spec.name] = a
+    for k in params:
+        law.spec(k)  # unknown names raise ParameterError
+    return out
+
+
+def _take_params(p, idx, column=False):
+    def take(v):
+        if isinstance(v, float):
+            return v
+        v = v[idx]
+        return v[:, None] if column else v
+
+    return {k: take(v) for k, v in p.items()}
+
+
+# --- result ----------------------------------------------------------------------------------
+@attrs.frozen(eq=False)
+class BatchResult:
+    """Per-scene sampled motion, SI: t (n_t,) shared or (n, n_t); u, v, omega, theta, force (n, n_t);
+    A, N (n, n_t) where the plan built them; stick_time (n,) [s], NaN where slip never stuck."""
+
+    t: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    omega: np.ndarray
+    theta: np.ndarray
+    force: np.ndarray
+    stick_time: np.ndarray
+    A: np.ndarray | None = None
+    N: np.ndarray | None = None
+    solver: str = ""
+    law: str = ""
+    info: dict = attrs.field(factory=dict)
+
+    def __len__(self) -> int:
+        return self.u.shape[0]
+
+    def trajectory(self, i: int) -> Trajectory:
+        """Scene i as an ordinary Trajectory."""
+        t = self.t if self.t.ndim == 1 else self.t[i]
+        st = float(self.stick_time[i])
+        return Trajectory(t=t, u=self.u[i], v=self.v[i], omega=self.omega[i], theta=self.theta[i], force=self.force[i],
+                          A=None if self.A is None else self.A[i], N=None if self.N is None else self.N[i],
+                          solver=f"batch:{self.solver}", law=self.law, stick_time=None if math.isnan(st) else st)
+
+
+# --- entry point -----------------------------------------------------------------------------
+def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol: float = 1e-8,
+                   atol: float | None = None, n: int = 201) -> BatchResult:
+    """Simulate ``law`` on many scenes of one structure.
+
+    scenes: a sequence of Scene or a SceneBatch; params: see ``batch_params``; t: sample times [s],
+    (n_t,) shared or (n_scenes, n_t), default n points over each scene's duration; solver: 'auto',
+    'exact', 'RK45' or 'DOP853'; rtol/atol: tolerances on the scaled problem (as ``solvers.ode``).
+    """
+    law = get_law(law)
+    batch = scenes if isinstance(scenes, SceneBatch) else SceneBatch.from_scenes(scenes)
+    if solver not in SOLVERS:
+        raise SolverError(f"batch: unknown solver {solver!r}; choose one of {', '.join(SOLVERS)}")
+    if not (0 < rtol < 1):
+        raise SolverError(f"rtol must be in (0, 1), got {rtol}")
+    nsc = batch.n
+    p = batch_params(law, params, nsc)
+    tgrid = _time_grid(batch, t, n)
+    T = np.broadcast_to(tgrid, (nsc, tgrid.shape[-1]))
+    plan = make_plan(batch.view(), law, "batch scene")
+    if "xi" in plan.states:
+        raise SolverError("batch: tangential compliance is not supported; use simulate(..., solver='ode')")
+    if solver in ("auto", "exact"):
+        p0 = {k: v if isinstance(v, float) else float(v[0]) for k, v in p.items()}
+        plan0 = make_plan(batch.scene(0), law)
+        try:
+            exact.check(plan0, p0)
+            solver = "exact"
+        except SolverError:
+            if solver == "exact":
+                raise
+            solver = "DOP853"
+    if solver == "exact":
+        out, info = _run_exact(law, batch, p, T)
+    else:
+        out, info = _run_rk(law, batch, p, T, solver, rtol, atol)
+    info.update({"rtol": rtol, "atol": rtol if atol is None else atol} if solver != "exact" else {})
+    return BatchResult(t=tgrid, solver=solver, law=law.name, info=info, **out)
+
+
+def _time_grid(batch, t, n):
+    if t is None:
+        dur = batch.values.get("duration")
+        if dur is None:
+            return np.linspace(0.0, batch.template.duration, n)
+        return dur[:, None] * np.linspace(0.0, 1.0, n)[None, :]
+    t = np.asarray(t, dtype=float)
+    ok = t.ndim in (1, 2) and t.shape[-1] > 0 and np.all(np.isfinite(t)) and np.all(t >= 0)
+    ok = ok and np.all(np.diff(t, axis=-1) >= 0) and (t.ndim == 1 or t.shape[0] == batch.n)
+    if not ok:
+        raise SolverError("batch: t must be (n_t,) or (n_scenes, n_t) non-decreasing times >= 0")
+    return t
+
+
+def _plan(law, view) -> Plan:
+    return make_plan(view, law, "batch scene")
+
+
+def _zero_slip(plan, y):
+    """Slip set to exactly zero at a stick event (states (d, k))."""
+    y = np.array(y, dtype=float)
+    y[0] = plan.scene.radius * y[plan.index("omega")] if plan.coupled else 0.0
+    return y
+
+
+def _finish(law, batch, p, T, Y, sliding, need):
+    """u, force, A and N on the output grid from the states, as ``segments.run`` does."""
+    view = batch.view(column=True)
+    plan = _plan(law, view)
+    u = np.where(sliding, plan.rigid_slip(Y), 0.0)
+    c = plan.contact(T, Y, u)
+    F = law.evaluate(_take_params(p, slice(None), column=True), c)
+    F = np.where(sliding, F, np.broadcast_to(need, F.shape))
+    A = c.A if c.A is not None else (view.area(T, None, u)[0] if plan.needs_area else None)
+    N = c.N
+    omega = Y[plan.index("omega")] if plan.has_spin else np.zeros_like(u)
+    theta = Y[plan.index("theta")] if plan.has_spin else np.zeros_like(u)
+    for name, arr in (("u", u), ("v", Y[0]), ("omega", omega), ("theta", theta), ("force", F)):
+        if not np.all(np.isfinite(arr)):
+            i = int(np.argmax(~np.all(np.isfinite(arr), axis=1)))
+            raise SolverError(f"batch: {name} became NaN or infinite for law '{law.name}' in scene {i}")
+    return {"u": u, "v": np.array(Y[0]), "omega": np.array(omega), "theta": np.array(theta), "force": F,
+            "A": None if A is None else np.broadcast_to(A, u.shape).copy(),
+            "N": None if N is None else np.broadcast_to(N, u.shape).copy()}
+
+
+def _bisect(fn, lo, hi, tol):
+    """First root of a per-scene sign change: fn(t (k,)) <= 0 at hi, > 0 at lo; returns hi side."""
+    for _ in range(vecrk.BISECTIONS + 10):
+        if np.all(hi - lo <= tol):
+            break
+        mid = 0.5 * (lo + hi)
+        below = fn(mid) <= 0.0
+        hi = np.where(below, mid, hi)
+        lo = np.where(below, lo, mid)
+    return hi
+
+
+# --- stuck phases ----------------------------------------------------------------------------
+def _breakaway(law, batch, p, ids, ts, ys, t_end, last_dir):
+    """Per stuck scene: (breakaway time or NaN, hold direction), as ``solvers.stick.breakaway``."""
+    view = batch.view(ids, column=True)
+    plan = _plan(law, view)
+    pc = _take_params(p, ids, column=True)
+    need = np.broadcast_to(stick.needed_force(plan), (ids.size, 1))[:, 0]
+    hold = np.where(need != 0, np.sign(need), np.where(last_dir != 0, np.sign(last_dir), 1.0))
+    known = _known_capacity(law, plan, pc, ids.size, ts, need)
+    if known is not None:
+        return known, hold, need
+    tiny = hold * np.broadcast_to(stick.vanishing_slip(plan), (ids.size, 1))[:, 0]
+    y3 = ys[:, :, None]
+
+    def margin(tt):
+        f, _ = plan.force(pc, tt, y3, np.broadcast_to(tiny[:, None], tt.shape))
+        return hold[:, None] * f - np.abs(need)[:, None]
+
+    frac = np.linspace(0.0, 1.0, stick.GRID)
+    grid = ts[:, None] + (t_end - ts)[:, None] * frac[None, :]
+    bad = margin(grid) < 0
+    first = np.argmax(bad, axis=1)
+    tb = np.full(ids.size, np.nan)
+    anyb = bad.any(axis=1)
+    tb[anyb & (first == 0)] = ts[anyb & (first == 0)]
+    ref = np.nonzero(anyb & (first > 0))[0]
+    if ref.size:
+        sub_view = batch.view(ids[ref], column=True)
+        sub_plan = _plan(law, sub_view)
+        sub_p = _take_params(p, ids[ref], column=True)
+
+        def g(tt):
+            f, _ = sub_plan.force(sub_p, tt[:, None], ys[:, ref, None], tiny[ref, None])
+            return hold[ref] * f[:, 0] - np.abs(need[ref])
+
+        lo = grid[ref, first[ref] - 1]
+        hi = grid[ref, first[ref]]
+        tb[ref] = _bisect(g, lo, hi, 1e-15 * np.maximum(t_end[ref], 1e-300))
+    return tb, hold, need
+
+
+def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask):
+    """Stuck-phase states (``solvers.stick.stuck_states``) at outputs in [t_from, t_to] not yet filled."""
+    plan = _plan(law, batch.view(ids, column=True))
+    Ts = T[ids]
+    Ys, _ = stick.stuck_states(plan, Ts, ts[:, None], ys[:, :, None])
+    sel = (Ts >= t_from[:, None]) & (Ts <= t_to[:, None]) & ~done[ids]
+    r, c = np.nonzero(sel)
+    Y[:, ids[r], c] = np.broadcast_to(Ys, (Y.shape[0],) + Ts.shape)[:, r, c]
+    done[ids[r], c] = True
+    stuck_mask[ids[r], c] = True
+
+
+# --- the vectorized Runge-Kutta path ----------------------------------------------------------
+def _run_rk(law, batch, p, T, method, rtol, atol):
+    nsc, m = T.shape
+    full = _plan(law, batch.view())
+    d = len(full.states)
+    t_end = T[:, -1].copy()
+    scale = np.broadcast_to(state_scales(full, t_end), (d, nsc))
+    Y = np.full((d, nsc, m), np.nan)
+    done = np.zeros((nsc, m), dtype=bool)
+    stuck_mask = np.zeros((nsc, m), dtype=bool)
+    stick_time = np.full(nsc, np.nan)
+    segments = np.zeros(nsc, dtype=int)
+    nfev = np.zeros(nsc, dtype=np.int64)
+    iterations = 0
+    y0 = np.broadcast_to(full.initial_state().reshape(d, -1), (d, nsc)).copy()
+    u_start = np.broadcast_to(full.rigid_slip(y0), (nsc,))
+    direction = np.sign(u_start)
+    t0 = np.zeros(nsc)
+    # scenes starting at zero slip begin stuck (they may break away at once)
+    slide_ids = np.nonzero(direction != 0)[0]
+    stuck_ids = np.nonzero(direction == 0)[0]
+    last_dir = np.zeros(nsc)
+    while slide_ids.size or stuck_ids.size:
+        if stuck_ids.size:
+            segments[stuck_ids] += 1
+            tb, hold, need = _breakaway(law, batch, p, stuck_ids, t0[stuck_ids], y0[:, stuck_ids], t_end[stuck_ids],
+                                        last_dir[stuck_ids])
+            end = np.where(np.isnan(tb), t_end[stuck_ids], tb)
+            held = ~(tb == t0[stuck_ids])  # breakaway at once: the sliding phase owns the outputs at t0
+            if held.any():
+                h_ids = stuck_ids[held]
+                _fill_stuck(law, batch, h_ids, t0[h_ids], y0[:, h_ids], t0[h_ids], end[held], T, Y, done, stuck_mask)
+            go = ~np.isnan(tb) & (tb < t_end[stuck_ids])
+            ids = stuck_ids[go]
+            if ids.size:
+                plan_s = _plan(law, batch.view(ids, column=True))
+                ys, _ = stick.stuck_states(plan_s, tb[go][:, None], t0[ids][:, None], y0[:, ids][:, :, None])
+                y0[:, ids] = ys[:, :, 0]
+                t0[ids] = tb[go]
+                direction[ids] = hold[go]
+            slide_ids = np.union1d(slide_ids, ids)
+            stuck_ids = np.array([], dtype=int)
+        if slide_ids.size == 0:
+            break
+        segments[slide_ids] += 1
+        if np.any(segments > MAX_SEGMENTS):
+            i = int(np.argmax(segments > MAX_SEGMENTS))
+            raise SolverError(f"batch {method}: slip changed between sliding and sticking more than {MAX_SEGMENTS} times "
+                              f"in scene {i} (chatter); the law is not suited to this scene")
+        res = _slide_rk(law, batch, p, slide_ids, t0, y0, direction, T, t_end, scale, method, rtol, atol)
+        iterations += res.iterations
+        nfev[slide_ids] += res.nfev
+        Yr = res.Y * scale[:, slide_ids, None]
+        r, c = np.nonzero(res.reached & ~done[slide_ids])
+        Y[:, slide_ids[r], c] = Yr[:, r, c]
+        done[slide_ids[r], c] = True
+        ev = np.nonzero(~np.isnan(res.t_event))[0]
+        ids = slide_ids[ev]
+        ts = res.t_event[ev] * t_end[ids]
+        first = np.isnan(stick_time[ids])
+        stick_time[ids[first]] = ts[first]
+        plan_e = _plan(law, batch.view(ids))
+        y0[:, ids] = _zero_slip(plan_e, res.y_event[:, ev] * scale[:, ids])
+        t0[ids] = ts
+        last_dir[ids] = direction[ids]
+        stuck_ids = ids[ts < t_end[ids]]
+        slide_ids = np.array([], dtype=int)
+    if not done.all():
+        i = int(np.argmax(~done.all(axis=1)))
+        raise SolverError(f"batch {method}: scene {i} ended before its last requested time")
+    need = stick.needed_force(_plan(law, batch.view(column=True)))
+    out = _finish(law, batch, p, T, Y, ~stuck_mask, need)
+    out["stick_time"] = stick_time
+    return out, {"nfev": int(nfev.sum()), "nfev_per_scene": nfev, "iterations": iterations,
+                 "segments": int(segments.max(initial=0)), "method": method}
+
+
+def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rtol, atol):
+    """One sliding phase for scenes ``ids`` on the scaled problem (time / span, states / scale)."""
+    span = t_end[ids]
+    sc = scale[:, ids]
+
+    def make_rhs(k):
+        g_ids = ids[k]
+        plan = _plan(law, batch.view(g_ids))
+        pv = _take_params(p, g_ids)
+        tsc, ssc = span[k], sc[:, k]
+        dirs = direction[g_ids]
+
+        def rhs(s, z):
+            t = s * tsc
+            y = z * ssc
+            u = stick.branch_slip(plan, plan.rigid_slip(y), dirs)
+            F, _ = plan.force(pv, t, y, u)
+            return plan.rates(t, y, F, u) * tsc / ssc
+
+        return rhs
+
+    def make_event(k):
+        g_ids = ids[k]
+        plan = _plan(law, batch.view(g_ids))
+        dsc = direction[g_ids] / sc[0, k]
+
+        def g(s, z):
+            return plan.rigid_slip(z * sc[:, k]) * dsc
+
+        return g
+
+    s_out = T[ids] / span[:, None]
+    return vecrk.integrate(make_rhs, t0[ids] / span, y0[:, ids] / sc, 1.0, s_out, method=method, rtol=rtol,
+                           atol=atol, make_event=make_event, breaks=_breaks(batch, ids, span))
+
+
+def _breaks(batch, ids, span):
+    """End of contact of half-sine area and normal-force models, in units of each scene's span."""
+    view = batch.view(ids)
+    cols = [np.broadcast_to(np.asarray(m.contact_time, dtype=float), ids.shape) / span
+            for m in (view.area, view.normal) if hasattr(m, "contact_time")]
+    return np.column_stack(cols) if cols else None
+
+
+# --- the vectorized closed forms -------------------------------------------------------------
+def _run_exact(law, batch, p, T):
+    nsc, m = T.shape
+    view = batch.view(column=True)
+    plan = _plan(law, view)
+    pc = _take_params(p, slice(None), column=True)
+    form = law.form(pc)
+    d = len(plan.states)
+    y0 = np.broadcast_to(plan.initial_state().reshape(d, -1, 1), (d, nsc, 1))
+    stick_time = np.full(nsc, np.nan)
+    stuck_mask = np.zeros((nsc, m), dtype=bool)
+    fallback = np.zeros(nsc, dtype=bool)
+    if isinstance(form, exact.AreaSlipForm):
+        J, K = exact._area_slip(plan, form.k, 0.0, y0, T)
+        Y = exact._states(plan, 0.0, y0, T, J, K)
+    else:
+        u_s = np.broadcast_to(plan.rigid_slip(y0), (nsc, 1))
+        sgn = np.sign(u_s)
+        fallback |= sgn[:, 0] == 0
+        sgn = np.where(sgn == 0, 1.0, sgn)
+        J1, K1, _ = exact._normal_area_rate(plan, form, 0.0, y0, 1.0, T, find_stop=False)
+        Y = exact._states(plan, 0.0, y0, T, sgn * J1, sgn * K1)
+        ts = _exact_stop(law, batch, p, plan, form, y0, u_s[:, 0], sgn[:, 0], T)
+        hit = ~np.isnan(ts) & ~fallback
+        if hit.any():
+            ids = np.nonzero(hit)[0]
+            stick_time[ids] = ts[ids]
+            sub = _plan(law, batch.view(ids, column=True))
+            sub_form = law.form(_take_params(p, ids, column=True))
+            tcol = ts[ids][:, None]
+            Js, Ks, _ = exact._normal_area_rate(sub, sub_form, 0.0, y0[:, ids], 1.0, tcol, find_stop=False)
+            ys = exact._states(sub, 0.0, y0[:, ids], tcol, sgn[ids] * Js, sgn[ids] * Ks)[:, :, 0]
+            ys = _zero_slip(sub, ys)
+            t_end = T[ids, -1]
+            tb, _, _ = _breakaway(law, batch, p, ids, ts[ids], ys, t_end, sgn[ids, 0])
+            fallback[ids[~np.isnan(tb) & (tb < t_end)]] = True
+            done = T[ids] <= tcol
+            Y[:, ids] = np.where(done[None], Y[:, ids], np.nan)
+            done_full = np.zeros((nsc, m), dtype=bool)
+            done_full[ids] = done
+            _fill_stuck(law, batch, ids, ts[ids], ys, ts[ids], t_end, T, Y, done_full, stuck_mask)
+    need = stick.needed_force(plan)
+    out = _finish(law, batch, p, T, np.nan_to_num(Y) if fallback.any() else Y, ~stuck_mask, need)
+    for i in np.nonzero(fallback)[0]:
+        _scalar_into(out, stick_time, law, batch, p, T, i)
+    out["stick_time"] = stick_time
+    return out, {"nfev": 0, "scalar_fallback": int(fallback.sum())}
+
+
+def _known_capacity(law, plan, pc, k, ts, need):
+    """Breakaway times without a scan, when the law's form makes them obvious, else None.
+
+    Under F = s (a N + c dA/dt) the holding capacity is a N + c dA/dt. With c = 0, a >= 0 and a
+    normal-force model that is never negative, the capacity a N >= 0 holds a scene that needs no
+    force (no drive: the rolling sphere) for ever, and a constant N needs one comparison.
+    """
+    form = law.form(pc)
+    if not isinstance(form, exact.NormalAreaRateForm) or not isinstance(plan.scene.normal, _NONNEGATIVE_N):
+        return None
+    if not (np.all(np.asarray(form.c) == 0.0) and np.all(np.asarray(form.a) >= 0.0)):
+        return None
+    if np.all(need == 0.0):
+        return np.full(k, np.nan)
+    if isinstance(plan.scene.normal, WeightNormal):
+        cap = np.broadcast_to(form.a * plan.scene.normal.value, (k, 1))[:, 0]
+        return np.where(cap < np.abs(need), ts, np.nan)
+    return None
+
+
+def _exact_stop(law, batch, p, plan, form, y0, u_s, sgn, T):
+    """First time each scene's slip reaches zero under F = s (a N + c dA/dt), NaN if it does not."""
+    nsc = T.shape[0]
+    t_end = T[:, -1]
+
+    def make_g(ids):  # sgn * slip at times tt (k, q) for scenes ids (None: all)
+        sub = plan if ids is None else _plan(law, batch.view(ids, column=True))
+        f = form if ids is None else law.form(_take_params(p, ids, column=True))
+        s = sgn[:, None] if ids is None else sgn[ids, None]
+        us = u_s[:, None] if ids is None else u_s[ids, None]
+        y0s = y0 if ids is None else y0[:, ids]
+
+        def g(tt):
+            J1 = exact._normal_area_rate(sub, f, 0.0, y0s, 1.0, tt, find_stop=False)[0]
+            return s * (us + sub.drive * tt) - sub.kappa * J1
+
+        return g
+
+    c_zero = np.all(np.asarray(form.c) == 0.0)
+    monotone = c_zero and (isinstance(batch.template.normal, exact.WeightNormal)
+                           or np.all(sgn * np.broadcast_to(plan.drive, (nsc, 1))[:, 0] <= 0.0))
+    if monotone:
+        g_end = make_g(None)(t_end[:, None])[:, 0]
+        ids = np.nonzero(g_end <= 0.0)[0]
+        lo, hi = np.zeros(ids.size), t_end[ids]
+    else:
+        grid = t_end[:, None] * np.linspace(0.0, 1.0, SCAN)[None, :]
+        gg = make_g(None)(grid)
+        bad = gg[:, 1:] <= 0.0
+        anyb = bad.any(axis=1)
+        ids = np.nonzero(anyb)[0]
+        first = np.argmax(bad[ids], axis=1) + 1
+        lo, hi = grid[ids, first - 1], grid[ids, first]
+    ts = np.full(nsc, np.nan)
+    if ids.size:
+        g = make_g(ids)
+        ts[ids] = _bisect(lambda x: g(x[:, None])[:, 0], lo, hi, 1e-15 * np.maximum(t_end[ids], 1e-300))
+        ts[ids[ts[ids] >= t_end[ids]]] = np.nan
+    return ts
+
+
+def _scalar_into(out, stick_time, law, batch, p, T, i):
+    """Re-run scene i with the scalar exact solver (breakaway after stick, or zero initial slip)."""
+    from .solvers import simulate
+
+    pi = {k: v if isinstance(v, float) else float(v[i]) for k, v in p.items()}
+    tr = simulate(law, batch.scene(i), pi, solver="exact", t=T[i])
+    for k in ("u", "v", "omega", "theta", "force", "A", "N"):
+        if out.get(k) is not None and getattr(tr, k) is not None:
+            out[k][i] = getattr(tr, k)
+    stick_time[i] = np.nan if tr.stick_time is None else tr.stick_time

@@ -1,0 +1,83 @@
+"""``frictionlab compare``: fit every law to every dataset, rank, test the equivalence, write a report."""
+from __future__ import annotations
+
+import os
+import shutil
+import sys
+import time
+from pathlib import Path
+
+from ..errors import OutputError
+
+
+def add_parser(sub):
+    p = sub.add_parser("compare", help="compare laws on datasets and write a report folder",
+                       description="Fit every law to every dataset (default: all registered laws, all built-in "
+                                   "datasets), rank them, test the paper's equivalence claim, and write "
+                                   "report.md, report.html, figures/, ranking.csv and results.json.")
+    p.add_argument("--laws", help="comma-separated law names (default: all registered)")
+    p.add_argument("--data", nargs="+", metavar="NAME_OR_TOML", help="datasets (default: every built-in)")
+    p.add_argument("--solver", action="append", metavar="SOLVER",
+                   help="exact, series, ode[:METHOD] or auto; repeat for several (default: exact where a closed "
+                        "form exists else ode, plus series where it applies)")
+    p.add_argument("--free", action="append", default=[], metavar="NAME=LO:HI",
+                   help="fit a scene quantity per dataset within bounds, with units, e.g. u0='5 m/s:31 m/s'")
+    p.add_argument("--out", type=Path, default=Path("report"), help="report folder (default: ./report)")
+    p.add_argument("--force", action="store_true", help="replace an existing report folder")
+    p.add_argument("--jobs", type=int, default=min(os.cpu_count() or 1, 4),
+                   help="worker processes (default: number of CPUs, at most 4)")
+    p.add_argument("--no-equivalence", action="store_true", help="skip the equivalence analysis")
+    p.set_defaults(func=run)
+
+
+class ProgressBar:
+    """A one-line progress bar on a terminal; silent when the stream is not one."""
+
+    def __init__(self, stream=None):
+        self.stream = stream or sys.stderr
+        self.active = hasattr(self.stream, "isatty") and self.stream.isatty()
+        self.start = time.perf_counter()
+
+    def __call__(self, done: int, total: int, label: str) -> None:
+        if not self.active:
+            return
+        width = shutil.get_terminal_size((80, 20)).columns
+        frac = done / total if total else 1.0
+        bar = "#" * int(20 * frac) + "." * (20 - int(20 * frac))
+        line = f"[{bar}] {done}/{total} {time.perf_counter() - self.start:5.1f}s {label}"
+        self.stream.write("\r" + line[: width - 1].ljust(width - 1))
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.active:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+def run(args) -> int:
+    from ..comparison import compare
+    from ..report import write_report
+    from .fit import parse_free
+
+    if args.out.exists() and not args.force:  # fail before the work, not after it
+        raise OutputError(f"{args.out}: output folder exists; choose another --out or pass --force")
+    if args.jobs < 1:
+        raise OutputError(f"--jobs must be at least 1, got {args.jobs}")
+    free = parse_free(args.free)
+    laws = [x.strip() for x in args.laws.split(",") if x.strip()] if args.laws else None
+    bar = ProgressBar()
+    try:
+        result = compare(laws=laws, datasets=args.data, solvers=args.solver, free=free,
+                         equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar)
+    finally:
+        bar.close()
+    if bar.active:
+        print("writing the report ...", file=sys.stderr, flush=True)
+    out = write_report(result, args.out, force=args.force)
+    ok = sum(f.ok for f in result.fits)
+    n_laws, n_data = len(result.laws), len(result.fitted_datasets)
+    print(f"compared {n_laws} law{'s' * (n_laws != 1)} on {n_data} dataset{'s' * (n_data != 1)}: {ok} fits, "
+          f"{sum(f.status == 'failed' for f in result.fits)} failed, {sum(f.status == 'skipped' for f in result.fits)} "
+          f"skipped, {len(result.equivalence)} equivalence tests, in {result.wall_time:.1f} s")
+    print(f"report: {out / 'report.html'} (also report.md, ranking.csv, results.json, figures/)")
+    return 0

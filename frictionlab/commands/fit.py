@@ -1,0 +1,77 @@
+"""``frictionlab fit LAW DATASET...``: fit one law to one dataset or, jointly, to several."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ..errors import ParameterError, SolverError
+from ..fitting import SCENE_QUANTITIES, fit
+from ..registry import get_law
+from ..units import to_si
+
+
+def add_parser(sub):
+    p = sub.add_parser("fit", help="fit a law to datasets (several datasets: a global fit)",
+                       description="Fit LAW to one dataset, or to several at once with shared law parameters.")
+    p.add_argument("law", help="registered law name (see 'frictionlab laws')")
+    p.add_argument("datasets", nargs="+", metavar="DATASET", help="built-in dataset name or TOML path")
+    p.add_argument("--solver", default="auto", help="auto (exact where a closed form exists, else ode), exact, "
+                   "series, ode or ode:METHOD (default: auto)")
+    p.add_argument("--free", action="append", default=[], metavar="NAME=LO:HI[:START]",
+                   help="fit a scene quantity per dataset within bounds, with units, e.g. u0='8 m/s:14 m/s'; "
+                        f"names: {', '.join(SCENE_QUANTITIES)}")
+    p.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
+                   help="hold a law parameter, with its unit, e.g. eta='0.1 Pa s'")
+    p.add_argument("--local", action="append", default=[], metavar="NAME",
+                   help="in a global fit, fit this law parameter separately per dataset")
+    p.add_argument("--observable", help="fit this column instead of the dataset's observable (e.g. theta)")
+    p.add_argument("--derive", choices=("poly9", "spline"), help="fit omega derived from the theta column")
+    p.add_argument("--json", type=Path, metavar="FILE", help="also write the result as JSON")
+    p.set_defaults(func=run)
+
+
+def _split(text: str, what: str) -> tuple[str, str]:
+    name, sep, rest = text.partition("=")
+    if not sep or not name.strip() or not rest.strip():
+        raise ParameterError(f"{what} {text!r}: expected NAME=VALUE")
+    return name.strip(), rest.strip()
+
+
+def parse_free(items) -> dict:
+    """'u0=8 m/s:14 m/s[:12 m/s]' -> {'u0': (8.0, 14.0[, 12.0])} in SI."""
+    out = {}
+    for item in items:
+        name, rest = _split(item, "--free")
+        if name not in SCENE_QUANTITIES:
+            raise ParameterError(f"--free {name}: not a scene quantity; choose from {', '.join(SCENE_QUANTITIES)}")
+        parts = rest.split(":")
+        if len(parts) not in (2, 3):
+            raise ParameterError(f"--free {item!r}: expected NAME=LOWER:UPPER or NAME=LOWER:UPPER:START")
+        out[name] = tuple(to_si(x.strip(), SCENE_QUANTITIES[name], f"--free {name}") for x in parts)
+    return out
+
+
+def parse_fix(law, items) -> dict:
+    out = {}
+    for item in items:
+        name, rest = _split(item, "--fix")
+        spec = law.spec(name)
+        out[name] = to_si(rest, spec.unit, f"--fix {name}")
+    return out
+
+
+def run(args) -> int:
+    from ..report import _fit_json
+
+    law = get_law(args.law)
+    result = fit(law, args.datasets, solver=args.solver, free=parse_free(args.free), fixed=parse_fix(law, args.fix),
+                 local=args.local, observable=args.observable, derive=args.derive)
+    if result.status == "skipped":  # asked for explicitly, an inapplicable solver is an error, not a skip
+        raise SolverError(result.reason)
+    print(result.summary())
+    if args.json:
+        from ..io import atomic_write_text
+        from ..report import _clean
+
+        atomic_write_text(args.json, json.dumps(_clean(_fit_json(result)), indent=1, allow_nan=False) + "\n")
+    return 0 if result.status != "failed" else 1

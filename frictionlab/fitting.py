@@ -1,0 +1,534 @@
+"""Fit a friction law to one or more datasets with lmfit.
+
+``fit(law, datasets, solver='auto', ...)`` returns a ``FitResult``; it never raises for a
+fit that fails (solver error, NaN from the law, no convergence): the result then has
+``status = 'failed'`` and a ``reason``. Bad *input* (unknown law, parameter or scene
+quantity) raises a one-line FrictionLabError.
+
+* Parameters come from the law's ParamSpecs; the optimizer sees value / spec.scale, so
+  lam ~ 1e6 Pa s/m and h ~ 1e-6 m are both order one. A dataset's ``[fixed]`` values are held.
+* Scene quantities can be freed by name with bounds (``free={'u0': (8, 14)}``, SI units);
+  they are always per dataset.
+* Residuals are (model - data) / sigma, sigma the dataset's noise estimate, so datasets in
+  different units fit together. With several datasets, law parameters are shared (a global
+  fit) unless named in ``local``.
+* Predictions go through ``predict``; a dataset kind plugs in with ``register_predictor``.
+"""
+from __future__ import annotations
+
+import math
+import re
+import time
+import warnings
+from collections.abc import Mapping, Sequence
+
+import attrs
+import numpy as np
+
+from .errors import DatasetError, FrictionLabError, ParameterError, SolverError
+from .identifiability import Identifiability, find_structure, in_ratio, jacobian, jacobian_errors, make_verdict
+from .predict import (PREDICTORS, SCENE_QUANTITIES, SkipDataset, Target, applicable_solvers,
+                      auto_solver, get_scene_quantity, make_target, predict, register_predictor, set_scene_quantity)
+from .registry import get_law
+from .scene import Scene
+
+__all__ = ["DatasetFit", "FitResult", "ParamResult", "PREDICTORS", "SCENE_QUANTITIES", "SkipDataset", "Stats", "Target",
+           "applicable_solvers", "auto_solver", "fit", "get_scene_quantity", "make_target", "predict",
+           "register_predictor", "set_scene_quantity"]
+
+PENALTY = 1e4  # weighted residual per point when the model cannot be evaluated
+ODE_STARTS = 2  # at most this many starts are refined when a dataset needs the (costlier) ODE solver
+FTOL = 1e-6  # relative chi-square and step tolerances of Levenberg-Marquardt
+
+
+# --- results -------------------------------------------------------------------------------
+@attrs.frozen
+class ParamResult:
+    """A fitted (or held) parameter: SI value and standard error, unit, bounds and role."""
+
+    name: str  # display name: 'lam', or 'u0[impact-golf-v28]' for a per-dataset quantity
+    key: str  # law parameter or scene quantity
+    kind: str  # 'law' | 'scene'
+    value: float
+    stderr: float | None
+    unit: str
+    vary: bool
+    initial: float
+    lower: float
+    upper: float
+    datasets: tuple[str, ...]
+    fixed_by: str = ""  # why it is held: '' when fitted
+
+
+@attrs.frozen
+class Stats:
+    """Fit statistics. chisqr uses noise-weighted residuals; rss and rmse are in the observable's
+    SI unit (single-dataset fits only, else nan). n_params counts identifiable directions."""
+
+    n_points: int
+    n_params: int
+    n_free: int
+    chisqr: float
+    redchi: float
+    rss: float
+    rmse: float
+    aic: float
+    aicc: float
+    bic: float
+
+
+@attrs.frozen(eq=False)
+class DatasetFit:
+    """One dataset's part of a fit: data, best model, residuals (SI) and what produced them."""
+
+    target: Target
+    solver: str
+    params: dict  # law parameters at the best fit (SI)
+    scene: Scene
+    model: np.ndarray
+    rss: float
+    rmse: float
+    chisqr: float
+
+    @property
+    def name(self) -> str:
+        return self.target.name
+
+    @property
+    def residual(self) -> np.ndarray:
+        return self.model - self.target.y
+
+    def trajectory(self, law, t=None, n: int = 401):
+        """The best-fit trajectory on times t (default: n points over the scene), or None for
+        kinds without a time series."""
+        from .solvers import simulate
+
+        if self.target.t is None:
+            return None
+        if t is None:
+            t = np.linspace(0.0, max(self.scene.duration, float(self.target.t[-1])), n)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return simulate(law, self.scene, self.params, solver=self.solver, t=t)
+
+
+@attrs.frozen(eq=False)
+class FitResult:
+    """Outcome of ``fit``: parameters with errors, statistics, identifiability, per-dataset fits."""
+
+    law: str
+    solver: str
+    datasets: tuple[str, ...]
+    status: str  # 'ok' | 'failed' | 'skipped'
+    reason: str = ""
+    params: dict = attrs.field(factory=dict)  # display name -> ParamResult
+    correlations: dict = attrs.field(factory=dict)  # (a, b) -> r, free parameters only
+    stats: Stats | None = None
+    identifiability: Identifiability | None = None
+    per_dataset: tuple[DatasetFit, ...] = ()
+    nfev: int = 0
+    wall_time: float = 0.0
+    message: str = ""
+    notes: tuple[str, ...] = ()
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    def value(self, name: str) -> float:
+        return self.params[name].value
+
+    def stderr(self, name: str) -> float | None:
+        return self.params[name].stderr
+
+    def summary(self) -> str:
+        """A few lines for the terminal."""
+        on = ", ".join(d.target.label for d in self.per_dataset) if self.per_dataset else ", ".join(self.datasets)
+        head = f"{self.law} [{self.solver}] on {on}: {self.status}"
+        if not self.ok:
+            return f"{head}: {self.reason}"
+        s = self.stats
+        lines = [head, f"  chi2 = {s.chisqr:.5g}, reduced chi2 = {s.redchi:.4g}, AIC = {s.aic:.5g}, "
+                       f"BIC = {s.bic:.5g}, n = {s.n_points}, k = {s.n_params}, nfev = {self.nfev}, "
+                       f"{self.wall_time:.2f} s"]
+        for p in self.params.values():
+            err = "held" if not p.vary and p.kind != "derived" else ("no error bar" if p.stderr is None else f"+/- {p.stderr:.3g}")
+            why = f" ({p.fixed_by})" if p.fixed_by else ""
+            lines.append(f"  {p.name:<28} = {p.value:.6g} {p.unit} {err}{why}")
+        for w in self.identifiability.warnings:
+            lines.append(f"  warning: {w}")
+        for n in self.notes:
+            lines.append(f"  note: {n}")
+        return "\n".join(lines)
+
+
+# --- the fit ---------------------------------------------------------------------------------
+@attrs.frozen
+class _Slot:
+    pname: str  # lmfit identifier
+    display: str
+    kind: str
+    key: str
+    targets: tuple[int, ...]
+    value: float  # SI start value
+    lower: float
+    upper: float
+    scale: float
+    unit: str
+    vary: bool
+    fixed_by: str = ""
+
+
+def _ident(text: str) -> str:
+    s = re.sub(r"\W", "_", text)
+    return s if re.match(r"[A-Za-z_]", s) else f"p_{s}"
+
+
+def _law_slots(law, targets, fixed, local, initial) -> list[_Slot]:
+    slots = []
+    multi = len(targets) > 1
+    for spec in law.params:
+        n = spec.name
+        start = float(initial.get(n, spec.default))
+        common = dict(kind="law", key=n, lower=spec.lower, upper=spec.upper, scale=spec.scale, unit=spec.unit)
+        if n in fixed:
+            slots.append(_Slot(_ident(n), n, targets=tuple(range(len(targets))), value=float(fixed[n]), vary=False,
+                               fixed_by="held by the caller", **common))
+            continue
+        held = {i: float(t.dataset.fixed[n]) for i, t in enumerate(targets) if n in t.dataset.fixed}
+        if not multi or (len(held) == len(targets) and len(set(held.values())) == 1):
+            if held:
+                slots.append(_Slot(_ident(n), n, targets=tuple(range(len(targets))), value=next(iter(held.values())),
+                                   vary=False, fixed_by=f"[fixed] in dataset {targets[0].name}"
+                                   if not multi else "[fixed] in every dataset", **common))
+            else:
+                slots.append(_Slot(_ident(n), n, targets=tuple(range(len(targets))), value=start, vary=True, **common))
+            continue
+        free = [i for i in range(len(targets)) if i not in held]
+        for i, v in held.items():
+            slots.append(_Slot(_ident(f"{n}__{i}"), f"{n}[{targets[i].name}]", targets=(i,), value=v, vary=False,
+                               fixed_by=f"[fixed] in dataset {targets[i].name}", **common))
+        if n in local:
+            for i in free:
+                slots.append(_Slot(_ident(f"{n}__{i}"), f"{n}[{targets[i].name}]", targets=(i,), value=start,
+                                   vary=True, **common))
+        elif free:
+            slots.append(_Slot(_ident(n), n, targets=tuple(free), value=start, vary=True, **common))
+    return slots
+
+
+def _scene_slots(targets, free) -> list[_Slot]:
+    slots = []
+    for name, bounds in free.items():
+        if not (isinstance(bounds, (tuple, list)) and len(bounds) in (2, 3)):
+            raise ParameterError(f"free scene quantity '{name}': give (lower, upper) or (lower, upper, start) in SI")
+        lo, hi = float(bounds[0]), float(bounds[1])
+        if not lo < hi:
+            raise ParameterError(f"free scene quantity '{name}': lower bound {lo:g} must be below upper {hi:g}")
+        for i, tg in enumerate(targets):
+            current = get_scene_quantity(tg.dataset.scene, name)
+            start = float(bounds[2]) if len(bounds) == 3 else min(max(current, lo), hi)
+            disp = name if len(targets) == 1 else f"{name}[{tg.name}]"
+            slots.append(_Slot(_ident(f"scene_{name}__{i}"), disp, "scene", name, (i,), start, lo, hi,
+                               max(abs(start), abs(lo), abs(hi), 1e-300) if start == 0 else abs(start),
+                               SCENE_QUANTITIES[name], True))
+    return slots
+
+
+def _lmfit_bound(b: float, slot: _Slot) -> float:
+    """Bounds far outside the parameter's scale are passed as infinite (the law still checks them)."""
+    return b if abs(b) <= 1e4 * slot.scale else math.copysign(math.inf, b)
+
+
+class _Model:
+    """Evaluates the weighted residual for a vector of scaled parameter values."""
+
+    def __init__(self, law, targets, solvers, slots):
+        self.law, self.targets, self.solvers, self.slots = law, targets, solvers, slots
+        self.failures = 0
+        self.last_error = ""
+        self.nfev = 0
+
+    def split(self, values: Mapping[str, float]):
+        """Per-target law parameters and scenes for SI slot values (by lmfit name)."""
+        out = []
+        for i, tg in enumerate(self.targets):
+            p, scene = {}, tg.dataset.scene
+            for s in self.slots:
+                if i in s.targets:
+                    if s.kind == "law":
+                        p[s.key] = values[s.pname]
+                    else:
+                        scene = set_scene_quantity(scene, s.key, values[s.pname])
+            out.append((p, scene))
+        return out
+
+    def models(self, values):
+        return [predict(self.law, tg, p, solver, scene)
+                for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values))]
+
+    def residual(self, values) -> np.ndarray:
+        self.nfev += 1
+        out = []
+        for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values)):
+            try:
+                m = predict(self.law, tg, p, solver, scene)
+                if m.shape != tg.y.shape or not np.all(np.isfinite(m)):
+                    raise SolverError(f"prediction for '{tg.name}' is not finite or has the wrong shape")
+                out.append((m - tg.y) / tg.sigma)
+            except SkipDataset:
+                raise
+            except FrictionLabError as exc:
+                self.failures += 1
+                self.last_error = str(exc)
+                out.append(np.full(tg.y.shape, PENALTY))
+        return np.concatenate(out)
+
+
+def _si(params, slots) -> dict[str, float]:
+    return {s.pname: params[s.pname].value * s.scale for s in slots}
+
+
+def _start_grid(slots, rng, limit: int) -> list[dict[str, float]]:
+    """Candidate starts in scaled units, the given start first: log-spaced multiples of the start
+    for positive quantities, steps of the scale around it for signed ones, the bounds' span for
+    scene quantities; clipped into the bounds. A full grid if it has at most ``limit`` points."""
+    levels = max(3, min(15, int(round(limit ** (1.0 / len(slots))))))
+    axes = []
+    for s in slots:
+        x0 = s.value / s.scale
+        lo, hi = s.lower / s.scale, s.upper / s.scale
+        if s.kind == "scene":
+            c = np.linspace(lo, hi, levels)
+        elif lo >= 0 and x0 > 0:
+            c = x0 * np.logspace(-1.5, 1.5, levels)
+        else:
+            c = x0 + np.sinh(np.linspace(-4.0, 4.0, levels))  # dense near the start, out to +/- 27 scales
+        axes.append(np.unique(np.clip(c, lo, hi)))
+    start = [s.value / s.scale for s in slots]
+    total = math.prod(len(a) for a in axes)
+    if total <= limit:
+        grid = np.array(np.meshgrid(*axes, indexing="ij")).reshape(len(axes), -1).T
+    else:
+        grid = np.array([[rng.choice(a) for a in axes] for _ in range(limit)])
+    grid = np.vstack([start, grid])
+    return [dict(zip((s.pname for s in slots), row)) for row in grid]
+
+
+def _distinct(scored: list[tuple], n: int) -> list[dict]:
+    """Up to n starts from (cost, order, candidate) sorted by cost: each differs from those taken by
+    more than 10% in some coordinate and has a different cost (equal costs mean a plateau, such as
+    a body stuck throughout, where a second start teaches nothing)."""
+    out, costs = [], []
+    for cost, _, c in scored:
+        if any(abs(cost - k) <= 1e-9 * max(abs(cost), 1e-300) for k in costs):
+            continue
+        if all(any(abs(c[k] - o[k]) > 0.1 * max(abs(c[k]), abs(o[k]), 1e-3) for k in c) for o in out):
+            out.append(c)
+            costs.append(cost)
+        if len(out) == n:
+            break
+    return out
+
+
+def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: int, max_nfev):
+    """Score a grid of starts, refine the best distinct ones with Levenberg-Marquardt, keep the lowest
+    chi-square. Returns (parameters, success, message)."""
+    varying = [s for s in slots if s.vary]
+    if not varying:
+        return params, True, "nothing to fit: every parameter is held"
+    starts = [{s.pname: params[s.pname].value for s in varying}]
+    if scan:
+        fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
+        scored = []
+        for cand in _start_grid(varying, np.random.default_rng(0), scan):
+            vals = {**fixed_part, **cand}
+            r = model.residual({s.pname: vals[s.pname] * s.scale for s in slots})
+            scored.append((float(r @ r), len(scored), cand))
+        scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins
+        slow = any(x.startswith("ode") for x in solvers)
+        starts = _distinct(scored, min(n_starts, ODE_STARTS) if slow else n_starts)
+    best = None
+    for start in starts:
+        trial = params.copy()
+        for k, v in start.items():
+            trial[k].set(value=v)
+        mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), trial, scale_covar=True,
+                               max_nfev=max_nfev or 200 * (len(varying) + 1))
+        r = mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
+        if best is None or (r.success, -r.chisqr) > (best.success, -best.chisqr):
+            best = r
+    return best.params, bool(best.success), str(best.message)
+
+
+def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[float]] | None = None,
+        fixed: Mapping[str, float] | None = None, local: Sequence[str] = (),
+        initial: Mapping[str, float] | None = None, observable: str | None = None, derive: str | None = None,
+        scan: int = 125, n_starts: int = 3, max_nfev: int | None = None) -> FitResult:
+    """Fit ``law`` to one dataset or a group of them (a global fit) and return a FitResult.
+
+    law: name or FrictionLaw. datasets: a Dataset, name, path or Target, or a list of them.
+    solver: 'auto' (exact where a closed form exists, else ode), 'exact', 'series', 'ode[:METHOD]'.
+    free: scene quantities to fit per dataset, name -> (lower, upper[, start]) in SI (see
+    SCENE_QUANTITIES). fixed: law parameters held for every dataset (SI), on top of each
+    dataset's [fixed]. local: law parameters fitted separately per dataset in a global fit.
+    initial: start values (SI). observable / derive: what to fit (see make_target).
+    scan: number of grid points scored before Levenberg-Marquardt (0: start from the defaults);
+    n_starts: Levenberg-Marquardt runs from the best distinct grid points (the lowest chi2 wins);
+    at most ODE_STARTS when a dataset is solved by 'ode' (deterministic, never timing-dependent).
+    """
+    import lmfit  # slow to import: only when fitting
+
+    law = get_law(law)
+    started = time.perf_counter()
+    items = datasets if isinstance(datasets, (list, tuple)) else [datasets]
+    if not items:
+        raise DatasetError("fit: no datasets given")
+    names = tuple(getattr(d, "name", str(d)) for d in items)
+
+    def give_up(status, reason, **kw):
+        return FitResult(law=law.name, solver=solver, datasets=names, status=status, reason=reason,
+                         wall_time=time.perf_counter() - started, **kw)
+
+    try:
+        targets = [d if isinstance(d, Target) else make_target(d, observable, derive) for d in items]
+    except SkipDataset as exc:
+        return give_up("skipped", str(exc))
+    names = tuple(t.name for t in targets)
+    for name in list(fixed or {}) + list(local) + list(initial or {}):
+        law.spec(name)  # unknown names are input errors
+    solvers = []
+    for tg in targets:
+        if tg.dataset.kind not in PREDICTORS:
+            return give_up("skipped", f"no predictor for dataset kind '{tg.dataset.kind}' (dataset '{tg.name}')")
+        if tg.dataset.scene is None:
+            return give_up("skipped", f"dataset '{tg.name}' has no scene")
+        ok = applicable_solvers(law, tg.dataset.scene)
+        s = auto_solver(law, tg.dataset.scene) if solver == "auto" else solver
+        base = s.partition(":")[0]
+        if base not in ok:
+            from .solvers import parse_solver
+
+            parse_solver(s)  # raises the one-line error for an unknown solver
+        if ok.get(base):
+            return give_up("skipped", f"{base} on '{tg.name}': {ok[base]}")
+        solvers.append(s)
+    slots = _law_slots(law, targets, dict(fixed or {}), set(local), dict(initial or {}))
+    slots += _scene_slots(targets, dict(free or {}))
+    model = _Model(law, targets, solvers, slots)
+    params = lmfit.Parameters()
+    for s in slots:
+        params.add(s.pname, value=s.value / s.scale, vary=s.vary, min=_lmfit_bound(s.lower, s) / s.scale,
+                   max=_lmfit_bound(s.upper, s) / s.scale)
+    varying = [s for s in slots if s.vary]
+    solver_label = solver if solver != "auto" else "+".join(dict.fromkeys(solvers))
+    n_points = sum(t.y.size for t in targets)
+
+    try:
+        best_params, success, message = _search(lmfit, model, params, slots, solvers, scan, n_starts, max_nfev)
+        values = _si(best_params, slots)
+        models = model.models(values)
+    except SkipDataset as exc:
+        return give_up("skipped", str(exc))
+    except FrictionLabError as exc:
+        return give_up("failed", f"the model cannot be evaluated at the best parameters: {exc}", nfev=model.nfev)
+    except Exception as exc:  # an optimizer or law crash is a failed fit, not a crashed comparison
+        return give_up("failed", f"{type(exc).__name__}: {exc}", nfev=model.nfev)
+
+    per = []
+    for tg, solver_i, (p, scene), m in zip(targets, solvers, model.split(values), models):
+        r = m - tg.y
+        per.append(DatasetFit(tg, solver_i, p, scene, m, float(r @ r), float(np.sqrt(np.mean(r**2))),
+                              float(np.sum((r / tg.sigma) ** 2))))
+    chisqr = sum(d.chisqr for d in per)
+    J = jacobian(model, slots, values)
+    structure = find_structure(law, slots, values, J)
+    stats = _stats(n_points, structure["k_eff"], len(varying), chisqr, per)
+    status, reason = "ok", ""
+    if not all(np.all(np.isfinite(d.model)) for d in per):
+        status, reason = "failed", "the best-fit model is not finite"
+    elif not success:
+        status, reason = "failed", f"did not converge: {message}"
+    elif model.failures and chisqr >= PENALTY**2:
+        status, reason = "failed", f"the solver failed at every trial: {model.last_error}"
+    notes = []
+    if model.failures:
+        notes.append(f"{model.failures} of {model.nfev} evaluations could not be solved and were penalized "
+                     f"(last: {model.last_error})")
+    notes += _series_notes(law, per)
+    jac = jacobian_errors(slots, values, J, structure, stats.redchi)
+    presults = _param_results(slots, best_params, targets, structure, jac)
+    correl = {}
+    if structure["ratios"] or structure["no_effect"]:  # lmfit's covariance is degenerate: use the identifiable part
+        correl = jac.get("correl", {})
+    else:
+        for s in varying:
+            for other, r in (best_params[s.pname].correl or {}).items():
+                o = next(x for x in slots if x.pname == other)
+                if s.display < o.display:
+                    correl[(s.display, o.display)] = float(r)
+    ident = make_verdict(structure, presults, correl)
+    return FitResult(law=law.name, solver=solver_label, datasets=names, status=status, reason=reason,
+                     params=presults, correlations=correl, stats=stats, identifiability=ident,
+                     per_dataset=tuple(per), nfev=model.nfev, wall_time=time.perf_counter() - started,
+                     message=message, notes=tuple(notes))
+
+
+def _stats(n, k, k_free, chisqr, per) -> Stats:
+    """AIC = n ln(chi2/n) + 2k (lmfit's convention: Gaussian errors, noise scale profiled out),
+    AICc = AIC + 2k(k+1)/(n-k-1), BIC = n ln(chi2/n) + k ln n."""
+    single = len(per) == 1
+    chi = max(chisqr, np.finfo(float).tiny)
+    ll = n * math.log(chi / n)
+    aic = ll + 2 * k
+    aicc = aic + (2 * k * (k + 1) / (n - k - 1) if n - k - 1 > 0 else math.inf)
+    return Stats(n_points=n, n_params=k, n_free=k_free, chisqr=chisqr,
+                 redchi=chisqr / (n - k) if n > k else math.inf,
+                 rss=per[0].rss if single else math.nan, rmse=per[0].rmse if single else math.nan,
+                 aic=aic, aicc=aicc, bic=ll + k * math.log(n))
+
+
+def _series_notes(law, per) -> list[str]:
+    from .solvers.series import B_ACCURATE
+
+    notes = []
+    for d in per:
+        if d.solver == "series":
+            form = law.form(d.params)
+            s = d.scene
+            b = form.k * s.area.peak * s.area.contact_time / (s.mass * math.pi)
+            if b > B_ACCURATE:
+                notes.append(f"series on '{d.name}' at b = {b:.3g}: the first-order expansion (eq 7) is accurate "
+                             f"only for b << 1 (below about {B_ACCURATE})")
+            if b > 0.5:
+                t_rev = math.acos(-(1 - b) / b) * s.area.contact_time / math.pi
+                notes.append(f"series on '{d.name}': with b = {b:.3g} > 0.5 the truncated slip u0 (1 - b + b cos phi t) "
+                             f"changes sign at t = {t_rev * 1e6:.0f} us (u(t_c) = u0 (1 - 2b) < 0), so the series "
+                             "force reverses there, while the exact slip u0 exp(-b (1 - cos phi t)) never does. The series "
+                             "spin falls exactly while its slip is negative: its rise-then-fall comes from the "
+                             "truncation, not from the law")
+    return notes
+
+
+def _param_results(slots, best, targets, structure, jac) -> dict[str, ParamResult]:
+    """ParamResults in SI: lmfit's error bars; none where the data cannot give one (ratio-only,
+    no effect); the Jacobian's over the identifiable directions where lmfit gave none or where a
+    degeneracy makes its covariance unreliable. Ratio-only pairs add their ratio ('derived')."""
+    out = {}
+    degenerate = bool(structure["ratios"] or structure["no_effect"])  # lmfit's covariance is then unreliable
+    for s in slots:
+        p = best[s.pname]
+        err = p.stderr * s.scale if (s.vary and p.stderr is not None and np.isfinite(p.stderr)) else None
+        if s.display in structure["no_effect"] or (s.vary and in_ratio(s, structure)):
+            err = None
+        elif s.vary and (err is None or degenerate):
+            err = jac["errors"].get(s.display)
+        out[s.display] = ParamResult(s.display, s.key, s.kind, p.value * s.scale, err, s.unit, s.vary, s.value,
+                                     s.lower, s.upper, tuple(targets[i].name for i in s.targets), s.fixed_by)
+    for name, (value, err, unit, slot) in jac["derived"].items():
+        out[name] = ParamResult(name, name.split("[")[0], "derived", value, err, unit, False, value, 0.0, math.inf,
+                                tuple(targets[i].name for i in slot.targets),
+                                "derived: the combination the data determine")
+    return out
+
+

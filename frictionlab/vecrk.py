@@ -1,0 +1,309 @@
+"""A vectorized explicit Runge-Kutta integrator for many independent ODE problems at once.
+
+Each problem (a column of the state array, shape (n_states, n_problems)) has its own time,
+step size and step control, exactly as scipy's RK45/DOP853 would take them alone; one
+iteration advances every unfinished problem by one step attempt with array operations over
+the batch. Output at requested times comes from each method's dense output, and a terminal
+event g(t, y) = 0 (crossing from g > 0 to g <= 0) is located per problem on the dense output.
+The Butcher tableaus are scipy's (``scipy.integrate.RK45`` and ``DOP853`` class attributes),
+so the same tolerances mean the same local error control. Knows nothing about friction.
+"""
+from __future__ import annotations
+
+import attrs
+import numpy as np
+from scipy.integrate import DOP853, RK45
+
+from .errors import SolverError
+
+METHODS = ("RK45", "DOP853")
+SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
+MAX_ITERATIONS = 200_000
+BISECTIONS = 60  # event location: interval shrinks by 2^-60, below double resolution
+
+
+@attrs.frozen
+class Result:
+    """Outputs of ``integrate``: Y (n_states, n, m) where reached (else NaN), reached (n, m) bool,
+    t_event (n,) (NaN where no event), y_event (n_states, n), and counters."""
+
+    Y: np.ndarray
+    reached: np.ndarray
+    t_event: np.ndarray
+    y_event: np.ndarray
+    nfev: np.ndarray  # per problem
+    iterations: int
+
+
+def _tableau(method):
+    cls = {"RK45": RK45, "DOP853": DOP853}[method]
+    return cls
+
+
+def _rms(x):
+    return np.sqrt(np.mean(x * x, axis=0))
+
+
+def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: float = 1e-8, atol: float | None = None,
+              make_event=None, breaks=None) -> Result:
+    """Integrate n problems y' = f(t, y) from t0 (n,) with y0 (d, n) to t_end (n,).
+
+    make_rhs(idx) returns rhs(t, y) for the problems ``idx`` (t (k,), y (d, k) -> (d, k)); it is
+    called once whenever the set of unfinished problems changes. t_out (n, m) holds each
+    problem's increasing output times (entries outside [t0, t_end] are never filled).
+    make_event(idx), if given, returns g(t, y) -> (k,); a problem stops where g crosses to <= 0.
+    breaks (n, nb), if given, are times where f has a kink or jump (e.g. the end of contact): no step
+    crosses one, so a short forcing window before it cannot be stepped over.
+    """
+    if method not in METHODS:
+        raise SolverError(f"batch: unknown method {method!r}; choose one of {', '.join(METHODS)}")
+    cls = _tableau(method)
+    atol = rtol if atol is None else atol
+    t0 = np.asarray(t0, dtype=float)
+    y = np.array(y0, dtype=float)
+    d, n = y.shape
+    t_end = np.broadcast_to(np.asarray(t_end, dtype=float), (n,))
+    t_out = np.asarray(t_out, dtype=float)
+    m = t_out.shape[1]
+    Y = np.full((d, n, m), np.nan)
+    reached = np.zeros((n, m), dtype=bool)
+    t_event = np.full(n, np.nan)
+    y_event = np.full((d, n), np.nan)
+    nfev = np.zeros(n, dtype=np.int64)
+    # next output index per problem: first t_out >= t0 (outputs exactly at t0 are the initial state)
+    ptr = (t_out < t0[:, None]).sum(axis=1)
+    t = t0.copy()
+    active = np.nonzero(t < t_end)[0]
+    _fill_at_start(Y, reached, ptr, t_out, t, y, active, n)
+    if active.size == 0:
+        return Result(Y, reached, t_event, y_event, nfev, 0)
+
+    order = cls.error_estimator_order
+    exponent = -1.0 / (order + 1)
+    A, B, C = cls.A, cls.B, cls.C
+    ns = cls.n_stages
+    rhs = make_rhs(active)
+    g = make_event(active) if make_event else None
+    f = rhs(t[active], y[:, active])
+    nfev[active] += 1
+    g_old = g(t[active], y[:, active]) if g else None
+    h = _initial_step(rhs, t[active], y[:, active], f, t_end[active] - t[active], cls.order, rtol, atol)
+    if breaks is not None:  # a first step that would cross a break is sized to reach it
+        h = np.minimum(h, np.where(breaks[active] > t[active, None], breaks[active] - t[active, None], np.inf).min(axis=1))
+    nfev[active] += 1
+    F = np.empty((d, n))
+    F[:, active] = f
+    H = np.zeros(n)
+    H[active] = h
+    Gold = np.full(n, np.nan)
+    if g:
+        Gold[active] = g_old
+    rejected = np.zeros(n, dtype=bool)
+    iterations = 0
+    while active.size:
+        iterations += 1
+        if iterations > MAX_ITERATIONS:
+            raise SolverError(f"batch {method}: more than {MAX_ITERATIONS} steps; the problem is stiff or singular")
+        ta, ya, fa = t[active], y[:, active], F[:, active]
+        ha = np.minimum(H[active], t_end[active] - ta)
+        if breaks is not None:
+            b = breaks[active]
+            ahead = np.where(b > ta[:, None] * (1 + 4 * np.finfo(float).eps), b, np.inf).min(axis=1)
+            ha = np.minimum(ha, ahead - ta)
+        min_step = 10.0 * np.abs(np.nextafter(ta, np.inf) - ta)
+        if np.any(ha < min_step):
+            bad = active[np.argmax(ha < min_step)]
+            raise SolverError(f"batch {method}: step size underflow in problem {bad} at t = {t[bad]:g}")
+        K = np.empty((ns + 1, d, active.size))
+        K[0] = fa
+        for s in range(1, ns):
+            dy = np.tensordot(A[s, :s], K[:s], axes=(0, 0)) * ha
+            K[s] = rhs(ta + C[s] * ha, ya + dy)
+        y_new = ya + np.tensordot(B, K[:ns], axes=(0, 0)) * ha
+        t_new = ta + ha
+        f_new = rhs(t_new, y_new)
+        K[ns] = f_new
+        nfev[active] += ns
+        scale = atol + np.maximum(np.abs(ya), np.abs(y_new)) * rtol
+        err = _error_norm(cls, K, ha, scale)
+        ok = err < 1.0
+        with np.errstate(divide="ignore"):
+            factor = np.where(err == 0.0, MAX_FACTOR, SAFETY * err**exponent)
+        factor = np.where(ok, np.minimum(MAX_FACTOR, factor), np.maximum(MIN_FACTOR, factor))
+        factor = np.where(ok & rejected[active], np.minimum(1.0, factor), factor)
+        H[active] = ha * factor
+        rejected[active] = ~ok
+        acc = np.nonzero(ok)[0]
+        if acc.size == 0:
+            continue
+        ia = active[acc]
+        stop = np.zeros(acc.size, dtype=bool)
+        if g:
+            g_new = g(t_new, y_new)[acc]
+            stop = (g_new <= 0.0) & (Gold[ia] > 0.0)
+            Gold[ia] = g_new
+        needs_dense = stop | _has_outputs(t_out, ptr, ia, t_new[acc])
+        if needs_dense.any():
+            dense = _dense(cls, rhs, K, ta, ha, ya, y_new, f_new)
+            if cls is DOP853:
+                nfev[active] += 3
+            t_stop_acc = t_new[acc]
+            if stop.any():
+                je = np.nonzero(stop)[0]
+                ts, ys = _locate(make_event, ia[je], dense, acc[je], ta[acc[je]], ha[acc[je]])
+                t_stop_acc = t_stop_acc.copy()
+                t_stop_acc[je] = ts
+                t_event[ia[je]] = ts
+                y_event[:, ia[je]] = ys
+            jd = np.nonzero(needs_dense)[0]
+            _fill_dense(Y, reached, ptr, t_out, ia[jd], acc[jd], t_stop_acc[jd], dense)
+        t[ia] = t_new[acc]
+        y[:, ia] = y_new[:, acc]
+        F[:, ia] = f_new[:, acc]
+        done = stop | (t_new[acc] >= t_end[ia])
+        if done.any():
+            keep = np.ones(active.size, dtype=bool)
+            keep[acc[done]] = False
+            active = active[keep]
+            if active.size:
+                rhs = make_rhs(active)
+                g = make_event(active) if make_event else None
+    return Result(Y, reached, t_event, y_event, nfev, iterations)
+
+
+def _error_norm(cls, K, h, scale):
+    if cls is DOP853:
+        err5 = np.tensordot(cls.E5, K, axes=(0, 0)) / scale
+        err3 = np.tensordot(cls.E3, K, axes=(0, 0)) / scale
+        e5 = np.sum(err5 * err5, axis=0)
+        e3 = np.sum(err3 * err3, axis=0)
+        denom = e5 + 0.01 * e3
+        with np.errstate(invalid="ignore", divide="ignore"):
+            out = np.abs(h) * e5 / np.sqrt(denom * scale.shape[0])
+        return np.where(denom > 0, out, 0.0)
+    return _rms(np.tensordot(cls.E, K, axes=(0, 0)) * h / scale)
+
+
+def _initial_step(rhs, t0, y0, f0, span, order, rtol, atol):
+    """scipy's select_initial_step (Hairer, Norsett and Wanner, II.4), per problem."""
+    scale = atol + np.abs(y0) * rtol
+    d0, d1 = _rms(y0 / scale), _rms(f0 / scale)
+    h0 = np.where((d0 < 1e-5) | (d1 < 1e-5), 1e-6, 0.01 * d0 / np.where(d1 > 0, d1, 1.0))
+    h0 = np.minimum(h0, span)
+    f1 = rhs(t0 + h0, y0 + h0 * f0)
+    d2 = _rms((f1 - f0) / scale) / h0
+    big = np.maximum(d1, d2)
+    with np.errstate(divide="ignore"):
+        h1 = np.where(big <= 1e-15, np.maximum(1e-6, h0 * 1e-3), (0.01 / np.where(big > 0, big, 1.0)) ** (1.0 / (order + 1)))
+    return np.minimum(np.minimum(100 * h0, h1), span)
+
+
+def _has_outputs(t_out, ptr, idx, t_new):
+    m = t_out.shape[1]
+    p = np.minimum(ptr[idx], m - 1)
+    return (ptr[idx] < m) & (t_out[idx, p] <= t_new)
+
+
+class _Dense:
+    """Dense output over the steps [t_old, t_old + h] of a subset of problems."""
+
+    def __init__(self, kind, t_old, h, y_old, coef):
+        self.kind, self.t_old, self.h, self.y_old, self.coef = kind, t_old, h, y_old, coef
+
+    def subset(self, rows) -> "_Dense":
+        """The dense output of rows only (so repeated calls need no gathering)."""
+        return _Dense(self.kind, self.t_old[rows], self.h[rows], self.y_old[:, rows], self.coef[:, :, rows])
+
+    def __call__(self, x, rows=slice(None)):
+        """States at fractions x (k,) of the step for subset rows (k,) -> (d, k)."""
+        coef = self.coef
+        if self.kind == "RK45":  # y_old + h * sum_j Q_j x^(j+1)
+            acc = coef[-1][:, rows] * x
+            for j in range(coef.shape[0] - 2, -1, -1):
+                acc = (acc + coef[j][:, rows]) * x
+            return self.y_old[:, rows] + self.h[rows] * acc
+        acc = coef[-1][:, rows] * x  # DOP853: nested x, (1 - x) products
+        one_minus = 1.0 - x
+        for i, j in enumerate(range(coef.shape[0] - 2, -1, -1), start=1):
+            acc = (acc + coef[j][:, rows]) * (x if i % 2 == 0 else one_minus)
+        return self.y_old[:, rows] + acc
+
+
+def _dense(cls, rhs, K, t_old, h, y_old, y_new, f_new):
+    """Dense output of the steps just taken by the whole active set (rejected rows are never read)."""
+    if cls is RK45:
+        return _Dense("RK45", t_old, h, y_old, np.tensordot(cls.P.T, K, axes=(1, 0)))
+    from scipy.integrate._ivp import dop853_coefficients as dc  # INTERPOLATOR_POWER only
+
+    ext = list(K)
+    for a, c in zip(cls.A_EXTRA, cls.C_EXTRA):
+        dy = np.tensordot(a[: len(ext)], np.array(ext), axes=(0, 0)) * h
+        ext.append(rhs(t_old + c * h, y_old + dy))
+    Kx = np.array(ext)
+    Fc = np.empty((dc.INTERPOLATOR_POWER,) + y_old.shape)
+    dyv = y_new - y_old
+    Fc[0] = dyv
+    Fc[1] = h * Kx[0] - dyv
+    Fc[2] = 2 * dyv - h * (f_new + Kx[0])
+    Fc[3:] = h * np.tensordot(cls.D, Kx, axes=(1, 0))
+    return _Dense("DOP853", t_old, h, y_old, Fc)
+
+
+def _fill_at_start(Y, reached, ptr, t_out, t, y, idx, n):
+    """Outputs requested exactly at each problem's start time take its initial state."""
+    m = t_out.shape[1]
+    rows = np.nonzero((ptr < m))[0]
+    if rows.size == 0:
+        return
+    at = t_out[rows, ptr[rows]] == t[rows]
+    r = rows[at]
+    Y[:, r, ptr[r]] = y[:, r]
+    reached[r, ptr[r]] = True
+    ptr[r] += 1
+
+
+def _fill_dense(Y, reached, ptr, t_out, idx, pos, t_stop, dense):
+    """Fill every output t_out[i, ptr_i:] <= t_stop_i of problems idx (rows pos of the dense output)."""
+    m = t_out.shape[1]
+    k = np.arange(m)
+    start = ptr[idx]
+    within = (k[None, :] >= start[:, None]) & (t_out[idx] <= t_stop[:, None])
+    rows, cols = np.nonzero(within)
+    if rows.size == 0:
+        return
+    x = (t_out[idx[rows], cols] - dense.t_old[pos[rows]]) / dense.h[pos[rows]]
+    Y[:, idx[rows], cols] = dense(x, pos[rows])
+    reached[idx[rows], cols] = True
+    ptr[idx] = np.maximum(ptr[idx], within.sum(axis=1) + start)
+
+
+def _locate(make_event, idx, dense, rows, t_old, h):
+    """First g <= 0 in each step, on the dense output: Illinois regula falsi on the bracket (bisection
+    after 30 rounds); returns (t_stop, y_stop) with t_stop on the g <= 0 side, bracket <= 4 eps."""
+    g = make_event(idx)
+    dense = dense.subset(rows)
+    rows = slice(None)
+    lo, hi = np.zeros(idx.size), np.ones(idx.size)
+    glo = g(t_old, dense(lo, rows))
+    ghi = g(t_old + h, dense(hi, rows))
+    eps = 4 * np.finfo(float).eps
+    side = np.zeros(idx.size)
+    for it in range(BISECTIONS + 40):
+        open_ = (hi - lo > eps) & (ghi != 0.0)
+        if not open_.any():
+            break
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mid = (lo * ghi - hi * glo) / (ghi - glo)
+        bad = ~np.isfinite(mid) | (mid <= lo) | (mid >= hi) | (it >= 30)  # bisection if it stalls
+        mid = np.where(bad, 0.5 * (lo + hi), mid)
+        mid = np.where(open_, mid, hi)
+        gm = g(t_old + mid * h, dense(mid, rows))
+        below = (gm <= 0.0) & open_
+        above = ~below & open_
+        hi, ghi = np.where(below, mid, hi), np.where(below, gm, ghi)
+        lo, glo = np.where(above, mid, lo), np.where(above, gm, glo)
+        # Illinois: halve the stale end's value when the same side moves twice
+        glo = np.where(below & (side < 0), glo * 0.5, glo)
+        ghi = np.where(above & (side > 0), ghi * 0.5, ghi)
+        side = np.where(below, -1.0, np.where(above, 1.0, side))
+    return t_old + hi * h, dense(hi, rows)

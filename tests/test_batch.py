@@ -1,0 +1,159 @@
+"""The batch engine agrees with frictionlab.simulate (exact and ode), scene by scene, stick included."""
+import math
+
+import numpy as np
+import pytest
+
+import frictionlab as fl
+from frictionlab.batch import SceneBatch, simulate_batch
+from frictionlab.errors import FrictionLabError, ParameterError, SceneError, SolverError
+from frictionlab.scene import G, ConstantArea, GrowthArea, HalfSineArea, HalfSineNormal, HertzNormal, Scene, WeightNormal
+
+M, R = 0.046, 0.0213
+
+
+def oblique(speed, angle, e=0.6, tc=450e-6, duration=None):
+    """Golf ball on a rigid target: half-sine normal force, slip coupling (stick = rolling)."""
+    vn, vt = speed * math.cos(angle), speed * math.sin(angle)
+    return Scene(kind="impact", mass=M, u0=vt, duration=duration or tc, radius=R,
+                 normal=HalfSineNormal(M * vn * (1 + e), tc), area=HalfSineArea(150e-6, tc),
+                 effects=frozenset({"slip-coupling", "spin"}))
+
+
+def incline(u0, alpha=0.3, area=None, mass=0.02):
+    return Scene(kind="incline", mass=mass, u0=u0, duration=1.0, incline=alpha, area=area,
+                 normal=WeightNormal(mass * G * math.cos(alpha)), effects=frozenset({"gravity"}))
+
+
+def paper(u0, peak, tc=500e-6):
+    return Scene(kind="impact", mass=M, u0=u0, duration=tc, radius=R, area=HalfSineArea(peak, tc),
+                 effects=frozenset({"spin"}))
+
+
+def check(law, scenes, params, solver, ref, tol, rtol=1e-10):
+    br = simulate_batch(law, scenes, params, solver=solver, rtol=rtol)
+    for i, s in enumerate(scenes):
+        tr = fl.simulate(law, s, params[i], solver=ref, t=br.t if br.t.ndim == 1 else br.t[i], rtol=1e-12)
+        V = max(abs(s.u0), 1e-3)
+        assert np.allclose(br.u[i], tr.u, rtol=0, atol=tol * V), (i, np.max(np.abs(br.u[i] - tr.u)))
+        assert np.allclose(br.v[i], tr.v, rtol=0, atol=tol * V)
+        assert np.allclose(br.omega[i], tr.omega, rtol=0, atol=tol * V / R)
+        assert np.allclose(br.theta[i], tr.theta, rtol=0, atol=tol * V * s.duration / R)
+        Fs = max(np.max(np.abs(tr.force)), 1e-12)
+        assert np.allclose(br.force[i], tr.force, rtol=0, atol=max(tol, 1e-9) * Fs * 10)
+        if tr.stick_time is None:
+            assert math.isnan(br.stick_time[i])
+        else:
+            assert br.stick_time[i] == pytest.approx(tr.stick_time, rel=max(tol, 1e-12) * 100)
+    return br
+
+
+@pytest.fixture(scope="module")
+def rng():
+    return np.random.default_rng(7)
+
+
+def test_coulomb_oblique_impact_with_rolling_matches_exact(rng):
+    n = 12
+    scenes = [oblique(rng.uniform(20, 60), rng.uniform(0.1, 1.3)) for _ in range(n)]
+    params = [{"mu": rng.uniform(0.1, 0.5)} for _ in range(n)]
+    br = check("coulomb", scenes, params, "exact", "exact", 1e-12)
+    assert 0 < np.sum(~np.isnan(br.stick_time)) < n  # both rolling and sliding-throughout scenes
+    after = br.t[None, :] > np.nan_to_num(br.stick_time, nan=np.inf)[:, None]
+    assert np.all(br.force[after] == 0.0) and np.all(br.u[after] == 0.0)  # F = 0 once rolling
+    for meth in ("DOP853", "RK45"):
+        check("coulomb", scenes, params, meth, "exact", 1e-7)
+
+
+def test_wear_paper_impact_matches_exact(rng):
+    n = 8
+    scenes = [paper(rng.uniform(10, 30), rng.uniform(100e-6, 300e-6)) for _ in range(n)]
+    params = [{"lam": rng.uniform(0.5e6, 2e6)} for _ in range(n)]
+    check("wear", scenes, params, "exact", "exact", 1e-13)
+    check("wear", scenes, params, "DOP853", "exact", 1e-8)
+
+
+def test_rk_reproduces_scalar_ode_steps(rng):
+    """Same tableau, same scaled problem, same step control: errors match solve_ivp's."""
+    scenes = [oblique(rng.uniform(20, 60), rng.uniform(0.1, 1.3)) for _ in range(6)]
+    params = [{"mu": rng.uniform(0.1, 0.5)} for _ in range(6)]
+    for meth in ("RK45", "DOP853"):
+        br = simulate_batch("coulomb", scenes, params, solver=meth, rtol=1e-6)
+        for i, s in enumerate(scenes):
+            od = fl.simulate("coulomb", s, params[i], solver=f"ode:{meth}", t=br.t, rtol=1e-6)
+            ex = fl.simulate("coulomb", s, params[i], solver="exact", t=br.t)
+            e_b, e_o = np.max(np.abs(br.u[i] - ex.u)), np.max(np.abs(od.u - ex.u))
+            assert e_b <= 2 * e_o + 1e-12 * s.u0
+
+
+def test_incline_coulomb_sticks_and_holds(rng):
+    scenes = [incline(rng.uniform(0.01, 0.3)) for _ in range(10)]
+    params = [{"mu": rng.uniform(0.1, 0.8)} for _ in range(10)]
+    for solver in ("exact", "DOP853"):
+        br = check("coulomb", scenes, params, solver, "exact", 1e-9)
+    stuck = ~np.isnan(br.stick_time)
+    assert stuck.any() and (~stuck).any()
+
+
+def test_zero_initial_slip_and_breakaway_area_rate(rng):
+    """Start at rest on an incline; area-rate law that lets go while the contact unloads."""
+    scenes = [incline(0.0) for _ in range(4)]
+    params = [{"mu": m} for m in (0.1, 0.2, 0.4, 0.5)]
+    check("coulomb", scenes, params, "exact", "exact", 1e-12)
+    check("coulomb", scenes, params, "RK45", "exact", 1e-9)
+    imp = [oblique(rng.uniform(20, 60), rng.uniform(0.1, 1.3), duration=540e-6) for _ in range(10)]
+    ap = [{"mu": rng.uniform(0.1, 0.5), "eta_prime": rng.uniform(-2e3, 2e3)} for _ in range(10)]
+    br = check("area-rate", imp, ap, "exact", "exact", 1e-11)
+    check("area-rate", imp, ap, "DOP853", "exact", 1e-6)
+    assert br.info["scalar_fallback"] >= 0
+
+
+def test_lubricated_and_dry_inclines_match_ode(rng):
+    lub = [incline(rng.uniform(0, 0.05), alpha=rng.uniform(0.2, 0.6), area=ConstantArea(rng.uniform(1e-4, 4e-4)))
+           for _ in range(5)]
+    lp = [{"eta": 0.1, "h": rng.uniform(5e-6, 2e-5)} for _ in range(5)]
+    check("couette", lub, lp, "exact", "exact", 1e-12)
+    check("couette", lub, lp, "RK45", "exact", 1e-5)
+    dry = [incline(0.0, alpha=0.5, area=GrowthArea(1e-5, rng.uniform(1e-5, 1e-4))) for _ in range(5)]
+    dp = [{"lam": rng.uniform(1e4, 1e5)} for _ in range(5)]
+    br = check("wear", dry, dp, "auto", "ode:DOP853", 1e-5)
+    assert br.solver == "DOP853"
+    with pytest.raises(SolverError):
+        simulate_batch("wear", dry, dp, solver="exact")
+
+
+def test_hertz_normal_uses_integrator(rng):
+    scenes = [Scene(kind="impact", mass=M, u0=rng.uniform(5, 30), duration=500e-6, radius=R,
+                    area=HalfSineArea(rng.uniform(1e-4, 3e-4), 500e-6), normal=HertzNormal(3e9),
+                    effects=frozenset({"slip-coupling"})) for _ in range(5)]
+    params = [{"mu": rng.uniform(0.1, 0.5)} for _ in range(5)]
+    check("coulomb", scenes, params, "auto", "ode:DOP853", 1e-7)
+
+
+def test_sweep_arrays_and_shared_params():
+    template = oblique(40.0, 0.5)
+    u0 = np.linspace(2.0, 30.0, 7)
+    batch = SceneBatch.sweep(template, {"u0": u0, "normal.impulse": np.linspace(1.0, 3.0, 7)})
+    br = simulate_batch("coulomb", batch, {"mu": 0.3}, solver="exact", n=51)
+    assert br.u.shape == (7, 51) and br.stick_time.shape == (7,)
+    s3 = batch.scene(3)
+    assert s3.u0 == u0[3] and s3.normal.impulse == pytest.approx(2.0)
+    tr = fl.simulate("coulomb", s3, {"mu": 0.3}, solver="exact", n=51)
+    assert np.allclose(br.trajectory(3).omega, tr.omega, rtol=1e-13)
+
+
+def test_per_scene_time_grids():
+    scenes = [paper(12.0, 130e-6, tc) for tc in (400e-6, 500e-6, 600e-6)]
+    br = simulate_batch("wear", scenes, {"lam": 1.8e6}, solver="DOP853", n=31)
+    assert br.t.shape == (3, 31) and br.t[2, -1] == pytest.approx(600e-6)
+
+
+def test_errors_are_one_line():
+    with pytest.raises(SceneError):
+        simulate_batch("coulomb", [oblique(30, 0.5), incline(0.1)], {"mu": 0.3})
+    with pytest.raises(ParameterError, match="scene 1"):
+        simulate_batch("coulomb", [oblique(30, 0.5)] * 3, {"mu": np.array([0.3, -1.0, 0.2])})
+    with pytest.raises(SolverError):
+        simulate_batch("coulomb", [oblique(30, 0.5)], solver="Radau")
+    with pytest.raises(FrictionLabError, match="needs"):
+        simulate_batch("wear", [incline(0.1)], solver="DOP853")

@@ -1,0 +1,209 @@
+"""The report folder: contents, self-contained HTML, schema, atomic writing, and the commands."""
+import csv
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from _fit_helpers import TRUTH, synthetic
+from frictionlab import compare, write_report
+from frictionlab.cli import main
+from frictionlab.commands.compare import ProgressBar
+from frictionlab.errors import OutputError
+from frictionlab.ranking import COLUMNS
+
+
+@pytest.fixture(scope="module")
+def comparison():
+    ds = synthetic("area-rate", TRUTH["area-rate"], seed=11, name="synth-impact")
+    return compare(laws=["wear", "area-rate"], datasets=[ds])
+
+
+@pytest.fixture(scope="module")
+def report_dir(comparison, tmp_path_factory):
+    return write_report(comparison, tmp_path_factory.mktemp("report") / "rep")
+
+
+def test_report_folder_contents(report_dir):
+    out = report_dir
+    names = {p.name for p in out.iterdir()}
+    assert {"report.md", "report.html", "ranking.csv", "results.json", "figures"} <= names
+    pngs = sorted((out / "figures").glob("*.png"))
+    assert {p.name for p in pngs} >= {"ranking.png", "fit-synth-impact.png", "force-synth-impact.png",
+                                      "equivalence-synth-impact.png", "derive-synth-impact.png"}
+    assert all(p.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for p in pngs)
+    md = (out / "report.md").read_text()
+    for p in pngs:
+        assert f"figures/{p.name}" in md
+    assert "SYNTHETIC" in md and "not measured" in md  # never presented as measured
+    assert "1/(φA0)" in md and "φ/A0" in md  # the paper's misprinted factor is named
+    assert "equivalent" in md
+    # the generating law and parameters are checked in the report itself
+    assert "**Known truth:** generated with area-rate. area-rate [exact] ranks #1" in md
+    assert "eta_prime: true 8000 N s/m^2, fitted" in md
+
+
+def test_html_is_self_contained(report_dir):
+    out = report_dir
+    html = (out / "report.html").read_text()
+    n_figs = len(list((out / "figures").glob("*.png")))
+    assert html.count("data:image/png;base64,") == n_figs
+    assert "src='figures/" not in html and "<link" not in html and "<script" not in html
+    assert "<table>" in html
+
+
+def test_ranking_csv_and_results_json(report_dir):
+    out = report_dir
+    rows = list(csv.DictReader(io.StringIO((out / "ranking.csv").read_text())))
+    assert list(rows[0]) == list(COLUMNS)
+    per = [r for r in rows if r["dataset"] == "synth-impact"]
+    assert {(r["law"], r["solver"]) for r in per} == {("wear", "exact"), ("wear", "series"), ("area-rate", "exact")}
+    best = [r for r in per if r["rank"] == "1"]
+    assert [r["law"] for r in best] == ["area-rate"]
+    assert sum(float(r["akaike_weight"]) for r in per) == pytest.approx(1.0)
+    assert any(r["dataset"] == "ALL" for r in rows)
+
+    data = json.loads((out / "results.json").read_text())
+    assert data["schema"] == "frictionlab.compare/1"
+    assert {"numpy", "scipy", "lmfit", "frictionlab"} <= set(data["versions"])
+    assert data["datasets"][0]["provenance"]["kind"] == "synthetic"
+    fit = next(f for f in data["fits"] if f["law"] == "area-rate")
+    assert set(fit["parameters"]) == {"mu", "eta_prime"}
+    mu = fit["parameters"]["mu"]
+    assert abs(mu["value"] - TRUTH["area-rate"]["mu"]) < 3 * mu["stderr"]
+    assert {"aic", "aicc", "bic", "redchi", "chisqr", "rss", "rmse"} <= set(fit["statistics"])
+    assert fit["statistics"]["observable_unit"] == "rad/s"
+    assert "verdict" in fit["identifiability"]
+    eq = data["equivalence"]
+    assert {e["solver"] for e in eq} == {"exact", "series"}
+    assert all(e["verdict"] and e["explanation"] and e["decomposition"] for e in eq)
+    assert "poly9" in data["derivations"]["synth-impact"]
+
+
+def test_existing_folder_is_refused_then_replaced_with_force(comparison, tmp_path):
+    out = tmp_path / "rep"
+    out.mkdir()
+    (out / "keep.txt").write_text("mine")
+    with pytest.raises(OutputError, match="exists"):
+        write_report(comparison, out)
+    assert (out / "keep.txt").read_text() == "mine"
+    write_report(comparison, out, force=True)
+    assert not (out / "keep.txt").exists() and (out / "report.md").exists()
+
+
+def test_a_failure_while_writing_leaves_nothing_behind(comparison, tmp_path, monkeypatch):
+    from frictionlab import figures
+
+    def boom(*a, **k):
+        raise RuntimeError("figure failed")
+
+    monkeypatch.setattr(figures, "force_figure", boom)
+    with pytest.raises(RuntimeError):
+        write_report(comparison, tmp_path / "rep")
+    assert list(tmp_path.iterdir()) == []
+
+
+def _write_dataset(folder: Path) -> Path:
+    ds = synthetic("wear", {"lam": 1.2e6}, seed=4, n=21)
+    t = ds.t * 1e6
+    rpm = ds.columns["omega"] * 60 / (2 * np.pi)
+    lines = ["t,omega"] + [f"{a:.6g},{b:.8g}" for a, b in zip(t, rpm)]
+    (folder / "tiny.csv").write_text("\n".join(lines) + "\n")
+    sigma = ds.noise["omega"] * 60 / (2 * np.pi)
+    (folder / "tiny.toml").write_text(f"""name = "tiny"
+kind = "impact"
+observable = "omega"
+[columns]
+t = "us"
+omega = "rpm"
+[noise]
+omega = "{sigma:.6g} rpm"
+[scene]
+mass = "46 g"
+radius = "21.3 mm"
+u0 = "12 m/s"
+effects = ["spin"]
+[scene.area]
+model = "half-sine"
+peak = "130 mm^2"
+contact_time = "500 us"
+[scene.normal]
+model = "half-sine"
+impulse = "2.0079 N*s"
+[provenance]
+kind = "synthetic"
+source = "tests"
+command = "tests/test_report.py"
+seed = 4
+""")
+    return folder / "tiny.toml"
+
+
+def test_compare_and_fit_commands(tmp_path, capsys):
+    toml = _write_dataset(tmp_path)
+    out = tmp_path / "rep"
+    assert main(["compare", "--laws", "wear,coulomb", "--data", str(toml), "--out", str(out), "--jobs", "1"]) == 0
+    captured = capsys.readouterr()
+    assert "report:" in captured.out and "[" not in captured.err  # no progress bar when not a terminal
+    assert (out / "report.html").exists()
+    assert main(["compare", "--laws", "wear", "--data", str(toml), "--out", str(out)]) == 2
+    assert "exists" in capsys.readouterr().err
+    assert main(["fit", "wear", str(toml), "--free", "u0=8 m/s:14 m/s"]) == 0
+    text = capsys.readouterr().out
+    assert "lam" in text and "u0" in text
+    assert main(["fit", "wear", str(toml), "--free", "u0=8:14"]) == 2
+    assert "unit" in capsys.readouterr().err
+    assert main(["compare", "--laws", "nope", "--data", str(toml), "--out", str(tmp_path / "x")]) == 2
+    assert "unknown law" in capsys.readouterr().err
+
+
+def test_progress_bar_draws_only_on_a_terminal():
+    class Tty(io.StringIO):
+        def isatty(self):
+            return True
+
+    tty, pipe = Tty(), io.StringIO()
+    for stream in (tty, pipe):
+        bar = ProgressBar(stream)
+        bar(3, 10, "wear [exact] on x")
+        bar.close()
+    assert "3/10" in tty.getvalue() and tty.getvalue().startswith("\r[######")
+    assert pipe.getvalue() == ""
+
+
+def test_a_new_dataset_kind_plugs_in_through_one_predictor(tmp_path, monkeypatch):
+    """Rows are impacts (no time column): a predictor registered for the kind is all compare and
+    the report need; without it the dataset is skipped with the reason."""
+    import attrs
+
+    from frictionlab import fitting, simulate
+    from frictionlab.dataset import Dataset
+
+    base = synthetic("wear", {"lam": 1.2e6})
+    speeds = np.array([8.0, 10.0, 12.0, 14.0, 16.0])
+
+    def final_spins(law, scene, params, solver, u0s):
+        return np.array([simulate(law, attrs.evolve(scene, u0=u), params, solver=solver,
+                                  t=np.array([0.0, scene.duration])).omega[-1] for u in u0s])
+
+    def predict_outcome(law, target, scene, params, solver):
+        return final_spins(law, scene, params, solver, target.dataset.columns["speed"])
+
+    truth = final_spins("wear", base.scene, {"lam": 1.2e6}, "exact", speeds)
+    rng = np.random.default_rng(2)
+    ds = Dataset(name="outcomes", kind="impact-outcome", observable="rebound_spin", path=None,
+                 columns={"speed": speeds, "rebound_spin": truth + rng.normal(0, 5.0, speeds.size)},
+                 units={"speed": "m/s", "rebound_spin": "rad/s"}, noise={"rebound_spin": 5.0},
+                 scene=attrs.evolve(base.scene, kind="impact-outcome"), fixed={}, provenance=base.provenance)
+    skipped = compare(laws=["wear"], datasets=[ds], equivalence=False)
+    assert "outcomes" in skipped.skipped_datasets and "predictor" in skipped.skipped_datasets["outcomes"]
+
+    monkeypatch.setitem(fitting.PREDICTORS, "impact-outcome", predict_outcome)
+    c = compare(laws=["wear", "coulomb"], datasets=[ds])
+    f = c.fit_for("outcomes", "wear", "exact")
+    assert f.ok and abs(f.value("lam") - 1.2e6) < 3 * f.stderr("lam")
+    out = write_report(c, tmp_path / "rep")
+    assert (out / "figures" / "fit-outcomes.png").exists()
+    assert not (out / "figures" / "force-outcomes.png").exists()  # no time series, no force history
