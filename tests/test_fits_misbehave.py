@@ -111,7 +111,10 @@ def test_a_fit_that_does_not_converge_is_recorded_and_the_comparison_completes(m
     assert {f.law for f in c.fits} == {"coulomb", "wear"}
     for f in c.fits:
         assert f.status == "failed", f.summary()
-        assert f.reason.startswith("did not converge") and "\n" not in f.reason, f.reason
+        # after lmfit aborts at max_nfev its parameters are not reliable (they vary with the
+        # process), so the recorded reason is either of these; the status is always 'failed'
+        assert re.match(r"did not converge|the model cannot be evaluated at the best parameters", f.reason), f.reason
+        assert "\n" not in f.reason
     assert all(r.status == "failed" and r.rank is None for r in c.ranking)
     assert all(r.rank is None for r in c.groups)  # nothing ranked on made-up numbers
 
