@@ -1,48 +1,33 @@
 """What solver tolerance does to a fit: fitted values, error bars, fit time and the ranking.
 
 ``fit_tolerance_study(laws, dataset, methods, rtols)`` fits every law to one dataset with
-``solver='ode:METHOD'`` at each tolerance, plus the closed form where it exists, and reports
-per fit: parameters and lmfit standard errors, their shift from the reference fit in units of
-the reference error bar, CPU time of the fit, AIC, the rank among the laws at that tolerance and
-whether the ranking equals the reference ranking (laws within ranking.TIE_AIC share a place). The reference is the closed-form fit where
-every law has one, else the tightest tolerance of the first method.
-
-Hook: ``fitting.fit`` takes no tolerance argument yet; its predictions read ``predict.FIT_RTOL``
-when they solve an ODE, so the study sets that module constant for the duration of each fit (in
-this process only; not thread-safe). When ``fit`` grows an ``rtol`` argument, ``_fit`` is the one
-place to change.
+``solver='ode:METHOD'`` at each tolerance (``fitting.fit(..., rtol=...)``), plus the closed form
+where it exists, and reports per fit: parameters and lmfit standard errors, their shift from the
+reference fit in units of the reference error bar, CPU time of the fit, AIC, the rank among the
+laws at that tolerance and whether the ranking equals the reference ranking (laws within
+ranking.TIE_AIC share a place). The reference is the closed-form fit where every law has one,
+else the tightest tolerance of the first method, or fits the caller already has (``reference``,
+e.g. a comparison's at the default tolerance). Fits may run on an executor: the tolerance is an
+argument of each fit, never shared state.
 """
 from __future__ import annotations
 
 import math
-import time
-from contextlib import contextmanager
 
 from .errors import FrictionLabError
 
 DEFAULT_RTOLS = (1e-3, 1e-5, 1e-7, 1e-10)
 
 
-@contextmanager
-def _fit_rtol(rtol):
-    import importlib
-
-    predict = importlib.import_module("frictionlab.predict")  # the package exports a function of that name
-    old = predict.FIT_RTOL
-    predict.FIT_RTOL = rtol
-    try:
-        yield
-    finally:
-        predict.FIT_RTOL = old
-
-
 def _fit(law, dataset, solver, rtol):
+    """(FitResult or the one-line error, CPU seconds of the fit)."""
     from .fitting import fit
 
-    t0 = time.process_time()
-    with _fit_rtol(rtol if rtol is not None else 1e-10):
-        r = fit(law, dataset, solver=solver)
-    return r, time.process_time() - t0
+    try:
+        r = fit(law, dataset, solver=solver, rtol=rtol)
+    except FrictionLabError as exc:
+        return exc, math.nan
+    return r, r.cpu_time
 
 
 def _ranking(fits: dict) -> tuple[tuple[str, ...], dict]:
@@ -50,7 +35,7 @@ def _ranking(fits: dict) -> tuple[tuple[str, ...], dict]:
     (wear and Couette are one model on some scenes). Also law -> rank (1 + laws clearly better)."""
     from .ranking import TIE_AIC
 
-    ok = {law: f.stats.aic for law, f in fits.items() if f.ok}
+    ok = {law: f.stats.aic for law, f in fits.items() if not isinstance(f, Exception) and f.ok}
     order = sorted(ok, key=ok.get)
     groups, rank = [], {}
     for law in order:
@@ -62,42 +47,67 @@ def _ranking(fits: dict) -> tuple[tuple[str, ...], dict]:
     return tuple(tuple(sorted(g)) for g in groups), rank
 
 
-def fit_tolerance_study(laws, dataset, methods=("LSODA", "DOP853"), rtols=DEFAULT_RTOLS, progress=None) -> list[dict]:
-    """Rows (one per law, solver, rtol, parameter): see the module docstring; SI units."""
+def _run_fits(todo, ds, executor, progress) -> dict:
+    """(solver, rtol, law) -> (FitResult or error, CPU seconds), fitted here or on ``executor``."""
+    label = lambda s, r, law: f"fit {law} to {ds.name} with {s}" + (f" rtol={r:g}" if r else "")  # noqa: E731
+    if executor is None:
+        out = {}
+        for key in todo:
+            if progress:
+                progress(label(*key))
+            out[key] = _fit(key[2], ds, key[0], key[1])
+        return out
+    futures = {key: executor.submit(_fit, key[2], ds, key[0], key[1]) for key in todo}
+    out = {}
+    for key, fut in futures.items():
+        out[key] = fut.result()
+        if progress:
+            progress(label(*key))
+    return out
+
+
+def fit_tolerance_study(laws, dataset, methods=("LSODA", "DOP853"), rtols=DEFAULT_RTOLS, progress=None, *,
+                        reference: dict | None = None, others: dict | None = None, executor=None) -> list[dict]:
+    """Rows (one per law, solver, rtol, parameter): see the module docstring; SI units.
+
+    reference: law -> FitResult made at the default tolerance (predict.FIT_RTOL); these are the
+    reference and are not refitted (their rows carry that rtol). others: law -> FitResult of laws
+    that need no ODE on this dataset: they join every ranking, unchanged. executor: anything with
+    ``submit(fn, *args)`` (e.g. a process pool) to run the fits on.
+    """
     from .dataset import load_dataset
-    from .predict import applicable_solvers
+    from .predict import FIT_RTOL, applicable_solvers
 
     ds = load_dataset(dataset)
-    runs = []  # (solver, rtol)
-    if all(applicable_solvers(law, ds.scene)["exact"] is None for law in laws):
+    runs = []  # (solver, rtol); solver None: the given reference fits
+    if reference:
+        runs.append((None, FIT_RTOL))
+    elif all(applicable_solvers(law, ds.scene)["exact"] is None for law in laws):
         runs.append(("exact", None))
     runs += [(f"ode:{m}", r) for m in methods for r in sorted(rtols, reverse=True)]
-    results = {}
-    for solver, rtol in runs:
-        for law in laws:
-            if progress:
-                progress(f"fit {law} to {ds.name} with {solver}" + (f" rtol={rtol:g}" if rtol else ""))
-            try:
-                results[(solver, rtol, law)] = _fit(law, ds, solver, rtol)
-            except FrictionLabError as exc:
-                results[(solver, rtol, law)] = (exc, math.nan)
-    ref_run = runs[0] if runs[0][0] == "exact" else (runs[0][0], min(rtols))
+    results = {(None, FIT_RTOL, law): (reference[law], reference[law].cpu_time) for law in laws} if reference else {}
+    results.update(_run_fits([(s, r, law) for s, r in runs if s is not None for law in laws], ds, executor, progress))
+    if reference:
+        ref_run, ref_label = runs[0], f"the given fits at rtol {FIT_RTOL:g}"
+    else:
+        ref_run = runs[0] if runs[0][0] == "exact" else (runs[0][0], min(rtols))
+        ref_label = f"{ref_run[0]}" + (f" rtol={ref_run[1]:g}" if ref_run[1] else "")
+    others = dict(others or {})
     ref = {law: results[(*ref_run, law)][0] for law in laws}
-    ref_rank = _ranking({k: v for k, v in ref.items() if not isinstance(v, Exception)})[0]
+    ref_rank = _ranking({**others, **ref})[0]
     rows = []
     for solver, rtol in runs:
         fits = {law: results[(solver, rtol, law)][0] for law in laws}
-        good = {k: v for k, v in fits.items() if not isinstance(v, Exception)}
-        rank, ranks = _ranking(good)
+        rank, ranks = _ranking({**others, **fits})
         for law in laws:
             f, secs = results[(solver, rtol, law)]
-            base = {"dataset": ds.name, "law": law, "solver": solver, "rtol": rtol, "fit_time_s": secs,
-                    "reference": f"{ref_run[0]}" + (f" rtol={ref_run[1]:g}" if ref_run[1] else ""),
-                    "ranking": " > ".join(" = ".join(g) for g in rank), "ranking_as_reference": rank == ref_rank}
+            base = {"dataset": ds.name, "law": law, "solver": solver or f.solver, "rtol": rtol, "fit_time_s": secs,
+                    "reference": ref_label, "ranking": " > ".join(" = ".join(g) for g in rank),
+                    "ranking_as_reference": rank == ref_rank}
             if isinstance(f, Exception) or not f.ok:
                 rows.append({**base, "status": str(f) if isinstance(f, Exception) else f"{f.status}: {f.reason}",
-                             "parameter": "", "value": math.nan, "stderr": None, "shift_in_stderr": math.nan,
-                             "aic": math.nan, "rank": None})
+                             "parameter": "", "value": math.nan, "stderr": None, "unit": "",
+                             "shift_in_stderr": math.nan, "aic": math.nan, "rank": None})
                 continue
             r0 = ref.get(law)
             for name, p in f.params.items():
@@ -109,8 +119,7 @@ def fit_tolerance_study(laws, dataset, methods=("LSODA", "DOP853"), rtols=DEFAUL
                     if p0.stderr:
                         shift = (p.value - p0.value) / p0.stderr
                 rows.append({**base, "status": "ok", "parameter": name, "value": p.value, "stderr": p.stderr,
-                             "shift_in_stderr": shift, "aic": f.stats.aic,
-                             "rank": ranks.get(law)})
+                             "unit": p.unit, "shift_in_stderr": shift, "aic": f.stats.aic, "rank": ranks.get(law)})
     return rows
 
 

@@ -13,6 +13,8 @@ quantity) raises a one-line FrictionLabError.
   different units fit together. With several datasets, law parameters are shared (a global
   fit) unless named in ``local``.
 * Predictions go through ``predict``; a dataset kind plugs in with ``register_predictor``.
+* ``rtol`` is the ODE tolerance of the fit's predictions (None: ``predict.FIT_RTOL``, 1e-10); it
+  is an argument of each call, so fits at different tolerances may run in parallel threads.
 """
 from __future__ import annotations
 
@@ -28,7 +30,8 @@ import numpy as np
 from .errors import DatasetError, FrictionLabError, ParameterError, SolverError
 from .identifiability import Identifiability, find_structure, in_ratio, jacobian, jacobian_errors, make_verdict
 from .predict import (PREDICTORS, SCENE_QUANTITIES, SkipDataset, Target, applicable_solvers,
-                      auto_solver, get_scene_quantity, make_target, predict, register_predictor, set_scene_quantity)
+                      auto_solver, get_scene_quantity, make_target, predict, register_predictor, set_scene_quantity,
+                      takes_rtol)
 from .registry import get_law
 from .scene import Scene
 
@@ -127,7 +130,8 @@ class FitResult:
     identifiability: Identifiability | None = None
     per_dataset: tuple[DatasetFit, ...] = ()
     nfev: int = 0
-    wall_time: float = 0.0
+    wall_time: float = 0.0  # seconds on the clock
+    cpu_time: float = 0.0  # CPU seconds of the fitting thread
     message: str = ""
     notes: tuple[str, ...] = ()
 
@@ -243,8 +247,8 @@ def _lmfit_bound(b: float, slot: _Slot) -> float:
 class _Model:
     """Evaluates the weighted residual for a vector of scaled parameter values."""
 
-    def __init__(self, law, targets, solvers, slots):
-        self.law, self.targets, self.solvers, self.slots = law, targets, solvers, slots
+    def __init__(self, law, targets, solvers, slots, rtol=None):
+        self.law, self.targets, self.solvers, self.slots, self.rtol = law, targets, solvers, slots, rtol
         self.failures = 0
         self.last_error = ""
         self.nfev = 0
@@ -264,7 +268,7 @@ class _Model:
         return out
 
     def models(self, values):
-        return [predict(self.law, tg, p, solver, scene)
+        return [predict(self.law, tg, p, solver, scene, self.rtol)
                 for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values))]
 
     def residual(self, values) -> np.ndarray:
@@ -272,7 +276,7 @@ class _Model:
         out = []
         for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values)):
             try:
-                m = predict(self.law, tg, p, solver, scene)
+                m = predict(self.law, tg, p, solver, scene, self.rtol)
                 if m.shape != tg.y.shape or not np.all(np.isfinite(m)):
                     raise SolverError(f"prediction for '{tg.name}' is not finite or has the wrong shape")
                 out.append((m - tg.y) / tg.sigma)
@@ -364,7 +368,7 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
 def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[float]] | None = None,
         fixed: Mapping[str, float] | None = None, local: Sequence[str] = (),
         initial: Mapping[str, float] | None = None, observable: str | None = None, derive: str | None = None,
-        scan: int = 125, n_starts: int = 3, max_nfev: int | None = None) -> FitResult:
+        scan: int = 125, n_starts: int = 3, max_nfev: int | None = None, rtol: float | None = None) -> FitResult:
     """Fit ``law`` to one dataset or a group of them (a global fit) and return a FitResult.
 
     law: name or FrictionLaw. datasets: a Dataset, name, path or Target, or a list of them.
@@ -376,11 +380,13 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     scan: number of grid points scored before Levenberg-Marquardt (0: start from the defaults);
     n_starts: Levenberg-Marquardt runs from the best distinct grid points (the lowest chi2 wins);
     at most ODE_STARTS when a dataset is solved by 'ode' (deterministic, never timing-dependent).
+    rtol: relative (and scaled absolute) tolerance of every ODE solve in the fit, in (0, 1);
+    None uses FIT_RTOL (1e-10). Closed forms and the series ignore it.
     """
     import lmfit  # slow to import: only when fitting
 
     law = get_law(law)
-    started = time.perf_counter()
+    started, cpu_started = time.perf_counter(), time.thread_time()
     items = datasets if isinstance(datasets, (list, tuple)) else [datasets]
     if not items:
         raise DatasetError("fit: no datasets given")
@@ -388,7 +394,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
 
     def give_up(status, reason, **kw):
         return FitResult(law=law.name, solver=solver, datasets=names, status=status, reason=reason,
-                         wall_time=time.perf_counter() - started, **kw)
+                         wall_time=time.perf_counter() - started, cpu_time=time.thread_time() - cpu_started, **kw)
 
     try:
         targets = [d if isinstance(d, Target) else make_target(d, observable, derive) for d in items]
@@ -397,12 +403,17 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     names = tuple(t.name for t in targets)
     for name in list(fixed or {}) + list(local) + list(initial or {}):
         law.spec(name)  # unknown names are input errors
+    if rtol is not None and (isinstance(rtol, bool) or not isinstance(rtol, (int, float)) or not 0 < rtol < 1):
+        raise ParameterError(f"fit: rtol must be a number in (0, 1), got {rtol!r}")
     solvers = []
     for tg in targets:
         if tg.dataset.kind not in PREDICTORS:
             return give_up("skipped", f"no predictor for dataset kind '{tg.dataset.kind}' (dataset '{tg.name}')")
         if tg.dataset.scene is None:
             return give_up("skipped", f"dataset '{tg.name}' has no scene")
+        if rtol is not None and not takes_rtol(PREDICTORS[tg.dataset.kind]):
+            raise ParameterError(f"fit: rtol given, but the predictor of dataset kind '{tg.dataset.kind}' "
+                                 "takes no 'rtol' keyword")
         ok = applicable_solvers(law, tg.dataset.scene)
         s = auto_solver(law, tg.dataset.scene) if solver == "auto" else solver
         base = s.partition(":")[0]
@@ -415,7 +426,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         solvers.append(s)
     slots = _law_slots(law, targets, dict(fixed or {}), set(local), dict(initial or {}))
     slots += _scene_slots(targets, dict(free or {}))
-    model = _Model(law, targets, solvers, slots)
+    model = _Model(law, targets, solvers, slots, rtol)
     params = lmfit.Parameters()
     for s in slots:
         params.add(s.pname, value=s.value / s.scale, vary=s.vary, min=_lmfit_bound(s.lower, s) / s.scale,
@@ -471,6 +482,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     return FitResult(law=law.name, solver=solver_label, datasets=names, status=status, reason=reason,
                      params=presults, correlations=correl, stats=stats, identifiability=ident,
                      per_dataset=tuple(per), nfev=model.nfev, wall_time=time.perf_counter() - started,
+                     cpu_time=time.thread_time() - cpu_started,
                      message=message, notes=tuple(notes))
 
 

@@ -1,12 +1,16 @@
 """What is fitted and how a law predicts it: targets, one predictor per dataset kind, solver choice.
 
-``predict(law, target, params, solver, scene)`` is the single place that turns law parameters
+``predict(law, target, params, solver, scene, rtol)`` is the single place that turns law parameters
 into the model of a dataset's observable. Time-series kinds ('impact', 'incline') simulate and
 read a trajectory series; another kind (e.g. 'impact-outcome', whose rows are impacts) plugs in
 with ``register_predictor(kind, fn)``. A kind without a predictor is skipped with that reason.
+``rtol`` is the ODE tolerance of the prediction (None: ``FIT_RTOL``); it is an argument, never
+module state, so fits at different tolerances can run side by side.
 """
 from __future__ import annotations
 
+import functools
+import inspect
 import warnings
 from collections.abc import Callable, Mapping
 
@@ -31,7 +35,8 @@ SCENE_QUANTITIES = {
 }
 
 
-FIT_RTOL = 1e-10  # ODE tolerance during fits: finite-difference Jacobians need a smooth model
+#: Default ODE tolerance of fits (``fit(..., rtol=None)``): finite-difference Jacobians need a smooth model.
+FIT_RTOL = 1e-10
 
 
 class SkipDataset(FrictionLabError):
@@ -88,22 +93,33 @@ def make_target(dataset, observable: str | None = None, derive: str | None = Non
 
 
 # --- predictions: one function per dataset kind -------------------------------------------
-Predictor = Callable[[FrictionLaw, Target, Scene, Mapping[str, float], str], np.ndarray]
+Predictor = Callable[..., np.ndarray]
 PREDICTORS: dict[str, Predictor] = {}
 
 
 def register_predictor(kind: str, fn: Predictor) -> None:
-    """Make dataset ``kind`` fittable: fn(law, target, scene, params, solver) -> model of target.y (SI)."""
+    """Make dataset ``kind`` fittable: fn(law, target, scene, params, solver[, rtol=...]) -> model of
+    target.y (SI). A predictor that solves ODEs takes the keyword ``rtol`` (always given a number)."""
     PREDICTORS[kind] = fn
 
 
-def _predict_series(law, target, scene, params, solver):
+@functools.lru_cache(maxsize=None)
+def takes_rtol(fn) -> bool:
+    """Whether predictor ``fn`` accepts the ``rtol`` keyword."""
+    try:
+        ps = inspect.signature(fn).parameters.values()
+    except (TypeError, ValueError):
+        return False
+    return any(p.name == "rtol" or p.kind is p.VAR_KEYWORD for p in ps)
+
+
+def _predict_series(law, target, scene, params, solver, rtol=FIT_RTOL):
     from .solvers import simulate
 
     if target.observable not in SERIES:
         raise SkipDataset(f"dataset '{target.name}': observable '{target.observable}' is not a simulated series "
                           f"({', '.join(SERIES)})")
-    tr = simulate(law, scene, params, solver=solver, t=target.t, rtol=FIT_RTOL)
+    tr = simulate(law, scene, params, solver=solver, t=target.t, rtol=rtol)
     return tr[SERIES[target.observable]]
 
 
@@ -112,17 +128,20 @@ register_predictor("incline", _predict_series)
 
 
 def predict(law, target: Target, params: Mapping[str, float], solver: str = "exact",
-            scene: Scene | None = None) -> np.ndarray:
+            scene: Scene | None = None, rtol: float | None = None) -> np.ndarray:
     """The law's prediction of ``target.y`` (SI) for law parameters ``params`` (SI), on ``scene``
-    (default: the dataset's). Raises SkipDataset for a kind nobody can predict yet."""
+    (default: the dataset's), solving any ODE to ``rtol`` (None: FIT_RTOL). Raises SkipDataset
+    for a kind nobody can predict yet."""
     law = get_law(law)
     kind = target.dataset.kind
     if kind not in PREDICTORS:
         raise SkipDataset(f"no predictor for dataset kind '{kind}' (dataset '{target.name}'); "
                           f"known: {', '.join(PREDICTORS)}")
+    fn = PREDICTORS[kind]
+    kw = {"rtol": FIT_RTOL if rtol is None else rtol} if takes_rtol(fn) else {}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # series accuracy warnings are recorded in the result instead
-        return np.asarray(PREDICTORS[kind](law, target, scene or target.dataset.scene, params, solver), dtype=float)
+        return np.asarray(fn(law, target, scene or target.dataset.scene, params, solver, **kw), dtype=float)
 
 
 def applicable_solvers(law, scene: Scene) -> dict[str, str | None]:

@@ -104,3 +104,34 @@ def test_tied_laws_share_a_place_in_the_tolerance_study():
 
     rows = fit_tolerance_study(["couette", "wear"], "incline-oil-a100", methods=("LSODA",), rtols=(1e-8,))
     assert all(r["rank"] == 1 and r["ranking"] == "couette = wear" and r["ranking_as_reference"] for r in rows)
+
+
+def test_fit_takes_its_tolerance_as_an_argument():
+    """rtol=None is the default FIT_RTOL exactly; a loose rtol changes the ODE fit; a bad one is one line."""
+    from frictionlab import fit
+    from frictionlab.errors import ParameterError
+    from frictionlab.predict import FIT_RTOL
+
+    default = fit("wear", "incline-oil-a100", solver="ode", scan=0)
+    explicit = fit("wear", "incline-oil-a100", solver="ode", scan=0, rtol=FIT_RTOL)
+    loose = fit("wear", "incline-oil-a100", solver="ode", scan=0, rtol=1e-3)
+    assert default.value("lam") == explicit.value("lam") != loose.value("lam")
+    assert default.cpu_time > 0
+    for bad in (0.0, 1.5, "1e-3", True):
+        with pytest.raises(ParameterError, match="rtol"):
+            fit("wear", "incline-oil-a100", solver="ode", rtol=bad)
+
+
+def test_tolerance_study_on_threads_matches_serial():
+    """No module state is patched: fits at different tolerances can run side by side."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from frictionlab.fitcost import fit_tolerance_study
+
+    args = (["wear"], "incline-oil-a100", ("LSODA",), (1e-3, 1e-6))
+    serial = fit_tolerance_study(*args)
+    with ThreadPoolExecutor(3) as ex:
+        threaded = fit_tolerance_study(*args, executor=ex)
+    assert [(r["rtol"], r["value"], r["stderr"]) for r in serial] == [(r["rtol"], r["value"], r["stderr"])
+                                                                        for r in threaded]
+    assert serial[1]["value"] != serial[2]["value"]  # the tolerances really differ
