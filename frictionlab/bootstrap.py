@@ -15,8 +15,11 @@ None runs here, one replicate after another; a ``concurrent.futures`` executor; 
 ``Client('tcp://scheduler:8786')`` for a real cluster). Functions and datasets travel by pickle.
 
 ``bootstrap_ranking(laws, dataset, n, seed, executor)`` fits every law to the same resampled
-copies and counts how often each ranks first by AIC. ``parameter_table`` and ``ranking_table``
-turn the results into rows for the comparison report.
+copies and counts how often each ranks first by AIC. A law given with a solver
+(``law_fit('wear', 'series')``) is its own candidate, labelled 'wear [series]', so the paper's
+series and the exact solution of one law compete as they do in the comparison's ranking. Fits
+already made on the original data can be passed (``base=``, ``bases=``) instead of being
+repeated. ``parameter_table`` and ``ranking_table`` turn the results into rows for the report.
 """
 from __future__ import annotations
 
@@ -57,6 +60,11 @@ class LawFit:
     def warm(self, values: Mapping[str, float]) -> "LawFit":
         return attrs.evolve(self, start=tuple(sorted(values.items())))
 
+    @property
+    def label(self) -> str:
+        """The candidate's name: the law, with ' [solver]' when a solver was named."""
+        return self.law if self.solver == "auto" else f"{self.law} [{self.solver}]"
+
 
 def law_fit(law, solver: str = "auto", **options) -> LawFit:
     """``LawFit`` for a law name and ``fitting.fit`` keyword options (free, fixed, local, ...)."""
@@ -67,8 +75,9 @@ def law_fit(law, solver: str = "auto", **options) -> LawFit:
 # --- results ---------------------------------------------------------------------------------------
 @attrs.frozen(eq=False)
 class BootstrapResult:
-    """Bootstrap of one fit. samples (n, k) holds the fitted values of ``names`` per replicate
-    (NaN rows where the refit failed); aic (n,) the replicate's AIC."""
+    """Bootstrap of one fit. samples (n, k) holds the fitted values of ``names`` (the parameters the
+    data determine, ``FitResult.determined``) per replicate (NaN rows where the refit failed); aic (n,)
+    the replicate's AIC."""
 
     law: str
     datasets: tuple[str, ...]
@@ -134,7 +143,7 @@ def _resample(datasets, models, method, rng):
 def _values(result, names):
     if not getattr(result, "ok", False):
         return None
-    return [result.params[k].value for k in names]
+    return [result.params[k].value if k in result.params else math.nan for k in names]
 
 
 def _aic(result):
@@ -174,13 +183,17 @@ def _dispatch(executor, fit_fns, datasets, models, method, seed, n, chunk):
     return [row for part in parts for row in part]
 
 
-def _prepare(fit_fn, dataset, method):
+def _prepare(fit_fn, dataset, method, base=None):
     from .dataset import load_dataset
 
     if method not in METHODS:
         raise ParameterError(f"bootstrap: method must be one of {', '.join(METHODS)}, got {method!r}")
     datasets = [load_dataset(d) for d in _as_list(dataset)]
-    base = fit_fn(datasets[0] if len(datasets) == 1 else datasets)
+    if base is None:
+        base = fit_fn(datasets[0] if len(datasets) == 1 else datasets)
+    elif tuple(getattr(base, "datasets", ())) != tuple(d.name for d in datasets):
+        raise ParameterError(f"bootstrap: the given fit is of {', '.join(getattr(base, 'datasets', ()))}, "
+                             f"not of {', '.join(d.name for d in datasets)}")
     if not getattr(base, "ok", False):
         raise FrictionLabError(f"bootstrap: the fit on the original data did not succeed "
                                f"({getattr(base, 'reason', '') or getattr(base, 'status', 'failed')})")
@@ -193,7 +206,7 @@ def _prepare(fit_fn, dataset, method):
                 raise FrictionLabError(f"bootstrap: dataset '{ds.name}' was not fitted on its own observable column; "
                                        "use method='case'")
             models[i] = part.model
-    names = tuple(k for k, p in base.params.items() if p.vary)
+    names = base.determined
     units = tuple(base.params[k].unit for k in names)
     law_values = {p.key: p.value for p in base.params.values() if p.vary and p.kind == "law"}
     replicate_fn = fit_fn.warm(law_values) if hasattr(fit_fn, "warm") else fit_fn
@@ -224,27 +237,29 @@ def _check_n(n, seed):
 
 # --- public API -----------------------------------------------------------------------------------------
 def bootstrap(fit_fn, dataset, n: int = 200, seed: int = 0, executor=None, method: str = "residual",
-              chunk: int | None = None) -> BootstrapResult:
+              chunk: int | None = None, base=None) -> BootstrapResult:
     """Refit ``n`` resampled copies of ``dataset`` (a Dataset, name or path, or a list fitted together).
 
     fit_fn(data) -> FitResult, e.g. ``law_fit('wear', solver='exact')`` (warm-started replicates) or
     any picklable callable. chunk: replicates per submitted task (default: n / 16, at least 1).
+    base: fit_fn's FitResult on the original data, if already made (else it is fitted here).
     """
     _check_n(n, seed)
-    datasets, base, models, names, units, rfn = _prepare(fit_fn, dataset, method)
+    datasets, base, models, names, units, rfn = _prepare(fit_fn, dataset, method, base)
     rows = _dispatch(executor, [(rfn, names)], datasets, models, method, seed, n, chunk)
     return _collect(base.law, datasets, method, seed, names, units, base, rows, 0)
 
 
 @attrs.frozen(eq=False)
 class RankingBootstrap:
-    """How often each law ranks first (lowest AIC) over paired resamples; per law a BootstrapResult."""
+    """How often each candidate ranks first (lowest AIC) over paired resamples; per candidate a
+    BootstrapResult. Candidates are labelled as ``LawFit.label``: the law, or 'law [solver]'."""
 
-    laws: tuple[str, ...]
+    laws: tuple[str, ...]  # candidate labels
     datasets: tuple[str, ...]
-    first: dict  # law -> number of replicates it ranked first (ties within tie AIC split evenly)
-    n_ranked: int  # replicates where every law's refit succeeded
-    results: dict  # law -> BootstrapResult
+    first: dict  # label -> number of replicates it ranked first (ties within tie AIC split evenly)
+    n_ranked: int  # replicates where every candidate's refit succeeded
+    results: dict  # label -> BootstrapResult
 
     def fraction(self, law: str) -> float:
         return self.first[law] / self.n_ranked if self.n_ranked else math.nan
@@ -252,28 +267,33 @@ class RankingBootstrap:
 
 def bootstrap_ranking(laws: Sequence, dataset, n: int = 200, seed: int = 0, executor=None, solver: str = "auto",
                       method: str = "case", chunk: int | None = None, tie: float | None = None,
-                      **fit_options) -> RankingBootstrap:
+                      bases: Sequence | None = None, **fit_options) -> RankingBootstrap:
     """Fit every law to the same ``n`` resampled copies of ``dataset`` and count first places by AIC.
 
     method 'case' (default) assumes no law's model; 'residual' resamples around the best law's fit.
-    laws: names or LawFit objects. tie: AIC difference counted as a tie (default ranking.TIE_AIC).
+    laws: names or LawFit objects (distinct labels). tie: AIC difference counted as a tie (default
+    ranking.TIE_AIC). bases: the laws' FitResults on the original data, if already made.
     """
     from .ranking import TIE_AIC
 
     _check_n(n, seed)
     tie = TIE_AIC if tie is None else tie
     fns = [f if isinstance(f, LawFit) else law_fit(f, solver, **fit_options) for f in laws]
-    prepared = [_prepare(f, dataset, "case") for f in fns]
+    names = [f.label for f in fns]
+    if len(set(names)) != len(names):
+        raise ParameterError(f"bootstrap: candidates must differ; got {', '.join(names)}")
+    if bases is not None and len(bases) != len(fns):
+        raise ParameterError(f"bootstrap: {len(bases)} base fits given for {len(fns)} candidates")
+    prepared = [_prepare(f, dataset, "case", b) for f, b in zip(fns, bases or [None] * len(fns))]
     datasets = prepared[0][0]
     models = [None] * len(datasets)
     if method == "residual":  # resample around the law that fits the original data best
         best = min(range(len(fns)), key=lambda i: _aic(prepared[i][1]))
-        models = _prepare(fns[best], dataset, "residual")[2]
+        models = _prepare(fns[best], dataset, "residual", prepared[best][1])[2]
     elif method not in METHODS:
         raise ParameterError(f"bootstrap: method must be one of {', '.join(METHODS)}, got {method!r}")
     rows = _dispatch(executor, [(p[5], p[3]) for p in prepared], datasets, models, method, seed, n, chunk)
-    names = [p[1].law for p in prepared]
-    results = {name: _collect(name, datasets, method, seed, p[3], p[4], p[1], rows, k)
+    results = {name: _collect(p[1].law, datasets, method, seed, p[3], p[4], p[1], rows, k)
                for k, (name, p) in enumerate(zip(names, prepared))}
     first = dict.fromkeys(names, 0.0)
     ranked = 0
@@ -290,9 +310,23 @@ def bootstrap_ranking(laws: Sequence, dataset, n: int = 200, seed: int = 0, exec
 
 
 # --- tables for the comparison report ----------------------------------------------------------------
+def wilson(k: float, m: int, level: float = 0.95) -> tuple[float, float]:
+    """Wilson score interval of a proportion k / m at ``level`` (nan, nan for m = 0)."""
+    from statistics import NormalDist
+
+    if not m:
+        return math.nan, math.nan
+    z = NormalDist().inv_cdf(0.5 + level / 2.0)
+    p = k / m
+    centre = (p + z * z / (2 * m)) / (1 + z * z / m)
+    half = z * math.sqrt(p * (1 - p) / m + z * z / (4 * m * m)) / (1 + z * z / m)
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
 def parameter_table(results, level: float = 0.95) -> list[dict]:
-    """Rows: law, datasets, parameter, unit, value (original fit), stderr (lmfit), boot_median,
-    boot_std, ci_low, ci_high (percentile, ``level``), n_ok, n_failed, method, seed. SI units."""
+    """Rows: law, solver, datasets, parameter, unit, value (original fit), stderr (lmfit),
+    boot_median, boot_std, ci_low, ci_high (percentile, ``level``), n_ok, n_failed, method, seed.
+    SI units."""
     if isinstance(results, BootstrapResult):
         results = [results]
     elif isinstance(results, RankingBootstrap):
@@ -305,7 +339,8 @@ def parameter_table(results, level: float = 0.95) -> list[dict]:
             col = b._column(name)
             lo, hi = b.interval(name, level)
             p = b.base.params[name]
-            rows.append({"law": b.law, "datasets": "+".join(b.datasets), "parameter": name, "unit": unit,
+            rows.append({"law": b.law, "solver": b.base.solver, "datasets": "+".join(b.datasets), "parameter": name,
+                         "unit": unit,
                          "value": p.value, "stderr": p.stderr, "boot_median": float(np.median(col)) if col.size else math.nan,
                          "boot_std": b.std(name), "ci_low": lo, "ci_high": hi, "level": level, "n_ok": int(col.size),
                          "n_failed": len(b.failures), "method": b.method, "seed": b.seed})
@@ -313,24 +348,51 @@ def parameter_table(results, level: float = 0.95) -> list[dict]:
 
 
 def ranking_table(rb: RankingBootstrap, level: float = 0.95) -> list[dict]:
-    """Rows: datasets, law, first_fraction with a Wilson interval at ``level``, first_count,
-    n_ranked (replicates where every law's refit succeeded), method, seed; most often first on top."""
-    from statistics import NormalDist
-
-    z = NormalDist().inv_cdf(0.5 + level / 2.0)
+    """Rows: datasets, candidate (label), law, solver, first_fraction with a Wilson interval at
+    ``level``, first_count, n_ranked (replicates where every candidate's refit succeeded), method,
+    seed; most often first on top."""
     m = rb.n_ranked
     rows = []
     for law in rb.laws:
         k = rb.first[law]
         p = k / m if m else math.nan
-        if m:
-            centre = (p + z * z / (2 * m)) / (1 + z * z / m)
-            half = z * math.sqrt(p * (1 - p) / m + z * z / (4 * m * m)) / (1 + z * z / m)
-            lo, hi = max(0.0, centre - half), min(1.0, centre + half)
-        else:
-            lo = hi = math.nan
+        lo, hi = wilson(k, m, level)
         any_result = rb.results[law]
-        rows.append({"datasets": "+".join(rb.datasets), "law": law, "first_fraction": p, "ci_low": lo, "ci_high": hi,
+        rows.append({"datasets": "+".join(rb.datasets), "candidate": law, "law": any_result.law,
+                     "solver": any_result.base.solver, "first_fraction": p, "ci_low": lo, "ci_high": hi,
                      "level": level, "first_count": k, "n_ranked": m, "method": any_result.method,
                      "seed": any_result.seed})
     return sorted(rows, key=lambda r: -(r["first_fraction"] if math.isfinite(r["first_fraction"]) else -1))
+
+
+# --- the comparison's bootstrap ------------------------------------------------------------------------
+def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, ode: bool = False, free: Mapping | None = None,
+                   progress=None) -> tuple[list[RankingBootstrap], dict]:
+    """Bootstrap the single-dataset fits of a comparison: per dataset, every candidate that fitted
+    (law [solver]) refitted to the same ``n`` case resamples, warm-started from its fit, which is
+    reused as the base. Datasets where a candidate needs the ODE solver are left out unless ``ode``.
+    Returns (one RankingBootstrap per dataset, {dataset: why it was not bootstrapped})."""
+    by_ds: dict = {}
+    for f in fits:
+        if len(f.datasets) == 1:
+            by_ds.setdefault(f.datasets[0], []).append(f)
+    out, skipped = [], {}
+    for name, group in by_ds.items():
+        ok = [f for f in group if f.ok]
+        slow = sorted({f"{f.law} [{f.solver}]" for f in ok if f.solver.startswith("ode")})
+        if not ok:
+            skipped[name] = "no law could be fitted"
+        elif slow and not ode:
+            skipped[name] = (f"{', '.join(slow)} need{'s' * (len(slow) == 1)} the ODE solver here (each fit takes "
+                             f"seconds, {n} refits each would take minutes); add --bootstrap-ode to include it")
+        else:
+            opts = {"free": dict(free)} if free else {}
+            fns = [law_fit(f.law, f.solver, **opts) for f in ok]
+            try:
+                out.append(bootstrap_ranking(fns, ok[0].per_dataset[0].target.dataset, n=n, seed=seed,
+                                             executor=executor, bases=ok))
+            except FrictionLabError as exc:
+                skipped[name] = str(exc)
+        if progress:
+            progress(name)
+    return out, skipped

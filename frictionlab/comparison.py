@@ -7,6 +7,11 @@ expansion applies; an explicit list fits each solver that applies (the others ar
 skipped with the reason). Contact-area datasets are supporting series and are not fitted; a
 dataset kind without a predictor is skipped with that reason. Nothing here raises for a fit
 that fails: it becomes a row with status 'failed' and its reason.
+
+Optionally (``bootstrap=N``) every candidate is refitted to N case resamples of its dataset
+(``bootstrap.bootstrap_fits``: parameter intervals and how often each candidate ranks first), and
+(``tolerance=rtols``) the laws that need the ODE on one dataset are refitted at looser
+tolerances (``fitcost.tolerance_check``). Every stage runs on one process pool when jobs > 1.
 """
 from __future__ import annotations
 
@@ -14,7 +19,8 @@ import os
 import platform
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
+from contextlib import contextmanager
 from multiprocessing import get_context
 
 import attrs
@@ -22,7 +28,9 @@ import numpy as np
 
 from .dataset import Dataset, builtin_names, load_dataset
 from .equivalence import AREA_RATE, WEAR, EquivalenceResult, analyze_equivalence
-from .errors import FrictionLabError
+from .errors import FrictionLabError, ParameterError
+from .bootstrap import bootstrap_fits
+from .fitcost import tolerance_check
 from .fitting import PREDICTORS, FitResult, applicable_solvers, auto_solver, fit
 from .ranking import RankRow, family, rank_fits, rank_groups
 from .registry import available_laws, get_law
@@ -44,6 +52,10 @@ class Comparison:
     wall_time: float
     versions: dict
     settings: dict
+    bootstrap: tuple = ()  # bootstrap.RankingBootstrap per bootstrapped dataset
+    bootstrap_skipped: dict = attrs.field(factory=dict)  # dataset -> why it was not bootstrapped
+    tolerance: tuple[dict, ...] = ()  # fitcost.tolerance_check rows
+    timings: dict = attrs.field(factory=dict)  # stage -> wall-clock seconds
 
     def fit_for(self, dataset: str, law: str, solver: str | None = None) -> FitResult | None:
         for f in self.fits:
@@ -104,26 +116,32 @@ def _equivalence_task(args) -> EquivalenceResult:
     return analyze_equivalence(*args)
 
 
-def _run(tasks, fn, jobs, progress, done, total, label):
-    """Run fn over tasks, in a process pool when jobs > 1; results in task order."""
-    results = [None] * len(tasks)
-    if jobs > 1 and len(tasks) > 1:
-        try:
-            ctx = get_context("fork")
-        except ValueError:  # no fork on this platform: run serially
-            ctx = None
-        if ctx is not None:
-            with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
-                futures = {pool.submit(fn, t): i for i, t in enumerate(tasks)}
-                from concurrent.futures import as_completed
+@contextmanager
+def _pool(jobs: int):
+    """A process pool of ``jobs`` forked workers, or None (run here) for one job or without fork."""
+    try:
+        ctx = get_context("fork") if jobs > 1 else None
+    except ValueError:  # no fork on this platform: run serially
+        ctx = None
+    if ctx is None:
+        yield None
+        return
+    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+        yield pool
 
-                for fut in as_completed(futures):
-                    i = futures[fut]
-                    results[i] = fut.result()
-                    done += 1
-                    if progress:
-                        progress(done, total, label(tasks[i]))
-            return results, done
+
+def _run(tasks, fn, pool, progress, done, total, label):
+    """Run fn over tasks, on the pool if there is one; results in task order."""
+    results = [None] * len(tasks)
+    if pool is not None and len(tasks) > 1:
+        futures = {pool.submit(fn, t): i for i, t in enumerate(tasks)}
+        for fut in as_completed(futures):
+            i = futures[fut]
+            results[i] = fut.result()
+            done += 1
+            if progress:
+                progress(done, total, label(tasks[i]))
+        return results, done
     for i, t in enumerate(tasks):
         results[i] = fn(t)
         done += 1
@@ -134,13 +152,17 @@ def _run(tasks, fn, jobs, progress, done, total, label):
 
 def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None, solvers: Sequence[str] | None = None,
             *, free: dict | None = None, equivalence: bool = True, jobs: int = 1,
-            progress: Progress | None = None) -> Comparison:
+            progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_ode: bool = False,
+            tolerance: Sequence[float] = ()) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
 
     laws: registered names (default all); datasets: built-in names, TOML paths or Datasets
     (default every built-in); solvers: None for the default choice, or a list of 'exact',
     'series', 'ode[:METHOD]', 'auto'; free: scene quantities fitted per dataset, name -> (lower,
     upper) in SI (see fitting.SCENE_QUANTITIES); jobs: worker processes; progress(done, total, label).
+    bootstrap: case resamples per dataset (0: none), drawn from ``seed``; datasets where a law
+    needs the ODE are bootstrapped only with bootstrap_ode. tolerance: looser ODE tolerances at
+    which the ODE laws of one dataset are refitted (empty: no tolerance check).
     """
     started = time.perf_counter()
     from .solvers import parse_solver
@@ -148,6 +170,12 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     for s in solvers or ():
         if s != "auto":
             parse_solver(s)  # an unknown solver is an input error, before any work
+    for name, v in (("bootstrap", bootstrap), ("seed", seed)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
+            raise ParameterError(f"compare: {name} must be a non-negative integer, got {v!r}")
+    for r in tolerance:
+        if isinstance(r, bool) or not isinstance(r, (int, float)) or not 0 < r < 1:
+            raise ParameterError(f"compare: every tolerance must be a number in (0, 1), got {r!r}")
     law_names = tuple(get_law(n).name for n in (laws or available_laws()))
     dss = tuple(load_dataset(d) for d in (datasets if datasets is not None else builtin_names()))
     if not dss:
@@ -169,19 +197,46 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     # slow (ode) fits first, so that workers finish together
     plan.sort(key=lambda x: not x[2].startswith("ode"))
     eq_pairs = _equivalence_pairs(law_names, plan) if equivalence else []
-    total = len(plan) + len(eq_pairs)
+    n_boot = len({f.datasets[0] for f in fits} | {t[1].name for t in plan}) if bootstrap else 0
+    total = len(plan) + len(eq_pairs) + n_boot + (1 if tolerance else 0)
     label = lambda t: f"{t[0]} [{t[2]}] on {t[1].name}"  # noqa: E731
-    results, done = _run(plan, _fit_task, jobs, progress, 0, total, label)
-    fits += results
-    eq_results = []
-    if eq_pairs:
-        lookup = {(f.datasets[0], f.law, f.solver): f for f in fits}
-        tasks = [(lookup[(d, WEAR, s)], lookup[(d, AREA_RATE, sa)]) for d, s, sa in eq_pairs]
-        eq_results, done = _run(tasks, _equivalence_task, jobs, progress, done, total,
-                                lambda t: f"equivalence on {t[0].datasets[0]} [{t[0].solver}]")
+    timings, boots, boot_skipped, tol_rows = {}, [], {}, []
     order = {d.name: i for i, d in enumerate(dss)}
+    with _pool(jobs) as pool:
+        t0 = time.perf_counter()
+        results, done = _run(plan, _fit_task, pool, progress, 0, total, label)
+        fits += results
+        fits.sort(key=lambda f: (order[f.datasets[0]], law_names.index(f.law), family(f.solver) == "series"))
+        timings["fits"] = time.perf_counter() - t0
+        eq_results = []
+        if eq_pairs:
+            t0 = time.perf_counter()
+            lookup = {(f.datasets[0], f.law, f.solver): f for f in fits}
+            tasks = [(lookup[(d, WEAR, s)], lookup[(d, AREA_RATE, sa)]) for d, s, sa in eq_pairs]
+            eq_results, done = _run(tasks, _equivalence_task, pool, progress, done, total,
+                                    lambda t: f"equivalence on {t[0].datasets[0]} [{t[0].solver}]")
+            timings["equivalence"] = time.perf_counter() - t0
+        step = _Step(progress, done, total)
+
+        def tolerance_stage():
+            t0 = time.perf_counter()
+            rows = tolerance_check(fits, tuple(tolerance), pool, fit_options={"free": dict(free)} if free else None)
+            step("tolerance check")
+            timings["tolerance"] = time.perf_counter() - t0
+            return rows
+
+        with ThreadPoolExecutor(1) as side:  # with a pool, the tolerance fits queue there ahead of the bootstrap
+            tol_future = side.submit(tolerance_stage) if tolerance and pool is not None else None
+            if tolerance and pool is None:
+                tol_rows = tolerance_stage()
+            if bootstrap:
+                t0 = time.perf_counter()
+                boots, boot_skipped = bootstrap_fits(fits, bootstrap, seed, pool, bootstrap_ode, free,
+                                                     progress=lambda name: step(f"bootstrap on {name}"))
+                timings["bootstrap"] = time.perf_counter() - t0
+            if tol_future is not None:
+                tol_rows = tol_future.result()
     eq_results.sort(key=lambda e: (order[e.dataset], family(e.solver) == "series"))
-    fits.sort(key=lambda f: (order[f.datasets[0]], law_names.index(f.law), family(f.solver) == "series"))
     ranking = rank_fits(fits)
     kinds = {d.name: d.kind for d in dss}
     groups = rank_groups(ranking, kinds)
@@ -189,7 +244,23 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                       equivalence=tuple(eq_results), skipped_datasets=skipped_ds,
                       wall_time=time.perf_counter() - started, versions=versions(),
                       settings={"solvers": list(solvers) if solvers else "default", "jobs": jobs,
-                                "equivalence": equivalence, "free": {k: list(v) for k, v in (free or {}).items()}})
+                                "equivalence": equivalence, "free": {k: list(v) for k, v in (free or {}).items()},
+                                "bootstrap": int(bootstrap), "seed": int(seed), "bootstrap_ode": bool(bootstrap_ode),
+                                "tolerance": [float(r) for r in tolerance]},
+                      bootstrap=tuple(boots), bootstrap_skipped=boot_skipped, tolerance=tuple(tol_rows),
+                      timings=timings)
+
+
+class _Step:
+    """Advances the progress count by one per finished stage item."""
+
+    def __init__(self, progress, done, total):
+        self.progress, self.done, self.total = progress, done, total
+
+    def __call__(self, label: str) -> None:
+        self.done += 1
+        if self.progress:
+            self.progress(self.done, self.total, label)
 
 
 def _equivalence_pairs(law_names, plan) -> list[tuple[str, str, str]]:

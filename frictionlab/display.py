@@ -68,9 +68,22 @@ def fmt_value(value: float, err: float | None, unit_: str) -> str:
 _SMALL = {"m": ("um", 1e6, 1e-3), "m^2": ("mm^2", 1e6, 1e-2), "s": ("us", 1e6, 2e-3)}
 
 
+def _scale(value: float | None, unit_: str) -> tuple[str, float]:
+    """(display unit, factor) for a parameter of SI unit ``unit_`` and size ``value``."""
+    if unit_ in _SMALL and value is not None and math.isfinite(value) and abs(value) < _SMALL[unit_][2]:
+        return _SMALL[unit_][:2]
+    return unit_, 1.0
+
+
 def param_text(value: float, err: float | None, unit_: str) -> str:
     """A parameter with its error for a table, small lengths, areas and times in um, mm^2, us."""
-    if unit_ in _SMALL and value is not None and abs(value) < _SMALL[unit_][2]:
-        name, f, _ = _SMALL[unit_]
-        return fmt_value(value * f, None if err is None else err * f, name)
-    return fmt_value(value, err, unit_)
+    name, f = _scale(value, unit_)
+    return fmt_value(value * f, None if err is None else err * f, name)
+
+
+def interval_text(lo: float, hi: float, unit_: str, like: float | None = None) -> str:
+    """'[lo, hi] unit', in the display unit that ``param_text`` uses for a value ``like``."""
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        return ""
+    name, f = _scale(like if like is not None else hi, unit_)
+    return f"[{fmt(lo * f)}, {fmt(hi * f)}]" + (f" {name}" if name else "")

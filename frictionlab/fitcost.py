@@ -9,6 +9,10 @@ ranking.TIE_AIC share a place). The reference is the closed-form fit where every
 else the tightest tolerance of the first method, or fits the caller already has (``reference``,
 e.g. a comparison's at the default tolerance). Fits may run on an executor: the tolerance is an
 argument of each fit, never shared state.
+
+``tolerance_check(fits, rtols)`` is the cheap version for the comparison report: on the first
+dataset where some law needs the ODE, only those laws are refitted at ``rtols``, against the
+comparison's own fits; ``frictionlab bench`` runs the full study.
 """
 from __future__ import annotations
 
@@ -19,12 +23,12 @@ from .errors import FrictionLabError
 DEFAULT_RTOLS = (1e-3, 1e-5, 1e-7, 1e-10)
 
 
-def _fit(law, dataset, solver, rtol):
+def _fit(law, dataset, solver, rtol, options=None):
     """(FitResult or the one-line error, CPU seconds of the fit)."""
     from .fitting import fit
 
     try:
-        r = fit(law, dataset, solver=solver, rtol=rtol)
+        r = fit(law, dataset, solver=solver, rtol=rtol, **(options or {}))
     except FrictionLabError as exc:
         return exc, math.nan
     return r, r.cpu_time
@@ -47,7 +51,7 @@ def _ranking(fits: dict) -> tuple[tuple[str, ...], dict]:
     return tuple(tuple(sorted(g)) for g in groups), rank
 
 
-def _run_fits(todo, ds, executor, progress) -> dict:
+def _run_fits(todo, ds, executor, progress, options) -> dict:
     """(solver, rtol, law) -> (FitResult or error, CPU seconds), fitted here or on ``executor``."""
     label = lambda s, r, law: f"fit {law} to {ds.name} with {s}" + (f" rtol={r:g}" if r else "")  # noqa: E731
     if executor is None:
@@ -55,9 +59,9 @@ def _run_fits(todo, ds, executor, progress) -> dict:
         for key in todo:
             if progress:
                 progress(label(*key))
-            out[key] = _fit(key[2], ds, key[0], key[1])
+            out[key] = _fit(key[2], ds, key[0], key[1], options)
         return out
-    futures = {key: executor.submit(_fit, key[2], ds, key[0], key[1]) for key in todo}
+    futures = {key: executor.submit(_fit, key[2], ds, key[0], key[1], options) for key in todo}
     out = {}
     for key, fut in futures.items():
         out[key] = fut.result()
@@ -67,13 +71,15 @@ def _run_fits(todo, ds, executor, progress) -> dict:
 
 
 def fit_tolerance_study(laws, dataset, methods=("LSODA", "DOP853"), rtols=DEFAULT_RTOLS, progress=None, *,
-                        reference: dict | None = None, others: dict | None = None, executor=None) -> list[dict]:
+                        reference: dict | None = None, others: dict | None = None, executor=None,
+                        fit_options: dict | None = None) -> list[dict]:
     """Rows (one per law, solver, rtol, parameter): see the module docstring; SI units.
 
     reference: law -> FitResult made at the default tolerance (predict.FIT_RTOL); these are the
     reference and are not refitted (their rows carry that rtol). others: law -> FitResult of laws
     that need no ODE on this dataset: they join every ranking, unchanged. executor: anything with
-    ``submit(fn, *args)`` (e.g. a process pool) to run the fits on.
+    ``submit(fn, *args)`` (e.g. a process pool) to run the fits on. fit_options: further keyword
+    arguments of every ``fitting.fit`` (e.g. the ``free`` scene quantities of the reference fits).
     """
     from .dataset import load_dataset
     from .predict import FIT_RTOL, applicable_solvers
@@ -86,7 +92,8 @@ def fit_tolerance_study(laws, dataset, methods=("LSODA", "DOP853"), rtols=DEFAUL
         runs.append(("exact", None))
     runs += [(f"ode:{m}", r) for m in methods for r in sorted(rtols, reverse=True)]
     results = {(None, FIT_RTOL, law): (reference[law], reference[law].cpu_time) for law in laws} if reference else {}
-    results.update(_run_fits([(s, r, law) for s, r in runs if s is not None for law in laws], ds, executor, progress))
+    results.update(_run_fits([(s, r, law) for s, r in runs if s is not None for law in laws], ds, executor, progress,
+                              fit_options))
     if reference:
         ref_run, ref_label = runs[0], f"the given fits at rtol {FIT_RTOL:g}"
     else:
@@ -110,9 +117,8 @@ def fit_tolerance_study(laws, dataset, methods=("LSODA", "DOP853"), rtols=DEFAUL
                              "shift_in_stderr": math.nan, "aic": math.nan, "rank": None})
                 continue
             r0 = ref.get(law)
-            for name, p in f.params.items():
-                if not p.vary:
-                    continue
+            for name in f.determined:
+                p = f.params[name]
                 shift = math.nan
                 if r0 is not None and not isinstance(r0, Exception) and r0.ok and name in r0.params:
                     p0 = r0.params[name]
@@ -140,3 +146,34 @@ def markdown(rows) -> str:
                      f"{f(r['fit_time_s'], '.3g')} | {f(r['aic'], '.6g')} | {r['rank'] or '-'} | {r['ranking']} | "
                      f"{'yes' if r['ranking_as_reference'] else 'NO'} |")
     return "\n".join(lines)
+
+
+def tolerance_check(fits, rtols=(1e-3, 1e-6), executor=None, n_datasets: int = 1, progress=None,
+                    fit_options: dict | None = None) -> list[dict]:
+    """``fit_tolerance_study`` rows for the first ``n_datasets`` datasets (in the order of ``fits``,
+    a comparison's single-dataset FitResults) on which a law is solved by 'ode'. Only those laws
+    are refitted, at each of ``rtols`` with the same ODE method; their fits in ``fits`` are the
+    reference, and the laws solved otherwise there join the ranking unchanged. The paper's series
+    is an approximation of a law, not a law, and is left out of this ranking."""
+    from .ranking import family
+    from .solvers import parse_solver
+
+    by_ds: dict = {}
+    for f in fits:
+        if len(f.datasets) == 1 and f.ok and family(f.solver) == "full":
+            by_ds.setdefault(f.datasets[0], {}).setdefault(f.law, f)
+    rows = []
+    for laws in by_ds.values():
+        ode = {law: f for law, f in laws.items() if f.solver.startswith("ode")}
+        if not ode:
+            continue
+        method = parse_solver(next(iter(ode.values())).solver)[1]
+        ode = {law: f for law, f in ode.items() if parse_solver(f.solver)[1] == method}
+        others = {law: f for law, f in laws.items() if law not in ode}
+        ds = next(iter(ode.values())).per_dataset[0].target.dataset
+        rows += fit_tolerance_study(list(ode), ds, (method,), rtols, progress, reference=ode, others=others,
+                                    executor=executor, fit_options=fit_options)
+        n_datasets -= 1
+        if n_datasets <= 0:
+            break
+    return rows

@@ -142,6 +142,15 @@ class FitResult:
     def value(self, name: str) -> float:
         return self.params[name].value
 
+    @property
+    def determined(self) -> tuple[str, ...]:
+        """Names of the parameters the data determine: the fitted ones, except those without effect
+        or entering only through a ratio, plus the derived combinations (e.g. 'eta/h')."""
+        ident = self.identifiability
+        arbitrary = set(ident.no_effect) | {k for pair in ident.ratio_only for k in pair} if ident else set()
+        return tuple(k for k, p in self.params.items()
+                     if (p.vary and not {k, p.key} & arbitrary) or p.kind == "derived")
+
     def stderr(self, name: str) -> float | None:
         return self.params[name].stderr
 
