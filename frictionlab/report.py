@@ -3,8 +3,9 @@
 ``write_report(comparison, out, force=False)`` writes, through ``io.atomic_dir``:
 
 * ``report.md`` and a self-contained ``report.html`` (figures embedded as base64 PNG): ranking
-  tables, equivalence verdicts with their numbers, identifiability warnings, the provenance of
-  every dataset (reconstructed and synthetic data are labelled as such, never as measured);
+  tables, bootstrap intervals and first-place shares, equivalence verdicts with their numbers,
+  what solver tolerance does to a fit, identifiability warnings, the provenance of every dataset
+  (reconstructed and synthetic data are labelled as such, never as measured);
 * ``figures/*.png``: per dataset the data with every law's fit and the residuals, the force
   histories, the equivalence forces; the ranking heat map; the theta -> omega derivations;
 * ``ranking.csv``: columns ``ranking.COLUMNS`` (per-dataset rows, then the 'ALL' group rows;
@@ -13,7 +14,7 @@
     created, versions{package: version}, settings, wall_time_s,
     datasets[{name, kind, observable, n_points, status: fitted|skipped, reason,
               provenance{kind, source, method, command, seed, truth}}],
-    fits[{dataset, law, solver, status: ok|failed|skipped, reason, message, nfev, wall_time_s,
+    fits[{dataset, law, solver, status: ok|failed|skipped, reason, message, nfev, wall_time_s, cpu_time_s,
           parameters{name: {value, stderr, unit, kind: law|scene|derived, vary, fixed_by, lower, upper}},
           correlations[{a, b, r}],
           statistics{observable, observable_unit, n_points, n_params, n_free, chisqr, redchi, rss, rmse,
@@ -27,7 +28,19 @@
                  cross[{law, to, status, rms, rms_sigma, dchi2, params}],
                  decomposition{b, u0, c_area, c_area_rate, mu, eta_prime, r2} | null}],
     derivations{dataset: {method: {rms_vs_omega_column, omega_peak, omega_end, noisy_rms_vs_omega_column,
-                                   noisy_omega_peak, noisy_omega_end, noisy_median_sigma}}}
+                                   noisy_omega_peak, noisy_omega_end, noisy_median_sigma}}},
+    timings_s{stage: wall-clock seconds} (fits, equivalence, tolerance, bootstrap),
+    bootstrap{n (0: not run), seed, method: case, level: 0.95, interval: percentile,
+              first_place_interval: wilson, ode,
+              datasets[{dataset, n_ranked,
+                        first_place[{datasets, candidate, law, solver, first_fraction, ci_low, ci_high, level,
+                                     first_count, n_ranked, method, seed}],
+                        parameters[{law, solver, datasets, parameter, unit, value, stderr, boot_median, boot_std,
+                                    ci_low, ci_high, level, n_ok, n_failed, method, seed}]}],
+              not_bootstrapped{dataset: reason}},
+    tolerance{default_rtol, rtols[],
+              rows[{dataset, law, solver, rtol, fit_time_s (CPU), reference, ranking, ranking_as_reference,
+                    status, parameter, value, stderr, unit, shift_in_stderr, aic, rank}]}
   All numbers SI (rad/s, s, m, N) unless the key says otherwise; non-finite numbers are null.
 """
 from __future__ import annotations
@@ -44,7 +57,8 @@ import numpy as np
 
 from . import figures
 from .comparison import Comparison
-from .display import fmt, param_text, unit
+from .bootstrap import parameter_table, ranking_table, wilson
+from .display import fmt, interval_text, param_text, unit
 from .equivalence import AREA_RATE, WEAR
 from .io import atomic_dir
 from .ranking import COLUMNS, TIE_AIC, to_csv
@@ -275,7 +289,11 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
         kinds.setdefault(d.provenance.kind, []).append(d.name)
     doc.h(1, "frictionlab: friction laws compared")
     doc.p(f"Generated {_dt.datetime.now().astimezone().strftime('%Y-%m-%d %H:%M %Z')} by frictionlab "
-          f"{c.versions.get('frictionlab')}; the comparison took {c.wall_time:.1f} s. Laws: {', '.join(c.laws)}. "
+          f"{c.versions.get('frictionlab')}; the comparison took {c.wall_time:.1f} s"
+          + (" (" + ", ".join(f"{k} {v:.1f} s" for k, v in c.timings.items()) + ", partly in parallel)"
+             if len(c.timings) > 1 else "")
+          + f" on {c.settings.get('jobs', 1)} worker process{'es' * (c.settings.get('jobs', 1) != 1)}. "
+          f"Laws: {', '.join(c.laws)}. "
           f"Datasets: {len(c.datasets)} ({len(fitted)} fitted).")
     not_measured = [n for k, v in kinds.items() if k != "measured" for n in v]
     if not_measured:
@@ -289,12 +307,14 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
     # summary
     doc.h(2, "Summary")
     items = []
+    boot = {rb.datasets[0]: rb for rb in c.bootstrap}
     for d in fitted:
         best = [r for r in c.ranking if r.dataset == d.name and r.rank == 1]
         if best:
             items.append(f"**{d.name}** ({d.provenance.kind}): best " + " = ".join(r.candidate for r in best)
                          + f" (Akaike weight {sum(r.akaike_weight for r in best):.2f}"
-                         + (" shared by a tie" if len(best) > 1 else "") + ")")
+                         + (" shared by a tie" if len(best) > 1 else "")
+                         + (f"; {_first_share(boot[d.name], best)}" if d.name in boot else "") + ")")
         else:
             items.append(f"**{d.name}**: no law could be fitted")
     for g in dict.fromkeys(r.dataset for r in c.groups):
@@ -313,6 +333,10 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
                 items.append(f"**{d.name}**: the paper's truncated series of {law} fits {better} than the {full.solver} "
                              f"solution of the same law (ΔAIC {abs(ser.aic - full.aic):.1f}): the approximation, not "
                              "the law, makes that difference (see the notes under Fits)")
+    verdicts = tolerance_verdicts(c)
+    if verdicts:
+        items.append(f"**Solver tolerance** ({c.tolerance[0]['dataset']}): refitted at " + verdicts[0]
+                     + " (see 'What solver tolerance does to a fit')")
     doc.items(items)
     if c.equivalence:
         doc.p("Equivalence of λAu and μN + μη′dA/dt: " + "; ".join(
@@ -349,6 +373,8 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
         rows = [r for r in c.ranking if r.dataset == d.name]
         doc.h(3, f"{d.name}")
         doc.table(*_candidate_table(rows, d.observable))
+
+    _bootstrap_section(doc, c)
 
     # per-dataset fits
     doc.h(2, "Fits")
@@ -430,6 +456,8 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
                 doc.p("Reported in the paper for this impact: " + ", ".join(f"{k} = {v}" for k, v in ref.items()
                                                                            if "omega" in k or k == "t_peak") + ".")
 
+    _tolerance_section(doc, c)
+
     # identifiability roll-up
     doc.h(2, "Identifiability warnings")
     allw = [f"{f.datasets[0]} — {f.law} [{f.solver}]: {f.identifiability.verdict}" for f in c.fits
@@ -492,6 +520,164 @@ def _equivalence_section(doc: Doc, figs: dict, c: Comparison):
                    if any(e.decomposition for e in mine) else "."))
 
 
+def _pct(x: float) -> str:
+    return f"{100 * x:.0f}%" if math.isfinite(x) else ""
+
+
+def _first_share(rb, best) -> str:
+    """'first in 97% of 200 resamples (95% interval 94-99%)' for the rank-1 candidates ``best``."""
+    if not rb.n_ranked:
+        return "no resample could rank every candidate"
+    k = sum(rb.first.get(r.candidate, 0.0) for r in best)
+    lo, hi = wilson(k, rb.n_ranked)
+    return f"first in {_pct(k / rb.n_ranked)} of {rb.n_ranked} resamples, 95% interval {_pct(lo)}–{_pct(hi)}"
+
+
+def _rtol(r: float) -> str:
+    return f"{r:.0e}".replace("e-0", "e-")
+
+
+def _bootstrap_section(doc: Doc, c: Comparison):
+    n, seed = c.settings.get("bootstrap", 0), c.settings.get("seed", 0)
+    doc.h(2, "Bootstrap: how firm are the parameters and the ranking")
+    if not n:
+        doc.p("Not run: this comparison was made with `--bootstrap 0`, so it has no confidence intervals from "
+              "resampling; the error bars under Fits are lmfit's standard errors only. Run `frictionlab compare "
+              "--bootstrap N` to add them.")
+        return
+    doc.p(f"Each candidate (law [solver]) was refitted to the same {n} **case resamples** of its dataset: rows drawn "
+          "with replacement and kept in time order, so no law's model is assumed. Each refit starts from the "
+          "candidate's best fit on the original data (no grid scan, one Levenberg-Marquardt run). Parameter "
+          "intervals are 95% **percentile intervals** (2.5th to 97.5th percentile of the refitted values). "
+          "**First place** is the share of resamples in which a candidate has the lowest AIC (candidates within "
+          f"ΔAIC ≤ {TIE_AIC} share first place and split the count), with a 95% **Wilson score interval**. "
+          f"Seed {seed} (`--seed`), the same for every dataset, so a dataset's numbers do not depend on which "
+          "others are compared, nor on the number of worker processes.")
+    if c.bootstrap_skipped:
+        doc.p("**Not bootstrapped:**")
+        doc.items([f"**{d}**: {why.replace('--bootstrap-ode', '`--bootstrap-ode`')}"
+                   for d, why in c.bootstrap_skipped.items()])
+    if not c.bootstrap:
+        return
+    rows = []
+    for rb in c.bootstrap:
+        best = [r for r in c.ranking if r.dataset == rb.datasets[0] and r.rank == 1]
+        labels = {r.candidate for r in best}
+        table = ranking_table(rb)
+        others = [f"{r['candidate']} {_pct(r['first_fraction'])} ({_pct(r['ci_low'])}–{_pct(r['ci_high'])})"
+                  for r in table if r["first_count"] > 0 and r["candidate"] not in labels]
+        never = [r["candidate"] for r in table if r["first_count"] == 0 and r["candidate"] not in labels]
+        rows.append([rb.datasets[0], " = ".join(r.candidate for r in best), _first_share(rb, best),
+                     "; ".join(others) or "none", ", ".join(never)])
+    doc.h(3, "First place under resampling")
+    doc.p("Candidates tied on the original data (the same curve, such as wear and Couette on a given area history) "
+          "split each first place between them; their shares are summed here. results.json has each one's share.")
+    doc.table(["dataset", "best on the original data", "its first places", "others ever first: share (95% interval)",
+               "never first"], rows)
+    doc.h(3, "Parameter intervals")
+    doc.p("Beside each fitted value and its lmfit standard error: the bootstrap median and 95% interval, and the "
+          "interval's width relative to ±1.96 standard errors. Near 1 the two agree; well above 1 the standard "
+          "error is too optimistic (it assumes the model is right and the residuals are independent noise); well "
+          "below 1 the resamples barely move the fit.")
+    prow, undetermined = [], {}
+    for rb in c.bootstrap:
+        for r in parameter_table(rb):
+            width = (r["ci_high"] - r["ci_low"]) / (2 * 1.96 * r["stderr"]) if r["stderr"] else math.nan
+            prow.append([r["datasets"], f"{r['law']} [{r['solver']}]", r["parameter"],
+                         param_text(r["value"], r["stderr"], r["unit"]),
+                         param_text(r["boot_median"], None, r["unit"]) if r["n_ok"] else "",
+                         interval_text(r["ci_low"], r["ci_high"], r["unit"], r["value"]), fmt(width, 2),
+                         f"{r['n_ok']} of {r['n_ok'] + r['n_failed']}"])
+        for b in rb.results.values():
+            missing = b.base.identifiability.missing_stderr
+            left = [p.name for p in b.base.params.values() if p.vary and p.name not in b.names]
+            if left:
+                why = "; ".join(dict.fromkeys(missing.get(k, "not determined") for k in left))
+                cands, dss = undetermined.setdefault((", ".join(left), why), ({}, {}))
+                cands[f"{b.law} [{b.base.solver}]"] = dss[rb.datasets[0]] = None
+    doc.table(["dataset", "law [solver]", "parameter", "fit ± standard error", "bootstrap median",
+               "95% interval", "width vs ±1.96σ", "refits ok"], prow)
+    if undetermined:
+        doc.p("Not bootstrapped, because the data do not determine them (the combination that is determined, such "
+              "as eta/h, is in the table):")
+        doc.items([f"{params} ({', '.join(cands)} on {', '.join(dss)}): {'each ' if ',' in params else ''}{why}"
+                   for (params, why), (cands, dss) in undetermined.items()])
+
+
+def _tolerance_section(doc: Doc, c: Comparison):
+    from .predict import FIT_RTOL
+
+    rtols = c.settings.get("tolerance") or []
+    doc.h(2, "What solver tolerance does to a fit")
+    if not rtols:
+        doc.p("Not run (`--no-tolerance`). `frictionlab bench` measures it in full.")
+        return
+    if not c.tolerance:
+        doc.p("No law needs the ODE solver on these datasets: every fit is closed-form or the paper's series, which "
+              "have no tolerance. `frictionlab bench` measures what tolerance costs and buys.")
+        return
+    rows = list(c.tolerance)
+    ds = rows[0]["dataset"]
+    method = next((r["solver"].partition(":")[2] for r in rows if ":" in r["solver"]), "LSODA")
+    laws = list(dict.fromkeys(r["law"] for r in rows))
+    held = [g for g in rows[0]["ranking"].replace(" = ", " > ").split(" > ") if g not in laws]
+    held_text = (f"; {', '.join(held)} (closed form) {'keeps its fit' if len(held) == 1 else 'keep their fits'} "
+                 "and joins the ranking") if held else ""
+    doc.p(f"Every ODE fit in this report solves to rtol {FIT_RTOL:g} (atol equal, on a problem scaled to order one): "
+          f"finite-difference Jacobians need a smooth model. How much does that matter? On **{ds}**, the laws that "
+          f"need the ODE there ({', '.join(laws)}; {method}) were refitted from scratch at rtol "
+          f"{' and '.join(_rtol(r) for r in rtols)}{held_text}. Shift = (value − value at "
+          f"{FIT_RTOL:g}) / its standard error, the largest over the law's parameters; fit time is the CPU seconds "
+          "of one whole fit (grid of starts and Levenberg-Marquardt) on this machine under its current load. "
+          "`frictionlab bench` runs the full study: more methods and tolerances, and work-precision diagrams.")
+    groups = {}
+    for r in rows:
+        groups.setdefault((r["rtol"], r["law"]), []).append(r)
+    table = []
+    for (rtol, law), rs in sorted(groups.items(), key=lambda kv: (kv[0][0], laws.index(kv[0][1]))):
+        r0 = rs[0]
+        if r0["status"] != "ok":
+            table.append([law, _rtol(rtol), r0["status"]] + [""] * 5)
+            continue
+        shifts = [abs(r["shift_in_stderr"]) for r in rs if math.isfinite(r["shift_in_stderr"])]
+        table.append([law, _rtol(rtol) + (" (default)" if rtol == FIT_RTOL else ""),
+                      "; ".join(f"{r['parameter']} = {param_text(r['value'], r['stderr'], r['unit'])}" for r in rs),
+                      fmt(max(shifts), 2) if shifts else "", fmt(r0["fit_time_s"], 2), fmt(r0["aic"]),
+                      r0["rank"], "yes" if r0["ranking_as_reference"] else "**no**"])
+    doc.table(["law", "rtol", "parameters (value ± standard error)", "largest shift [σ]", "fit time [CPU s]", "AIC",
+               "rank", f"ranking as at {FIT_RTOL:g}"], table)
+    verdicts = tolerance_verdicts(c)
+    doc.items([v + "." for v in verdicts])
+
+
+def tolerance_verdicts(c: Comparison) -> list[str]:
+    """Per looser tolerance: whether the ranking changes, the largest parameter shift and AIC change,
+    and the fit time against the default tolerance's."""
+    from .predict import FIT_RTOL
+
+    rows = list(c.tolerance)
+    ref = {r["law"]: r for r in rows if r["rtol"] == FIT_RTOL}
+    out = []
+    for rtol in c.settings.get("tolerance") or []:
+        at = [r for r in rows if r["rtol"] == rtol]
+        if not at:
+            continue
+        shift = max(((abs(r["shift_in_stderr"]), r) for r in at if math.isfinite(r["shift_in_stderr"])),
+                    key=lambda x: x[0], default=None)
+        daic = max(((abs(r["aic"] - ref[r["law"]]["aic"]), r["law"]) for r in at
+                    if r["law"] in ref and math.isfinite(r["aic"]) and math.isfinite(ref[r["law"]]["aic"])),
+                   default=None)
+        t = sum({r["law"]: r["fit_time_s"] for r in at}.values())
+        t0 = sum({r["law"]: r["fit_time_s"] for r in ref.values()}.values())
+        out.append(f"rtol {_rtol(rtol)}: the ranking is " + ("unchanged" if at[0]["ranking_as_reference"] else
+                                                              f"**different** ({at[0]['ranking']})")
+                   + (f"; the largest shift is {shift[0]:.2g}σ ({shift[1]['law']} {shift[1]['parameter']})"
+                      if shift else "")
+                   + (f", the largest AIC change {daic[0]:.2g} ({daic[1]})" if daic else "")
+                   + f"; the fits took {t:.1f} CPU s against {t0:.1f} s at {_rtol(FIT_RTOL)}")
+    return out
+
+
 def _method_section(doc: Doc, c: Comparison):
     doc.h(2, "Method")
     doc.items([
@@ -542,7 +728,7 @@ def _clean(obj):
 def _fit_json(f) -> dict:
     out = {"dataset": f.datasets[0] if len(f.datasets) == 1 else list(f.datasets), "law": f.law, "solver": f.solver,
            "status": f.status, "reason": f.reason, "message": f.message, "nfev": f.nfev, "wall_time_s": f.wall_time,
-           "notes": list(f.notes)}
+           "cpu_time_s": f.cpu_time, "notes": list(f.notes)}
     if f.ok:
         obs = f.per_dataset[0].target.observable
         out["parameters"] = {n: {"value": p.value, "stderr": p.stderr, "unit": p.unit, "kind": p.kind, "vary": p.vary,
@@ -581,6 +767,21 @@ def _equivalence_json(e) -> dict:
                                                       "eta_prime": d.eta_prime, "r2": d.r2}}
 
 
+def _bootstrap_json(c: Comparison) -> dict:
+    per = [{"dataset": rb.datasets[0], "n_ranked": rb.n_ranked, "first_place": ranking_table(rb),
+            "parameters": parameter_table(rb)} for rb in c.bootstrap]
+    return {"n": c.settings.get("bootstrap", 0), "seed": c.settings.get("seed", 0), "method": "case",
+            "level": 0.95, "interval": "percentile", "first_place_interval": "wilson",
+            "ode": c.settings.get("bootstrap_ode", False), "datasets": per,
+            "not_bootstrapped": dict(c.bootstrap_skipped)}
+
+
+def _tolerance_json(c: Comparison) -> dict:
+    from .predict import FIT_RTOL
+
+    return {"default_rtol": FIT_RTOL, "rtols": c.settings.get("tolerance", []), "rows": list(c.tolerance)}
+
+
 def results_json(c: Comparison, deriv_stats: dict | None = None) -> dict:
     datasets = []
     for d in c.datasets:
@@ -595,7 +796,8 @@ def results_json(c: Comparison, deriv_stats: dict | None = None) -> dict:
                    "fits": [_fit_json(f) for f in c.fits], "ranking": [_row_json(r) for r in c.ranking],
                    "groups": [_row_json(r) for r in c.groups],
                    "equivalence": [_equivalence_json(e) for e in c.equivalence],
-                   "derivations": deriv_stats or {}})
+                   "derivations": deriv_stats or {}, "timings_s": c.timings,
+                   "bootstrap": _bootstrap_json(c), "tolerance": _tolerance_json(c)})
 
 
 def write_report(c: Comparison, out, force: bool = False) -> Path:

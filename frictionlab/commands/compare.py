@@ -7,7 +7,12 @@ import sys
 import time
 from pathlib import Path
 
-from ..errors import OutputError
+from ..errors import OutputError, ParameterError
+
+#: Default number of bootstrap resamples: about +15-30 s on 2 cores for the built-in datasets.
+BOOTSTRAP_N = 200
+#: Looser ODE tolerances at which the ODE laws of one dataset are refitted for the report.
+TOLERANCE_RTOLS = (1e-3, 1e-6)
 
 
 def add_parser(sub):
@@ -27,6 +32,15 @@ def add_parser(sub):
     p.add_argument("--jobs", type=int, default=min(os.cpu_count() or 1, 4),
                    help="worker processes (default: number of CPUs, at most 4)")
     p.add_argument("--no-equivalence", action="store_true", help="skip the equivalence analysis")
+    p.add_argument("--bootstrap", type=int, default=BOOTSTRAP_N, metavar="N",
+                   help=f"case resamples per dataset for confidence intervals and first-place shares "
+                        f"(default: {BOOTSTRAP_N}; 0: none)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the bootstrap resamples (default: 0)")
+    p.add_argument("--bootstrap-ode", action="store_true",
+                   help="also bootstrap datasets where a law needs the ODE solver (slow: minutes per 100 resamples)")
+    p.add_argument("--no-tolerance", dest="tolerance", action="store_false",
+                   help="skip refitting the ODE laws of one dataset at looser tolerances "
+                        f"({', '.join(f'{r:g}' for r in TOLERANCE_RTOLS)})")
     p.set_defaults(func=run)
 
 
@@ -63,12 +77,18 @@ def run(args) -> int:
         raise OutputError(f"{args.out}: output folder exists; choose another --out or pass --force")
     if args.jobs < 1:
         raise OutputError(f"--jobs must be at least 1, got {args.jobs}")
+    if args.bootstrap < 0:
+        raise ParameterError(f"--bootstrap must be 0 (none) or a positive number of resamples, got {args.bootstrap}")
+    if args.seed < 0:
+        raise ParameterError(f"--seed must be a non-negative integer, got {args.seed}")
     free = parse_free(args.free)
     laws = [x.strip() for x in args.laws.split(",") if x.strip()] if args.laws else None
     bar = ProgressBar()
     try:
         result = compare(laws=laws, datasets=args.data, solvers=args.solver, free=free,
-                         equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar)
+                         equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar,
+                         bootstrap=args.bootstrap, seed=args.seed, bootstrap_ode=args.bootstrap_ode,
+                         tolerance=TOLERANCE_RTOLS if args.tolerance else ())
     finally:
         bar.close()
     if bar.active:
