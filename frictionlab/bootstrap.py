@@ -320,7 +320,7 @@ def wilson(k: float, m: int, level: float = 0.95) -> tuple[float, float]:
     p = k / m
     centre = (p + z * z / (2 * m)) / (1 + z * z / m)
     half = z * math.sqrt(p * (1 - p) / m + z * z / (4 * m * m)) / (1 + z * z / m)
-    return max(0.0, centre - half), min(1.0, centre + half)
+    return (0.0 if k <= 0 else max(0.0, centre - half)), (1.0 if k >= m else min(1.0, centre + half))
 
 
 def parameter_table(results, level: float = 0.95) -> list[dict]:
@@ -379,12 +379,15 @@ def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, ode: bool = False
     out, skipped = [], {}
     for name, group in by_ds.items():
         ok = [f for f in group if f.ok]
-        slow = sorted({f"{f.law} [{f.solver}]" for f in ok if f.solver.startswith("ode")})
+        slow = [f for f in ok if f.solver.startswith("ode")]
         if not ok:
             skipped[name] = "no law could be fitted"
         elif slow and not ode:
-            skipped[name] = (f"{', '.join(slow)} need{'s' * (len(slow) == 1)} the ODE solver here (each fit takes "
-                             f"seconds, {n} refits each would take minutes); add --bootstrap-ode to include it")
+            skipped[name] = (f"{', '.join(f'{f.law} [{f.solver}]' for f in slow)} need{'s' * (len(slow) == 1)} the "
+                             f"ODE solver here; {'its fit' if len(slow) == 1 else 'their fits'} took "
+                             f"{sum(f.cpu_time for f in slow):.1f} CPU s on the original data, and each of the {n} "
+                             f"resamples would refit {'it' if len(slow) == 1 else 'them'}; add --bootstrap-ode to "
+                             "include it")
         else:
             opts = {"free": dict(free)} if free else {}
             fns = [law_fit(f.law, f.solver, **opts) for f in ok]

@@ -72,3 +72,28 @@ def test_bad_arguments_are_one_line_errors():
         bootstrap(law_fit("couette"), DS, n=3, method="jackknife")
     with pytest.raises(FrictionLabError):
         bootstrap(law_fit("couette"), "no-such-dataset", n=3)
+
+
+def test_case_resamples_repeat_times_and_the_ode_solver_takes_them():
+    import attrs
+
+    from frictionlab import load_dataset
+
+    dry = load_dataset("incline-dry-d10")
+    dry = attrs.evolve(dry, columns={k: v[::4] for k, v in dry.columns.items()})
+    b = bootstrap(law_fit("wear", solver="ode"), dry, n=3, seed=1, method="case")
+    assert b.n_ok == 3 and not b.failures
+
+
+def test_candidates_are_labelled_by_solver_and_reuse_given_fits():
+    from frictionlab import fit
+
+    base = [fit("couette", DS, solver="exact"), fit("couette", DS, solver="ode")]
+    rb = bootstrap_ranking([law_fit("couette", "exact"), law_fit("couette", "ode")], DS, n=3, seed=2, bases=base)
+    assert rb.laws == ("couette [exact]", "couette [ode]")
+    assert rb.results["couette [exact]"].base is base[0]
+    rows = ranking_table(rb)
+    assert {(r["candidate"], r["law"], r["solver"]) for r in rows} == {("couette [exact]", "couette", "exact"),
+                                                                        ("couette [ode]", "couette", "ode")}
+    with pytest.raises(ParameterError, match="differ"):
+        bootstrap_ranking([law_fit("couette", "exact"), law_fit("couette", "exact")], DS, n=2)

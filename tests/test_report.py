@@ -82,6 +82,84 @@ def test_ranking_csv_and_results_json(report_dir):
     assert "poly9" in data["derivations"]["synth-impact"]
 
 
+def _small_pair():
+    """A synthetic impact (closed forms) and every 4th row of a dry incline (wear needs the ODE there)."""
+    import attrs
+
+    from frictionlab import load_dataset
+
+    dry = load_dataset("incline-dry-d10")
+    dry = attrs.evolve(dry, name="dry-small", columns={k: v[::4] for k, v in dry.columns.items()})
+    return [synthetic("wear", TRUTH["wear"], seed=3, n=21, name="impact-small"), dry]
+
+
+@pytest.fixture(scope="module")
+def boot_report(tmp_path_factory):
+    """Bootstrap (10 resamples, seed 7, two worker processes) and the tolerance check at 1e-3."""
+    c = compare(laws=["wear", "coulomb"], datasets=_small_pair(), equivalence=False, tolerance=(1e-3,), bootstrap=10,
+                seed=7, jobs=2)
+    out = write_report(c, tmp_path_factory.mktemp("boot") / "rep")
+    return (out / "report.md").read_text(), json.loads((out / "results.json").read_text())
+
+
+def _bootstrap_tables(c) -> str:
+    from frictionlab.report import Doc, _bootstrap_section
+
+    doc = Doc()
+    _bootstrap_section(doc, c)
+    md = doc.markdown()
+    return md[md.index("### First place under resampling"):]
+
+
+def test_bootstrap_tables_depend_on_the_seed_only(boot_report):
+    md, data = boot_report
+    impact = _small_pair()[:1]
+    again = compare(laws=["wear", "coulomb"], datasets=impact, equivalence=False, bootstrap=10, seed=7, jobs=1)
+    other = compare(laws=["wear", "coulomb"], datasets=impact, equivalence=False, bootstrap=10, seed=8, jobs=1)
+    tables = md[md.index("### First place under resampling"):md.index("## Fits")].strip() + "\n"
+    assert _bootstrap_tables(again) == tables  # same seed, one worker process or two: the same numbers
+    assert _bootstrap_tables(other) != tables
+    assert "case resamples" in md and "percentile intervals" in md and "Wilson score interval" in md
+
+
+def test_results_json_carries_the_intervals(boot_report):
+    md, data = boot_report
+    b = data["bootstrap"]
+    assert (b["n"], b["seed"], b["method"], b["interval"], b["first_place_interval"]) == (10, 7, "case", "percentile",
+                                                                                          "wilson")
+    (impact,) = b["datasets"]  # the ODE dataset is left out by default, with the reason and the flag
+    assert impact["dataset"] == "impact-small" and impact["n_ranked"] == 10
+    assert "--bootstrap-ode" in b["not_bootstrapped"]["dry-small"] and "`--bootstrap-ode`" in md
+    lam = next(r for r in impact["parameters"] if r["law"] == "wear" and r["solver"] == "exact")
+    assert lam["parameter"] == "lam" and lam["ci_low"] < lam["value"] < lam["ci_high"] and lam["n_ok"] == 10
+    first = {r["candidate"]: r for r in impact["first_place"]}
+    assert set(first) == {"wear [exact]", "wear [series]", "coulomb [exact]"}
+    assert sum(r["first_count"] for r in first.values()) == pytest.approx(10)
+    assert all(0 <= r["ci_low"] <= r["first_fraction"] <= r["ci_high"] <= 1 for r in first.values())
+
+
+def test_tolerance_table_in_the_report(boot_report):
+    md, data = boot_report
+    section = md[md.index("## What solver tolerance does to a fit"):md.index("## Identifiability warnings")]
+    assert "On **dry-small**" in section and "`frictionlab bench`" in section
+    assert "| wear | 1e-10 (default) |" in section and "| wear | 1e-3 |" in section
+    assert "coulomb (closed form) keeps its fit" in section
+    assert "**Solver tolerance** (dry-small): refitted at rtol 1e-3" in md
+    tol = data["tolerance"]
+    assert tol["default_rtol"] == 1e-10 and tol["rtols"] == [1e-3]
+    assert {(r["law"], r["rtol"]) for r in tol["rows"]} == {("wear", 1e-10), ("wear", 1e-3)}
+    assert all(r["fit_time_s"] > 0 for r in tol["rows"])
+
+
+def test_without_bootstrap_the_report_says_so(report_dir):
+    md = (report_dir / "report.md").read_text()
+    assert "## Bootstrap: how firm are the parameters and the ranking" in md
+    assert "Not run: this comparison was made with `--bootstrap 0`" in md
+    assert "### First place under resampling" not in md and "Parameter intervals" not in md
+    data = json.loads((report_dir / "results.json").read_text())
+    assert data["bootstrap"]["n"] == 0 and data["bootstrap"]["datasets"] == []
+
+
 def test_existing_folder_is_refused_then_replaced_with_force(comparison, tmp_path):
     out = tmp_path / "rep"
     out.mkdir()
@@ -144,10 +222,15 @@ seed = 4
 def test_compare_and_fit_commands(tmp_path, capsys):
     toml = _write_dataset(tmp_path)
     out = tmp_path / "rep"
-    assert main(["compare", "--laws", "wear,coulomb", "--data", str(toml), "--out", str(out), "--jobs", "1"]) == 0
+    assert main(["compare", "--laws", "wear,coulomb", "--data", str(toml), "--out", str(out), "--jobs", "1",
+                 "--bootstrap", "5", "--seed", "2"]) == 0
     captured = capsys.readouterr()
     assert "report:" in captured.out and "[" not in captured.err  # no progress bar when not a terminal
     assert (out / "report.html").exists()
+    assert "first in 100% of 5 resamples" in (out / "report.md").read_text()
+    for bad in (["--bootstrap", "-1"], ["--seed", "-3"]):
+        assert main(["compare", "--data", str(toml), "--out", str(tmp_path / "y")] + bad) == 2
+        assert bad[0] in capsys.readouterr().err
     assert main(["compare", "--laws", "wear", "--data", str(toml), "--out", str(out)]) == 2
     assert "exists" in capsys.readouterr().err
     assert main(["fit", "wear", str(toml), "--free", "u0=8 m/s:14 m/s"]) == 0

@@ -106,6 +106,7 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
             zero_slip.direction = -direction
             events = [zero_slip]
         s_eval = np.clip(np.asarray(t_out, dtype=float) / tscale, t0 / tscale, T / tscale)
+        s_eval, back = np.unique(s_eval, return_inverse=True)  # repeated times (e.g. a resample) solved once
         try:
             sol = solve_ivp(f, (t0 / tscale, T / tscale), np.asarray(y0, dtype=float) / scale, method=method,
                             t_eval=s_eval, rtol=rtol, atol=atol, events=events)
@@ -117,7 +118,7 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
             raise SolverError(f"ode:{method}: integration failed for law '{plan.law.name}': {exc}") from exc
         if sol.status == -1:
             raise SolverError(f"ode:{method}: integration failed for law '{plan.law.name}': {sol.message}")
-        Y = sol.y * scale[:, None]
+        Y = sol.y[:, back[back < sol.y.shape[1]]] * scale[:, None]  # a stop ends the samples reached
         t_stop = y_stop = None
         if events is not None and sol.t_events[0].size:
             t_stop = float(sol.t_events[0][0]) * tscale
