@@ -51,6 +51,36 @@ def _optional(check):
     return optional
 
 
+# --- reading a [scene] table --------------------------------------------------------------
+def spec_reader(spec: Mapping, where: str):
+    """q(key, unit, table=spec, prefix='scene', required=True, positive=True, default=None) -> SI float.
+
+    Reads a quantity string from a TOML table with one-line errors naming file and field.
+    """
+    def q(key, unit, table=spec, prefix="scene", required=True, positive=True, default=None):
+        if key not in table:
+            if required:
+                raise SceneError(f"{where}: [{prefix}] is missing '{key}'")
+            return default
+        value = to_si(table[key], unit, f"{where}: {prefix}.{key}")
+        if positive and not value > 0:
+            raise SceneError(f"{where}: {prefix}.{key} must be positive, got {table[key]!r}")
+        return value
+
+    return q
+
+
+def read_effects(spec: Mapping, where: str, default=()) -> frozenset:
+    """The ``effects`` list of a [scene] table, checked against EFFECTS."""
+    effects = spec.get("effects", list(default))
+    if not isinstance(effects, list) or not all(isinstance(e, str) for e in effects):
+        raise SceneError(f"{where}: scene.effects must be a list of names")
+    bad = [e for e in effects if e not in EFFECTS]
+    if bad:
+        raise SceneError(f"{where}: scene.effects: unknown effect(s) {bad}; known: {', '.join(EFFECTS)}")
+    return frozenset(effects)
+
+
 # --- contact-area models ------------------------------------------------------------
 @attrs.frozen
 class HalfSineArea:
@@ -255,23 +285,8 @@ class Scene:
         if extra:
             raise SceneError(f"{where}: [scene] has unknown key(s) {sorted(extra)}; known: {', '.join(sorted(known))}")
 
-        def q(key, unit, table=spec, prefix="scene", required=True, positive=True, default=None):
-            if key not in table:
-                if required:
-                    raise SceneError(f"{where}: [{prefix}] is missing '{key}'")
-                return default
-            value = to_si(table[key], unit, f"{where}: {prefix}.{key}")
-            if positive and not value > 0:
-                raise SceneError(f"{where}: {prefix}.{key} must be positive, got {table[key]!r}")
-            return value
-
-        effects = spec.get("effects", [])
-        if not isinstance(effects, list) or not all(isinstance(e, str) for e in effects):
-            raise SceneError(f"{where}: scene.effects must be a list of names")
-        bad = [e for e in effects if e not in EFFECTS]
-        if bad:
-            raise SceneError(f"{where}: scene.effects: unknown effect(s) {bad}; known: {', '.join(EFFECTS)}")
-        effects = frozenset(effects)
+        q = spec_reader(spec, where)
+        effects = read_effects(spec, where)
 
         mass = q("mass", "kg")
         radius = q("radius", "m", required="spin" in effects or "slip-coupling" in effects)
