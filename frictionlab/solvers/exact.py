@@ -222,14 +222,18 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     area = s.area if np.any(np.asarray(form.c) != 0.0) else None
 
     def JK(tt):
+        # terms that vanish (no area term; start at first contact) are skipped: a batch of many
+        # scenes evaluates this on large grids
         IN, IIN = _normal_integrals(s.normal, tt)
-        IN0, IIN0 = _normal_integrals(s.normal, np.array([t0]))
-        A, IA = _area_integrals(area, tt)
-        A0, IA0 = _area_integrals(area, np.array([t0]))
-        dt = tt - t0
-        J = sgn * (form.a * (IN - IN0) + form.c * (A - A0))
-        K = sgn * (form.a * (IIN - IIN0 - IN0 * dt) + form.c * (IA - IA0 - A0 * dt))
-        return J, K
+        J, K = form.a * IN, form.a * IIN
+        if t0 != 0.0:
+            IN0, IIN0 = _normal_integrals(s.normal, np.array([t0]))
+            J, K = J - form.a * IN0, K - form.a * (IIN0 + IN0 * (tt - t0))
+        if area is not None:
+            A, IA = _area_integrals(area, tt)
+            A0, IA0 = _area_integrals(area, np.array([t0]))
+            J, K = J + form.c * (A - A0), K + form.c * (IA - IA0 - A0 * (tt - t0))
+        return (J, K) if sgn == 1.0 else (sgn * J, sgn * K)
 
     J, K = JK(t)
     if not find_stop or t.size == 0:
