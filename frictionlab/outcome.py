@@ -209,6 +209,11 @@ class OutcomeScene:
                       compliance=self.compliance, effects=self.effects)
         return Inbound(scene, vt, vn, spin, e, tc)
 
+    def example(self) -> Scene:
+        """One representative impact (reference speed or 30 m/s, 45 deg): what a solver check needs."""
+        vref = self.normal["restitution"].reference_speed or 30.0
+        return self.impact(vref, math.pi / 4).scene
+
     # -- from a TOML [scene] table --------------------------------------------------------------
     @classmethod
     def from_spec(cls, spec: Mapping, where: str) -> "OutcomeScene":
@@ -369,3 +374,28 @@ def predict_outcomes(law, dataset_or_scene, params: Mapping[str, float] | None =
             out[k][i] = v
         out["rolled"][i] = tr.stick_time is not None
     return out
+
+
+# --- fitting: the impact-outcome predictor ---------------------------------------------------------
+def outcome_predictor(law, target, scene, params, solver):
+    """Model of an impact-outcome target for ``frictionlab.predict``: the observable outcome per row, SI.
+
+    Not registered by default (the fitting tests use 'impact-outcome' as their example of a kind
+    without a predictor); ``register_outcome_predictor()`` makes these datasets fittable by
+    ``fit`` and ``compare``, row by row through ``predict_outcomes``.
+    """
+    from .predict import FIT_RTOL, SkipDataset
+
+    if target.observable not in OUTCOMES:
+        raise SkipDataset(f"dataset '{target.name}': '{target.observable}' is not an impact outcome "
+                          f"({', '.join(OUTCOMES)})")
+    rows = rows_of(target.dataset)
+    return predict_outcomes(law, scene, params, solver, speed=rows["speed"], incidence=rows["incidence"],
+                            spin=rows["spin"], rtol=FIT_RTOL)[target.observable]
+
+
+def register_outcome_predictor() -> None:
+    """Make impact-outcome datasets fittable (``frictionlab.predict.register_predictor``)."""
+    from .predict import register_predictor
+
+    register_predictor("impact-outcome", outcome_predictor)

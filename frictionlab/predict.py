@@ -131,6 +131,8 @@ def applicable_solvers(law, scene: Scene) -> dict[str, str | None]:
     from .solvers import exact, series
 
     law = get_law(law)
+    if hasattr(scene, "example"):  # an impact-outcome template: check on one of its impacts
+        scene = scene.example()
     try:
         plan = make_plan(scene, law)
     except FrictionLabError as exc:

@@ -209,3 +209,16 @@ def test_bad_outcome_datasets(tmp_path, old, new, match):
     with pytest.raises(DatasetError, match=match) as err:
         fl.load_dataset(tmp_path / "d.toml")
     assert "\n" not in str(err.value)
+
+
+def test_registered_predictor_fits_the_synthetic_truth(monkeypatch):
+    """With the predictor registered, fitting Coulomb to the synthetic outcomes recovers mu = 0.25."""
+    from frictionlab import fitting
+    from frictionlab.outcome import outcome_predictor
+    from frictionlab.predict import PREDICTORS
+
+    monkeypatch.setitem(PREDICTORS, "impact-outcome", outcome_predictor)
+    r = fitting.fit("coulomb", "impact-outcome-synthetic", solver="exact")
+    assert r.ok
+    mu, err = r.value("mu"), r.stderr("mu")
+    assert 0 < err < 0.01 and abs(mu - 0.25) < 3 * err
