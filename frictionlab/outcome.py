@@ -378,12 +378,8 @@ def predict_outcomes(law, dataset_or_scene, params: Mapping[str, float] | None =
 
 # --- fitting: the impact-outcome predictor ---------------------------------------------------------
 def outcome_predictor(law, target, scene, params, solver):
-    """Model of an impact-outcome target for ``frictionlab.predict``: the observable outcome per row, SI.
-
-    Not registered by default (the fitting tests use 'impact-outcome' as their example of a kind
-    without a predictor); ``register_outcome_predictor()`` makes these datasets fittable by
-    ``fit`` and ``compare``, row by row through ``predict_outcomes``.
-    """
+    """Model of an impact-outcome target for ``frictionlab.predict``: the observable outcome per row, SI,
+    row by row through ``predict_outcomes`` (registered for the 'impact-outcome' kind in predict.py)."""
     from .predict import FIT_RTOL, SkipDataset
 
     if target.observable not in OUTCOMES:
@@ -393,9 +389,3 @@ def outcome_predictor(law, target, scene, params, solver):
     return predict_outcomes(law, scene, params, solver, speed=rows["speed"], incidence=rows["incidence"],
                             spin=rows["spin"], rtol=FIT_RTOL)[target.observable]
 
-
-def register_outcome_predictor() -> None:
-    """Make impact-outcome datasets fittable (``frictionlab.predict.register_predictor``)."""
-    from .predict import register_predictor
-
-    register_predictor("impact-outcome", outcome_predictor)

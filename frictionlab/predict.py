@@ -107,8 +107,15 @@ def _predict_series(law, target, scene, params, solver):
     return tr[SERIES[target.observable]]
 
 
+def _predict_outcomes(law, target, scene, params, solver):
+    from .outcome import outcome_predictor
+
+    return outcome_predictor(law, target, scene, params, solver)
+
+
 register_predictor("impact", _predict_series)
 register_predictor("incline", _predict_series)
+register_predictor("impact-outcome", _predict_outcomes)
 
 
 def predict(law, target: Target, params: Mapping[str, float], solver: str = "exact",

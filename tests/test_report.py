@@ -197,6 +197,7 @@ def test_a_new_dataset_kind_plugs_in_through_one_predictor(tmp_path, monkeypatch
                  columns={"speed": speeds, "rebound_spin": truth + rng.normal(0, 5.0, speeds.size)},
                  units={"speed": "m/s", "rebound_spin": "rad/s"}, noise={"rebound_spin": 5.0},
                  scene=attrs.evolve(base.scene, kind="impact-outcome"), fixed={}, provenance=base.provenance)
+    monkeypatch.delitem(fitting.PREDICTORS, "impact-outcome")
     skipped = compare(laws=["wear"], datasets=[ds], equivalence=False)
     assert "outcomes" in skipped.skipped_datasets and "predictor" in skipped.skipped_datasets["outcomes"]
 
