@@ -133,3 +133,12 @@ def test_failing_fit_on_the_command_line(bad_laws, tmp_path, run_cli):
     ranking = (rep / "ranking.csv").read_text().splitlines()
     assert any(line.startswith("impact-golf-v28,nan-above-5,") and line.endswith(",failed") for line in ranking)
     assert any(line.startswith("impact-golf-v28,wear,") and ",1," in line for line in ranking)
+
+
+@pytest.mark.parametrize("kw", [{"fixed": {"lam": -1.0}}, {"initial": {"lam": -1.0}}, {"fixed": {"lam": float("nan")}}])
+def test_fit_refuses_held_or_start_values_outside_the_bounds(kw):
+    """A held lam of -1 used to be clipped to 0 and 'fitted' with status ok."""
+    from frictionlab.errors import ParameterError
+
+    with pytest.raises(ParameterError, match=r"law 'wear': lam = .* is outside its bounds"):
+        fitting.fit("wear", "impact-golf-v28", **kw)
