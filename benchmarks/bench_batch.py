@@ -126,41 +126,56 @@ def bare_wear(batch, lam):
 
 # --- measurements ---------------------------------------------------------------------------------
 def rk_vs_loop(name, law, batch, params, args, rng):
+    """Batch DOP853 against loops of simulate(ode:METHOD) on a random subset. Batch runs and loop
+    chunks alternate, so slow and fast spells of a shared machine hit both alike."""
     n = batch.n
-    t_batch, br = median_time(lambda: simulate_batch(law, batch, params, solver="DOP853", rtol=args.rtol, n=NT),
-                              args.repeats)
     ex = simulate_batch(law, batch, params, solver="exact", n=NT)
     scale = np.abs(batch.values["u0"])
-    err_batch = np.max(np.abs(br.u - ex.u), axis=1) / scale
     sub = rng.choice(n, size=min(args.sample, n), replace=False)
+    chunks = np.array_split(sub, args.repeats)
+    batch_times, loop_times, errs = [], {m: 0.0 for m in args.loop_methods}, {m: [] for m in args.loop_methods}
+    br = None
+    for chunk in chunks:
+        t, br = median_time(lambda: simulate_batch(law, batch, params, solver="DOP853", rtol=args.rtol, n=NT), 1)
+        batch_times.append(t)
+        for method in args.loop_methods:
+            t0 = clock()
+            for i in chunk:
+                p = {k: float(v[i]) for k, v in params.items()}
+                tr = fl.simulate(law, batch.scene(int(i)), p, solver=f"ode:{method}", rtol=args.rtol,
+                                 t=br.t[i] if br.t.ndim == 2 else br.t)
+                errs[method].append(np.max(np.abs(tr.u - ex.u[i])) / scale[i])
+            loop_times[method] += clock() - t0
+    t_batch = float(np.median(batch_times))
+    err_batch = np.max(np.abs(br.u - ex.u), axis=1) / scale
     print(f"\n[{name}] {n} scenes x {NT} samples; {int(np.sum(~np.isnan(ex.stick_time)))} scenes stick (roll)")
-    print(f"  batch DOP853 rtol={args.rtol:g}: {t_batch:.3f} s ({t_batch / n * 1e6:.1f} us/scene); "
-          f"slip error max {err_batch.max():.2e}, median {np.median(err_batch):.2e}")
+    print(f"  batch DOP853 rtol={args.rtol:g}: {t_batch:.3f} s ({t_batch / n * 1e6:.1f} us/scene, median of "
+          f"{len(batch_times)} runs {', '.join(f'{x:.3f}' for x in batch_times)}); slip error max "
+          f"{err_batch.max():.2e}, median {np.median(err_batch):.2e}")
     results = {}
     for method in args.loop_methods:
-        t0 = clock()
-        errs = []
-        for i in sub:
-            scene = batch.scene(int(i))
-            p = {k: float(v[i]) for k, v in params.items()}
-            tr = fl.simulate(law, scene, p, solver=f"ode:{method}", rtol=args.rtol, t=br.t[i] if br.t.ndim == 2 else br.t)
-            errs.append(np.max(np.abs(tr.u - ex.u[i])) / scale[i])
-        dt = clock() - t0
+        dt = loop_times[method]
         est = dt / sub.size * n
-        errs = np.array(errs)
-        matched = 1.1 * errs.max() >= err_batch[sub].max()  # equal within 10%
+        e = np.array(errs[method])
+        matched = 1.1 * e.max() >= err_batch[sub].max()  # equal within 10%
         results[method] = est
         print(f"  loop simulate(solver='ode:{method}', rtol={args.rtol:g}): {dt:.2f} s for a random {sub.size} of {n} "
-              f"scenes -> extrapolated {est:.1f} s for all; slip error max {errs.max():.2e} "
-              f"(batch on the same scenes {err_batch[sub].max():.2e}: {'batch as accurate or better' if matched else 'batch LESS accurate'})")
+              f"scenes -> extrapolated {est:.1f} s for all; slip error max {e.max():.2e} "
+              f"(batch on the same scenes {err_batch[sub].max():.2e}: "
+              f"{'batch as accurate or better' if matched else 'batch LESS accurate'})")
         print(f"  RATIO loop/batch ({method}): {est / t_batch:.0f}x  (target >= 100x: {'met' if est / t_batch >= 100 else 'NOT met'})")
     return results, t_batch
 
 
 def exact_vs_bare(name, law, batch, params, bare, args, rng):
     n = batch.n
-    t_batch, br = median_time(lambda: simulate_batch(law, batch, params, solver="exact", n=NT), args.repeats)
-    t_bare, out = median_time(lambda: bare(batch, next(iter(params.values()))), args.repeats)
+    tb, tr_, br, out = [], [], None, None
+    for _ in range(max(args.repeats, 5)):  # alternate, so load spells hit both alike
+        t, br = median_time(lambda: simulate_batch(law, batch, params, solver="exact", n=NT), 1)
+        tb.append(t)
+        t, out = median_time(lambda: bare(batch, next(iter(params.values()))), 1)
+        tr_.append(t)
+    t_batch, t_bare = float(np.median(tb)), float(np.median(tr_))
     diff = max(np.max(np.abs(a - b) / (np.max(np.abs(b)) + 1e-300)) for a, b in
                zip((br.u, br.v, br.omega, br.theta, br.force), out))
     sub = rng.choice(n, size=min(args.sample, n), replace=False)
@@ -221,6 +236,16 @@ def numba_closed_form(batch, params, t_bare, bare):
     print(f"  numba-compiled loop of the same closed form: {t_nb:.3f} s (bare numpy / numba = {t_bare / t_nb:.2f}x)")
 
 
+def scaling(args, rng):
+    """Per-scene cost of the numpy batch against batch size: the interpreter overhead is paid per
+    step of the whole batch, so it vanishes per scene as the batch grows."""
+    print("\n[scaling] batch DOP853 on coulomb-roll, per-scene CPU time by batch size")
+    for n in (10, 100, 1000, args.n):
+        b, p = coulomb_family(n, rng)
+        t, _ = median_time(lambda: simulate_batch("coulomb", b, p, solver="DOP853", rtol=args.rtol, n=NT), args.repeats)
+        print(f"  n = {n:>6}: {t / n * 1e6:9.1f} us/scene")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=10_000, help="scenes per family")
@@ -243,6 +268,7 @@ def main(argv=None):
     rk_vs_loop("wear-paper", "wear", wb, wp, args, rng)
     exact_vs_bare("coulomb-roll", "coulomb", cb, cp, bare_coulomb, args, rng)
     exact_vs_bare("wear-paper", "wear", wb, wp, bare_wear, args, rng)
+    scaling(args, rng)
 
 
 if __name__ == "__main__":

@@ -12,13 +12,22 @@ parameters (every built-in law does: its force is arithmetic on the parameter va
 
 Solvers:
   'exact'   the closed forms of ``solvers.exact`` over the whole batch; stick located per scene by
-            vectorized bisection. A scene that breaks away after sticking (rare: it needs a law whose
+            vectorized bracketed root finding (``vecrk.root_bracketed``). A scene that breaks away after sticking (rare: it needs a law whose
             holding capacity drops below the drive) is re-run alone with the scalar exact solver.
   'RK45', 'DOP853'  ``frictionlab.vecrk``: scipy's tableaus, per-scene adaptive steps, dense output,
             zero slip located per scene; stuck phases and breakaway handled per scene.
   'auto'    'exact' where the law and scene admit a closed form, else 'DOP853'.
 Tolerances act on the same scaled problem as ``solvers.ode`` (time by the span, states by
-``ode.state_scales``), so rtol means what it means for ``simulate(..., solver='ode:...')``.
+``ode.state_scales``), so rtol means what it means for ``simulate(..., solver='ode:...')``;
+with the same method the batch takes the same steps as solve_ivp (tests check the errors match).
+``simulate_sweep`` runs a batch in chunks on an executor (local, concurrent.futures or Dask).
+
+Why numpy (measured by benchmarks/bench_batch.py): one numpy step over 10,000 scenes costs
+about 25-35 us per scene at rtol 1e-8, 125-250x less CPU than a Python loop of solve_ivp, and
+the cost per scene stops falling beyond ~1,000 scenes, so the interpreter is no longer the
+bottleneck. numba compiles the same inline closed form about 2x faster than bare numpy, but a
+compiled engine would need every law plugin, a plain Python class, written in numba's subset;
+numpy keeps the plugin contract (a force that broadcasts) and needs no compiler.
 """
 from __future__ import annotations
 
@@ -141,6 +150,11 @@ class SceneBatch:
             top["normal"] = attrs.evolve(s.normal, **normal)
         return attrs.evolve(s, **top) if top else s
 
+    def subset(self, idx) -> "SceneBatch":
+        """The scenes ``idx`` (an index array or slice) as a batch of their own."""
+        idx = np.arange(self.n)[idx]
+        return SceneBatch(self.template, {k: v[idx] for k, v in self.values.items()}, int(idx.size))
+
     def __len__(self) -> int:
         return self.n
 
@@ -260,6 +274,42 @@ def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol:
     return BatchResult(t=tgrid, solver=solver, law=law.name, info=info, **out)
 
 
+def simulate_sweep(law, scenes, params=None, t=None, solver: str = "auto", rtol: float = 1e-8,
+                   atol: float | None = None, n: int = 201, executor=None, chunk: int = 5000) -> BatchResult:
+    """``simulate_batch`` in chunks of ``chunk`` scenes, dispatched on ``executor`` (as in
+    ``frictionlab.bootstrap``: None runs here; a concurrent.futures executor or a dask.distributed
+    Client spreads the chunks). Results are concatenated in scene order and equal the one-call result.
+    """
+    law = get_law(law)
+    batch = scenes if isinstance(scenes, SceneBatch) else SceneBatch.from_scenes(scenes)
+    p = batch_params(law, params, batch.n)
+    tgrid = _time_grid(batch, t, n)
+    chunk = max(1, int(chunk))
+    jobs = []
+    for start in range(0, batch.n, chunk):
+        sl = slice(start, min(start + chunk, batch.n))
+        args = (law.name, batch.subset(sl), _take_params(p, sl), tgrid if tgrid.ndim == 1 else tgrid[sl], solver, rtol,
+                atol, n)
+        jobs.append(args)
+    if executor is None:
+        parts = [simulate_batch(*a) for a in jobs]
+    else:
+        parts = [f.result() for f in [executor.submit(simulate_batch, *a) for a in jobs]]
+    return _concat(parts, tgrid)
+
+
+def _concat(parts, tgrid) -> BatchResult:
+    def cat(name):
+        arrs = [getattr(r, name) for r in parts]
+        return None if any(a is None for a in arrs) else np.concatenate(arrs, axis=0)
+
+    info = {"chunks": len(parts), "solver_per_chunk": [r.solver for r in parts],
+            "nfev": int(sum(r.info.get("nfev", 0) for r in parts))}
+    return BatchResult(t=tgrid, u=cat("u"), v=cat("v"), omega=cat("omega"), theta=cat("theta"), force=cat("force"),
+                       stick_time=cat("stick_time"), A=cat("A"), N=cat("N"), solver=parts[0].solver, law=parts[0].law,
+                       info=info)
+
+
 def _time_grid(batch, t, n):
     if t is None:
         dur = batch.values.get("duration")
@@ -297,25 +347,24 @@ def _finish(law, batch, p, T, Y, sliding, need):
     N = c.N
     omega = Y[plan.index("omega")] if plan.has_spin else np.zeros_like(u)
     theta = Y[plan.index("theta")] if plan.has_spin else np.zeros_like(u)
-    for name, arr in (("u", u), ("v", Y[0]), ("omega", omega), ("theta", theta), ("force", F)):
-        if not np.all(np.isfinite(arr)):
-            i = int(np.argmax(~np.all(np.isfinite(arr), axis=1)))
+    for name, arr in (("states", Y), ("force", F)):
+        if not np.isfinite(arr).all():
+            bad = ~np.isfinite(arr) if arr.ndim == 2 else ~np.isfinite(arr).all(axis=0)
+            i = int(np.argmax(bad.any(axis=1)))
             raise SolverError(f"batch: {name} became NaN or infinite for law '{law.name}' in scene {i}")
-    return {"u": u, "v": np.array(Y[0]), "omega": np.array(omega), "theta": np.array(theta), "force": F,
-            "A": None if A is None else np.broadcast_to(A, u.shape).copy(),
-            "N": None if N is None else np.broadcast_to(N, u.shape).copy()}
+
+    def full(a):
+        return None if a is None else (a if np.shape(a) == u.shape else np.broadcast_to(a, u.shape).copy())
+
+    return {"u": u, "v": Y[0], "omega": omega, "theta": theta, "force": F, "A": full(A), "N": full(N)}
 
 
-def _bisect(fn, lo, hi, tol):
-    """First root of a per-scene sign change: fn(t (k,)) <= 0 at hi, > 0 at lo; returns hi side."""
-    for _ in range(vecrk.BISECTIONS + 10):
-        if np.all(hi - lo <= tol):
-            break
-        mid = 0.5 * (lo + hi)
-        below = fn(mid) <= 0.0
-        hi = np.where(below, mid, hi)
-        lo = np.where(below, lo, mid)
-    return hi
+def _root(make_fn, lo, hi, tol, gtol=0.0):
+    """First root of a per-scene sign change, fn > 0 at lo and <= 0 at hi; returns the hi side.
+
+    make_fn(rows) gives fn for scenes rows (positions in lo/hi), see ``vecrk.root_bracketed``."""
+    fn = make_fn(np.arange(np.size(lo)))
+    return vecrk.root_bracketed(make_fn, lo, hi, fn(lo), fn(hi), tol, gtol)
 
 
 # --- stuck phases ----------------------------------------------------------------------------
@@ -345,30 +394,38 @@ def _breakaway(law, batch, p, ids, ts, ys, t_end, last_dir):
     tb[anyb & (first == 0)] = ts[anyb & (first == 0)]
     ref = np.nonzero(anyb & (first > 0))[0]
     if ref.size:
-        sub_view = batch.view(ids[ref], column=True)
-        sub_plan = _plan(law, sub_view)
-        sub_p = _take_params(p, ids[ref], column=True)
 
-        def g(tt):
-            f, _ = sub_plan.force(sub_p, tt[:, None], ys[:, ref, None], tiny[ref, None])
-            return hold[ref] * f[:, 0] - np.abs(need[ref])
+        def make_fn(rows):
+            r = ref[rows]
+            plan_r = _plan(law, batch.view(ids[r], column=True))
+            p_r = _take_params(p, ids[r], column=True)
+
+            def fn(tt):
+                f, _ = plan_r.force(p_r, tt[:, None], ys[:, r, None], tiny[r, None])
+                return hold[r] * f[:, 0] - np.abs(need[r])
+
+            return fn
 
         lo = grid[ref, first[ref] - 1]
         hi = grid[ref, first[ref]]
-        tb[ref] = _bisect(g, lo, hi, 1e-15 * np.maximum(t_end[ref], 1e-300))
+        tb[ref] = _root(make_fn, lo, hi, 1e-15 * np.maximum(t_end[ref], 1e-300))
     return tb, hold, need
 
 
 def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask):
     """Stuck-phase states (``solvers.stick.stuck_states``) at outputs in [t_from, t_to] not yet filled."""
-    plan = _plan(law, batch.view(ids, column=True))
+    assert Y.flags.c_contiguous and done.flags.c_contiguous  # written through flat views
     Ts = T[ids]
-    Ys, _ = stick.stuck_states(plan, Ts, ts[:, None], ys[:, :, None])
     sel = (Ts >= t_from[:, None]) & (Ts <= t_to[:, None]) & ~done[ids]
     r, c = np.nonzero(sel)
-    Y[:, ids[r], c] = np.broadcast_to(Ys, (Y.shape[0],) + Ts.shape)[:, r, c]
-    done[ids[r], c] = True
-    stuck_mask[ids[r], c] = True
+    if r.size == 0:
+        return
+    plan = _plan(law, batch.view(ids[r]))
+    Ys, _ = stick.stuck_states(plan, Ts[r, c], ts[r], ys[:, r])
+    flat = ids[r] * T.shape[1] + c
+    Y.reshape(Y.shape[0], -1)[:, flat] = Ys
+    done.reshape(-1)[flat] = True
+    stuck_mask.reshape(-1)[flat] = True
 
 
 # --- the vectorized Runge-Kutta path ----------------------------------------------------------
@@ -423,10 +480,14 @@ def _run_rk(law, batch, p, T, method, rtol, atol):
         res = _slide_rk(law, batch, p, slide_ids, t0, y0, direction, T, t_end, scale, method, rtol, atol)
         iterations += res.iterations
         nfev[slide_ids] += res.nfev
-        Yr = res.Y * scale[:, slide_ids, None]
-        r, c = np.nonzero(res.reached & ~done[slide_ids])
-        Y[:, slide_ids[r], c] = Yr[:, r, c]
-        done[slide_ids[r], c] = True
+        new = res.reached & ~done[slide_ids]
+        if slide_ids.size == nsc:  # every scene slides (the usual first phase): no gathering
+            np.copyto(Y, res.Y * scale[:, :, None], where=new[None])
+            done |= new
+        else:
+            r, c = np.nonzero(new)
+            Y[:, slide_ids[r], c] = res.Y[:, r, c] * scale[:, slide_ids[r]]
+            done[slide_ids[r], c] = True
         ev = np.nonzero(~np.isnan(res.t_event))[0]
         ids = slide_ids[ev]
         ts = res.t_event[ev] * t_end[ids]
@@ -516,23 +577,19 @@ def _run_exact(law, batch, p, T):
         Y = exact._states(plan, 0.0, y0, T, sgn * J1, sgn * K1)
         ts = _exact_stop(law, batch, p, plan, form, y0, u_s[:, 0], sgn[:, 0], T)
         hit = ~np.isnan(ts) & ~fallback
-        if hit.any():
+        if hit.any():  # stuck states after the stick time, on the whole grid (cheaper than gathering)
+            stick_time[hit] = ts[hit]
+            tcol = np.where(hit, ts, 0.0)[:, None]
+            Js, Ks, _ = exact._normal_area_rate(plan, form, 0.0, y0, 1.0, tcol, find_stop=False)
+            ys = exact._states(plan, 0.0, y0, tcol, sgn * Js, sgn * Ks)[:, :, 0]
+            ys = _zero_slip(_plan(law, batch.view()), ys)
             ids = np.nonzero(hit)[0]
-            stick_time[ids] = ts[ids]
-            sub = _plan(law, batch.view(ids, column=True))
-            sub_form = law.form(_take_params(p, ids, column=True))
-            tcol = ts[ids][:, None]
-            Js, Ks, _ = exact._normal_area_rate(sub, sub_form, 0.0, y0[:, ids], 1.0, tcol, find_stop=False)
-            ys = exact._states(sub, 0.0, y0[:, ids], tcol, sgn[ids] * Js, sgn[ids] * Ks)[:, :, 0]
-            ys = _zero_slip(sub, ys)
             t_end = T[ids, -1]
-            tb, _, _ = _breakaway(law, batch, p, ids, ts[ids], ys, t_end, sgn[ids, 0])
+            tb, _, _ = _breakaway(law, batch, p, ids, ts[ids], ys[:, ids], t_end, sgn[ids, 0])
             fallback[ids[~np.isnan(tb) & (tb < t_end)]] = True
-            done = T[ids] <= tcol
-            Y[:, ids] = np.where(done[None], Y[:, ids], np.nan)
-            done_full = np.zeros((nsc, m), dtype=bool)
-            done_full[ids] = done
-            _fill_stuck(law, batch, ids, ts[ids], ys, ts[ids], t_end, T, Y, done_full, stuck_mask)
+            stuck_mask = T > np.where(hit, ts, np.inf)[:, None]
+            Ys, _ = stick.stuck_states(plan, T, tcol, ys[:, :, None])
+            np.copyto(Y, Ys, where=stuck_mask[None])
     need = stick.needed_force(plan)
     out = _finish(law, batch, p, T, np.nan_to_num(Y) if fallback.any() else Y, ~stuck_mask, need)
     for i in np.nonzero(fallback)[0]:
@@ -596,8 +653,12 @@ def _exact_stop(law, batch, p, plan, form, y0, u_s, sgn, T):
         lo, hi = grid[ids, first - 1], grid[ids, first]
     ts = np.full(nsc, np.nan)
     if ids.size:
-        g = make_g(ids)
-        ts[ids] = _bisect(lambda x: g(x[:, None])[:, 0], lo, hi, 1e-15 * np.maximum(t_end[ids], 1e-300))
+        def make_fn(rows):
+            g = make_g(ids[rows])
+            return lambda x: g(x[:, None])[:, 0]
+
+        noise = 8 * np.finfo(float).eps * np.abs(u_s[ids])  # slip is u_s minus terms of its size
+        ts[ids] = _root(make_fn, lo, hi, 1e-15 * np.maximum(t_end[ids], 1e-300), noise)
         ts[ids[ts[ids] >= t_end[ids]]] = np.nan
     return ts
 

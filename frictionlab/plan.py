@@ -7,7 +7,10 @@ State components (each only when called for):
   xi     tangential spring deflection [m]               effect 'compliance'
 
 Slip u is v, or v - r omega with 'slip-coupling'; with 'compliance' it is the slip of a
-massless contact patch, found from  F(u) = k xi + c (w - u),  w the rigid contact-point velocity.
+massless contact patch, found from  F(u) = k xi + c (w - u),  w the rigid contact-point velocity;
+the body feels the spring and damper force k xi + c (w - u), which while the patch sticks (u = 0) is
+static friction up to the law's capacity. For the laws' closed-form families the patch slip is
+solved by hand, otherwise by root finding.
 """
 from __future__ import annotations
 
@@ -18,7 +21,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from .errors import SceneError
-from .law import QUANTITIES, Contact, FrictionLaw
+from .law import QUANTITIES, AreaSlipForm, Contact, FrictionLaw, NormalAreaRateForm
 from .scene import G, GrowthArea, HertzNormal, Scene
 
 
@@ -63,13 +66,17 @@ class Plan:
         v = y[0]
         return v - self.scene.radius * y[self.index("omega")] if self.coupled else v
 
+    def area(self, t, y, u) -> tuple[np.ndarray, np.ndarray]:
+        """Contact area [m^2] and its rate [m^2/s] at times t for states y and slip u."""
+        x = y[self.index("x")] if "x" in self.states else None
+        return self.scene.area(t, x, u)
+
     def contact(self, t, y, u) -> Contact:
         """The contact quantities the law requires, and only those, at times t for states y."""
         s = self.scene
         A = dAdt = N = None
-        if self.needs_area or isinstance(s.normal, HertzNormal) and self.needs_normal:
-            x = y[self.index("x")] if "x" in self.states else None
-            A, dAdt = s.area(t, x, u)
+        if self.needs_area:
+            A, dAdt = self.area(t, y, u)
         if self.needs_normal:
             N = s.normal(t, A)
         req = self.law.requires
@@ -85,6 +92,9 @@ class Plan:
         k, c = self.scene.compliance.stiffness, self.scene.compliance.damping
         w = float(self.rigid_slip(y))
         target = k * y[self.index("xi")] + c * w
+        fast = self._patch_slip_closed_form(p, t, y, target, c)
+        if fast is not None:
+            return fast
 
         def g(u):
             f, _ = self.force(p, np.array([t]), y[:, None], np.array([u]))
@@ -103,10 +113,38 @@ class Plan:
                 raise SceneError(f"law '{self.law.name}': no contact-patch slip balances the tangential spring at t = {t:g} s")
         return brentq(g, a, b, xtol=1e-15 * max(abs(bound), 1e-300), rtol=4 * np.finfo(float).eps)
 
-    def slip(self, p, t, y) -> float:
-        if "xi" in self.states:
-            return self.patch_slip(p, t, y)
-        return self.rigid_slip(y)
+    def _patch_slip_closed_form(self, p, t, y, target, c):
+        """The patch slip solved by hand for the laws' closed-form families, or None.
+
+        F = k A u:  u = target / (k A + c).
+        F = sign(u) Q, Q = a N + c' dA/dt >= 0 (Coulomb, area-rate while loading): the patch
+        sticks (u = 0) while |target| <= Q, else slips with u = (target - sign(target) Q) / c.
+        """
+        form = self.law.form(p)
+        if not isinstance(form, (AreaSlipForm, NormalAreaRateForm)):
+            return None
+        cq = self.contact(np.array([t]), y[:, None], np.array([0.0]))
+        if isinstance(form, AreaSlipForm):
+            return target / (form.k * float(cq.A[0]) + c)
+        Q = form.a * float(cq.N[0]) + (form.c * float(cq.dAdt[0]) if form.c != 0.0 else 0.0)
+        if Q < 0:
+            return None  # the law pushes along the slip: let the root finder decide
+        if abs(target) <= Q:
+            return 0.0
+        return (target - math.copysign(Q, target)) / c
+
+    def patch_force(self, p, t, y) -> tuple[float, float]:
+        """(F, u) for a compliant contact: the force the spring and damper pass to the body, and the patch slip.
+
+        F = k xi + c (w - u) equals the law's F(u) while the patch slips; while it sticks
+        (u = 0) it is the static friction the law's F(0) alone cannot express.
+        """
+        u = self.patch_slip(p, t, y)
+        if u != 0.0:  # slipping: the balance F(u) = k xi + c (w - u) holds, take the law's value
+            f, _ = self.force(p, np.array([t]), y[:, None], np.array([u]))
+            return float(f[0]), u
+        k, c = self.scene.compliance.stiffness, self.scene.compliance.damping
+        return k * float(y[self.index("xi")]) + c * float(self.rigid_slip(y)), 0.0
 
     def rates(self, t, y, F, u) -> np.ndarray:
         """Time derivatives of the state for friction force F and slip u (works on batches)."""
@@ -141,8 +179,13 @@ def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan
     spin = "spin" in effects or coupled
     if spin and scene.radius is None:
         raise SceneError(f"{scene_name}: effect 'spin' needs scene.radius")
-    needs_area = bool({"A", "dAdt"} & set(law.requires))
     needs_normal = "N" in law.requires
+    hertz = needs_normal and isinstance(scene.normal, HertzNormal)
+    if hertz and scene.area is None:
+        raise SceneError(f"law '{law.name}' needs N (normal force), which {scene_name} computes from the contact "
+                         "area (Hertz model) but has no [scene.area] model")
+    # the area is evaluated when the law reads A or dA/dt, or when a Hertz normal force reads A
+    needs_area = bool({"A", "dAdt"} & set(law.requires)) or hertz
     states = ["v"]
     if spin:
         states += ["omega", "theta"]

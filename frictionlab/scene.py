@@ -28,13 +28,36 @@ EFFECTS = {
 }
 
 
+# --- validation of Python-built models: no NaN or negative size slips through ----------
+def _number(test, words):
+    def check(instance, attribute, value):
+        # a batch view (frictionlab.batch) puts arrays over scenes in these fields: check every element
+        v = None if isinstance(value, (bool, np.bool_)) else np.asarray(value)
+        ok = v is not None and v.dtype.kind in "fi"
+        if not ok or not np.all(np.isfinite(v)) or not np.all(test(v)):
+            raise SceneError(f"{type(instance).__name__}.{attribute.name} must be {words}, got {value!r}")
+    return check
+
+
+_positive = _number(lambda v: v > 0, "a positive finite number")
+_nonnegative = _number(lambda v: v >= 0, "a finite number >= 0")
+_finite = _number(lambda v: True, "a finite number")
+
+
+def _optional(check):
+    def optional(instance, attribute, value):
+        if value is not None:
+            check(instance, attribute, value)
+    return optional
+
+
 # --- contact-area models ------------------------------------------------------------
 @attrs.frozen
 class HalfSineArea:
     """A(t) = peak sin(pi t / contact_time) for 0 <= t <= contact_time, else 0. Eq (1) of the paper."""
 
-    peak: float  # [m^2]
-    contact_time: float  # [s]
+    peak: float = attrs.field(validator=_nonnegative)  # [m^2]
+    contact_time: float = attrs.field(validator=_positive)  # [s]
 
     def __call__(self, t, x=None, speed=None):
         t = np.asarray(t, dtype=float)
@@ -47,7 +70,7 @@ class HalfSineArea:
 class ConstantArea:
     """A constant contact area [m^2]."""
 
-    area: float
+    area: float = attrs.field(validator=_nonnegative)
 
     def __call__(self, t, x=None, speed=None):
         t = np.asarray(t, dtype=float)
@@ -58,8 +81,8 @@ class ConstantArea:
 class GrowthArea:
     """Wear growth with sliding length x: A = initial + rate * x [m^2, m^2/m]; dA/dt = rate * |slip|."""
 
-    initial: float
-    rate: float
+    initial: float = attrs.field(validator=_nonnegative)
+    rate: float = attrs.field(validator=_nonnegative)
 
     def __call__(self, t, x=None, speed=None):
         x = np.zeros(np.shape(t)) if x is None else np.asarray(x, dtype=float)
@@ -69,24 +92,41 @@ class GrowthArea:
 
 @attrs.frozen(eq=False)
 class TableArea:
-    """A measured area column, smoothed by a spline whose derivative gives dA/dt.
+    """A measured area column [m^2] at times t [s], smoothed by a spline whose derivative gives dA/dt.
 
-    The smoothing spline's roughness penalty is chosen by generalized cross-validation,
-    so measurement noise does not blow up the derivative.
+    The smoothing spline's roughness penalty is chosen by generalized cross-validation on the
+    data scaled to order one (time to [0, 1], area to its peak): in SI units (1e-4 s, 1e-4 m^2)
+    the criterion is ill-posed and scipy returns a nearly straight line. Outside the measured
+    span the area holds its end value and dA/dt is zero.
     """
 
     t: np.ndarray
     A: np.ndarray
     spline: object = attrs.field(init=False, repr=False)
+    slope: object = attrs.field(init=False, repr=False)
 
     def __attrs_post_init__(self):
         from scipy.interpolate import make_smoothing_spline
 
-        object.__setattr__(self, "spline", make_smoothing_spline(self.t, self.A))
+        t, A = np.asarray(self.t, dtype=float), np.asarray(self.A, dtype=float)
+        if t.ndim != 1 or t.shape != A.shape or t.size < 5:
+            raise SceneError(f"area column: need at least 5 (t, A) samples of equal length, got {t.size} and {A.size}")
+        if np.any(np.diff(t) <= 0) or not (np.all(np.isfinite(t)) and np.all(np.isfinite(A))):
+            raise SceneError("area column: times must increase strictly and values be finite")
+        if np.any(A < 0):
+            raise SceneError("area column: negative contact area")
+        span = t[-1] - t[0]
+        peak = float(np.max(A)) or 1.0
+        unit = make_smoothing_spline((t - t[0]) / span, A / peak)
+        object.__setattr__(self, "spline", lambda tt: peak * unit((tt - t[0]) / span))
+        slope = unit.derivative()
+        object.__setattr__(self, "slope", lambda tt: (peak / span) * slope((tt - t[0]) / span))
 
     def __call__(self, t, x=None, speed=None):
-        t = np.clip(np.asarray(t, dtype=float), self.t[0], self.t[-1])
-        return np.maximum(self.spline(t), 0.0), self.spline.derivative()(t)
+        t = np.asarray(t, dtype=float)
+        inside = (t >= self.t[0]) & (t <= self.t[-1])
+        tc = np.clip(t, self.t[0], self.t[-1])
+        return np.maximum(self.spline(tc), 0.0), np.where(inside, self.slope(tc), 0.0)
 
 
 # --- normal-force models ------------------------------------------------------------
@@ -94,8 +134,8 @@ class TableArea:
 class HalfSineNormal:
     """N(t) = peak sin(pi t / contact_time), impulse = 2 peak contact_time / pi = m v_n (1 + e)."""
 
-    impulse: float  # [N s]
-    contact_time: float  # [s]
+    impulse: float = attrs.field(validator=_nonnegative)  # [N s]
+    contact_time: float = attrs.field(validator=_positive)  # [s]
 
     @property
     def peak(self) -> float:
@@ -112,7 +152,7 @@ class HalfSineNormal:
 class HertzNormal:
     """Hertz-type N = coefficient * A^(3/2) [N/m^3]; for a sphere k = 4 E* / (3 pi^1.5 R)."""
 
-    coefficient: float
+    coefficient: float = attrs.field(validator=_nonnegative)
 
     def __call__(self, t, A=None):
         return self.coefficient * np.maximum(A, 0.0) ** 1.5
@@ -133,7 +173,7 @@ class TableNormal:
 class WeightNormal:
     """N = m g cos(alpha) on an incline [N]."""
 
-    value: float
+    value: float = attrs.field(validator=_nonnegative)
 
     def __call__(self, t, A=None):
         return np.full(np.shape(t), self.value)
@@ -146,8 +186,8 @@ class Compliance:
     The damper must be positive: it makes the patch slip well defined for every law.
     """
 
-    stiffness: float
-    damping: float
+    stiffness: float = attrs.field(validator=_positive)
+    damping: float = attrs.field(validator=_positive)
 
 
 @attrs.frozen
@@ -155,24 +195,35 @@ class Scene:
     """Everything about an experiment except the friction law; SI floats throughout."""
 
     kind: str
-    mass: float  # [kg]
-    u0: float  # initial tangential velocity of the body [m/s]
-    duration: float  # simulated time span [s]
-    radius: float | None = None  # [m]
-    inertia_factor: float = 0.4  # I = inertia_factor * m r^2
-    omega0: float = 0.0  # [rad/s]
+    mass: float = attrs.field(validator=_positive)  # [kg]
+    u0: float = attrs.field(validator=_finite)  # initial slip at the contact [m/s] (body velocity minus r omega0 with slip coupling)
+    duration: float = attrs.field(validator=_nonnegative)  # simulated time span [s]
+    radius: float | None = attrs.field(default=None, validator=_optional(_positive))  # [m]
+    inertia_factor: float = attrs.field(default=0.4, validator=_positive)  # I = inertia_factor * m r^2
+    omega0: float = attrs.field(default=0.0, validator=_finite)  # [rad/s]
     incline: float | None = None  # [rad]
     area: object | None = None
     normal: object | None = None
     compliance: Compliance | None = None
-    effects: frozenset = frozenset()
+    effects: frozenset = attrs.field(default=frozenset(), converter=frozenset)
 
     def __attrs_post_init__(self):
+        if self.kind not in KINDS:
+            raise SceneError(f"Scene.kind must be one of {', '.join(KINDS)}, got {self.kind!r}")
+        unknown = sorted(set(self.effects) - set(EFFECTS))
+        if unknown:
+            raise SceneError(f"Scene.effects: unknown effect(s) {unknown}; known: {', '.join(EFFECTS)}")
+        if self.incline is not None:
+            _finite(self, attrs.fields(Scene).incline, self.incline)
+            if not np.all((0 < np.asarray(self.incline)) & (np.asarray(self.incline) < math.pi / 2)):
+                raise SceneError(f"Scene.incline must be between 0 and pi/2 rad, got {self.incline!r}")
+        if {"spin", "slip-coupling"} & set(self.effects) and self.radius is None:
+            raise SceneError("Scene: effects 'spin' and 'slip-coupling' need a radius")
         if "gravity" in self.effects:
             if self.incline is None:
                 raise SceneError("effect 'gravity' needs scene.incline")
             if self.normal is None:  # a block on an incline is pressed on by its weight
-                object.__setattr__(self, "normal", WeightNormal(self.mass * G * math.cos(self.incline)))
+                object.__setattr__(self, "normal", WeightNormal(self.mass * G * np.cos(self.incline)))
 
     @property
     def inertia(self) -> float:
@@ -242,6 +293,7 @@ class Scene:
         area = _area_from_spec(spec.get("area"), where, q, columns, t)
         contact_time = getattr(area, "contact_time", None)
         normal = _normal_from_spec(spec.get("normal"), where, q, columns, t, mass, contact_time, spec, incline)
+        contact_time = contact_time if contact_time is not None else getattr(normal, "contact_time", None)
         compliance = None
         if "compliance" in spec:
             c = spec["compliance"]
@@ -249,7 +301,7 @@ class Scene:
                                     q("damping", "N*s/m", c, "scene.compliance"))
             effects |= {"compliance"}
         elif "compliance" in effects:
-            raise SceneError(f"{where}: effect 'compliance' needs a [scene.compliance] table with 'stiffness'")
+            raise SceneError(f"{where}: effect 'compliance' needs a [scene.compliance] table with 'stiffness' and 'damping'")
 
         duration = q("duration", "s", required=False)
         if duration is None:
@@ -261,11 +313,17 @@ class Scene:
                 raise SceneError(f"{where}: [scene] needs 'duration' (no contact time or time column to take it from)")
             else:
                 duration = 0.0
-        return cls(kind=kind, mass=mass, u0=u0, duration=duration, radius=radius, inertia_factor=inertia_factor,
-                   omega0=omega0, incline=incline, area=area, normal=normal, compliance=compliance, effects=effects)
+        try:
+            return cls(kind=kind, mass=mass, u0=u0, duration=duration, radius=radius, inertia_factor=inertia_factor,
+                       omega0=omega0, incline=incline, area=area, normal=normal, compliance=compliance,
+                       effects=effects)
+        except SceneError as exc:
+            raise SceneError(f"{where}: {exc}") from None
 
 
 def _column(columns, name, where, prefix, quantity):
+    if "t" not in columns:
+        raise SceneError(f"{where}: {prefix}.model = 'column' needs the time column 't'")
     if name != quantity:
         raise SceneError(f"{where}: {prefix}.column = {name!r}: the column must be the {quantity!r} column")
     if name not in columns:
@@ -288,7 +346,10 @@ def _area_from_spec(a, where, q, columns, t):
         A = _column(columns, a.get("column", "A"), where, p, "A")
         if np.any(A < 0):
             raise SceneError(f"{where}: area column has negative values")
-        return TableArea(t, A)
+        try:
+            return TableArea(t, A)
+        except SceneError as exc:
+            raise SceneError(f"{where}: {p}: {exc}") from None
     raise SceneError(f"{where}: {p}.model must be one of half-sine, constant, growth, column; got {model!r}")
 
 

@@ -35,13 +35,17 @@ class Result:
     iterations: int
 
 
-def _tableau(method):
-    cls = {"RK45": RK45, "DOP853": DOP853}[method]
-    return cls
-
-
 def _rms(x):
     return np.sqrt(np.mean(x * x, axis=0))
+
+
+def _combine(coefs, K):
+    """sum_j coefs[j] K[j] over the nonzero coefficients (K: sequence of equal-shape arrays)."""
+    out = None
+    for c, k in zip(coefs, K):
+        if c != 0.0:
+            out = c * k if out is None else out + c * k
+    return np.zeros_like(K[0]) if out is None else out
 
 
 def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: float = 1e-8, atol: float | None = None,
@@ -57,7 +61,7 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
     """
     if method not in METHODS:
         raise SolverError(f"batch: unknown method {method!r}; choose one of {', '.join(METHODS)}")
-    cls = _tableau(method)
+    cls = {"RK45": RK45, "DOP853": DOP853}[method]
     atol = rtol if atol is None else atol
     t0 = np.asarray(t0, dtype=float)
     y = np.array(y0, dtype=float)
@@ -65,8 +69,8 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
     t_end = np.broadcast_to(np.asarray(t_end, dtype=float), (n,))
     t_out = np.asarray(t_out, dtype=float)
     m = t_out.shape[1]
+    shared = t_out[0] if np.all(t_out == t_out[:1]) else None
     Y = np.full((d, n, m), np.nan)
-    reached = np.zeros((n, m), dtype=bool)
     t_event = np.full(n, np.nan)
     y_event = np.full((d, n), np.nan)
     nfev = np.zeros(n, dtype=np.int64)
@@ -74,9 +78,10 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
     ptr = (t_out < t0[:, None]).sum(axis=1)
     t = t0.copy()
     active = np.nonzero(t < t_end)[0]
-    _fill_at_start(Y, reached, ptr, t_out, t, y, active, n)
+    ptr0 = ptr.copy()  # outputs are filled contiguously from here: reached is [ptr0, ptr) at the end
+    _fill_at_start(Y, ptr, t_out, t, y)
     if active.size == 0:
-        return Result(Y, reached, t_event, y_event, nfev, 0)
+        return Result(Y, _reached(ptr0, ptr, m), t_event, y_event, nfev, 0)
 
     order = cls.error_estimator_order
     exponent = -1.0 / (order + 1)
@@ -117,9 +122,9 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
         K = np.empty((ns + 1, d, active.size))
         K[0] = fa
         for s in range(1, ns):
-            dy = np.tensordot(A[s, :s], K[:s], axes=(0, 0)) * ha
+            dy = _combine(A[s, :s], K[:s]) * ha
             K[s] = rhs(ta + C[s] * ha, ya + dy)
-        y_new = ya + np.tensordot(B, K[:ns], axes=(0, 0)) * ha
+        y_new = ya + _combine(B, K[:ns]) * ha
         t_new = ta + ha
         f_new = rhs(t_new, y_new)
         K[ns] = f_new
@@ -156,7 +161,7 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
                 t_event[ia[je]] = ts
                 y_event[:, ia[je]] = ys
             jd = np.nonzero(needs_dense)[0]
-            _fill_dense(Y, reached, ptr, t_out, ia[jd], acc[jd], t_stop_acc[jd], dense)
+            _fill_dense(Y, ptr, t_out, ia[jd], acc[jd], t_stop_acc[jd], dense, shared)
         t[ia] = t_new[acc]
         y[:, ia] = y_new[:, acc]
         F[:, ia] = f_new[:, acc]
@@ -168,20 +173,25 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
             if active.size:
                 rhs = make_rhs(active)
                 g = make_event(active) if make_event else None
-    return Result(Y, reached, t_event, y_event, nfev, iterations)
+    return Result(Y, _reached(ptr0, ptr, m), t_event, y_event, nfev, iterations)
+
+
+def _reached(ptr0, ptr, m):
+    k = np.arange(m)[None, :]
+    return (k >= ptr0[:, None]) & (k < ptr[:, None])
 
 
 def _error_norm(cls, K, h, scale):
     if cls is DOP853:
-        err5 = np.tensordot(cls.E5, K, axes=(0, 0)) / scale
-        err3 = np.tensordot(cls.E3, K, axes=(0, 0)) / scale
+        err5 = _combine(cls.E5, K) / scale
+        err3 = _combine(cls.E3, K) / scale
         e5 = np.sum(err5 * err5, axis=0)
         e3 = np.sum(err3 * err3, axis=0)
         denom = e5 + 0.01 * e3
         with np.errstate(invalid="ignore", divide="ignore"):
             out = np.abs(h) * e5 / np.sqrt(denom * scale.shape[0])
         return np.where(denom > 0, out, 0.0)
-    return _rms(np.tensordot(cls.E, K, axes=(0, 0)) * h / scale)
+    return _rms(_combine(cls.E, K) * h / scale)
 
 
 def _initial_step(rhs, t0, y0, f0, span, order, rtol, atol):
@@ -205,39 +215,56 @@ def _has_outputs(t_out, ptr, idx, t_new):
 
 
 class _Dense:
-    """Dense output over the steps [t_old, t_old + h] of a subset of problems."""
+    """Dense output over the steps [t_old, t_old + h] of the active problems.
+
+    Coefficients are stored as (d * n_coef, k) rows, so evaluating many output times is one
+    ``np.take`` along the last axis and a Horner scheme on contiguous (d, q) arrays (measured
+    about 7x faster than gathering (n_coef, d) blocks per output)."""
 
     def __init__(self, kind, t_old, h, y_old, coef):
-        self.kind, self.t_old, self.h, self.y_old, self.coef = kind, t_old, h, y_old, coef
+        nc, d, k = coef.shape
+        self.kind, self.t_old, self.h, self.y_old, self.shape = kind, t_old, h, y_old, (d, nc)
+        self.flat = np.ascontiguousarray(coef.transpose(1, 0, 2)).reshape(d * nc, k)
 
     def subset(self, rows) -> "_Dense":
         """The dense output of rows only (so repeated calls need no gathering)."""
-        return _Dense(self.kind, self.t_old[rows], self.h[rows], self.y_old[:, rows], self.coef[:, :, rows])
+        out = object.__new__(_Dense)
+        out.kind, out.shape = self.kind, self.shape
+        out.t_old, out.h, out.y_old, out.flat = self.t_old[rows], self.h[rows], self.y_old[:, rows], self.flat[:, rows]
+        return out
 
-    def __call__(self, x, rows=slice(None)):
-        """States at fractions x (k,) of the step for subset rows (k,) -> (d, k)."""
-        coef = self.coef
+    def __call__(self, x, rows=None):
+        """States at fractions x (q,) of the step for problems rows (q,) (None: all) -> (d, q)."""
+        d, nc = self.shape
+        if rows is None:
+            C, y0, h = self.flat, self.y_old, self.h
+        else:
+            C, y0, h = np.take(self.flat, rows, axis=1), np.take(self.y_old, rows, axis=1), self.h[rows]
+        C = C.reshape(d, nc, -1)
+        acc = C[:, nc - 1] * x
         if self.kind == "RK45":  # y_old + h * sum_j Q_j x^(j+1)
-            acc = coef[-1][:, rows] * x
-            for j in range(coef.shape[0] - 2, -1, -1):
-                acc = (acc + coef[j][:, rows]) * x
-            return self.y_old[:, rows] + self.h[rows] * acc
-        acc = coef[-1][:, rows] * x  # DOP853: nested x, (1 - x) products
-        one_minus = 1.0 - x
-        for i, j in enumerate(range(coef.shape[0] - 2, -1, -1), start=1):
-            acc = (acc + coef[j][:, rows]) * (x if i % 2 == 0 else one_minus)
-        return self.y_old[:, rows] + acc
+            for j in range(nc - 2, -1, -1):
+                acc += C[:, j]
+                acc *= x
+            acc *= h
+        else:  # DOP853: nested x, (1 - x) products
+            om = 1.0 - x
+            for i, j in enumerate(range(nc - 2, -1, -1), start=1):
+                acc += C[:, j]
+                acc *= x if i % 2 == 0 else om
+        acc += y0
+        return acc
 
 
 def _dense(cls, rhs, K, t_old, h, y_old, y_new, f_new):
     """Dense output of the steps just taken by the whole active set (rejected rows are never read)."""
     if cls is RK45:
-        return _Dense("RK45", t_old, h, y_old, np.tensordot(cls.P.T, K, axes=(1, 0)))
+        return _Dense("RK45", t_old, h, y_old, np.array([_combine(col, K) for col in cls.P.T]))
     from scipy.integrate._ivp import dop853_coefficients as dc  # INTERPOLATOR_POWER only
 
     ext = list(K)
     for a, c in zip(cls.A_EXTRA, cls.C_EXTRA):
-        dy = np.tensordot(a[: len(ext)], np.array(ext), axes=(0, 0)) * h
+        dy = _combine(a[: len(ext)], ext) * h
         ext.append(rhs(t_old + c * h, y_old + dy))
     Kx = np.array(ext)
     Fc = np.empty((dc.INTERPOLATOR_POWER,) + y_old.shape)
@@ -245,11 +272,11 @@ def _dense(cls, rhs, K, t_old, h, y_old, y_new, f_new):
     Fc[0] = dyv
     Fc[1] = h * Kx[0] - dyv
     Fc[2] = 2 * dyv - h * (f_new + Kx[0])
-    Fc[3:] = h * np.tensordot(cls.D, Kx, axes=(1, 0))
+    Fc[3:] = h * np.array([_combine(row, Kx) for row in cls.D])
     return _Dense("DOP853", t_old, h, y_old, Fc)
 
 
-def _fill_at_start(Y, reached, ptr, t_out, t, y, idx, n):
+def _fill_at_start(Y, ptr, t_out, t, y):
     """Outputs requested exactly at each problem's start time take its initial state."""
     m = t_out.shape[1]
     rows = np.nonzero((ptr < m))[0]
@@ -258,52 +285,98 @@ def _fill_at_start(Y, reached, ptr, t_out, t, y, idx, n):
     at = t_out[rows, ptr[rows]] == t[rows]
     r = rows[at]
     Y[:, r, ptr[r]] = y[:, r]
-    reached[r, ptr[r]] = True
     ptr[r] += 1
 
 
-def _fill_dense(Y, reached, ptr, t_out, idx, pos, t_stop, dense):
+def _fill_dense(Y, ptr, t_out, idx, pos, t_stop, dense, shared=None):
     """Fill every output t_out[i, ptr_i:] <= t_stop_i of problems idx (rows pos of the dense output)."""
-    m = t_out.shape[1]
-    k = np.arange(m)
     start = ptr[idx]
-    within = (k[None, :] >= start[:, None]) & (t_out[idx] <= t_stop[:, None])
-    rows, cols = np.nonzero(within)
-    if rows.size == 0:
-        return
-    x = (t_out[idx[rows], cols] - dense.t_old[pos[rows]]) / dense.h[pos[rows]]
-    Y[:, idx[rows], cols] = dense(x, pos[rows])
-    reached[idx[rows], cols] = True
-    ptr[idx] = np.maximum(ptr[idx], within.sum(axis=1) + start)
+    m = t_out.shape[1]
+    if shared is not None:  # one grid for all problems: count with searchsorted, no (k, m) mask
+        stop = np.maximum(np.searchsorted(shared, t_stop, side="right"), start)
+        counts = stop - start
+        total = int(counts.sum())
+        if total == 0:
+            return
+        rows = np.repeat(np.arange(idx.size), counts)
+        cols = np.arange(total) + np.repeat(start - (np.cumsum(counts) - counts), counts)
+        tq = shared[cols]
+    else:
+        within = (np.arange(m)[None, :] >= start[:, None]) & (t_out[idx] <= t_stop[:, None])
+        rows, cols = np.nonzero(within)
+        if rows.size == 0:
+            return
+        stop = within.sum(axis=1) + start
+        tq = t_out[idx[rows], cols]
+    p = pos[rows]
+    x = (tq - dense.t_old[p]) / dense.h[p]
+    Y.reshape(Y.shape[0], -1)[:, idx[rows] * m + cols] = dense(x, p)  # Y is C-contiguous (d, n, m)
+    ptr[idx] = np.maximum(ptr[idx], stop)
+
+
+def root_bracketed(make_fn, lo, hi, glo, ghi, tol, gtol=0.0):
+    """Per problem, the first point where fn <= 0 in brackets [lo, hi] with fn(lo) > 0 >= fn(hi).
+
+    make_fn(rows) returns fn for the problems ``rows`` (it is rebuilt on the unfinished problems
+    whenever half of them have converged). Regula falsi with the Anderson-Bjorck correction and
+    the bracket kept; a bisection step wherever the secant leaves the bracket or the last three
+    steps did not halve it. Returns the fn <= 0 end once the bracket is within tol, or once |fn|
+    there is within gtol (the rounding noise of fn: no finer answer is meaningful).
+    """
+    n = np.size(lo)
+    out = np.array(hi, dtype=float)
+    cur = np.arange(n)
+    lo, hi, glo, ghi = (np.array(a, dtype=float) for a in (lo, hi, glo, ghi))
+    tol = np.broadcast_to(np.asarray(tol, dtype=float), (n,))
+    gtol = np.broadcast_to(np.asarray(gtol, dtype=float), (n,))
+    side = np.zeros(n)
+    widths = [np.full(n, np.inf)] * 3
+    fn = make_fn(cur)
+    for it in range(BISECTIONS + 40):
+        open_ = (hi - lo > tol) & (np.abs(ghi) > gtol)
+        out[cur] = hi
+        if not open_.any():
+            break
+        if open_.sum() <= cur.size // 2:  # drop the converged problems
+            cur = cur[open_]
+            lo, hi, glo, ghi, tol, gtol, side = (a[open_] for a in (lo, hi, glo, ghi, tol, gtol, side))
+            widths = [w[open_] for w in widths]
+            open_ = open_[open_]
+            fn = make_fn(cur)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mid = (lo * ghi - hi * glo) / (ghi - glo)
+        slow = (hi - lo) > 0.5 * widths[0]
+        widths = widths[1:] + [hi - lo]
+        bad = ~np.isfinite(mid) | (mid <= lo) | (mid >= hi) | slow | (it >= 30)
+        mid = np.where(bad, 0.5 * (lo + hi), mid)
+        mid = np.where(open_, mid, hi)
+        gm = fn(mid)
+        below = (gm <= 0.0) & open_
+        above = ~below & open_
+        # the same end moved twice: scale the stale end's value (Anderson-Bjorck, m = 1 - g_new/g_replaced)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            m_hi = np.where(below, 1.0 - gm / ghi, 0.5)
+            m_lo = np.where(above, 1.0 - gm / glo, 0.5)
+        m_hi = np.where(m_hi > 0, m_hi, 0.5)
+        m_lo = np.where(m_lo > 0, m_lo, 0.5)
+        hi, ghi = np.where(below, mid, hi), np.where(below, gm, ghi)
+        lo, glo = np.where(above, mid, lo), np.where(above, gm, glo)
+        glo = np.where(below & (side < 0), glo * m_hi, glo)
+        ghi = np.where(above & (side > 0), ghi * m_lo, ghi)
+        side = np.where(below, -1.0, np.where(above, 1.0, side))
+    return out
 
 
 def _locate(make_event, idx, dense, rows, t_old, h):
-    """First g <= 0 in each step, on the dense output: Illinois regula falsi on the bracket (bisection
-    after 30 rounds); returns (t_stop, y_stop) with t_stop on the g <= 0 side, bracket <= 4 eps."""
-    g = make_event(idx)
+    """First g <= 0 within each step, on the dense output; returns (t_stop, y_stop)."""
     dense = dense.subset(rows)
-    rows = slice(None)
+
+    def make_fn(sub):
+        g, dn, t0, hh = make_event(idx[sub]), dense.subset(sub), t_old[sub], h[sub]
+        return lambda x: g(t0 + x * hh, dn(x))
+
+    eps = np.finfo(float).eps
+    fn = make_fn(np.arange(idx.size))
     lo, hi = np.zeros(idx.size), np.ones(idx.size)
-    glo = g(t_old, dense(lo, rows))
-    ghi = g(t_old + h, dense(hi, rows))
-    eps = 4 * np.finfo(float).eps
-    side = np.zeros(idx.size)
-    for it in range(BISECTIONS + 40):
-        open_ = (hi - lo > eps) & (ghi != 0.0)
-        if not open_.any():
-            break
-        with np.errstate(invalid="ignore", divide="ignore"):
-            mid = (lo * ghi - hi * glo) / (ghi - glo)
-        bad = ~np.isfinite(mid) | (mid <= lo) | (mid >= hi) | (it >= 30)  # bisection if it stalls
-        mid = np.where(bad, 0.5 * (lo + hi), mid)
-        mid = np.where(open_, mid, hi)
-        gm = g(t_old + mid * h, dense(mid, rows))
-        below = (gm <= 0.0) & open_
-        above = ~below & open_
-        hi, ghi = np.where(below, mid, hi), np.where(below, gm, ghi)
-        lo, glo = np.where(above, mid, lo), np.where(above, gm, glo)
-        # Illinois: halve the stale end's value when the same side moves twice
-        glo = np.where(below & (side < 0), glo * 0.5, glo)
-        ghi = np.where(above & (side > 0), ghi * 0.5, ghi)
-        side = np.where(below, -1.0, np.where(above, 1.0, side))
-    return t_old + hi * h, dense(hi, rows)
+    x = root_bracketed(make_fn, lo, hi, fn(lo), fn(hi), 4 * eps, 8 * eps)  # g is slip / its scale
+    return t_old + x * h, dense(x)

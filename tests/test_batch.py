@@ -157,3 +157,57 @@ def test_errors_are_one_line():
         simulate_batch("coulomb", [oblique(30, 0.5)], solver="Radau")
     with pytest.raises(FrictionLabError, match="needs"):
         simulate_batch("wear", [incline(0.1)], solver="DOP853")
+
+
+def test_sweep_in_chunks_on_an_executor_equals_one_call():
+    from concurrent.futures import ThreadPoolExecutor
+
+    from frictionlab.batch import simulate_sweep
+
+    rng = np.random.default_rng(3)
+    batch = SceneBatch.sweep(oblique(40.0, 0.5), {"u0": rng.uniform(2, 30, 11)})
+    mu = rng.uniform(0.1, 0.5, 11)
+    one = simulate_batch("coulomb", batch, {"mu": mu}, solver="DOP853", n=41)
+    with ThreadPoolExecutor(2) as ex:
+        swept = simulate_sweep("coulomb", batch, {"mu": mu}, solver="DOP853", n=41, executor=ex, chunk=4)
+    assert swept.info["chunks"] == 3
+    for name in ("u", "v", "omega", "theta", "force", "stick_time"):
+        assert np.array_equal(getattr(swept, name), getattr(one, name), equal_nan=True)
+
+
+@pytest.mark.slow
+def test_benchmark_script_runs(capsys):
+    """benchmarks/bench_batch.py end to end on a small problem (slow: deselected by default)."""
+    import importlib.util
+    import pathlib
+
+    path = pathlib.Path(__file__).resolve().parents[1] / "benchmarks" / "bench_batch.py"
+    spec = importlib.util.spec_from_file_location("bench_batch", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    mod.main(["--n", "300", "--sample", "10", "--repeats", "1", "--no-numba"])
+    out = capsys.readouterr().out
+    assert out.count("RATIO loop/batch") == 4 and out.count("RATIO batch/bare") == 2
+
+
+def test_shared_table_model_is_allowed_different_tables_are_not():
+    from frictionlab.scene import TableNormal
+
+    tc = 450e-6
+    tt = np.linspace(0, tc, 50)
+    table = TableNormal(tt, 3000.0 * np.sin(np.pi * tt / tc))
+    scenes = [Scene(kind="impact", mass=M, u0=u0, duration=tc, radius=R, normal=table,
+                    effects=frozenset({"slip-coupling"})) for u0 in (3.0, 8.0)]
+    br = simulate_batch("coulomb", scenes, {"mu": 0.3}, solver="auto", n=41)
+    assert br.solver == "DOP853"
+    tr = fl.simulate("coulomb", scenes[1], {"mu": 0.3}, solver="ode:DOP853", t=br.t, rtol=1e-10)
+    assert np.allclose(br.u[1], tr.u, atol=1e-6 * 8.0)
+    other = attrs_evolve(scenes[1], normal=TableNormal(tt, 2.0 * table.N))
+    with pytest.raises(SceneError, match="normal.t|normal.N"):
+        SceneBatch.from_scenes([scenes[0], other])
+
+
+def attrs_evolve(obj, **kw):
+    import attrs
+
+    return attrs.evolve(obj, **kw)

@@ -95,15 +95,31 @@ def _states(plan, t0, y0, t, J, K):
 
 
 # --- F = k A u ------------------------------------------------------------------------
+B_LAPLACE = 500.0  # above this b the integral of exp(-2 b sin^2) is summed as a Laplace-type series
+
+
 def bessel_integral(b, phi, t) -> np.ndarray:
     """int_0^t exp(b cos(phi s) - b) ds for 0 <= t <= pi/phi, to machine precision.
 
     b [-], phi [1/s] and t [s] broadcast against each other (a batch passes (n, 1) columns
-    and an (n, m) grid). The sines sin(k phi t) come from the three-term recurrence
-    sin((k+1)x) = 2 cos(x) sin(kx) - sin((k-1)x); terms stop once 2 I_k(b) e^-b / k falls
-    below 1e-17 I_0(b) e^-b for every b (the series converges like (b/2)^k / k!).
+    and an (n, m) grid).
+    b <= 500: the Bessel (Jacobi-Anger) series ive(0,b) t + 2 sum_k ive(k,b) sin(k phi t) / (k phi);
+    the sines come from the recurrence sin((k+1)x) = 2 cos(x) sin(kx) - sin((k-1)x); terms stop
+    once 2 I_k(b) e^-b / k falls below 1e-17 I_0(b) e^-b for every b.
+    b > 500: the series would need ~sqrt(90 b) terms (6e6 at b = 4.5e11) and loses accuracy;
+    instead see ``_laplace_integral``.
     """
     b, phi, t = (np.asarray(v, dtype=float) for v in (b, phi, t))
+    big = b > B_LAPLACE
+    if not np.any(big):
+        return _bessel_series(b, phi, t)
+    if np.all(big):
+        return _laplace_integral(b, phi, t)
+    return np.where(big, _laplace_integral(np.where(big, b, 2 * B_LAPLACE), phi, t),
+                    _bessel_series(np.where(big, 0.0, b), phi, t))
+
+
+def _bessel_series(b, phi, t):
     kmax = int(math.ceil(math.sqrt(2.0 * max(float(np.max(b, initial=0.0)), 1.0) * 45.0))) + 20
     w0 = ive(0, b)
     x = phi * t
@@ -116,6 +132,27 @@ def bessel_integral(b, phi, t) -> np.ndarray:
         if np.all(2.0 * w <= 1e-17 * k * w0):
             break
         s_prev, s_k = s_k, two_cos * s_k - s_prev
+    return out
+
+
+def _laplace_integral(b, phi, t):
+    """The same integral for large b: with x = sin(phi s / 2) it is (2/phi) int_0^X exp(-2 b x^2) / sqrt(1 - x^2) dx.
+
+    The integrand is below exp(-b/2) for x > 1/2, so X is capped there and 1/sqrt(1 - x^2) is
+    expanded, sum_n C(2n,n)/4^n x^(2n); each term is an incomplete gamma function and the terms
+    fall like (1/(4b))^n.
+    """
+    from scipy.special import gamma, gammainc
+
+    X = np.minimum(np.sin(phi * t / 2.0), 0.5)
+    z = 2.0 * b * X * X
+    out = np.zeros(np.broadcast(b, z).shape)
+    c = 1.0
+    for n in range(12):
+        a = n + 0.5
+        out = out + c * 0.5 * (2.0 * b) ** (-a) * gamma(a) * gammainc(a, z)
+        c *= (2 * n + 1) / (2 * n + 2)
+    return (2.0 / phi) * out
     return out
 
 
@@ -185,14 +222,18 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     area = s.area if np.any(np.asarray(form.c) != 0.0) else None
 
     def JK(tt):
+        # terms that vanish (no area term; start at first contact) are skipped: a batch of many
+        # scenes evaluates this on large grids
         IN, IIN = _normal_integrals(s.normal, tt)
-        IN0, IIN0 = _normal_integrals(s.normal, np.array([t0]))
-        A, IA = _area_integrals(area, tt)
-        A0, IA0 = _area_integrals(area, np.array([t0]))
-        dt = tt - t0
-        J = sgn * (form.a * (IN - IN0) + form.c * (A - A0))
-        K = sgn * (form.a * (IIN - IIN0 - IN0 * dt) + form.c * (IA - IA0 - A0 * dt))
-        return J, K
+        J, K = form.a * IN, form.a * IIN
+        if t0 != 0.0:
+            IN0, IIN0 = _normal_integrals(s.normal, np.array([t0]))
+            J, K = J - form.a * IN0, K - form.a * (IIN0 + IN0 * (tt - t0))
+        if area is not None:
+            A, IA = _area_integrals(area, tt)
+            A0, IA0 = _area_integrals(area, np.array([t0]))
+            J, K = J + form.c * (A - A0), K + form.c * (IA - IA0 - A0 * (tt - t0))
+        return (J, K) if sgn == 1.0 else (sgn * J, sgn * K)
 
     J, K = JK(t)
     if not find_stop or t.size == 0:
@@ -213,8 +254,15 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     if bad.size == 0:
         return J, K, None
     i = int(bad[0]) + 1
-    if g[i] == 0.0:
-        return J, K, float(grid[i])
-    t_stop = brentq(lambda x: sgn * slip(x)[0] + margin, grid[i - 1], grid[i], xtol=1e-15 * max(T, 1e-300),
-                    rtol=4 * np.finfo(float).eps)
-    return J, K, float(t_stop)
+    xtol, rtol = 1e-15 * max(T, 1e-300), 4 * np.finfo(float).eps
+    t_margin = float(grid[i]) if g[i] == 0.0 else brentq(lambda x: sgn * slip(x)[0] + margin, grid[i - 1], grid[i],
+                                                         xtol=xtol, rtol=rtol)
+    # the margin only detects the stop; the stop itself is where slip is zero, found from the
+    # last time slip was strictly of the phase's sign (the closed form is exact, keep it so)
+    ahead = np.nonzero(sgn * slip(grid[:i]) > 0.0)[0]
+    if ahead.size == 0:
+        return J, K, t_margin
+    lo = float(grid[int(ahead[-1])])
+    if sgn * slip(t_margin)[0] >= 0.0:
+        return J, K, t_margin
+    return J, K, float(brentq(lambda x: sgn * slip(x)[0], lo, t_margin, xtol=xtol, rtol=rtol))

@@ -29,6 +29,41 @@ def state_scales(plan, T: float) -> np.ndarray:
     return np.array(np.broadcast_arrays(*[size[k] for k in plan.states]), dtype=float)
 
 
+def phase_scales(plan, p, t0: float, T: float, y0, direction: float) -> np.ndarray:
+    """Typical size of each state over a sliding phase [t0, T], so that tolerances act relative to it.
+
+    Velocities scale with the largest of the initial slip and body speed, and the speed the
+    drive can reach: |drive| (T - t0), or less where the law's force at that speed exceeds
+    the drive (a lubricated block levels off at u_inf << g T). Spin and angle scale with the
+    friction impulse the law can deliver, J ~ min(F (T - t0), (V + |drive| T) / kappa), F the
+    law's largest force at slip V over the span: with a weak law (b = 1e-6) spin is tiny, and
+    scaling it by V / r would leave it to the absolute tolerance alone.
+    """
+    s = plan.scene
+    r = s.radius or 1.0
+    span = max(T - t0, T * 1e-12, 1e-300)
+    tt = np.linspace(t0, T, 33)
+    yy = np.repeat(np.asarray(y0, dtype=float)[:, None], tt.size, axis=1)
+
+    def largest_force(u):
+        F, _ = plan.force(p, tt, yy, np.full(tt.size, u))
+        return float(np.max(np.abs(F)))
+
+    V = max(abs(s.u0), abs(float(y0[0])), abs(float(plan.rigid_slip(y0))), abs(s.omega0) * r)
+    if plan.drive != 0.0:
+        reach = abs(plan.drive) * span
+        F = largest_force(np.sign(plan.drive) * reach)
+        V = max(V, reach * min(1.0, s.mass * abs(plan.drive) / F) if F > 0 else reach)
+    V = V if V > 0 and np.isfinite(V) else 1.0
+    size = {"v": V, "x": V * span, "xi": V * span}
+    if plan.has_spin:
+        J = min(largest_force((direction or 1.0) * V) * span, (V + abs(plan.drive) * span) / plan.kappa)
+        w = max(r * J / s.inertia, abs(s.omega0), 1e-12 * V / r)
+        size["omega"] = w
+        size["theta"] = max(w * span, abs(float(y0[plan.index("theta")])), 1e-300)
+    return np.array([size[k] for k in plan.states])
+
+
 def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = None):
     """A sliding-phase function for ``segments.run`` using solve_ivp ``method``."""
     if method not in METHODS:
@@ -43,17 +78,21 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
         if len(t_out) == 0 or t_out[-1] <= t0:
             return np.repeat(np.asarray(y0, dtype=float)[:, None], len(t_out), axis=1), None, None, {"nfev": 0}
         T = float(t_out[-1])
-        scale = state_scales(plan, T)
+        scale = phase_scales(plan, p, t0, T, y0, direction)
         tscale = T
         compliant = "xi" in plan.states
+
 
         def f(s, z):
             t = s * tscale
             y = z * scale
-            u = plan.slip(p, t, y)
-            if not compliant and direction != 0:
-                u = stick.branch_slip(plan, u, direction)
-            F, _ = plan.force(p, np.asarray(t), y, np.asarray(u))
+            if compliant:
+                F, u = plan.patch_force(p, t, y)
+            else:
+                u = plan.rigid_slip(y)
+                if direction != 0:
+                    u = stick.branch_slip(plan, u, direction)
+                F, _ = plan.force(p, np.asarray(t), y, np.asarray(u))
             return plan.rates(t, y, F, u) * tscale / scale
 
         events = None

@@ -22,6 +22,7 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
     Y = np.empty((len(plan.states), n))
     F = np.empty(n)
     sliding = np.zeros(n, dtype=bool)
+    dirs = np.zeros(n)  # slip direction of the sliding phase each sample belongs to
     done = np.zeros(n, dtype=bool)
     t0, y0 = 0.0, plan.initial_state()
     info: dict = {"nfev": 0, "segments": 0}
@@ -49,10 +50,12 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
             idx = np.nonzero(todo)[0][: Ys.shape[1]]
             Y[:, idx] = Ys
             sliding[idx] = True
+            dirs[idx] = direction
             done[idx] = True
+            if t_stop is not None and stick_time is None:
+                stick_time = t_stop
             if t_stop is None or t_stop >= T:
                 break
-            stick_time = t_stop if stick_time is None else stick_time
             last_direction = direction
             t0, y0 = t_stop, _zero_slip(plan, y_stop)
             phase = "stuck"
@@ -72,16 +75,19 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
     if not done.all():
         raise SolverError(f"{solver_name}: solution ended at t = {t0:g} s before the last requested time {T:g} s")
     u = np.empty(n)
-    if compliant:
+    if compliant:  # the force on the body is the spring's and damper's, also while the patch sticks
         for i in np.nonzero(sliding)[0]:
-            u[i] = plan.patch_slip(p, t_eval[i], Y[:, i])
+            F[i], u[i] = plan.patch_force(p, t_eval[i], Y[:, i])
     else:
         u[:] = plan.rigid_slip(Y)
+        # within a sliding phase slip keeps its sign: rounding (1e-15 m/s) must not flip it
+        held = sliding & (dirs != 0)
+        u[held] = dirs[held] * np.maximum(dirs[held] * u[held], 0.0)
     u[~sliding] = 0.0
     c = plan.contact(t_eval, Y, u)
-    if sliding.any():
+    if sliding.any() and not compliant:
         F[sliding] = plan.law.evaluate(p, _subset(c, sliding))
-    A = c.A if c.A is not None else (plan.scene.area(t_eval, None, u)[0] if plan.needs_area else None)
+    A = c.A if c.A is not None else (plan.area(t_eval, Y, u)[0] if plan.needs_area else None)
     omega = Y[plan.index("omega")] if plan.has_spin else np.zeros(n)
     theta = Y[plan.index("theta")] if plan.has_spin else np.zeros(n)
     for name, arr in (("u", u), ("v", Y[0]), ("omega", omega), ("theta", theta), ("force", F)):

@@ -51,14 +51,18 @@ def breakaway(plan, p, t0: float, t1: float, y0, slip_before: float) -> float | 
     direction = hold_direction(plan, slip_before)
     grid = np.linspace(t0, t1, GRID)
     # the stuck state changes only through omega/theta, which no law reads: y0 is enough
-    margin = capacity(plan, p, grid, y0, direction) - need
-    bad = np.nonzero(margin < 0)[0]
+    cap = capacity(plan, p, grid, y0, direction)
+    # a capacity equal to the need up to rounding (mu = tan(alpha) exactly) holds: without this
+    # tolerance the contact would break away and stick again at once, forever
+    tol = 64 * np.finfo(float).eps * max(need, float(np.max(np.abs(cap))))
+    margin = cap - need
+    bad = np.nonzero(margin < -tol)[0]
     if bad.size == 0:
         return None
     i = int(bad[0])
     if i == 0:
         return t0
-    g = lambda s: capacity(plan, p, s, y0, direction)[0] - need  # noqa: E731
+    g = lambda s: capacity(plan, p, s, y0, direction)[0] - need + tol  # noqa: E731
     return brentq(g, grid[i - 1], grid[i], xtol=1e-15 * max(t1, 1e-300))
 
 
@@ -68,9 +72,12 @@ def stuck_states(plan, t, ts, ys):
     F = needed_force(plan)
     dt = np.asarray(t, dtype=float) - ts
     out = {}
+    # without slip coupling the stuck body does not move (v = 0 exactly); with it the slip
+    # v - r omega stays zero while both change
+    a_v = plan.drive - F / s.mass if plan.coupled else 0.0
     for i, name in enumerate(plan.states):
         if name == "v":
-            out[name] = ys[i] + (plan.drive - F / s.mass) * dt
+            out[name] = ys[i] + a_v * dt
         elif name == "omega":
             out[name] = ys[i] + F * s.radius / s.inertia * dt
         elif name == "theta":

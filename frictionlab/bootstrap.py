@@ -1,0 +1,336 @@
+"""Bootstrap confidence intervals for fitted parameters, and how often each law ranks first.
+
+``bootstrap(fit_fn, dataset, n, seed, executor)`` refits ``n`` resampled copies of a dataset (or
+of a group of datasets, fitted together) and returns a ``BootstrapResult``:
+  method='residual'  y* = best-fit model + residuals of the original fit drawn with replacement
+                     (centred); times, scene and noise estimate unchanged.
+  method='case'      rows drawn with replacement (kept in time order): no model assumed.
+Replicate r draws from its own generator, ``SeedSequence(seed).spawn(n)[r]``, inside the task that
+fits it, so the numbers depend on the seed only, never on the executor, its workers or the order
+in which tasks finish.
+
+``executor`` is anything with ``submit(fn, *args) -> future`` whose futures have ``result()``:
+None runs here, one replicate after another; a ``concurrent.futures`` executor; or a
+``dask.distributed.Client`` (pip install 'frictionlab[dask]'; e.g. ``Client(LocalCluster())`` or
+``Client('tcp://scheduler:8786')`` for a real cluster). Functions and datasets travel by pickle.
+
+``bootstrap_ranking(laws, dataset, n, seed, executor)`` fits every law to the same resampled
+copies and counts how often each ranks first by AIC. ``parameter_table`` and ``ranking_table``
+turn the results into rows for the comparison report.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+
+import attrs
+import numpy as np
+
+from .errors import FrictionLabError, ParameterError
+
+METHODS = ("residual", "case")
+
+
+# --- fitting functions that travel ---------------------------------------------------------------
+@attrs.frozen
+class LawFit:
+    """A picklable fit function: ``fitting.fit(law, data, solver, **options)``.
+
+    ``warm(values)`` returns a copy that starts from ``values`` with no grid scan and one
+    Levenberg-Marquardt run: replicates start at the original best fit, which is where the
+    bootstrap asks how far the optimum moves.
+    """
+
+    law: str
+    solver: str = "auto"
+    options: tuple = ()  # sorted (key, value) pairs of fitting.fit keyword arguments
+    start: tuple = ()  # sorted (name, value) law-parameter start values, SI
+
+    def __call__(self, data):
+        from .fitting import fit
+
+        kw = dict(self.options)
+        if self.start:
+            kw.update(initial={**dict(kw.get("initial") or {}), **dict(self.start)}, scan=0, n_starts=1)
+        return fit(self.law, data, solver=self.solver, **kw)
+
+    def warm(self, values: Mapping[str, float]) -> "LawFit":
+        return attrs.evolve(self, start=tuple(sorted(values.items())))
+
+
+def law_fit(law, solver: str = "auto", **options) -> LawFit:
+    """``LawFit`` for a law name and ``fitting.fit`` keyword options (free, fixed, local, ...)."""
+    name = law if isinstance(law, str) else law.name
+    return LawFit(name, solver, tuple(sorted(options.items())))
+
+
+# --- results ---------------------------------------------------------------------------------------
+@attrs.frozen(eq=False)
+class BootstrapResult:
+    """Bootstrap of one fit. samples (n, k) holds the fitted values of ``names`` per replicate
+    (NaN rows where the refit failed); aic (n,) the replicate's AIC."""
+
+    law: str
+    datasets: tuple[str, ...]
+    method: str
+    seed: int
+    names: tuple[str, ...]
+    units: tuple[str, ...]
+    base: object  # the FitResult on the original data
+    samples: np.ndarray
+    aic: np.ndarray
+    failures: tuple[str, ...]  # reasons, one per failed replicate
+
+    @property
+    def n(self) -> int:
+        return self.samples.shape[0]
+
+    @property
+    def n_ok(self) -> int:
+        return int(np.sum(np.all(np.isfinite(self.samples), axis=1))) if self.samples.size else self.n - len(self.failures)
+
+    def interval(self, name: str, level: float = 0.95) -> tuple[float, float]:
+        """Percentile interval [SI] of parameter ``name`` over the successful replicates."""
+        col = self._column(name)
+        if col.size == 0:
+            return math.nan, math.nan
+        a = (1.0 - level) / 2.0
+        lo, hi = np.quantile(col, [a, 1.0 - a])
+        return float(lo), float(hi)
+
+    def std(self, name: str) -> float:
+        col = self._column(name)
+        return float(np.std(col, ddof=1)) if col.size > 1 else math.nan
+
+    def _column(self, name):
+        if name not in self.names:
+            raise ParameterError(f"bootstrap of '{self.law}': no fitted parameter '{name}' (has: {', '.join(self.names)})")
+        col = self.samples[:, self.names.index(name)]
+        return col[np.isfinite(col)]
+
+
+# --- resampling (runs inside the tasks) --------------------------------------------------------------
+def _as_list(dataset):
+    return list(dataset) if isinstance(dataset, (list, tuple)) else [dataset]
+
+
+def _resample(datasets, models, method, rng):
+    """Resampled copies of datasets; models[i] is dataset i's best-fit model of its observable."""
+    out = []
+    for ds, model in zip(datasets, models):
+        cols = dict(ds.columns)
+        if method == "case":
+            idx = np.sort(rng.integers(0, len(ds), len(ds)))
+            cols = {k: v[idx] for k, v in cols.items()}
+        else:
+            y = cols[ds.observable]
+            res = y - model
+            res = res - res.mean()
+            cols[ds.observable] = model + res[rng.integers(0, res.size, res.size)]
+        out.append(attrs.evolve(ds, columns=cols))
+    return out
+
+
+def _values(result, names):
+    if not getattr(result, "ok", False):
+        return None
+    return [result.params[k].value for k in names]
+
+
+def _aic(result):
+    stats = getattr(result, "stats", None)
+    return float(stats.aic) if stats is not None and getattr(result, "ok", False) else math.nan
+
+
+def _run_chunk(fit_fns, datasets, models, method, seeds):
+    """Fit every function in fit_fns to the replicates of seeds; returns, per seed, per function,
+    (values or None, aic, failure reason)."""
+    single = len(datasets) == 1
+    out = []
+    for seed in seeds:
+        rng = np.random.default_rng(seed)
+        data = _resample(datasets, models, method, rng)
+        row = []
+        for fn, names in fit_fns:
+            try:
+                r = fn(data[0] if single else data)
+                vals = _values(r, names)
+                row.append((vals, _aic(r), "" if vals is not None else (getattr(r, "reason", "") or "fit failed")))
+            except FrictionLabError as exc:
+                row.append((None, math.nan, str(exc)))
+        out.append(row)
+    return out
+
+
+def _dispatch(executor, fit_fns, datasets, models, method, seed, n, chunk):
+    seeds = np.random.SeedSequence(seed).spawn(n)
+    chunk = max(1, int(chunk or math.ceil(n / 16)))
+    groups = [seeds[i:i + chunk] for i in range(0, n, chunk)]
+    if executor is None:
+        parts = [_run_chunk(fit_fns, datasets, models, method, g) for g in groups]
+    else:
+        futures = [executor.submit(_run_chunk, fit_fns, datasets, models, method, g) for g in groups]
+        parts = [f.result() for f in futures]
+    return [row for part in parts for row in part]
+
+
+def _prepare(fit_fn, dataset, method):
+    from .dataset import load_dataset
+
+    if method not in METHODS:
+        raise ParameterError(f"bootstrap: method must be one of {', '.join(METHODS)}, got {method!r}")
+    datasets = [load_dataset(d) for d in _as_list(dataset)]
+    base = fit_fn(datasets[0] if len(datasets) == 1 else datasets)
+    if not getattr(base, "ok", False):
+        raise FrictionLabError(f"bootstrap: the fit on the original data did not succeed "
+                               f"({getattr(base, 'reason', '') or getattr(base, 'status', 'failed')})")
+    models = [None] * len(datasets)
+    if method == "residual":
+        for i, ds in enumerate(datasets):
+            part = next((p for p in base.per_dataset if p.target.name == ds.name), None)
+            if part is None or part.target.derivation or part.target.observable != ds.observable \
+                    or part.model.shape != ds.y.shape:
+                raise FrictionLabError(f"bootstrap: dataset '{ds.name}' was not fitted on its own observable column; "
+                                       "use method='case'")
+            models[i] = part.model
+    names = tuple(k for k, p in base.params.items() if p.vary)
+    units = tuple(base.params[k].unit for k in names)
+    law_values = {p.key: p.value for p in base.params.values() if p.vary and p.kind == "law"}
+    replicate_fn = fit_fn.warm(law_values) if hasattr(fit_fn, "warm") else fit_fn
+    return datasets, base, models, names, units, replicate_fn
+
+
+def _collect(law, datasets, method, seed, names, units, base, rows, k):
+    samples = np.full((len(rows), len(names)), np.nan)
+    aic = np.full(len(rows), np.nan)
+    failures = []
+    for r, row in enumerate(rows):
+        vals, a, why = row[k]
+        if vals is None:
+            failures.append(why)
+        else:
+            samples[r] = vals
+            aic[r] = a
+    return BootstrapResult(law=law, datasets=tuple(d.name for d in datasets), method=method, seed=seed, names=names,
+                           units=units, base=base, samples=samples, aic=aic, failures=tuple(failures))
+
+
+def _check_n(n, seed):
+    if not (isinstance(n, (int, np.integer)) and n >= 1):
+        raise ParameterError(f"bootstrap: n must be a positive integer, got {n!r}")
+    if not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ParameterError(f"bootstrap: seed must be a non-negative integer, got {seed!r}")
+
+
+# --- public API -----------------------------------------------------------------------------------------
+def bootstrap(fit_fn, dataset, n: int = 200, seed: int = 0, executor=None, method: str = "residual",
+              chunk: int | None = None) -> BootstrapResult:
+    """Refit ``n`` resampled copies of ``dataset`` (a Dataset, name or path, or a list fitted together).
+
+    fit_fn(data) -> FitResult, e.g. ``law_fit('wear', solver='exact')`` (warm-started replicates) or
+    any picklable callable. chunk: replicates per submitted task (default: n / 16, at least 1).
+    """
+    _check_n(n, seed)
+    datasets, base, models, names, units, rfn = _prepare(fit_fn, dataset, method)
+    rows = _dispatch(executor, [(rfn, names)], datasets, models, method, seed, n, chunk)
+    return _collect(base.law, datasets, method, seed, names, units, base, rows, 0)
+
+
+@attrs.frozen(eq=False)
+class RankingBootstrap:
+    """How often each law ranks first (lowest AIC) over paired resamples; per law a BootstrapResult."""
+
+    laws: tuple[str, ...]
+    datasets: tuple[str, ...]
+    first: dict  # law -> number of replicates it ranked first (ties within tie AIC split evenly)
+    n_ranked: int  # replicates where every law's refit succeeded
+    results: dict  # law -> BootstrapResult
+
+    def fraction(self, law: str) -> float:
+        return self.first[law] / self.n_ranked if self.n_ranked else math.nan
+
+
+def bootstrap_ranking(laws: Sequence, dataset, n: int = 200, seed: int = 0, executor=None, solver: str = "auto",
+                      method: str = "case", chunk: int | None = None, tie: float | None = None,
+                      **fit_options) -> RankingBootstrap:
+    """Fit every law to the same ``n`` resampled copies of ``dataset`` and count first places by AIC.
+
+    method 'case' (default) assumes no law's model; 'residual' resamples around the best law's fit.
+    laws: names or LawFit objects. tie: AIC difference counted as a tie (default ranking.TIE_AIC).
+    """
+    from .ranking import TIE_AIC
+
+    _check_n(n, seed)
+    tie = TIE_AIC if tie is None else tie
+    fns = [f if isinstance(f, LawFit) else law_fit(f, solver, **fit_options) for f in laws]
+    prepared = [_prepare(f, dataset, "case") for f in fns]
+    datasets = prepared[0][0]
+    models = [None] * len(datasets)
+    if method == "residual":  # resample around the law that fits the original data best
+        best = min(range(len(fns)), key=lambda i: _aic(prepared[i][1]))
+        models = _prepare(fns[best], dataset, "residual")[2]
+    elif method not in METHODS:
+        raise ParameterError(f"bootstrap: method must be one of {', '.join(METHODS)}, got {method!r}")
+    rows = _dispatch(executor, [(p[5], p[3]) for p in prepared], datasets, models, method, seed, n, chunk)
+    names = [p[1].law for p in prepared]
+    results = {name: _collect(name, datasets, method, seed, p[3], p[4], p[1], rows, k)
+               for k, (name, p) in enumerate(zip(names, prepared))}
+    first = dict.fromkeys(names, 0.0)
+    ranked = 0
+    for row in rows:
+        aics = np.array([cell[1] for cell in row])
+        if not np.all(np.isfinite(aics)):
+            continue
+        ranked += 1
+        winners = [names[k] for k in np.nonzero(aics <= aics.min() + tie)[0]]
+        for w in winners:
+            first[w] += 1.0 / len(winners)
+    return RankingBootstrap(laws=tuple(names), datasets=tuple(d.name for d in datasets), first=first,
+                            n_ranked=ranked, results=results)
+
+
+# --- tables for the comparison report ----------------------------------------------------------------
+def parameter_table(results, level: float = 0.95) -> list[dict]:
+    """Rows: law, datasets, parameter, unit, value (original fit), stderr (lmfit), boot_median,
+    boot_std, ci_low, ci_high (percentile, ``level``), n_ok, n_failed, method, seed. SI units."""
+    if isinstance(results, BootstrapResult):
+        results = [results]
+    elif isinstance(results, RankingBootstrap):
+        results = list(results.results.values())
+    elif isinstance(results, Mapping):
+        results = list(results.values())
+    rows = []
+    for b in results:
+        for name, unit in zip(b.names, b.units):
+            col = b._column(name)
+            lo, hi = b.interval(name, level)
+            p = b.base.params[name]
+            rows.append({"law": b.law, "datasets": "+".join(b.datasets), "parameter": name, "unit": unit,
+                         "value": p.value, "stderr": p.stderr, "boot_median": float(np.median(col)) if col.size else math.nan,
+                         "boot_std": b.std(name), "ci_low": lo, "ci_high": hi, "level": level, "n_ok": int(col.size),
+                         "n_failed": len(b.failures), "method": b.method, "seed": b.seed})
+    return rows
+
+
+def ranking_table(rb: RankingBootstrap, level: float = 0.95) -> list[dict]:
+    """Rows: datasets, law, first_fraction with a Wilson interval at ``level``, first_count,
+    n_ranked (replicates where every law's refit succeeded), method, seed; most often first on top."""
+    from statistics import NormalDist
+
+    z = NormalDist().inv_cdf(0.5 + level / 2.0)
+    m = rb.n_ranked
+    rows = []
+    for law in rb.laws:
+        k = rb.first[law]
+        p = k / m if m else math.nan
+        if m:
+            centre = (p + z * z / (2 * m)) / (1 + z * z / m)
+            half = z * math.sqrt(p * (1 - p) / m + z * z / (4 * m * m)) / (1 + z * z / m)
+            lo, hi = max(0.0, centre - half), min(1.0, centre + half)
+        else:
+            lo = hi = math.nan
+        any_result = rb.results[law]
+        rows.append({"datasets": "+".join(rb.datasets), "law": law, "first_fraction": p, "ci_low": lo, "ci_high": hi,
+                     "level": level, "first_count": k, "n_ranked": m, "method": any_result.method,
+                     "seed": any_result.seed})
+    return sorted(rows, key=lambda r: -(r["first_fraction"] if math.isfinite(r["first_fraction"]) else -1))

@@ -1,0 +1,99 @@
+"""Work-precision: measurement rows, the written folder (whole or nothing), the command's errors."""
+import csv
+import math
+
+import pytest
+
+from frictionlab import bench
+from frictionlab.cli import main
+
+
+@pytest.fixture()
+def tiny(monkeypatch):
+    """A fast configuration: two tolerances, one repeat, short timing loops, small batches."""
+    monkeypatch.setattr(bench, "QUICK_RTOLS", (1e-3, 1e-6))
+    monkeypatch.setattr(bench, "ODE_METHODS", ("RK45",))
+    monkeypatch.setattr(bench, "BATCH_METHODS", ("DOP853",))
+    monkeypatch.setattr(bench, "MIN_LOOP", 0.0)
+    monkeypatch.setattr(bench, "CHECK_RTOL", 1e-8)
+    monkeypatch.setattr(bench, "FIT_CASES", (("incline-oil-a100", ("couette", "coulomb")),))
+    monkeypatch.setattr(bench, "QUICK_FIT_RTOLS", (1e-4,))
+    real = bench.measure_case
+
+    def fast(name, law, params, scene, rtols, repeats, batch_size, n_t=201, progress=None):
+        return real(name, law, params, scene, rtols, 1, 2, n_t=21, progress=progress)
+
+    monkeypatch.setattr(bench, "measure_case", fast)
+
+
+def test_environment_states_hardware_and_versions():
+    env = bench.environment()
+    assert env["cpu"] and env["cores"] >= 1
+    assert {"python", "numpy", "scipy"} <= set(env["versions"])
+
+
+def test_measure_case_errors_shrink_with_tolerance(tiny):
+    title, law, params, scene = bench.cases()["impact-paper"]
+    rows, meta = bench.measure_case("impact-paper", law, params, scene, (1e-3, 1e-8), 1, 3, n_t=41)
+    assert meta["reference"].startswith("exact")
+    by = {(r["method"], r["rtol"]): r for r in rows}
+    assert by[("exact", None)]["error"] < 1e-14
+    assert by[("series", None)]["error"] > 0.1  # b = 0.81: the truncated series is far off
+    for m in ("ode:RK45", "batch:DOP853"):
+        assert by[(m, 1e-8)]["error"] < by[(m, 1e-3)]["error"] < 1e-2
+    assert all(r["status"] == "ok" and r["time_median_s"] > 0 for r in rows)
+
+
+def test_reference_without_closed_form_is_a_tight_integration(monkeypatch):
+    monkeypatch.setattr(bench, "CHECK_RTOL", 1e-10)
+    title, law, params, scene = bench.cases()["incline-dry"]
+    import numpy as np
+
+    ref, name, check = bench.reference(law, params, scene, np.linspace(0, scene.duration, 21))
+    assert "1e-13" in name and check < 1e-9
+
+
+def test_bench_command_writes_whole_folder(tiny, tmp_path, capsys):
+    out = tmp_path / "wp"
+    assert main(["bench", "--out", str(out), "--quick"]) == 0
+    names = {p.name for p in out.iterdir()}
+    assert {"workprecision.csv", "workprecision.md", "environment.json"} <= names
+    assert {f"workprecision_{k}.png" for k in bench.cases()} <= names
+    rows = list(csv.DictReader(open(out / "workprecision.csv")))
+    assert {r["case"] for r in rows} == set(bench.cases())
+    assert any(r["method"] == "batch:DOP853" for r in rows)
+    assert all(math.isfinite(float(r["time_median_s"])) for r in rows if r["status"] == "ok")
+    md = (out / "workprecision.md").read_text()
+    assert "Hardware:" in md and "numpy" in md and "What the tolerance does to a fit" in md
+    fits = list(csv.DictReader(open(out / "fit_tolerance.csv")))
+    assert {r["solver"] for r in fits} == {"exact", "ode:LSODA"} and {r["law"] for r in fits} == {"couette", "coulomb"}
+    assert all(r["ranking_as_reference"] == "True" for r in fits)
+    # existing folder: refused before measuring, one line, exit 2
+    assert main(["bench", "--out", str(out), "--quick"]) == 2
+    assert "exists" in capsys.readouterr().err
+
+
+def test_failed_run_leaves_no_folder(tiny, tmp_path, monkeypatch):
+    out = tmp_path / "wp"
+    one = {"impact-paper": bench.cases()["impact-paper"]}
+    monkeypatch.setattr(bench, "cases", lambda: one)
+
+    def boom(*a, **k):
+        raise bench.FrictionLabError("disk full")
+
+    monkeypatch.setattr(bench, "plot_case", boom)
+    assert main(["bench", "--out", str(out), "--quick", "--no-fits"]) == 2
+    assert not out.exists() and not list(tmp_path.iterdir())
+
+
+def test_fit_tolerance_study_rows():
+    from frictionlab.fitcost import fit_tolerance_study, markdown
+
+    rows = fit_tolerance_study(["couette"], "incline-oil-a100", methods=("LSODA",), rtols=(1e-3, 1e-8))
+    assert [r["solver"] for r in rows] == ["exact", "ode:LSODA", "ode:LSODA"]
+    assert rows[0]["shift_in_stderr"] == 0.0 and abs(rows[2]["shift_in_stderr"]) < 1e-2
+    assert all(r["fit_time_s"] > 0 and r["rank"] == 1 for r in rows)
+    assert "| couette | exact |" in markdown(rows)
+    import importlib
+
+    assert importlib.import_module("frictionlab.predict").FIT_RTOL == 1e-10  # restored after the study

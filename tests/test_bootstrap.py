@@ -1,0 +1,74 @@
+"""Bootstrap: determinism by seed, executors (local, threads, Dask) give identical numbers, tables."""
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+
+from frictionlab.bootstrap import (bootstrap, bootstrap_ranking, law_fit, parameter_table, ranking_table)
+from frictionlab.errors import FrictionLabError, ParameterError
+
+DS = "incline-oil-a100"  # synthetic Couette data, eta fixed: h is the one fitted parameter
+
+
+@pytest.fixture(scope="module")
+def local():
+    return bootstrap(law_fit("couette", solver="exact"), DS, n=12, seed=11)
+
+
+def test_residual_bootstrap_interval_covers_the_fit(local):
+    assert local.names == ("h",) and local.n_ok == 12 and not local.failures
+    lo, hi = local.interval("h")
+    h = local.base.value("h")
+    assert lo < h < hi
+    # the bootstrap spread agrees with lmfit's standard error to within a factor of two
+    assert 0.5 < local.std("h") / local.base.stderr("h") < 2.0
+    row = parameter_table(local)[0]
+    assert row["parameter"] == "h" and row["unit"] == "m" and row["ci_low"] == lo and row["n_ok"] == 12
+
+
+def test_same_seed_same_numbers_any_executor(local):
+    again = bootstrap(law_fit("couette", solver="exact"), DS, n=12, seed=11, chunk=5)
+    assert np.array_equal(again.samples, local.samples)
+    with ThreadPoolExecutor(2) as ex:
+        threaded = bootstrap(law_fit("couette", solver="exact"), DS, n=12, seed=11, executor=ex, chunk=2)
+    assert np.array_equal(threaded.samples, local.samples)
+    other = bootstrap(law_fit("couette", solver="exact"), DS, n=12, seed=12)
+    assert not np.array_equal(other.samples, local.samples)
+
+
+def test_dask_local_cluster_matches_local_run(local):
+    pytest.importorskip("dask")
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        remote = bootstrap(law_fit("couette", solver="exact"), DS, n=12, seed=11, executor=client, chunk=3)
+        via_executor = bootstrap(law_fit("couette", solver="exact"), DS, n=12, seed=11,
+                                 executor=client.get_executor(), chunk=4)
+    assert np.array_equal(remote.samples, local.samples)
+    assert np.array_equal(via_executor.samples, local.samples)
+
+
+def test_case_resampling_and_ranking_table():
+    rb = bootstrap_ranking(["couette", "coulomb"], DS, n=6, seed=3)
+    assert rb.n_ranked == 6
+    rows = ranking_table(rb)
+    assert [r["law"] for r in rows] == ["couette", "coulomb"]  # Coulomb cannot level off
+    assert rows[0]["first_fraction"] == 1.0 and rows[0]["ci_low"] > 0.5
+    assert sum(r["first_count"] for r in rows) == 6
+    table = parameter_table(rb)
+    assert {r["law"] for r in table} == {"couette", "coulomb"}
+
+
+def test_equivalent_laws_split_first_place():
+    """Wear and Couette are the same model on a constant area: ties are split, not broken by noise."""
+    rb = bootstrap_ranking(["couette", "wear"], DS, n=4, seed=5)
+    assert rb.fraction("couette") == pytest.approx(0.5) and rb.fraction("wear") == pytest.approx(0.5)
+
+
+def test_bad_arguments_are_one_line_errors():
+    with pytest.raises(ParameterError):
+        bootstrap(law_fit("couette"), DS, n=0)
+    with pytest.raises(ParameterError):
+        bootstrap(law_fit("couette"), DS, n=3, method="jackknife")
+    with pytest.raises(FrictionLabError):
+        bootstrap(law_fit("couette"), "no-such-dataset", n=3)
