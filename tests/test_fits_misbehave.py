@@ -142,3 +142,22 @@ def test_fit_refuses_held_or_start_values_outside_the_bounds(kw):
 
     with pytest.raises(ParameterError, match=r"law 'wear': lam = .* is outside its bounds"):
         fitting.fit("wear", "impact-golf-v28", **kw)
+
+
+# -- never lose a result ------------------------------------------------------------------------
+def test_a_failed_forced_rewrite_keeps_the_previous_report(tmp_path):
+    from frictionlab.io import atomic_dir
+
+    out = tmp_path / "report"
+    out.mkdir()
+    (out / "ranking.csv").write_text("the previous result\n")
+    with pytest.raises(RuntimeError, match="figure failed"):
+        with atomic_dir(out, force=True) as tmp:
+            (tmp / "ranking.csv").write_text("half of a new result")
+            raise RuntimeError("figure failed")
+    assert (out / "ranking.csv").read_text() == "the previous result\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]  # no temporary folders left behind
+    with atomic_dir(out, force=True) as tmp:
+        (tmp / "ranking.csv").write_text("the new result\n")
+    assert (out / "ranking.csv").read_text() == "the new result\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]
