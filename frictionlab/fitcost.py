@@ -4,7 +4,7 @@
 ``solver='ode:METHOD'`` at each tolerance, plus the closed form where it exists, and reports
 per fit: parameters and lmfit standard errors, their shift from the reference fit in units of
 the reference error bar, CPU time of the fit, AIC, the rank among the laws at that tolerance and
-whether the ranking equals the reference ranking. The reference is the closed-form fit where
+whether the ranking equals the reference ranking (laws within ranking.TIE_AIC share a place). The reference is the closed-form fit where
 every law has one, else the tightest tolerance of the first method.
 
 Hook: ``fitting.fit`` takes no tolerance argument yet; its predictions read ``predict.FIT_RTOL``
@@ -45,9 +45,21 @@ def _fit(law, dataset, solver, rtol):
     return r, time.process_time() - t0
 
 
-def _ranking(fits: dict) -> tuple[str, ...]:
+def _ranking(fits: dict) -> tuple[tuple[str, ...], dict]:
+    """Laws grouped by AIC, best first; laws within ranking.TIE_AIC of each other share a group
+    (wear and Couette are one model on some scenes). Also law -> rank (1 + laws clearly better)."""
+    from .ranking import TIE_AIC
+
     ok = {law: f.stats.aic for law, f in fits.items() if f.ok}
-    return tuple(sorted(ok, key=ok.get))
+    order = sorted(ok, key=ok.get)
+    groups, rank = [], {}
+    for law in order:
+        if groups and ok[law] - ok[groups[-1][-1]] <= TIE_AIC:
+            groups[-1].append(law)
+        else:
+            groups.append([law])
+        rank[law] = 1 + sum(1 for o in order if ok[o] < ok[law] - TIE_AIC)
+    return tuple(tuple(sorted(g)) for g in groups), rank
 
 
 def fit_tolerance_study(laws, dataset, methods=("LSODA", "DOP853"), rtols=DEFAULT_RTOLS, progress=None) -> list[dict]:
@@ -71,17 +83,17 @@ def fit_tolerance_study(laws, dataset, methods=("LSODA", "DOP853"), rtols=DEFAUL
                 results[(solver, rtol, law)] = (exc, math.nan)
     ref_run = runs[0] if runs[0][0] == "exact" else (runs[0][0], min(rtols))
     ref = {law: results[(*ref_run, law)][0] for law in laws}
-    ref_rank = _ranking({k: v for k, v in ref.items() if not isinstance(v, Exception)})
+    ref_rank = _ranking({k: v for k, v in ref.items() if not isinstance(v, Exception)})[0]
     rows = []
     for solver, rtol in runs:
         fits = {law: results[(solver, rtol, law)][0] for law in laws}
         good = {k: v for k, v in fits.items() if not isinstance(v, Exception)}
-        rank = _ranking(good)
+        rank, ranks = _ranking(good)
         for law in laws:
             f, secs = results[(solver, rtol, law)]
             base = {"dataset": ds.name, "law": law, "solver": solver, "rtol": rtol, "fit_time_s": secs,
                     "reference": f"{ref_run[0]}" + (f" rtol={ref_run[1]:g}" if ref_run[1] else ""),
-                    "ranking": " > ".join(rank), "ranking_as_reference": rank == ref_rank}
+                    "ranking": " > ".join(" = ".join(g) for g in rank), "ranking_as_reference": rank == ref_rank}
             if isinstance(f, Exception) or not f.ok:
                 rows.append({**base, "status": str(f) if isinstance(f, Exception) else f"{f.status}: {f.reason}",
                              "parameter": "", "value": math.nan, "stderr": None, "shift_in_stderr": math.nan,
@@ -98,7 +110,7 @@ def fit_tolerance_study(laws, dataset, methods=("LSODA", "DOP853"), rtols=DEFAUL
                         shift = (p.value - p0.value) / p0.stderr
                 rows.append({**base, "status": "ok", "parameter": name, "value": p.value, "stderr": p.stderr,
                              "shift_in_stderr": shift, "aic": f.stats.aic,
-                             "rank": rank.index(law) + 1 if law in rank else None})
+                             "rank": ranks.get(law)})
     return rows
 
 
@@ -108,14 +120,14 @@ def markdown(rows) -> str:
         return ""
     lines = [f"Reference: {rows[0]['reference']}. 'shift' is (value - reference value) / reference standard error; "
              "fit time is CPU seconds.", "",
-             "| law | solver | rtol | parameter | value | stderr | shift | fit time [s] | AIC | rank | ranking as reference |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| law | solver | rtol | parameter | value | stderr | shift | fit time [s] | AIC | rank | ranking | as reference |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         def f(x, spec):
             return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else format(x, spec)
 
         lines.append(f"| {r['law']} | {r['solver']} | {f(r['rtol'], '.0e')} | {r['parameter'] or r['status']} | "
                      f"{f(r['value'], '.6g')} | {f(r['stderr'], '.3g')} | {f(r['shift_in_stderr'], '.2g')} | "
-                     f"{f(r['fit_time_s'], '.3g')} | {f(r['aic'], '.6g')} | {r['rank'] or '-'} | "
+                     f"{f(r['fit_time_s'], '.3g')} | {f(r['aic'], '.6g')} | {r['rank'] or '-'} | {r['ranking']} | "
                      f"{'yes' if r['ranking_as_reference'] else 'NO'} |")
     return "\n".join(lines)

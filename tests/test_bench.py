@@ -97,3 +97,10 @@ def test_fit_tolerance_study_rows():
     import importlib
 
     assert importlib.import_module("frictionlab.predict").FIT_RTOL == 1e-10  # restored after the study
+
+
+def test_tied_laws_share_a_place_in_the_tolerance_study():
+    from frictionlab.fitcost import fit_tolerance_study
+
+    rows = fit_tolerance_study(["couette", "wear"], "incline-oil-a100", methods=("LSODA",), rtols=(1e-8,))
+    assert all(r["rank"] == 1 and r["ranking"] == "couette = wear" and r["ranking_as_reference"] for r in rows)
