@@ -290,6 +290,10 @@ def _quantity(value, si, where):
 def _provenance(p, path) -> Provenance:
     if not isinstance(p, dict):
         raise DatasetError(f"{path}: missing required table [provenance] (kind = {' | '.join(PROVENANCE_KINDS)})")
+    extra = set(p) - {"kind", "source", "method", "command", "seed", "truth"}
+    if extra:
+        raise DatasetError(f"{path}: [provenance] has unknown key(s) {sorted(extra)}; "
+                           "known: kind, source, method, command, seed, truth")
     kind = p.get("kind")
     if kind not in PROVENANCE_KINDS:
         raise DatasetError(f"{path}: provenance.kind = {kind!r}, expected one of {', '.join(PROVENANCE_KINDS)}")

@@ -397,6 +397,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     names = tuple(t.name for t in targets)
     for name in list(fixed or {}) + list(local) + list(initial or {}):
         law.spec(name)  # unknown names are input errors
+    law.resolve({**(initial or {}), **(fixed or {})})  # so are held or start values outside the bounds
     solvers = []
     for tg in targets:
         if tg.dataset.kind not in PREDICTORS:

@@ -312,6 +312,7 @@ class Scene:
         compliance = None
         if "compliance" in spec:
             c = spec["compliance"]
+            _known_keys(c, {"stiffness", "damping"}, where, "[scene.compliance]")
             compliance = Compliance(q("stiffness", "N/m", c, "scene.compliance"),
                                     q("damping", "N*s/m", c, "scene.compliance"))
             effects |= {"compliance"}
@@ -346,11 +347,27 @@ def _column(columns, name, where, prefix, quantity):
     return columns[name]
 
 
+#: Keys each area and normal-force model reads; anything else is a typo that would be ignored.
+AREA_KEYS = {"half-sine": {"peak", "contact_time"}, "constant": {"area"}, "growth": {"initial", "rate"},
+             "column": {"column"}}
+NORMAL_KEYS = {"half-sine": {"contact_time", "impulse", "normal_speed", "restitution"},
+               "hertz": {"coefficient", "modulus", "radius"}, "column": {"column"}, "weight": set()}
+
+
+def _known_keys(table, keys, where, label):
+    extra = set(table) - set(keys)
+    if extra:
+        raise SceneError(f"{where}: {label} has unknown key(s) {sorted(extra)}; "
+                         f"known: {', '.join(sorted(keys)) or 'none'}")
+
+
 def _area_from_spec(a, where, q, columns, t):
     if a is None:
         return None
     p = "scene.area"
     model = a.get("model")
+    if isinstance(model, str) and model in AREA_KEYS:
+        _known_keys(a, AREA_KEYS[model] | {"model"}, where, f"[{p}] with model {model!r}")
     if model == "half-sine":
         return HalfSineArea(q("peak", "m^2", a, p), q("contact_time", "s", a, p))
     if model == "constant":
@@ -373,6 +390,8 @@ def _normal_from_spec(n, where, q, columns, t, mass, contact_time, spec, incline
         return None
     p = "scene.normal"
     model = n.get("model")
+    if isinstance(model, str) and model in NORMAL_KEYS:
+        _known_keys(n, NORMAL_KEYS[model] | {"model"}, where, f"[{p}] with model {model!r}")
     if model == "half-sine":
         tc = q("contact_time", "s", n, p, required=contact_time is None, default=contact_time)
         if "impulse" in n:

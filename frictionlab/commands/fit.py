@@ -56,7 +56,7 @@ def parse_fix(law, items) -> dict:
     for item in items:
         name, rest = _split(item, "--fix")
         spec = law.spec(name)
-        out[name] = to_si(rest, spec.unit, f"--fix {name}")
+        out[name] = law.resolve({name: to_si(rest, spec.unit, f"--fix {name}")})[name]  # bounds checked
     return out
 
 
