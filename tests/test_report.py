@@ -7,6 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from frictionlab.errors import FrictionLabError
+
 from _fit_helpers import TRUTH, synthetic
 from frictionlab import compare, write_report
 from frictionlab.cli import main
@@ -198,8 +200,8 @@ def test_a_new_dataset_kind_plugs_in_through_one_predictor(tmp_path, monkeypatch
                  units={"speed": "m/s", "rebound_spin": "rad/s"}, noise={"rebound_spin": 5.0},
                  scene=attrs.evolve(base.scene, kind="impact-outcome"), fixed={}, provenance=base.provenance)
     monkeypatch.delitem(fitting.PREDICTORS, "impact-outcome")
-    skipped = compare(laws=["wear"], datasets=[ds], equivalence=False)
-    assert "outcomes" in skipped.skipped_datasets and "predictor" in skipped.skipped_datasets["outcomes"]
+    with pytest.raises(FrictionLabError, match=r"none of the datasets can be fitted: outcomes: no predictor"):
+        compare(laws=["wear"], datasets=[ds], equivalence=False)
 
     monkeypatch.setitem(fitting.PREDICTORS, "impact-outcome", predict_outcome)
     c = compare(laws=["wear", "coulomb"], datasets=[ds])
