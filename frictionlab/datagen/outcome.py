@@ -68,6 +68,9 @@ def build(out_dir: Path) -> list[Path]:
                        "restitution": PULSE["restitution"], "reference_speed": f"{PULSE['reference_speed']:g} m/s",
                        "contact_time_exponent": PULSE["exponent"],
                        "restitution_slope": f"{PULSE['slope']:g} s/m"},
+            # for laws that read A or dA/dt (the generating Coulomb law does not): a half-sine area whose
+            # peak grows as v_n^(4/5) (Hertz), 150 mm^2 at the reference speed, as the paper's golf ball
+            "area": {"model": "half-sine", "peak": "150 mm^2", "reference_speed": f"{PULSE['reference_speed']:g} m/s"},
         },
         "provenance": {
             "kind": "synthetic",
