@@ -97,6 +97,14 @@ def main(argv=None) -> int:
             raise
         print(f"frictionlab: error: {one_line(exc)}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # the reader of our output went away (| head): stop quietly, as cat does
+        try:
+            import os
+
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError):
+            pass
+        return 141
     except OSError as exc:  # the file system refused (permissions, a full disk): the user's to fix
         if args.debug:
             raise

@@ -101,7 +101,7 @@ def candidates(law, dataset: Dataset, solvers: Sequence[str] | None) -> list[tup
             out.append((auto_solver(law, dataset.scene), ok["ode"]))
         else:
             out.append((s, ok.get(s.partition(":")[0])))
-    return out
+    return list(dict.fromkeys(out))  # 'auto' and the solver it picks name one candidate
 
 
 def _fit_task(args) -> FitResult:
@@ -176,8 +176,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     for r in tolerance:
         if isinstance(r, bool) or not isinstance(r, (int, float)) or not 0 < r < 1:
             raise ParameterError(f"compare: every tolerance must be a number in (0, 1), got {r!r}")
-    law_names = tuple(get_law(n).name for n in (laws or available_laws()))
-    dss = tuple(load_dataset(d) for d in (datasets if datasets is not None else builtin_names()))
+    law_names = tuple(dict.fromkeys(get_law(n).name for n in (laws or available_laws())))
+    dss = _unique_datasets(load_dataset(d) for d in (datasets if datasets is not None else builtin_names()))
     if not dss:
         raise FrictionLabError("compare: no datasets to compare")
     skipped_ds, plan, fits = {}, [], []
@@ -194,6 +194,9 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                     fits.append(FitResult(law=law, solver=solver, datasets=(ds.name,), status="skipped", reason=why))
                 else:
                     plan.append((law, ds, solver, dict(free or {})))
+    if len(skipped_ds) == len(dss):
+        raise FrictionLabError("compare: none of the datasets can be fitted: "
+                               + "; ".join(f"{k}: {v}" for k, v in skipped_ds.items()))
     # slow (ode) fits first, so that workers finish together
     plan.sort(key=lambda x: not x[2].startswith("ode"))
     eq_pairs = _equivalence_pairs(law_names, plan) if equivalence else []
@@ -261,6 +264,17 @@ class _Step:
         self.done += 1
         if self.progress:
             self.progress(self.done, self.total, label)
+
+
+def _unique_datasets(dss) -> tuple[Dataset, ...]:
+    """Datasets with repeats dropped; two different datasets under one name are an error."""
+    out: dict[str, Dataset] = {}
+    for ds in dss:
+        if ds.name in out and out[ds.name].path != ds.path:
+            raise FrictionLabError(f"compare: two datasets are named '{ds.name}' ({out[ds.name].path} and {ds.path}); "
+                                   "names must be unique")
+        out.setdefault(ds.name, ds)
+    return tuple(out.values())
 
 
 def _equivalence_pairs(law_names, plan) -> list[tuple[str, str, str]]:

@@ -60,6 +60,8 @@ class Dataset:
 
     @property
     def t(self) -> np.ndarray:
+        if "t" not in self.columns:
+            raise DatasetError(f"dataset '{self.name}' ({self.kind}) has no time column: one impact per row")
         return self.columns["t"]
 
     @property
@@ -140,6 +142,11 @@ def from_meta(meta: dict, path: Path) -> Dataset:
     observable = _req(meta, "observable", path)
     if observable == "t":
         raise DatasetError(f"{path}: observable = 't': the time column cannot be the observable")
+    if kind == "impact-outcome":
+        from .outcome import OUTCOMES
+
+        if observable not in OUTCOMES:
+            raise DatasetError(f"{path}: observable {observable!r} is not an impact outcome ({', '.join(OUTCOMES)})")
     units = _req(meta, "columns", path, dict)
     for col, u in units.items():
         if not isinstance(u, str):
@@ -194,10 +201,18 @@ def from_meta(meta: dict, path: Path) -> Dataset:
         if not isinstance(spec, dict):
             raise DatasetError(f"{path}: missing required table [scene]")
         try:
-            scene = Scene.from_spec(spec, kind, str(path), columns, columns.get("t"))
+            if kind == "impact-outcome":
+                from .outcome import OutcomeScene
+
+                scene = OutcomeScene.from_spec(spec, str(path))
+            else:
+                scene = Scene.from_spec(spec, kind, str(path), columns, columns.get("t"))
         except FrictionLabError as exc:
             raise DatasetError(str(exc)) from None
-        _check_observable(scene, observable, path)
+        if kind == "impact-outcome":
+            _check_outcome_rows(columns, observable, path, csv, scene)
+        else:
+            _check_observable(scene, observable, path)
 
     fixed, fixed_units = {}, {}
     for key, value in _table(meta, "fixed", path, "[fixed]").items():
@@ -241,6 +256,23 @@ def _check_observable(scene: Scene, observable: str, path) -> None:
         raise DatasetError(f"{path}: observable 'N' needs a [scene.normal] model")
 
 
+def _check_outcome_rows(columns, observable, path, csv, scene) -> None:
+    """An impact-outcome dataset: one impact per row (speed, incidence), an outcome as observable."""
+    for col in ("speed", "incidence"):
+        if col not in columns:
+            raise DatasetError(f"{path}: an impact-outcome dataset needs a '{col}' column in [columns] "
+                               "(one impact per row)")
+    bad = np.nonzero(~(columns["speed"] > 0))[0]
+    if bad.size:
+        raise DatasetError(f"{csv}: column 'speed' line {_line_of_row(csv, int(bad[0]))}: impact speed must be positive")
+    inc = columns["incidence"]
+    bad = np.nonzero(~((inc > 0) & (inc < math.pi / 2)))[0]
+    if bad.size:
+        raise DatasetError(f"{csv}: column 'incidence' line {_line_of_row(csv, int(bad[0]))}: incidence must be "
+                           f"strictly between 0 and 90 deg (measured from the "
+                           f"{'surface normal' if scene.angle_reference == 'normal' else 'surface'})")
+
+
 def _names(columns) -> str:
     """Column names for a one-line message (repr when a name holds odd characters)."""
     return ", ".join(c if c.isprintable() and "," not in c else repr(c) for c in columns)
@@ -258,6 +290,10 @@ def _quantity(value, si, where):
 def _provenance(p, path) -> Provenance:
     if not isinstance(p, dict):
         raise DatasetError(f"{path}: missing required table [provenance] (kind = {' | '.join(PROVENANCE_KINDS)})")
+    extra = set(p) - {"kind", "source", "method", "command", "seed", "truth"}
+    if extra:
+        raise DatasetError(f"{path}: [provenance] has unknown key(s) {sorted(extra)}; "
+                           "known: kind, source, method, command, seed, truth")
     kind = p.get("kind")
     if kind not in PROVENANCE_KINDS:
         raise DatasetError(f"{path}: provenance.kind = {kind!r}, expected one of {', '.join(PROVENANCE_KINDS)}")

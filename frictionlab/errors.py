@@ -4,6 +4,10 @@
 class FrictionLabError(Exception):
     """Base class: a user-facing error whose message is one complete line."""
 
+    def __str__(self) -> str:
+        # a name taken from a user's file (a TOML key, a CSV header) may hold a line break
+        return super().__str__().replace("\r", "\\r").replace("\n", "\\n")
+
 
 class UnitError(FrictionLabError):
     """A quantity or unit string that cannot be read or has the wrong dimension."""

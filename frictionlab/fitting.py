@@ -412,6 +412,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     names = tuple(t.name for t in targets)
     for name in list(fixed or {}) + list(local) + list(initial or {}):
         law.spec(name)  # unknown names are input errors
+    law.resolve({**(initial or {}), **(fixed or {})})  # so are held or start values outside the bounds
     if rtol is not None and (isinstance(rtol, bool) or not isinstance(rtol, (int, float)) or not 0 < rtol < 1):
         raise ParameterError(f"fit: rtol must be a number in (0, 1), got {rtol!r}")
     solvers = []
@@ -444,14 +445,16 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     solver_label = solver if solver != "auto" else "+".join(dict.fromkeys(solvers))
     n_points = sum(t.y.size for t in targets)
 
+    success, message = True, ""
     try:
         best_params, success, message = _search(lmfit, model, params, slots, solvers, scan, n_starts, max_nfev)
         values = _si(best_params, slots)
         models = model.models(values)
     except SkipDataset as exc:
         return give_up("skipped", str(exc))
-    except FrictionLabError as exc:
-        return give_up("failed", f"the model cannot be evaluated at the best parameters: {exc}", nfev=model.nfev)
+    except FrictionLabError as exc:  # an aborted search leaves parameters that mean nothing: say it did not converge
+        why = f"did not converge: {message}" if not success else f"the model cannot be evaluated at the best parameters: {exc}"
+        return give_up("failed", why, nfev=model.nfev)
     except Exception as exc:  # an optimizer or law crash is a failed fit, not a crashed comparison
         return give_up("failed", f"{type(exc).__name__}: {exc}", nfev=model.nfev)
 

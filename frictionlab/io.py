@@ -10,18 +10,37 @@ from pathlib import Path
 from .errors import OutputError
 
 
-def atomic_write_text(path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file in the same folder, then rename."""
+def check_writable(path) -> Path:
+    """Raise OutputError unless a file can be written at ``path`` (its folder exists and is a folder)."""
     path = Path(path)
-    if not path.parent.exists():
-        raise OutputError(f"{path}: folder {path.parent} does not exist")
+    parent = path.parent if str(path.parent) else Path(".")
+    if not parent.exists():
+        raise OutputError(f"{path}: folder {parent} does not exist")
+    if not parent.is_dir():
+        raise OutputError(f"{path}: cannot write: {parent} is not a directory")
+    if path.is_dir():
+        raise OutputError(f"{path}: cannot write: it is a folder")
+    return path
+
+
+def atomic_write_bytes(path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary file in the same folder, then rename."""
+    path = check_writable(path)
+    tmp = None
     try:
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
         os.replace(tmp, path)
     except OSError as exc:
+        if tmp is not None and os.path.exists(tmp):
+            os.unlink(tmp)
         raise OutputError(f"{path}: cannot write: {exc.strerror or exc}") from None
+
+
+def atomic_write_text(path, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` through a temporary file in the same folder, then rename."""
+    atomic_write_bytes(path, text.encode("utf-8"))
 
 
 @contextmanager

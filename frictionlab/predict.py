@@ -123,8 +123,15 @@ def _predict_series(law, target, scene, params, solver, rtol=FIT_RTOL):
     return tr[SERIES[target.observable]]
 
 
+def _predict_outcomes(law, target, scene, params, solver, rtol=FIT_RTOL):
+    from .outcome import outcome_predictor
+
+    return outcome_predictor(law, target, scene, params, solver, rtol)
+
+
 register_predictor("impact", _predict_series)
 register_predictor("incline", _predict_series)
+register_predictor("impact-outcome", _predict_outcomes)
 
 
 def predict(law, target: Target, params: Mapping[str, float], solver: str = "exact",
@@ -150,6 +157,8 @@ def applicable_solvers(law, scene: Scene) -> dict[str, str | None]:
     from .solvers import exact, series
 
     law = get_law(law)
+    if hasattr(scene, "example"):  # an impact-outcome template: check on one of its impacts
+        scene = scene.example()
     try:
         plan = make_plan(scene, law)
     except FrictionLabError as exc:

@@ -25,7 +25,7 @@ from .fitting import FitResult
 TIE_AIC = 0.01
 
 COLUMNS = ("dataset", "law", "solver", "n_points", "n_params", "rss", "rmse", "redchi", "aic", "aicc", "bic",
-           "delta_aic", "akaike_weight", "rank", "status")
+           "delta_aic", "akaike_weight", "rank", "status", "reason")  # reason: why a fit failed or was skipped
 
 
 @attrs.frozen

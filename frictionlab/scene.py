@@ -51,6 +51,36 @@ def _optional(check):
     return optional
 
 
+# --- reading a [scene] table --------------------------------------------------------------
+def spec_reader(spec: Mapping, where: str):
+    """q(key, unit, table=spec, prefix='scene', required=True, positive=True, default=None) -> SI float.
+
+    Reads a quantity string from a TOML table with one-line errors naming file and field.
+    """
+    def q(key, unit, table=spec, prefix="scene", required=True, positive=True, default=None):
+        if key not in table:
+            if required:
+                raise SceneError(f"{where}: [{prefix}] is missing '{key}'")
+            return default
+        value = to_si(table[key], unit, f"{where}: {prefix}.{key}")
+        if positive and not value > 0:
+            raise SceneError(f"{where}: {prefix}.{key} must be positive, got {table[key]!r}")
+        return value
+
+    return q
+
+
+def read_effects(spec: Mapping, where: str, default=()) -> frozenset:
+    """The ``effects`` list of a [scene] table, checked against EFFECTS."""
+    effects = spec.get("effects", list(default))
+    if not isinstance(effects, list) or not all(isinstance(e, str) for e in effects):
+        raise SceneError(f"{where}: scene.effects must be a list of names")
+    bad = [e for e in effects if e not in EFFECTS]
+    if bad:
+        raise SceneError(f"{where}: scene.effects: unknown effect(s) {bad}; known: {', '.join(EFFECTS)}")
+    return frozenset(effects)
+
+
 # --- contact-area models ------------------------------------------------------------
 @attrs.frozen
 class HalfSineArea:
@@ -255,23 +285,8 @@ class Scene:
         if extra:
             raise SceneError(f"{where}: [scene] has unknown key(s) {sorted(extra)}; known: {', '.join(sorted(known))}")
 
-        def q(key, unit, table=spec, prefix="scene", required=True, positive=True, default=None):
-            if key not in table:
-                if required:
-                    raise SceneError(f"{where}: [{prefix}] is missing '{key}'")
-                return default
-            value = to_si(table[key], unit, f"{where}: {prefix}.{key}")
-            if positive and not value > 0:
-                raise SceneError(f"{where}: {prefix}.{key} must be positive, got {table[key]!r}")
-            return value
-
-        effects = spec.get("effects", [])
-        if not isinstance(effects, list) or not all(isinstance(e, str) for e in effects):
-            raise SceneError(f"{where}: scene.effects must be a list of names")
-        bad = [e for e in effects if e not in EFFECTS]
-        if bad:
-            raise SceneError(f"{where}: scene.effects: unknown effect(s) {bad}; known: {', '.join(EFFECTS)}")
-        effects = frozenset(effects)
+        q = spec_reader(spec, where)
+        effects = read_effects(spec, where)
 
         mass = q("mass", "kg")
         radius = q("radius", "m", required="spin" in effects or "slip-coupling" in effects)
@@ -297,6 +312,7 @@ class Scene:
         compliance = None
         if "compliance" in spec:
             c = spec["compliance"]
+            _known_keys(c, {"stiffness", "damping"}, where, "[scene.compliance]")
             compliance = Compliance(q("stiffness", "N/m", c, "scene.compliance"),
                                     q("damping", "N*s/m", c, "scene.compliance"))
             effects |= {"compliance"}
@@ -331,11 +347,27 @@ def _column(columns, name, where, prefix, quantity):
     return columns[name]
 
 
+#: Keys each area and normal-force model reads; anything else is a typo that would be ignored.
+AREA_KEYS = {"half-sine": {"peak", "contact_time"}, "constant": {"area"}, "growth": {"initial", "rate"},
+             "column": {"column"}}
+NORMAL_KEYS = {"half-sine": {"contact_time", "impulse", "normal_speed", "restitution"},
+               "hertz": {"coefficient", "modulus", "radius"}, "column": {"column"}, "weight": set()}
+
+
+def _known_keys(table, keys, where, label):
+    extra = set(table) - set(keys)
+    if extra:
+        raise SceneError(f"{where}: {label} has unknown key(s) {sorted(extra)}; "
+                         f"known: {', '.join(sorted(keys)) or 'none'}")
+
+
 def _area_from_spec(a, where, q, columns, t):
     if a is None:
         return None
     p = "scene.area"
     model = a.get("model")
+    if isinstance(model, str) and model in AREA_KEYS:
+        _known_keys(a, AREA_KEYS[model] | {"model"}, where, f"[{p}] with model {model!r}")
     if model == "half-sine":
         return HalfSineArea(q("peak", "m^2", a, p), q("contact_time", "s", a, p))
     if model == "constant":
@@ -358,6 +390,8 @@ def _normal_from_spec(n, where, q, columns, t, mass, contact_time, spec, incline
         return None
     p = "scene.normal"
     model = n.get("model")
+    if isinstance(model, str) and model in NORMAL_KEYS:
+        _known_keys(n, NORMAL_KEYS[model] | {"model"}, where, f"[{p}] with model {model!r}")
     if model == "half-sine":
         tc = q("contact_time", "s", n, p, required=contact_time is None, default=contact_time)
         if "impulse" in n:

@@ -39,12 +39,15 @@ class Trajectory:
         out.update({k: getattr(self, k) for k in ("A", "N") if getattr(self, k) is not None})
         return out
 
+    def csv_text(self) -> str:
+        """The columns (SI, units in CSV_UNITS) as CSV text, full precision."""
+        cols = self.columns()
+        rows = np.column_stack(list(cols.values()))
+        lines = [",".join(cols)] + [",".join(f"{x:.17g}" for x in row) for row in rows]
+        return "\n".join(lines) + "\n"
+
     def to_csv(self, path) -> None:
         """Write the columns (SI) to ``path`` atomically."""
         from .io import atomic_write_text
 
-        cols = self.columns()
-        header = ",".join(cols)
-        rows = np.column_stack(list(cols.values()))
-        lines = [header] + [",".join(f"{x:.17g}" for x in row) for row in rows]
-        atomic_write_text(path, "\n".join(lines) + "\n")
+        atomic_write_text(path, self.csv_text())

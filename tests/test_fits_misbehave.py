@@ -131,5 +131,46 @@ def test_failing_fit_on_the_command_line(bad_laws, tmp_path, run_cli):
     assert "Traceback" not in out.stderr
     assert "1 failed" in out.stdout
     ranking = (rep / "ranking.csv").read_text().splitlines()
-    assert any(line.startswith("impact-golf-v28,nan-above-5,") and line.endswith(",failed") for line in ranking)
+    assert any(line.startswith("impact-golf-v28,nan-above-5,") and ",failed," in line and "NaN" in line
+               for line in ranking)
     assert any(line.startswith("impact-golf-v28,wear,") and ",1," in line for line in ranking)
+
+
+@pytest.mark.parametrize("kw", [{"fixed": {"lam": -1.0}}, {"initial": {"lam": -1.0}}, {"fixed": {"lam": float("nan")}}])
+def test_fit_refuses_held_or_start_values_outside_the_bounds(kw):
+    """A held lam of -1 used to be clipped to 0 and 'fitted' with status ok."""
+    from frictionlab.errors import ParameterError
+
+    with pytest.raises(ParameterError, match=r"law 'wear': lam = .* is outside its bounds"):
+        fitting.fit("wear", "impact-golf-v28", **kw)
+
+
+# -- never lose a result ------------------------------------------------------------------------
+def test_a_failed_forced_rewrite_keeps_the_previous_report(tmp_path):
+    from frictionlab.io import atomic_dir
+
+    out = tmp_path / "report"
+    out.mkdir()
+    (out / "ranking.csv").write_text("the previous result\n")
+    with pytest.raises(RuntimeError, match="figure failed"):
+        with atomic_dir(out, force=True) as tmp:
+            (tmp / "ranking.csv").write_text("half of a new result")
+            raise RuntimeError("figure failed")
+    assert (out / "ranking.csv").read_text() == "the previous result\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]  # no temporary folders left behind
+    with atomic_dir(out, force=True) as tmp:
+        (tmp / "ranking.csv").write_text("the new result\n")
+    assert (out / "ranking.csv").read_text() == "the new result\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]
+
+
+@pytest.mark.parametrize("kw", [
+    {"laws": ["wear", "wear"], "datasets": ["incline-oil-a100"], "solvers": ["auto"]},
+    {"laws": ["wear"], "datasets": ["incline-oil-a100", "incline-oil-a100"], "solvers": ["auto"]},
+    {"laws": ["wear"], "datasets": ["incline-oil-a100"], "solvers": ["auto", "exact"]},
+], ids=["law-twice", "dataset-twice", "solver-twice"])
+def test_a_candidate_named_twice_is_ranked_once(kw):
+    c = comparison.compare(**kw, equivalence=False, jobs=1)
+    rows = [r for r in c.ranking if r.dataset == "incline-oil-a100"]
+    assert len(rows) == 1
+    assert rows[0].akaike_weight == pytest.approx(1.0) and rows[0].status == "ok"

@@ -192,9 +192,9 @@ def test_kinds_without_predictor_and_contact_area_are_skipped():
     ds = synthetic("wear", {"lam": 1.2e6})
     import attrs
 
-    outcome = attrs.evolve(ds, kind="impact-outcome", name="outcome")
+    outcome = attrs.evolve(ds, kind="pendulum", name="outcome")  # a kind nobody predicts
     r = fit("wear", outcome)
-    assert r.status == "skipped" and "impact-outcome" in r.reason
+    assert r.status == "skipped" and "no predictor for dataset kind 'pendulum'" in r.reason
     area = attrs.evolve(ds, kind="contact-area", name="area")
     assert fit("wear", area).status == "skipped"
 

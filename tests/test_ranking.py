@@ -1,6 +1,8 @@
 """Ranking: statistics arithmetic, ties, groups, and known-truth rankings on synthetic data."""
 import math
 
+import attrs
+
 import pytest
 
 from _fit_helpers import TRUTH, incline_scene, synthetic
@@ -37,11 +39,12 @@ def test_groups_sum_aic_and_mark_incomplete_candidates():
 
 
 def test_csv_has_the_documented_columns():
-    text = to_csv(_rank([row("d", "a", 1.0), row("d", "b", math.nan, status="failed")], 0.01))
+    failed = attrs.evolve(row("d", "b", math.nan, status="failed"), reason="did not converge")
+    text = to_csv(_rank([row("d", "a", 1.0), failed], 0.01))
     lines = text.splitlines()
     assert lines[0] == ",".join(COLUMNS) == ("dataset,law,solver,n_points,n_params,rss,rmse,redchi,aic,aicc,bic,"
-                                            "delta_aic,akaike_weight,rank,status")
-    assert lines[2].endswith(",,failed")  # no rank, no numbers for a failed fit
+                                            "delta_aic,akaike_weight,rank,status,reason")
+    assert lines[2].endswith(",,failed,did not converge")  # no rank, no numbers for a failed fit, its reason
 
 
 @pytest.mark.parametrize("law", sorted(TRUTH))

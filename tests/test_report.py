@@ -7,6 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from frictionlab.errors import FrictionLabError
+
 from _fit_helpers import TRUTH, synthetic
 from frictionlab import compare, write_report
 from frictionlab.cli import main
@@ -280,8 +282,9 @@ def test_a_new_dataset_kind_plugs_in_through_one_predictor(tmp_path, monkeypatch
                  columns={"speed": speeds, "rebound_spin": truth + rng.normal(0, 5.0, speeds.size)},
                  units={"speed": "m/s", "rebound_spin": "rad/s"}, noise={"rebound_spin": 5.0},
                  scene=attrs.evolve(base.scene, kind="impact-outcome"), fixed={}, provenance=base.provenance)
-    skipped = compare(laws=["wear"], datasets=[ds], equivalence=False)
-    assert "outcomes" in skipped.skipped_datasets and "predictor" in skipped.skipped_datasets["outcomes"]
+    monkeypatch.delitem(fitting.PREDICTORS, "impact-outcome")
+    with pytest.raises(FrictionLabError, match=r"none of the datasets can be fitted: outcomes: no predictor"):
+        compare(laws=["wear"], datasets=[ds], equivalence=False)
 
     monkeypatch.setitem(fitting.PREDICTORS, "impact-outcome", predict_outcome)
     c = compare(laws=["wear", "coulomb"], datasets=[ds])

@@ -4,7 +4,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from ..errors import ParameterError, SolverError
+from ..errors import OutputError, ParameterError, SolverError
 from ..fitting import SCENE_QUANTITIES, fit
 from ..registry import get_law
 from ..units import to_si
@@ -56,7 +56,7 @@ def parse_fix(law, items) -> dict:
     for item in items:
         name, rest = _split(item, "--fix")
         spec = law.spec(name)
-        out[name] = to_si(rest, spec.unit, f"--fix {name}")
+        out[name] = law.resolve({name: to_si(rest, spec.unit, f"--fix {name}")})[name]  # bounds checked
     return out
 
 
@@ -64,6 +64,8 @@ def run(args) -> int:
     from ..report import _fit_json
 
     law = get_law(args.law)
+    if args.json and not args.json.parent.is_dir():  # before the work, not after
+        raise OutputError(f"{args.json}: cannot write: folder {args.json.parent} does not exist")
     result = fit(law, args.datasets, solver=args.solver, free=parse_free(args.free), fixed=parse_fix(law, args.fix),
                  local=args.local, observable=args.observable, derive=args.derive)
     if result.status == "skipped":  # asked for explicitly, an inapplicable solver is an error, not a skip

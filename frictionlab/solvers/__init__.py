@@ -46,6 +46,9 @@ def simulate(law, scene, params=None, solver: str = "ode", t=None, rtol: float =
     if isinstance(scene, Dataset):
         name = f"dataset '{scene.name}'"
         fixed = {k: v for k, v in scene.fixed.items() if k in law.param_names}
+        if scene.kind == "impact-outcome":
+            raise SceneError(f"dataset '{scene.name}' (impact-outcome) holds one impact per row; simulate its rows "
+                             "with frictionlab.outcome.predict_outcomes")
         if scene.scene is None:
             raise SceneError(f"dataset '{scene.name}' ({scene.kind}) has no [scene] to simulate; "
                              "it is a supporting series, not a motion to fit")

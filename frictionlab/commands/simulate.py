@@ -1,0 +1,211 @@
+"""``frictionlab simulate DATASET --law NAME``: one law on one dataset's scene, as a table, CSV or figure.
+
+Law parameters come from the law's defaults, then the dataset's [fixed] values, then --param
+(values with units, e.g. lam='1.81e6 Pa s/m'; a dimensional value must say its unit). The CSV
+holds SI columns t,u,v,omega,theta,force (and A, N where the plan built them); for an
+impact-outcome dataset it holds one row per impact. Outputs are written only after the whole
+simulation and figure succeeded, so a failed run writes nothing.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..dataset import load_dataset
+from ..errors import ParameterError, SolverError
+from ..registry import get_law
+from ..units import to_si
+
+RPM = 60.0 / (2.0 * math.pi)
+PLOT_POINTS = 501
+
+
+def add_parser(sub):
+    p = sub.add_parser("simulate", help="simulate a law on a dataset's scene",
+                       description="Simulate LAW on the scene of DATASET (built-in name or TOML path).")
+    p.add_argument("dataset", metavar="DATASET_OR_TOML", help="built-in dataset name or path to its TOML")
+    p.add_argument("--law", required=True, help="registered law name (see 'frictionlab laws')")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                   help="law parameter with its unit, e.g. lam='1.81e6 Pa s/m' or mu=0.2 (repeatable)")
+    p.add_argument("--solver", default="ode", help="exact, series, ode or ode:METHOD (default: ode, i.e. LSODA)")
+    p.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance of the ode solver (default 1e-10)")
+    p.add_argument("--points", type=int, metavar="N",
+                   help="write N evenly spaced times over the scene's duration instead of the dataset's times")
+    p.add_argument("--out", type=Path, metavar="FILE.csv", help="write the simulated series (SI) as CSV")
+    p.add_argument("--plot", type=Path, metavar="FILE.png", help="write a figure of the observable with the data")
+    p.set_defaults(func=run)
+
+
+def parse_params(law, items) -> dict[str, float]:
+    """['lam=1.81e6 Pa s/m', 'mu=0.2'] -> SI floats, each converted against the law's parameter unit."""
+    from .fit import _split
+
+    out = {}
+    for item in items:
+        name, value = _split(item, "--param")
+        spec = law.spec(name)
+        out[name] = to_si(value, spec.unit, f"--param {name}")
+    return out
+
+
+def run(args) -> int:
+    from ..io import atomic_write_bytes, atomic_write_text, check_writable
+
+    law = get_law(args.law)
+    params = parse_params(law, args.param)
+    if not 0 < args.rtol < 1:
+        raise SolverError(f"--rtol: rtol must be a number in (0, 1), got {args.rtol:g}")
+    if args.points is not None and args.points < 2:
+        raise ParameterError(f"--points must be at least 2, got {args.points}")
+    ds = load_dataset(args.dataset)
+    for path in (args.out, args.plot):
+        if path is not None:
+            check_writable(path)
+    if ds.kind == "impact-outcome":
+        text, summary, figure = _outcomes(law, ds, params, args)
+    else:
+        text, summary, figure = _series(law, ds, params, args)
+    written = []
+    try:  # both outputs or neither
+        if args.plot is not None:
+            atomic_write_bytes(args.plot, figure)
+            written.append(args.plot)
+        if args.out is not None:
+            atomic_write_text(args.out, text)
+            written.append(args.out)
+    except Exception:
+        for p in written:
+            p.unlink(missing_ok=True)
+        raise
+    print(summary)
+    for p in written:
+        print(f"wrote {p}")
+    return 0
+
+
+def _params_text(law, p) -> str:
+    return ", ".join(f"{s.name} = {p[s.name]:.6g}" + (f" {s.unit}" if s.unit else "") for s in law.params)
+
+
+# --- time series ---------------------------------------------------------------------------------
+def _series(law, ds, params, args):
+    from ..solvers import simulate
+
+    scene = ds.scene
+    if scene is None:
+        simulate(law, ds, params, solver=args.solver, rtol=args.rtol)  # raises the loader's one-line error
+    t_end = max(float(scene.duration), float(ds.t[-1]))
+    t = np.linspace(0.0, t_end, args.points) if args.points else ds.t
+    tr = simulate(law, ds, params, solver=args.solver, rtol=args.rtol, t=t)
+    p = law.resolve({**{k: v for k, v in ds.fixed.items() if k in law.param_names}, **params})
+    summary = _summary(law, ds, tr, p)
+    figure = None
+    if args.plot is not None:
+        fine = tr
+        if len(t) < PLOT_POINTS:  # a smooth curve; any solver warning was already given for the run above
+            import warnings
+
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                fine = simulate(law, ds, params, solver=args.solver, rtol=args.rtol,
+                                t=np.linspace(0.0, t_end, PLOT_POINTS))
+        figure = _series_figure(ds, fine, f"{law.name} [{tr.solver}]: {_params_text(law, p)}")
+    return tr.csv_text(), summary, figure
+
+
+def _summary(law, ds, tr, p) -> str:
+    from ..display import fmt_time
+
+    T = float(tr.t[-1])
+    lines = [f"{law.name} on {ds.name} ({tr.solver}): {_params_text(law, p)}"]
+    if np.any(tr.omega != 0) or "omega" in (ds.observable, *ds.columns):
+        i = int(np.argmax(np.abs(tr.omega)))
+        lines.append(f"  peak spin      {tr.omega[i] * RPM:.6g} rpm at t = {fmt_time(tr.t[i], T)}")
+    else:
+        i = int(np.argmax(np.abs(tr.v)))
+        lines.append(f"  peak velocity  {tr.v[i]:.6g} m/s at t = {fmt_time(tr.t[i], T)}")
+    lines.append(f"  at t = {fmt_time(T, T)}: slip u = {tr.u[-1]:.6g} m/s, v = {tr.v[-1]:.6g} m/s, "
+                 f"spin {tr.omega[-1] * RPM:.6g} rpm, theta {math.degrees(tr.theta[-1]):.6g} deg, "
+                 f"force {tr.force[-1]:.6g} N")
+    lines.append("  stick          " + ("slip never reached zero" if tr.stick_time is None else
+                                        f"slip reached zero at t = {fmt_time(tr.stick_time, T)}"))
+    b = tr.info.get("b")
+    if b is not None:
+        lines.append(f"  series b       {b:.4g}")
+    return "\n".join(lines)
+
+
+def _series_figure(ds, tr, title) -> bytes:
+    from ..display import NAMES, time_unit, unit
+    from ..figures import _plt, _png
+
+    plt = _plt()
+    obs = ds.observable
+    uname, uf = unit(obs)
+    tname, tf = time_unit(float(tr.t[-1]))
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    model = tr[obs] if obs in ("u", "v", "omega", "theta") else tr.columns().get(obs)
+    if model is not None:
+        ax.plot(tr.t * tf, model * uf, color="#1b9e77", lw=1.8, label="simulated")
+    ax.errorbar(ds.t * tf, ds.y * uf, yerr=ds.sigma * uf, fmt="o", ms=3.5, color="k", ecolor="0.6", lw=0.8,
+                label=f"{ds.name} ({ds.provenance.kind})")
+    ax.set_xlabel(f"time [{tname}]")
+    ax.set_ylabel(f"{NAMES.get(obs, obs)} [{uname}]")
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return _png(fig)
+
+
+# --- impact outcomes --------------------------------------------------------------------------------
+OUTCOME_COLUMNS = ("speed", "incidence", "rebound_spin", "tangential_cor", "rebound_angle", "contact_time",
+                   "restitution", "rolled")
+
+
+def _outcomes(law, ds, params, args):
+    from ..outcome import predict_outcomes
+    from ..table import render
+
+    out = predict_outcomes(law, ds, params, args.solver, rtol=args.rtol)
+    p = law.resolve({**{k: v for k, v in ds.fixed.items() if k in law.param_names}, **params})
+    rows = [{"speed [m/s]": out["speed"][i], "incidence [deg]": math.degrees(out["incidence"][i]),
+             "rebound spin [rpm]": out["rebound_spin"][i] * RPM, "e_T": out["tangential_cor"][i],
+             "rebound angle [deg]": math.degrees(out["rebound_angle"][i]), "rolled": bool(out["rolled"][i])}
+            for i in range(len(out["speed"]))]
+    summary = f"{law.name} on {ds.name} ({args.solver}): {_params_text(law, p)}\n" + render(rows)
+    lines = [",".join(OUTCOME_COLUMNS)]
+    for i in range(len(out["speed"])):
+        lines.append(",".join(f"{float(out[c][i]):.17g}" if c != "rolled" else str(int(out[c][i]))
+                              for c in OUTCOME_COLUMNS))
+    figure = _outcome_figure(law, ds, p, args) if args.plot is not None else None
+    return "\n".join(lines) + "\n", summary, figure
+
+
+def _outcome_figure(law, ds, p, args) -> bytes:
+    from ..figures import _plt, _png
+    from ..outcome import predict_outcomes
+
+    plt = _plt()
+    obs = ds.observable
+    uname, uf = {"rebound_spin": ("rpm", RPM), "rebound_angle": ("deg", 180 / math.pi)}.get(obs, ("-", 1.0))
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    speeds = np.unique(ds.columns["speed"])
+    inc = ds.columns["incidence"]
+    grid = np.linspace(max(inc.min() - 0.05, 1e-3), min(inc.max() + 0.05, math.pi / 2 - 1e-3), 61)
+    for k, v in enumerate(speeds):
+        color = f"C{k}"
+        model = predict_outcomes(law, ds.scene, p, args.solver, speed=np.full(grid.shape, v), incidence=grid,
+                                 rtol=args.rtol)
+        ax.plot(np.degrees(grid), model[obs] * uf, color=color, lw=1.6, label=f"{v:g} m/s, {law.name}")
+        sel = ds.columns["speed"] == v
+        ax.errorbar(np.degrees(inc[sel]), ds.y[sel] * uf, yerr=ds.sigma * uf, fmt="o", ms=3.5, color=color,
+                    ecolor="0.6", lw=0.8)
+    ref = "surface normal" if ds.scene.angle_reference == "normal" else "surface"
+    ax.set_xlabel(f"incidence from the {ref} [deg]")
+    ax.set_ylabel(f"{obs.replace('_', ' ')} [{uname}]")
+    ax.set_title(f"{ds.name} ({ds.provenance.kind}): {law.name}, {_params_text(law, p)}", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    return _png(fig)

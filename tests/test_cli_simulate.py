@@ -1,0 +1,127 @@
+"""``frictionlab simulate``: summary, CSV (SI), figure, parameters with units, one-line errors."""
+from __future__ import annotations
+
+import math
+import shutil
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import frictionlab as fl
+from frictionlab import cli
+from frictionlab.dataset import builtin_dir
+from frictionlab.figures import is_png
+from frictionlab.outcome import predict_outcomes
+
+RPM = 60 / (2 * math.pi)
+
+
+def run(capsys, *argv):
+    rc = cli.main(list(argv))
+    out = capsys.readouterr()
+    return rc, out.out, out.err
+
+
+def test_series_summary_reproduces_the_paper(run_cli):
+    res = run_cli("simulate", "impact-golf-v28", "--law", "wear", "--param", "lam=1.81e6 Pa s/m",
+                  "--solver", "series", "--points", "5001")
+    out, err = res.stdout, res.stderr
+    assert res.returncode == 0
+    b = 1.81e6 * 130e-6 * 500e-6 / (0.046 * math.pi)
+    assert err.startswith("warning: series: b = 0.814") and err.count("\n") == 1  # the accuracy warning names b
+    peak = 5 * 12.0 / (4 * 0.0213) * RPM  # eq (9) at cos(phi t) = -(1 - b)/b
+    line = next(x for x in out.splitlines() if "peak spin" in x)
+    assert float(line.split()[2]) == pytest.approx(peak, rel=1e-6)
+    end = 5 * 12.0 / 0.0213 * b * (1 - b) * RPM  # eq (10) at t_c
+    assert f"spin {end:.6g} rpm" in out
+    assert "series b       0.8141" in out
+
+
+def test_csv_is_si_and_equals_the_api(capsys, tmp_path):
+    csv = tmp_path / "w.csv"
+    rc, out, err = run(capsys, "simulate", "impact-golf-v28", "--law", "wear", "--param", "lam=1810 kPa s/m",
+                       "--solver", "exact", "--out", str(csv))
+    assert rc == 0 and err == "" and f"wrote {csv}" in out
+    df = pd.read_csv(csv)
+    assert list(df.columns) == ["t", "u", "v", "omega", "theta", "force", "A"]
+    ds = fl.load_dataset("impact-golf-v28")
+    tr = fl.simulate("wear", ds, {"lam": 1.81e6}, solver="exact")
+    assert np.array_equal(df["t"].to_numpy(), ds.t)  # the dataset's times, in seconds
+    for col in ("u", "v", "omega", "theta", "force", "A"):
+        assert np.allclose(df[col].to_numpy(), tr[col], rtol=1e-15, atol=0), col
+    assert df["t"].iloc[-1] == pytest.approx(500e-6)
+
+
+def test_coulomb_csv_has_normal_force_and_stick_time(capsys, tmp_path):
+    csv = tmp_path / "c.csv"
+    rc, out, _ = run(capsys, "simulate", "impact-golf-v28", "--law", "coulomb", "--param", "mu=0.3",
+                     "--solver", "exact", "--points", "101", "--out", str(csv))
+    assert rc == 0
+    df = pd.read_csv(csv)
+    assert list(df.columns) == ["t", "u", "v", "omega", "theta", "force", "N"] and len(df) == 101
+    # without slip coupling the ball's slip stops once mu int N dt = m u0 (half-sine N, e = 0.8)
+    m, u0, tc = 0.046, 12.0, 500e-6
+    impulse = m * 28 * math.cos(math.radians(30)) * 1.8
+    t_s = math.acos(1 - m * u0 / (0.3 * impulse / 2)) * tc / math.pi
+    assert f"slip reached zero at t = {t_s * 1e6:.4g} us" in out
+
+
+def test_defaults_and_fixed_values_are_used(capsys):
+    rc, out, _ = run(capsys, "simulate", "impact-golf-v28", "--law", "wear")
+    assert rc == 0 and "lam = 1e+06 Pa s/m" in out  # the law's default
+    rc, out, _ = run(capsys, "simulate", "incline-oil-a100", "--law", "couette", "--param", "h=40 um")
+    assert rc == 0 and "eta = 0.1 Pa s" in out and "h = 4e-05 m" in out  # eta from the dataset's [fixed]
+    assert "peak velocity" in out and "peak spin" not in out  # an incline block has no spin
+
+
+def test_plot_and_toml_path(capsys, tmp_path):
+    for ext in ("toml", "csv"):
+        shutil.copy(builtin_dir() / f"incline-dry-d10.{ext}", tmp_path / f"d.{ext}")
+    png, csv = tmp_path / "fig.png", tmp_path / "v.csv"
+    rc, out, _ = run(capsys, "simulate", str(tmp_path / "d.toml"), "--law", "wear", "--param", "lam=2e4 Pa s/m",
+                     "--plot", str(png), "--out", str(csv))
+    assert rc == 0 and is_png(png.read_bytes()) and csv.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d.csv", "d.toml", "fig.png", "v.csv"]
+
+
+def test_failed_plot_writes_no_csv(capsys, tmp_path):
+    csv = tmp_path / "x.csv"
+    rc, _, err = run(capsys, "simulate", "impact-golf-v28", "--law", "wear", "--out", str(csv),
+                     "--plot", str(tmp_path / "missing" / "fig.png"))
+    assert rc == 2 and "fig.png" in err and not csv.exists()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_outcome_dataset(capsys, tmp_path):
+    csv, png = tmp_path / "o.csv", tmp_path / "o.png"
+    rc, out, _ = run(capsys, "simulate", "impact-outcome-synthetic", "--law", "coulomb", "--param", "mu=0.25",
+                     "--solver", "exact", "--out", str(csv), "--plot", str(png))
+    assert rc == 0 and is_png(png.read_bytes())
+    df = pd.read_csv(csv)
+    ds = fl.load_dataset("impact-outcome-synthetic")
+    ref = predict_outcomes("coulomb", ds, {"mu": 0.25}, "exact")
+    assert len(df) == len(ds) == 21
+    for col in ("speed", "incidence", "rebound_spin", "tangential_cor", "rebound_angle"):
+        assert np.allclose(df[col].to_numpy(), ref[col], rtol=1e-15), col
+    assert "rebound spin [rpm]" in out and "rolled" in out
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["--law", "nope"], "unknown law 'nope'"),
+    (["--law", "wear", "--param", "mu=0.3"], "law 'wear' has no parameter 'mu'"),
+    (["--law", "wear", "--param", "lam=-1 Pa s/m"], "lam = .* outside its bounds"),
+    (["--law", "wear", "--param", "lam=1e6"], "--param lam: .*no unit"),
+    (["--law", "wear", "--param", "lam"], "--param 'lam': expected NAME=VALUE"),
+    (["--law", "wear", "--solver", "rk4"], "unknown solver 'rk4'"),
+    (["--law", "coulomb", "--solver", "series"], "series: law 'coulomb' has no series solution"),
+    (["--law", "wear", "--rtol", "0"], "rtol must be a number in \\(0, 1\\)"),
+    (["--law", "wear", "--points", "1"], "--points must be at least 2"),
+])
+def test_errors_are_one_line(capsys, tmp_path, argv, match):
+    out_csv = tmp_path / "never.csv"
+    rc, out, err = run(capsys, "simulate", "impact-golf-v28", *argv, "--out", str(out_csv))
+    lines = err.strip().splitlines()
+    assert rc == 2 and len(lines) == 1 and lines[0].startswith("frictionlab")
+    assert pytest.importorskip("re").search(match, lines[0]), lines[0]
+    assert not out_csv.exists() and out == ""
