@@ -366,11 +366,13 @@ def ranking_table(rb: RankingBootstrap, level: float = 0.95) -> list[dict]:
 
 
 # --- the comparison's bootstrap ------------------------------------------------------------------------
-def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, ode: bool = False, free: Mapping | None = None,
+def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, slow: bool = False, free: Mapping | None = None,
                    progress=None) -> tuple[list[RankingBootstrap], dict]:
     """Bootstrap the single-dataset fits of a comparison: per dataset, every candidate that fitted
     (law [solver]) refitted to the same ``n`` case resamples, warm-started from its fit, which is
-    reused as the base. Datasets where a candidate needs the ODE solver are left out unless ``ode``.
+    reused as the base. Without ``slow``, only datasets whose every fit is one closed-form or series
+    solution per evaluation are bootstrapped: not those where a law needs the ODE solver, nor those
+    without a time series (an impact-outcome set simulates every impact at each evaluation).
     Returns (one RankingBootstrap per dataset, {dataset: why it was not bootstrapped})."""
     by_ds: dict = {}
     for f in fits:
@@ -379,15 +381,11 @@ def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, ode: bool = False
     out, skipped = [], {}
     for name, group in by_ds.items():
         ok = [f for f in group if f.ok]
-        slow = [f for f in ok if f.solver.startswith("ode")]
+        why = _slow(ok, n) if ok else ""
         if not ok:
             skipped[name] = "no law could be fitted"
-        elif slow and not ode:
-            skipped[name] = (f"{', '.join(f'{f.law} [{f.solver}]' for f in slow)} need{'s' * (len(slow) == 1)} the "
-                             f"ODE solver here; {'its fit' if len(slow) == 1 else 'their fits'} took "
-                             f"{sum(f.cpu_time for f in slow):.1f} CPU s on the original data, and each of the {n} "
-                             f"resamples would refit {'it' if len(slow) == 1 else 'them'}; add --bootstrap-ode to "
-                             "include it")
+        elif why and not slow:
+            skipped[name] = why
         else:
             opts = {"free": dict(free)} if free else {}
             fns = [law_fit(f.law, f.solver, **opts) for f in ok]
@@ -399,3 +397,21 @@ def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, ode: bool = False
         if progress:
             progress(name)
     return out, skipped
+
+
+def _slow(fits, n: int) -> str:
+    """Why refitting ``fits`` (one dataset's) n times is slow, or '' if it is not."""
+    ode = [f for f in fits if f.solver.startswith("ode")]
+    target = fits[0].per_dataset[0].target
+    if ode:
+        what = f"{', '.join(f'{f.law} [{f.solver}]' for f in ode)} need{'s' * (len(ode) == 1)} the ODE solver here"
+    elif target.t is None:
+        what = (f"a {target.dataset.kind} set: each evaluation of a fit simulates every one of its "
+                f"{target.y.size} rows")
+        ode = fits
+    else:
+        return ""
+    one = len(ode) == 1
+    return (f"{what}; {'its fit' if one else 'their fits'} took {sum(f.cpu_time for f in ode):.1f} CPU s on the "
+            f"original data, and each of the {n} resamples would refit {'it' if one else 'them'}; add "
+            "--bootstrap-all to include it")

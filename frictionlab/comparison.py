@@ -152,7 +152,7 @@ def _run(tasks, fn, pool, progress, done, total, label):
 
 def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None, solvers: Sequence[str] | None = None,
             *, free: dict | None = None, equivalence: bool = True, jobs: int = 1,
-            progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_ode: bool = False,
+            progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
             tolerance: Sequence[float] = ()) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
 
@@ -161,7 +161,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     'series', 'ode[:METHOD]', 'auto'; free: scene quantities fitted per dataset, name -> (lower,
     upper) in SI (see fitting.SCENE_QUANTITIES); jobs: worker processes; progress(done, total, label).
     bootstrap: case resamples per dataset (0: none), drawn from ``seed``; datasets where a law
-    needs the ODE are bootstrapped only with bootstrap_ode. tolerance: looser ODE tolerances at
+    needs the ODE, or without a time series, are bootstrapped only with bootstrap_all. tolerance: looser ODE tolerances at
     which the ODE laws of one dataset are refitted (empty: no tolerance check).
     """
     started = time.perf_counter()
@@ -234,7 +234,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                 tol_rows = tolerance_stage()
             if bootstrap:
                 t0 = time.perf_counter()
-                boots, boot_skipped = bootstrap_fits(fits, bootstrap, seed, pool, bootstrap_ode, free,
+                boots, boot_skipped = bootstrap_fits(fits, bootstrap, seed, pool, bootstrap_all, free,
                                                      progress=lambda name: step(f"bootstrap on {name}"))
                 timings["bootstrap"] = time.perf_counter() - t0
             if tol_future is not None:
@@ -248,7 +248,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                       wall_time=time.perf_counter() - started, versions=versions(),
                       settings={"solvers": list(solvers) if solvers else "default", "jobs": jobs,
                                 "equivalence": equivalence, "free": {k: list(v) for k, v in (free or {}).items()},
-                                "bootstrap": int(bootstrap), "seed": int(seed), "bootstrap_ode": bool(bootstrap_ode),
+                                "bootstrap": int(bootstrap), "seed": int(seed), "bootstrap_all": bool(bootstrap_all),
                                 "tolerance": [float(r) for r in tolerance]},
                       bootstrap=tuple(boots), bootstrap_skipped=boot_skipped, tolerance=tuple(tol_rows),
                       timings=timings)

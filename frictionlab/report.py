@@ -31,7 +31,7 @@
                                    noisy_omega_peak, noisy_omega_end, noisy_median_sigma}}},
     timings_s{stage: wall-clock seconds} (fits, equivalence, tolerance, bootstrap),
     bootstrap{n (0: not run), seed, method: case, level: 0.95, interval: percentile,
-              first_place_interval: wilson, ode,
+              first_place_interval: wilson, all (slow datasets included),
               datasets[{dataset, n_ranked,
                         first_place[{datasets, candidate, law, solver, first_fraction, ci_low, ci_high, level,
                                      first_count, n_ranked, method, seed}],
@@ -555,7 +555,7 @@ def _bootstrap_section(doc: Doc, c: Comparison):
           "others are compared, nor on the number of worker processes.")
     if c.bootstrap_skipped:
         doc.p("**Not bootstrapped:**")
-        doc.items([f"**{d}**: {why.replace('--bootstrap-ode', '`--bootstrap-ode`')}"
+        doc.items([f"**{d}**: {why.replace('--bootstrap-all', '`--bootstrap-all`')}"
                    for d, why in c.bootstrap_skipped.items()])
     if not c.bootstrap:
         return
@@ -772,7 +772,7 @@ def _bootstrap_json(c: Comparison) -> dict:
             "parameters": parameter_table(rb)} for rb in c.bootstrap]
     return {"n": c.settings.get("bootstrap", 0), "seed": c.settings.get("seed", 0), "method": "case",
             "level": 0.95, "interval": "percentile", "first_place_interval": "wilson",
-            "ode": c.settings.get("bootstrap_ode", False), "datasets": per,
+            "all": c.settings.get("bootstrap_all", False), "datasets": per,
             "not_bootstrapped": dict(c.bootstrap_skipped)}
 
 

@@ -97,3 +97,13 @@ def test_candidates_are_labelled_by_solver_and_reuse_given_fits():
                                                                         ("couette [ode]", "couette", "ode")}
     with pytest.raises(ParameterError, match="differ"):
         bootstrap_ranking([law_fit("couette", "exact"), law_fit("couette", "exact")], DS, n=2)
+
+
+def test_slow_datasets_are_left_out_with_the_reason_and_the_flag():
+    """An impact-outcome set simulates every impact at each evaluation: not bootstrapped by default."""
+    from frictionlab import fit
+    from frictionlab.bootstrap import bootstrap_fits
+
+    f = fit("wear", "impact-outcome-synthetic")
+    done, skipped = bootstrap_fits([f], 5)
+    assert done == [] and "impact-outcome set" in skipped[f.datasets[0]] and "--bootstrap-all" in skipped[f.datasets[0]]

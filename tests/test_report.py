@@ -131,7 +131,7 @@ def test_results_json_carries_the_intervals(boot_report):
                                                                                           "wilson")
     (impact,) = b["datasets"]  # the ODE dataset is left out by default, with the reason and the flag
     assert impact["dataset"] == "impact-small" and impact["n_ranked"] == 10
-    assert "--bootstrap-ode" in b["not_bootstrapped"]["dry-small"] and "`--bootstrap-ode`" in md
+    assert "--bootstrap-all" in b["not_bootstrapped"]["dry-small"] and "`--bootstrap-all`" in md
     lam = next(r for r in impact["parameters"] if r["law"] == "wear" and r["solver"] == "exact")
     assert lam["parameter"] == "lam" and lam["ci_low"] < lam["value"] < lam["ci_high"] and lam["n_ok"] == 10
     first = {r["candidate"]: r for r in impact["first_place"]}

@@ -36,8 +36,9 @@ def add_parser(sub):
                    help=f"case resamples per dataset for confidence intervals and first-place shares "
                         f"(default: {BOOTSTRAP_N}; 0: none)")
     p.add_argument("--seed", type=int, default=0, help="seed of the bootstrap resamples (default: 0)")
-    p.add_argument("--bootstrap-ode", action="store_true",
-                   help="also bootstrap datasets where a law needs the ODE solver (slow: minutes per 100 resamples)")
+    p.add_argument("--bootstrap-all", action="store_true",
+                   help="also bootstrap the slow datasets: where a law needs the ODE solver, and impact-outcome sets "
+                        "(minutes per 100 resamples)")
     p.add_argument("--no-tolerance", dest="tolerance", action="store_false",
                    help="skip refitting the ODE laws of one dataset at looser tolerances "
                         f"({', '.join(f'{r:g}' for r in TOLERANCE_RTOLS)})")
@@ -87,7 +88,7 @@ def run(args) -> int:
     try:
         result = compare(laws=laws, datasets=args.data, solvers=args.solver, free=free,
                          equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar,
-                         bootstrap=args.bootstrap, seed=args.seed, bootstrap_ode=args.bootstrap_ode,
+                         bootstrap=args.bootstrap, seed=args.seed, bootstrap_all=args.bootstrap_all,
                          tolerance=TOLERANCE_RTOLS if args.tolerance else ())
     finally:
         bar.close()
