@@ -406,8 +406,9 @@ def _slow(fits, n: int) -> str:
     if ode:
         what = f"{', '.join(f'{f.law} [{f.solver}]' for f in ode)} need{'s' * (len(ode) == 1)} the ODE solver here"
     elif target.t is None:
-        what = (f"a {target.dataset.kind} set: each evaluation of a fit simulates every one of its "
-                f"{target.y.size} rows")
+        kind = target.dataset.kind
+        what = (f"{'an' if kind[0] in 'aeiou' else 'a'} {kind} set: each evaluation of a fit simulates every one "
+                f"of its {target.y.size} rows")
         ode = fits
     else:
         return ""

@@ -314,7 +314,8 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
             items.append(f"**{d.name}** ({d.provenance.kind}): best " + " = ".join(r.candidate for r in best)
                          + f" (Akaike weight {sum(r.akaike_weight for r in best):.2f}"
                          + (" shared by a tie" if len(best) > 1 else "")
-                         + (f"; {_first_share(boot[d.name], best)}" if d.name in boot else "") + ")")
+                         + (f"; {_first_share(boot[d.name], best)}" if d.name in boot else
+                            "; not bootstrapped" if d.name in c.bootstrap_skipped else "") + ")")
         else:
             items.append(f"**{d.name}**: no law could be fitted")
     for g in dict.fromkeys(r.dataset for r in c.groups):
@@ -691,8 +692,11 @@ def _method_section(doc: Doc, c: Comparison):
         "identifiable directions (rank of the Jacobian): a pair entering only as a ratio counts once, a "
         "parameter without effect not at all.",
         f"Ties: candidates within ΔAIC ≤ {TIE_AIC} share a rank. Akaike weight w = exp(−Δ/2)/Σexp(−Δ/2).",
-        "Solvers: 'exact' where the law and scene admit a closed form, else 'ode' (LSODA, rtol 1e-10); "
-        "'series' (the paper's first-order expansion, eqs 7-11) in addition wherever it is defined.",
+        "Solvers: 'exact' where the law and scene admit a closed form, else 'ode' (LSODA, rtol 1e-10; what a "
+        "looser tolerance changes is under 'What solver tolerance does to a fit'); 'series' (the paper's first-order "
+        "expansion, eqs 7-11) in addition wherever it is defined.",
+        "Bootstrap (`--bootstrap N`, `--seed`): case resampling, every candidate refitted to the same resamples; "
+        "95% percentile intervals for parameters, 95% Wilson intervals for first-place shares (see 'Bootstrap').",
         f"Settings: {json.dumps(c.settings)}.",
     ])
     doc.h(2, "Files")
