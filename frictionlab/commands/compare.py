@@ -42,7 +42,7 @@ def add_parser(sub):
                         "(minutes per 100 resamples)")
     p.add_argument("--no-tolerance", dest="tolerance", action="store_false",
                    help="skip refitting the ODE laws of one dataset at looser tolerances "
-                        f"({', '.join(f'{r:g}' for r in TOLERANCE_RTOLS)})")
+                        f"({' and '.join(f'{r:.0e}'.replace('e-0', 'e-') for r in TOLERANCE_RTOLS)})")
     p.set_defaults(func=run)
 
 
