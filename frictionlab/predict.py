@@ -19,7 +19,6 @@ import numpy as np
 
 from .dataset import Dataset, load_dataset
 from .errors import DatasetError, FrictionLabError, ParameterError
-from .law import FrictionLaw
 from .registry import get_law
 from .scene import Scene
 

@@ -10,6 +10,7 @@ import inspect
 import warnings
 from importlib.metadata import entry_points
 
+import attrs
 import numpy as np
 
 from .errors import FrictionLabError, LawError, RegistryError
@@ -62,7 +63,7 @@ def validate_law(law: FrictionLaw, source: str) -> None:
     p = law.defaults()
     try:
         f_pos = law.evaluate(p, probe)
-        f_neg = law.evaluate(p, attrs_replace(probe, u=-probe.u))
+        f_neg = law.evaluate(p, attrs.evolve(probe, u=-probe.u))
     except FrictionLabError as exc:  # name the plugin, not only the law
         msg = str(exc)
         prefix = f"law '{law.name}': "
@@ -72,12 +73,6 @@ def validate_law(law: FrictionLaw, source: str) -> None:
             f"law '{law.name}' ({source}): force() does not oppose slip at its defaults; "
             "frictionlab's convention is F > 0 for u > 0 (m dv/dt = drive - F)"
         )
-
-
-def attrs_replace(c: Contact, **kw) -> Contact:
-    import attrs
-
-    return attrs.evolve(c, **kw)
 
 
 def _add(law: FrictionLaw, source: str) -> None:

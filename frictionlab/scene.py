@@ -12,7 +12,7 @@ from collections.abc import Mapping
 import attrs
 import numpy as np
 
-from .errors import SceneError, UnitError
+from .errors import SceneError
 from .units import to_si
 
 G = 9.80665  # standard gravity [m/s^2]

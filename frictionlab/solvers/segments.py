@@ -14,6 +14,7 @@ from ..trajectory import Trajectory
 from . import stick
 
 MAX_SEGMENTS = 200
+COUNTERS = ("nfev", "njev", "nlu")  # solver statistics summed over segments
 
 
 def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
@@ -45,8 +46,8 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
         todo = (~done) & (t_eval >= t0)
         if phase == "slide":
             Ys, t_stop, y_stop, seg = slide(plan, p, t0, y0, direction, t_eval[todo])
-            for k, v in seg.items():
-                info[k] = info.get(k, 0) + v if isinstance(v, (int, float)) and k in ("nfev", "njev", "nlu") else v
+            for k, v in seg.items():  # counters add up over segments; settings are kept as given
+                info[k] = info.get(k, 0) + v if k in COUNTERS else v
             idx = np.nonzero(todo)[0][: Ys.shape[1]]
             Y[:, idx] = Ys
             sliding[idx] = True
