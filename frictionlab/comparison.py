@@ -56,6 +56,7 @@ class Comparison:
     bootstrap_skipped: dict = attrs.field(factory=dict)  # dataset -> why it was not bootstrapped
     tolerance: tuple[dict, ...] = ()  # fitcost.tolerance_check rows
     timings: dict = attrs.field(factory=dict)  # stage -> wall-clock seconds
+    answers: tuple = ()  # answers.Answer per dataset group: the report's first screen (filled by the verdict layer)
 
     def fit_for(self, dataset: str, law: str, solver: str | None = None) -> FitResult | None:
         for f in self.fits:

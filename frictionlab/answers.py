@@ -1,0 +1,45 @@
+"""The answer to the mission's question, one row per dataset group: what the report's first screen shows.
+
+This module is the contract between the verdict layer (which fills the rows) and everything that
+shows them (the report's first screen, the CLI's closing summary, ``results.json``). A row is
+plain text and numbers, already decided: consumers render it, they never re-derive a verdict.
+
+Groups: a dataset's ``group`` (TOML key ``group``; default: its name without the last
+``-suffix``, so ``impact-golf-v28`` and ``impact-golf-v61`` form ``impact-golf``).
+"""
+from __future__ import annotations
+
+import attrs
+
+#: The equivalence verdicts a row may carry.
+EQUIVALENCE = ("equivalent", "not equivalent", "cannot tell at this noise", "not tested")
+
+
+@attrs.frozen
+class Answer:
+    """One dataset group's answer. Every text field is one short sentence or phrase ("" when not applicable)."""
+
+    group: str  # group label, e.g. "impact-golf"
+    datasets: tuple[str, ...]  # member datasets that were fitted
+    provenance: str  # measured | reported | reconstructed | synthetic | mixed
+    best: str | None  # the best candidate ("wear = couette [exact]"), None when no law could be fitted
+    fits: bool  # the best candidate passes the goodness-of-fit tests
+    headline: str  # "best: X" or "no registered law describes these data (best of a poor set: X)"
+    goodness: str  # how well the best fits, e.g. "chi2 p = 0.41, runs test p = 0.62"
+    equivalence: str  # one of EQUIVALENCE: lambda A u against mu N + mu eta' dA/dt on this group
+    noise_threshold: str  # e.g. "the two laws differ by more than the noise when sigma < 150 rpm"
+    series_vs_exact: str  # e.g. "the series' spin falls because its slip crosses zero at 309 us"
+    transfer: str = ""  # e.g. "one lambda serves both speeds: no (prediction error 12 sigma)"
+    details: dict = attrs.field(factory=dict)  # machine-readable numbers behind the texts (SI), for results.json
+
+    def as_dict(self) -> dict:
+        return attrs.asdict(self)
+
+
+def group_of(dataset) -> str:
+    """The group a dataset belongs to: its declared ``group``, else its name without the last ``-suffix``."""
+    declared = getattr(dataset, "group", "") or ""
+    if declared:
+        return declared
+    name = dataset.name
+    return name.rsplit("-", 1)[0] if "-" in name else name
