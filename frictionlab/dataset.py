@@ -1,7 +1,8 @@
 """Datasets: a CSV series plus a TOML sidecar of the same stem, loaded into SI arrays.
 
 The TOML holds ``name``, ``kind``, ``observable``, ``[columns]`` (column -> unit),
-``[noise]`` (observable -> quantity), ``[scene]``, ``[fixed]`` law parameters,
+``[noise]`` (observable -> quantity, and ``kind = "known" | "assumed"``: whether sigma was
+measured or is a guess; default assumed), ``[scene]``, ``[fixed]`` law parameters,
 ``[provenance]`` and optionally ``[reported]``. Loading validates everything and fails
 with a one-line ``DatasetError`` naming the file and the field.
 """
@@ -20,6 +21,9 @@ from .scene import KINDS, Scene
 from .units import unit_factor
 
 PROVENANCE_KINDS = ("measured", "reported", "reconstructed", "synthetic")
+#: What a dataset says about its noise: 'known' (sigma measured: the likelihood uses it) or
+#: 'assumed' (a guess: the fit profiles sigma out). Absent means assumed.
+NOISE_KINDS = ("known", "assumed")
 DATA_KINDS = KINDS + ("contact-area",)
 
 #: SI unit of each well-known column; other columns must declare a unit of their own.
@@ -57,6 +61,7 @@ class Dataset:
     description: str = ""
     reported: dict = attrs.field(factory=dict)
     fixed_units: dict = attrs.field(factory=dict)
+    noise_kind: str = "assumed"  # NOISE_KINDS: is the [noise] sigma measured ('known') or a guess ('assumed')?
 
     @property
     def t(self) -> np.ndarray:
@@ -186,6 +191,11 @@ def from_meta(meta: dict, path: Path) -> Dataset:
     noise_spec = _table(meta, "noise", path, "[noise]")
     if observable not in noise_spec:
         raise DatasetError(f"{path}: [noise] must give the noise of the observable, e.g. {observable} = '100 rpm'")
+    noise_spec = dict(noise_spec)
+    noise_kind = noise_spec.pop("kind", "assumed")
+    if noise_kind not in NOISE_KINDS:
+        raise DatasetError(f"{path}: noise.kind = {noise_kind!r}, expected one of {', '.join(NOISE_KINDS)} "
+                           "(known: sigma measured; assumed: a guess, profiled out by the fit)")
     noise = {}
     for col, value in noise_spec.items():
         if col not in columns:
@@ -239,7 +249,7 @@ def from_meta(meta: dict, path: Path) -> Dataset:
     return Dataset(name=name, kind=kind, observable=observable, path=path, columns=columns, units=dict(units),
                    noise=noise, scene=scene, fixed=fixed, provenance=provenance,
                    description=meta.get("description", ""), reported=reported,
-                   fixed_units=fixed_units)
+                   fixed_units=fixed_units, noise_kind=noise_kind)
 
 
 #: Trajectory series each observable needs, and what in a scene provides it.

@@ -10,7 +10,14 @@ quantity) raises a one-line FrictionLabError.
 * Scene quantities can be freed by name with bounds (``free={'u0': (8, 14)}``, SI units);
   they are always per dataset.
 * Residuals are (model - data) / sigma, sigma the dataset's noise estimate, so datasets in
-  different units fit together. With several datasets, law parameters are shared (a global
+  different units fit together.
+* The likelihood follows what the dataset says about its noise (``Dataset.noise_kind``): 'known'
+  sigma is used as given (-2 ln L = chi2 + sum ln(2 pi sigma_i^2), error bars NOT scaled);
+  'assumed' sigma is profiled out, one scale per dataset (-2 ln L = n ln(chi2/n) + n +
+  sum ln(2 pi sigma_i^2), one more parameter in AIC/AICc/BIC, error bars scaled by sqrt(reduced
+  chi2)). The constant is kept, so -2 ln L of different datasets add. A derived series (omega
+  smoothed from theta) has correlated points: it gets no likelihood, no criteria, no error bars.
+* Every fit carries its goodness of fit (``goodness.py``) and plausibility flags (``plausibility.py``). With several datasets, law parameters are shared (a global
   fit) unless named in ``local``.
 * Predictions go through ``predict``; a dataset kind plugs in with ``register_predictor``.
 * ``rtol`` is the ODE tolerance of the fit's predictions (None: ``predict.FIT_RTOL``, 1e-10); it
@@ -28,10 +35,12 @@ import attrs
 import numpy as np
 
 from .errors import DatasetError, FrictionLabError, ParameterError, SolverError
+from .goodness import combine, goodness
 from .identifiability import Identifiability, find_structure, in_ratio, jacobian, jacobian_errors, make_verdict
 from .predict import (PREDICTORS, SCENE_QUANTITIES, SkipDataset, Target, applicable_solvers,
                       auto_solver, get_scene_quantity, make_target, predict, register_predictor, set_scene_quantity,
                       takes_rtol)
+from .plausibility import check_plausibility
 from .registry import get_law
 from .scene import Scene
 
@@ -78,6 +87,10 @@ class Stats:
     aic: float
     aicc: float
     bic: float
+    likelihood: str = "assumed"  # 'known' | 'assumed' | 'mixed' | 'none' (see the module docstring)
+    neg2loglik: float = math.nan  # -2 ln L at the best fit, constant included
+    k_lik: int = 0  # parameters counted by AIC/AICc/BIC: n_params plus one profiled sigma per assumed dataset
+    likelihood_reason: str = ""  # why this likelihood (the dataset's [noise] kind)
 
 
 @attrs.frozen(eq=False)
@@ -92,6 +105,7 @@ class DatasetFit:
     rss: float
     rmse: float
     chisqr: float
+    goodness: object = None  # goodness.Goodness of this dataset's residuals
 
     @property
     def name(self) -> str:
@@ -134,6 +148,9 @@ class FitResult:
     cpu_time: float = 0.0  # CPU seconds of the fitting thread
     message: str = ""
     notes: tuple[str, ...] = ()
+    goodness: object = None  # goodness.Goodness over the fitted datasets (Bonferroni over a group)
+    flags: tuple[str, ...] = ()  # plausibility.check: why the fit is physically implausible ('' if none)
+    plausibility: dict = attrs.field(factory=dict)  # the numbers behind the flags (SI)
 
     @property
     def ok(self) -> bool:
@@ -344,9 +361,10 @@ def _distinct(scored: list[tuple], n: int) -> list[dict]:
     return out
 
 
-def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: int, max_nfev):
+def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: int, max_nfev, scale_covar: bool = True):
     """Score a grid of starts, refine the best distinct ones with Levenberg-Marquardt, keep the lowest
-    chi-square. Returns (parameters, success, message)."""
+    chi-square. Returns (parameters, success, message). scale_covar: scale lmfit's error bars by
+    sqrt(reduced chi2) (only when sigma is not known)."""
     varying = [s for s in slots if s.vary]
     if not varying:
         return params, True, "nothing to fit: every parameter is held"
@@ -366,7 +384,7 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
         trial = params.copy()
         for k, v in start.items():
             trial[k].set(value=v)
-        mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), trial, scale_covar=True,
+        mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), trial, scale_covar=scale_covar,
                                max_nfev=max_nfev or 200 * (len(varying) + 1))
         r = mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
         if best is None or (r.success, -r.chisqr) > (best.success, -best.chisqr):
@@ -445,9 +463,11 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     solver_label = solver if solver != "auto" else "+".join(dict.fromkeys(solvers))
     n_points = sum(t.y.size for t in targets)
 
+    likelihood = _likelihood(targets)
     success, message = True, ""
     try:
-        best_params, success, message = _search(lmfit, model, params, slots, solvers, scan, n_starts, max_nfev)
+        best_params, success, message = _search(lmfit, model, params, slots, solvers, scan, n_starts, max_nfev,
+                                                scale_covar=likelihood != "known")
         values = _si(best_params, slots)
         models = model.models(values)
     except SkipDataset as exc:
@@ -458,14 +478,16 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     except Exception as exc:  # an optimizer or law crash is a failed fit, not a crashed comparison
         return give_up("failed", f"{type(exc).__name__}: {exc}", nfev=model.nfev)
 
+    J = jacobian(model, slots, values)
+    structure = find_structure(law, slots, values, J)
+    k_each = structure["k_eff"] / len(targets)  # a group's parameters shared out for each member's test
     per = []
     for tg, solver_i, (p, scene), m in zip(targets, solvers, model.split(values), models):
         r = m - tg.y
         per.append(DatasetFit(tg, solver_i, p, scene, m, float(r @ r), float(np.sqrt(np.mean(r**2))),
-                              float(np.sum((r / tg.sigma) ** 2))))
+                              float(np.sum((r / tg.sigma) ** 2)),
+                              goodness(r / tg.sigma, round(k_each), _likelihood([tg]))))
     chisqr = sum(d.chisqr for d in per)
-    J = jacobian(model, slots, values)
-    structure = find_structure(law, slots, values, J)
     stats = _stats(n_points, structure["k_eff"], len(varying), chisqr, per)
     status, reason = "ok", ""
     if not all(np.all(np.isfinite(d.model)) for d in per):
@@ -479,8 +501,12 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         notes.append(f"{model.failures} of {model.nfev} evaluations could not be solved and were penalized "
                      f"(last: {model.last_error})")
     notes += _series_notes(law, per)
-    jac = jacobian_errors(slots, values, J, structure, stats.redchi)
+    jac = jacobian_errors(slots, values, J, structure, stats.redchi if likelihood != "known" else 1.0)
     presults = _param_results(slots, best_params, targets, structure, jac)
+    if likelihood == "none":  # error bars rest on independent points: a smoothed series has none to give
+        presults = {k: attrs.evolve(p, stderr=None) for k, p in presults.items()}
+        notes.append("fitted to a derived series (omega smoothed from theta): its points are correlated, so no "
+                     "chi-square, information criterion or error bar is valid; fit theta itself for those")
     correl = {}
     if structure["ratios"] or structure["no_effect"]:  # lmfit's covariance is degenerate: use the identifiable part
         correl = jac.get("correl", {})
@@ -491,25 +517,64 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
                 if s.display < o.display:
                     correl[(s.display, o.display)] = float(r)
     ident = make_verdict(structure, presults, correl)
+    flags, numbers, nfev = (), {}, model.nfev
+    if status == "ok":
+        flags, numbers = check_plausibility(law, per, model, slots, values, likelihood)
     return FitResult(law=law.name, solver=solver_label, datasets=names, status=status, reason=reason,
                      params=presults, correlations=correl, stats=stats, identifiability=ident,
-                     per_dataset=tuple(per), nfev=model.nfev, wall_time=time.perf_counter() - started,
+                     per_dataset=tuple(per), nfev=nfev, wall_time=time.perf_counter() - started,
                      cpu_time=time.thread_time() - cpu_started,
-                     message=message, notes=tuple(notes))
+                     message=message, notes=tuple(notes), goodness=combine([d.goodness for d in per]),
+                     flags=tuple(flags), plausibility=numbers)
+
+
+def _likelihood(targets) -> str:
+    """'none' if a target is a derived (smoothed) series, else the datasets' noise kind ('mixed' if they differ)."""
+    if any(t.derivation for t in targets):
+        return "none"
+    kinds = {t.dataset.noise_kind for t in targets}
+    return kinds.pop() if len(kinds) == 1 else "mixed"
+
+
+LIKELIHOOD_REASON = {
+    "known": "[noise] kind = known: sigma is measured, so the Gaussian likelihood uses it as given "
+             "(AIC = chi2 + 2k + sum ln(2 pi sigma^2)); error bars are not rescaled",
+    "assumed": "[noise] kind = assumed (or not given): sigma is a guess, so it is profiled out "
+               "(-2 ln L = n ln(chi2/n) + n + sum ln(2 pi sigma^2), one more parameter); error bars are scaled "
+               "by sqrt(reduced chi2)",
+    "mixed": "the datasets differ: known sigma used where measured, profiled where assumed",
+    "none": "fitted to a derived series (omega smoothed from theta): correlated points, no valid likelihood",
+}
+
+
+def neg2loglik(chisqr: float, n: int, sigma: np.ndarray, kind: str) -> float:
+    """-2 ln L of one dataset [constant included]: chi2 + C if sigma is known, n ln(chi2/n) + n + C if
+    it is profiled (the maximum over a common scale of the declared sigmas); C = sum ln(2 pi sigma_i^2)."""
+    const = float(np.sum(np.log(2 * math.pi * np.asarray(sigma, dtype=float) ** 2)))
+    if kind == "known":
+        return chisqr + const
+    return n * math.log(max(chisqr, np.finfo(float).tiny) / n) + n + const
 
 
 def _stats(n, k, k_free, chisqr, per) -> Stats:
-    """AIC = n ln(chi2/n) + 2k (lmfit's convention: Gaussian errors, noise scale profiled out),
-    AICc = AIC + 2k(k+1)/(n-k-1), BIC = n ln(chi2/n) + k ln n."""
+    """Information criteria from the likelihood the datasets' noise calls for (module docstring):
+    AIC = -2 ln L + 2 k', AICc = AIC + 2k'(k'+1)/(n-k'-1), BIC = -2 ln L + k' ln n, where k' = k plus
+    one profiled sigma per assumed-noise dataset. NaN for a derived (smoothed) series."""
     single = len(per) == 1
-    chi = max(chisqr, np.finfo(float).tiny)
-    ll = n * math.log(chi / n)
-    aic = ll + 2 * k
-    aicc = aic + (2 * k * (k + 1) / (n - k - 1) if n - k - 1 > 0 else math.inf)
-    return Stats(n_points=n, n_params=k, n_free=k_free, chisqr=chisqr,
-                 redchi=chisqr / (n - k) if n > k else math.inf,
-                 rss=per[0].rss if single else math.nan, rmse=per[0].rmse if single else math.nan,
-                 aic=aic, aicc=aicc, bic=ll + k * math.log(n))
+    kind = _likelihood([d.target for d in per])
+    base = dict(n_points=n, n_params=k, n_free=k_free, chisqr=chisqr, redchi=chisqr / (n - k) if n > k else math.inf,
+                rss=per[0].rss if single else math.nan, rmse=per[0].rmse if single else math.nan,
+                likelihood=kind, likelihood_reason=LIKELIHOOD_REASON[kind])
+    if kind == "none":
+        return Stats(aic=math.nan, aicc=math.nan, bic=math.nan, **base)
+    ll, kk = 0.0, k
+    for d in per:
+        own = d.target.dataset.noise_kind
+        ll += neg2loglik(d.chisqr, d.target.y.size, d.target.sigma, own)
+        kk += own != "known"
+    aic = ll + 2 * kk
+    aicc = aic + (2 * kk * (kk + 1) / (n - kk - 1) if n - kk - 1 > 0 else math.inf)
+    return Stats(aic=aic, aicc=aicc, bic=ll + kk * math.log(n), neg2loglik=ll, k_lik=kk, **base)
 
 
 def _series_notes(law, per) -> list[str]:

@@ -67,13 +67,13 @@ def build(out_dir: Path) -> list[Path]:
         meta = {
             "name": f"impact-golf-v{speed}",
             "kind": "impact",
-            "observable": "omega",
+            "observable": "theta",
             "description": (f"Golf ball (46 g, 42.6 mm) in oblique impact on a rigid steel target inclined 30 deg, "
                             f"inbound {speed} m/s: spin and rotation angle during contact, at the 10 us framing "
                             "interval. A reconstruction that agrees with every number the paper states; "
                             "not the camera measurements themselves."),
             "columns": {"t": "us", "omega": "rpm", "theta": "deg"},
-            "noise": {"omega": f"{NOISE_RPM[speed]} rpm", "theta": f"{NOISE_THETA_DEG} deg"},
+            "noise": {"kind": "assumed", "omega": f"{NOISE_RPM[speed]} rpm", "theta": f"{NOISE_THETA_DEG} deg"},
             "scene": {
                 "mass": "46 g", "radius": "21.3 mm", "inertia_factor": 0.4,
                 "u0": f"{s['u0']:g} m/s", "impact_speed": f"{speed} m/s", "incidence": "30 deg",
@@ -110,7 +110,7 @@ def build(out_dir: Path) -> list[Path]:
         "description": ("Contact area of a golf ball on a transparent PMMA target at 32 m/s, as eq (1) of the paper "
                         "describes it; a supporting series (scenes may use it as a measured-area column), not fitted."),
         "columns": {"t": "us", "A": "mm^2"},
-        "noise": {"A": "5 mm^2"},
+        "noise": {"kind": "assumed", "A": "5 mm^2"},
         "provenance": {
             "kind": "reconstructed",
             "source": SOURCE + "; Fig. 2a: peak 150 mm^2 at 220 us",

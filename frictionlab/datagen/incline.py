@@ -68,7 +68,7 @@ def _oil(out_dir, a_mm2, seed):
                         f"down a {c['incline_deg']:g} deg PMMA incline under silicone oil. SYNTHETIC: generated with "
                         "the Couette law, not measured."),
         "columns": {"t": "s", "v": "m/s"},
-        "noise": {"v": f"{c['noise'] * 1e3:g} mm/s"},
+        "noise": {"kind": "known", "v": f"{c['noise'] * 1e3:g} mm/s"},
         "scene": {"mass": f"{c['mass'] * 1e3:g} g", "u0": "0 m/s", "incline": f"{c['incline_deg']:g} deg",
                   "area": {"model": "constant", "area": f"{a_mm2} mm^2"}},
         "fixed": {"eta": f"{c['eta']:g} Pa s"},
@@ -106,7 +106,7 @@ def _dry(out_dir, d_mm, a0_mm2, seed):
                         f"{c['rate_mm2_per_m']:g} mm^2 per metre slid. SYNTHETIC: generated with the wear law, "
                         "not measured."),
         "columns": {"t": "s", "v": "m/s"},
-        "noise": {"v": f"{c['noise'] * 1e3:g} mm/s"},
+        "noise": {"kind": "known", "v": f"{c['noise'] * 1e3:g} mm/s"},
         "scene": {"mass": f"{mass * 1e3:.6g} g", "radius": f"{d_mm / 2:g} mm", "u0": "0 m/s",
                   "incline": f"{c['incline_deg']:g} deg",
                   "area": {"model": "growth", "initial": f"{a0_mm2:g} mm^2", "rate": f"{c['rate_mm2_per_m']:g} mm^2/m"}},

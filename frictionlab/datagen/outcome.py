@@ -59,7 +59,7 @@ def build(out_dir: Path) -> list[Path]:
                         "(rigid sphere, slip coupling and stick), not measured."),
         "columns": {"speed": "m/s", "incidence": "deg", "rebound_spin": "rpm", "tangential_cor": "",
                     "rebound_angle": "deg"},
-        "noise": noise_text,
+        "noise": {"kind": "known", **noise_text},
         "scene": {
             "mass": f"{BALL['mass'] * 1e3:g} g", "radius": f"{BALL['radius'] * 1e3:g} mm",
             "inertia_factor": BALL["inertia_factor"], "effects": ["spin", "slip-coupling"],
