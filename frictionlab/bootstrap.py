@@ -2,9 +2,13 @@
 
 ``bootstrap(fit_fn, dataset, n, seed, executor)`` refits ``n`` resampled copies of a dataset (or
 of a group of datasets, fitted together) and returns a ``BootstrapResult``:
+  method='parametric' y* = best-fit model + Gaussian noise of the dataset's declared sigma (a
+                     simulation from the fit, then a refit): the comparison's choice, valid for
+                     time series (no resampling of correlated points) where sigma is known.
   method='residual'  y* = best-fit model + residuals of the original fit drawn with replacement
                      (centred); times, scene and noise estimate unchanged.
-  method='case'      rows drawn with replacement (kept in time order): no model assumed.
+  method='case'      rows drawn with replacement (kept in time order): no model assumed; breaks
+                     the time structure of a series, so only for independent rows.
 Replicate r draws from its own generator, ``SeedSequence(seed).spawn(n)[r]``, inside the task that
 fits it, so the numbers depend on the seed only, never on the executor, its workers or the order
 in which tasks finish.
@@ -31,7 +35,7 @@ import numpy as np
 
 from .errors import FrictionLabError, ParameterError
 
-METHODS = ("residual", "case")
+METHODS = ("parametric", "residual", "case")
 
 
 # --- fitting functions that travel ---------------------------------------------------------------
@@ -48,6 +52,7 @@ class LawFit:
     solver: str = "auto"
     options: tuple = ()  # sorted (key, value) pairs of fitting.fit keyword arguments
     start: tuple = ()  # sorted (name, value) law-parameter start values, SI
+    name: str = ""  # the candidate's name when it differs from the law's (e.g. 'wear = couette')
 
     def __call__(self, data):
         from .fitting import fit
@@ -63,7 +68,8 @@ class LawFit:
     @property
     def label(self) -> str:
         """The candidate's name: the law, with ' [solver]' when a solver was named."""
-        return self.law if self.solver == "auto" else f"{self.law} [{self.solver}]"
+        name = self.name or self.law
+        return name if self.solver == "auto" else f"{name} [{self.solver}]"
 
 
 def law_fit(law, solver: str = "auto", **options) -> LawFit:
@@ -131,6 +137,8 @@ def _resample(datasets, models, method, rng):
         if method == "case":
             idx = np.sort(rng.integers(0, len(ds), len(ds)))
             cols = {k: v[idx] for k, v in cols.items()}
+        elif method == "parametric":
+            cols[ds.observable] = model + rng.normal(0.0, ds.noise[ds.observable], model.shape)
         else:
             y = cols[ds.observable]
             res = y - model
@@ -198,7 +206,7 @@ def _prepare(fit_fn, dataset, method, base=None):
         raise FrictionLabError(f"bootstrap: the fit on the original data did not succeed "
                                f"({getattr(base, 'reason', '') or getattr(base, 'status', 'failed')})")
     models = [None] * len(datasets)
-    if method == "residual":
+    if method in ("residual", "parametric"):
         for i, ds in enumerate(datasets):
             part = next((p for p in base.per_dataset if p.target.name == ds.name), None)
             if part is None or part.target.derivation or part.target.observable != ds.observable \
@@ -270,7 +278,8 @@ def bootstrap_ranking(laws: Sequence, dataset, n: int = 200, seed: int = 0, exec
                       bases: Sequence | None = None, **fit_options) -> RankingBootstrap:
     """Fit every law to the same ``n`` resampled copies of ``dataset`` and count first places by AIC.
 
-    method 'case' (default) assumes no law's model; 'residual' resamples around the best law's fit.
+    method 'case' (default) assumes no law's model; 'residual' resamples around the best law's fit;
+    'parametric' simulates from the best (unflagged) law's fit with the declared noise.
     laws: names or LawFit objects (distinct labels). tie: AIC difference counted as a tie (default
     ranking.TIE_AIC). bases: the laws' FitResults on the original data, if already made.
     """
@@ -287,9 +296,9 @@ def bootstrap_ranking(laws: Sequence, dataset, n: int = 200, seed: int = 0, exec
     prepared = [_prepare(f, dataset, "case", b) for f, b in zip(fns, bases or [None] * len(fns))]
     datasets = prepared[0][0]
     models = [None] * len(datasets)
-    if method == "residual":  # resample around the law that fits the original data best
-        best = min(range(len(fns)), key=lambda i: _aic(prepared[i][1]))
-        models = _prepare(fns[best], dataset, "residual", prepared[best][1])[2]
+    if method in ("residual", "parametric"):  # resample around the best unflagged fit to the original data
+        best = min(range(len(fns)), key=lambda i: (bool(getattr(prepared[i][1], "flags", ())), _aic(prepared[i][1])))
+        models = _prepare(fns[best], dataset, method, prepared[best][1])[2]
     elif method not in METHODS:
         raise ParameterError(f"bootstrap: method must be one of {', '.join(METHODS)}, got {method!r}")
     rows = _dispatch(executor, [(p[5], p[3]) for p in prepared], datasets, models, method, seed, n, chunk)
@@ -368,12 +377,18 @@ def ranking_table(rb: RankingBootstrap, level: float = 0.95) -> list[dict]:
 # --- the comparison's bootstrap ------------------------------------------------------------------------
 def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, slow: bool = False, free: Mapping | None = None,
                    progress=None) -> tuple[list[RankingBootstrap], dict]:
-    """Bootstrap the single-dataset fits of a comparison: per dataset, every candidate that fitted
-    (law [solver]) refitted to the same ``n`` case resamples, warm-started from its fit, which is
-    reused as the base. Without ``slow``, only datasets whose every fit is one closed-form or series
-    solution per evaluation are bootstrapped: not those where a law needs the ODE solver, nor those
-    without a time series (an impact-outcome set simulates every impact at each evaluation).
+    """Bootstrap the single-dataset fits of a comparison, parametrically: per dataset, ``n`` replicates
+    simulated from the best unflagged fit with the declared noise, and every candidate that fitted
+    (law [solver]; structurally identical laws once, ``ranking.merge_identical``) refitted to them,
+    warm-started from its fit, which is reused as the base. Datasets whose noise is not known
+    (assumed: e.g. a noise-free reconstructed series) are skipped with that reason: resampling them
+    would measure the method's determinism, not the data's firmness. Without ``slow``, only datasets
+    whose every fit is one closed-form or series solution per evaluation are bootstrapped: not those
+    where a law needs the ODE solver, nor those without a time series (an impact-outcome set
+    simulates every impact at each evaluation).
     Returns (one RankingBootstrap per dataset, {dataset: why it was not bootstrapped})."""
+    from .ranking import merge_identical
+
     by_ds: dict = {}
     for f in fits:
         if len(f.datasets) == 1:
@@ -382,16 +397,23 @@ def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, slow: bool = Fals
     for name, group in by_ds.items():
         ok = [f for f in group if f.ok]
         why = _slow(ok, n) if ok else ""
+        target = ok[0].per_dataset[0].target if ok else None
         if not ok:
             skipped[name] = "no law could be fitted"
+        elif target.derivation or target.dataset.noise_kind != "known":
+            skipped[name] = (f"no firmness figure: its noise is {target.dataset.noise_kind}, not measured "
+                             f"({target.dataset.provenance.kind} series), so replicates simulated with a guessed sigma "
+                             "would measure the guess, not the data")
         elif why and not slow:
             skipped[name] = why
         else:
             opts = {"free": dict(free)} if free else {}
-            fns = [law_fit(f.law, f.solver, **opts) for f in ok]
+            merged = merge_identical(ok)
+            fns = [attrs.evolve(law_fit(f.law, f.solver, **opts), name=" = ".join(members) if len(members) > 1 else "")
+                   for f, members, _ in merged]
             try:
-                out.append(bootstrap_ranking(fns, ok[0].per_dataset[0].target.dataset, n=n, seed=seed,
-                                             executor=executor, bases=ok))
+                out.append(bootstrap_ranking(fns, target.dataset, n=n, seed=seed, method="parametric",
+                                             executor=executor, bases=[f for f, _, _ in merged]))
             except FrictionLabError as exc:
                 skipped[name] = str(exc)
         if progress:

@@ -26,6 +26,7 @@ from multiprocessing import get_context
 import attrs
 import numpy as np
 
+from .answers import group_of
 from .dataset import Dataset, builtin_names, load_dataset
 from .equivalence import AREA_RATE, WEAR, EquivalenceResult, analyze_equivalence
 from .errors import FrictionLabError, ParameterError
@@ -34,6 +35,7 @@ from .fitcost import tolerance_check
 from .fitting import PREDICTORS, FitResult, applicable_solvers, auto_solver, fit
 from .ranking import RankRow, family, rank_fits, rank_groups
 from .registry import available_laws, get_law
+from .verdicts import make_answers
 
 Progress = Callable[[int, int, str], None]
 
@@ -46,7 +48,7 @@ class Comparison:
     datasets: tuple[Dataset, ...]  # every dataset asked for, fitted or not
     fits: tuple[FitResult, ...]
     ranking: tuple[RankRow, ...]  # per dataset
-    groups: tuple[RankRow, ...]  # ALL and ALL[kind]
+    groups: tuple[RankRow, ...]  # ALL, ALL[kind] and each dataset group of two or more
     equivalence: tuple[EquivalenceResult, ...]
     skipped_datasets: dict  # name -> reason
     wall_time: float
@@ -243,7 +245,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     eq_results.sort(key=lambda e: (order[e.dataset], family(e.solver) == "series"))
     ranking = rank_fits(fits)
     kinds = {d.name: d.kind for d in dss}
-    groups = rank_groups(ranking, kinds)
+    groups = rank_groups(ranking, kinds, named={d.name: group_of(d) for d in dss})
+    answers = make_answers([d for d in dss if d.name not in skipped_ds], fits, ranking, groups)
     return Comparison(laws=law_names, datasets=dss, fits=tuple(fits), ranking=tuple(ranking), groups=tuple(groups),
                       equivalence=tuple(eq_results), skipped_datasets=skipped_ds,
                       wall_time=time.perf_counter() - started, versions=versions(),
@@ -252,7 +255,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                                 "bootstrap": int(bootstrap), "seed": int(seed), "bootstrap_all": bool(bootstrap_all),
                                 "tolerance": [float(r) for r in tolerance]},
                       bootstrap=tuple(boots), bootstrap_skipped=boot_skipped, tolerance=tuple(tol_rows),
-                      timings=timings)
+                      timings=timings, answers=answers)
 
 
 class _Step:

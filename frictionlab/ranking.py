@@ -157,6 +157,8 @@ def _parameterization(f: FitResult) -> str:
 def merge_identical(fits: list[FitResult]) -> list[tuple[FitResult, tuple[str, ...], str]]:
     """Single-dataset fits with structurally identical laws merged: (representative: the lowest AIC,
     member laws, their parameterizations and the shared form), in order of first appearance."""
+    from .registry import get_law
+
     groups: dict = {}
     order = []
     for f in fits:
@@ -173,6 +175,7 @@ def merge_identical(fits: list[FitResult]) -> list[tuple[FitResult, tuple[str, .
             out.append((members[0], (members[0].law,), ""))
             continue
         best = min(members, key=lambda f: f.stats.aic)
+        members = sorted(members, key=lambda f: (len(get_law(f.law).params), f.law))  # 'wear = couette': simplest first
         form_cls = key[1][0]
         what = (form_cls.__doc__ or form_cls.__name__).split(".")[0]
         text = (f"one closed-form family ({what}): " + "; ".join(_parameterization(f) for f in members))

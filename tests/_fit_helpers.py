@@ -45,7 +45,7 @@ def synthetic(law: str, params: dict, scene: Scene | None = None, *, n: int = 26
         noise[c] = sigma
     units = {"t": "s", **{c: {"omega": "rad/s", "theta": "rad", "v": "m/s"}[c] for c in cols if c != "t"}}
     return Dataset(name=name or f"synthetic-{law}", kind=scene.kind, observable=observable, path=None, columns=cols,
-                   units=units, noise=noise, scene=scene, fixed=dict(fixed or {}),
+                   units=units, noise=noise, scene=scene, fixed=dict(fixed or {}), noise_kind="known",
                    provenance=Provenance(kind="synthetic", source="tests", command="tests/_fit_helpers.py",
                                          seed=seed, truth={"law": law, **{k: f"{v} {get_law(law).spec(k).unit}".strip()
                                                                           for k, v in params.items()}}))

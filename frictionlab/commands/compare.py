@@ -102,4 +102,8 @@ def run(args) -> int:
           f"{sum(f.status == 'failed' for f in result.fits)} failed, {sum(f.status == 'skipped' for f in result.fits)} "
           f"skipped, {len(result.equivalence)} equivalence tests, in {result.wall_time:.1f} s")
     print(f"report: {out / 'report.html'} (also report.md, ranking.csv, results.json, figures/)")
+    from ..verdicts import answers_table
+
+    if result.answers:
+        print(answers_table(result.answers))
     return 0
