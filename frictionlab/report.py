@@ -184,7 +184,10 @@ def _candidate_table(rows, observable: str) -> tuple[list[str], list[list]]:
     out = []
     for r in rows:
         status = r.status + (f" (with {', '.join(r.tied_with)})" if r.tied_with else "") + \
-            (f": {r.reason}" if r.reason else "")
+            (f": {r.reason}" if r.reason else "") + \
+            ("" if r.fits is None else "; fits" if r.fits else "; does not fit") + \
+            (f"; sigma {r.likelihood}" if r.likelihood else "") + \
+            ("".join(f"; FLAG: {f}" for f in r.flags))
         out.append([r.rank or "–", r.candidate, r.n_points or "", r.n_params if r.rank else "",
                     fmt(r.rmse * uf) if math.isfinite(r.rmse) else "", fmt(r.redchi), fmt(r.aic), fmt(r.aicc),
                     fmt(r.bic), _fixed(r.delta_aic, 2), _fixed(r.akaike_weight, 3), status])
@@ -306,12 +309,15 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
 
     # summary
     doc.h(2, "Summary")
-    items = []
+    items = [f"**{a.group}** ({a.provenance}): {a.headline}; goodness of fit: {a.goodness}"
+             + (f"; series vs exact: {a.series_vs_exact}" if a.series_vs_exact else "") for a in c.answers]
     boot = {rb.datasets[0]: rb for rb in c.bootstrap}
     for d in fitted:
         best = [r for r in c.ranking if r.dataset == d.name and r.rank == 1]
         if best:
-            items.append(f"**{d.name}** ({d.provenance.kind}): best " + " = ".join(r.candidate for r in best)
+            fits = all(r.fits for r in best) and not any(r.flags for r in best)
+            items.append(f"**{d.name}** ({d.provenance.kind}): {'best' if fits else 'top-ranked (does not fit)'} "
+                         + " = ".join(r.candidate for r in best)
                          + f" (Akaike weight {sum(r.akaike_weight for r in best):.2f}"
                          + (" shared by a tie" if len(best) > 1 else "")
                          + (f"; {_first_share(boot[d.name], best)}" if d.name in boot else
@@ -320,8 +326,10 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
             items.append(f"**{d.name}**: no law could be fitted")
     for g in dict.fromkeys(r.dataset for r in c.groups):
         best = [r.candidate for r in c.groups if r.dataset == g and r.rank == 1]
+        fits = all(r.fits and not r.flags for r in c.groups if r.dataset == g and r.rank == 1)
         if best:
-            items.append(f"**{g}**: best " + " = ".join(best) + " (summed AIC over the group"
+            items.append(f"**{g}**: {'best' if fits else 'top-ranked (does not fit)'} " + " = ".join(best)
+                         + " (summed AIC over the group"
                          + ("; a tie" if len(best) > 1 else "") + ")")
     for d in fitted:
         for law in c.laws:
@@ -359,8 +367,11 @@ def build(c: Comparison) -> tuple[Doc, dict[str, bytes], dict]:
 
     # ranking
     doc.h(2, "Ranking")
-    doc.p(f"Each law is fitted separately to each dataset and ranked by AIC; candidates within ΔAIC ≤ {TIE_AIC} "
-          "share a rank (their best fits are the same curve). The solver is part of the candidate: where the paper's "
+    doc.p("Each law is fitted separately to each dataset and ranked by AIC, unflagged candidates first (a fit "
+          "flagged as physically implausible ranks after them, its flag in the status); laws of one closed-form "
+          "family (wear = couette) are one candidate; candidates within ΔAIC < 2 are indistinguishable by the "
+          "data. A candidate 'fits' when χ² p ≥ 0.01 (known σ) and runs-test p ≥ 0.01; the top one is called best "
+          "only if it fits. The solver is part of the candidate: where the paper's "
           "truncated series applies it is ranked next to the exact (or numerical) solution of the same law, so the "
           "effect of the approximation is visible. Weights are Akaike weights within each dataset.")
     figs["ranking.png"] = figures.ranking_figure(list(c.ranking))
@@ -546,8 +557,9 @@ def _bootstrap_section(doc: Doc, c: Comparison):
               "resampling; the error bars under Fits are lmfit's standard errors only. Run `frictionlab compare "
               "--bootstrap N` to add them.")
         return
-    doc.p(f"Each candidate (law [solver]) was refitted to the same {n} **case resamples** of its dataset: rows drawn "
-          "with replacement and kept in time order, so no law's model is assumed. Each refit starts from the "
+    doc.p(f"Each candidate (law [solver]) was refitted to the same {n} **parametric replicates** of its dataset: the "
+          "best unflagged fit plus Gaussian noise of the dataset's declared (known) sigma, so the time structure of "
+          "a series is never resampled; datasets whose sigma is only assumed get no firmness figure. Each refit starts from the "
           "candidate's best fit on the original data (no grid scan, one Levenberg-Marquardt run). Parameter "
           "intervals are 95% **percentile intervals** (2.5th to 97.5th percentile of the refitted values). "
           "**First place** is the share of resamples in which a candidate has the lowest AIC (candidates within "
@@ -685,17 +697,22 @@ def _method_section(doc: Doc, c: Comparison):
         "Fits: lmfit Levenberg-Marquardt on residuals (model − data)/σ, σ the dataset's stated noise; parameters "
         "scaled by their typical size so the optimizer sees order-one numbers; a grid of starts is scored first "
         "and the best few distinct ones are refined; dataset `[fixed]` values are held.",
-        "Standard errors: from the covariance scaled by the reduced χ² (lmfit's default), i.e. they assume the "
-        "model is right and the noise level is as estimated by the residuals.",
-        "Statistics: χ² = Σ((model − data)/σ)², reduced χ² = χ²/(n − k), AIC = n ln(χ²/n) + 2k, "
-        "AICc = AIC + 2k(k+1)/(n − k − 1), BIC = n ln(χ²/n) + k ln n (lmfit's convention). k counts the "
+        "Likelihood and standard errors follow each dataset's `[noise] kind`: known σ (measured): −2 ln L = χ² + "
+        "Σ ln(2πσ²), standard errors from the covariance unscaled; assumed σ (a guess, the default): σ profiled, "
+        "−2 ln L = n ln(χ²/n) + n + Σ ln(2πσ²), one more parameter, standard errors scaled by √(reduced χ²).",
+        "Statistics: χ² = Σ((model − data)/σ)², reduced χ² = χ²/(n − k), AIC = −2 ln L + 2k′, "
+        "AICc = AIC + 2k′(k′+1)/(n − k′ − 1), BIC = −2 ln L + k′ ln n, k′ = k plus the profiled σ. k counts the "
         "identifiable directions (rank of the Jacobian): a pair entering only as a ratio counts once, a "
-        "parameter without effect not at all.",
-        f"Ties: candidates within ΔAIC ≤ {TIE_AIC} share a rank. Akaike weight w = exp(−Δ/2)/Σexp(−Δ/2).",
+        "parameter without effect not at all. Groups add −2 ln L and k and use the group's n.",
+        "Goodness of fit: χ² p-value (known σ only) and the Wald-Wolfowitz runs test on residual signs (one-sided, "
+        "too few runs); fits when both are ≥ 0.01 (Bonferroni-adjusted over a group).",
+        f"Ties: candidates within ΔAIC ≤ {TIE_AIC} share a rank; within ΔAIC < 2 they are indistinguishable. "
+        "Akaike weight w = exp(−Δ/2)/Σexp(−Δ/2).",
         "Solvers: 'exact' where the law and scene admit a closed form, else 'ode' (LSODA, rtol 1e-10; what a "
         "looser tolerance changes is under 'What solver tolerance does to a fit'); 'series' (the paper's first-order "
         "expansion, eqs 7-11) in addition wherever it is defined.",
-        "Bootstrap (`--bootstrap N`, `--seed`): case resampling, every candidate refitted to the same resamples; "
+        "Bootstrap (`--bootstrap N`, `--seed`): parametric (simulated from the best fit with the declared sigma; "
+        "only where sigma is known), every candidate refitted to the same replicates; "
         "95% percentile intervals for parameters, 95% Wilson intervals for first-place shares (see 'Bootstrap').",
         f"Settings: {json.dumps(c.settings)}.",
     ])
@@ -774,7 +791,7 @@ def _equivalence_json(e) -> dict:
 def _bootstrap_json(c: Comparison) -> dict:
     per = [{"dataset": rb.datasets[0], "n_ranked": rb.n_ranked, "first_place": ranking_table(rb),
             "parameters": parameter_table(rb)} for rb in c.bootstrap]
-    return {"n": c.settings.get("bootstrap", 0), "seed": c.settings.get("seed", 0), "method": "case",
+    return {"n": c.settings.get("bootstrap", 0), "seed": c.settings.get("seed", 0), "method": "parametric",
             "level": 0.95, "interval": "percentile", "first_place_interval": "wilson",
             "all": c.settings.get("bootstrap_all", False), "datasets": per,
             "not_bootstrapped": dict(c.bootstrap_skipped)}

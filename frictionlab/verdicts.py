@@ -114,9 +114,10 @@ def series_vs_exact(fits) -> tuple[str, dict]:
         law = get_law(law_name)
         d = sf.per_dataset[0]
         form = law.form(d.params)
-        if ef is None or not isinstance(form, AreaSlipForm):
-            continue
         sc = d.scene
+        if ef is None or not isinstance(form, AreaSlipForm) or d.target.t is None \
+                or not hasattr(sc.area, "peak") or not hasattr(sc.area, "contact_time"):
+            continue
         b = form.k * sc.area.peak * sc.area.contact_time / (sc.mass * math.pi)
         t = np.linspace(0.0, sc.area.contact_time, 2001)
         t_series = _slip_zero(d.trajectory(law, t))

@@ -121,13 +121,13 @@ def test_bootstrap_tables_depend_on_the_seed_only(boot_report):
     tables = md[md.index("### First place under resampling"):md.index("## Fits")].strip() + "\n"
     assert _bootstrap_tables(again) == tables  # same seed, one worker process or two: the same numbers
     assert _bootstrap_tables(other) != tables
-    assert "case resamples" in md and "percentile intervals" in md and "Wilson score interval" in md
+    assert "parametric replicates" in md and "percentile intervals" in md and "Wilson score interval" in md
 
 
 def test_results_json_carries_the_intervals(boot_report):
     md, data = boot_report
     b = data["bootstrap"]
-    assert (b["n"], b["seed"], b["method"], b["interval"], b["first_place_interval"]) == (10, 7, "case", "percentile",
+    assert (b["n"], b["seed"], b["method"], b["interval"], b["first_place_interval"]) == (10, 7, "parametric", "percentile",
                                                                                           "wilson")
     (impact,) = b["datasets"]  # the ODE dataset is left out by default, with the reason and the flag
     assert impact["dataset"] == "impact-small" and impact["n_ranked"] == 10
@@ -199,6 +199,7 @@ observable = "omega"
 t = "us"
 omega = "rpm"
 [noise]
+kind = "known"
 omega = "{sigma:.6g} rpm"
 [scene]
 mass = "46 g"
