@@ -29,7 +29,8 @@ def test_every_builtin_loads_with_honest_provenance():
 def test_golf_units_become_si():
     d = fl.load_dataset("impact-golf-v28")
     assert d.t[1] == pytest.approx(10e-6)
-    assert d.sigma == pytest.approx(200 * RPM)
+    assert d.observable == "theta" and d.sigma == pytest.approx(math.radians(0.5))
+    assert d.noise["omega"] == pytest.approx(200 * RPM)
     s = d.scene
     assert (s.mass, s.radius, s.u0) == pytest.approx((0.046, 0.0213, 12.0))
     assert s.area.peak == pytest.approx(130e-6) and s.area.contact_time == pytest.approx(500e-6)
@@ -42,14 +43,15 @@ def test_golf_reconstruction_agrees_with_every_stated_number(speed):
     d = fl.load_dataset(f"impact-golf-v{speed}")
     rep = d.reported
     q = lambda s: fl.units.to_si(s, {"rpm": "rad/s", "us": "s", "deg": "rad"}[s.split()[1]], "test")  # noqa: E731
-    i = int(np.argmax(d.y))
-    assert d.y[0] == 0.0
-    assert d.y[i] == pytest.approx(q(rep["omega_peak"]), rel=1e-6)
+    w = d.columns["omega"]
+    i = int(np.argmax(w))
+    assert w[0] == 0.0
+    assert w[i] == pytest.approx(q(rep["omega_peak"]), rel=1e-6)
     assert d.t[i] == pytest.approx(q(rep["t_peak"]))
-    assert d.y[-1] == pytest.approx(q(rep["omega_at_contact_end"]), rel=1e-6)
+    assert w[-1] == pytest.approx(q(rep["omega_at_contact_end"]), rel=1e-6)
     assert d.t[-1] == pytest.approx(q(rep["contact_time"]))
     assert d.columns["theta"].max() == pytest.approx(q(rep["theta_max"]), rel=1e-6)
-    assert np.all(np.diff(d.y[: i + 1]) > 0) and np.all(np.diff(d.y[i + 1:]) < 0)  # one peak
+    assert np.all(np.diff(w[: i + 1]) > 0) and np.all(np.diff(w[i + 1:]) < 0)  # one peak
 
 
 def test_area_series_matches_stated_peak():
@@ -78,7 +80,7 @@ def _edit(path: Path, old: str, new: str):
     (".toml", 'mass = "46 g"', 'mass = "-46 g"', r"g.toml: scene.mass must be positive"),
     (".toml", 'mass = "46 g"', "mass = 0.046", r"g.toml: scene.mass: 0.046 has no unit"),
     (".toml", 'peak = "130 mm^2"', 'peak = "-130 mm^2"', r"g.toml: scene.area.peak must be positive"),
-    (".toml", 'observable = "omega"', 'observable = "spin_rate"', r"observable 'spin_rate' is not declared"),
+    (".toml", 'observable = "theta"', 'observable = "spin_rate"', r"observable 'spin_rate' is not declared"),
     (".toml", 'kind = "reconstructed"', 'kind = "vibes"', r"provenance.kind = 'vibes', expected one of"),
     (".toml", "[columns]", "[columns", r"g.toml: TOML does not parse"),
     (".csv", "\n10,", "\n0,", r"g.csv: column 't' must increase strictly"),
