@@ -18,11 +18,16 @@
           parameters{name: {value, stderr, unit, kind: law|scene|derived, vary, fixed_by, lower, upper}},
           correlations[{a, b, r}],
           statistics{observable, observable_unit, n_points, n_params, n_free, chisqr, redchi, rss, rmse,
-                     aic, aicc, bic},
+                     aic, aicc, bic, likelihood: known|assumed|mixed|none, likelihood_reason, neg2loglik, k_lik},
+          goodness{likelihood, chi2_p, runs_p, runs, runs_expected, lag1, lag1_p, fits, reason},
+          flags[] (plausibility), plausibility{max_slip_ratio, max_spin_ratio, work_fraction, effect_dchi2{}},
           identifiability{verdict, warnings[], at_bounds[], missing_stderr{name: reason},
                           high_correlations[{a, b, r}], ratio_only[[a, b]], no_effect[]},
           notes[]}],
-    ranking[row], groups[row] (row: the ranking.csv columns plus reason, tied_with),
+    ranking[row], groups[row] (row: the ranking.csv columns plus reason, tied_with, flags[], members[],
+                               parameterizations),
+    answers[answers.Answer as a dict: group, datasets, provenance, best, fits, headline, goodness,
+            equivalence, noise_threshold, series_vs_exact, transfer, details{}],
     equivalence[{dataset, solver, area_rate_solver, status, verdict, explanation, reason, checks{},
                  force_correlation, force_distance, impulse_Ns{}, aic{}, redchi{}, shape{}, fitted{},
                  cross[{law, to, status, rms, rms_sigma, dchi2, params}],
@@ -30,7 +35,7 @@
     derivations{dataset: {method: {rms_vs_omega_column, omega_peak, omega_end, noisy_rms_vs_omega_column,
                                    noisy_omega_peak, noisy_omega_end, noisy_median_sigma}}},
     timings_s{stage: wall-clock seconds} (fits, equivalence, tolerance, bootstrap),
-    bootstrap{n (0: not run), seed, method: case, level: 0.95, interval: percentile,
+    bootstrap{n (0: not run), seed, method: parametric, level: 0.95, interval: percentile,
               first_place_interval: wilson, all (slow datasets included),
               datasets[{dataset, n_ranked,
                         first_place[{datasets, candidate, law, solver, first_fraction, ci_low, ci_high, level,
@@ -759,7 +764,12 @@ def _fit_json(f) -> dict:
         s = f.stats
         out["statistics"] = {"observable": obs, "observable_unit": _SI_UNITS.get(obs, "SI"), "n_points": s.n_points,
                              "n_params": s.n_params, "n_free": s.n_free, "chisqr": s.chisqr, "redchi": s.redchi,
-                             "rss": s.rss, "rmse": s.rmse, "aic": s.aic, "aicc": s.aicc, "bic": s.bic}
+                             "rss": s.rss, "rmse": s.rmse, "aic": s.aic, "aicc": s.aicc, "bic": s.bic,
+                             "likelihood": s.likelihood, "likelihood_reason": s.likelihood_reason,
+                             "neg2loglik": s.neg2loglik, "k_lik": s.k_lik}
+        out["goodness"] = f.goodness.as_dict() if f.goodness is not None else None
+        out["flags"] = list(f.flags)
+        out["plausibility"] = f.plausibility
         i = f.identifiability
         out["identifiability"] = {"verdict": i.verdict, "warnings": list(i.warnings), "at_bounds": list(i.at_bounds),
                                   "missing_stderr": dict(i.missing_stderr),
@@ -772,7 +782,8 @@ _SI_UNITS = {"omega": "rad/s", "theta": "rad", "v": "m/s", "u": "m/s"}
 
 
 def _row_json(r) -> dict:
-    return {**{k: getattr(r, k) for k in COLUMNS}, "reason": r.reason, "tied_with": list(r.tied_with)}
+    return {**r.as_dict(), "reason": r.reason, "tied_with": list(r.tied_with), "flags": list(r.flags),
+            "members": list(r.members), "parameterizations": r.parameterizations}
 
 
 def _equivalence_json(e) -> dict:
@@ -815,7 +826,7 @@ def results_json(c: Comparison, deriv_stats: dict | None = None) -> dict:
     return _clean({"schema": SCHEMA, "created": _dt.datetime.now().astimezone().isoformat(timespec="seconds"),
                    "versions": c.versions, "settings": c.settings, "wall_time_s": c.wall_time, "datasets": datasets,
                    "fits": [_fit_json(f) for f in c.fits], "ranking": [_row_json(r) for r in c.ranking],
-                   "groups": [_row_json(r) for r in c.groups],
+                   "groups": [_row_json(r) for r in c.groups], "answers": [a.as_dict() for a in c.answers],
                    "equivalence": [_equivalence_json(e) for e in c.equivalence],
                    "derivations": deriv_stats or {}, "timings_s": c.timings,
                    "bootstrap": _bootstrap_json(c), "tolerance": _tolerance_json(c)})
