@@ -41,6 +41,7 @@ class Goodness:
     lag1_p: float
     fits: bool | None  # None when no test could be made
     reason: str  # one phrase: why it fits or does not
+    members: int = 1  # datasets combined (p-values Bonferroni-adjusted when more than one)
 
     def as_dict(self) -> dict:
         return attrs.asdict(self)
@@ -55,7 +56,8 @@ class Goodness:
             parts.append(f"runs p = {_p(self.runs_p)}")
         if math.isfinite(self.lag1):
             parts.append(f"lag-1 r = {self.lag1:+.2f}")
-        return ", ".join(parts) or "no test possible"
+        text = ", ".join(parts) or "no test possible"
+        return text + (f" (p Bonferroni-adjusted over {self.members} datasets)" if self.members > 1 else "")
 
 
 def _p(p: float) -> str:
@@ -145,6 +147,6 @@ def combine(members: list[Goodness]) -> Goodness:
 
     lags = [(g.lag1, g.lag1_p) for g in members if math.isfinite(g.lag1)]
     r1, r1_p = max(lags) if lags else (math.nan, math.nan)
-    return _decide(kinds.pop() if len(kinds) == 1 else "mixed", adjusted(g.chi2_p for g in members),
+    return attrs.evolve(_decide(kinds.pop() if len(kinds) == 1 else "mixed", adjusted(g.chi2_p for g in members),
                    adjusted(g.runs_p for g in members), sum(g.runs for g in members),
-                   sum(g.runs_expected for g in members if math.isfinite(g.runs_expected)), r1, r1_p)
+                   sum(g.runs_expected for g in members if math.isfinite(g.runs_expected)), r1, r1_p), members=m)

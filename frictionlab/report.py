@@ -588,8 +588,9 @@ def _bootstrap_section(doc: Doc, c: Comparison):
         rows.append([rb.datasets[0], " = ".join(r.candidate for r in best), _first_share(rb, best),
                      "; ".join(others) or "none", ", ".join(never)])
     doc.h(3, "First place under resampling")
-    doc.p("Candidates tied on the original data (the same curve, such as wear and Couette on a given area history) "
-          "split each first place between them; their shares are summed here. results.json has each one's share.")
+    doc.p("Laws of one closed-form family (wear = couette) are one candidate, refitted once; candidates still tied "
+          "on the original data split each first place between them; their shares are summed here. results.json has "
+          "each one's share.")
     doc.table(["dataset", "best on the original data", "its first places", "others ever first: share (95% interval)",
                "never first"], rows)
     doc.h(3, "Parameter intervals")

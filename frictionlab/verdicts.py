@@ -107,7 +107,8 @@ def series_vs_exact(fits) -> tuple[str, dict]:
 
     numbers, sentences = {}, []
     by = {(f.datasets[0], f.law, f.solver): f for f in fits if len(f.datasets) == 1}
-    for (name, law_name, solver), sf in by.items():
+    simplest_first = sorted(by.items(), key=lambda kv: (len(get_law(kv[0][1]).params), kv[0][1]))
+    for (name, law_name, solver), sf in simplest_first:
         if solver != "series" or name in numbers:
             continue
         ef = by.get((name, law_name, "exact"))
@@ -131,7 +132,9 @@ def series_vs_exact(fits) -> tuple[str, dict]:
                  else f"never does (its minimum is {np.min(ex.u) / sc.u0:.2f} u0)")
         sentences.append(f"{name}: the series slip {series} (b = {b:.2f}); the exact {law_name} slip {exact}; "
                          f"series better by delta-AIC {ef.stats.aic - sf.stats.aic:.1f}")
-    return "; ".join(sentences), numbers
+    order = [n for n in dict.fromkeys(f.datasets[0] for f in fits) if n in numbers]
+    sentences.sort(key=lambda text: next(i for i, n in enumerate(order) if text.startswith(n + ":")))
+    return "; ".join(sentences), {n: numbers[n] for n in order}
 
 
 def answers_table(answers) -> str:
