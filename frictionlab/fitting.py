@@ -181,6 +181,13 @@ class FitResult:
         lines = [head, f"  chi2 = {s.chisqr:.5g}, reduced chi2 = {s.redchi:.4g}, AIC = {s.aic:.5g}, "
                        f"BIC = {s.bic:.5g}, n = {s.n_points}, k = {s.n_params}, nfev = {self.nfev}, "
                        f"{self.wall_time:.2f} s"]
+        lines.append(f"  likelihood: {s.likelihood} sigma ({s.likelihood_reason})" if s.likelihood != "none"
+                     else f"  likelihood: none ({s.likelihood_reason})")
+        if self.goodness is not None:
+            verdict = {True: "fits", False: "does not fit", None: "not tested"}[self.goodness.fits]
+            lines.append(f"  goodness of fit: {verdict}: {self.goodness.text} ({self.goodness.reason})")
+        for flag in self.flags:
+            lines.append(f"  FLAG (implausible): {flag}")
         for p in self.params.values():
             err = "held" if not p.vary and p.kind != "derived" else ("no error bar" if p.stderr is None else f"+/- {p.stderr:.3g}")
             why = f" ({p.fixed_by})" if p.fixed_by else ""
