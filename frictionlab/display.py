@@ -38,7 +38,7 @@ def fmt_time(t: float, ref: float | None = None) -> str:
 
 
 def fmt(x, digits: int = 4) -> str:
-    """A number for a table: '' for None/nan, fixed or scientific by size."""
+    """A number for a table with ``digits`` significant figures: '' for None/nan, fixed or scientific by size."""
     if x is None:
         return ""
     if isinstance(x, (int,)) and not isinstance(x, bool):
@@ -51,8 +51,8 @@ def fmt(x, digits: int = 4) -> str:
         return "" if math.isnan(x) else ("inf" if x > 0 else "-inf")
     if x == 0:
         return "0"
-    if 1e-3 <= abs(x) < 1e5:
-        return f"{x:.{digits}g}"
+    if 1e-3 <= abs(x) < 1e5:  # the same number of significant figures everywhere: 1.000, 12.50, 1234
+        return f"{x:#.{digits}g}".rstrip(".")
     return f"{x:.{digits - 1}e}"
 
 

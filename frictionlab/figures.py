@@ -26,7 +26,7 @@ def _plt():
 
 def _png(fig) -> bytes:
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=DPI, bbox_inches="tight")
+    fig.savefig(buf, format="png", dpi=DPI)  # constrained layout: one draw, no tight bbox pass
     _plt().close(fig)
     return buf.getvalue()
 
@@ -67,7 +67,7 @@ def fit_figure(dataset, fits, rows) -> bytes:
     uname, uf = unit(obs)
     x, xlabel, tf = _x_axis(dataset, obs)
     order = np.argsort(x, kind="stable")
-    fig, (ax, axr) = plt.subplots(2, 1, figsize=(7.6, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 1.6]})
+    fig, (ax, axr) = plt.subplots(2, 1, figsize=(7.6, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 1.6]}, layout="constrained")
     y = target.y if ok else dataset.columns[obs]
     sigma = target.sigma if ok else np.full(x.shape, dataset.noise.get(obs, np.nan))
     kind = dataset.provenance.kind
@@ -113,7 +113,7 @@ def force_figure(dataset, fits) -> bytes:
     ok = [f for f in fits if f.ok and f.per_dataset[0].target.t is not None]
     t_end = float(dataset.t[-1])
     tname, tf = time_unit(t_end)
-    fig, ax = plt.subplots(figsize=(7.6, 3.8))
+    fig, ax = plt.subplots(figsize=(7.6, 3.8), layout="constrained")
     for i, f in enumerate(ok):
         tr = f.per_dataset[0].trajectory(f.law, np.linspace(0.0, t_end, 400))
         ax.plot(tr.t * tf, tr.force, label=f"{f.law} [{f.solver}]", **_style(f.law, f.solver, i))
@@ -143,7 +143,7 @@ def ranking_figure(rows) -> bytes:
             text[i][j] = f"#{r.rank}\n{r.delta_aic:.1f}" + ("" if r.solver in ("exact", "series") else f"\n{r.solver}")
         else:
             text[i][j] = r.status
-    fig, ax = plt.subplots(figsize=(1.25 * len(datasets) + 3.2, 0.55 * len(cands) + 1.8))
+    fig, ax = plt.subplots(figsize=(1.25 * len(datasets) + 3.2, 0.55 * len(cands) + 1.8), layout="constrained")
     cmap = plt.get_cmap("viridis_r").with_extremes(bad="0.9")
     im = ax.imshow(np.where(np.isnan(M), np.nan, M + 1.0), cmap=cmap, aspect="auto",
                    norm=LogNorm(vmin=1.0, vmax=max(10.0, np.nanmax(M + 1.0) if np.isfinite(M).any() else 10.0)))
@@ -167,7 +167,7 @@ def derivation_figure(dataset, derived: dict, noisy: dict, sigma_theta: float, s
     tname, tf = time_unit(float(t[-1]))
     du, df = unit("omega")
     au, af = unit("theta")
-    fig, axes = plt.subplots(2, 2, figsize=(10.5, 6.6), sharex=True)
+    fig, axes = plt.subplots(2, 2, figsize=(10.5, 6.6), sharex=True, layout="constrained")
     colors = {"poly9": "#d95f02", "spline": "#1b9e77"}
     for col, (title, res) in enumerate((("theta column as given", derived),
                                         (f"with simulated noise σθ = {sigma_theta * af:.2g} {au} (seed {seed})",
@@ -201,7 +201,6 @@ def derivation_figure(dataset, derived: dict, noisy: dict, sigma_theta: float, s
             axw.set_ylim(lo, hi)
     fig.suptitle(f"{dataset.name}: spin derived from rotation angle (shaded: ±1σ each route passes on from θ noise)",
                  fontsize=11)
-    fig.tight_layout()
     return _png(fig)
 
 
@@ -213,7 +212,7 @@ def equivalence_figure(dataset, fw_list, fa, decomps) -> bytes:
     t_end = float(dataset.t[-1])
     tname, tf = time_unit(t_end)
     t = np.linspace(0.0, t_end, 400)
-    fig, axes = plt.subplots(1, max(1, len(fw_list)), figsize=(5.4 * max(1, len(fw_list)), 3.9), squeeze=False)
+    fig, axes = plt.subplots(1, max(1, len(fw_list)), figsize=(5.4 * max(1, len(fw_list)), 3.9), squeeze=False, layout="constrained")
     Fa = fa.per_dataset[0].trajectory(fa.law, t).force
     for ax, fw, dec in zip(axes[0], fw_list, decomps):
         Fw = fw.per_dataset[0].trajectory(fw.law, t).force
@@ -235,7 +234,52 @@ def equivalence_figure(dataset, fw_list, fa, decomps) -> bytes:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
     fig.suptitle(f"{dataset.name}: is λAu equivalent to μN + μη' dA/dt?", fontsize=11)
-    fig.tight_layout()
+    return _png(fig)
+
+
+def finding_figure(findings) -> bytes:
+    """Per finding (report.first_screen.SeriesFinding), one column: the data's spin with the series and the
+    exact fit of the same law (top), the slip u(t) of each (bottom), the series' zero crossing marked."""
+    plt = _plt()
+    n = len(findings)
+    fig, axes = plt.subplots(2, n, figsize=(4.6 * n + 0.4, 4.3), sharex="col", squeeze=False, layout="constrained",
+                             gridspec_kw={"height_ratios": [1.5, 1]})
+    su, sf = unit("omega")
+    for j, f in enumerate(findings):
+        d = f.dataset
+        ax, axu = axes[0, j], axes[1, j]
+        t_end = float(d.t[-1])
+        tname, tf = time_unit(t_end)
+        t = np.linspace(0.0, t_end, 300)
+        obs = f.series.per_dataset[0].target.observable
+        if obs == "omega":
+            target = f.series.per_dataset[0].target
+            ax.errorbar(d.t * tf, target.y * sf, yerr=target.sigma * sf, fmt="o", ms=2.6, color="black",
+                        ecolor="0.75", elinewidth=0.7, label=f"data ({d.provenance.kind})", zorder=1)
+        for fit, color, ls in ((f.full, "#1b9e77", "-"), (f.series, "#d95f02", "--")):
+            tr = fit.per_dataset[0].trajectory(fit.law, t)
+            label = f"{fit.law} [{fit.solver}]" + (" (paper's truncated series)" if fit.solver == "series" else "")
+            ax.plot(t * tf, tr["omega"] * sf, color=color, ls=ls, lw=2, label=label, zorder=3)
+            axu.plot(t * tf, tr["u"], color=color, ls=ls, lw=2, label=label)
+        axu.axhline(0, color="0.3", lw=0.8)
+        if f.t_cross is not None:
+            for a in (ax, axu):
+                a.axvline(f.t_cross * tf, color="#d95f02", ls=":", lw=1.3)
+            axu.annotate(f"series slip = 0 at {f.t_cross * tf:.0f} {tname}:\nfriction reverses, spin falls",
+                         xy=(f.t_cross * tf, 0.0), xytext=(0.03, 0.1), textcoords="axes fraction", fontsize=8,
+                         arrowprops={"arrowstyle": "->", "color": "0.3"})
+        ax.axvline(f.contact_time * tf, color="0.6", lw=0.8)
+        axu.axvline(f.contact_time * tf, color="0.6", lw=0.8)
+        ax.set_title(f"{d.name}" + ("" if d.provenance.kind == "measured" else f" ({d.provenance.kind} data)"),
+                     fontsize=10)
+        ax.set_ylabel(f"spin ω [{su}]")
+        axu.set_ylabel("slip u [m/s]")
+        axu.set_xlabel(f"time [{tname}] (grey line: end of contact t_c)")
+        ax.legend(fontsize=7, loc="lower right")
+        for a in (ax, axu):
+            a.grid(alpha=0.3)
+    fig.suptitle("Why the paper's spin falls: its truncated series' slip turns negative; the exact solution's never does",
+                 fontsize=10.5)
     return _png(fig)
 
 
