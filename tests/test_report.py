@@ -60,7 +60,10 @@ def test_html_is_self_contained(report_dir):
 def test_ranking_csv_and_results_json(report_dir):
     out = report_dir
     rows = list(csv.DictReader(io.StringIO((out / "ranking.csv").read_text())))
-    assert list(rows[0]) == list(COLUMNS)
+    assert list(rows[0]) == list(COLUMNS) + ["observable", "rss_unit", "rmse_unit"]
+    assert {(r["observable"], r["rss_unit"], r["rmse_unit"]) for r in rows if r["dataset"] == "synth-impact"} == {
+        ("omega", "(rad/s)^2", "rad/s")}
+    assert all(r["rmse_unit"] == "" for r in rows if r["dataset"].startswith("ALL"))
     per = [r for r in rows if r["dataset"] == "synth-impact"]
     assert {(r["law"], r["solver"]) for r in per} == {("wear", "exact"), ("wear", "series"), ("area-rate", "exact")}
     best = [r for r in per if r["rank"] == "1"]

@@ -72,3 +72,25 @@ def test_names_and_descriptions_never_leak_raw_html(comp, tmp_path):
     for text in (md, page):
         assert "<script>alert" not in text and "<b>bold</b>" not in text and "<i>raw</i>" not in text
     assert "&lt;script&gt;alert(1)&lt;/script&gt;" in md and "impact-&lt;b&gt;bold&lt;/b&gt;" in page
+
+
+def test_one_functional_form_is_one_entry():
+    from frictionlab import figures
+    from frictionlab.report import ranking
+
+    ds = synthetic("wear", {"lam": 1.2e6}, seed=8, n=21, name="impact-forms")
+    c = compare(laws=["wear", "couette", "coulomb"], datasets=[ds], solvers=["exact"], equivalence=False)
+    curves = figures.distinct_curves(c.fits_on("impact-forms"))
+    assert sorted(tuple(sorted(laws)) for _, laws in curves) == [("couette", "wear"), ("coulomb",)]
+    md = markdown("t", build(c, modules=[ranking])[0])
+    rows = [line for line in md.splitlines() if line.startswith("| 1 |") or line.startswith("| 3 |")]
+    assert len(rows) == 2 and "couette = wear [exact]" in rows[0] and "| 1.000 | same curve |" in rows[0]
+    assert ranking.law_aliases(c) == {"couette": "couette = wear", "wear": "couette = wear"}
+
+
+def test_table_numbers_keep_their_significant_figures():
+    from frictionlab.display import fmt
+
+    assert [fmt(x) for x in (1.0, 0.5, 12.5, 1100.0, 10090.4, 3.41391)] == ["1.000", "0.5000", "12.50", "1100",
+                                                                            "10090", "3.414"]
+    assert fmt(-5.349e11) == "-5.349e+11" and fmt(1e-4, 3) == "1.00e-04"

@@ -36,12 +36,11 @@ from pathlib import Path
 import attrs
 
 from ..io import atomic_dir
-from ..ranking import to_csv
 from . import (bootstrap, datasets, derivation, equivalence, first_screen, fits, identifiability, method, ranking,
                summary, tolerance)
 from .doc import Section
 from .render import html_page, markdown
-from .results import SCHEMA, clean, fit_json, results_json
+from .results import SCHEMA, clean, fit_json, ranking_csv, results_json
 from .tolerance import tolerance_verdicts
 
 TITLE = "frictionlab: friction laws compared"
@@ -95,7 +94,7 @@ def write_report(c, out, force: bool = False, progress=None) -> Path:
                 progress(i, total, f"figure {f.name}")
         (tmp / "report.md").write_text(markdown(TITLE, sections), encoding="utf-8")
         (tmp / "report.html").write_text(html_page(TITLE, sections, images), encoding="utf-8")
-        (tmp / "ranking.csv").write_text(to_csv(list(c.ranking) + list(c.groups)), encoding="utf-8")
+        (tmp / "ranking.csv").write_text(ranking_csv(c), encoding="utf-8")
         (tmp / "results.json").write_text(json.dumps(results_json(c, extra), indent=1, allow_nan=False),
                                           encoding="utf-8")
         if progress:

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from .. import figures
-from ..display import param_text
+from ..display import param_cells, param_text
 from ..errors import FrictionLabError
 from ..registry import get_law
 from ..units import to_si
@@ -58,6 +58,40 @@ def reported_check(d, c) -> str:
     return ("**Reported by the source:** " + "; ".join(parts) + ".") if parts else ""
 
 
+def plausibility(f) -> dict[str, str]:
+    """Parameter -> comment from the verdict layer's plausibility flags, if the fit carries them
+    (``FitResult.plausibility``: a dict name -> text, or texts starting with the name)."""
+    flags = getattr(f, "plausibility", None) or {}
+    if isinstance(flags, dict):
+        return {str(k): str(v) for k, v in flags.items()}
+    out = {}
+    for text in flags:
+        name = str(text).split(" ", 1)[0].rstrip(":")
+        out[name] = (out[name] + "; " if name in out else "") + str(text)
+    return out
+
+
+def param_rows(f) -> list[list[str]]:
+    """One row per parameter of fit ``f``: value, error and unit in separate cells, its role, and a
+    comment where the value means nothing (no effect, only a ratio determined) or is flagged implausible."""
+    ratio_keys = {k for pair in f.identifiability.ratio_only for k in pair}
+    flags = plausibility(f)
+    rows = []
+    for p in f.params.values():
+        role, comment = ("fitted" if p.vary else (p.fixed_by or "held")), ""
+        if p.vary and p.kind == "law" and p.key in ratio_keys:
+            role, comment = "fitted", "arbitrary: only the ratio is determined"
+        elif p.vary and p.name in f.identifiability.no_effect:
+            comment = "arbitrary: it has no effect on these data (the value is where the optimizer stopped)"
+        elif p.vary and p.stderr is None:
+            comment = f"no error bar: {f.identifiability.missing_stderr.get(p.name, 'see warnings')}"
+        if p.name in flags:
+            comment = "; ".join(x for x in (comment, "implausible: " + flags[p.name]) if x)
+        value, err, unit = param_cells(p.value, p.stderr if p.vary or p.kind == "derived" else None, p.unit)
+        rows.append([f"{f.law} [{f.solver}]", p.name, value, err, unit, role, comment])
+    return rows
+
+
 def build(ctx) -> Section:
     c = ctx.c
     sec = Section(TITLE)
@@ -79,19 +113,9 @@ def build(ctx) -> Section:
                         lambda d=d, fits=fits: figures.force_figure(d, fits))
         prow = []
         for f in fits:
-            if not f.ok:
-                continue
-            ratio_keys = {k for pair in f.identifiability.ratio_only for k in pair}
-            for p in f.params.values():
-                role = "fitted" if p.vary else (p.fixed_by or "held")
-                if p.vary and p.kind == "law" and p.key in ratio_keys:
-                    role = "arbitrary: only the ratio is determined"
-                elif p.vary and p.stderr is None:
-                    role = f"fitted; no error bar: {f.identifiability.missing_stderr.get(p.name, 'see warnings')}"
-                prow.append([f"{f.law} [{f.solver}]", p.name, param_text(p.value, p.stderr if p.vary or
-                                                                         p.kind == "derived" else None, p.unit),
-                             role])
-        sec.table(["law [solver]", "parameter", "value ± standard error", "role"], prow)
+            if f.ok:
+                prow += param_rows(f)
+        sec.table(["law [solver]", "parameter", "value", "± standard error", "unit", "role", "comment"], prow)
         warns = [f"{f.law} [{f.solver}]: {w}" for f in fits if f.ok for w in f.identifiability.warnings]
         notes = [f"{f.law} [{f.solver}]: {n}" for f in fits if f.ok for n in f.notes]
         bad = [f"{f.law} [{f.solver}]: {f.status}: {f.reason}" for f in fits if not f.ok]
@@ -104,5 +128,4 @@ def build(ctx) -> Section:
         if bad:
             sec.p("**Not fitted:**")
             sec.items(bad)
-
     return sec

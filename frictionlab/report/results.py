@@ -1,7 +1,7 @@
 """results.json, schema ``frictionlab.compare/1``, and ranking.csv.
 
-* ``ranking.csv``: columns ``ranking.COLUMNS`` (per-dataset rows, then the 'ALL' group rows;
-  rss and rmse in the observable's SI unit, empty for groups);
+ranking.csv: columns ``ranking.COLUMNS`` then ``UNIT_COLUMNS`` (observable, rss_unit, rmse_unit); per-dataset
+  rows, then the group rows (ALL, ALL[kind]); rss and rmse in the observable's SI unit, empty for groups.
 results.json:
     created, versions{package: version}, settings, wall_time_s,
     datasets[{name, kind, observable, n_points, status: fitted|skipped, reason,
@@ -45,8 +45,12 @@ import math
 import numpy as np
 
 from ..bootstrap import parameter_table, ranking_table
+from ..dataset import COLUMN_SI
 from ..predict import FIT_RTOL
-from ..ranking import COLUMNS
+from ..ranking import COLUMNS, to_csv
+
+#: Columns ranking.csv adds after ``ranking.COLUMNS``: what rss and rmse are measured in.
+UNIT_COLUMNS = ("observable", "rss_unit", "rmse_unit")
 
 SCHEMA = "frictionlab.compare/1"
 
@@ -78,7 +82,7 @@ def fit_json(f) -> dict:
                              for n, p in f.params.items()}
         out["correlations"] = [{"a": a, "b": b, "r": r} for (a, b), r in f.correlations.items()]
         s = f.stats
-        out["statistics"] = {"observable": obs, "observable_unit": _SI_UNITS.get(obs, "SI"), "n_points": s.n_points,
+        out["statistics"] = {"observable": obs, "observable_unit": COLUMN_SI.get(obs, "SI"), "n_points": s.n_points,
                              "n_params": s.n_params, "n_free": s.n_free, "chisqr": s.chisqr, "redchi": s.redchi,
                              "rss": s.rss, "rmse": s.rmse, "aic": s.aic, "aicc": s.aicc, "bic": s.bic}
         i = f.identifiability
@@ -89,7 +93,6 @@ def fit_json(f) -> dict:
     return out
 
 
-_SI_UNITS = {"omega": "rad/s", "theta": "rad", "v": "m/s", "u": "m/s"}
 
 
 def _row_json(r) -> dict:
@@ -142,3 +145,17 @@ def results_json(c, extra: dict | None = None) -> dict:
                    "series_slip_zero_s": extra.get("series_slip_zero_s", {}),
                    "answers": [a.as_dict() for a in c.answers],
                    "bootstrap": _bootstrap_json(c), "tolerance": _tolerance_json(c)})
+
+
+def ranking_csv(c) -> str:
+    """ranking.csv: ``ranking.to_csv`` with the unit columns appended (empty for group rows)."""
+    rows = list(c.ranking) + list(c.groups)
+    obs = {d.name: d.observable for d in c.datasets}
+    lines = to_csv(rows).rstrip("\n").split("\n")
+    out = [lines[0] + "," + ",".join(UNIT_COLUMNS)]
+    for r, line in zip(rows, lines[1:]):
+        o = obs.get(r.dataset, "")
+        u = (COLUMN_SI.get(o, "") or "1") if o and r.dataset in obs and r.rank is not None else ""
+        rss_unit = f"({u})^2" if "/" in u else (f"{u}^2" if u not in ("", "1") else u)
+        out.append(line + "," + ",".join((o, rss_unit, u)))
+    return "\n".join(out) + "\n"
