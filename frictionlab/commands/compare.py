@@ -18,10 +18,11 @@ TOLERANCE_RTOLS = (1e-3, 1e-6)
 
 def add_parser(sub):
     p = sub.add_parser("compare", help="compare laws on datasets and write a report folder",
-                       description="Fit every law to every dataset (default: all registered laws, all built-in "
+                       description="Fit every law to every dataset (default: the four mission laws, all built-in "
                                    "datasets), rank them, test the paper's equivalence claim, and write "
                                    "report.md, report.html, figures/, ranking.csv and results.json.")
-    p.add_argument("--laws", help="comma-separated law names (default: all registered)")
+    p.add_argument("--laws", help="comma-separated law names, or 'all' for every registered law (default: "
+                                    "coulomb, area-rate, wear, couette)")
     p.add_argument("--data", nargs="+", metavar="NAME_OR_TOML", help="datasets (default: every built-in)")
     p.add_argument("--solver", action="append", metavar="SOLVER",
                    help="exact, series, ode[:METHOD] or auto; repeat for several (default: exact where a closed "
