@@ -235,8 +235,9 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                 tol_rows = tolerance_stage()
             if bootstrap:
                 t0 = time.perf_counter()
-                boots, boot_skipped = bootstrap_fits(fits, bootstrap, seed, pool, bootstrap_all, free,
-                                                     progress=lambda name: step(f"bootstrap on {name}"))
+                boots, boot_skipped = bootstrap_fits(
+                    fits, bootstrap, seed, pool, bootstrap_all, free,
+                    progress=lambda name, k, n: step(f"bootstrap on {name}: {k}/{n} resamples", advance=k == n))
                 timings["bootstrap"] = time.perf_counter() - t0
             if tol_future is not None:
                 tol_rows = tol_future.result()
@@ -256,13 +257,13 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
 
 
 class _Step:
-    """Advances the progress count by one per finished stage item."""
+    """Advances the progress count by one per finished stage item (``advance=False``: only a new label)."""
 
     def __init__(self, progress, done, total):
         self.progress, self.done, self.total = progress, done, total
 
-    def __call__(self, label: str) -> None:
-        self.done += 1
+    def __call__(self, label: str, advance: bool = True) -> None:
+        self.done += bool(advance)
         if self.progress:
             self.progress(self.done, self.total, label)
 
