@@ -74,6 +74,33 @@ class Comparison:
     def fitted_datasets(self) -> list[Dataset]:
         return [d for d in self.datasets if d.name not in self.skipped_datasets]
 
+    def to_dataframe(self):
+        """The ranking as a tidy pandas DataFrame: one row per dataset and candidate (law, solver), with
+        the observable and the units of rss and rmse; group rows (ALL, ALL[kind]) after them."""
+        from .frames import ranking_frame
+
+        return ranking_frame(self)
+
+    def parameters_dataframe(self):
+        """Every fitted parameter as a tidy pandas DataFrame: dataset, law, solver, parameter, value,
+        stderr, unit, kind, vary, fixed_by, lower, upper."""
+        from .frames import parameters_frame
+
+        return parameters_frame(self.fits)
+
+    def __repr__(self) -> str:
+        ok = sum(f.ok for f in self.fits)
+        best = "; ".join(f"{d.name}: " + " = ".join(r.candidate for r in self.ranking if r.dataset == d.name
+                                                    and r.rank == 1) for d in self.fitted_datasets[:3])
+        more = f"; ... {len(self.fitted_datasets) - 3} more" if len(self.fitted_datasets) > 3 else ""
+        return (f"<Comparison of {len(self.laws)} laws on {len(self.fitted_datasets)} datasets: {ok} fits; "
+                f"lowest AIC: {best}{more}>")
+
+    def _repr_html_(self) -> str:
+        from .frames import comparison_html
+
+        return comparison_html(self)
+
 
 def versions() -> dict:
     import lmfit
