@@ -80,7 +80,8 @@ def _verdict(rows: list[RankRow]):
     second = next((r for r in rows if r not in firsts), None)
     details = {"candidate": best, "rank_rows": len(rows), "aic": top.aic, "likelihood": top.likelihood,
                "chi2_p": top.chi2_p, "runs_p": top.runs_p, "lag1": top.lag1, "fits_rule": g.reason if g else "",
-               "flags": list(top.flags), "members": list(top.members), "parameterizations": top.parameterizations,
+               "flags": list(top.flags), "plausibility": list(top.flags), "members": list(top.members),
+               "parameterizations": top.parameterizations,
                "indistinguishable_from": [r.candidate for r in near],
                "delta_aic_to_next": (second.aic - top.aic) if second else math.nan,
                "next": second.candidate if second else ""}

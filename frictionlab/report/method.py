@@ -1,0 +1,54 @@
+"""'Method', 'Files' and 'Versions': how the numbers were made and what the folder holds."""
+from __future__ import annotations
+
+import json
+
+from ..ranking import COLUMNS, TIE_AIC
+from .doc import Section
+from .results import SCHEMA
+
+
+def build(ctx) -> list[Section]:
+    c = ctx.c
+    method = Section("Method")
+    method.items([
+        "Fits: lmfit Levenberg-Marquardt on residuals (model − data)/σ, σ the dataset's stated noise; parameters "
+        "scaled by their typical size so the optimizer sees order-one numbers; a grid of starts is scored first "
+        "and the best few distinct ones are refined; dataset `[fixed]` values are held.",
+        "Likelihood and standard errors follow each dataset's `[noise] kind`: known σ (measured): −2 ln L = χ² + "
+        "Σ ln(2πσ²), standard errors from the covariance unscaled; assumed σ (a guess, the default): σ profiled, "
+        "−2 ln L = n ln(χ²/n) + n + Σ ln(2πσ²), one more parameter, standard errors scaled by √(reduced χ²). "
+        "A fit to ω derived from θ by a smoother has correlated points: no likelihood, criteria or error bars.",
+        "Statistics: χ² = Σ((model − data)/σ)², reduced χ² = χ²/(n − k), AIC = −2 ln L + 2k′, "
+        "AICc = AIC + 2k′(k′+1)/(n − k′ − 1), BIC = −2 ln L + k′ ln n, k′ = k plus the profiled σ. k counts the "
+        "identifiable directions (rank of the Jacobian): a pair entering only as a ratio counts once, a "
+        "parameter without effect not at all. Groups add −2 ln L and k and use the group's n.",
+        "Goodness of fit: χ² p-value (known σ only) and the Wald-Wolfowitz runs test on residual signs (one-sided: "
+        "too few runs); a candidate fits when both are ≥ 0.01 (Bonferroni-adjusted over a group); the top "
+        "candidate is called best only if it fits and carries no plausibility flag.",
+        "Plausibility: flagged when slip or r|ω| exceeds 10× the starting speed, friction does net negative work, or "
+        "a fitted law parameter can be set to 0 changing χ² (in variance units) by less than 1; flagged fits rank "
+        "after unflagged ones.",
+        f"Ties: candidates within ΔAIC ≤ {TIE_AIC} share a rank; within ΔAIC < 2 they are indistinguishable by "
+        "the data. Laws of one closed-form family (law.form()) are one candidate, e.g. wear = couette. "
+        "Akaike weight w = exp(−Δ/2)/Σexp(−Δ/2).",
+        "Solvers: 'exact' where the law and scene admit a closed form, else 'ode' (LSODA, rtol 1e-10; what a "
+        "looser tolerance changes is under 'What solver tolerance does to a fit'); 'series' (the paper's first-order "
+        "expansion, eqs 7-11) in addition wherever it is defined.",
+        "Bootstrap (`--bootstrap N`, `--seed`): parametric (the best unflagged fit plus noise of the declared σ, "
+        "only where σ is known), every candidate refitted to the same replicates; "
+        "95% percentile intervals for parameters, 95% Wilson intervals for first-place shares (see 'Bootstrap').",
+        f"Settings: {json.dumps(c.settings)}.",
+    ])
+    files = Section("Files")
+    files.items([
+        "`ranking.csv`: " + ", ".join(COLUMNS) + " — per-dataset rows, then group rows (ALL, ALL[kind]); rss and "
+        "rmse in the observable's SI unit, named in the unit columns; empty for groups.",
+        f"`results.json`: schema `{SCHEMA}` — every fit with parameters, errors, correlations, statistics, "
+        "identifiability and notes; the rankings; the equivalence results; dataset provenance; versions. The "
+        "schema is documented in `frictionlab/report/results.py`.",
+        "`figures/`: the PNG figures of this report; `report.html` embeds them.",
+    ])
+    versions = Section("Versions")
+    versions.table(["component", "version"], [[k, v] for k, v in c.versions.items()])
+    return [method, files, versions]
