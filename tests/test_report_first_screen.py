@@ -47,7 +47,7 @@ def test_finding_computed_from_the_fitted_series(comp):
 
 
 def test_without_answers_nothing_is_declared_to_fit(comp):
-    md = markdown("t", _first(comp)[0])
+    md = markdown("t", _first(attrs.evolve(comp, answers=()))[0])
     assert "`Comparison.answers` is empty)" in md and "lowest AIC (not a fit test)" in md
     assert "No data in this comparison for: goodness-of-fit test, noise threshold, transfer." in md
 
@@ -63,6 +63,13 @@ def test_answers_are_rendered_and_empty_columns_said(comp):
     assert "No data in this comparison for: noise threshold, transfer." in md
     assert "chi2 p = 0.41" in md and "implausible: eta' = -7.9e11" in md
     assert "`Comparison.answers` is empty" not in md
+
+
+def test_the_verdict_layer_fills_the_first_screen(comp):
+    md = markdown("t", _first(comp)[0])
+    assert "`Comparison.answers` is empty" not in md
+    (a,) = comp.answers
+    assert a.headline in md.replace("\\", "") and a.goodness.split(" (")[0] in md
 
 
 def test_names_and_descriptions_never_leak_raw_html(comp, tmp_path):
@@ -83,8 +90,9 @@ def test_one_functional_form_is_one_entry():
     curves = figures.distinct_curves(c.fits_on("impact-forms"))
     assert sorted(tuple(sorted(laws)) for _, laws in curves) == [("couette", "wear"), ("coulomb",)]
     md = markdown("t", build(c, modules=[ranking])[0])
-    rows = [line for line in md.splitlines() if line.startswith("| 1 |") or line.startswith("| 3 |")]
-    assert len(rows) == 2 and "couette = wear [exact]" in rows[0] and "| 1.000 | same curve |" in rows[0]
+    rows = [line for line in md.splitlines() if line.startswith("| 1 |") or line.startswith("| 2 |")]
+    # the ranking merges one closed-form family into one candidate (ranking.merge_identical)
+    assert len(rows) == 2 and "wear = couette [exact]" in rows[0] and "| 1.000 |" in rows[0]
     assert ranking.law_aliases(c) == {"couette": "couette = wear", "wear": "couette = wear"}
 
 
