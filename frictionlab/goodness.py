@@ -57,7 +57,7 @@ class Goodness:
         if math.isfinite(self.lag1):
             parts.append(f"lag-1 r = {self.lag1:+.2f}")
         text = ", ".join(parts) or "no test possible"
-        return text + (f" (p Bonferroni-adjusted over {self.members} datasets)" if self.members > 1 else "")
+        return text + (f"; p Bonferroni-adjusted over {self.members} datasets" if self.members > 1 else "")
 
 
 def _p(p: float) -> str:

@@ -67,7 +67,7 @@ def _verdict(rows: list[RankRow]):
     g = top.goodness
     noise = {"known": "sigma known", "assumed": "sigma assumed, profiled", "mixed": "sigma known and assumed",
              "none": "no likelihood"}.get(top.likelihood, top.likelihood)
-    goodness = f"{g.text if g else 'no test'} ({noise})"
+    goodness = f"{g.text if g else 'no test'}; {noise}"
     if fits:
         headline = f"best: {best}"
         if near:
