@@ -195,3 +195,54 @@ def test_a_parameter_without_effect_is_found_by_sensitivity():
     assert r.ok and any("eta_prime" in f and "no measurable effect" in f for f in r.flags), r.flags
     plain = fit("coulomb", "incline-oil-a100")
     assert not plain.flags and plain.plausibility["effect_dchi2"]["mu"] > 1e3
+
+
+def test_a_trajectory_that_leaves_the_plausible_range_is_flagged():
+    from frictionlab.fitting import DatasetFit, make_target
+    from frictionlab.plausibility import RANGE, check_plausibility
+
+    class NoModel:  # no free parameters: only the trajectory checks run
+        def residual(self, values):
+            return np.zeros(1)
+
+    data = load_dataset("impact-golf-v28")
+    target = make_target(data)
+
+    def flags(params):
+        d = DatasetFit(target, "exact", params, data.scene, target.y, 0.0, 0.0, 0.0)
+        return check_plausibility(fl.get_law("area-rate"), [d], NoModel(), [], {}, "assumed")
+
+    pumped, numbers = flags({"mu": 0.1, "eta_prime": -1e8})  # mu eta' dA/dt pushes the ball along its slip
+    assert numbers["max_slip_ratio"] > RANGE and any("times the starting speed" in f for f in pumped)
+    # over a closed pulse eta' dA/dt has no net impulse, so the slip still ends below u0: no net negative work
+    assert not any("net negative work" in f for f in pumped)
+    sane, numbers = flags({"mu": 0.12, "eta_prime": 6300.0})  # the fit to these data
+    assert not sane and numbers["max_slip_ratio"] <= 1.0 + 1e-9
+
+
+class PushingDrag(FrictionLaw):
+    """F = -c A u: a 'friction' that pushes along the slip (an energy source), to test the work check."""
+
+    name = "pushing-drag-test"
+    formula = "F = -c A u"
+    citation = "tests"
+    params = (ParamSpec("c", "Pa s/m", 100.0, 0.0, 1e9, 100.0, "negative damping per area"),)
+    requires = frozenset({"u", "A"})
+
+    def force(self, p, c):
+        return -p["c"] * c.A * c.u
+
+
+def test_friction_that_supplies_energy_is_flagged():
+    from frictionlab.fitting import DatasetFit, make_target
+    from frictionlab.plausibility import check_plausibility
+
+    class NoModel:
+        def residual(self, values):
+            return np.zeros(1)
+
+    data = load_dataset("incline-oil-a100")
+    target = make_target(data)
+    d = DatasetFit(target, "ode", {"c": 100.0}, data.scene, target.y, 0.0, 0.0, 0.0)
+    flags, numbers = check_plausibility(PushingDrag(), [d], NoModel(), [], {}, "known")
+    assert numbers["work_fraction"] == pytest.approx(-1.0) and any("net negative work" in f for f in flags)
