@@ -109,6 +109,13 @@ def build(ctx) -> Section:
     sec.table(*group_table(list(c.groups)))
     for d in c.fitted_datasets:
         sec.h3(d.name)
+        lik = next((f.stats for f in c.fits_on(d.name) if f.ok), None)
+        if lik is not None:
+            sec.p(f"Likelihood: σ {lik.likelihood}. {lik.likelihood_reason[0].upper()}{lik.likelihood_reason[1:]}.")
         sec.table(*candidate_table([r for r in c.ranking if r.dataset == d.name], d.observable,
                                    curve_labels(c, d.name)))
+        merged = [f"{r.candidate}: {r.parameterizations}" for r in c.ranking
+                  if r.dataset == d.name and r.parameterizations]
+        if merged:
+            sec.items(merged)
     return sec
