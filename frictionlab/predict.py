@@ -19,20 +19,12 @@ import numpy as np
 
 from .dataset import Dataset, load_dataset
 from .errors import DatasetError, FrictionLabError, ParameterError
+from .freeable import SCENE_QUANTITIES
 from .registry import get_law
 from .scene import Scene
 
 #: Trajectory series that a time-series observable reads.
 SERIES = {"omega": "omega", "theta": "theta", "v": "v", "u": "u"}
-
-#: Scene quantities that can be freed, with their SI unit (dotted names reach into sub-models).
-SCENE_QUANTITIES = {
-    "u0": "m/s", "omega0": "rad/s", "mass": "kg", "radius": "m", "incline": "rad",
-    "area.peak": "m^2", "area.contact_time": "s", "area.area": "m^2", "area.initial": "m^2", "area.rate": "m^2/m",
-    "normal.impulse": "N*s", "normal.contact_time": "s", "normal.value": "N", "normal.coefficient": "N/m^3",
-    "compliance.stiffness": "N/m", "compliance.damping": "N*s/m",
-}
-
 
 #: Default ODE tolerance of fits (``fit(..., rtol=None)``): finite-difference Jacobians need a smooth model.
 FIT_RTOL = 1e-10

@@ -6,8 +6,6 @@ import shutil
 import tempfile
 from pathlib import Path
 
-from ..dataset import builtin_dir, builtin_names, load_dataset
-from ..table import render
 
 
 def add_parser(sub):
@@ -21,6 +19,9 @@ def add_parser(sub):
 
 
 def run(args) -> int:
+    from ..dataset import builtin_dir, builtin_names, load_dataset
+    from ..table import render
+
     if args.action == "rebuild":
         return _rebuild(args)
     if args.action == "show":
@@ -40,6 +41,7 @@ def _short(s: str, n: int = 70) -> str:
 
 
 def _show(name) -> int:
+    from ..dataset import load_dataset
     from ..errors import DatasetError
 
     if not name:
@@ -66,6 +68,7 @@ def _show(name) -> int:
 
 def _rebuild(args) -> int:
     from ..datagen import rebuild
+    from ..dataset import builtin_dir
 
     if args.check:
         with tempfile.TemporaryDirectory() as tmp:

@@ -1,10 +1,6 @@
 """``frictionlab laws``: list the registered laws with parameters, units, bounds and needs."""
 from __future__ import annotations
 
-from ..law import QUANTITIES
-from ..registry import available_laws, law_source
-from ..table import render
-
 
 def add_parser(sub):
     p = sub.add_parser("laws", help="list the registered friction laws")
@@ -13,6 +9,10 @@ def add_parser(sub):
 
 
 def run(args) -> int:
+    from ..law import QUANTITIES
+    from ..registry import available_laws, law_source
+    from ..table import render
+
     laws = available_laws()
     if args.brief:
         print(render([{"law": n, "formula": law.formula, "requires": ", ".join(sorted(law.requires)),
