@@ -652,7 +652,7 @@ def _tolerance_section(doc: Doc, c: Comparison):
 
 
 def tolerance_verdicts(c: Comparison) -> list[str]:
-    """Per looser tolerance: whether the ranking changes, the largest parameter shift and AIC change,
+    """Per other tolerance: whether the ranking changes, the largest parameter shift and AIC change,
     and the fit time against the default tolerance's."""
     from .predict import FIT_RTOL
 
@@ -680,6 +680,8 @@ def tolerance_verdicts(c: Comparison) -> list[str]:
 
 
 def _method_section(doc: Doc, c: Comparison):
+    from .predict import FIT_RTOL
+
     doc.h(2, "Method")
     doc.items([
         "Fits: lmfit Levenberg-Marquardt on residuals (model − data)/σ, σ the dataset's stated noise; parameters "
@@ -692,8 +694,8 @@ def _method_section(doc: Doc, c: Comparison):
         "identifiable directions (rank of the Jacobian): a pair entering only as a ratio counts once, a "
         "parameter without effect not at all.",
         f"Ties: candidates within ΔAIC ≤ {TIE_AIC} share a rank. Akaike weight w = exp(−Δ/2)/Σexp(−Δ/2).",
-        "Solvers: 'exact' where the law and scene admit a closed form, else 'ode' (LSODA, rtol 1e-10; what a "
-        "looser tolerance changes is under 'What solver tolerance does to a fit'); 'series' (the paper's first-order "
+        "Solvers: 'exact' where the law and scene admit a closed form, else 'ode' (LSODA, rtol "
+        f"{_rtol(FIT_RTOL)}; what another tolerance changes is under 'What solver tolerance does to a fit'); 'series' (the paper's first-order "
         "expansion, eqs 7-11) in addition wherever it is defined.",
         "Bootstrap (`--bootstrap N`, `--seed`): case resampling, every candidate refitted to the same resamples; "
         "95% percentile intervals for parameters, 95% Wilson intervals for first-place shares (see 'Bootstrap').",

@@ -144,12 +144,12 @@ def test_tolerance_table_in_the_report(boot_report):
     md, data = boot_report
     section = md[md.index("## What solver tolerance does to a fit"):md.index("## Identifiability warnings")]
     assert "On **dry-small**" in section and "`frictionlab bench`" in section
-    assert "| wear | 1e-10 (default) |" in section and "| wear | 1e-3 |" in section
+    assert "| wear | 1e-6 (default) |" in section and "| wear | 1e-3 |" in section
     assert "coulomb (closed form) keeps its fit" in section
     assert "**Solver tolerance** (dry-small): refitted at rtol 1e-3" in md
     tol = data["tolerance"]
-    assert tol["default_rtol"] == 1e-10 and tol["rtols"] == [1e-3]
-    assert {(r["law"], r["rtol"]) for r in tol["rows"]} == {("wear", 1e-10), ("wear", 1e-3)}
+    assert tol["default_rtol"] == 1e-6 and tol["rtols"] == [1e-3]
+    assert {(r["law"], r["rtol"]) for r in tol["rows"]} == {("wear", 1e-6), ("wear", 1e-3)}
     assert all(r["fit_time_s"] > 0 for r in tol["rows"])
 
 
