@@ -25,3 +25,25 @@ def test_a_well_determined_ode_fit_still_runs_every_start():
     r = fit("wear", data, solver="ode")
     assert r.ok and not any("Levenberg-Marquardt start" in n for n in r.notes)
     assert math.isclose(r.value("lam"), fit("wear", data, solver="exact").value("lam"), rel_tol=1e-4)
+
+
+@pytest.mark.parametrize("law, params", [("coulomb", {"mu": 0.25}), ("wear", {"lam": 1e6}),
+                                         ("area-rate", {"mu": 0.2, "eta_prime": 1e3}),
+                                         ("couette", {"eta": 0.1, "h": 1e-7})])
+def test_impact_outcomes_on_the_batch_engine_equal_the_row_by_row_solve(law, params):
+    import numpy as np
+
+    from frictionlab import get_law, load_dataset
+    from frictionlab.outcome import _rebounds, rows_of
+
+    ds = load_dataset("impact-outcome-synthetic")
+    rows = rows_of(ds)
+    imps = [ds.scene.impact(float(a), float(b), float(c)) for a, b, c in zip(rows["speed"], rows["incidence"], rows["spin"])]
+    p = get_law(law).resolve(params)
+    v2, w2, rolled = _rebounds(law, imps, p, "exact", 1e-6)  # all rows in one batch
+    alone = [_rebounds(law, [imp], p, "exact", 1e-6) for imp in imps]  # one row at a time: the scalar solver
+    assert np.allclose(v2, [a[0][0] for a in alone], rtol=1e-12, atol=1e-12 * np.max(np.abs(v2)))
+    assert np.allclose(w2, [a[1][0] for a in alone], rtol=1e-12, atol=1e-12 * np.max(np.abs(w2)))
+    assert list(rolled) == [bool(a[2][0]) for a in alone]
+    if law == "coulomb":
+        assert 0 < rolled.sum() < len(imps)  # both kinds of row are exercised
