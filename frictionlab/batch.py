@@ -48,6 +48,9 @@ from .trajectory import Trajectory
 
 SOLVERS = ("auto", "exact") + vecrk.METHODS
 SCAN = 1024  # uniform points scanned for the first zero of slip when it is not provably monotone
+#: Scenes per chunk of ``simulate_batch``: beyond this the batch runs in chunks written into the result,
+#: so working arrays stay those of one chunk (per-scene cost and memory flat in the number of scenes).
+CHUNK = 8192
 MAX_SEGMENTS = 200
 _NONNEGATIVE_N = (HalfSineNormal, HertzNormal, WeightNormal)
 _TOP = ("mass", "u0", "duration", "radius", "inertia_factor", "omega0", "incline")
@@ -252,6 +255,8 @@ def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol:
     nsc = batch.n
     p = batch_params(law, params, nsc)
     tgrid = _time_grid(batch, t, n)
+    if nsc > CHUNK:
+        return _chunked(law, batch, p, tgrid, solver, rtol, atol, n)
     T = np.broadcast_to(tgrid, (nsc, tgrid.shape[-1]))
     plan = make_plan(batch.view(), law, "batch scene")
     if "xi" in plan.states:
@@ -272,6 +277,30 @@ def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol:
         out, info = _run_rk(law, batch, p, T, solver, rtol, atol)
     info.update({"rtol": rtol, "atol": rtol if atol is None else atol} if solver != "exact" else {})
     return BatchResult(t=tgrid, solver=solver, law=law.name, info=info, **out)
+
+
+def _chunked(law, batch, p, tgrid, solver, rtol, atol, n) -> BatchResult:
+    """``simulate_batch`` chunk by chunk (CHUNK scenes each), each chunk's arrays copied into the
+    result as it finishes, so only one chunk's working arrays exist at a time."""
+    out, parts = {}, []
+    for start in range(0, batch.n, CHUNK):
+        sl = slice(start, min(start + CHUNK, batch.n))
+        r = simulate_batch(law, batch.subset(sl), _take_params(p, sl), tgrid if tgrid.ndim == 1 else tgrid[sl],
+                           solver, rtol, atol, n)
+        for name in ("u", "v", "omega", "theta", "force", "stick_time", "A", "N"):
+            a = getattr(r, name)
+            if a is None:
+                continue
+            if name not in out:
+                out[name] = np.empty((batch.n,) + a.shape[1:], dtype=a.dtype)
+            out[name][sl] = a
+        parts.append((r.solver, r.info))
+        del r
+    solvers = {s for s, _ in parts}
+    info = {"chunks": len(parts), "nfev": int(sum(i.get("nfev", 0) for _, i in parts)),
+            **({"rtol": rtol, "atol": rtol if atol is None else atol} if "exact" not in solvers else {})}
+    return BatchResult(t=tgrid, solver="+".join(sorted(solvers)), law=law.name, info=info,
+                       **{k: out.get(k) for k in ("u", "v", "omega", "theta", "force", "stick_time", "A", "N")})
 
 
 def simulate_sweep(law, scenes, params=None, t=None, solver: str = "auto", rtol: float = 1e-8,

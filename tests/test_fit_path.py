@@ -47,3 +47,29 @@ def test_impact_outcomes_on_the_batch_engine_equal_the_row_by_row_solve(law, par
     assert list(rolled) == [bool(a[2][0]) for a in alone]
     if law == "coulomb":
         assert 0 < rolled.sum() < len(imps)  # both kinds of row are exercised
+
+
+def test_a_batch_in_chunks_equals_the_batch_in_one_call(monkeypatch):
+    import numpy as np
+
+    from frictionlab import batch as B
+    from frictionlab.scene import HalfSineNormal, Scene
+
+    rng = np.random.default_rng(3)
+    n = 37
+    tc = rng.uniform(400e-6, 500e-6, n)
+    template = Scene(kind="impact", mass=0.046, u0=1.0, duration=tc[0], radius=0.0213,
+                     normal=HalfSineNormal(1.0, tc[0]), effects=frozenset({"slip-coupling", "spin"}))
+    sb = B.SceneBatch.sweep(template, {"u0": rng.uniform(2, 40, n), "normal.impulse": rng.uniform(0.5, 4, n),
+                                       "normal.contact_time": tc, "duration": tc})
+    mu = rng.uniform(0.1, 0.5, n)
+    for solver in ("exact", "DOP853"):
+        whole = B.simulate_batch("coulomb", sb, {"mu": mu}, solver=solver, n=21)
+        monkeypatch.setattr(B, "CHUNK", 10)
+        parts = B.simulate_batch("coulomb", sb, {"mu": mu}, solver=solver, n=21)
+        monkeypatch.undo()
+        assert parts.info["chunks"] == 4 and whole.solver == parts.solver == solver
+        for name in ("u", "v", "omega", "theta", "force", "N"):
+            assert np.array_equal(getattr(whole, name), getattr(parts, name)), name
+        assert np.array_equal(whole.stick_time, parts.stick_time, equal_nan=True)
+        assert 0 < np.isfinite(whole.stick_time).sum() < n

@@ -121,17 +121,20 @@ def bessel_integral(b, phi, t) -> np.ndarray:
 
 def _bessel_series(b, phi, t):
     kmax = int(math.ceil(math.sqrt(2.0 * max(float(np.max(b, initial=0.0)), 1.0) * 45.0))) + 20
-    w0 = ive(0, b)
+    # every weight in one call; the series stops at the first k whose term is negligible for every b
+    k = np.arange(kmax + 1, dtype=float).reshape((-1,) + (1,) * np.ndim(b))
+    w = ive(k, b)
+    small = (2.0 * w[1:] <= 1e-17 * k[1:] * w[0]).reshape(kmax, -1).all(axis=1)
+    last = int(np.argmax(small)) + 1 if small.any() else kmax
+    coef = 2.0 * w[1:] / (k[1:] * phi)
     x = phi * t
-    out = w0 * t
+    out = w[0] * t
     two_cos = 2.0 * np.cos(x)
     s_prev, s_k = np.zeros_like(x), np.sin(x)
-    for k in range(1, kmax + 1):
-        w = ive(k, b)
-        out = out + (2.0 * w / (k * phi)) * s_k
-        if np.all(2.0 * w <= 1e-17 * k * w0):
-            break
-        s_prev, s_k = s_k, two_cos * s_k - s_prev
+    for j in range(last):
+        out = out + coef[j] * s_k
+        if j + 1 < last:
+            s_prev, s_k = s_k, two_cos * s_k - s_prev
     return out
 
 
