@@ -368,10 +368,14 @@ def _finish(law, batch, p, T, Y, sliding, need):
     """u, force, A and N on the output grid from the states, as ``segments.run`` does."""
     view = batch.view(column=True)
     plan = _plan(law, view)
-    u = np.where(sliding, plan.rigid_slip(Y), 0.0)
+    stuck = ~sliding
+    u = plan.rigid_slip(Y)  # written in place below (a copy where it would alias the states): memory, not speed
+    u = u.copy() if np.shares_memory(u, Y) else u
+    u[stuck] = 0.0
     c = plan.contact(T, Y, u)
     F = law.evaluate(_take_params(p, slice(None), column=True), c)
-    F = np.where(sliding, F, np.broadcast_to(need, F.shape))
+    F = F if F.flags.writeable and not np.shares_memory(F, u) else F.copy()
+    np.copyto(F, np.broadcast_to(need, F.shape), where=stuck)
     A = c.A if c.A is not None else (view.area(T, None, u)[0] if plan.needs_area else None)
     N = c.N
     omega = Y[plan.index("omega")] if plan.has_spin else np.zeros_like(u)
@@ -464,7 +468,7 @@ def _run_rk(law, batch, p, T, method, rtol, atol):
     d = len(full.states)
     t_end = T[:, -1].copy()
     scale = np.broadcast_to(state_scales(full, t_end), (d, nsc))
-    Y = np.full((d, nsc, m), np.nan)
+    Y = None  # states on the output grid; the first sliding phase's own array when every scene slides
     done = np.zeros((nsc, m), dtype=bool)
     stuck_mask = np.zeros((nsc, m), dtype=bool)
     stick_time = np.full(nsc, np.nan)
@@ -486,6 +490,8 @@ def _run_rk(law, batch, p, T, method, rtol, atol):
                                         last_dir[stuck_ids])
             end = np.where(np.isnan(tb), t_end[stuck_ids], tb)
             held = ~(tb == t0[stuck_ids])  # breakaway at once: the sliding phase owns the outputs at t0
+            if Y is None:
+                Y = np.full((d, nsc, m), np.nan)
             if held.any():
                 h_ids = stuck_ids[held]
                 _fill_stuck(law, batch, h_ids, t0[h_ids], y0[:, h_ids], t0[h_ids], end[held], T, Y, done, stuck_mask)
@@ -510,7 +516,11 @@ def _run_rk(law, batch, p, T, method, rtol, atol):
         iterations += res.iterations
         nfev[slide_ids] += res.nfev
         new = res.reached & ~done[slide_ids]
-        if slide_ids.size == nsc:  # every scene slides (the usual first phase): no gathering
+        if Y is None:  # the first phase and every scene slides: its outputs (NaN where not reached) are Y
+            Y = res.Y
+            Y *= scale[:, :, None]
+            done |= new
+        elif slide_ids.size == nsc:  # every scene slides: no gathering
             np.copyto(Y, res.Y * scale[:, :, None], where=new[None])
             done |= new
         else:
