@@ -24,6 +24,7 @@ _EXPORTS = {
     "FitResult": "fitting", "ParamResult": "fitting", "Target": "fitting", "fit": "fitting",
     "make_target": "fitting", "predict": "fitting", "register_predictor": "fitting",
     "AreaSlipForm": "law", "Contact": "law", "FrictionLaw": "law", "NormalAreaRateForm": "law", "ParamSpec": "law",
+    "StateSpec": "law",
     "make_plan": "plan",
     "RankRow": "ranking",
     "available_laws": "registry", "get_law": "registry", "register_law": "registry", "unregister_law": "registry",
