@@ -73,3 +73,46 @@ def test_a_batch_in_chunks_equals_the_batch_in_one_call(monkeypatch):
             assert np.array_equal(getattr(whole, name), getattr(parts, name)), name
         assert np.array_equal(whole.stick_time, parts.stick_time, equal_nan=True)
         assert 0 < np.isfinite(whole.stick_time).sum() < n
+
+
+@pytest.mark.parametrize("dataset", ["impact-golf-v28", "incline-dry-d10", "incline-oil-a100"])
+@pytest.mark.parametrize("law", ["coulomb", "area-rate", "wear", "couette", "stribeck"])
+def test_the_one_state_right_hand_side_equals_the_general_one(dataset, law):
+    """Plan.derivatives on one state vector (the scalar ODE's fast path) is bitwise the batch path's."""
+    import numpy as np
+
+    from frictionlab import get_law, load_dataset
+    from frictionlab.plan import make_plan
+
+    ds, lw = load_dataset(dataset), get_law(law)
+    plan = make_plan(ds.scene, lw)
+    p = lw.resolve({k: v for k, v in ds.fixed.items() if k in lw.param_names})
+    rng = np.random.default_rng(5)
+    y0 = plan.initial_state(p)
+    scale = np.maximum(np.abs(y0), 1.0)
+    for t in np.linspace(0.0, ds.scene.duration, 7):
+        for direction in (1.0, -1.0, 0.0):
+            y = y0 + scale * rng.normal(size=y0.shape)
+            fast = plan.derivatives(p, t, y, direction)
+            general = plan.derivatives(p, np.array([t]), y[:, None], np.array([direction]))[:, 0]
+            assert np.array_equal(fast, general), (t, direction)
+
+
+def test_the_one_state_right_hand_side_reports_a_bad_force_as_the_law_does():
+    import numpy as np
+
+    from frictionlab import FrictionLaw, ParamSpec, load_dataset
+    from frictionlab.errors import LawError
+    from frictionlab.plan import make_plan
+
+    class Bad(FrictionLaw):
+        name, formula, citation = "bad-rhs", "F = nan", "test"
+        params = (ParamSpec("k", "", 1.0, 0.0, 2.0, 1.0, "k"),)
+        requires = frozenset({"u"})
+
+        def force(self, p, c):
+            return np.full(np.shape(c.u), np.nan)
+
+    plan = make_plan(load_dataset("incline-dry-d10").scene, Bad())
+    with pytest.raises(LawError, match="NaN or infinite"):
+        plan.derivatives({"k": 1.0}, 0.1, np.full(len(plan.states), 0.1), 1.0)
