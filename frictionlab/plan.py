@@ -105,7 +105,8 @@ class Plan:
         if self.needs_normal:
             N = s.normal(t, A)
         req = self.law.requires
-        state = {n: y[self.index(k)] for n, k in zip(self.law.state_names, self.law_states)} or None
+        state = ({n: y[self.index(k)] for n, k in zip(self.law.state_names, self.law_states)} or None
+                 if self.law.states else None)
         return Contact(t=np.asarray(t, dtype=float), u=np.asarray(u, dtype=float),
                        N=N if "N" in req else None, A=A if "A" in req else None, dAdt=dAdt if "dAdt" in req else None,
                        state=state)
@@ -180,7 +181,7 @@ class Plan:
         for none: a stage that overshoots zero slip then sees vanishing slip on the phase's side
         (``stick.branch_slip``). Works on batches (y of shape (n_states, ...)).
         """
-        if np.ndim(y) == 1 and np.ndim(direction) == 0 and not self.law_states and "xi" not in self.states:
+        if not self.law.states and np.ndim(y) == 1 and np.ndim(direction) == 0 and "xi" not in self.states:
             return self._one_state(p, t, y, float(direction))
         if "xi" in self.states:
             F, u = self.patch_force(p, t, y)

@@ -116,3 +116,29 @@ def test_the_one_state_right_hand_side_reports_a_bad_force_as_the_law_does():
     plan = make_plan(load_dataset("incline-dry-d10").scene, Bad())
     with pytest.raises(LawError, match="NaN or infinite"):
         plan.derivatives({"k": 1.0}, 0.1, np.full(len(plan.states), 0.1), 1.0)
+
+
+@pytest.mark.parametrize("method", ["LSODA", "DOP853", "RK45", "Radau", "BDF"])
+@pytest.mark.parametrize("stops", [True, False])
+def test_the_ode_loop_equals_solve_ivp(method, stops):
+    """ode.solve is solve_ivp's loop for sorted outputs and one terminal event: the same numbers."""
+    import numpy as np
+    from scipy.integrate import solve_ivp
+
+    from frictionlab.solvers.ode import solve
+
+    def f(s, z):  # a damped oscillator: z[0] crosses zero falling near s = 0.35
+        return np.array([z[1], -20.0 * z[0] - 0.5 * z[1]])
+
+    def crossing(s, z):
+        return z[0] + (0.0 if stops else 5.0)
+
+    crossing.terminal, crossing.direction = True, -1
+    s_eval = np.linspace(0.0, 1.0, 41)
+    ref = solve_ivp(f, (0.0, 1.0), [1.0, 0.0], method=method, t_eval=s_eval, rtol=1e-7, atol=1e-9, events=crossing)
+    Z, s_event, z_event, solver = solve(f, 0.0, 1.0, [1.0, 0.0], method, s_eval, 1e-7, 1e-9, crossing, -1.0)
+    assert np.array_equal(Z, ref.y) and solver.nfev == ref.nfev
+    if stops:
+        assert s_event == ref.t_events[0][0] and np.array_equal(z_event, ref.y_events[0][0]) and Z.shape[1] < 41
+    else:
+        assert s_event is None and ref.t_events[0].size == 0 and Z.shape[1] == 41
