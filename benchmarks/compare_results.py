@@ -2,10 +2,11 @@
 
     python benchmarks/compare_results.py BEFORE/results.json AFTER/results.json [--tol 1.0]
 
-For each fit present in both (dataset, law, solver) and each varied parameter, prints the shift
-|after - before| in units of the larger of the two standard errors (a parameter without one is
-compared relatively, against 1e-6), and each fit's status and reduced chi-square. Exit 1 if a shift
-exceeds --tol standard errors, a fit's status changed, or a fit is missing on one side.
+For each fit present in both (dataset, law, solver) and each fitted or derived parameter (such as
+eta/h), prints the shift |after - before| in units of the larger of the two standard errors, and
+each fit's status and chi-square. A parameter with an error bar on neither side is one the data do
+not determine (eta and h apart, a parameter without effect): it is listed as such, not compared.
+Exit 1 if a shift exceeds --tol standard errors, a fit's status changed, or a fit is missing on one side.
 """
 from __future__ import annotations
 
@@ -43,25 +44,23 @@ def main() -> int:
             continue
         for name, pa in a["parameters"].items():
             pb = b["parameters"].get(name)
-            if pb is None or not pa.get("vary", True):
+            if pb is None or not (pa.get("vary", True) or pa.get("kind") == "derived"):
                 continue
             errs = [e for e in (pa.get("stderr"), pb.get("stderr")) if e is not None and math.isfinite(e) and e > 0]
-            shift = abs(pb["value"] - pa["value"])
-            if errs:
-                z, unit = shift / max(errs), "se"
-            else:
-                z, unit = shift / max(abs(pa["value"]), 1e-300) / 1e-6, "1e-6 rel"
-            rows.append((z, key, name, pa["value"], pb["value"], unit))
+            if not errs:
+                rows.append((0.0, key, name, pa["value"], pb["value"], "undetermined"))
+                continue
+            z = abs(pb["value"] - pa["value"]) / max(errs)
+            rows.append((z, key, name, pa["value"], pb["value"], "se"))
             if z > args.tol:
-                bad.append(f"{key} {name}: {pa['value']:.6g} -> {pb['value']:.6g} ({z:.3g} {unit})")
-        ra, rb = a["statistics"].get("redchi"), b["statistics"].get("redchi")
-        rows.append((0.0, key, "redchi", ra, rb, "info"))
+                bad.append(f"{key} {name}: {pa['value']:.6g} -> {pb['value']:.6g} ({z:.3g} se)")
+        rows.append((0.0, key, "chi2", a["statistics"].get("chisqr"), b["statistics"].get("chisqr"), "info"))
     print(f"{'shift':>9}  {'dataset':24s} {'law':10s} {'solver':8s} {'param':10s} {'before':>13s} {'after':>13s}")
     for z, key, name, va, vb, unit in sorted(rows, key=lambda r: (-r[0], r[1], r[2])):
-        shown = f"{z:.3g} {unit}" if unit != "info" else ""
+        shown = {"se": f"{z:.3g} se", "undetermined": "undeterm."}.get(unit, "")
         print(f"{shown:>9}  {key[0]:24s} {key[1]:10s} {key[2]:8s} {name:10s} {va:13.6g} {vb:13.6g}")
-    n_par = sum(r[5] != "info" for r in rows)
-    print(f"\n{len(set(old) & set(new))} fits compared, {n_par} parameters; largest shift "
+    n_par = sum(r[5] == "se" for r in rows)
+    print(f"\n{len(set(old) & set(new))} fits compared, {n_par} determined parameters; largest shift "
           f"{max((r[0] for r in rows if r[5] == 'se'), default=0):.3g} standard errors")
     for line in bad:
         print("DIFFERS:", line)
