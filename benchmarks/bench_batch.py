@@ -301,10 +301,11 @@ def scaling(args, rng):
     frictionlab.batch.CHUNK scenes)."""
     import tracemalloc
 
-    from frictionlab.batch import CHUNK
+    from frictionlab import batch as batch_module
 
+    chunk = getattr(batch_module, "CHUNK", None)
     print(f"\n[scaling] batch DOP853 rtol={args.rtol:g}, per-scene CPU and peak memory by batch size "
-          f"(chunks of {CHUNK} scenes)")
+          + (f"(chunks of {chunk} scenes)" if chunk else "(no automatic chunking)"))
     for fam, law in ((coulomb_family, "coulomb"), (wear_family, "wear")):
         per = {}
         for n in args.scaling:
