@@ -36,6 +36,7 @@ from scipy.integrate import solve_ivp
 from scipy.special import ive
 
 from frictionlab.batch import SceneBatch, simulate_batch
+from frictionlab.solvers.ode import SLIP_MARGIN
 from frictionlab.scene import HalfSineArea, HalfSineNormal, Scene
 
 M, R = 0.046, 0.0213
@@ -155,8 +156,8 @@ def plain_coulomb(u0, impulse, tc, mu, rtol, method):
         F = mu * d * (Np * math.sin(math.pi * t / tc) if t < tc else 0.0)
         return [-F / M * T / sv, F * R / INERTIA * T / sw, z[1] * sw * T / sth]
 
-    def slip(s, z):
-        return (z[0] * sv - R * z[1] * sw) / sv * d
+    def slip(s, z):  # the library's event: slip past zero by SLIP_MARGIN of its scale
+        return (z[0] * sv - R * z[1] * sw) / sv * d + SLIP_MARGIN
 
     slip.terminal, slip.direction = True, -1
     sol = solve_ivp(rhs, (0.0, 1.0), [u0 / sv, 0.0, 0.0], method=method, t_eval=np.linspace(0.0, 1.0, NT),
@@ -177,7 +178,7 @@ def plain_wear(u0, peak, tc, lam, rtol, method):
         return [-F / M * T / sv, F * R / INERTIA * T / sw, z[1] * sw * T / sth]
 
     def slip(s, z):
-        return z[0]
+        return z[0] + SLIP_MARGIN
 
     slip.terminal, slip.direction = True, -1
     sol = solve_ivp(rhs, (0.0, 1.0), [u0 / sv, 0.0, 0.0], method=method, t_eval=np.linspace(0.0, 1.0, NT),
