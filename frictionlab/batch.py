@@ -22,12 +22,13 @@ Tolerances act on the same scaled problem as ``solvers.ode`` (time by the span, 
 with the same method the batch takes the same steps as solve_ivp (tests check the errors match).
 ``simulate_sweep`` runs a batch in chunks on an executor (local, concurrent.futures or Dask).
 
-Why numpy (measured by benchmarks/bench_batch.py): one numpy step over 10,000 scenes costs
-about 25-35 us per scene at rtol 1e-8, 125-250x less CPU than a Python loop of solve_ivp, and
-the cost per scene stops falling beyond ~1,000 scenes, so the interpreter is no longer the
-bottleneck. numba compiles the same inline closed form about 2x faster than bare numpy, but a
-compiled engine would need every law plugin, a plain Python class, written in numba's subset;
-numpy keeps the plugin contract (a force that broadcasts) and needs no compiler.
+Why numpy (measured by benchmarks/bench_batch.py, CPU time on a shared 2-core machine): at 10,000
+scenes and rtol 1e-8 a DOP853 solve costs 25-45 us per scene, about 45x
+less than a loop of solve_ivp on a plain Python right-hand side at the same method, rtol, event
+and accuracy (not the 100x targeted); a third of it fills the outputs from the dense interpolant.
+Beyond CHUNK scenes the batch runs in chunks, so memory stays about 1.4x the results. A compiled
+engine would be faster, but would need every law plugin, a plain Python class, written in
+numba's subset; numpy keeps the plugin contract (a force that broadcasts) and needs no compiler.
 """
 from __future__ import annotations
 
