@@ -691,7 +691,11 @@ def _exact_stop(law, batch, p, plan, form, y0, u_s, sgn, T):
         first = np.argmax(bad[ids], axis=1) + 1
         lo, hi = grid[ids, first - 1], grid[ids, first]
     ts = np.full(nsc, np.nan)
-    if ids.size:
+    if ids.size and monotone and exact.closed_stop_applies(plan, form, 0.0):
+        ts[ids] = np.minimum(np.broadcast_to(exact.half_sine_stop(plan, form, u_s[:, None]), (nsc, 1))[ids, 0],
+                             t_end[ids])
+        ts[ids[ts[ids] >= t_end[ids]]] = np.nan
+    elif ids.size:
         def make_fn(rows):
             g = make_g(ids[rows])
             return lambda x: g(x[:, None])[:, 0]

@@ -142,3 +142,40 @@ def test_the_ode_loop_equals_solve_ivp(method, stops):
         assert s_event == ref.t_events[0][0] and np.array_equal(z_event, ref.y_events[0][0]) and Z.shape[1] < 41
     else:
         assert s_event is None and ref.t_events[0].size == 0 and Z.shape[1] == 41
+
+
+def test_the_closed_form_stop_of_coulomb_impacts_equals_the_root_finder(monkeypatch):
+    """Coulomb on a half-sine pulse stops where (2/phi) arcsin(sqrt(q/2)) says: scalar and batch
+    closed forms against the general bracketed root search (the fast path switched off)."""
+    import numpy as np
+
+    from frictionlab import batch as B
+    from frictionlab import simulate
+    from frictionlab.scene import HalfSineNormal, Scene
+    from frictionlab.solvers import exact
+
+    rng = np.random.default_rng(11)
+    n = 40
+    tc = rng.uniform(400e-6, 500e-6, n)
+    template = Scene(kind="impact", mass=0.046, u0=1.0, duration=tc[0], radius=0.0213,
+                     normal=HalfSineNormal(1.0, tc[0]), effects=frozenset({"slip-coupling", "spin"}))
+    sb = B.SceneBatch.sweep(template, {"u0": rng.uniform(2, 40, n), "normal.impulse": rng.uniform(0.5, 4, n),
+                                       "normal.contact_time": tc, "duration": tc})
+    mu = rng.uniform(0.1, 0.5, n)
+    t = np.linspace(0.0, 1.0, 41)[None, :] * tc[:, None]
+    fast = B.simulate_batch("coulomb", sb, {"mu": mu}, solver="exact", t=t)
+    scalar_fast = [simulate("coulomb", sb.scene(i), {"mu": mu[i]}, solver="exact", t=t[i]) for i in range(n)]
+    monkeypatch.setattr(exact, "closed_stop_applies", lambda plan, form, t0: False)
+    slow = B.simulate_batch("coulomb", sb, {"mu": mu}, solver="exact", t=t)
+    scalar_slow = [simulate("coulomb", sb.scene(i), {"mu": mu[i]}, solver="exact", t=t[i]) for i in range(n)]
+    stops = np.isfinite(slow.stick_time)
+    assert 0 < stops.sum() < n and np.array_equal(stops, np.isfinite(fast.stick_time))
+    assert np.allclose(fast.stick_time[stops], slow.stick_time[stops], rtol=0, atol=1e-12 * tc.max())
+    for name in ("u", "v", "omega", "theta"):
+        a, b = getattr(fast, name), getattr(slow, name)
+        assert np.allclose(a, b, rtol=1e-10, atol=1e-10 * np.max(np.abs(b))), name
+    for f, s_ in zip(scalar_fast, scalar_slow):
+        assert (f.stick_time is None) == (s_.stick_time is None)
+        if f.stick_time is not None:
+            assert abs(f.stick_time - s_.stick_time) <= 1e-12 * tc.max()
+        assert np.allclose(f.omega, s_.omega, rtol=1e-10, atol=1e-10 * np.max(np.abs(s_.omega)))
