@@ -15,8 +15,8 @@ them far less than wall time. Scene families (random, seeded):
    contact time, states by the library's state scales), the same method, rtol (= atol) and zero-slip
    event, timed on a random subset and extrapolated (the output says so). Accuracy: the largest slip
    error over the grid against the closed form, relative to u0, on that subset. The ratio is printed
-   only when the batch is as accurate (its error not larger); otherwise the benchmark says so and
-   prints no ratio. Target >= 100x.
+   only when the batch is as accurate (its error not larger, beyond round-off: a relative 1e-6 of the
+   error itself); otherwise the benchmark says so and prints no ratio. Target >= 100x.
 2. Batch closed forms against bare numpy of the same expressions (the same sine recurrence and
    Bessel weights on both sides). Target: within 1.5x.
 3. Per-scene CPU and peak memory (tracemalloc: numpy's allocations) by batch size, against the size of
@@ -217,7 +217,7 @@ def rk_vs_plain(name, law, batch, params, args, rng):
     err_batch = np.max(np.abs(br.u - ex.u), axis=1) / scale
     est = loop_time / sub.size * n
     e = np.array(errs)
-    matched = err_batch[sub].max() <= e.max()
+    matched = err_batch[sub].max() <= e.max() * (1 + 1e-6)  # not larger, beyond round-off in the error itself
     print(f"\n[{name}] {n} scenes x {NT} samples; {int(np.sum(~np.isnan(ex.stick_time)))} scenes stick (roll)")
     print(f"  batch DOP853 rtol={args.rtol:g}: {t_batch:.3f} s ({t_batch / n * 1e6:.1f} us/scene, median of "
           f"{len(batch_times)} runs {', '.join(f'{x:.3f}' for x in batch_times)}); slip error max "
