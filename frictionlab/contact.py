@@ -142,7 +142,7 @@ class MindlinCompliance:
     """
 
     shear: float = attrs.field(validator=_positive("shear"))  # G* [Pa]
-    damping_ratio: float = attrs.field(default=0.05, validator=_positive("damping_ratio"))  # [-]
+    damping_ratio: float = attrs.field(default=0.01, validator=_positive("damping_ratio"))  # [-]
     radius_floor: float = 1e-12  # [m] smallest contact radius used for k_t and c
     model = "mindlin"
 
@@ -173,7 +173,7 @@ def compliance_from_spec(c, where: str, q, pair: Pair | None, radius: float | No
     shear = q("shear_modulus", "Pa", c, p, required=pair is None)
     if shear is None:
         shear = pair.shear
-    ratio = q("damping_ratio", "", c, p, required=False, default=0.05)
+    ratio = q("damping_ratio", "", c, p, required=False, default=0.01)
     floor = 1e-9 * radius if radius else 1e-12
     return MindlinCompliance(shear, ratio, floor)
 
