@@ -212,3 +212,19 @@ def test_mindlin_from_materials_loads(tmp_path):
     with pytest.raises(SceneError, match="shear"):
         MindlinCompliance(-1.0)
     assert attrs.evolve(ds.scene, friction=None).friction is None
+
+
+def test_report_section_shows_predictions_and_the_criterion():
+    from types import SimpleNamespace
+
+    from frictionlab.report import Context
+    from frictionlab.report import rebound as section
+
+    ctx = Context(SimpleNamespace(datasets=[load_dataset("kharaz2001-spin")]))
+    sec = section.build(ctx)
+    text = " ".join(str(payload) for _, payload in sec.blocks)
+    assert "rigid model is within 10 % at 3 of 3" in text
+    assert "Mindlin model is within 15 % of the measured spin at 2 of 3" in text
+    assert [f.name for f in sec.figures] == ["psi2-psi1.png"]
+    assert len(ctx.json["rebound_predictions"]["kharaz2001-spin"]) == 7
+    assert section.build(Context(SimpleNamespace(datasets=[load_dataset("impact-outcome-synthetic")]))) is None
