@@ -228,3 +228,22 @@ def test_report_section_shows_predictions_and_the_criterion():
     assert [f.name for f in sec.figures] == ["psi2-psi1.png"]
     assert len(ctx.json["rebound_predictions"]["kharaz2001-spin"]) == 7
     assert section.build(Context(SimpleNamespace(datasets=[load_dataset("impact-outcome-synthetic")]))) is None
+
+
+def test_time_series_scene_takes_mindlin_from_materials():
+    from frictionlab import Scene, simulate
+
+    spec = {"mass": "0.2618 g", "radius": "2.5 mm", "u0": "1.3 m/s", "effects": ["spin", "slip-coupling"],
+            "area": {"model": "half-sine", "peak": "0.13 mm^2", "contact_time": "13 us"},
+            "normal": {"model": "half-sine", "contact_time": "13 us", "normal_speed": "3.67 m/s", "restitution": 0.98},
+            "compliance": {"model": "mindlin"},
+            "materials": {"ball_young": "380 GPa", "ball_poisson": 0.23, "surface_young": "70 GPa",
+                          "surface_poisson": 0.25}}
+    scene = Scene.from_spec(spec, "impact", "s.toml")
+    assert scene.compliance.shear == pytest.approx(PAIR.shear) and "compliance" in scene.effects
+    tr = simulate("coulomb", scene, {"mu": MU}, solver="ode", n=101)
+    assert np.all(np.abs(tr.force) <= MU * tr.N * (1 + 1e-6) + 1e-12)  # the Coulomb limit holds
+    assert np.any(np.diff(np.sign(tr.v - R * tr.omega)) != 0)  # the contact point reverses (stick regime)
+    with pytest.raises(SceneError, match="needs a \\[scene.compliance\\] table"):
+        Scene.from_spec({**{k: v for k, v in spec.items() if k != "compliance"},
+                         "effects": ["spin", "compliance"]}, "impact", "s.toml")
