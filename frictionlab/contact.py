@@ -8,8 +8,12 @@ Mindlin (no-slip tangential stiffness of the same contact):
 The ratio of tangential to normal incremental stiffness, k_t / k_n = 8 G* a / (2 E* a) = 4 G*/E*, is the
 ``stiffness_ratio`` kappa; for like materials it is 2 (1 - nu) / (2 - nu).
 
-Normalized angles (Maw, Barber and Fawcett, Wear 38 (1976) 101-114; the prefactor kappa / mu is the one
-that makes the elastic solution depend on the single parameter chi below):
+Normalized angles (Maw, Barber and Fawcett, "The oblique impact of elastic spheres", Wear 38 (1976)
+101-114, as quoted at https://th4.ilovetranslation.com/oG4oFPoRdOw=d: one non-dimensional parameter chi,
+chi = 1.2558 for a thin diametral slice with nu = 0.28, and "Psi2 is negative for low values of Psi1".
+The prefactor kappa / mu is the one that makes the elastic solution depend on chi alone; with
+kappa = 4 G*/E* it reduces to MBF's 2 (1 - nu) / (2 - nu) for like materials, and chi below reproduces
+their 1.2558, checked in tests/test_contact.py):
     Psi1 = (kappa / mu) * v_c1 / v_n1     (incidence of the contact point, v_c1 = v_t1 - r omega_1)
     Psi2 = (kappa / mu) * v_c2 / v_n2     (rebound of the contact point, v_n2 = e v_n1)
     chi  = (kappa / 2) (1 + m r^2 / I)    (= (1 - nu)(1 + r^2/k^2)/(2 - nu) for like materials, as in MBF)
