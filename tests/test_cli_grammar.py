@@ -114,3 +114,20 @@ def test_quiet_silences_progress(tmp_path, capsys):
     assert capsys.readouterr().err == ""
     assert main(argv + ["--out", str(tmp_path / "r2")]) == 0
     assert "compare: 1/" in capsys.readouterr().err
+
+
+def test_compare_summary_renders_the_answers_only():
+    from frictionlab.answers import Answer
+    from frictionlab.commands.compare import answer_lines
+
+    class C:
+        answers = ()
+
+    assert answer_lines(C()) == ["answers: none (the verdict layer filled no Comparison.answers); see the report's "
+                                 "tables"]
+    a = Answer(group="impact-golf", datasets=("a",), provenance="reconstructed", best="wear [exact]", fits=False,
+               headline="no registered law describes these data", goodness="chi2 p < 1e-6", equivalence="not equivalent",
+               noise_threshold="", series_vs_exact="the series' slip crosses zero at 309 us")
+    C.answers = (a,)
+    assert answer_lines(C())[1] == ("  impact-golf: no registered law describes these data; chi2 p < 1e-6; lambda A u "
+                                    "vs mu N + mu eta' dA/dt: not equivalent; the series' slip crosses zero at 309 us")
