@@ -178,13 +178,31 @@ def _run(tasks, fn, pool, progress, done, total, label):
     return results, done
 
 
+#: The laws ``compare`` fits by default: the four of the mission (the seed paper's question). Other
+#: registered laws (stribeck, lugre, dahl, rate-and-state, installed plugins) join when named or with "all".
+DEFAULT_LAWS = ("coulomb", "area-rate", "wear", "couette")
+
+
+def select_laws(laws: Sequence[str] | None) -> tuple[str, ...]:
+    """Law names to compare: None -> DEFAULT_LAWS; "all" (alone or in the list) -> every registered law."""
+    if laws is None:
+        names = DEFAULT_LAWS
+    elif isinstance(laws, str):
+        names = (laws,)
+    else:
+        names = tuple(laws)
+    if "all" in names:
+        names = tuple(available_laws()) + tuple(n for n in names if n != "all")
+    return tuple(dict.fromkeys(get_law(n).name for n in names))
+
+
 def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None, solvers: Sequence[str] | None = None,
             *, free: dict | None = None, equivalence: bool = True, jobs: int = 1,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
             tolerance: Sequence[float] = ()) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
 
-    laws: registered names (default all); datasets: built-in names, TOML paths or Datasets
+    laws: registered names, None for DEFAULT_LAWS, or "all" for every registered law; datasets: built-in names, TOML paths or Datasets
     (default every built-in); solvers: None for the default choice, or a list of 'exact',
     'series', 'ode[:METHOD]', 'auto'; free: scene quantities fitted per dataset, name -> (lower,
     upper) in SI (see fitting.SCENE_QUANTITIES); jobs: worker processes; progress(done, total, label).
@@ -204,7 +222,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     for r in tolerance:
         if isinstance(r, bool) or not isinstance(r, (int, float)) or not 0 < r < 1:
             raise ParameterError(f"compare: every tolerance must be a number in (0, 1), got {r!r}")
-    law_names = tuple(dict.fromkeys(get_law(n).name for n in (laws or available_laws())))
+    law_names = select_laws(laws)
     dss = _unique_datasets(load_dataset(d) for d in (datasets if datasets is not None else builtin_names()))
     if not dss:
         raise FrictionLabError("compare: no datasets to compare")

@@ -18,14 +18,15 @@ def add_parser(sub):
     from ..cli import ListAction, subcommand
 
     p = subcommand(sub, "compare", help="compare laws on datasets and write a report folder",
-                   description="Fit every law to every dataset (default: all registered laws, all built-in "
-                               "datasets), rank them, test the paper's equivalence claim, and write report.md, "
+                   description="Fit every law to every dataset (default: the four mission laws, all "
+                               "built-in datasets), rank them, test the paper's equivalence claim, and write report.md, "
                                "report.html, figures/, ranking.csv and results.json.",
-                   examples="""  frictionlab compare                          # every law on every built-in dataset into ./report
+                   examples="""  frictionlab compare                          # the four mission laws on every built-in dataset into ./report
   frictionlab compare --laws wear,area-rate --data impact-golf-v28 --out golf
   frictionlab compare --data my.toml --data impact-golf-v61 --solver exact --solver series
   frictionlab compare --bootstrap 0 --no-tolerance --quiet --out quick   # fastest, no progress lines""")
-    p.add_argument("--laws", "--law", action=ListAction, metavar="NAME", help="law names (default: all registered)")
+    p.add_argument("--laws", "--law", action=ListAction, metavar="NAME", help="law names, or 'all' for every registered law "
+                   "(default: coulomb, area-rate, wear, couette)")
     p.add_argument("--data", action=ListAction, metavar="NAME_OR_TOML", help="datasets (default: every built-in)")
     p.add_argument("--solver", "--solvers", action=ListAction, metavar="SOLVER",
                    help="exact, series, ode[:METHOD] or auto (default: exact where a closed form exists else ode, "

@@ -36,8 +36,11 @@ def check(plan, p) -> None:
 
 def _form_and_reason(plan, p):
     law, s = plan.law, plan.scene
-    form = law.form(p)
     name = f"law '{law.name}'"
+    if law.states:
+        raise SolverError(f"exact: {name} has internal state ({', '.join(law.state_names)}): closed forms do not "
+                          "apply; use --solver ode")
+    form = law.form(p)
     if form is None:
         raise SolverError(f"exact: {name} declares no closed form; use the ode solver")
     if "xi" in plan.states:

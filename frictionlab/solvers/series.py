@@ -39,6 +39,9 @@ def slip_zero(t: np.ndarray, u: np.ndarray) -> float | None:
 
 def check(plan, p) -> AreaSlipForm:
     law, s = plan.law, plan.scene
+    if law.states:
+        raise SolverError(f"series: law '{law.name}' has internal state ({', '.join(law.state_names)}): the paper's "
+                          "series does not apply; use --solver ode")
     form = law.form(p)
     if not isinstance(form, AreaSlipForm):
         raise SolverError(f"series: law '{law.name}' has no series solution (the paper's series, eqs (7)-(11), "
