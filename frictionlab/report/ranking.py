@@ -66,24 +66,13 @@ def candidate_table(rows, observable: str, labels: dict | None = None) -> tuple[
     return headers, out
 
 
-def group_table(rows, alias: dict | None = None) -> tuple[list[str], list[list]]:
-    """Group rows; laws that are one curve on every dataset (``alias``) share a row, weights summed."""
+def group_table(rows) -> tuple[list[str], list[list]]:
     headers = ["group", "rank", "law [solver]", "n", "k", "reduced χ²", "ΣAIC", "ΣAICc", "ΣBIC", "ΔAIC",
                "Akaike weight", "status"]
-    alias = alias or {}
-    merged: dict[tuple, list] = {}
-    for r in rows:
-        merged.setdefault((r.dataset, alias.get(r.law, r.law), r.solver), []).append(r)
-    out = []
-    for (group, label, solver), rs in merged.items():
-        r = rs[0]
-        same = len(rs) > 1 and r.status == "tied" and set(r.tied_with) <= {x.candidate for x in rs}
-        weight = sum(x.akaike_weight for x in rs) if r.rank else r.akaike_weight
-        out.append([group, r.rank or "–", f"{label} [{solver}]", r.n_points or "", r.n_params if r.rank else "",
-                    fmt(r.redchi), fmt(r.aic), fmt(r.aicc), fmt(r.bic), fixed(r.delta_aic, 2), fixed(weight, 3),
-                    ("same curve" if same else r.status) + (f": {r.reason}" if r.reason else "")])
+    out = [[r.dataset, r.rank or "–", r.candidate, r.n_points or "", r.n_params if r.rank else "", fmt(r.redchi),
+            fmt(r.aic), fmt(r.aicc), fmt(r.bic), fixed(r.delta_aic, 2), fixed(r.akaike_weight, 3),
+            r.status + (f": {r.reason}" if r.reason else "")] for r in rows]
     return headers, out
-
 
 def build(ctx) -> Section:
     c = ctx.c
@@ -100,7 +89,7 @@ def build(ctx) -> Section:
     sec.p("Sums of the per-dataset AIC (independent fits, so log-likelihoods add). 'exact' and 'ode' solve the "
           "same equations and count as one candidate; a candidate that could not be fitted to every dataset of a "
           "group is 'incomplete' there.")
-    sec.table(*group_table(list(c.groups), alias))
+    sec.table(*group_table(list(c.groups)))
     for d in c.fitted_datasets:
         sec.h3(d.name)
         sec.table(*candidate_table([r for r in c.ranking if r.dataset == d.name], d.observable,
