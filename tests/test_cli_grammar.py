@@ -85,6 +85,7 @@ def test_datasets_show_in_units_a_person_reads(capsys):
     assert "SpeedLaw(" not in capsys.readouterr().out
 
 
+@pytest.mark.filterwarnings("ignore::frictionlab.solvers.series.SeriesAccuracyWarning")
 def test_series_output_does_not_contradict_itself(capsys):
     assert main(["simulate", "impact-golf-v28", "--law", "wear", "--param", "lam=1.81e6 Pa s/m",
                  "--solver", "series"]) == 0
