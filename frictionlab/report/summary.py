@@ -82,6 +82,12 @@ def build(ctx) -> Section:
                      + " (see 'What solver tolerance does to a fit')")
     sec.items(items)
     if c.equivalence:
-        sec.p("Equivalence of λAu and μN + μη′dA/dt: " + "; ".join(
-            f"{e.dataset} [wear {e.solver}]: **{e.verdict or e.status}**" for e in c.equivalence) + ".")
+        sec.p("Equivalence of λAu and μN + μη′dA/dt per dataset (details under 'Equivalence test'):")
+        verdicts: dict[str, dict[str, str]] = {}
+        for e in c.equivalence:
+            key = "series" if e.solver == "series" else "full"
+            verdicts.setdefault(e.dataset, {})[key] = (e.verdict or e.status) + ("" if key == "series" else
+                                                                                  f" [{e.solver}]")
+        sec.table(["dataset", "wear solved exactly or numerically", "wear by the paper's series"],
+                  [[d, v.get("full", ""), v.get("series", "–")] for d, v in verdicts.items()])
     return sec
