@@ -32,8 +32,7 @@ def main() -> int:
     bad = []
     for key in sorted(set(old) - set(new)):
         bad.append(f"missing after: {key}")
-    for key in sorted(set(new) - set(old)):
-        bad.append(f"new fit (not compared): {key}")
+    added = sorted(set(new) - set(old))
     rows = []
     for key in sorted(set(old) & set(new)):
         a, b = old[key], new[key]
@@ -62,6 +61,8 @@ def main() -> int:
     n_par = sum(r[5] == "se" for r in rows)
     print(f"\n{len(set(old) & set(new))} fits compared, {n_par} determined parameters; largest shift "
           f"{max((r[0] for r in rows if r[5] == 'se'), default=0):.3g} standard errors")
+    for key in added:
+        print("new fit, not compared:", key)
     for line in bad:
         print("DIFFERS:", line)
     print("agree within" if not bad else "do NOT agree within", f"{args.tol:g} standard errors")
