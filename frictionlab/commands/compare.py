@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 
 from ..errors import OutputError, ParameterError
+from .fit import FIT_TIMEOUT, fit_timeout
 
 #: Default number of bootstrap resamples: about +15 s (idle) to +35 s (busy machine) on 2 cores for the
 #: built-in datasets, on top of 35-60 s without it.
@@ -43,6 +44,9 @@ def add_parser(sub):
     p.add_argument("--no-tolerance", dest="tolerance", action="store_false",
                    help="skip refitting the ODE laws of one dataset at looser tolerances "
                         f"({' and '.join(f'{r:.0e}'.replace('e-0', 'e-') for r in TOLERANCE_RTOLS)})")
+    p.add_argument("--fit-timeout", type=fit_timeout, default=FIT_TIMEOUT, metavar="SECONDS",
+                   help=f"time budget of each fit; a fit past it is a failed row with that reason "
+                        f"(default {FIT_TIMEOUT:g})")
     p.set_defaults(func=run)
 
 
@@ -72,11 +76,10 @@ class ProgressBar:
 
 def run(args) -> int:
     from ..comparison import compare
+    from ..io import check_target, output_lock
     from ..report import write_report
     from .fit import parse_free
 
-    if args.out.exists() and not args.force:  # fail before the work, not after it
-        raise OutputError(f"{args.out}: output folder exists; choose another --out or pass --force")
     if args.jobs < 1:
         raise OutputError(f"--jobs must be at least 1, got {args.jobs}")
     if args.bootstrap < 0:
@@ -84,18 +87,24 @@ def run(args) -> int:
     if args.seed < 0:
         raise ParameterError(f"--seed must be a non-negative integer, got {args.seed}")
     free = parse_free(args.free)
-    laws = [x.strip() for x in args.laws.split(",") if x.strip()] if args.laws else None
-    bar = ProgressBar()
-    try:
-        result = compare(laws=laws, datasets=args.data, solvers=args.solver, free=free,
-                         equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar,
-                         bootstrap=args.bootstrap, seed=args.seed, bootstrap_all=args.bootstrap_all,
-                         tolerance=TOLERANCE_RTOLS if args.tolerance else ())
-    finally:
-        bar.close()
-    if bar.active:
-        print("writing the report ...", file=sys.stderr, flush=True)
-    out = write_report(result, args.out, force=args.force)
+    laws = None
+    if args.laws is not None:
+        laws = [x.strip() for x in args.laws.split(",")]
+        if not all(laws):
+            raise ParameterError(f"--laws {args.laws!r}: expected comma-separated law names, with no empty name")
+    with output_lock(args.out):  # a second run to the same --out fails now, not after the work
+        check_target(args.out, args.force)
+        bar = ProgressBar()
+        try:
+            result = compare(laws=laws, datasets=args.data, solvers=args.solver, free=free,
+                             equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar,
+                             bootstrap=args.bootstrap, seed=args.seed, bootstrap_all=args.bootstrap_all,
+                             tolerance=TOLERANCE_RTOLS if args.tolerance else (), fit_timeout=args.fit_timeout)
+        finally:
+            bar.close()
+        if bar.active:
+            print("writing the report ...", file=sys.stderr, flush=True)
+        out = write_report(result, args.out, force=args.force)
     ok = sum(f.ok for f in result.fits)
     n_laws, n_data = len(result.laws), len(result.fitted_datasets)
     print(f"compared {n_laws} law{'s' * (n_laws != 1)} on {n_data} dataset{'s' * (n_data != 1)}: {ok} fits, "

@@ -22,6 +22,9 @@ RPM = 60.0 / (2.0 * math.pi)
 PLOT_POINTS = 501
 
 
+MAX_POINTS = 1_000_000  # simulated times written by --points
+
+
 def add_parser(sub):
     p = sub.add_parser("simulate", help="simulate a law on a dataset's scene",
                        description="Simulate LAW on the scene of DATASET (built-in name or TOML path).")
@@ -57,8 +60,8 @@ def run(args) -> int:
     params = parse_params(law, args.param)
     if not 0 < args.rtol < 1:
         raise SolverError(f"--rtol: rtol must be a number in (0, 1), got {args.rtol:g}")
-    if args.points is not None and args.points < 2:
-        raise ParameterError(f"--points must be at least 2, got {args.points}")
+    if args.points is not None and not 2 <= args.points <= MAX_POINTS:
+        raise ParameterError(f"--points must be between 2 and {MAX_POINTS}, got {args.points}")
     ds = load_dataset(args.dataset)
     for path in (args.out, args.plot):
         if path is not None:
