@@ -260,6 +260,10 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
         fits += results
         fits.sort(key=lambda f: (order[f.datasets[0]], law_names.index(f.law), family(f.solver) == "series"))
         timings["fits"] = time.perf_counter() - t0
+        if all(f.status == "skipped" for f in fits):
+            reasons = list(dict.fromkeys(f.reason for f in fits))
+            raise FrictionLabError("compare: no fit could be made: " + "; ".join(reasons[:3])
+                                   + (f" (and {len(reasons) - 3} more reasons)" if len(reasons) > 3 else ""))
         eq_results = []
         if eq_pairs:
             t0 = time.perf_counter()

@@ -18,7 +18,7 @@ import numpy as np
 from .errors import DatasetError, FrictionLabError
 from .scene import KINDS, Scene
 from .io import MAX_CSV_BYTES, check_name, read_bytes, read_text, read_toml
-from .units import MAX_SI, check_time_scale, unit_factor
+from .units import MAX_SI, check_text, check_time_scale, unit_factor
 
 PROVENANCE_KINDS = ("measured", "reported", "reconstructed", "synthetic")
 DATA_KINDS = KINDS + ("contact-area",)
@@ -235,6 +235,13 @@ def from_meta(meta: dict, path: Path) -> Dataset:
     if extra:
         raise DatasetError(f"{path}: unknown top-level key(s) {sorted(extra)}")
     reported = _table(meta, "reported", path, "[reported]")
+    for table, values in (("reported", reported), ("provenance.truth", provenance.truth)):
+        for key, value in values.items():  # read by the report later: refuse what pint would choke on now
+            if isinstance(value, str):
+                try:
+                    check_text(value, f"{path}: {table}.{key}")
+                except FrictionLabError as exc:
+                    raise DatasetError(str(exc)) from None
     if not isinstance(meta.get("description", ""), str):
         raise DatasetError(f"{path}: 'description' must be a string")
     return Dataset(name=name, kind=kind, observable=observable, path=path, columns=columns, units=dict(units),

@@ -488,7 +488,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     solver_label = solver if solver != "auto" else "+".join(dict.fromkeys(solvers))
     n_points = sum(t.y.size for t in targets)
     if n_points < len(varying) + 1:
-        return give_up("skipped", f"{n_points} data point{'s' * (n_points != 1)} for {len(varying)} free parameter"
+        return give_up("skipped", f"{', '.join(names)}: {n_points} data point{'s' * (n_points != 1)} for {len(varying)} free parameter"
                                   f"{'s' * (len(varying) != 1)}: a fit needs at least {len(varying) + 1}")
 
     success, message = True, ""

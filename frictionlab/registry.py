@@ -56,6 +56,9 @@ def validate_law(law: FrictionLaw, source: str) -> None:
             raise LawError(f"law plugin {source}: missing class attribute '{attr}'")
     if not isinstance(law.name, str) or not law.name or any(ch.isspace() for ch in law.name):
         raise LawError(f"law plugin {source}: name must be a non-empty word, got {law.name!r}")
+    if not isinstance(law.requires, (set, frozenset)) or not all(isinstance(q, str) for q in law.requires):
+        raise LawError(f"law '{law.name}' ({source}): requires must be a frozenset of quantity names, "
+                       f"got {law.requires!r}")
     unknown = set(law.requires) - set(QUANTITIES)
     if unknown:
         raise LawError(
@@ -272,9 +275,10 @@ def load_law_file(path) -> None:
     sys.modules[spec.name] = module
     try:
         spec.loader.exec_module(module)
-    except FrictionLabError:
+    except FrictionLabError as exc:
         del sys.modules[spec.name]
-        raise
+        msg = str(exc)
+        raise type(exc)(msg if str(path) in msg else f"--load {path}: {msg}") from None
     except (Exception, SystemExit, KeyboardInterrupt) as exc:
         del sys.modules[spec.name]
         what = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__

@@ -15,6 +15,8 @@ from .fit import FIT_TIMEOUT, fit_timeout
 BOOTSTRAP_N = 150
 #: Looser ODE tolerances at which the ODE laws of one dataset are refitted for the report.
 TOLERANCE_RTOLS = (1e-3, 1e-6)
+MAX_JOBS = 64  # worker processes: more only forks processes that wait
+MAX_BOOTSTRAP = 100_000  # resamples: far past where percentile intervals stop moving
 
 
 def add_parser(sub):
@@ -80,10 +82,11 @@ def run(args) -> int:
     from ..report import write_report
     from .fit import parse_free
 
-    if args.jobs < 1:
-        raise OutputError(f"--jobs must be at least 1, got {args.jobs}")
-    if args.bootstrap < 0:
-        raise ParameterError(f"--bootstrap must be 0 (none) or a positive number of resamples, got {args.bootstrap}")
+    if not 1 <= args.jobs <= MAX_JOBS:
+        raise OutputError(f"--jobs must be between 1 and {MAX_JOBS}, got {args.jobs}")
+    if not 0 <= args.bootstrap <= MAX_BOOTSTRAP:
+        raise ParameterError(f"--bootstrap must be 0 (none) or a number of resamples up to {MAX_BOOTSTRAP}, "
+                             f"got {args.bootstrap}")
     if args.seed < 0:
         raise ParameterError(f"--seed must be a non-negative integer, got {args.seed}")
     free = parse_free(args.free)
