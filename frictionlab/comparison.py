@@ -281,7 +281,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             timings["tolerance"] = time.perf_counter() - t0
             return rows
 
-        with ThreadPoolExecutor(1) as side:  # with a pool, the tolerance fits queue there ahead of the bootstrap
+        side = ThreadPoolExecutor(1)  # with a pool, the tolerance fits queue there ahead of the bootstrap
+        try:
             tol_future = side.submit(tolerance_stage) if tolerance and pool is not None else None
             if tolerance and pool is None:
                 tol_rows = tolerance_stage()
@@ -292,6 +293,10 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                 timings["bootstrap"] = time.perf_counter() - t0
             if tol_future is not None:
                 tol_rows = tol_future.result()
+        except BaseException:  # ^C, SIGTERM, a crash: do not wait for the side thread; the pool is stopped next
+            side.shutdown(wait=False, cancel_futures=True)
+            raise
+        side.shutdown(wait=True)
     eq_results.sort(key=lambda e: (order[e.dataset], family(e.solver) == "series"))
     ranking = rank_fits(fits)
     kinds = {d.name: d.kind for d in dss}
