@@ -207,8 +207,8 @@ def from_meta(meta: dict, path: Path) -> Dataset:
                 scene = OutcomeScene.from_spec(spec, str(path))
             else:
                 scene = Scene.from_spec(spec, kind, str(path), columns, columns.get("t"))
-        except FrictionLabError as exc:
-            raise DatasetError(str(exc)) from None
+        except FrictionLabError as exc:  # a model's own check (no file in it) still names the file
+            raise DatasetError(str(exc) if str(exc).startswith(str(path)) else f"{path}: [scene]: {exc}") from None
         if kind == "impact-outcome":
             _check_outcome_rows(columns, observable, path, csv, scene)
         else:

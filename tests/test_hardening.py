@@ -388,3 +388,46 @@ def test_a_signal_during_compare_with_workers_leaves_no_process_and_no_output(si
         time.sleep(0.05)
     assert not [p for p in workers if _alive(p)], "worker processes outlived the run"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["slow.py"]  # no report, no lock, no temporary folder
+
+
+# --- every quantity of a scene at the edges of the accepted range ----------------------------------
+@pytest.mark.parametrize("base", ["impact-golf-v28", "incline-dry-d10", "incline-oil-a100", "impact-outcome-synthetic"])
+def test_quantities_at_the_limits_give_errors_naming_the_field_never_a_class(base, tmp_path):
+    """Every 'key = "number unit"' of a built-in TOML set to the largest, a negative and the smallest
+    accepted magnitude: it loads, or the one-line error names the file, not an internal class."""
+    import re
+
+    from frictionlab.dataset import builtin_dir
+    from frictionlab.errors import FrictionLabError
+
+    text = (builtin_dir() / f"{base}.toml").read_text()
+    (tmp_path / "d.csv").write_bytes((builtin_dir() / f"{base}.csv").read_bytes())
+    fields = list(re.finditer(r'^(\w+) = "([-+0-9.e]+) ([^"]+)"$', text, re.M))
+    assert len(fields) >= 5
+    for m in fields:
+        for value in ("1e100", "-1e100", "1.1e-100"):
+            (tmp_path / "d.toml").write_text(text[:m.start()] + f'{m.group(1)} = "{value} {m.group(3)}"'
+                                             + text[m.end():])
+            try:
+                fl.load_dataset(tmp_path / "d.toml")
+            except FrictionLabError as exc:
+                msg = str(exc)
+                assert msg.startswith(str(tmp_path / "d.")), msg
+                assert not re.search(r"\b[A-Z][a-z]+[A-Z]\w*\.\w+", msg), msg  # like WeightNormal.value
+
+
+def test_a_full_disk_during_compare_is_one_line_naming_the_report(tmp_path, monkeypatch, capsys):
+    from frictionlab import cli
+
+    def full(self, *a, **k):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(Path, "write_bytes", full)
+    monkeypatch.setattr(Path, "write_text", full)
+    monkeypatch.chdir(tmp_path)
+    rc = cli.main(["compare", "--laws", "wear", "--data", "incline-oil-a100", "--bootstrap", "0", "--no-tolerance",
+                   "--no-equivalence", "--jobs", "1", "--out", "rep"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1, err
+    assert err[0].startswith("frictionlab: error: rep: cannot write") and err[0].endswith("No space left on device")
+    assert list(tmp_path.iterdir()) == []
