@@ -23,6 +23,7 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from multiprocessing import get_context
 
@@ -184,7 +185,11 @@ def _run(tasks, fn, pool, progress, done, total, label):
         futures = {pool.submit(fn, t): i for i, t in enumerate(tasks)}
         for fut in as_completed(futures):
             i = futures[fut]
-            results[i] = fut.result()
+            try:
+                results[i] = fut.result()
+            except BrokenProcessPool:  # a worker was killed, or a plugin ended its process (os._exit)
+                raise FrictionLabError(f"compare: a worker process died while running {label(tasks[i])} "
+                                       "(killed, out of memory, or a law plugin that ends its process)") from None
             done += 1
             if progress:
                 progress(done, total, label(tasks[i]))
