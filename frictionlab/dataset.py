@@ -152,7 +152,7 @@ def from_meta(meta: dict, path: Path) -> Dataset:
         raise DatasetError(f"{path}: observable {observable!r} is not declared in [columns] ({', '.join(units)})")
 
     csv = path.with_suffix(".csv")
-    raw = read_csv(csv, within=path.parent)
+    raw = read_csv(csv)
     columns = {}
     for col, unit in units.items():
         if col not in raw:
@@ -335,15 +335,15 @@ def _provenance(p, path) -> Provenance:
                       seed=p.get("seed"), truth=p.get("truth", {}))
 
 
-def read_csv(csv: Path, within=None) -> dict[str, np.ndarray]:
+def read_csv(csv: Path) -> dict[str, np.ndarray]:
     """Read a numeric CSV with a header row into float arrays; one-line errors on bad content.
-    ``within``: the folder the CSV must lie in once links are resolved (see io.read_bytes)."""
+    The CSV must lie in its folder once links are resolved (see io.read_bytes)."""
     import warnings
 
     import pandas as pd
 
     try:
-        text = read_bytes(csv, MAX_CSV_BYTES, within).decode("utf-8-sig")
+        text = read_bytes(csv, MAX_CSV_BYTES, within=Path(csv).parent).decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise DatasetError(f"{csv}: CSV does not parse: not UTF-8 text (byte {exc.start + 1})") from None
     try:

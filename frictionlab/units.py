@@ -199,10 +199,13 @@ def _dim(q) -> str:
     return "dimensionless" if d == "dimensionless" else d
 
 
-#: A time column whose last time is more than TIME_SPAN_MAX times the scene's duration, or less
-#: than 1/TIME_SPAN_MAX of it, is refused: such a ratio is a unit slip (s for us is 1e6), not data.
+#: A time column is refused when its last time exceeds TIME_SPAN_MAX times the scene's duration (the
+#: scene ends long before the data do) or falls below TIME_SPAN_MIN times it (the data would cover
+#: less than 0.2% of the scene). A unit slip by a factor 1000 or more (s for ms, s for us, ns for
+#: us) always lands outside, while data that stop early or run on a little pass.
 TIME_SPAN_MAX = 20.0
-_TIME_UNITS = (("ns", 1e-9), ("us", 1e-6), ("ms", 1e-3), ("s", 1.0), ("min", 60.0), ("h", 3600.0))
+TIME_SPAN_MIN = 1 / 500
+_TIME_UNITS = (("ns", 1e-9), ("us", 1e-6), ("ms", 1e-3), ("s", 1.0))
 
 
 def check_time_scale(t_last: float, duration: float, unit: str, where: str, duration_field: str) -> None:
@@ -211,12 +214,13 @@ def check_time_scale(t_last: float, duration: float, unit: str, where: str, dura
     if not (t_last > 0 and duration > 0):
         return
     ratio = t_last / duration
-    if 1 / TIME_SPAN_MAX <= ratio <= TIME_SPAN_MAX:
+    if TIME_SPAN_MIN <= ratio <= TIME_SPAN_MAX:
         return
-    factor = unit_factor(unit, "s", where)
-    raw = t_last / factor
-    guess = min(_TIME_UNITS, key=lambda u: abs(math.log(raw * u[1] / duration)))[0]
-    hint = f"; the values look like {guess}" if guess != unit.strip() else ""
+    raw = t_last / unit_factor(unit, "s", where)
+    guess, factor = min(_TIME_UNITS, key=lambda u: abs(math.log(raw * u[1] / duration)))
+    fits = TIME_SPAN_MIN <= raw * factor / duration <= TIME_SPAN_MAX and guess != unit.strip()
     raise UnitError(f"{where}: the last time is {raw:g} {unit}, {ratio:.3g} times {duration_field} "
-                    f"({duration:g} s): declared unit {unit!r} is implausible{hint} "
-                    f"(accepted: within a factor {TIME_SPAN_MAX:g} of the scene's duration)")
+                    f"({duration:g} s): declared unit {unit!r} is implausible"
+                    + (f"; the values look like {guess}" if fits else "")
+                    + f" (accepted: the last time within {TIME_SPAN_MIN:g} to {TIME_SPAN_MAX:g} times the "
+                    "scene's duration)")
