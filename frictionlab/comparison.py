@@ -35,6 +35,7 @@ from .equivalence import AREA_RATE, WEAR, EquivalenceResult, analyze_equivalence
 from .errors import FrictionLabError, ParameterError, Terminated
 from .bootstrap import bootstrap_fits
 from .fitcost import tolerance_check
+from .io import check_name
 from .fitting import PREDICTORS, FitResult, applicable_solvers, auto_solver, fit
 from .ranking import RankRow, family, rank_fits, rank_groups
 from .registry import available_laws, get_law
@@ -226,6 +227,9 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     for name, v in (("bootstrap", bootstrap), ("seed", seed)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
             raise ParameterError(f"compare: {name} must be a non-negative integer, got {v!r}")
+    if fit_timeout is not None and (isinstance(fit_timeout, bool) or not isinstance(fit_timeout, (int, float))
+                                    or not 0 < fit_timeout < float("inf")):
+        raise ParameterError(f"compare: fit_timeout must be a positive number of seconds, got {fit_timeout!r}")
     for r in tolerance:
         if isinstance(r, bool) or not isinstance(r, (int, float)) or not 0 < r < 1:
             raise ParameterError(f"compare: every tolerance must be a number in (0, 1), got {r!r}")
@@ -333,6 +337,7 @@ def _unique_datasets(dss) -> tuple[Dataset, ...]:
     """Datasets with repeats dropped; two different datasets under one name are an error."""
     out: dict[str, Dataset] = {}
     for ds in dss:
+        check_name(ds.name, f"{ds.path or 'dataset'}: name")  # it becomes part of the report's file names
         if ds.name in out and out[ds.name].path != ds.path:
             raise FrictionLabError(f"compare: two datasets are named '{ds.name}' ({out[ds.name].path} and {ds.path}); "
                                    "names must be unique")

@@ -301,18 +301,21 @@ def _hold_lock(path: Path):
     return proc
 
 
-def test_a_second_run_to_a_locked_output_fails_at_once_and_writes_nothing(tmp_path, run_cli):
+def test_a_second_run_to_a_locked_output_fails_at_once_and_writes_nothing(tmp_path, capsys):
+    from frictionlab import cli
+
     out = tmp_path / "rep"
-    holder = _hold_lock(out)
+    holder = _hold_lock(out)  # another process
     try:
-        res = run_cli("compare", "--laws", "wear", "--data", "incline-oil-a100", "--bootstrap", "0",
-                      "--no-tolerance", "--out", out, cwd=tmp_path)
+        rc = cli.main(["compare", "--laws", "wear", "--data", "incline-oil-a100", "--bootstrap", "0",
+                       "--no-tolerance", "--out", str(out)])
     finally:
         holder.stdin.close()
         holder.wait(10)
-    assert res.returncode == 2, res.stderr
-    assert res.stderr.strip() == (f"frictionlab: error: {out}: another frictionlab run is writing this output "
-                                  f"(lock {tmp_path / '.rep.lock'}); wait for it to finish or choose another --out")
+    err = capsys.readouterr().err
+    assert rc == 2, err
+    assert err.strip() == (f"frictionlab: error: {out}: another frictionlab run is writing this output "
+                           f"(lock {tmp_path / '.rep.lock'}); wait for it to finish or choose another --out")
     assert sorted(p.name for p in tmp_path.iterdir()) == []  # the holder removed its lock; nothing else
 
 
