@@ -322,7 +322,7 @@ def test_a_second_run_to_a_locked_output_fails_at_once_and_writes_nothing(tmp_pa
 def test_two_concurrent_runs_to_one_output_never_both_succeed(tmp_path):
     out = tmp_path / "rep"
     argv = [sys.executable, "-m", "frictionlab", "compare", "--laws", "wear", "--data", "incline-oil-a100",
-            "--bootstrap", "0", "--no-tolerance", "--no-equivalence", "--jobs", "1", "--out", str(out)]
+            "--bootstrap", "0", "--no-tolerance", "--no-equivalence", "--jobs", "1", "--quiet", "--out", str(out)]
     procs = [subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
              for _ in range(2)]
     results = [(p.wait(120), p.stderr.read()) for p in procs]
@@ -364,8 +364,8 @@ def test_a_signal_during_compare_with_workers_leaves_no_process_and_no_output(si
     (tmp_path / "slow.py").write_text(SLOW_LAW % "0.005")
     out = tmp_path / "rep"
     proc = subprocess.Popen([sys.executable, "-m", "frictionlab", "--load", str(tmp_path / "slow.py"), "compare",
-                             "--laws", "slow-viscous", "--data", "incline-oil-a100", "incline-oil-a200",
-                             "incline-dry-d10", "--jobs", "2", "--bootstrap", "0", "--no-tolerance",
+                             "--laws", "slow-viscous", "--data", "incline-oil-a100,incline-oil-a200,incline-dry-d10",
+                             "--quiet", "--jobs", "2", "--bootstrap", "0", "--no-tolerance",
                              "--no-equivalence", "--out", str(out)],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
     try:
@@ -429,7 +429,7 @@ def test_a_full_disk_during_compare_is_one_line_naming_the_report(tmp_path, monk
     monkeypatch.setattr(Path, "write_text", full)
     monkeypatch.chdir(tmp_path)
     rc = cli.main(["compare", "--laws", "wear", "--data", "incline-oil-a100", "--bootstrap", "0", "--no-tolerance",
-                   "--no-equivalence", "--jobs", "1", "--out", "rep"])
+                   "--no-equivalence", "--jobs", "1", "--quiet", "--out", "rep"])
     err = capsys.readouterr().err.strip().splitlines()
     assert rc == 2 and len(err) == 1, err
     assert err[0].startswith("frictionlab: error: rep: cannot write") and err[0].endswith("No space left on device")
