@@ -35,7 +35,6 @@ from .equivalence import AREA_RATE, WEAR, EquivalenceResult, analyze_equivalence
 from .errors import FrictionLabError, ParameterError, Terminated
 from .bootstrap import bootstrap_fits
 from .fitcost import tolerance_check
-from .io import check_name
 from .fitting import PREDICTORS, FitResult, applicable_solvers, auto_solver, fit
 from .ranking import RankRow, family, rank_fits, rank_groups
 from .registry import available_laws, get_law
@@ -383,7 +382,6 @@ def _unique_datasets(dss) -> tuple[Dataset, ...]:
     """Datasets with repeats dropped; two different datasets under one name are an error."""
     out: dict[str, Dataset] = {}
     for ds in dss:
-        check_name(ds.name, f"{ds.path or 'dataset'}: name")  # it becomes part of the report's file names
         if ds.name in out and out[ds.name].path != ds.path:
             raise FrictionLabError(f"compare: two datasets are named '{ds.name}' ({out[ds.name].path} and {ds.path}); "
                                    "names must be unique")
