@@ -352,13 +352,12 @@ def predict_outcomes(law, dataset_or_scene, params: Mapping[str, float] | None =
     speed, incidence, normal_speed, tangential_speed, restitution, contact_time [s],
     rebound_speed_t (v_t2) [m/s] and rolled (slip stopped during contact, bool).
     """
-    from .dataset import Dataset
     from .registry import get_law
     from .solvers import simulate
 
     law = get_law(law)
     fixed = {}
-    if isinstance(dataset_or_scene, Dataset):
+    if not isinstance(dataset_or_scene, OutcomeScene) and hasattr(dataset_or_scene, "columns"):  # a Dataset
         ds = dataset_or_scene
         if ds.kind != "impact-outcome":
             raise DatasetError(f"dataset '{ds.name}' is a {ds.kind} dataset; predict_outcomes needs an impact-outcome one")
@@ -411,22 +410,3 @@ def predict_outcomes(law, dataset_or_scene, params: Mapping[str, float] | None =
         out["psi1"] = normalized_angle(vc1, out["normal_speed"], mu, kappa)
         out["psi2"] = normalized_angle(np.tan(out["contact_rebound_angle"]), 1.0, mu, kappa)
     return out
-
-
-# --- fitting: the impact-outcome predictor ---------------------------------------------------------
-def outcome_predictor(law, target, scene, params, solver, rtol: float | None = None):
-    """Model of an impact-outcome target for ``frictionlab.predict``: the observable outcome per row, SI,
-    row by row through ``predict_outcomes`` (registered for the 'impact-outcome' kind in predict.py),
-    ODEs solved to ``rtol`` (None: FIT_RTOL)."""
-    from .predict import FIT_RTOL, SkipDataset
-
-    if target.observable not in OUTCOMES:
-        raise SkipDataset(f"dataset '{target.name}': '{target.observable}' is not an impact outcome "
-                          f"({', '.join(OUTCOMES)})")
-    if target.observable in ("psi1", "psi2") and (scene.materials is None or scene.friction is None):
-        raise SkipDataset(f"dataset '{target.name}': {target.observable} needs [scene.materials] with the "
-                          "moduli and the stated friction coefficient")
-    rows = rows_of(target.dataset)
-    return predict_outcomes(law, scene, params, solver, speed=rows["speed"], incidence=rows["incidence"],
-                            spin=rows["spin"], rtol=FIT_RTOL if rtol is None else rtol)[target.observable]
-

@@ -19,6 +19,7 @@ import numpy as np
 
 from .dataset import Dataset, load_dataset
 from .errors import DatasetError, FrictionLabError, ParameterError
+from .outcome import OUTCOMES, predict_outcomes, rows_of
 from .registry import get_law
 from .scene import Scene
 
@@ -122,15 +123,23 @@ def _predict_series(law, target, scene, params, solver, rtol=FIT_RTOL):
     return tr[SERIES[target.observable]]
 
 
-def _predict_outcomes(law, target, scene, params, solver, rtol=FIT_RTOL):
-    from .outcome import outcome_predictor
-
-    return outcome_predictor(law, target, scene, params, solver, rtol)
+def outcome_predictor(law, target, scene, params, solver, rtol=FIT_RTOL):
+    """Model of an impact-outcome target: the observable outcome per row, SI, row by row through
+    ``outcome.predict_outcomes``, ODEs solved to ``rtol``."""
+    if target.observable not in OUTCOMES:
+        raise SkipDataset(f"dataset '{target.name}': '{target.observable}' is not an impact outcome "
+                          f"({', '.join(OUTCOMES)})")
+    if target.observable in ("psi1", "psi2") and (scene.materials is None or scene.friction is None):
+        raise SkipDataset(f"dataset '{target.name}': {target.observable} needs [scene.materials] with the "
+                          "moduli and the stated friction coefficient")
+    rows = rows_of(target.dataset)
+    return predict_outcomes(law, scene, params, solver, speed=rows["speed"], incidence=rows["incidence"],
+                            spin=rows["spin"], rtol=FIT_RTOL if rtol is None else rtol)[target.observable]
 
 
 register_predictor("impact", _predict_series)
 register_predictor("incline", _predict_series)
-register_predictor("impact-outcome", _predict_outcomes)
+register_predictor("impact-outcome", outcome_predictor)
 
 
 def predict(law, target: Target, params: Mapping[str, float], solver: str = "exact",

@@ -56,7 +56,7 @@ def test_html_is_self_contained(report_dir):
     assert html.count("data:image/png;base64,") == n_figs
     assert "src='figures/" not in html and 'src="figures/' not in html and "<link" not in html
     assert "<script src" not in html and html.count("<script>") == 1  # the inline table sorter only
-    assert '<table class="sortable">' in html
+    assert '<table class="sortable' in html
 
 
 def test_ranking_csv_and_results_json(report_dir):
@@ -310,3 +310,14 @@ def test_a_new_dataset_kind_plugs_in_through_one_predictor(tmp_path, monkeypatch
     out = write_report(c, tmp_path / "rep")
     assert (out / "figures" / "fit-outcomes.png").exists()
     assert not (out / "figures" / "force-outcomes.png").exists()  # no time series, no force history
+
+
+def test_a_long_step_is_not_silent():
+    import time as _time
+
+    pipe = io.StringIO()
+    with Progress("compare", stream=pipe, every=3600, heartbeat=0.2) as bar:
+        bar(1, 3, "first")
+        _time.sleep(1.2)  # one long step: heartbeat lines, not silence
+    lines = pipe.getvalue().splitlines()
+    assert len(lines) >= 2 and all(" compare: 1/3 done, still working (" in x for x in lines[1:])

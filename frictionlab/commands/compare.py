@@ -88,5 +88,20 @@ def run(args) -> int:
     print(f"compared {n_laws} law{'s' * (n_laws != 1)} on {n_data} dataset{'s' * (n_data != 1)}: {ok} fits, "
           f"{sum(f.status == 'failed' for f in result.fits)} failed, {sum(f.status == 'skipped' for f in result.fits)} "
           f"skipped, {len(result.equivalence)} equivalence tests, in {result.wall_time:.1f} s")
+    for line in answer_lines(result):
+        print(line)
     print(f"report: {out / 'report.html'} (also report.md, ranking.csv, results.json, figures/)")
     return 0
+
+
+def answer_lines(c) -> list[str]:
+    """The report's first screen in a few lines: per dataset group the verdict layer's answer
+    (Comparison.answers); without answers, says so instead of inventing verdicts."""
+    if not c.answers:
+        return ["answers: none (the verdict layer filled no Comparison.answers); see the report's tables"]
+    out = ["answers:"]
+    for a in c.answers:
+        parts = [a.headline, a.goodness, f"lambda A u vs mu N + mu eta' dA/dt: {a.equivalence}" if a.equivalence
+                 else "", a.series_vs_exact, a.transfer]
+        out.append(f"  {a.group}: " + "; ".join(p for p in parts if p))
+    return out
