@@ -20,6 +20,11 @@ quantity) raises a one-line FrictionLabError.
 * Every fit carries its goodness of fit (``goodness.py``) and plausibility flags (``plausibility.py``). With several datasets, law parameters are shared (a global
   fit) unless named in ``local``.
 * Predictions go through ``predict``; a dataset kind plugs in with ``register_predictor``.
+* ``timeout`` is a time budget per fit in seconds (None: none): a fit that exceeds it is a failed
+  result saying so. It is checked before every evaluation of the model and, in the main thread,
+  by an alarm that interrupts a single evaluation that runs away.
+* A fit needs at least one data point more than it has free parameters; with fewer it is skipped
+  with that reason, never ranked.
 * ``rtol`` is the ODE tolerance of the fit's predictions (None: ``predict.FIT_RTOL``, 1e-10); it
   is an argument of each call, so fits at different tolerances may run in parallel threads.
 """
@@ -27,9 +32,12 @@ from __future__ import annotations
 
 import math
 import re
+import signal
+import threading
 import time
 import warnings
 from collections.abc import Mapping, Sequence
+from contextlib import contextmanager
 
 import attrs
 import numpy as np
@@ -50,6 +58,7 @@ __all__ = ["DatasetFit", "FitResult", "ParamResult", "PREDICTORS", "SCENE_QUANTI
 
 PENALTY = 1e4  # weighted residual per point when the model cannot be evaluated
 ODE_STARTS = 2  # at most this many starts are refined when a dataset needs the (costlier) ODE solver
+VALLEY_R = 0.999  # |correlation| at an ODE fit's optimum above which further starts are not run (see _valley)
 FTOL = 1e-6  # relative chi-square and step tolerances of Levenberg-Marquardt
 
 
@@ -300,6 +309,9 @@ def _scene_slots(targets, free) -> list[_Slot]:
         lo, hi = float(bounds[0]), float(bounds[1])
         if not lo < hi:
             raise ParameterError(f"free scene quantity '{name}': lower bound {lo:g} must be below upper {hi:g}")
+        if len(bounds) == 3 and not lo <= float(bounds[2]) <= hi:
+            raise ParameterError(f"free scene quantity '{name}': start {float(bounds[2]):g} is outside its bounds "
+                                 f"[{lo:g}, {hi:g}]")
         for i, tg in enumerate(targets):
             current = get_scene_quantity(tg.dataset.scene, name)
             start = float(bounds[2]) if len(bounds) == 3 else min(max(current, lo), hi)
@@ -315,11 +327,36 @@ def _lmfit_bound(b: float, slot: _Slot) -> float:
     return b if abs(b) <= 1e4 * slot.scale else math.copysign(math.inf, b)
 
 
+class FitTimeout(BaseException):
+    """A fit ran past its time budget (a BaseException, so that no handler of a law's errors keeps it)."""
+
+
+@contextmanager
+def _alarm(seconds: float | None):
+    """Raise FitTimeout in the main thread after ``seconds`` (no-op elsewhere, or if an alarm is set)."""
+    if (seconds is None or not hasattr(signal, "setitimer") or threading.current_thread() is not threading.main_thread()
+            or signal.getitimer(signal.ITIMER_REAL)[0] > 0):
+        yield
+        return
+
+    def ring(signum, frame):
+        raise FitTimeout()
+
+    old = signal.signal(signal.SIGALRM, ring)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+
+
 class _Model:
     """Evaluates the weighted residual for a vector of scaled parameter values."""
 
-    def __init__(self, law, targets, solvers, slots, rtol=None):
+    def __init__(self, law, targets, solvers, slots, rtol=None, deadline=None):
         self.law, self.targets, self.solvers, self.slots, self.rtol = law, targets, solvers, slots, rtol
+        self.deadline = deadline  # time.monotonic() after which an evaluation raises FitTimeout
         self.failures = 0
         self.last_error = ""
         self.nfev = 0
@@ -343,6 +380,8 @@ class _Model:
                 for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values))]
 
     def residual(self, values) -> np.ndarray:
+        if self.deadline is not None and time.monotonic() > self.deadline:
+            raise FitTimeout()
         self.nfev += 1
         out = []
         for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values)):
@@ -406,13 +445,30 @@ def _distinct(scored: list[tuple], n: int) -> list[dict]:
     return out
 
 
+def _valley(result) -> str:
+    """Why a converged Levenberg-Marquardt run ended in a valley the data do not close ('' if not):
+    two parameters correlated beyond VALLEY_R, or a parameter at a bound. Another start ends in the
+    same valley (the comparison's area-rate fit on a dry incline walks mu -> 0, eta' -> infinity
+    with mu eta' fixed, from either start), so an ODE fit does not pay for it twice."""
+    for p in result.params.values():
+        if not p.vary:
+            continue
+        if any(abs(v - p.value) <= 1e-9 * max(abs(p.value), 1.0) for v in (p.min, p.max) if math.isfinite(v)):
+            return f"{p.name} at a bound"
+        for other, r in (p.correl or {}).items():
+            if abs(r) >= VALLEY_R:
+                return f"{p.name} and {other} correlated at r = {r:.4f}"
+    return ""
+
+
 def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: int, max_nfev, scale_covar: bool = True):
     """Score a grid of starts, refine the best distinct ones with Levenberg-Marquardt, keep the lowest
-    chi-square. Returns (parameters, success, message, lmfit MinimizerResult or None). scale_covar: scale
-    lmfit's error bars by sqrt(reduced chi2) (only when sigma is not known)."""
+    chi-square. Returns (parameters, success, message, lmfit MinimizerResult or None, notes). scale_covar:
+    scale lmfit's error bars by sqrt(reduced chi2) (only when sigma is not known)."""
     varying = [s for s in slots if s.vary]
     if not varying:
-        return params, True, "nothing to fit: every parameter is held", None
+        return params, True, "nothing to fit: every parameter is held", None, []
+    slow = any(x.startswith("ode") for x in solvers)
     starts = [{s.pname: params[s.pname].value for s in varying}]
     if scan:
         fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
@@ -422,10 +478,9 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
             r = model.residual({s.pname: vals[s.pname] * s.scale for s in slots})
             scored.append((float(r @ r), len(scored), cand))
         scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins
-        slow = any(x.startswith("ode") for x in solvers)
         starts = _distinct(scored, min(n_starts, ODE_STARTS) if slow else n_starts)
-    best = None
-    for start in starts:
+    best, notes = None, []
+    for i, start in enumerate(starts):
         trial = params.copy()
         for k, v in start.items():
             trial[k].set(value=v)
@@ -434,13 +489,19 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
         r = mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
         if best is None or (r.success, -r.chisqr) > (best.success, -best.chisqr):
             best = r
-    return best.params, bool(best.success), str(best.message), best
+        why = _valley(r) if slow and r.success and i + 1 < len(starts) else ""
+        if why:
+            notes.append(f"one Levenberg-Marquardt start of {len(starts)}: the first ended where the data do not "
+                         f"determine the parameters ({why}), where another start ends too")
+            break
+    return best.params, bool(best.success), str(best.message), best, notes
 
 
 def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[float]] | None = None,
         fixed: Mapping[str, float] | None = None, local: Sequence[str] = (),
         initial: Mapping[str, float] | None = None, observable: str | None = None, derive: str | None = None,
-        scan: int = 125, n_starts: int = 3, max_nfev: int | None = None, rtol: float | None = None) -> FitResult:
+        scan: int = 125, n_starts: int = 3, max_nfev: int | None = None, rtol: float | None = None,
+        timeout: float | None = None) -> FitResult:
     """Fit ``law`` to one dataset or a group of them (a global fit) and return a FitResult.
 
     law: name or FrictionLaw. datasets: a Dataset, name, path or Target, or a list of them.
@@ -454,6 +515,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     at most ODE_STARTS when a dataset is solved by 'ode' (deterministic, never timing-dependent).
     rtol: relative (and scaled absolute) tolerance of every ODE solve in the fit, in (0, 1);
     None uses FIT_RTOL (1e-10). Closed forms and the series ignore it.
+    timeout: time budget of the fit in seconds (None: none); past it the fit is 'failed'.
     """
     import lmfit  # slow to import: only when fitting
 
@@ -478,6 +540,9 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     law.resolve({**(initial or {}), **(fixed or {})})  # so are held or start values outside the bounds
     if rtol is not None and (isinstance(rtol, bool) or not isinstance(rtol, (int, float)) or not 0 < rtol < 1):
         raise ParameterError(f"fit: rtol must be a number in (0, 1), got {rtol!r}")
+    if timeout is not None and (isinstance(timeout, bool) or not isinstance(timeout, (int, float))
+                                or not 0 < timeout < math.inf):
+        raise ParameterError(f"fit: timeout must be a positive number of seconds, got {timeout!r}")
     solvers = []
     for tg in targets:
         if tg.dataset.kind not in PREDICTORS:
@@ -499,7 +564,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         solvers.append(s)
     slots = _law_slots(law, targets, dict(fixed or {}), set(local), dict(initial or {}))
     slots += _scene_slots(targets, dict(free or {}))
-    model = _Model(law, targets, solvers, slots, rtol)
+    model = _Model(law, targets, solvers, slots, rtol, None if timeout is None else time.monotonic() + timeout)
     params = lmfit.Parameters()
     for s in slots:
         params.add(s.pname, value=s.value / s.scale, vary=s.vary, min=_lmfit_bound(s.lower, s) / s.scale,
@@ -507,14 +572,22 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     varying = [s for s in slots if s.vary]
     solver_label = solver if solver != "auto" else "+".join(dict.fromkeys(solvers))
     n_points = sum(t.y.size for t in targets)
+    if n_points < len(varying) + 1:
+        return give_up("skipped", f"{', '.join(names)}: {n_points} data point{'s' * (n_points != 1)} for {len(varying)} free parameter"
+                                  f"{'s' * (len(varying) != 1)}: a fit needs at least {len(varying) + 1}")
 
     likelihood = _likelihood(targets)
     success, message = True, ""
     try:
-        best_params, success, message, best = _search(lmfit, model, params, slots, solvers, scan, n_starts,
-                                                      max_nfev, scale_covar=likelihood != "known")
-        values = _si(best_params, slots)
-        models = model.models(values)
+        with _alarm(timeout):
+            best_params, success, message, best, search_notes = _search(lmfit, model, params, slots, solvers, scan,
+                                                                        n_starts, max_nfev,
+                                                                        scale_covar=likelihood != "known")
+            values = _si(best_params, slots)
+            models = model.models(values)
+        model.deadline = None  # the error analysis below is bounded work
+    except FitTimeout:
+        return give_up("failed", f"exceeded its time budget of {timeout:g} s (--fit-timeout)", nfev=model.nfev)
     except SkipDataset as exc:
         return give_up("skipped", str(exc))
     except FrictionLabError as exc:  # an aborted search leaves parameters that mean nothing: say it did not converge
@@ -541,7 +614,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         status, reason = "failed", f"did not converge: {message}"
     elif model.failures and chisqr >= PENALTY**2:
         status, reason = "failed", f"the solver failed at every trial: {model.last_error}"
-    notes = []
+    notes = list(search_notes)
     if model.failures:
         notes.append(f"{model.failures} of {model.nfev} evaluations could not be solved and were penalized "
                      f"(last: {model.last_error})")

@@ -11,15 +11,14 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import numpy as np
-
-from ..dataset import load_dataset
 from ..errors import ParameterError, SolverError
-from ..registry import get_law
-from ..units import to_si
 
 RPM = 60.0 / (2.0 * math.pi)
 PLOT_POINTS = 501
+
+
+MAX_POINTS = 1_000_000  # simulated times written by --points
+MIN_RTOL = 1e-14  # tighter than this, the ODE solvers give up on round-off
 
 
 def add_parser(sub):
@@ -46,6 +45,7 @@ def add_parser(sub):
 
 def parse_params(law, items) -> dict[str, float]:
     """['lam=1.81e6 Pa s/m', 'mu=0.2'] -> SI floats, each converted against the law's parameter unit."""
+    from ..units import to_si
     from .fit import _split
 
     out = {}
@@ -57,14 +57,17 @@ def parse_params(law, items) -> dict[str, float]:
 
 
 def run(args) -> int:
+    from ..dataset import load_dataset
     from ..io import atomic_write_bytes, atomic_write_text, check_writable
+    from ..registry import get_law
 
     law = get_law(args.law)
     params = parse_params(law, args.param)
-    if not 0 < args.rtol < 1:
-        raise SolverError(f"--rtol: rtol must be a number in (0, 1), got {args.rtol:g}")
-    if args.points is not None and args.points < 2:
-        raise ParameterError(f"--points must be at least 2, got {args.points}")
+    if not MIN_RTOL <= args.rtol < 1:
+        raise SolverError(f"--rtol: rtol must be a number in (0, 1), at least {MIN_RTOL:g} (a float resolves "
+                          f"about 2e-16), got {args.rtol:g}")
+    if args.points is not None and not 2 <= args.points <= MAX_POINTS:
+        raise ParameterError(f"--points must be between 2 and {MAX_POINTS}, got {args.points}")
     ds = load_dataset(args.dataset)
     for path in (args.out, args.plot):
         if path is not None:
@@ -97,6 +100,7 @@ def _params_text(law, p) -> str:
 
 # --- time series ---------------------------------------------------------------------------------
 def _series(law, ds, params, args):
+    import numpy as np
     from ..solvers import simulate
 
     scene = ds.scene
@@ -122,6 +126,7 @@ def _series(law, ds, params, args):
 
 
 def _summary(law, ds, tr, p) -> str:
+    import numpy as np
     from ..display import fmt_time
 
     T = float(tr.t[-1])
@@ -211,6 +216,7 @@ def _outcomes(law, ds, params, args):
 
 
 def _outcome_figure(law, ds, p, args) -> bytes:
+    import numpy as np
     from ..figures import _plt, _png
     from ..outcome import predict_outcomes
 

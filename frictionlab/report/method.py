@@ -3,9 +3,11 @@ from __future__ import annotations
 
 import json
 
+from ..predict import FIT_RTOL
 from ..ranking import COLUMNS, TIE_AIC
 from .doc import Section
 from .results import SCHEMA
+from .text import rtol_text
 
 
 def build(ctx) -> list[Section]:
@@ -32,9 +34,9 @@ def build(ctx) -> list[Section]:
         f"Ties: candidates within ΔAIC ≤ {TIE_AIC} share a rank; within ΔAIC < 2 they are indistinguishable by "
         "the data. Laws of one closed-form family (law.form()) are one candidate, e.g. wear = couette. "
         "Akaike weight w = exp(−Δ/2)/Σexp(−Δ/2).",
-        "Solvers: 'exact' where the law and scene admit a closed form, else 'ode' (LSODA, rtol 1e-10; what a "
-        "looser tolerance changes is under 'What solver tolerance does to a fit'); 'series' (the paper's first-order "
-        "expansion, eqs 7-11) in addition wherever it is defined.",
+        "Solvers: 'exact' where the law and scene admit a closed form, else 'ode' (LSODA, rtol "
+        f"{rtol_text(FIT_RTOL)}; what another tolerance changes is under 'What solver tolerance does to a fit'); 'series' "
+        "(the paper's first-order expansion, eqs 7-11) in addition wherever it is defined.",
         "Bootstrap (`--bootstrap N`, `--seed`): parametric (the best unflagged fit plus noise of the declared σ, "
         "only where σ is known), every candidate refitted to the same replicates; "
         "95% percentile intervals for parameters, 95% Wilson intervals for first-place shares (see 'Bootstrap').",

@@ -86,7 +86,6 @@ def group_table(rows) -> tuple[list[str], list[list]]:
             r.status + (f": {r.reason}" if r.reason else "") + _flags(r)] for r in rows]
     return headers, out
 
-
 def build(ctx) -> Section:
     c = ctx.c
     sec = Section(TITLE)
