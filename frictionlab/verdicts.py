@@ -15,7 +15,8 @@ laws merged; see ``ranking``) and states, per group:
 
 The equivalence verdict, the noise threshold and the transfer test are left "not tested" / ""
 here; their producers fill them (``fill_*`` hooks of the equivalence and transfer modules).
-``answers_table(answers)`` is the short text table ``frictionlab compare`` prints at the end.
+``frictionlab compare`` prints them (``commands.compare.answer_lines``); the report's first screen
+renders them (``report/first_screen.py``).
 """
 from __future__ import annotations
 
@@ -75,6 +76,8 @@ def _verdict(rows: list[RankRow]):
                          f"(delta-AIC < {NEAR_TIE:g})")
     elif top.fits and top.flags:  # every candidate is flagged: the flag is part of the headline
         headline = f"best: {best}, flagged: {top.flags[0]}"
+    elif top.fits is None:  # no test possible (too few points for the runs test and sigma only assumed)
+        headline = f"fit not testable (top-ranked by AIC: {best}): {g.reason if g else 'no goodness of fit'}"
     else:
         headline = f"{POOR} (best of a poor set: {best})"
     second = next((r for r in rows if r not in firsts), None)
@@ -136,20 +139,3 @@ def series_vs_exact(fits) -> tuple[str, dict]:
     order = [n for n in dict.fromkeys(f.datasets[0] for f in fits) if n in numbers]
     sentences.sort(key=lambda text: next(i for i, n in enumerate(order) if text.startswith(n + ":")))
     return "; ".join(sentences), {n: numbers[n] for n in order}
-
-
-def answers_table(answers) -> str:
-    """The answers as a short text table (one block per group), for the end of ``frictionlab compare``."""
-    if not answers:
-        return ""
-    lines = ["Answers (one per dataset group):"]
-    for a in answers:
-        lines.append(f"  {a.group} ({a.provenance}; {', '.join(a.datasets)})")
-        lines.append(f"    {a.headline}")
-        lines.append(f"    goodness of fit: {a.goodness}")
-        lines.append(f"    equivalence: {a.equivalence}" + (f"; {a.noise_threshold}" if a.noise_threshold else ""))
-        if a.series_vs_exact:
-            lines.append(f"    series vs exact: {a.series_vs_exact}")
-        if a.transfer:
-            lines.append(f"    transfer: {a.transfer}")
-    return "\n".join(lines)

@@ -12,7 +12,8 @@ from _fit_helpers import TRUTH, incline_scene, synthetic
 from frictionlab import FrictionLaw, ParamSpec, compare, fit, load_dataset
 from frictionlab.goodness import FITS_LEVEL, runs_test
 from frictionlab.ranking import NEAR_TIE, RankRow, _rank, rank_groups
-from frictionlab.verdicts import POOR, answers_table
+from frictionlab.commands.compare import answer_lines
+from frictionlab.verdicts import POOR
 
 REGISTERED = ["coulomb", "area-rate", "wear", "couette"]
 
@@ -105,8 +106,8 @@ def test_unregistered_law_gets_no_registered_law_and_a_registered_truth_gets_bes
     (a,) = c.answers
     assert a.fits and a.headline == "best: wear = couette [exact]", a.headline
     assert "chi2 p" in a.goodness and "sigma known" in a.goodness
-    assert "no registered law" in answers_table(c.answers + compare(laws=REGISTERED, datasets=[drag],
-                                                                    equivalence=False).answers)
+    both = attrs.evolve(c, answers=c.answers + compare(laws=REGISTERED, datasets=[drag], equivalence=False).answers)
+    assert any("no registered law" in line for line in answer_lines(both))
 
 
 def test_builtin_synthetic_inclines_pass_goodness_of_fit_with_the_true_law_best():
@@ -246,3 +247,14 @@ def test_friction_that_supplies_energy_is_flagged():
     d = DatasetFit(target, "ode", {"c": 100.0}, data.scene, target.y, 0.0, 0.0, 0.0)
     flags, numbers = check_plausibility(PushingDrag(), [d], NoModel(), [], {}, "known")
     assert numbers["work_fraction"] == pytest.approx(-1.0) and any("net negative work" in f for f in flags)
+
+
+def test_too_few_points_with_assumed_sigma_is_untestable_not_a_poor_set():
+    from frictionlab.goodness import goodness
+    from frictionlab.verdicts import _verdict
+
+    g = goodness(np.array([0.3, -0.2, 0.1, 0.4, -0.5]), 1, "assumed")  # 5 points: no runs test, no chi2
+    row = RankRow("d", "coulomb", "exact", 5, 1, 1.0, 1.0, 1.0, 3.0, 3.0, 3.0, rank=1, fits=g.fits, goodness=g,
+                  likelihood="assumed")
+    best, fits, headline, _, _ = _verdict([row])
+    assert g.fits is None and not fits and headline.startswith("fit not testable") and POOR not in headline

@@ -92,10 +92,6 @@ def run(args) -> int:
     for line in answer_lines(result):
         print(line)
     print(f"report: {out / 'report.html'} (also report.md, ranking.csv, results.json, figures/)")
-    from ..verdicts import answers_table
-
-    if result.answers:
-        print(answers_table(result.answers))
     return 0
 
 
