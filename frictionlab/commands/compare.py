@@ -7,6 +7,7 @@ import sys
 import time
 from pathlib import Path
 
+from ..equivalence import REPLICATES
 from ..errors import OutputError, ParameterError
 
 #: Default number of bootstrap resamples: about +15 s (idle) to +35 s (busy machine) on 2 cores for the
@@ -32,14 +33,20 @@ def add_parser(sub):
     p.add_argument("--force", action="store_true", help="replace an existing report folder")
     p.add_argument("--jobs", type=int, default=min(os.cpu_count() or 1, 4),
                    help="worker processes (default: number of CPUs, at most 4)")
-    p.add_argument("--no-equivalence", action="store_true", help="skip the equivalence analysis")
+    p.add_argument("--no-equivalence", action="store_true", help="skip the equivalence (discrimination) tests")
+    p.add_argument("--replicates", type=int, default=REPLICATES, metavar="R",
+                   help=f"replicate datasets per law in the equivalence test's parametric bootstrap (default: "
+                        f"{REPLICATES}; at least 10; the Monte-Carlo error of a p-value is about sqrt(p(1-p)/R))")
+    p.add_argument("--no-transfer", dest="transfer", action="store_false",
+                   help="skip predicting across the datasets of a group and the shared-parameter fits")
     p.add_argument("--bootstrap", type=int, default=BOOTSTRAP_N, metavar="N",
                    help=f"case resamples per dataset for confidence intervals and first-place shares "
                         f"(default: {BOOTSTRAP_N}; 0: none)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the bootstrap resamples (default: 0)")
+    p.add_argument("--seed", type=int, default=0,
+                   help="seed of the bootstrap resamples and of the equivalence test's replicates (default: 0)")
     p.add_argument("--bootstrap-all", action="store_true",
-                   help="also bootstrap the slow datasets: where a law needs the ODE solver, and impact-outcome sets "
-                        "(minutes per 100 resamples)")
+                   help="also bootstrap, and run the equivalence test on, the slow datasets: where a law needs the "
+                        "ODE solver, and impact-outcome sets (minutes per 100 resamples)")
     p.add_argument("--no-tolerance", dest="tolerance", action="store_false",
                    help="skip refitting the ODE laws of one dataset at looser tolerances "
                         f"({' and '.join(f'{r:.0e}'.replace('e-0', 'e-') for r in TOLERANCE_RTOLS)})")
@@ -83,6 +90,8 @@ def run(args) -> int:
         raise ParameterError(f"--bootstrap must be 0 (none) or a positive number of resamples, got {args.bootstrap}")
     if args.seed < 0:
         raise ParameterError(f"--seed must be a non-negative integer, got {args.seed}")
+    if args.replicates < 10:
+        raise ParameterError(f"--replicates must be at least 10, got {args.replicates}")
     free = parse_free(args.free)
     laws = [x.strip() for x in args.laws.split(",") if x.strip()] if args.laws else None
     bar = ProgressBar()
@@ -90,7 +99,8 @@ def run(args) -> int:
         result = compare(laws=laws, datasets=args.data, solvers=args.solver, free=free,
                          equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar,
                          bootstrap=args.bootstrap, seed=args.seed, bootstrap_all=args.bootstrap_all,
-                         tolerance=TOLERANCE_RTOLS if args.tolerance else ())
+                         tolerance=TOLERANCE_RTOLS if args.tolerance else (), replicates=args.replicates,
+                         transfer=args.transfer)
     finally:
         bar.close()
     if bar.active:
