@@ -311,8 +311,8 @@ def _threshold(d_ab: float, d_ba: float, n: int, sigma: float) -> float:
 def _verdict(e: EquivalenceResult) -> tuple[str, str]:
     a, b = f"{e.law_a} [{e.solver_a}]", f"{e.law_b} [{e.solver_b}]"
     m = min(e.t_a.size, e.t_b.size)
-    pa = f"p = {e.p_a:.2f} ± {e.mc_error(e.p_a):.2f} under {a}"
-    pb = f"p = {e.p_b:.2f} ± {e.mc_error(e.p_b):.2f} under {b}"
+    pa = f"p = {e.p_a:.2g} ± {e.mc_error(e.p_a):.1g} under {a}"
+    pb = f"p = {e.p_b:.2g} ± {e.mc_error(e.p_b):.1g} under {b}"
     head = (f"T = χ²({e.law_a}) − χ²({e.law_b}) = {e.t_obs:.4g} on the data; against {m} replicates from each fit "
             f"({pa}; {pb})")
     power = (f"the test rejects {a} on {100 * e.power_a:.0f}% of {b}'s replicates and {b} on "

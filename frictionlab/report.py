@@ -509,7 +509,7 @@ def _equivalence_section(doc: Doc, figs: dict, c: Comparison):
                          f"{e.status}: {e.reason}"] + [""] * 5)
             continue
         rows.append([e.dataset, f"{e.law_a} [{e.solver_a}]", f"{e.law_b} [{e.solver_b}]", e.verdict,
-                     fmt(e.t_obs, 4), f"{e.p_a:.2f} ± {e.mc_error(e.p_a):.2f}", f"{e.p_b:.2f} ± {e.mc_error(e.p_b):.2f}",
+                     fmt(e.t_obs, 4), f"{e.p_a:.2g} ± {e.mc_error(e.p_a):.1g}", f"{e.p_b:.2g} ± {e.mc_error(e.p_b):.1g}",
                      f"{e.power_a:.0%} / {e.power_b:.0%}", e.threshold_text()])
     doc.table(["dataset", "law A", "law B", "verdict", "T = χ²A − χ²B", "p under A", "p under B",
                "power (reject A | B / reject B | A)", "noise threshold"], rows)

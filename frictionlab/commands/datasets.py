@@ -17,6 +17,9 @@ def add_parser(sub):
     p.add_argument("--out", type=Path, help="rebuild into this folder instead of the built-in one")
     p.add_argument("--check", action="store_true", help="rebuild into a temporary folder and compare with the "
                    "committed files; exit 1 if any differs")
+    p.add_argument("--known-truth", action="store_true",
+                   help="rebuild the known-truth datasets (default folder: ./examples/known-truth) instead of the "
+                        "built-in ones")
     p.set_defaults(func=run)
 
 
@@ -65,27 +68,29 @@ def _show(name) -> int:
 
 
 def _rebuild(args) -> int:
-    from ..datagen import rebuild
+    from ..datagen import GENERATORS, KNOWN_TRUTH, KNOWN_TRUTH_DIR, rebuild
 
+    generators = KNOWN_TRUTH if args.known_truth else GENERATORS
+    home = (args.out or KNOWN_TRUTH_DIR) if args.known_truth else builtin_dir()
     if args.check:
         with tempfile.TemporaryDirectory() as tmp:
-            written = rebuild(Path(tmp))
+            written = rebuild(Path(tmp), generators)
             differ = [p.name for p in written
-                      if not (builtin_dir() / p.name).exists() or not filecmp.cmp(p, builtin_dir() / p.name, shallow=False)]
+                      if not (home / p.name).exists() or not filecmp.cmp(p, home / p.name, shallow=False)]
         if differ:
             print(f"differ from the committed files: {', '.join(differ)}")
             return 1
-        print(f"{len(written)} generated files equal the committed ones in {builtin_dir()}")
+        print(f"{len(written)} generated files equal the committed ones in {home}")
         return 0
     from ..errors import OutputError
 
-    out = args.out or builtin_dir()
+    out = args.out or home
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"{out}: cannot create the output folder: {exc.strerror or exc}") from None
     with tempfile.TemporaryDirectory(dir=out) as tmp:
-        written = rebuild(Path(tmp))
+        written = rebuild(Path(tmp), generators)
         for p in written:  # all generated first, then moved: no half-rebuilt folder
             shutil.move(str(p), out / p.name)
     print(f"wrote {len(written)} files to {out}")
