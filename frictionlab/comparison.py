@@ -30,7 +30,7 @@ import attrs
 import numpy as np
 
 from .dataset import Dataset, builtin_names, load_dataset
-from .equivalence import PAIRS, REPLICATES, EquivalenceResult, analyze_equivalence
+from .equivalence import MIN_REPLICATES, PAIRS, REPLICATES, EquivalenceResult, analyze_equivalence
 from .errors import FrictionLabError, ParameterError
 from .bootstrap import bootstrap_fits
 from .fitcost import tolerance_check
@@ -215,8 +215,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                                + "; ".join(f"{k}: {v}" for k, v in skipped_ds.items()))
     # slow (ode) fits first, so that workers finish together
     plan.sort(key=lambda x: not x[2].startswith("ode"))
-    if equivalence and replicates < 10:
-        raise ParameterError(f"compare: replicates must be at least 10, got {replicates}")
+    if equivalence and replicates < MIN_REPLICATES:
+        raise ParameterError(f"compare: replicates must be at least {MIN_REPLICATES}, got {replicates}")
     eq_pairs = _equivalence_pairs(law_names, plan, pairs) if equivalence else []
     n_boot = len({f.datasets[0] for f in fits} | {t[1].name for t in plan}) if bootstrap else 0
     total = len(plan) + len(eq_pairs) + n_boot + (1 if tolerance else 0)

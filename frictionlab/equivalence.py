@@ -43,7 +43,7 @@ import attrs
 import numpy as np
 
 from .display import unit
-from .errors import FrictionLabError
+from .errors import FrictionLabError, ParameterError
 from .fitting import FitResult, Target, fit
 from .law import AreaSlipForm
 from .registry import get_law
@@ -56,6 +56,7 @@ ALPHA = 0.05  # level of the test, each side
 POWER = 0.5  # the nulls overlap when data from either law reject the other less often than this
 CRITICAL = 3.84  # expected Delta-chi2 at which two laws differ by more than the noise (chi2, 1 dof, 95%)
 REPLICATES = 40  # default R per null
+MIN_REPLICATES = 20  # the smallest p-value is 1 / (R + 1): below ALPHA only from R = 20
 TIE_REL = 1e-4  # |T* - T| below this fraction of max(n, chi2) is a tie (the optimizer's resolution)
 VERDICTS = ("equivalent", "not equivalent", "cannot tell at this noise")
 
@@ -185,9 +186,12 @@ def decomposition(fw: FitResult) -> Decomposition | None:
 
 # --- refits ---------------------------------------------------------------------------------------
 def _refit_options(f: FitResult) -> dict:
-    """fit() keywords that repeat ``f``'s setup, warm-started at its best values."""
-    initial = {p.key: p.value for p in f.params.values() if p.kind == "law" and p.vary}
-    fixed = {p.key: p.value for p in f.params.values() if p.kind == "law" and p.fixed_by == "held by the caller"}
+    """fit() keywords that repeat ``f``'s setup, warm-started at its best values. Of a pair that enters
+    only through its ratio (eta/h) the second is held: the chi-square is the same, the search shorter."""
+    held = {pair[1] for pair in (f.identifiability.ratio_only if f.identifiability else ())}
+    initial = {p.key: p.value for p in f.params.values() if p.kind == "law" and p.vary and p.name not in held}
+    fixed = {p.key: p.value for p in f.params.values()
+             if p.kind == "law" and (p.fixed_by == "held by the caller" or (p.vary and p.name in held))}
     free = {p.key: (p.lower, p.upper, p.value) for p in f.params.values() if p.kind == "scene" and p.vary}
     return {"solver": f.per_dataset[0].solver, "initial": initial, "fixed": fixed, "free": free}
 
@@ -247,8 +251,9 @@ def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = RE
     if not (fit_a.ok and fit_b.ok):
         bad = fit_a if not fit_a.ok else fit_b
         return EquivalenceResult(**base, status="skipped", reason=f"{bad.law} [{bad.solver}] {bad.status}: {bad.reason}")
-    if replicates < 10:
-        raise FrictionLabError(f"equivalence: replicates must be at least 10, got {replicates}")
+    if replicates < MIN_REPLICATES:
+        raise ParameterError(f"equivalence: replicates must be at least {MIN_REPLICATES} (so that a p-value can fall "
+                             f"below {ALPHA:g}), got {replicates}")
     da, db = fit_a.per_dataset[0], fit_b.per_dataset[0]
     target = da.target
     n = int(target.y.size)
@@ -277,7 +282,7 @@ def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = RE
     t_obs = float(fit_a.stats.chisqr - fit_b.stats.chisqr)
     res = dict(**base, **common, t_obs=t_obs, t_a=t_a, t_b=t_b, failed=failed, d_ab=d_ab, d_ba=d_ba,
                threshold=threshold)
-    if min(t_a.size, t_b.size) < max(10, replicates // 2):
+    if min(t_a.size, t_b.size) < max(MIN_REPLICATES, replicates // 2):
         return EquivalenceResult(**res, status="failed",
                                  reason=f"{failed} of {2 * replicates} replicate refits failed: too few to test")
     tol = TIE_REL * max(n, fit_a.stats.chisqr, fit_b.stats.chisqr)
@@ -331,3 +336,45 @@ def _verdict(e: EquivalenceResult) -> tuple[str, str]:
                               f"data of this noise cannot tell them apart. {thr}.")
     return "cannot tell at this noise", (f"{head}: T is consistent with both although {power}: "
                                          f"T falls where the two null distributions overlap. {thr}.")
+
+
+# --- the first screen ------------------------------------------------------------------------------
+def group_answer(results, datasets, pair: tuple[str, str] = PAIRS[0]) -> dict:
+    """The equivalence fields of one group's ``answers.Answer`` from the tests of ``pair`` (default the
+    paper's: wear against area-rate) on the member ``datasets`` (names): ``equivalence`` (the exact
+    or numerical law), ``equivalence_series`` (the paper's series), ``noise_threshold`` (one
+    sentence) and ``details`` (numbers per dataset). A group verdict is 'not equivalent' if any member
+    tells the laws apart, 'equivalent' if every member says so, else 'cannot tell at this noise';
+    'not tested' without a test."""
+    names = set(datasets)
+    mine = [e for e in results if e.dataset in names and (e.law_a, e.law_b) == pair]
+    full = [e for e in mine if not e.involves_series]
+    series = [e for e in mine if e.involves_series]
+
+    def verdict(es):
+        vs = [e.verdict for e in es if e.ok]
+        if not vs:
+            return "not tested"
+        if "not equivalent" in vs:
+            return "not equivalent"
+        return "equivalent" if all(v == "equivalent" for v in vs) else "cannot tell at this noise"
+
+    def thresholds(es):
+        parts = []
+        for e in es:
+            if not math.isfinite(e.threshold):
+                continue
+            name, f = unit(e.observable)
+            parts.append("at any noise (one curve)" if e.threshold == 0 else
+                         f"when sigma < {_num(e.threshold * f)} {name} on {e.dataset} (sigma {_num(e.sigma * f)} {name})")
+        return ", ".join(parts)
+
+    text = ""
+    if thresholds(full):
+        text = f"{pair[0]} and {pair[1]} differ by more than the noise {thresholds(full)}"
+        if thresholds(series):
+            text += f"; the paper's series of {pair[0]}: {thresholds(series)}"
+    elif thresholds(series):
+        text = f"the paper's series of {pair[0]} and {pair[1]} differ by more than the noise {thresholds(series)}"
+    return {"equivalence": verdict(full), "equivalence_series": verdict(series), "noise_threshold": text,
+            "details": {"equivalence": [e.as_dict() | {"t_a": None, "t_b": None} for e in mine]}}

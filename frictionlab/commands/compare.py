@@ -7,7 +7,7 @@ import sys
 import time
 from pathlib import Path
 
-from ..equivalence import REPLICATES
+from ..equivalence import MIN_REPLICATES, REPLICATES
 from ..errors import OutputError, ParameterError
 
 #: Default number of bootstrap resamples: about +15 s (idle) to +35 s (busy machine) on 2 cores for the
@@ -36,7 +36,7 @@ def add_parser(sub):
     p.add_argument("--no-equivalence", action="store_true", help="skip the equivalence (discrimination) tests")
     p.add_argument("--replicates", type=int, default=REPLICATES, metavar="R",
                    help=f"replicate datasets per law in the equivalence test's parametric bootstrap (default: "
-                        f"{REPLICATES}; at least 10; the Monte-Carlo error of a p-value is about sqrt(p(1-p)/R))")
+                        f"{REPLICATES}; at least {MIN_REPLICATES}; the Monte-Carlo error of a p-value is about sqrt(p(1-p)/R))")
     p.add_argument("--no-transfer", dest="transfer", action="store_false",
                    help="skip predicting across the datasets of a group and the shared-parameter fits")
     p.add_argument("--bootstrap", type=int, default=BOOTSTRAP_N, metavar="N",
@@ -90,8 +90,8 @@ def run(args) -> int:
         raise ParameterError(f"--bootstrap must be 0 (none) or a positive number of resamples, got {args.bootstrap}")
     if args.seed < 0:
         raise ParameterError(f"--seed must be a non-negative integer, got {args.seed}")
-    if args.replicates < 10:
-        raise ParameterError(f"--replicates must be at least 10, got {args.replicates}")
+    if args.replicates < MIN_REPLICATES:
+        raise ParameterError(f"--replicates must be at least {MIN_REPLICATES}, got {args.replicates}")
     free = parse_free(args.free)
     laws = [x.strip() for x in args.laws.split(",") if x.strip()] if args.laws else None
     bar = ProgressBar()
