@@ -514,6 +514,13 @@ def _equivalence_section(doc: Doc, figs: dict, c: Comparison):
     doc.table(["dataset", "law A", "law B", "verdict", "T = χ²A − χ²B", "p under A", "p under B",
                "power (reject A | B / reject B | A)", "noise threshold"], rows)
     doc.items([f"**{e.dataset}: {e.label} — {e.verdict}**: {e.explanation}" for e in c.equivalence if e.ok])
+    for d in c.fitted_datasets:
+        tested = [e for e in c.equivalence if e.dataset == d.name and e.ok]
+        if tested:
+            name = f"discrimination-{d.name}.png"
+            figs[name] = figures.discrimination_figure(d.name, tested)
+            doc.fig(name, f"{d.name}: T under each law's fit (histograms) and on the data (line); a law is rejected "
+                          "when the line lies in the far tail of its histogram.")
     for e in c.equivalence:
         if e.decomposition is not None:
             d = e.decomposition
