@@ -38,7 +38,7 @@ def fmt_time(t: float, ref: float | None = None) -> str:
 
 
 def fmt(x, digits: int = 4) -> str:
-    """A number for a table: '' for None/nan, fixed or scientific by size."""
+    """A number for a table with ``digits`` significant figures: '' for None/nan, fixed or scientific by size."""
     if x is None:
         return ""
     if isinstance(x, (int,)) and not isinstance(x, bool):
@@ -51,8 +51,11 @@ def fmt(x, digits: int = 4) -> str:
         return "" if math.isnan(x) else ("inf" if x > 0 else "-inf")
     if x == 0:
         return "0"
-    if 1e-3 <= abs(x) < 1e5:
-        return f"{x:.{digits}g}"
+    if 1e-3 <= abs(x) < 1e5:  # the same number of significant figures everywhere: 1.000, 12.50, 1234, 10090
+        exp = math.floor(math.log10(abs(x)))
+        if exp >= digits - 1:
+            return f"{round(x, digits - 1 - exp):.0f}"
+        return f"{x:#.{digits}g}".rstrip(".")
     return f"{x:.{digits - 1}e}"
 
 
@@ -79,6 +82,12 @@ def param_text(value: float, err: float | None, unit_: str) -> str:
     """A parameter with its error for a table, small lengths, areas and times in um, mm^2, us."""
     name, f = _scale(value, unit_)
     return fmt_value(value * f, None if err is None else err * f, name)
+
+
+def param_cells(value: float, err: float | None, unit_: str) -> tuple[str, str, str]:
+    """(value, standard error, unit) as table cells, in the display unit ``param_text`` would use."""
+    name, f = _scale(value, unit_)
+    return fmt(value * f), ("" if err is None else fmt(err * f, 2)), name
 
 
 def interval_text(lo: float, hi: float, unit_: str, like: float | None = None) -> str:

@@ -52,14 +52,18 @@ def test_html_is_self_contained(report_dir):
     html = (out / "report.html").read_text()
     n_figs = len(list((out / "figures").glob("*.png")))
     assert html.count("data:image/png;base64,") == n_figs
-    assert "src='figures/" not in html and "<link" not in html and "<script" not in html
-    assert "<table>" in html
+    assert "src='figures/" not in html and 'src="figures/' not in html and "<link" not in html
+    assert "<script src" not in html and html.count("<script>") == 1  # the inline table sorter only
+    assert '<table class="sortable">' in html
 
 
 def test_ranking_csv_and_results_json(report_dir):
     out = report_dir
     rows = list(csv.DictReader(io.StringIO((out / "ranking.csv").read_text())))
-    assert list(rows[0]) == list(COLUMNS)
+    assert list(rows[0]) == list(COLUMNS) + ["observable", "rss_unit", "rmse_unit"]
+    assert {(r["observable"], r["rss_unit"], r["rmse_unit"]) for r in rows if r["dataset"] == "synth-impact"} == {
+        ("omega", "(rad/s)^2", "rad/s")}
+    assert all(r["rmse_unit"] == "" for r in rows if r["dataset"].startswith("ALL"))
     per = [r for r in rows if r["dataset"] == "synth-impact"]
     assert {(r["law"], r["solver"]) for r in per} == {("wear", "exact"), ("wear", "series"), ("area-rate", "exact")}
     best = [r for r in per if r["rank"] == "1"]
@@ -107,11 +111,10 @@ def boot_report(tmp_path_factory):
 
 
 def _bootstrap_tables(c) -> str:
-    from frictionlab.report import Doc, _bootstrap_section
+    from frictionlab.report import bootstrap, build
+    from frictionlab.report.render import markdown
 
-    doc = Doc()
-    _bootstrap_section(doc, c)
-    md = doc.markdown()
+    md = markdown("t", build(c, modules=[bootstrap])[0])
     return md[md.index("### First place under resampling"):]
 
 

@@ -61,7 +61,7 @@ def parse_fix(law, items) -> dict:
 
 
 def run(args) -> int:
-    from ..report import _fit_json
+    from ..report import fit_json as _fit_json
 
     law = get_law(args.law)
     if args.json and not args.json.parent.is_dir():  # before the work, not after
@@ -73,7 +73,7 @@ def run(args) -> int:
     print(result.summary())
     if args.json:
         from ..io import atomic_write_text
-        from ..report import _clean
+        from ..report import clean as _clean
 
         atomic_write_text(args.json, json.dumps(_clean(_fit_json(result)), indent=1, allow_nan=False) + "\n")
     return 0 if result.status != "failed" else 1
