@@ -30,6 +30,7 @@ import attrs
 import numpy as np
 
 from .dataset import Dataset, builtin_names, load_dataset
+from . import equivalence as _equivalence, transfer as _transfer
 from .equivalence import MIN_REPLICATES, PAIRS, REPLICATES, EquivalenceResult, analyze_equivalence
 from .errors import FrictionLabError, ParameterError
 from .bootstrap import bootstrap_fits
@@ -282,6 +283,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     ranking = rank_fits(fits)
     kinds = {d.name: d.kind for d in dss}
     groups = rank_groups(ranking, kinds)
+    answers: tuple = ()  # the verdict layer's rows; the equivalence and transfer fields are filled here
+    answers = _transfer.fill_answers(_equivalence.fill_answers(answers, eq_results), transfer_results)
     return Comparison(laws=law_names, datasets=dss, fits=tuple(fits), ranking=tuple(ranking), groups=tuple(groups),
                       equivalence=tuple(eq_results), transfer=tuple(transfer_results), skipped_datasets=skipped_ds,
                       wall_time=time.perf_counter() - started, versions=versions(),
@@ -291,7 +294,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                                 "tolerance": [float(r) for r in tolerance], "replicates": int(replicates),
                                 "pairs": [list(p) for p in pairs], "transfer": bool(transfer)},
                       bootstrap=tuple(boots), bootstrap_skipped=boot_skipped, tolerance=tuple(tol_rows),
-                      timings=timings)
+                      timings=timings, answers=answers)
 
 
 class _Step:

@@ -378,3 +378,13 @@ def group_answer(results, datasets, pair: tuple[str, str] = PAIRS[0]) -> dict:
         text = f"the paper's series of {pair[0]} and {pair[1]} differ by more than the noise {thresholds(series)}"
     return {"equivalence": verdict(full), "equivalence_series": verdict(series), "noise_threshold": text,
             "details": {"equivalence": [e.as_dict() | {"t_a": None, "t_b": None} for e in mine]}}
+
+
+def fill_answers(answers, results) -> tuple:
+    """``answers`` (answers.Answer rows) with their equivalence fields filled from the tests ``results``."""
+    out = []
+    for a in answers:
+        g = group_answer(results, a.datasets)
+        out.append(attrs.evolve(a, equivalence=g["equivalence"], equivalence_series=g["equivalence_series"],
+                                noise_threshold=g["noise_threshold"], details={**a.details, **g["details"]}))
+    return tuple(out)

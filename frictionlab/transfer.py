@@ -247,3 +247,18 @@ def assemble(group: str, cands: dict, parts: dict) -> TransferResult:
     names = tuple(f.datasets[0] for f in next(iter(cands.values())))
     preds = tuple(p for c in cands for p in parts[c][0])
     return TransferResult(group=group, datasets=names, predictions=preds, shared=tuple(parts[c][1] for c in cands))
+
+
+def fill_answers(answers, results: Sequence[TransferResult]) -> tuple:
+    """``answers`` (answers.Answer rows) with the transfer field of each group that has a transfer result."""
+    by = {t.group: t for t in results}
+    out = []
+    for a in answers:
+        t = by.get(a.group)
+        if t is None:
+            out.append(a)
+            continue
+        d = t.as_dict()
+        out.append(attrs.evolve(a, transfer=t.answer(),
+                                details={**a.details, "transfer": {k: d[k] for k in ("ranking", "shared", "alpha")}}))
+    return tuple(out)

@@ -123,3 +123,11 @@ def test_group_answer_states_exact_and_series_separately():
     assert "rpm on synth-v1" in a["noise_threshold"] and "the paper's series of wear" in a["noise_threshold"]
     assert group_answer(results, ["other"])["equivalence"] == "not tested"
     assert results[0].decomposition is None and results[1].decomposition is not None  # series only
+    from frictionlab.answers import Answer
+    from frictionlab.equivalence import fill_answers
+
+    row = Answer(group="synth", datasets=("synth-v1",), provenance="synthetic", best=None, fits=False, headline="",
+                 goodness="", equivalence="not tested", noise_threshold="", series_vs_exact="")
+    (filled,) = fill_answers((row,), results)
+    assert (filled.equivalence, filled.equivalence_series) == (a["equivalence"], a["equivalence_series"])
+    assert filled.noise_threshold == a["noise_threshold"] and filled.details["equivalence"]

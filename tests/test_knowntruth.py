@@ -66,6 +66,14 @@ def test_transfer_verdicts_match_the_truth():
     assert {(p.source, p.target) for p in tr["kt-speeds"].predictions} == {("kt-speeds-v20", "kt-speeds-v40"),
                                                                           ("kt-speeds-v40", "kt-speeds-v20")}
     assert "yes for wear [exact]" in tr["kt-speeds"].answer() and "no, for no law" in tr["kt-twolam"].answer()
+    from frictionlab.answers import Answer
+    from frictionlab.transfer import fill_answers
+
+    rows = [Answer(group=g, datasets=tuple(tr[g].datasets), provenance="synthetic", best=None, fits=False, headline="",
+                   goodness="", equivalence="not tested", noise_threshold="", series_vs_exact="") for g in tr]
+    filled = {a.group: a for a in fill_answers(rows, c.transfer)}
+    assert filled["kt-speeds"].transfer == tr["kt-speeds"].answer()
+    assert filled["kt-twolam"].details["transfer"]["shared"][0]["serves"] is False
 
 
 def test_unregistered_law_is_fitted_by_no_registered_law():
