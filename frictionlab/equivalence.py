@@ -4,7 +4,9 @@
 B to one dataset (each with its own solver) and asks whether the data can tell them apart:
 
 1. Statistic: T = chi2_A - chi2_B on the data (noise-weighted by the dataset's declared sigma, so
-   T is -2 times the log-likelihood ratio of B against A). T > 0: B fits better.
+   with known noise T is -2 times the log-likelihood ratio of B against A; with an assumed sigma it
+   is a weighted difference of residual sums, calibrated by the same bootstrap). T > 0: B fits
+   better. T compares the two laws only: whether either fits is the goodness-of-fit test's question.
 2. Null distributions: R replicate datasets are simulated from each fit (its best-fit curve plus
    Gaussian noise of the declared sigma; replicate r draws from ``SeedSequence([seed, key]).spawn``,
    the same draws under both fits); both laws are refitted to every replicate (warm-started at

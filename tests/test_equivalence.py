@@ -131,3 +131,14 @@ def test_group_answer_states_exact_and_series_separately():
     (filled,) = fill_answers((row,), results)
     assert (filled.equivalence, filled.equivalence_series) == (a["equivalence"], a["equivalence_series"])
     assert filled.noise_threshold == a["noise_threshold"] and filled.details["equivalence"]
+
+
+def test_slow_pairs_are_left_out_with_the_reason():
+    from frictionlab.comparison import _slow_pair
+    from frictionlab.fitting import FitResult
+
+    ode = FitResult(law="wear", solver="ode", datasets=("x",), status="ok", cpu_time=2.5)
+    exact = FitResult(law="coulomb", solver="exact", datasets=("x",), status="ok")
+    why = _slow_pair(exact, ode, 40)
+    assert "wear [ode] needs the ODE solver" in why and "2.5 CPU s" in why and "160 times" in why
+    assert "--bootstrap-all" in why

@@ -110,6 +110,6 @@ def run(args) -> int:
     n_laws, n_data = len(result.laws), len(result.fitted_datasets)
     print(f"compared {n_laws} law{'s' * (n_laws != 1)} on {n_data} dataset{'s' * (n_data != 1)}: {ok} fits, "
           f"{sum(f.status == 'failed' for f in result.fits)} failed, {sum(f.status == 'skipped' for f in result.fits)} "
-          f"skipped, {len(result.equivalence)} equivalence tests, in {result.wall_time:.1f} s")
+          f"skipped, {sum(e.ok for e in result.equivalence)} equivalence tests, in {result.wall_time:.1f} s")
     print(f"report: {out / 'report.html'} (also report.md, ranking.csv, results.json, figures/)")
     return 0
