@@ -108,6 +108,15 @@ def test_compare_command_on_the_folder_matches_every_truth(run_cli, tmp_path):
         assert cw["verdict"] == "not equivalent"
         if truth in ("coulomb", "wear", "couette"):
             assert (cw["p_a"] < 0.05) == (truth != "coulomb")
+    # the unregistered law: no registered law (whatever is registered by then) describes its data
+    drag = [f for f in data["fits"] if f["dataset"] == "kt-drag-impact" and f["status"] == "ok"]
+    assert drag
+    for f in drag:
+        st = f["statistics"]
+        assert chi2_dist.sf(st["chisqr"], st["n_points"] - st["n_params"]) < 1e-6, (f["law"], f["solver"])
+    for a in data.get("answers", []):  # filled once the verdict layer is in
+        if a["group"] == "kt-drag":
+            assert a["headline"].startswith("no registered law describes these data"), a["headline"]
     tr = {t["group"]: t for t in data["transfer"]}
     serves = lambda g: {s["law"]: s["serves"] for s in tr[g]["shared"] if s["solver"] == "exact"}  # noqa: E731
     assert serves("kt-speeds")["wear"] is True and serves("kt-twolam")["wear"] is False
