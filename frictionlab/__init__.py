@@ -8,7 +8,7 @@ from .derive import derive_omega
 from .equivalence import EquivalenceResult, analyze_equivalence
 from .errors import FrictionLabError
 from .fitting import FitResult, ParamResult, Target, fit, make_target, predict, register_predictor
-from .law import AreaSlipForm, Contact, FrictionLaw, NormalAreaRateForm, ParamSpec
+from .law import AreaSlipForm, Contact, FrictionLaw, NormalAreaRateForm, ParamSpec, StateSpec
 from .plan import make_plan
 from .ranking import RankRow
 from .registry import available_laws, get_law, register_law, unregister_law
@@ -20,7 +20,7 @@ from .trajectory import Trajectory
 __version__ = "0.1.0"
 
 __all__ = [
-    "AreaSlipForm", "Contact", "Dataset", "FrictionLabError", "FrictionLaw", "NormalAreaRateForm", "ParamSpec",
+    "AreaSlipForm", "Contact", "Dataset", "FrictionLabError", "FrictionLaw", "NormalAreaRateForm", "ParamSpec", "StateSpec",
     "Scene", "Trajectory", "available_laws", "get_law", "load_dataset", "make_plan", "register_law", "simulate",
     "unregister_law",
     # fitting, ranking, comparison, report

@@ -254,6 +254,9 @@ def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol:
     tgrid = _time_grid(batch, t, n)
     T = np.broadcast_to(tgrid, (nsc, tgrid.shape[-1]))
     plan = make_plan(batch.view(), law, "batch scene")
+    if plan.law_states:
+        raise SolverError(f"batch: law '{law.name}' has internal state ({', '.join(law.state_names)}), which the "
+                          "explicit batch engine does not integrate (stiff); use simulate(..., solver='ode')")
     if "xi" in plan.states:
         raise SolverError("batch: tangential compliance is not supported; use simulate(..., solver='ode')")
     if solver in ("auto", "exact"):
@@ -522,11 +525,7 @@ def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rt
         dirs = direction[g_ids]
 
         def rhs(s, z):
-            t = s * tsc
-            y = z * ssc
-            u = stick.branch_slip(plan, plan.rigid_slip(y), dirs)
-            F, _ = plan.force(pv, t, y, u)
-            return plan.rates(t, y, F, u) * tsc / ssc
+            return plan.derivatives(pv, s * tsc, z * ssc, dirs) * tsc / ssc
 
         return rhs
 

@@ -80,6 +80,33 @@ class Comparison:
     def fitted_datasets(self) -> list[Dataset]:
         return [d for d in self.datasets if d.name not in self.skipped_datasets]
 
+    def to_dataframe(self):
+        """The ranking as a tidy pandas DataFrame: one row per dataset and candidate (law, solver), with
+        the observable and the units of rss and rmse; group rows (ALL, ALL[kind]) after them."""
+        from .frames import ranking_frame
+
+        return ranking_frame(self)
+
+    def parameters_dataframe(self):
+        """Every fitted parameter as a tidy pandas DataFrame: dataset, law, solver, parameter, value,
+        stderr, unit, kind, vary, fixed_by, lower, upper."""
+        from .frames import parameters_frame
+
+        return parameters_frame(self.fits)
+
+    def __repr__(self) -> str:
+        ok = sum(f.ok for f in self.fits)
+        best = "; ".join(f"{d.name}: " + " = ".join(r.candidate for r in self.ranking if r.dataset == d.name
+                                                    and r.rank == 1) for d in self.fitted_datasets[:3])
+        more = f"; ... {len(self.fitted_datasets) - 3} more" if len(self.fitted_datasets) > 3 else ""
+        return (f"<Comparison of {len(self.laws)} laws on {len(self.fitted_datasets)} datasets: {ok} fits; "
+                f"lowest AIC: {best}{more}>")
+
+    def _repr_html_(self) -> str:
+        from .frames import comparison_html
+
+        return comparison_html(self)
+
 
 def versions() -> dict:
     import lmfit
@@ -163,6 +190,24 @@ def _run(tasks, fn, pool, progress, done, total, label):
     return results, done
 
 
+#: The laws ``compare`` fits by default: the four of the mission (the seed paper's question). Other
+#: registered laws (stribeck, lugre, dahl, rate-and-state, installed plugins) join when named or with "all".
+DEFAULT_LAWS = ("coulomb", "area-rate", "wear", "couette")
+
+
+def select_laws(laws: Sequence[str] | None) -> tuple[str, ...]:
+    """Law names to compare: None -> DEFAULT_LAWS; "all" (alone or in the list) -> every registered law."""
+    if laws is None:
+        names = DEFAULT_LAWS
+    elif isinstance(laws, str):
+        names = (laws,)
+    else:
+        names = tuple(laws)
+    if "all" in names:
+        names = tuple(available_laws()) + tuple(n for n in names if n != "all")
+    return tuple(dict.fromkeys(get_law(n).name for n in names))
+
+
 def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None, solvers: Sequence[str] | None = None,
             *, free: dict | None = None, equivalence: bool = True, jobs: int = 1,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
@@ -170,7 +215,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             transfer: bool = True) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
 
-    laws: registered names (default all); datasets: built-in names, TOML paths or Datasets
+    laws: registered names, None for DEFAULT_LAWS, or "all" for every registered law; datasets: built-in names, TOML paths or Datasets
     (default every built-in); solvers: None for the default choice, or a list of 'exact',
     'series', 'ode[:METHOD]', 'auto'; free: scene quantities fitted per dataset, name -> (lower,
     upper) in SI (see fitting.SCENE_QUANTITIES); jobs: worker processes; progress(done, total, label).
@@ -193,7 +238,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     for r in tolerance:
         if isinstance(r, bool) or not isinstance(r, (int, float)) or not 0 < r < 1:
             raise ParameterError(f"compare: every tolerance must be a number in (0, 1), got {r!r}")
-    law_names = tuple(dict.fromkeys(get_law(n).name for n in (laws or available_laws())))
+    law_names = select_laws(laws)
     dss = _unique_datasets(load_dataset(d) for d in (datasets if datasets is not None else builtin_names()))
     if not dss:
         raise FrictionLabError("compare: no datasets to compare")
@@ -274,8 +319,9 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                 tol_rows = tolerance_stage()
             if bootstrap:
                 t0 = time.perf_counter()
-                boots, boot_skipped = bootstrap_fits(fits, bootstrap, seed, pool, bootstrap_all, free,
-                                                     progress=lambda name: step(f"bootstrap on {name}"))
+                boots, boot_skipped = bootstrap_fits(
+                    fits, bootstrap, seed, pool, bootstrap_all, free,
+                    progress=lambda name, k, n: step(f"bootstrap on {name}: {k}/{n} resamples", advance=k == n))
                 timings["bootstrap"] = time.perf_counter() - t0
             if tol_future is not None:
                 tol_rows = tol_future.result()
@@ -298,13 +344,13 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
 
 
 class _Step:
-    """Advances the progress count by one per finished stage item."""
+    """Advances the progress count by one per finished stage item (``advance=False``: only a new label)."""
 
     def __init__(self, progress, done, total):
         self.progress, self.done, self.total = progress, done, total
 
-    def __call__(self, label: str) -> None:
-        self.done += 1
+    def __call__(self, label: str, advance: bool = True) -> None:
+        self.done += bool(advance)
         if self.progress:
             self.progress(self.done, self.total, label)
 

@@ -5,12 +5,16 @@ State components (each only when called for):
   omega  spin [rad/s], theta rotation angle [rad]       effect 'spin' or 'slip-coupling'
   x      sliding length [m]                             area model 'growth' and the law uses A or dA/dt
   xi     tangential spring deflection [m]               effect 'compliance'
+  law:NAME  each internal state of a law with memory     the law declares ``states`` (law.py)
 
 Slip u is v, or v - r omega with 'slip-coupling'; with 'compliance' it is the slip of a
 massless contact patch, found from  F(u) = k xi + c (w - u),  w the rigid contact-point velocity;
 the body feels the spring and damper force k xi + c (w - u), which while the patch sticks (u = 0) is
 static friction up to the law's capacity. For the laws' closed-form families the patch slip is
 solved by hand, otherwise by root finding.
+
+``Plan.derivatives(p, t, y, direction)`` is the one right-hand side dy/dt of every integrator
+(solvers.ode and the batch engine): callers never assemble slip, force and rates themselves.
 """
 from __future__ import annotations
 
@@ -23,6 +27,9 @@ from scipy.optimize import brentq
 from .errors import SceneError
 from .law import QUANTITIES, AreaSlipForm, Contact, FrictionLaw, NormalAreaRateForm
 from .scene import G, GrowthArea, HertzNormal, Scene
+
+#: Prefix of a law's internal states in the plan's state vector ("law:theta" cannot clash with the spin angle).
+LAW_PREFIX = "law:"
 
 
 @attrs.frozen(eq=False)
@@ -51,14 +58,32 @@ class Plan:
     def has_spin(self) -> bool:
         return "omega" in self.states
 
+    @property
+    def law_states(self) -> tuple[str, ...]:
+        """The plan's names of the law's internal states ("law:z", ...); () for a memoryless law."""
+        return tuple(LAW_PREFIX + n for n in self.law.state_names)
+
     def index(self, name: str) -> int:
         return self.states.index(name)
 
-    def initial_state(self) -> np.ndarray:
+    def initial_state(self, p=None) -> np.ndarray:
+        """The state vector at t = 0; a law with memory needs its parameters ``p`` (SI) for its initial states."""
         s = self.scene
         values = {"v": s.u0 + (s.radius * s.omega0 if self.coupled else 0.0), "omega": s.omega0, "theta": 0.0,
                   "x": 0.0, "xi": 0.0}
-        return np.array(np.broadcast_arrays(*[values[k] for k in self.states]), dtype=float)
+        values.update({k: 0.0 for k in self.law_states})
+        y0 = np.array(np.broadcast_arrays(*[values[k] for k in self.states]), dtype=float)
+        if self.law_states:
+            if p is None:
+                raise SceneError(f"law '{self.law.name}' has internal states: its initial state needs the parameters")
+            y = y0.reshape(len(self.states), -1)
+            u = np.broadcast_to(self.rigid_slip(y), y.shape[1:])
+            c = attrs.evolve(self.contact(np.zeros(u.shape), y, u), state=None)
+            init = self.law.initial_states(p, c)
+            for name in self.law.state_names:
+                y[self.index(LAW_PREFIX + name)] = init[name]
+            y0 = y.reshape(y0.shape)
+        return y0
 
     # -- contact quantities ----------------------------------------------------------
     def rigid_slip(self, y: np.ndarray) -> np.ndarray:
@@ -80,8 +105,10 @@ class Plan:
         if self.needs_normal:
             N = s.normal(t, A)
         req = self.law.requires
+        state = {n: y[self.index(k)] for n, k in zip(self.law.state_names, self.law_states)} or None
         return Contact(t=np.asarray(t, dtype=float), u=np.asarray(u, dtype=float),
-                       N=N if "N" in req else None, A=A if "A" in req else None, dAdt=dAdt if "dAdt" in req else None)
+                       N=N if "N" in req else None, A=A if "A" in req else None, dAdt=dAdt if "dAdt" in req else None,
+                       state=state)
 
     def force(self, p, t, y, u) -> tuple[np.ndarray, Contact]:
         c = self.contact(t, y, u)
@@ -146,9 +173,29 @@ class Plan:
         k, c = self.scene.compliance.stiffness, self.scene.compliance.damping
         return k * float(y[self.index("xi")]) + c * float(self.rigid_slip(y)), 0.0
 
-    def rates(self, t, y, F, u) -> np.ndarray:
+    def derivatives(self, p, t, y, direction=0.0) -> np.ndarray:
+        """dy/dt at time t [s] for state y and law parameters p (SI): THE right-hand side of every integrator.
+
+        ``direction`` is the slip direction of the sliding phase (+1, -1; arrays for a batch), or 0
+        for none: a stage that overshoots zero slip then sees vanishing slip on the phase's side
+        (``stick.branch_slip``). Works on batches (y of shape (n_states, ...)).
+        """
+        if "xi" in self.states:
+            F, u = self.patch_force(p, t, y)
+            c = self.contact(np.asarray(t), y, np.asarray(u)) if self.law_states else None
+        else:
+            u = self.rigid_slip(y)
+            if np.any(direction):
+                from .solvers.stick import branch_slip
+
+                u = branch_slip(self, u, direction)
+            F, c = self.force(p, np.asarray(t), y, np.asarray(u))
+        return self._rates(p, t, y, F, u, c)
+
+    def _rates(self, p, t, y, F, u, c) -> np.ndarray:
         """Time derivatives of the state for friction force F and slip u (works on batches)."""
         s = self.scene
+        law_rates = self.law.evaluate_rates(p, c) if self.law_states else {}
         out = []
         for name in self.states:
             if name == "v":
@@ -161,7 +208,9 @@ class Plan:
                 out.append(np.abs(u))
             elif name == "xi":
                 out.append(self.rigid_slip(y) - u)
-        return np.array(out)
+            else:
+                out.append(law_rates[name[len(LAW_PREFIX):]])
+        return np.array(np.broadcast_arrays(*out), dtype=float)
 
 
 def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan:
@@ -195,5 +244,6 @@ def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan
         if scene.compliance is None or not scene.compliance.damping > 0:
             raise SceneError(f"{scene_name}: effect 'compliance' needs a positive stiffness and damping")
         states.append("xi")
+    states += [LAW_PREFIX + n for n in law.state_names]
     return Plan(scene=scene, law=law, states=tuple(states), coupled=coupled, needs_area=needs_area,
                 needs_normal=needs_normal)

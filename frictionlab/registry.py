@@ -14,7 +14,7 @@ import attrs
 import numpy as np
 
 from .errors import FrictionLabError, LawError, RegistryError
-from .law import QUANTITIES, Contact, FrictionLaw
+from .law import QUANTITIES, Contact, FrictionLaw, StateSpec
 
 GROUP = "frictionlab.laws"
 
@@ -39,7 +39,7 @@ def _as_law(obj, source: str) -> FrictionLaw:
 
 
 def validate_law(law: FrictionLaw, source: str) -> None:
-    """Check a law's declaration and probe its force once with its defaults."""
+    """Check a law's declaration and probe its force (and, for a law with memory, its rates) with its defaults."""
     for attr in ("name", "formula", "citation", "params", "requires"):
         if not hasattr(law, attr):
             raise LawError(f"law plugin {source}: missing class attribute '{attr}'")
@@ -52,6 +52,12 @@ def validate_law(law: FrictionLaw, source: str) -> None:
         )
     if "u" not in law.requires:
         raise LawError(f"law '{law.name}' ({source}): every law must require the slip velocity 'u'")
+    states = getattr(law, "states", ())
+    if not isinstance(states, tuple) or not all(isinstance(x, StateSpec) for x in states):
+        raise LawError(f"law '{law.name}' ({source}): states must be a tuple of frictionlab.StateSpec, got {states!r}")
+    names = [x.name for x in states]
+    if len(set(names)) != len(names):
+        raise LawError(f"law '{law.name}' ({source}): state names repeat: {names}")
     n = 5
     probe = Contact(
         t=np.linspace(0.0, 1e-3, n),
@@ -62,8 +68,15 @@ def validate_law(law: FrictionLaw, source: str) -> None:
     )
     p = law.defaults()
     try:
+        if states:  # forces at the initial states, and the rates there: finite, one array per state
+            probe = attrs.evolve(probe, state=law.initial_states(p, probe))
+            law.evaluate_rates(p, probe)
+            neg = attrs.evolve(probe, u=-probe.u)
+            probe_neg = attrs.evolve(neg, state=law.initial_states(p, attrs.evolve(neg, state=None)))
+        else:
+            probe_neg = attrs.evolve(probe, u=-probe.u)
         f_pos = law.evaluate(p, probe)
-        f_neg = law.evaluate(p, attrs.evolve(probe, u=-probe.u))
+        f_neg = law.evaluate(p, probe_neg)
     except FrictionLabError as exc:  # name the plugin, not only the law
         msg = str(exc)
         prefix = f"law '{law.name}': "
@@ -102,7 +115,11 @@ def _load() -> None:
             seen.add(key)
             source = f"entry point '{ep.name} = {ep.value}' of {dist_name}"
             try:
-                law = _as_law(ep.load(), source)
+                try:
+                    obj = ep.load()
+                except FrictionLabError as exc:  # e.g. a degenerate ParamSpec or StateSpec at import
+                    raise LawError(f"law plugin {source}: {exc}") from None
+                law = _as_law(obj, source)
             except FrictionLabError as exc:
                 warnings.warn(f"frictionlab: skipped law plugin: {exc}", PluginWarning, stacklevel=3)
                 continue

@@ -13,6 +13,7 @@ class Trajectory:
     """Sampled motion: time t [s], slip u [m/s], body velocity v [m/s], spin omega [rad/s],
     rotation angle theta [rad], friction force [N], and contact area A [m^2] and normal force
     N [N] where the plan built them. A body without a spin state has omega = theta = 0.
+    ``law_states`` holds a law's internal states by name (SI, e.g. {"z": ...}); empty for a memoryless law.
     """
 
     t: np.ndarray
@@ -27,6 +28,7 @@ class Trajectory:
     law: str = ""
     stick_time: float | None = None  # first time slip reached zero and stuck [s]
     info: dict = attrs.field(factory=dict)  # solver statistics (nfev, method, tolerances, ...)
+    law_states: dict = attrs.field(factory=dict)
 
     def __getitem__(self, name: str) -> np.ndarray:
         value = getattr(self, name, None)

@@ -172,15 +172,15 @@ def test_readme_law_example_runs_as_written(tmp_path, run_cli):
     (tmp_path / "my_laws.py").write_text(code)
     out = run_cli("--load", tmp_path / "my_laws.py", "laws", "--brief")
     assert out.returncode == 0, out.stderr
-    assert "stribeck" in out.stdout
+    assert "exp-stribeck" in out.stdout
     namespace = {}
     exec(compile(code, "my_laws.py", "exec"), namespace)
     try:
-        law = fl.get_law("stribeck")
+        law = fl.get_law("exp-stribeck")
         scene = fl.Scene(kind="incline", mass=0.1, u0=1.0, duration=0.05, normal=fl.scene.WeightNormal(1.0))
-        traj = fl.simulate("stribeck", scene, solver="ode", t=np.linspace(0, 0.05, 6))
+        traj = fl.simulate("exp-stribeck", scene, solver="ode", t=np.linspace(0, 0.05, 6))
         # mu between mu_k and mu_s, so the block decelerates at between 0.2 and 0.4 N / 0.1 kg
         assert 1.0 - 4.0 * 0.05 <= traj.v[-1] <= 1.0 - 2.0 * 0.05
         assert law.citation.startswith("R. Stribeck")
     finally:
-        fl.unregister_law("stribeck")
+        fl.unregister_law("exp-stribeck")

@@ -95,3 +95,17 @@ def test_table_numbers_keep_their_significant_figures():
     assert [fmt(x) for x in (1.0, 0.5, 12.5, 1100.0, 10090.4, 3.41391)] == ["1.000", "0.5000", "12.50", "1100",
                                                                             "10090", "3.414"]
     assert fmt(-5.349e11) == "-5.349e+11" and fmt(1e-4, 3) == "1.00e-04"
+
+
+def test_a_parameter_far_from_its_bounds_is_not_at_a_bound():
+    """lam = 1655 +/- 84 Pa s/m in [0, 1e13] is 20 standard errors from 0: no bound warning; lam pressed to 0 is."""
+    from frictionlab import fit
+
+    weak = synthetic("wear", {"lam": 1655.0}, seed=4, n=26, rel_noise=0.003, name="weak")
+    f = fit("wear", weak, solver="exact")
+    assert f.ok and f.value("lam") > 10 * f.stderr("lam")
+    assert f.identifiability.at_bounds == () and not any("bound" in w for w in f.identifiability.warnings)
+    none = synthetic("coulomb", {"mu": 0.2}, seed=4, n=26, name="backwards")
+    none = attrs.evolve(none, columns={**none.columns, "omega": -np.abs(none.columns["omega"])})
+    g = fit("wear", none, solver="exact")
+    assert "lam" in g.identifiability.at_bounds

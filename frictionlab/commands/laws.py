@@ -1,4 +1,4 @@
-"""``frictionlab laws``: list the registered laws with parameters, units, bounds and needs."""
+"""``frictionlab laws``: list the registered laws with parameters, units, bounds, needs and internal states."""
 from __future__ import annotations
 
 from ..law import QUANTITIES
@@ -7,7 +7,13 @@ from ..table import render
 
 
 def add_parser(sub):
-    p = sub.add_parser("laws", help="list the registered friction laws")
+    from ..cli import subcommand
+
+    p = subcommand(sub, "laws", help="list the registered friction laws",
+                   description="List the registered friction laws: formula, what each needs (N, A, dA/dt, u), "
+                               "citation, where it is defined, and its parameters with units, defaults and bounds.",
+                   examples="""  frictionlab laws --brief
+  frictionlab laws --load my_laws.py        # laws registered in your file appear in the list""")
     p.add_argument("--brief", action="store_true", help="one line per law")
     p.set_defaults(func=run)
 
@@ -16,7 +22,8 @@ def run(args) -> int:
     laws = available_laws()
     if args.brief:
         print(render([{"law": n, "formula": law.formula, "requires": ", ".join(sorted(law.requires)),
-                       "parameters": ", ".join(law.param_names)} for n, law in laws.items()]))
+                       "parameters": ", ".join(law.param_names), "states": ", ".join(law.state_names) or "-"}
+                      for n, law in laws.items()]))
         return 0
     for name, law in laws.items():
         print(f"{name}: {law.formula}")
@@ -26,6 +33,11 @@ def run(args) -> int:
         rows = [{"parameter": s.name, "unit": s.unit or "-", "default": s.default, "lower": s.lower, "upper": s.upper,
                  "scale": s.scale, "description": s.description} for s in law.params]
         print("    " + render(rows).replace("\n", "\n    "))
+        if law.states:
+            states = [{"state": s.name, "unit": s.unit or "-", "initial": s.initial, "scale": s.scale,
+                       "description": s.description} for s in law.states]
+            print("  internal states (integrated with the motion; ODE solver only):")
+            print("    " + render(states).replace("\n", "\n    "))
         for a, b in law.ratio_only:
             print(f"  note: {a} and {b} enter only as {a}/{b}; fix one to identify the other")
         print()

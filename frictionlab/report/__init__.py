@@ -30,11 +30,11 @@ and add ``mysection`` to ``SECTIONS`` at the place it belongs. Return None to le
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
 import attrs
 
+from ..errors import OutputError
 from ..io import atomic_dir
 from . import (bootstrap, datasets, derivation, equivalence, first_screen, fits, identifiability, method, ranking,
                summary, tolerance, transfer)
@@ -79,10 +79,9 @@ def write_report(c, out, force: bool = False, progress=None) -> Path:
     progress(done, total, label), if given, is called after each figure and file.
     """
     out = Path(out)
+    if out.exists() and not force:  # said in Python's terms; the command line checks before its work
+        raise OutputError(f"{out}: the folder exists; pass force=True to replace it, or choose another folder")
     with atomic_dir(out, force=force) as tmp:
-        umask = os.umask(0)
-        os.umask(umask)
-        tmp.chmod(0o777 & ~umask)  # mkdtemp makes it private; the report is meant to be read
         sections, extra = build(c)
         figs = [f for s in sections for f in s.figures]
         total, images = len(figs) + 1, {}

@@ -17,6 +17,7 @@ import numpy as np
 from .. import figures
 from ..answers import group_of
 from ..display import fmt_time
+from ..solvers.series import slip_zero
 from .doc import Section
 from .text import PROVENANCE_WORDS, sig
 
@@ -37,15 +38,6 @@ class SeriesFinding:
     t_cross: float | None  # s; None if the series' slip stays positive
     contact_time: float  # s
     full_min_slip: float  # m/s, the smallest slip of the exact (or ODE) solution during contact
-
-
-def slip_zero(t: np.ndarray, u: np.ndarray) -> float | None:
-    """The first time u crosses from positive to <= 0, linearly interpolated (None if it never does)."""
-    i = np.nonzero(u <= 0.0)[0]
-    if not len(i) or i[0] == 0:
-        return None
-    k = int(i[0])
-    return float(t[k - 1] + (t[k] - t[k - 1]) * u[k - 1] / (u[k - 1] - u[k]))
 
 
 def series_findings(c, law_order=("wear", "couette")) -> list[SeriesFinding]:

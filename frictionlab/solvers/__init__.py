@@ -37,7 +37,7 @@ def simulate(law, scene, params=None, solver: str = "ode", t=None, rtol: float =
 
     law: a registered name or a FrictionLaw; scene: a Scene or a Dataset (its ``[fixed]``
     parameters apply and its time column is the default ``t``); params: SI values overriding
-    the law's defaults; solver: 'exact', 'series', 'ode' or 'ode:METHOD'; t: sample times [s],
+    the law's defaults; solver: 'exact', 'series', 'ode' (LSODA) or 'ode:METHOD'; t: sample times [s],
     default n points over the scene's duration.
     """
     law = get_law(law)

@@ -11,9 +11,12 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from ..errors import SolverError
-from . import stick
 
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+
+#: Right-hand-side evaluations one sliding phase may take before it is stopped with an error (a
+#: problem too stiff for the method, e.g. rate-and-state friction as slip reaches zero).
+MAX_NFEV = 100_000
 
 #: Slip, relative to its scale, by which the zero-slip event waits past zero (see zero_slip).
 SLIP_MARGIN = 1e-12
@@ -25,8 +28,13 @@ def state_scales(plan, T: float) -> np.ndarray:
     r = 1.0 if s.radius is None else s.radius
     V = np.maximum(np.maximum(np.abs(s.u0), np.abs(plan.drive) * T), np.abs(s.omega0) * (0.0 if s.radius is None else r))
     V = np.where(V > 1e-300, V, 1.0)
-    size = {"v": V, "omega": V / r, "theta": V * T / r, "x": V * T, "xi": V * T}
+    size = {"v": V, "omega": V / r, "theta": V * T / r, "x": V * T, "xi": V * T, **law_state_scales(plan)}
     return np.array(np.broadcast_arrays(*[size[k] for k in plan.states]), dtype=float)
+
+
+def law_state_scales(plan) -> dict[str, float]:
+    """The declared scale of each internal state of the plan's law, by plan name ("law:z")."""
+    return {k: spec.scale for k, spec in zip(plan.law_states, plan.law.states)}
 
 
 def phase_scales(plan, p, t0: float, T: float, y0, direction: float) -> np.ndarray:
@@ -55,7 +63,7 @@ def phase_scales(plan, p, t0: float, T: float, y0, direction: float) -> np.ndarr
         F = largest_force(np.sign(plan.drive) * reach)
         V = max(V, reach * min(1.0, s.mass * abs(plan.drive) / F) if F > 0 else reach)
     V = V if V > 0 and np.isfinite(V) else 1.0
-    size = {"v": V, "x": V * span, "xi": V * span}
+    size = {"v": V, "x": V * span, "xi": V * span, **law_state_scales(plan)}
     if plan.has_spin:
         J = min(largest_force((direction or 1.0) * V) * span, (V + abs(plan.drive) * span) / plan.kappa)
         w = max(r * J / s.inertia, abs(s.omega0), 1e-12 * V / r)
@@ -82,18 +90,14 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
         tscale = T
         compliant = "xi" in plan.states
 
+        calls = [0]
 
         def f(s, z):
-            t = s * tscale
-            y = z * scale
-            if compliant:
-                F, u = plan.patch_force(p, t, y)
-            else:
-                u = plan.rigid_slip(y)
-                if direction != 0:
-                    u = stick.branch_slip(plan, u, direction)
-                F, _ = plan.force(p, np.asarray(t), y, np.asarray(u))
-            return plan.rates(t, y, F, u) * tscale / scale
+            calls[0] += 1
+            if calls[0] > MAX_NFEV:
+                raise SolverError(f"ode:{method}: law '{plan.law.name}' needed more than {MAX_NFEV} right-hand-side "
+                                  f"evaluations (stopped at t = {s * tscale:.6g} s): too stiff for {method} here")
+            return plan.derivatives(p, s * tscale, z * scale, direction) * tscale / scale
 
         events = None
         if not compliant and direction != 0:

@@ -4,6 +4,10 @@ A sliding-phase function has the signature
     slide(plan, p, t0, y0, direction, t_out) -> (Y_out, t_stop, y_stop, info)
 where Y_out holds the states at the times t_out (all >= t0, only those reached), t_stop is
 the time slip reached zero (None if it did not before t_out[-1] or the end), y_stop the state there.
+
+A law with memory is integrated in one phase through zero slip (direction 0: no stick event): its
+internal state carries what static friction there is (LuGre's bristles), and its force is
+continuous in the slip, so no stuck phase is needed.
 """
 from __future__ import annotations
 
@@ -25,13 +29,15 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
     sliding = np.zeros(n, dtype=bool)
     dirs = np.zeros(n)  # slip direction of the sliding phase each sample belongs to
     done = np.zeros(n, dtype=bool)
-    t0, y0 = 0.0, plan.initial_state()
+    t0, y0 = 0.0, plan.initial_state(p)
     info: dict = {"nfev": 0, "segments": 0}
     stick_time = None
     compliant = "xi" in plan.states
     u_start = float(plan.rigid_slip(y0))
     direction = float(np.sign(u_start))
-    if compliant or u_start != 0.0:
+    if plan.law_states:
+        phase, direction = "slide", 0.0
+    elif compliant or u_start != 0.0:
         phase = "slide"
     else:
         tb = stick.breakaway(plan, p, 0.0, max(T, 0.0), y0, 0.0)
@@ -95,14 +101,16 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
         if not np.all(np.isfinite(arr)):
             raise SolverError(f"{solver_name}: {name} became NaN or infinite for law '{plan.law.name}' with {dict(p)}")
     return Trajectory(t=t_eval, u=u, v=Y[0].copy(), omega=omega, theta=theta, force=F, A=A, N=c.N,
-                      solver=solver_name, law=plan.law.name, stick_time=stick_time, info=info)
+                      solver=solver_name, law=plan.law.name, stick_time=stick_time, info=info,
+                      law_states={n: Y[plan.index(k)].copy() for n, k in zip(plan.law.state_names, plan.law_states)})
 
 
 def _subset(c, mask):
     import attrs
 
-    return attrs.evolve(c, **{k: (getattr(c, k)[mask] if getattr(c, k) is not None else None)
-                              for k in ("t", "u", "N", "A", "dAdt")})
+    state = None if c.state is None else {k: v[mask] for k, v in c.state.items()}
+    return attrs.evolve(c, state=state, **{k: (getattr(c, k)[mask] if getattr(c, k) is not None else None)
+                                           for k in ("t", "u", "N", "A", "dAdt")})
 
 
 def _zero_slip(plan, y):

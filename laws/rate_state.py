@@ -1,0 +1,52 @@
+"""Dieterich-Ruina rate-and-state friction, shared by the aging and slip evolution laws.
+
+mu = mu0 + a ln(V/V0) + b ln(V0 theta/Dc),  F = mu N sign(V). Evaluated in the regularized form
+mu = a asinh(V/(2 V0) exp(psi/a)), psi = mu0 + b ln(V0 theta/Dc) (Rice and Ben-Zion 1996), which
+equals the log form to relative exp(-2 mu/a) (1e-50 at mu = 0.6, a = 0.01) and stays finite
+through V = 0. Steady state theta_ss = Dc/|V|, mu_ss = mu0 + (a - b) ln(|V|/V0).
+Software anchor: rsfmodel (Leeman et al., SciPy 2016).
+"""
+import numpy as np
+
+from frictionlab.law import FrictionLaw, ParamSpec, StateSpec
+
+#: Slip speed [m/s] below which the steady state is taken at this speed (theta_ss = Dc/|V| is infinite at 0).
+V_FLOOR = 1e-15
+
+
+def asinh_exp(L):
+    """asinh(exp(L)) without overflow, elementwise."""
+    L = np.asarray(L, dtype=float)
+    with np.errstate(over="ignore"):
+        big = L + np.log1p(np.sqrt(1.0 + np.exp(-2.0 * np.maximum(L, 0.0))))
+    return np.where(L > 0, big, np.arcsinh(np.exp(np.minimum(L, 0.0))))
+
+
+class RateState(FrictionLaw):
+    """Base of the two rate-and-state laws (not registered itself): subclasses define ``rates``."""
+
+    citation = ("Dieterich, J. Geophys. Res. 84 (1979); Ruina, J. Geophys. Res. 88 (1983); Marone, "
+                "Annu. Rev. Earth Planet. Sci. 26 (1998)")
+    params = (
+        ParamSpec("mu0", "", 0.6, 0.0, 2.0, 0.1, "steady-state friction at V0"),
+        ParamSpec("a", "", 0.01, 1e-5, 0.5, 0.01, "direct-effect parameter"),
+        ParamSpec("b", "", 0.01, 0.0, 0.5, 0.01, "evolution-effect parameter"),
+        ParamSpec("Dc", "m", 1e-5, 1e-9, 1.0, 1e-5, "critical slip distance"),
+        ParamSpec("V0", "m/s", 1e-6, 1e-12, 1e3, 1e-6, "reference slip speed (fix it: it trades off with mu0)"),
+    )
+    requires = frozenset({"u", "N"})
+    states = (StateSpec("theta", "s", "steady", 1.0, "state variable (contact age)"),)
+
+    def mu(self, p, V, theta):
+        """Friction coefficient [-] at slip speed V [m/s] and state theta [s] (signed like V)."""
+        V = np.asarray(V, dtype=float)
+        psi = p["mu0"] + p["b"] * np.log(p["V0"] * np.maximum(theta, 1e-300) / p["Dc"])
+        with np.errstate(divide="ignore"):
+            L = np.log(np.abs(V) / (2.0 * p["V0"])) + psi / p["a"]
+        return p["a"] * np.sign(V) * asinh_exp(L)
+
+    def force(self, p, c):
+        return c.N * self.mu(p, c.u, c.state["theta"])
+
+    def steady_state(self, p, c):
+        return {"theta": p["Dc"] / np.maximum(np.abs(c.u), V_FLOOR)}
