@@ -13,7 +13,9 @@ B to one dataset (each with its own solver) and asks whether the data can tell t
    their best fits, closed forms where the law has one) and T recomputed. Large T speaks against
    A, small T against B: p_A = P(T* >= T | A), p_B = P(T* <= T | B), each (1 + count) / (R + 1)
    with ties (|dT| within TIE_REL of the chi-square scale: the same curve) counted half; their
-   Monte-Carlo standard error sqrt(p (1 - p) / R) is reported.
+   Monte-Carlo standard error sqrt(p (1 - p) / R) is reported. The other tails are reported too
+   (q_A = P(T* <= T | A), q_B = P(T* >= T | B)): T beyond the favoured law's own replicates on its
+   favourable side means the data are not like that law's either (neither law produces them).
 3. Overlap of the two nulls: the power of the test at level ALPHA, i.e. how often data from B
    reject A (T* under B beyond the (1 - ALPHA) quantile under A) and vice versa.
 
@@ -103,6 +105,8 @@ class EquivalenceResult:
     t_b: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # T on replicates of B's fit
     p_a: float = math.nan  # P(T* >= T | A): small rejects A
     p_b: float = math.nan  # P(T* <= T | B): small rejects B
+    q_a: float = math.nan  # P(T* <= T | A): small means T lies beyond A's replicates on A's favourable side
+    q_b: float = math.nan  # P(T* >= T | B): likewise for B
     power_a: float = math.nan  # share of B's replicates that reject A at ALPHA
     power_b: float = math.nan  # share of A's replicates that reject B at ALPHA
     failed: int = 0  # replicates dropped because a refit failed
@@ -293,7 +297,8 @@ def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = RE
     crit_a, crit_b = float(np.quantile(t_a, 1 - ALPHA)), float(np.quantile(t_b, ALPHA))
     power_a = float(np.mean(t_b > crit_a + tol))  # data from B that reject A
     power_b = float(np.mean(t_a < crit_b - tol))  # data from A that reject B
-    res.update(p_a=p_a, p_b=p_b, power_a=power_a, power_b=power_b)
+    res.update(p_a=p_a, p_b=p_b, power_a=power_a, power_b=power_b, q_a=_p_upper(-t_a, -t_obs, tol),
+               q_b=_p_upper(t_b, t_obs, tol))
     verdict, why = _verdict(EquivalenceResult(**res, status="ok"))
     return EquivalenceResult(**res, status="ok", verdict=verdict, explanation=why)
 
@@ -331,7 +336,12 @@ def _verdict(e: EquivalenceResult) -> tuple[str, str]:
             which = f"the data reject both {a} and {b} (T lies outside both null distributions)"
         else:
             bad, good = (a, b) if rej_a else (b, a)
-            which = f"the data reject {bad} and are consistent with {good}"
+            q = e.q_b if rej_a else e.q_a
+            if q < ALPHA:
+                which = (f"the data reject {bad}, and T lies beyond {good}'s replicates on its favourable side "
+                         f"(p = {q:.2g}): the data are not like {good}'s either")
+            else:
+                which = f"the data reject {bad} and are consistent with {good}"
         return "not equivalent", f"{head}: {which}; {power}. {thr}."
     if max(e.power_a, e.power_b) < POWER:
         return "equivalent", (f"{head}: T is consistent with both and the two null distributions overlap ({power}): "

@@ -76,8 +76,8 @@ class SharedFit:
     dk: int = 0
     p_value: float = math.nan
     delta_aic: float = math.nan  # AIC_shared - AIC_separate = lr - 2 dk (known noise)
-    shared: dict = attrs.field(factory=dict)  # param -> SI value of the shared fit
-    separate: dict = attrs.field(factory=dict)  # dataset -> {param: SI value}
+    shared: dict = attrs.field(factory=dict)  # param -> SI value of the shared fit (eta/h for a ratio-only pair)
+    separate: dict = attrs.field(factory=dict)  # dataset -> {param: SI value}, likewise
 
     @property
     def candidate(self) -> str:
@@ -151,6 +151,13 @@ def _law_params(f: FitResult) -> dict:
     return {p.key: p.value for p in f.params.values() if p.kind == "law"}
 
 
+def _determined(f: FitResult) -> dict:
+    """The fitted law values the data determine (SI): ratio-only pairs replaced by their ratio (eta/h)."""
+    ratio = {k for pair in (f.identifiability.ratio_only if f.identifiability else ()) for k in pair}
+    return {p.name: p.value for p in f.params.values()
+            if (p.kind == "law" and p.vary and p.name not in ratio) or p.kind == "derived"}
+
+
 def predict_from(source: FitResult, target: FitResult) -> Prediction:
     """``source``'s law parameters predicting ``target``'s data (same law and solver), on the
     target's own scene and with its ``[fixed]`` values."""
@@ -179,8 +186,7 @@ def shared_fit(fits: Sequence[FitResult], free: dict | None = None) -> SharedFit
     law, solver = fits[0].law, fits[0].solver
     names = tuple(f.datasets[0] for f in fits)
     base = dict(law=law, solver=solver, datasets=names,
-                separate={f.datasets[0]: {k: p.value for k, p in f.params.items() if p.kind == "law" and p.vary}
-                          for f in fits})
+                separate={f.datasets[0]: _determined(f) for f in fits})
     targets = [f.per_dataset[0].target for f in fits]
     chi2_sep, k_sep = sum(f.stats.chisqr for f in fits), sum(f.stats.n_params for f in fits)
     best = None
@@ -199,7 +205,7 @@ def shared_fit(fits: Sequence[FitResult], free: dict | None = None) -> SharedFit
     p = float(chi2_dist.sf(max(lr, 0.0), dk))
     return SharedFit(**base, status="ok", chi2_shared=best.stats.chisqr, k_shared=best.stats.n_params,
                      chi2_separate=chi2_sep, k_separate=k_sep, lr=lr, dk=dk, p_value=p, delta_aic=lr - 2 * dk,
-                     shared={p.key: p.value for p in best.params.values() if p.kind == "law" and p.vary})
+                     shared=_determined(best))
 
 
 def transfer_candidate(fits: Sequence[FitResult], free: dict | None = None) -> tuple[list[Prediction], SharedFit]:

@@ -28,7 +28,9 @@ def add_parser(sub):
   frictionlab compare --bootstrap 0 --no-tolerance --quiet --out quick   # fastest, no progress lines""")
     p.add_argument("--laws", "--law", action=ListAction, metavar="NAME", help="law names, or 'all' for every registered law "
                    "(default: coulomb, area-rate, wear, couette)")
-    p.add_argument("--data", action=ListAction, metavar="NAME_OR_TOML", help="datasets (default: every built-in)")
+    p.add_argument("--data", action=ListAction, nargs="+", metavar="NAME_OR_TOML",
+                   help="datasets, several after one --data (e.g. a shell glob), comma-separated or repeated "
+                        "(default: every built-in)")
     p.add_argument("--solver", "--solvers", action=ListAction, metavar="SOLVER",
                    help="exact, series, ode[:METHOD] or auto (default: exact where a closed form exists else ode, "
                         "plus series where it applies)")

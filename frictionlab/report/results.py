@@ -18,7 +18,7 @@ results.json:
     answers[Answer.as_dict()] (answers.py; empty until the verdict layer fills them),
     series_slip_zero_s{dataset: time the fitted truncated series' slip crosses zero, null if never},
     equivalence[EquivalenceResult.as_dict(): {dataset, law_a, law_b, solver_a, solver_b, status, verdict,
-                 explanation, reason, replicates, seed, n_points, chi2{}, k{}, t_obs, t_a[], t_b[], p_a, p_b,
+                 explanation, reason, replicates, seed, n_points, chi2{}, k{}, t_obs, t_a[], t_b[], p_a, p_b, q_a, q_b,
                  p_a_mc_error, p_b_mc_error, power_a, power_b, failed, d_ab, d_ba, sigma, sigma_varies,
                  observable, threshold, threshold_text, alpha, power_level, critical_dchi2, fitted{},
                  decomposition{b, u0, c_area, c_area_rate, mu, eta_prime, r2} | null}],
