@@ -12,9 +12,10 @@ that fitted every member:
   (28 -> 61 and 61 -> 28); candidates are ranked by their summed predictive chi2.
 * Shared against separate: one global fit with a single law parameter set for the whole group
   (``fitting.fit`` on all members; started from each member's own fit, the lowest chi2 kept)
-  against the members' separate fits. With known noise the likelihood-ratio statistic is
-  LR = chi2_shared - chi2_separate, asymptotically chi-square with dk = k_separate - k_shared
-  degrees of freedom (p-value), and delta-AIC = AIC_shared - AIC_separate = LR - 2 dk.
+  against the members' separate fits. The likelihood-ratio statistic LR = -2 ln L_shared +
+  2 ln L_separate (with known noise: chi2_shared - chi2_separate; with an assumed sigma profiled per
+  dataset, from ``Stats.neg2loglik`` when the fit carries it) is asymptotically chi-square with
+  dk = k_separate - k_shared degrees of freedom (p-value); delta-AIC = AIC_shared - AIC_separate = LR - 2 dk.
   One parameter set serves the group when p >= ALPHA (the data do not ask for separate values).
 
 ``transfer(fits, group_of=answers.group_of)`` returns one ``TransferResult`` per group with at
@@ -68,9 +69,9 @@ class SharedFit:
     datasets: tuple[str, ...]
     status: str  # ok | failed | skipped
     reason: str = ""
-    chi2_shared: float = math.nan
+    chi2_shared: float = math.nan  # -2 ln L of the shared fit (chi2 with known noise; see _neg2ll)
     k_shared: int = 0
-    chi2_separate: float = math.nan
+    chi2_separate: float = math.nan  # sum of the separate fits' -2 ln L
     k_separate: int = 0
     lr: float = math.nan  # chi2_shared - chi2_separate
     dk: int = 0
@@ -151,6 +152,18 @@ def _law_params(f: FitResult) -> dict:
     return {p.key: p.value for p in f.params.values() if p.kind == "law"}
 
 
+def _neg2ll(f: FitResult) -> float:
+    """-2 ln L of a fit from the likelihood its datasets' noise calls for (``Stats.neg2loglik``), else its
+    chi-square at the declared sigma (the two differ by a constant with known noise)."""
+    v = getattr(f.stats, "neg2loglik", math.nan)
+    return float(v) if math.isfinite(v) else float(f.stats.chisqr)
+
+
+def _k(f: FitResult) -> int:
+    """Parameters the likelihood counts (``Stats.k_lik``: plus a profiled sigma per assumed-noise dataset)."""
+    return int(getattr(f.stats, "k_lik", 0) or f.stats.n_params)
+
+
 def _determined(f: FitResult) -> dict:
     """The fitted law values the data determine (SI): ratio-only pairs replaced by their ratio (eta/h)."""
     ratio = {k for pair in (f.identifiability.ratio_only if f.identifiability else ()) for k in pair}
@@ -188,7 +201,9 @@ def shared_fit(fits: Sequence[FitResult], free: dict | None = None) -> SharedFit
     base = dict(law=law, solver=solver, datasets=names,
                 separate={f.datasets[0]: _determined(f) for f in fits})
     targets = [f.per_dataset[0].target for f in fits]
-    chi2_sep, k_sep = sum(f.stats.chisqr for f in fits), sum(f.stats.n_params for f in fits)
+    if any(getattr(f.stats, "likelihood", "known") == "none" for f in fits):
+        return SharedFit(**base, status="skipped", reason="a member's fit has no likelihood (a derived series)")
+    chi2_sep, k_sep = sum(_neg2ll(f) for f in fits), sum(_k(f) for f in fits)
     best = None
     for f in sorted(fits, key=lambda f: f.stats.chisqr):
         start = {p.key: p.value for p in f.params.values() if p.kind == "law" and p.vary}
@@ -197,13 +212,12 @@ def shared_fit(fits: Sequence[FitResult], free: dict | None = None) -> SharedFit
             best = r
     if best is None:
         return SharedFit(**base, status="failed", reason="the shared fit did not succeed from any member's parameters")
-    lr, dk = best.stats.chisqr - chi2_sep, k_sep - best.stats.n_params
+    lr, dk = _neg2ll(best) - chi2_sep, k_sep - _k(best)
     if dk <= 0:
         return SharedFit(**base, status="skipped", reason="no law parameter is fitted per dataset: nothing to share",
-                         chi2_shared=best.stats.chisqr, k_shared=best.stats.n_params, chi2_separate=chi2_sep,
-                         k_separate=k_sep)
+                         chi2_shared=_neg2ll(best), k_shared=_k(best), chi2_separate=chi2_sep, k_separate=k_sep)
     p = float(chi2_dist.sf(max(lr, 0.0), dk))
-    return SharedFit(**base, status="ok", chi2_shared=best.stats.chisqr, k_shared=best.stats.n_params,
+    return SharedFit(**base, status="ok", chi2_shared=_neg2ll(best), k_shared=_k(best),
                      chi2_separate=chi2_sep, k_separate=k_sep, lr=lr, dk=dk, p_value=p, delta_aic=lr - 2 * dk,
                      shared=_determined(best))
 
