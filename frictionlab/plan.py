@@ -4,14 +4,16 @@ State components (each only when called for):
   v      body tangential velocity [m/s]                 always
   omega  spin [rad/s], theta rotation angle [rad]       effect 'spin' or 'slip-coupling'
   x      sliding length [m]                             area model 'growth' and the law uses A or dA/dt
-  xi     tangential spring deflection [m]               effect 'compliance'
+  xi     tangential spring deflection [m]               effect 'compliance' (for 'mindlin' the
+         elastic deflection S / k_t(t) of the spring force S; frictionlab.contact)
   law:NAME  each internal state of a law with memory     the law declares ``states`` (law.py)
 
 Slip u is v, or v - r omega with 'slip-coupling'; with 'compliance' it is the slip of a
 massless contact patch, found from  F(u) = k xi + c (w - u),  w the rigid contact-point velocity;
 the body feels the spring and damper force k xi + c (w - u), which while the patch sticks (u = 0) is
 static friction up to the law's capacity. For the laws' closed-form families the patch slip is
-solved by hand, otherwise by root finding.
+solved by hand, otherwise by root finding. k and c are constants for model 'linear' and follow
+the contact radius for 'mindlin' (``Plan.spring``).
 
 ``Plan.derivatives(p, t, y, direction)`` is the one right-hand side dy/dt of every integrator
 (solvers.ode and the batch engine): callers never assemble slip, force and rates themselves.
@@ -114,9 +116,17 @@ class Plan:
         c = self.contact(t, y, u)
         return self.law.evaluate(p, c), c
 
+    def spring(self, t, y) -> tuple[float, float, float]:
+        """(k [N/m], c [N s/m], loading rate (da/dt)/a [1/s]) of the tangential compliance at time t."""
+        comp = self.scene.compliance
+        if comp.model == "linear":
+            return comp.stiffness, comp.damping, 0.0
+        A, dAdt = self.area(np.array([t]), y[:, None], np.array([0.0]))
+        return comp.spring(float(A[0]), float(dAdt[0]), 1.0 / self.kappa)
+
     def patch_slip(self, p, t, y) -> float:
         """Slip of the compliant contact patch: the root of F(u) + c u = k xi + c w (scalar state)."""
-        k, c = self.scene.compliance.stiffness, self.scene.compliance.damping
+        k, c, _ = self.spring(t, y)
         w = float(self.rigid_slip(y))
         target = k * y[self.index("xi")] + c * w
         fast = self._patch_slip_closed_form(p, t, y, target, c)
@@ -170,7 +180,7 @@ class Plan:
         if u != 0.0:  # slipping: the balance F(u) = k xi + c (w - u) holds, take the law's value
             f, _ = self.force(p, np.array([t]), y[:, None], np.array([u]))
             return float(f[0]), u
-        k, c = self.scene.compliance.stiffness, self.scene.compliance.damping
+        k, c, _ = self.spring(t, y)
         return k * float(y[self.index("xi")]) + c * float(self.rigid_slip(y)), 0.0
 
     def derivatives(self, p, t, y, direction=0.0) -> np.ndarray:
@@ -207,7 +217,8 @@ class Plan:
             elif name == "x":
                 out.append(np.abs(u))
             elif name == "xi":
-                out.append(self.rigid_slip(y) - u)
+                loading = self.spring(t, y)[2] if s.compliance.model != "linear" else 0.0
+                out.append(self.rigid_slip(y) - u - loading * y[self.index("xi")])
             else:
                 out.append(law_rates[name[len(LAW_PREFIX):]])
         return np.array(np.broadcast_arrays(*out), dtype=float)
@@ -241,8 +252,12 @@ def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan
     if needs_area and isinstance(scene.area, GrowthArea):
         states.append("x")
     if "compliance" in effects:
-        if scene.compliance is None or not scene.compliance.damping > 0:
-            raise SceneError(f"{scene_name}: effect 'compliance' needs a positive stiffness and damping")
+        if scene.compliance is None:
+            raise SceneError(f"{scene_name}: effect 'compliance' needs a compliance model (linear or mindlin)")
+        if scene.compliance.model == "mindlin":
+            if scene.area is None:
+                raise SceneError(f"{scene_name}: compliance model 'mindlin' takes the contact radius from the "
+                                 "contact area: add a [scene.area] model (hertz or half-sine)")
         states.append("xi")
     states += [LAW_PREFIX + n for n in law.state_names]
     return Plan(scene=scene, law=law, states=tuple(states), coupled=coupled, needs_area=needs_area,
