@@ -352,13 +352,11 @@ def predict_outcomes(law, dataset_or_scene, params: Mapping[str, float] | None =
     speed, incidence, normal_speed, tangential_speed, restitution, contact_time [s],
     rebound_speed_t (v_t2) [m/s] and rolled (slip stopped during contact, bool).
     """
-    from .dataset import Dataset
     from .registry import get_law
-    from .solvers import simulate
 
     law = get_law(law)
     fixed = {}
-    if isinstance(dataset_or_scene, Dataset):
+    if not isinstance(dataset_or_scene, OutcomeScene) and hasattr(dataset_or_scene, "columns"):  # a Dataset
         ds = dataset_or_scene
         if ds.kind != "impact-outcome":
             raise DatasetError(f"dataset '{ds.name}' is a {ds.kind} dataset; predict_outcomes needs an impact-outcome one")
@@ -383,27 +381,29 @@ def predict_outcomes(law, dataset_or_scene, params: Mapping[str, float] | None =
                                      "rebound_speed_t", "cm_tangential_cor", "contact_rebound_angle")}
     out["rolled"] = np.zeros(n, dtype=bool)
     r = template.radius
+    imps = []
     for i in range(n):
         try:
-            imp = template.impact(float(rows["speed"][i]), float(rows["incidence"][i]), float(rows["spin"][i]))
+            imps.append(template.impact(float(rows["speed"][i]), float(rows["incidence"][i]), float(rows["spin"][i])))
         except SceneError as exc:
             raise SceneError(f"row {i + 1}: {exc}") from None
-        tr = simulate(law, imp.scene, p, solver=solver, t=np.array([0.0, imp.contact_time]), rtol=rtol)
-        v2, w2 = float(tr.v[-1]), float(tr.omega[-1])
-        slip_in = imp.tangential_speed - r * imp.spin
-        if slip_in == 0.0:
+        if imps[-1].tangential_speed - r * imps[-1].spin == 0.0:
             raise SceneError(f"row {i + 1}: the contact point does not slip on arrival (v_t = r omega), "
                              "so its tangential restitution is undefined")
+    v2, w2, rolled = _rebounds(law, imps, p, solver, rtol)
+    for i, imp in enumerate(imps):
+        slip_in = imp.tangential_speed - r * imp.spin
         vn2 = imp.restitution * imp.normal_speed
-        angle = math.atan2(v2, vn2) if template.angle_reference == "normal" else math.atan2(vn2, v2)
-        cm_cor = v2 / imp.tangential_speed if imp.tangential_speed != 0.0 else math.nan
+        angle = math.atan2(v2[i], vn2) if template.angle_reference == "normal" else math.atan2(vn2, v2[i])
+        cm_cor = v2[i] / imp.tangential_speed if imp.tangential_speed != 0.0 else math.nan
         for k, v in (("speed", rows["speed"][i]), ("incidence", rows["incidence"][i]),
                      ("normal_speed", imp.normal_speed), ("tangential_speed", imp.tangential_speed),
-                     ("restitution", imp.restitution), ("contact_time", imp.contact_time), ("rebound_spin", w2),
-                     ("tangential_cor", 0.0 - (v2 - r * w2) / slip_in), ("rebound_angle", angle), ("rebound_speed_t", v2),
-                     ("cm_tangential_cor", cm_cor), ("contact_rebound_angle", math.atan2(v2 - r * w2, vn2))):
+                     ("restitution", imp.restitution), ("contact_time", imp.contact_time), ("rebound_spin", w2[i]),
+                     ("tangential_cor", 0.0 - (v2[i] - r * w2[i]) / slip_in), ("rebound_angle", angle),
+                     ("rebound_speed_t", v2[i]), ("cm_tangential_cor", cm_cor),
+                     ("contact_rebound_angle", math.atan2(v2[i] - r * w2[i], vn2))):
             out[k][i] = v
-        out["rolled"][i] = tr.stick_time is not None
+    out["rolled"][:] = rolled
     out["normal_cor"] = out["restitution"].copy()
     if template.materials is not None and template.friction is not None:
         kappa, mu = template.materials.stiffness_ratio, template.friction
@@ -413,20 +413,27 @@ def predict_outcomes(law, dataset_or_scene, params: Mapping[str, float] | None =
     return out
 
 
-# --- fitting: the impact-outcome predictor ---------------------------------------------------------
-def outcome_predictor(law, target, scene, params, solver, rtol: float | None = None):
-    """Model of an impact-outcome target for ``frictionlab.predict``: the observable outcome per row, SI,
-    row by row through ``predict_outcomes`` (registered for the 'impact-outcome' kind in predict.py),
-    ODEs solved to ``rtol`` (None: FIT_RTOL)."""
-    from .predict import FIT_RTOL, SkipDataset
+def _rebounds(law, imps, p, solver, rtol):
+    """Tangential velocity [m/s] and spin [rad/s] at the end of each impact, and whether its slip stopped.
 
-    if target.observable not in OUTCOMES:
-        raise SkipDataset(f"dataset '{target.name}': '{target.observable}' is not an impact outcome "
-                          f"({', '.join(OUTCOMES)})")
-    if target.observable in ("psi1", "psi2") and (scene.materials is None or scene.friction is None):
-        raise SkipDataset(f"dataset '{target.name}': {target.observable} needs [scene.materials] with the "
-                          "moduli and the stated friction coefficient")
-    rows = rows_of(target.dataset)
-    return predict_outcomes(law, scene, params, solver, speed=rows["speed"], incidence=rows["incidence"],
-                            spin=rows["spin"], rtol=FIT_RTOL if rtol is None else rtol)[target.observable]
+    The closed forms run on the batch engine (``batch.simulate_batch``, one vectorized call for all
+    rows; tests check it equals the row-by-row solve) when the rows' scenes share one structure;
+    otherwise, for the ODE solver, or when the batch refuses, each row is simulated alone (which
+    also names the row in any error)."""
+    from .errors import FrictionLabError
+    from .solvers import simulate
 
+    if solver == "exact" and len(imps) > 1:
+        from .batch import SceneBatch, simulate_batch
+
+        try:
+            t = np.array([[0.0, imp.contact_time] for imp in imps])
+            br = simulate_batch(law, SceneBatch.from_scenes([imp.scene for imp in imps]), p, t=t, solver="exact")
+            return br.v[:, -1], br.omega[:, -1], ~np.isnan(br.stick_time)
+        except FrictionLabError:
+            pass  # the row-by-row path below gives the answer or the error naming the row
+    v2, w2, rolled = (np.empty(len(imps)) for _ in range(3))
+    for i, imp in enumerate(imps):
+        tr = simulate(law, imp.scene, p, solver=solver, t=np.array([0.0, imp.contact_time]), rtol=rtol)
+        v2[i], w2[i], rolled[i] = float(tr.v[-1]), float(tr.omega[-1]), tr.stick_time is not None
+    return v2, w2, rolled.astype(bool)

@@ -107,7 +107,8 @@ class Plan:
         if self.needs_normal:
             N = s.normal(t, A)
         req = self.law.requires
-        state = {n: y[self.index(k)] for n, k in zip(self.law.state_names, self.law_states)} or None
+        state = ({n: y[self.index(k)] for n, k in zip(self.law.state_names, self.law_states)} or None
+                 if self.law.states else None)
         return Contact(t=np.asarray(t, dtype=float), u=np.asarray(u, dtype=float),
                        N=N if "N" in req else None, A=A if "A" in req else None, dAdt=dAdt if "dAdt" in req else None,
                        state=state)
@@ -190,6 +191,8 @@ class Plan:
         for none: a stage that overshoots zero slip then sees vanishing slip on the phase's side
         (``stick.branch_slip``). Works on batches (y of shape (n_states, ...)).
         """
+        if not self.law.states and np.ndim(y) == 1 and np.ndim(direction) == 0 and "xi" not in self.states:
+            return self._one_state(p, t, y, float(direction))
         if "xi" in self.states:
             F, u = self.patch_force(p, t, y)
             c = self.contact(np.asarray(t), y, np.asarray(u)) if self.law_states else None
@@ -201,6 +204,32 @@ class Plan:
                 u = branch_slip(self, u, direction)
             F, c = self.force(p, np.asarray(t), y, np.asarray(u))
         return self._rates(p, t, y, F, u, c)
+
+    def _one_state(self, p, t, y, direction: float) -> np.ndarray:
+        """``derivatives`` for one state vector of a memoryless law without compliance (every scalar ODE
+        solve): the same arithmetic on Python floats, bitwise equal to the general path (tests check it),
+        without its array bookkeeping. The law's force is checked by ``FrictionLaw.evaluate`` (the
+        one-line error) only when it is not a finite number of the right shape."""
+        s = self.scene
+        v = float(y[0])
+        u = v - s.radius * float(y[self.index("omega")]) if self.coupled else v
+        if direction != 0.0 and not direction * u > 0:
+            from .solvers.stick import vanishing_slip
+
+            u = direction * float(vanishing_slip(self))
+        c = self.contact(t, y, u)
+        try:
+            f = self.law.force(p, c)
+            F = float(f) if np.ndim(f) == 0 else math.nan
+        except Exception:
+            F = math.nan
+        if not math.isfinite(F):
+            F = float(self.law.evaluate(p, c))  # raises the law's one-line error, or F was right after all
+        rate = {"v": self.drive - F / s.mass, "x": abs(u)}
+        if self.has_spin:
+            rate["omega"] = F * s.radius / s.inertia
+            rate["theta"] = float(y[self.index("omega")])
+        return np.array([rate[k] for k in self.states])
 
     def _rates(self, p, t, y, F, u, c) -> np.ndarray:
         """Time derivatives of the state for friction force F and slip u (works on batches)."""
