@@ -142,3 +142,10 @@ def test_slow_pairs_are_left_out_with_the_reason():
     why = _slow_pair(exact, ode, 40)
     assert "wear [ode] needs the ODE solver" in why and "2.5 CPU s" in why and "160 times" in why
     assert "--bootstrap-all" in why
+
+
+def test_command_line_defaults_agree_with_the_library():
+    from frictionlab.commands import compare as cmd
+    from frictionlab.equivalence import MIN_REPLICATES, REPLICATES
+
+    assert cmd.REPLICATES == REPLICATES and MIN_REPLICATES == 20
