@@ -14,7 +14,7 @@ import importlib
 import sys
 import warnings
 
-from .errors import FrictionLabError
+from .errors import FrictionLabError, Terminated
 
 COMMANDS = ("laws", "datasets", "simulate", "fit", "compare", "bench")
 
@@ -29,7 +29,10 @@ class ListAction(argparse.Action):
     def __call__(self, parser, namespace, values, option_string=None):
         items = list(getattr(namespace, self.dest, None) or [])
         for v in values if isinstance(values, list) else [values]:
-            items += [x.strip() for x in v.split(",") if x.strip()]
+            parts = [x.strip() for x in v.split(",")]
+            if not all(parts):  # '--laws ,' must not mean the default set
+                parser.error(f"argument {option_string}: {v!r} holds an empty name; give names separated by commas")
+            items += parts
         setattr(namespace, self.dest, items)
 
 
@@ -92,23 +95,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 def load_file(path: str) -> None:
     """Import a user's Python file by path (for laws registered at run time)."""
-    import importlib.util
-    from pathlib import Path
+    from .registry import load_law_file
 
-    from .errors import RegistryError
-
-    p = Path(path)
-    if not p.is_file():
-        raise RegistryError(f"--load {path}: no such file")
-    spec = importlib.util.spec_from_file_location(f"frictionlab_user_{p.stem}", p)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    try:
-        spec.loader.exec_module(module)
-    except FrictionLabError:
-        raise
-    except Exception as exc:
-        raise RegistryError(f"--load {path}: import failed: {type(exc).__name__}: {exc}") from exc
+    load_law_file(path)
 
 
 def main(argv=None) -> int:
@@ -132,6 +121,7 @@ def main(argv=None) -> int:
         parser.print_help()
         return 2
     formatwarning = warnings.formatwarning
+    sigterm = _terminate_cleanly()
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("default")
@@ -161,6 +151,9 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("frictionlab: interrupted", file=sys.stderr)
         return 130
+    except Terminated:
+        print("frictionlab: terminated", file=sys.stderr)
+        return 143
     except Exception as exc:  # a bug, not bad input: say so in one line, exit 1
         if args.debug:
             raise
@@ -169,6 +162,23 @@ def main(argv=None) -> int:
         return 1
     finally:
         warnings.formatwarning = formatwarning
+        sigterm()
+
+
+def _terminate_cleanly():
+    """Make SIGTERM an exception (errors.Terminated) while a command runs, so that clean-up runs:
+    workers stopped, temporary output removed, locks released. Returns the function that undoes it."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+
+    def on_sigterm(signum, frame):
+        raise Terminated(signum)
+
+    old = signal.signal(signal.SIGTERM, on_sigterm)
+    return lambda: signal.signal(signal.SIGTERM, old)
 
 
 if __name__ == "__main__":  # pragma: no cover

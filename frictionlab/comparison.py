@@ -18,11 +18,15 @@ tolerances (``fitcost.tolerance_check``). Every stage runs on one process pool w
 """
 from __future__ import annotations
 
+import functools
 import os
 import platform
+import signal
+import threading
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from multiprocessing import get_context
 
@@ -32,7 +36,7 @@ import numpy as np
 from .dataset import Dataset, builtin_names, load_dataset
 from . import equivalence as _equivalence, transfer as _transfer
 from .equivalence import MIN_REPLICATES, PAIRS, REPLICATES, EquivalenceResult, analyze_equivalence
-from .errors import FrictionLabError, ParameterError
+from .errors import FrictionLabError, ParameterError, Terminated
 from .bootstrap import bootstrap_fits
 from .fitcost import tolerance_check
 from .fitting import PREDICTORS, FitResult, applicable_solvers, auto_solver, fit
@@ -138,10 +142,10 @@ def candidates(law, dataset: Dataset, solvers: Sequence[str] | None) -> list[tup
     return list(dict.fromkeys(out))  # 'auto' and the solver it picks name one candidate
 
 
-def _fit_task(args) -> FitResult:
+def _fit_task(args, timeout=None) -> FitResult:
     law, dataset, solver, free = args
     try:
-        return fit(law, dataset, solver=solver, free=free)
+        return fit(law, dataset, solver=solver, free=free, timeout=timeout)
     except FrictionLabError as exc:  # e.g. a freed scene quantity this scene does not have
         return FitResult(law=law, solver=solver, datasets=(dataset.name,), status="skipped", reason=str(exc))
 
@@ -156,9 +160,25 @@ def _transfer_task(args):
     return transfer_candidate(fits, free)
 
 
+def _worker_init() -> None:
+    """In a worker: ^C goes to the parent, which stops the pool; SIGTERM ends the worker at once."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def _on_sigterm(signum, frame):
+    raise Terminated(signum)
+
+
 @contextmanager
 def _pool(jobs: int):
-    """A process pool of ``jobs`` forked workers, or None (run here) for one job or without fork."""
+    """A process pool of ``jobs`` forked workers, or None (run here) for one job or without fork.
+
+    On any exception, ^C (KeyboardInterrupt) and SIGTERM included, the workers are terminated and
+    reaped before the exception goes on: no worker outlives the call. SIGTERM becomes the exception
+    ``errors.Terminated`` while the pool lives (when called from the main thread and nothing else
+    handles SIGTERM).
+    """
     try:
         ctx = get_context("fork") if jobs > 1 else None
     except ValueError:  # no fork on this platform: run serially
@@ -166,8 +186,35 @@ def _pool(jobs: int):
     if ctx is None:
         yield None
         return
-    with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx) as pool:
+    handle = (threading.current_thread() is threading.main_thread()
+              and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL)
+    if handle:
+        signal.signal(signal.SIGTERM, _on_sigterm)
+    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init)
+    try:
         yield pool
+    except BaseException:
+        _stop(pool)
+        raise
+    else:
+        pool.shutdown(wait=True)
+    finally:
+        if handle:
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def _stop(pool: ProcessPoolExecutor) -> None:
+    """Cancel what is queued, terminate the workers (SIGTERM, then SIGKILL after 5 s) and reap them."""
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in procs:
+        if p.is_alive():
+            p.terminate()
+    for p in procs:
+        p.join(5)
+        if p.is_alive():
+            p.kill()
+            p.join()
 
 
 def _run(tasks, fn, pool, progress, done, total, label):
@@ -177,7 +224,11 @@ def _run(tasks, fn, pool, progress, done, total, label):
         futures = {pool.submit(fn, t): i for i, t in enumerate(tasks)}
         for fut in as_completed(futures):
             i = futures[fut]
-            results[i] = fut.result()
+            try:
+                results[i] = fut.result()
+            except BrokenProcessPool:  # a worker was killed, or a plugin ended its process (os._exit)
+                raise FrictionLabError(f"compare: a worker process died while running {label(tasks[i])} "
+                                       "(killed, out of memory, or a law plugin that ends its process)") from None
             done += 1
             if progress:
                 progress(done, total, label(tasks[i]))
@@ -211,8 +262,8 @@ def select_laws(laws: Sequence[str] | None) -> tuple[str, ...]:
 def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None, solvers: Sequence[str] | None = None,
             *, free: dict | None = None, equivalence: bool = True, jobs: int = 1,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
-            tolerance: Sequence[float] = (), replicates: int = REPLICATES, pairs: Sequence = PAIRS,
-            transfer: bool = True) -> Comparison:
+            tolerance: Sequence[float] = (), fit_timeout: float | None = None, replicates: int = REPLICATES,
+            pairs: Sequence = PAIRS, transfer: bool = True) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
 
     laws: registered names, None for DEFAULT_LAWS, or "all" for every registered law; datasets: built-in names, TOML paths or Datasets
@@ -221,7 +272,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     upper) in SI (see fitting.SCENE_QUANTITIES); jobs: worker processes; progress(done, total, label).
     bootstrap: case resamples per dataset (0: none), drawn from ``seed``; datasets where a law
     needs the ODE, or without a time series, are bootstrapped only with bootstrap_all. tolerance: looser ODE tolerances at
-    which the ODE laws of one dataset are refitted (empty: no tolerance check). replicates: R per
+    which the ODE laws of one dataset are refitted (empty: no tolerance check). fit_timeout: time
+    budget of each fit in seconds (None: none); a fit past it is a failed row saying so. replicates: R per
     law of the equivalence test's parametric bootstrap (seeded by ``seed``); pairs: (law A, law B)
     to test (default equivalence.PAIRS); pairs where a law needs the ODE solver, or without a time
     series, are tested only with bootstrap_all. transfer: run the transfer stage.
@@ -235,6 +287,9 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     for name, v in (("bootstrap", bootstrap), ("seed", seed), ("replicates", replicates)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
             raise ParameterError(f"compare: {name} must be a non-negative integer, got {v!r}")
+    if fit_timeout is not None and (isinstance(fit_timeout, bool) or not isinstance(fit_timeout, (int, float))
+                                    or not 0 < fit_timeout < float("inf")):
+        raise ParameterError(f"compare: fit_timeout must be a positive number of seconds, got {fit_timeout!r}")
     for r in tolerance:
         if isinstance(r, bool) or not isinstance(r, (int, float)) or not 0 < r < 1:
             raise ParameterError(f"compare: every tolerance must be a number in (0, 1), got {r!r}")
@@ -271,10 +326,15 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     order = {d.name: i for i, d in enumerate(dss)}
     with _pool(jobs) as pool:
         t0 = time.perf_counter()
-        results, done = _run(plan, _fit_task, pool, progress, 0, total, label)
+        results, done = _run(plan, functools.partial(_fit_task, timeout=fit_timeout), pool, progress, 0, total,
+                             label)
         fits += results
         fits.sort(key=lambda f: (order[f.datasets[0]], law_names.index(f.law), family(f.solver) == "series"))
         timings["fits"] = time.perf_counter() - t0
+        if all(f.status == "skipped" for f in fits):
+            reasons = list(dict.fromkeys(f.reason for f in fits))
+            raise FrictionLabError("compare: no fit could be made: " + "; ".join(reasons[:3])
+                                   + (f" (and {len(reasons) - 3} more reasons)" if len(reasons) > 3 else ""))
         eq_results = []
         if eq_pairs:
             t0 = time.perf_counter()
@@ -313,7 +373,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             timings["tolerance"] = time.perf_counter() - t0
             return rows
 
-        with ThreadPoolExecutor(1) as side:  # with a pool, the tolerance fits queue there ahead of the bootstrap
+        side = ThreadPoolExecutor(1)  # with a pool, the tolerance fits queue there ahead of the bootstrap
+        try:
             tol_future = side.submit(tolerance_stage) if tolerance and pool is not None else None
             if tolerance and pool is None:
                 tol_rows = tolerance_stage()
@@ -325,6 +386,10 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                 timings["bootstrap"] = time.perf_counter() - t0
             if tol_future is not None:
                 tol_rows = tol_future.result()
+        except BaseException:  # ^C, SIGTERM, a crash: do not wait for the side thread; the pool is stopped next
+            side.shutdown(wait=False, cancel_futures=True)
+            raise
+        side.shutdown(wait=True)
     eq_results.sort(key=lambda e: (order[e.dataset], _pair_index(pairs, e), "series" in (e.solver_a, e.solver_b)))
     ranking = rank_fits(fits)
     kinds = {d.name: d.kind for d in dss}
@@ -337,8 +402,9 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                       settings={"solvers": list(solvers) if solvers else "default", "jobs": jobs,
                                 "equivalence": equivalence, "free": {k: list(v) for k, v in (free or {}).items()},
                                 "bootstrap": int(bootstrap), "seed": int(seed), "bootstrap_all": bool(bootstrap_all),
-                                "tolerance": [float(r) for r in tolerance], "replicates": int(replicates),
-                                "pairs": [list(p) for p in pairs], "transfer": bool(transfer)},
+                                "tolerance": [float(r) for r in tolerance], "fit_timeout": fit_timeout,
+                                "replicates": int(replicates), "pairs": [list(p) for p in pairs],
+                                "transfer": bool(transfer)},
                       bootstrap=tuple(boots), bootstrap_skipped=boot_skipped, tolerance=tuple(tol_rows),
                       timings=timings, answers=answers)
 

@@ -7,8 +7,8 @@ with a one-line ``DatasetError`` naming the file and the field.
 """
 from __future__ import annotations
 
+import io
 import math
-import tomllib
 from importlib import resources
 from pathlib import Path
 
@@ -18,7 +18,8 @@ import numpy as np
 from .errors import DatasetError, FrictionLabError
 from .outcome import OUTCOMES, OutcomeScene
 from .scene import KINDS, Scene
-from .units import unit_factor
+from .io import MAX_CSV_BYTES, check_name, read_bytes, read_text, read_toml
+from .units import MAX_SI, check_text, check_time_scale, unit_factor
 
 PROVENANCE_KINDS = ("measured", "reported", "reconstructed", "synthetic")
 DATA_KINDS = KINDS + ("contact-area",)
@@ -109,13 +110,7 @@ def load_dataset(name_or_path: str | Path) -> Dataset:
     if isinstance(name_or_path, Dataset):
         return name_or_path
     path = resolve(name_or_path)
-    try:
-        meta = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise DatasetError(f"{path}: TOML does not parse: {exc}") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise DatasetError(f"{path}: cannot read: {exc}") from None
-    return from_meta(meta, path)
+    return from_meta(read_toml(path), path)
 
 
 def _req(meta, key, path, typ=str):
@@ -137,7 +132,7 @@ def _table(meta, key, path, where=None):
 
 def from_meta(meta: dict, path: Path) -> Dataset:
     """Build a Dataset from a parsed TOML dict whose CSV sits beside ``path``."""
-    name = _req(meta, "name", path)
+    name = check_name(_req(meta, "name", path), f"{path}: name")
     kind = _req(meta, "kind", path)
     if kind not in DATA_KINDS:
         raise DatasetError(f"{path}: kind = {kind!r}, expected one of {', '.join(DATA_KINDS)}")
@@ -169,6 +164,11 @@ def from_meta(meta: dict, path: Path) -> Dataset:
             columns[col] = raw[col] * unit_factor(unit, si, f"{path}: columns.{col}")
         except FrictionLabError as exc:
             raise DatasetError(str(exc)) from None
+        bad = np.nonzero(~(np.abs(columns[col]) <= MAX_SI))[0]
+        if bad.size:
+            i = int(bad[0])
+            raise DatasetError(f"{csv}: column {col!r} line {_line_of_row(csv, i)}: {raw[col][i]:g} {unit} is beyond "
+                               f"the accepted magnitude {MAX_SI:g} in SI units")
     if "t" in columns:
         t = columns["t"]
         bad = np.nonzero(np.diff(t) <= 0)[0]
@@ -205,12 +205,13 @@ def from_meta(meta: dict, path: Path) -> Dataset:
                 scene = OutcomeScene.from_spec(spec, str(path))
             else:
                 scene = Scene.from_spec(spec, kind, str(path), columns, columns.get("t"))
-        except FrictionLabError as exc:
-            raise DatasetError(str(exc)) from None
+        except FrictionLabError as exc:  # a model's own check (no file in it) still names the file
+            raise DatasetError(str(exc) if str(exc).startswith(str(path)) else f"{path}: [scene]: {exc}") from None
         if kind == "impact-outcome":
             _check_outcome_rows(columns, observable, path, csv, scene)
         else:
             _check_observable(scene, observable, path)
+            _check_time_unit(columns, units, spec, kind, scene, path)
 
     fixed, fixed_units = {}, {}
     for key, value in _table(meta, "fixed", path, "[fixed]").items():
@@ -232,12 +233,33 @@ def from_meta(meta: dict, path: Path) -> Dataset:
     if extra:
         raise DatasetError(f"{path}: unknown top-level key(s) {sorted(extra)}")
     reported = _table(meta, "reported", path, "[reported]")
+    for table, values in (("reported", reported), ("provenance.truth", provenance.truth)):
+        for key, value in values.items():  # read by the report later: refuse what pint would choke on now
+            if isinstance(value, str):
+                try:
+                    check_text(value, f"{path}: {table}.{key}")
+                except FrictionLabError as exc:
+                    raise DatasetError(str(exc)) from None
     if not isinstance(meta.get("description", ""), str):
         raise DatasetError(f"{path}: 'description' must be a string")
     return Dataset(name=name, kind=kind, observable=observable, path=path, columns=columns, units=dict(units),
                    noise=noise, scene=scene, fixed=fixed, provenance=provenance,
                    description=meta.get("description", ""), reported=reported,
                    fixed_units=fixed_units)
+
+
+def _check_time_unit(columns, units, spec, kind, scene, path) -> None:
+    """The time column must span about the scene's duration (given, or the impact's contact time)."""
+    if "duration" in spec:
+        field = "scene.duration"
+    elif kind == "impact" and scene.duration > 0:
+        field = "the scene's contact time"
+    else:
+        return  # the duration was taken from the time column itself
+    try:
+        check_time_scale(float(columns["t"][-1]), scene.duration, units["t"], f"{path}: columns.t", field)
+    except FrictionLabError as exc:
+        raise DatasetError(str(exc)) from None
 
 
 #: Trajectory series each observable needs, and what in a scene provides it.
@@ -312,21 +334,22 @@ def _provenance(p, path) -> Provenance:
 
 
 def read_csv(csv: Path) -> dict[str, np.ndarray]:
-    """Read a numeric CSV with a header row into float arrays; one-line errors on bad content."""
+    """Read a numeric CSV with a header row into float arrays; one-line errors on bad content.
+    The CSV must lie in its folder once links are resolved (see io.read_bytes)."""
     import warnings
 
     import pandas as pd
 
     try:
+        text = read_bytes(csv, MAX_CSV_BYTES, within=Path(csv).parent).decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise DatasetError(f"{csv}: CSV does not parse: not UTF-8 text (byte {exc.start + 1})") from None
+    try:
         with warnings.catch_warnings():
             # more fields in every row than in the header: pandas would shift the columns silently
             warnings.simplefilter("error", pd.errors.ParserWarning)
-            df = pd.read_csv(csv, comment="#", skipinitialspace=True, index_col=False, dtype=str,
+            df = pd.read_csv(io.StringIO(text), comment="#", skipinitialspace=True, index_col=False, dtype=str,
                              keep_default_na=False)
-    except FileNotFoundError:
-        raise DatasetError(f"{csv}: no such file") from None
-    except IsADirectoryError:
-        raise DatasetError(f"{csv}: is a folder, not a CSV file") from None
     except pd.errors.EmptyDataError:
         raise DatasetError(f"{csv}: file is empty") from None
     except pd.errors.ParserWarning:
@@ -335,7 +358,7 @@ def read_csv(csv: Path) -> dict[str, np.ndarray]:
         first = (str(exc).splitlines() or [type(exc).__name__])[0]
         raise DatasetError(f"{csv}: CSV does not parse: {first}") from None
     names = [str(c).strip() for c in df.columns]
-    header = _header_names(csv)
+    header = _header_names(text)
     for i, name in enumerate(header if header is not None else names):
         if not name:
             raise DatasetError(f"{csv}: header column {i + 1} has no name (a stray comma?)")
@@ -368,20 +391,23 @@ def _number(text) -> float:
         return math.nan
 
 
-def _header_names(csv: Path) -> list[str] | None:
+def _header_names(text: str) -> list[str] | None:
     """Column names as written in the header line (pandas renames duplicates), or None if unreadable."""
     import csv as csvmod
 
     try:
-        with open(csv, encoding="utf-8-sig", newline="") as fh:
-            rows = (r for r in csvmod.reader(line for line in fh if line.strip() and not line.lstrip().startswith("#")))
-            return [c.strip() for c in next(rows)]
-    except (OSError, UnicodeError, csvmod.Error, StopIteration):
+        lines = text.splitlines(keepends=True)
+        rows = (r for r in csvmod.reader(line for line in lines if line.strip() and not line.lstrip().startswith("#")))
+        return [c.strip() for c in next(rows)]
+    except (csvmod.Error, StopIteration):
         return None
 
 
 def _line_of_row(csv: Path, row: int) -> int:
     """1-based line number in the file of data row ``row`` (0-based, after header and comments)."""
-    lines = Path(csv).read_text(encoding="utf-8", errors="replace").splitlines()
+    try:
+        lines = read_text(csv, MAX_CSV_BYTES).splitlines()
+    except DatasetError:
+        return 0
     data = [i for i, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")]
     return data[row + 1] + 1 if row + 1 < len(data) else len(lines)

@@ -39,3 +39,8 @@ class SolverError(FrictionLabError):
 
 class OutputError(FrictionLabError):
     """An output path that exists or cannot be written."""
+
+
+class Terminated(BaseException):
+    """The process received SIGTERM (raised by the handler frictionlab installs while it runs, so that
+    clean-up code runs: worker processes stopped, temporary output removed, locks released)."""

@@ -13,6 +13,11 @@ quantity) raises a one-line FrictionLabError.
   different units fit together. With several datasets, law parameters are shared (a global
   fit) unless named in ``local``.
 * Predictions go through ``predict``; a dataset kind plugs in with ``register_predictor``.
+* ``timeout`` is a time budget per fit in seconds (None: none): a fit that exceeds it is a failed
+  result saying so. It is checked before every evaluation of the model and, in the main thread,
+  by an alarm that interrupts a single evaluation that runs away.
+* A fit needs at least one data point more than it has free parameters; with fewer it is skipped
+  with that reason, never ranked.
 * ``rtol`` is the ODE tolerance of the fit's predictions (None: ``predict.FIT_RTOL``, 1e-10); it
   is an argument of each call, so fits at different tolerances may run in parallel threads.
 """
@@ -20,9 +25,12 @@ from __future__ import annotations
 
 import math
 import re
+import signal
+import threading
 import time
 import warnings
 from collections.abc import Mapping, Sequence
+from contextlib import contextmanager
 
 import attrs
 import numpy as np
@@ -277,6 +285,9 @@ def _scene_slots(targets, free) -> list[_Slot]:
         lo, hi = float(bounds[0]), float(bounds[1])
         if not lo < hi:
             raise ParameterError(f"free scene quantity '{name}': lower bound {lo:g} must be below upper {hi:g}")
+        if len(bounds) == 3 and not lo <= float(bounds[2]) <= hi:
+            raise ParameterError(f"free scene quantity '{name}': start {float(bounds[2]):g} is outside its bounds "
+                                 f"[{lo:g}, {hi:g}]")
         for i, tg in enumerate(targets):
             current = get_scene_quantity(tg.dataset.scene, name)
             start = float(bounds[2]) if len(bounds) == 3 else min(max(current, lo), hi)
@@ -292,11 +303,36 @@ def _lmfit_bound(b: float, slot: _Slot) -> float:
     return b if abs(b) <= 1e4 * slot.scale else math.copysign(math.inf, b)
 
 
+class FitTimeout(BaseException):
+    """A fit ran past its time budget (a BaseException, so that no handler of a law's errors keeps it)."""
+
+
+@contextmanager
+def _alarm(seconds: float | None):
+    """Raise FitTimeout in the main thread after ``seconds`` (no-op elsewhere, or if an alarm is set)."""
+    if (seconds is None or not hasattr(signal, "setitimer") or threading.current_thread() is not threading.main_thread()
+            or signal.getitimer(signal.ITIMER_REAL)[0] > 0):
+        yield
+        return
+
+    def ring(signum, frame):
+        raise FitTimeout()
+
+    old = signal.signal(signal.SIGALRM, ring)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+
+
 class _Model:
     """Evaluates the weighted residual for a vector of scaled parameter values."""
 
-    def __init__(self, law, targets, solvers, slots, rtol=None):
+    def __init__(self, law, targets, solvers, slots, rtol=None, deadline=None):
         self.law, self.targets, self.solvers, self.slots, self.rtol = law, targets, solvers, slots, rtol
+        self.deadline = deadline  # time.monotonic() after which an evaluation raises FitTimeout
         self.failures = 0
         self.last_error = ""
         self.nfev = 0
@@ -320,6 +356,8 @@ class _Model:
                 for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values))]
 
     def residual(self, values) -> np.ndarray:
+        if self.deadline is not None and time.monotonic() > self.deadline:
+            raise FitTimeout()
         self.nfev += 1
         out = []
         for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values)):
@@ -437,7 +475,8 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
 def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[float]] | None = None,
         fixed: Mapping[str, float] | None = None, local: Sequence[str] = (),
         initial: Mapping[str, float] | None = None, observable: str | None = None, derive: str | None = None,
-        scan: int = 125, n_starts: int = 3, max_nfev: int | None = None, rtol: float | None = None) -> FitResult:
+        scan: int = 125, n_starts: int = 3, max_nfev: int | None = None, rtol: float | None = None,
+        timeout: float | None = None) -> FitResult:
     """Fit ``law`` to one dataset or a group of them (a global fit) and return a FitResult.
 
     law: name or FrictionLaw. datasets: a Dataset, name, path or Target, or a list of them.
@@ -451,6 +490,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     at most ODE_STARTS when a dataset is solved by 'ode' (deterministic, never timing-dependent).
     rtol: relative (and scaled absolute) tolerance of every ODE solve in the fit, in (0, 1);
     None uses FIT_RTOL (1e-10). Closed forms and the series ignore it.
+    timeout: time budget of the fit in seconds (None: none); past it the fit is 'failed'.
     """
     import lmfit  # slow to import: only when fitting
 
@@ -475,6 +515,9 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     law.resolve({**(initial or {}), **(fixed or {})})  # so are held or start values outside the bounds
     if rtol is not None and (isinstance(rtol, bool) or not isinstance(rtol, (int, float)) or not 0 < rtol < 1):
         raise ParameterError(f"fit: rtol must be a number in (0, 1), got {rtol!r}")
+    if timeout is not None and (isinstance(timeout, bool) or not isinstance(timeout, (int, float))
+                                or not 0 < timeout < math.inf):
+        raise ParameterError(f"fit: timeout must be a positive number of seconds, got {timeout!r}")
     solvers = []
     for tg in targets:
         if tg.dataset.kind not in PREDICTORS:
@@ -496,7 +539,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         solvers.append(s)
     slots = _law_slots(law, targets, dict(fixed or {}), set(local), dict(initial or {}))
     slots += _scene_slots(targets, dict(free or {}))
-    model = _Model(law, targets, solvers, slots, rtol)
+    model = _Model(law, targets, solvers, slots, rtol, None if timeout is None else time.monotonic() + timeout)
     params = lmfit.Parameters()
     for s in slots:
         params.add(s.pname, value=s.value / s.scale, vary=s.vary, min=_lmfit_bound(s.lower, s) / s.scale,
@@ -504,13 +547,20 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     varying = [s for s in slots if s.vary]
     solver_label = solver if solver != "auto" else "+".join(dict.fromkeys(solvers))
     n_points = sum(t.y.size for t in targets)
+    if n_points < len(varying) + 1:
+        return give_up("skipped", f"{', '.join(names)}: {n_points} data point{'s' * (n_points != 1)} for {len(varying)} free parameter"
+                                  f"{'s' * (len(varying) != 1)}: a fit needs at least {len(varying) + 1}")
 
     success, message = True, ""
     try:
-        best_params, success, message, best, search_notes = _search(lmfit, model, params, slots, solvers, scan,
-                                                                    n_starts, max_nfev)
-        values = _si(best_params, slots)
-        models = model.models(values)
+        with _alarm(timeout):
+            best_params, success, message, best, search_notes = _search(lmfit, model, params, slots, solvers, scan,
+                                                                        n_starts, max_nfev)
+            values = _si(best_params, slots)
+            models = model.models(values)
+        model.deadline = None  # the error analysis below is bounded work
+    except FitTimeout:
+        return give_up("failed", f"exceeded its time budget of {timeout:g} s (--fit-timeout)", nfev=model.nfev)
     except SkipDataset as exc:
         return give_up("skipped", str(exc))
     except FrictionLabError as exc:  # an aborted search leaves parameters that mean nothing: say it did not converge

@@ -1,13 +1,179 @@
-"""Writing outputs whole or not at all."""
+"""Files in and out: inputs read only from regular files of bounded size, outputs written whole or
+not at all, under a lock, with the permissions the umask gives.
+
+Rules (stated once):
+
+* An input file is read only if it is a regular file (a FIFO, device or socket is refused before
+  it is opened, so nothing blocks) no larger than its limit (``MAX_TOML_BYTES``,
+  ``MAX_CSV_BYTES``). A file found beside another (a dataset's CSV beside its TOML) must lie,
+  once symbolic links are resolved, inside the folder of the file that names it: a link within
+  that folder is followed, a link out of it is refused.
+* TOML may start with a UTF-8 byte-order mark (it is dropped); brackets, braces and dotted keys
+  nest at most ``MAX_TOML_DEPTH`` deep.
+* An output folder is built in a temporary folder beside it and moved into place at the end,
+  while a lock (``.NAME.lock`` beside the target, removed afterwards) keeps a second frictionlab
+  run away from the same target: that run fails at once, naming the target. The target is
+  checked again just before the move. ``force`` replaces only a folder that holds the marker
+  file ``MARKER`` (every folder written here gets one) or an empty folder; anything else,
+  a regular file included, is refused.
+* Every error names the path it concerns, "No space left on device" included.
+"""
 from __future__ import annotations
 
+import errno
 import os
+import re
 import shutil
+import stat
 import tempfile
+import threading
 from contextlib import contextmanager
 from pathlib import Path
 
-from .errors import OutputError
+from .errors import DatasetError, OutputError
+
+MAX_TOML_BYTES = 1 << 20  # 1 MiB: a dataset's sidecar is a few kB
+MAX_CSV_BYTES = 256 << 20  # 256 MiB
+MAX_TOML_DEPTH = 16
+#: File that marks a folder written by frictionlab (a report, a bench report, rebuilt datasets).
+MARKER = ".frictionlab-output"
+#: A name that becomes a file name (a dataset's name): a letter or digit, then letters, digits
+#: and . _ + -, at most MAX_NAME characters.
+MAX_NAME = 100
+_SLUG = re.compile(r"[A-Za-z0-9][A-Za-z0-9._+-]*")
+
+
+# --- reading --------------------------------------------------------------------------------
+def _kind(mode: int) -> str:
+    for test, name in ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+                       (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"), (stat.S_ISDIR, "a folder")):
+        if test(mode):
+            return name
+    return "not a regular file"
+
+
+def read_bytes(path, limit: int, within=None, error=DatasetError) -> bytes:
+    """The bytes of the regular file ``path``, at most ``limit`` of them; ``within``: a folder the
+    file's real path must lie in. Raises ``error`` with a one-line message naming the path."""
+    path = Path(path)
+    if within is not None:
+        real, base = os.path.realpath(path), os.path.realpath(within)
+        if os.path.commonpath([real, base]) != base:
+            raise error(f"{path}: is a symbolic link to {real}, outside the dataset's folder {base}; "
+                        "links are followed only within that folder (copy the file there)")
+    try:
+        st = os.stat(path)
+        if not stat.S_ISREG(st.st_mode):  # refused before opening: opening a FIFO could block
+            raise error(f"{path}: is {_kind(st.st_mode)}, not a regular file")
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+    except FileNotFoundError:
+        raise error(f"{path}: no such file") from None
+    except OSError as exc:
+        raise error(f"{path}: cannot read: {exc.strerror or exc}") from None
+    try:
+        st = os.fstat(fd)  # the file opened may not be the one checked (a swap in between)
+        if not stat.S_ISREG(st.st_mode):
+            raise error(f"{path}: is {_kind(st.st_mode)}, not a regular file")
+        if st.st_size > limit:
+            raise error(f"{path}: is {st.st_size} bytes, more than the limit of {limit} bytes")
+        chunks, size = [], 0
+        while True:
+            chunk = os.read(fd, 1 << 20)
+            if not chunk:
+                break
+            size += len(chunk)
+            if size > limit:
+                raise error(f"{path}: is more than the limit of {limit} bytes")
+            chunks.append(chunk)
+        return b"".join(chunks)
+    except OSError as exc:
+        raise error(f"{path}: cannot read: {exc.strerror or exc}") from None
+    finally:
+        os.close(fd)
+
+
+def read_text(path, limit: int, within=None, error=DatasetError) -> str:
+    """A UTF-8 text file (a leading byte-order mark is dropped), read as ``read_bytes`` does."""
+    data = read_bytes(path, limit, within, error)
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise error(f"{path}: cannot read: not UTF-8 text (byte {exc.start + 1})") from None
+
+
+def toml_depth(text: str) -> int:
+    """Deepest nesting of a TOML text: brackets and braces, and dots in a key, outside strings and
+    comments (a cheap scan, so that a pathological file is refused before it is parsed)."""
+    depth = deepest = dots = 0
+    i, n = 0, len(text)
+    while i < n:
+        ch = text[i]
+        if ch in "\"'":
+            quote = text[i:i + 3] if text[i:i + 3] in ('"""', "'''") else ch
+            i += len(quote)
+            while i < n and not text.startswith(quote, i):
+                i += 2 if (quote[0] == '"' and text[i] == "\\") else 1
+            i += len(quote)
+            continue
+        if ch == "#":
+            while i < n and text[i] != "\n":
+                i += 1
+            continue
+        if ch in "[{":
+            depth += 1
+            dots = 0
+        elif ch in "]}":
+            depth -= 1
+        elif ch in "=,\n":
+            dots = 0
+        elif ch == ".":
+            dots += 1
+        deepest = max(deepest, depth + dots)
+        i += 1
+    return deepest
+
+
+def read_toml(path, error=DatasetError) -> dict:
+    """A TOML file as a dict, read as ``read_text`` does, with one-line errors naming the path."""
+    import tomllib
+
+    text = read_text(path, MAX_TOML_BYTES, error=error)
+    if toml_depth(text) > MAX_TOML_DEPTH:
+        raise error(f"{path}: TOML nests deeper than {MAX_TOML_DEPTH} levels (tables, arrays or dotted keys)")
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise error(f"{path}: TOML does not parse: {exc}") from None
+    except RecursionError:
+        raise error(f"{path}: TOML nests too deeply to parse") from None
+
+
+def check_name(name: str, where: str) -> str:
+    """``name`` if it can become part of a file name (see _SLUG), else a one-line DatasetError."""
+    shown = name if len(name) <= 40 else name[:37] + "..."
+    if len(name) > MAX_NAME:
+        raise DatasetError(f"{where}: {shown!r} is {len(name)} characters long; at most {MAX_NAME}")
+    if not _SLUG.fullmatch(name):
+        raise DatasetError(f"{where}: {shown!r} must start with a letter or digit and hold only letters, digits "
+                           "and . _ + - (it becomes part of file names)")
+    return name
+
+
+# --- writing --------------------------------------------------------------------------------
+def _umask() -> int:
+    with _umask_lock:
+        mask = os.umask(0o022)
+        os.umask(mask)
+    return mask
+
+
+_umask_lock = threading.Lock()
+
+
+def _oserror(path, exc: OSError, doing: str = "cannot write") -> OutputError:
+    """An OutputError naming ``path`` (and the file concerned, if another) for an OSError."""
+    other = f" ({exc.filename})" if getattr(exc, "filename", None) and str(exc.filename) != str(path) else ""
+    return OutputError(f"{path}: {doing}{other}: {exc.strerror or exc}")
 
 
 def check_writable(path) -> Path:
@@ -20,14 +186,9 @@ def check_writable(path) -> Path:
         raise OutputError(f"{path}: cannot write: {parent} is not a directory")
     if path.is_dir():
         raise OutputError(f"{path}: cannot write: it is a folder")
+    if path.exists() and not path.is_file():
+        raise OutputError(f"{path}: cannot write: it is {_kind(os.stat(path).st_mode)}")
     return path
-
-
-def _umask_mode(mode: int) -> int:
-    """``mode`` as the process umask leaves it (what open() would give a new file or folder)."""
-    umask = os.umask(0)
-    os.umask(umask)
-    return mode & ~umask
 
 
 def atomic_write_bytes(path, data: bytes) -> None:
@@ -36,14 +197,14 @@ def atomic_write_bytes(path, data: bytes) -> None:
     tmp = None
     try:
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        os.fchmod(fd, 0o666 & ~_umask())
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
-        os.chmod(tmp, _umask_mode(0o666))  # mkstemp makes it private; the output is the user's as any file
         os.replace(tmp, path)
     except OSError as exc:
         if tmp is not None and os.path.exists(tmp):
             os.unlink(tmp)
-        raise OutputError(f"{path}: cannot write: {exc.strerror or exc}") from None
+        raise _oserror(path, exc) from None
 
 
 def atomic_write_text(path, text: str) -> None:
@@ -51,32 +212,136 @@ def atomic_write_text(path, text: str) -> None:
     atomic_write_bytes(path, text.encode("utf-8"))
 
 
-@contextmanager
-def atomic_dir(path, force: bool = False):
-    """Yield a temporary folder beside ``path``; move it into place only if the block succeeds.
+_held: dict[str, int] = {}  # lock file -> times held by this process
 
-    An existing ``path`` is refused unless ``force``, in which case it is replaced at the end.
-    """
+
+@contextmanager
+def output_lock(path):
+    """Hold an exclusive lock on the output ``path`` (a file ``.NAME.lock`` beside it, removed on
+    release). A second holder, in this process or another, fails at once with an OutputError."""
+    import fcntl
+
     path = Path(path)
-    if path.exists() and not force:
-        raise OutputError(f"{path}: output folder exists; choose another --out or pass --force")
+    parent = path.parent if str(path.parent) else Path(".")
+    lock = parent / f".{path.name}.lock"
+    key = os.path.abspath(lock)
+    if key in _held:  # already ours (compare holds it, then write_report asks again)
+        _held[key] += 1
+        try:
+            yield
+        finally:
+            _held[key] -= 1
+        return
+    busy = OutputError(f"{path}: another frictionlab run is writing this output (lock {lock}); "
+                       "wait for it to finish or choose another --out")
+    while True:
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o666 & ~_umask())
+        except FileNotFoundError:
+            raise OutputError(f"{path}: parent folder {parent} does not exist") from None
+        except OSError as exc:
+            raise _oserror(path, exc, "cannot lock") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as exc:
+            os.close(fd)
+            if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                raise busy from None
+            raise _oserror(path, exc, "cannot lock") from None
+        try:  # the holder before us may have removed the file after we opened it: lock the new one
+            same = os.fstat(fd).st_ino == os.stat(lock).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            break
+        os.close(fd)
+    _held[key] = 1
+    try:
+        yield
+    finally:
+        del _held[key]
+        try:
+            os.unlink(lock)
+        except OSError:
+            pass
+        os.close(fd)
+
+
+def _replaceable(path: Path) -> bool:
+    """True if ``force`` may replace ``path``: a folder with frictionlab's marker, or an empty one."""
+    return path.is_dir() and not path.is_symlink() and ((path / MARKER).is_file() or not any(path.iterdir()))
+
+
+def check_target(path, force: bool = False) -> Path:
+    """Raise OutputError unless an output folder may be created (or, with ``force``, replaced) at ``path``."""
+    path = Path(path)
+    if os.path.lexists(path):
+        if not force:
+            raise OutputError(f"{path}: output folder exists; choose another --out or pass --force")
+        if not _replaceable(path):
+            what = "a folder frictionlab did not write" if path.is_dir() and not path.is_symlink() else \
+                "not a folder" if not path.is_symlink() else "a symbolic link"
+            raise OutputError(f"{path}: --force replaces only a folder written by frictionlab (it holds {MARKER}) "
+                              f"or an empty one; this is {what}: remove it yourself or choose another --out")
     parent = path.parent if str(path.parent) else Path(".")
     if not parent.exists():
         raise OutputError(f"{path}: parent folder {parent} does not exist")
-    try:
-        tmp = Path(tempfile.mkdtemp(dir=parent, prefix=f".{path.name}.", suffix=".tmp"))
-        tmp.chmod(_umask_mode(0o777))  # mkdtemp makes it private; the folder is the user's as any folder
-    except OSError as exc:
-        raise OutputError(f"{path}: cannot write in {parent}: {exc.strerror or exc}") from None
-    try:
-        yield tmp
-        if path.exists():
-            old = parent / f".{path.name}.old"
-            shutil.rmtree(old, ignore_errors=True)
-            os.replace(path, old)
-            os.replace(tmp, path)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, path)
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+    if not parent.is_dir():
+        raise OutputError(f"{path}: cannot write: {parent} is not a directory")
+    return path
+
+
+@contextmanager
+def atomic_dir(path, force: bool = False, marker: str = "frictionlab output\n"):
+    """Yield a temporary folder beside ``path``; move it into place only if the block succeeds.
+
+    An existing ``path`` is refused unless ``force`` and it is a frictionlab output folder (it holds
+    MARKER) or empty; it is then replaced at the end. The folder gets a MARKER file holding
+    ``marker``, and permissions from the umask. The target is locked throughout (output_lock).
+    """
+    path = Path(path)
+    with output_lock(path):
+        check_target(path, force)
+        parent = path.parent if str(path.parent) else Path(".")
+        try:
+            tmp = Path(tempfile.mkdtemp(dir=parent, prefix=f".{path.name}.", suffix=".tmp"))
+        except OSError as exc:
+            raise _oserror(path, exc) from None
+        try:
+            try:
+                os.chmod(tmp, 0o777 & ~_umask())
+                yield tmp
+                (tmp / MARKER).write_text(marker, encoding="utf-8")
+                _fix_modes(tmp)
+            except OSError as exc:
+                raise _oserror(path, exc) from None
+            check_target(path, force)  # again: something may have appeared during the work
+            old = None
+            try:
+                if os.path.lexists(path):
+                    old = Path(tempfile.mkdtemp(dir=parent, prefix=f".{path.name}.", suffix=".old"))
+                    os.replace(path, old / "x")
+                os.replace(tmp, path)
+            except OSError as exc:
+                if old is not None and (old / "x").exists() and not os.path.lexists(path):
+                    os.replace(old / "x", path)  # put the old one back
+                raise _oserror(path, exc) from None
+            finally:
+                if old is not None:
+                    shutil.rmtree(old, ignore_errors=True)
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _fix_modes(folder: Path) -> None:
+    """Give files and folders below ``folder`` the permissions the umask allows (0666 / 0777 & ~umask),
+    whatever created them (tempfile makes them private)."""
+    mask = _umask()
+    for root, dirs, files in os.walk(folder):
+        for d in dirs:
+            os.chmod(os.path.join(root, d), 0o777 & ~mask)
+        for f in files:
+            p = os.path.join(root, f)
+            if not os.path.islink(p):
+                os.chmod(p, (0o777 if os.stat(p).st_mode & 0o111 else 0o666) & ~mask)
+

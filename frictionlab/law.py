@@ -183,11 +183,14 @@ class FrictionLaw:
     def evaluate(self, p: Mapping[str, float], c: Contact) -> np.ndarray:
         """``force`` with its output checked: a float array of the input's shape, finite."""
         try:
-            f = np.asarray(self.force(p, c), dtype=float)
+            f = np.asarray(self.force(p, c))
         except FrictionLabError:
             raise
-        except Exception as exc:
+        except (Exception, SystemExit) as exc:  # a plugin's exit is its failure, not the program's
             raise LawError(f"law '{self.name}': force() raised {type(exc).__name__}: {exc}") from exc
+        if f.dtype.kind not in "fiu":  # complex, bool, object, text: never silently cast to float
+            raise LawError(f"law '{self.name}': force() returned {f.dtype} values; expected real floats [N]")
+        f = f.astype(float, copy=False)
         if f.shape != np.shape(c.u):
             f = np.broadcast_to(f, np.shape(c.u)) if f.ndim == 0 else f
             if f.shape != np.shape(c.u):

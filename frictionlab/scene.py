@@ -363,7 +363,10 @@ def _area_from_spec(a, where, q, columns, t):
     if model == "constant":
         return ConstantArea(q("area", "m^2", a, p))
     if model == "growth":
-        return GrowthArea(q("initial", "m^2", a, p), q("rate", "m^2/m", a, p, positive=False))
+        rate = q("rate", "m^2/m", a, p, positive=False)
+        if rate < 0:
+            raise SceneError(f"{where}: {p}.rate must be >= 0 (the contact grows as it slides), got {a['rate']!r}")
+        return GrowthArea(q("initial", "m^2", a, p), rate)
     if model == "column":
         A = _column(columns, a.get("column", "A"), where, p, "A")
         if np.any(A < 0):

@@ -7,8 +7,24 @@ from __future__ import annotations
 
 import functools
 import math
+import re
 
 from .errors import UnitError
+
+#: Limits checked on a quantity string before pint evaluates it (pint computes integer powers
+#: exactly, so "9**9**9 g" would never finish, and "10**400 g" overflows a float).
+MAX_TEXT = 200  # characters in a quantity or unit string
+MAX_POWER = 12  # largest |exponent| after ** or ^ (m^3, s^-2 ... need far less)
+MAX_LITERAL = 1e300  # largest number written in a quantity string
+#: Accepted size of a value once converted to SI: |x| in [MIN_SI, MAX_SI], or exactly 0.
+#: No physical input of frictionlab comes near these bounds (kg, m, s, Pa, N/m ...), and a
+#: product of three such values stays finite, so a scene built from them never overflows.
+MAX_SI = 1e100
+MIN_SI = 1e-100
+
+_POWER = re.compile(r"\*\*|\^")
+_EXPONENT = re.compile(r"\s*(\(\s*[-+]?\s*\d+(?:\.\d*)?\s*\)|[-+]?\s*\d+(?:\.\d*)?)(?![\d.eE])")
+_LITERAL = re.compile(r"(?<![A-Za-z_\d.])(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
 
 #: SI unit string for each kind of quantity the project reads.
 SI = {
@@ -36,23 +52,83 @@ def _target(unit: str):
     return ureg.Quantity(1.0, unit) if unit else ureg.Quantity(1.0)
 
 
+def check_text(text: str, where: str) -> str:
+    """Refuse a quantity or unit string pint could choke on, before pint sees it: longer than
+    MAX_TEXT, control characters, a power that is not a plain number of at most MAX_POWER, a
+    chained power (a**b**c), a number beyond MAX_LITERAL or one that underflows to 0."""
+    shown = text if len(text) <= 40 else text[:37] + "..."
+    if len(text) > MAX_TEXT:
+        raise UnitError(f"{where}: {shown!r} is {len(text)} characters long; a quantity has at most {MAX_TEXT}")
+    if not text.isprintable():
+        raise UnitError(f"{where}: {shown!r} holds control characters")
+    last_end = None
+    for m in _POWER.finditer(text):
+        if (last_end is not None and not text[last_end:m.start()].strip()) or _powered_group(text, m.start()):
+            raise UnitError(f"{where}: {shown!r}: a power of a power is not accepted; write the exponent as one number")
+        e = _EXPONENT.match(text, m.end())
+        if e is None:
+            raise UnitError(f"{where}: {shown!r}: the exponent after {m.group()!r} must be a plain number "
+                            f"between -{MAX_POWER} and {MAX_POWER}")
+        value = float(re.sub(r"[\s()]", "", e.group(1)))
+        if abs(value) > MAX_POWER:
+            raise UnitError(f"{where}: {shown!r}: exponent {value:g} is beyond the accepted +/-{MAX_POWER}")
+        last_end = e.end()
+    for m in _LITERAL.finditer(text):
+        value = float(m.group())
+        if not (math.isfinite(value) and value <= MAX_LITERAL):
+            raise UnitError(f"{where}: {shown!r}: the number {m.group()[:20]}{'...' * (len(m.group()) > 20)} "
+                            f"is beyond the accepted magnitude {MAX_LITERAL:g}")
+        if value == 0 and re.search(r"[1-9]", m.group(1)):
+            raise UnitError(f"{where}: {shown!r}: the number {m.group()} underflows to 0")
+    return text.strip()
+
+
+def _powered_group(text: str, op: int) -> bool:
+    """True if the power operator at ``op`` applies to a parenthesized group that holds a power."""
+    base = text[:op].rstrip()
+    if not base.endswith(")"):
+        return False
+    depth = 0
+    for i in range(len(base) - 1, -1, -1):
+        depth += {")": 1, "(": -1}.get(base[i], 0)
+        if depth == 0:
+            return bool(_POWER.search(base[i:]))
+    return True  # unbalanced: pint would refuse it anyway
+
+
+def check_magnitude(value: float, shown, where: str, si_unit: str = "") -> float:
+    """``value`` (SI) unless it is not finite or its size is outside [MIN_SI, MAX_SI] (0 passes)."""
+    if not math.isfinite(value):
+        raise UnitError(f"{where}: {shown!r} is not finite")
+    if abs(value) > MAX_SI or 0 < abs(value) < MIN_SI:
+        raise UnitError(f"{where}: {shown!r} is {value:.3g} {si_unit or ''}".rstrip()
+                        + f" in SI units; accepted magnitudes are {MIN_SI:g} to {MAX_SI:g} (or 0)")
+    return value
+
+
 def unit_factor(unit: str, si_unit: str, where: str) -> float:
     """Factor that converts a value in ``unit`` to ``si_unit``; ``where`` names the field."""
     ureg = _registry()
+    unit = check_text(unit, where)
     try:
-        q = ureg.Quantity(1.0, unit.strip()) if unit.strip() else ureg.Quantity(1.0)
+        q = ureg.Quantity(1.0, unit) if unit else ureg.Quantity(1.0)
     except Exception:
         raise UnitError(f"{where}: unknown unit {unit!r}") from None
+    if not hasattr(q, "dimensionality"):
+        raise UnitError(f"{where}: unknown unit {unit!r}")
     target = _target(si_unit)
     if q.dimensionality != target.dimensionality:
         raise UnitError(
             f"{where}: unit {unit!r} is {_dim(q)}, expected {_dim(target)} (like {si_unit or 'a plain number'!r})"
         )
     _check_angle(q, target, repr(unit), si_unit, where)
-    factor = float(q.to(target.units).magnitude)
+    try:
+        factor = float(q.to(target.units).magnitude)
+    except (OverflowError, ValueError, ArithmeticError):
+        factor = math.nan
     if not (math.isfinite(factor) and factor > 0):
         raise UnitError(f"{where}: unit {unit!r} does not convert to {si_unit or 'a plain number'!r}")
-    return factor
+    return check_magnitude(factor, unit, f"{where} (unit factor)", si_unit)
 
 
 def to_si(value, si_unit: str, where: str) -> float:
@@ -66,31 +142,36 @@ def to_si(value, si_unit: str, where: str) -> float:
     if isinstance(value, (int, float)):
         if si_unit:
             raise UnitError(f"{where}: {value!r} has no unit; write it as a string like '{value} {si_unit}'")
-        out = float(value)
+        try:
+            out = float(value)
+        except OverflowError:
+            out = math.inf
     elif isinstance(value, str):
         ureg = _registry()
+        text = check_text(value, where)
         try:
-            q = ureg.Quantity(value.strip())
+            q = ureg.Quantity(text)
+            if not hasattr(q, "dimensionality"):  # pint returns a plain number for "30"
+                q = ureg.Quantity(float(q))
         except Exception:
             raise UnitError(f"{where}: cannot read quantity {value!r}") from None
-        if not hasattr(q, "dimensionality"):  # pint returns a plain number for "30"
-            q = ureg.Quantity(float(q))
         if si_unit and q.unitless:
             raise UnitError(f"{where}: {value!r} has no unit; write it like '{value.strip()} {si_unit}'")
         target = _target(si_unit)
-        if q.dimensionality != target.dimensionality or q.dimensionality != target.dimensionality:
+        if q.dimensionality != target.dimensionality:
             raise UnitError(
                 f"{where}: {value!r} is {_dim(q)}, expected {_dim(target)} (like '1 {si_unit}')"
                 if si_unit
                 else f"{where}: {value!r} should be a plain number"
             )
         _check_angle(q, target, repr(value), si_unit, where)
-        out = float(q.to(target.units).magnitude)
+        try:
+            out = float(q.to(target.units).magnitude)
+        except (OverflowError, ValueError, ArithmeticError):
+            out = math.inf
     else:
         raise UnitError(f"{where}: expected a quantity string like '1 {si_unit}', got {type(value).__name__}")
-    if not math.isfinite(out):
-        raise UnitError(f"{where}: {value!r} is not finite")
-    return out
+    return check_magnitude(out, value, where, si_unit)
 
 
 def _angle_power(q) -> float:
@@ -116,3 +197,30 @@ def _check_angle(q, target, shown: str, si_unit: str, where: str) -> None:
 def _dim(q) -> str:
     d = str(q.dimensionality)
     return "dimensionless" if d == "dimensionless" else d
+
+
+#: A time column is refused when its last time exceeds TIME_SPAN_MAX times the scene's duration (the
+#: scene ends long before the data do) or falls below TIME_SPAN_MIN times it (the data would cover
+#: less than 0.2% of the scene). A unit slip by a factor 1000 or more (s for ms, s for us, ns for
+#: us) always lands outside, while data that stop early or run on a little pass.
+TIME_SPAN_MAX = 20.0
+TIME_SPAN_MIN = 1 / 500
+_TIME_UNITS = (("ns", 1e-9), ("us", 1e-6), ("ms", 1e-3), ("s", 1.0))
+
+
+def check_time_scale(t_last: float, duration: float, unit: str, where: str, duration_field: str) -> None:
+    """Refuse a time column whose span does not fit the scene's duration (an error, not a warning:
+    a time unit off by 1e3 or 1e6 fits confidently and wrongly). ``t_last`` and ``duration`` in s."""
+    if not (t_last > 0 and duration > 0):
+        return
+    ratio = t_last / duration
+    if TIME_SPAN_MIN <= ratio <= TIME_SPAN_MAX:
+        return
+    raw = t_last / unit_factor(unit, "s", where)
+    guess, factor = min(_TIME_UNITS, key=lambda u: abs(math.log(raw * u[1] / duration)))
+    fits = TIME_SPAN_MIN <= raw * factor / duration <= TIME_SPAN_MAX and guess != unit.strip()
+    raise UnitError(f"{where}: the last time is {raw:g} {unit}, {ratio:.3g} times {duration_field} "
+                    f"({duration:g} s): declared unit {unit!r} is implausible"
+                    + (f"; the values look like {guess}" if fits else "")
+                    + f" (accepted: the last time within {TIME_SPAN_MIN:g} to {TIME_SPAN_MAX:g} times the "
+                    "scene's duration)")

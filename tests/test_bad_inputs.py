@@ -12,8 +12,10 @@ from __future__ import annotations
 
 import hashlib
 import importlib.util
+import os
 import re
 import shutil
+import stat
 import sys
 import tomllib
 from pathlib import Path
@@ -72,37 +74,59 @@ def prepare(case: dict, tmp: Path, argv: list[str]) -> list[str]:
     if base:
         for ext in ("toml", "csv"):
             shutil.copy(builtin_dir() / f"{base}.{ext}", tmp / f"d.{ext}")
+    out = tmp / ("out.csv" if command_of(argv) == "simulate" else "out")
+    fill = {"{tmp}": str(tmp), "{data}": str(tmp / "d.toml"), "{out}": str(out),
+            "{existing}": str(tmp / "existing"), "{notdir}": str(tmp / "a-file"), "{file}": str(tmp / "a-file")}
+
+    def filled(text: str) -> str:
+        for k, v in fill.items():
+            text = text.replace(k, v)
+        return text
+
     for e in case.get("edit", []):
         path = tmp / f"d.{e['file']}"
         if e.get("delete"):
             path.unlink()
+        elif e.get("bom"):
+            path.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
         elif "content" in e:
             path.write_bytes(e["content"].encode(e.get("encoding", "utf-8")))
         else:
             text = path.read_text(encoding="utf-8")
             assert e["old"] in text, f"case {case['id']}: {e['old']!r} no longer occurs in {base}.{e['file']}"
-            path.write_text(text.replace(e["old"], e["new"], 1), encoding="utf-8")
+            path.write_text(text.replace(e["old"], e["new"] * e.get("times", 1), 1), encoding="utf-8")
     for f in case.get("files", []):
-        (tmp / f["path"]).write_text(f["content"], encoding="utf-8")
+        path = tmp / f["path"]
+        kind = f.get("kind", "file")
+        if kind == "fifo":
+            os.mkfifo(path)
+        elif kind == "symlink":
+            path.symlink_to(filled(f["target"]))
+        elif kind == "dir":
+            path.mkdir()
+        else:
+            path.write_text(f["content"], encoding="utf-8")
     (tmp / "existing").mkdir()
     (tmp / "existing" / "keep.txt").write_text("an earlier report\n")
     (tmp / "a-file").write_text("a regular file, so nothing can be created below it\n")
-    out = tmp / ("out.csv" if command_of(argv) == "simulate" else "out")
-    fill = {"{tmp}": str(tmp), "{data}": str(tmp / "d.toml"), "{out}": str(out),
-            "{existing}": str(tmp / "existing"), "{notdir}": str(tmp / "a-file")}
-    filled = []
-    for a in argv:
-        for k, v in fill.items():
-            a = a.replace(k, v)
-        filled.append(a)
-    return filled
+    return [filled(a) for a in argv]
 
 
 def snapshot(folder: Path) -> dict[str, str]:
-    """Every path below ``folder`` with a hash of its content ('dir' for folders)."""
+    """Every path below ``folder`` with a hash of its content ('dir' for folders; a link or special
+    file by what it is, never opened: a FIFO would block, a link may lead anywhere)."""
     out = {}
     for p in sorted(folder.rglob("*")):
-        out[str(p.relative_to(folder))] = "dir" if p.is_dir() else hashlib.sha256(p.read_bytes()).hexdigest()
+        mode = p.lstat().st_mode
+        if stat.S_ISLNK(mode):
+            value = f"link to {os.readlink(p)}"
+        elif stat.S_ISDIR(mode):
+            value = "dir"
+        elif not stat.S_ISREG(mode):
+            value = f"special {stat.S_IFMT(mode):o}"
+        else:
+            value = hashlib.sha256(p.read_bytes()).hexdigest()
+        out[str(p.relative_to(folder))] = value
     return out
 
 

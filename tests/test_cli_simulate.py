@@ -116,7 +116,7 @@ def test_outcome_dataset(capsys, tmp_path):
     (["--law", "wear", "--solver", "rk4"], "unknown solver 'rk4'"),
     (["--law", "coulomb", "--solver", "series"], "series: law 'coulomb' has no series solution"),
     (["--law", "wear", "--rtol", "0"], "rtol must be a number in \\(0, 1\\)"),
-    (["--law", "wear", "--points", "1"], "--points must be at least 2"),
+    (["--law", "wear", "--points", "1"], "--points must be between 2 and"),
 ])
 def test_errors_are_one_line(capsys, tmp_path, argv, match):
     out_csv = tmp_path / "never.csv"

@@ -147,11 +147,12 @@ def test_fit_refuses_held_or_start_values_outside_the_bounds(kw):
 
 # -- never lose a result ------------------------------------------------------------------------
 def test_a_failed_forced_rewrite_keeps_the_previous_report(tmp_path):
-    from frictionlab.io import atomic_dir
+    from frictionlab.io import MARKER, atomic_dir
 
     out = tmp_path / "report"
     out.mkdir()
     (out / "ranking.csv").write_text("the previous result\n")
+    (out / MARKER).write_text("frictionlab output\n")  # a report written earlier
     with pytest.raises(RuntimeError, match="figure failed"):
         with atomic_dir(out, force=True) as tmp:
             (tmp / "ranking.csv").write_text("half of a new result")

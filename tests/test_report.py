@@ -12,6 +12,7 @@ from frictionlab.errors import FrictionLabError
 
 from _fit_helpers import TRUTH, synthetic
 from frictionlab import compare, write_report
+from frictionlab.io import MARKER
 from frictionlab.cli import main
 from frictionlab.progress import Progress
 from frictionlab.errors import OutputError
@@ -175,8 +176,13 @@ def test_existing_folder_is_refused_then_replaced_with_force(comparison, tmp_pat
     with pytest.raises(OutputError, match="exists"):
         write_report(comparison, out)
     assert (out / "keep.txt").read_text() == "mine"
-    write_report(comparison, out, force=True)
-    assert not (out / "keep.txt").exists() and (out / "report.md").exists()
+    with pytest.raises(OutputError, match="replaces only a folder written by frictionlab"):
+        write_report(comparison, out, force=True)  # not a report: --force does not delete it either
+    assert (out / "keep.txt").read_text() == "mine"
+    (out / "keep.txt").unlink()
+    write_report(comparison, out, force=True)  # an empty folder may be replaced (a report too: test_hardening)
+    assert (out / "report.md").exists() and (out / MARKER).is_file()
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no .old, .tmp or .lock left
 
 
 def test_a_failure_while_writing_leaves_nothing_behind(comparison, tmp_path, monkeypatch):

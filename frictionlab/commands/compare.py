@@ -6,6 +6,7 @@ from pathlib import Path
 
 from ..errors import OutputError, ParameterError
 from ..progress import Progress
+from .fit import FIT_TIMEOUT, fit_timeout
 
 #: Default number of bootstrap resamples: about +15 s (idle) to +35 s (busy machine) on 2 cores for the
 #: built-in datasets, on top of 35-60 s without it.
@@ -16,6 +17,8 @@ REPLICATES = 40
 #: ODE tolerances at which the ODE laws of one dataset are refitted for the report: a looser one
 #: and a tighter one than the fits' default (predict.FIT_RTOL, 1e-6), so the report shows the default converged.
 TOLERANCE_RTOLS = (1e-3, 1e-10)
+MAX_JOBS = 64  # worker processes: more only forks processes that wait
+MAX_BOOTSTRAP = 100_000  # resamples: far past where percentile intervals stop moving
 
 
 def add_parser(sub):
@@ -60,23 +63,26 @@ def add_parser(sub):
     p.add_argument("--no-tolerance", dest="tolerance", action="store_false",
                    help="skip refitting the ODE laws of one dataset at other tolerances "
                         f"({' and '.join(f'{r:.0e}'.replace('e-0', 'e-') for r in TOLERANCE_RTOLS)})")
+    p.add_argument("--fit-timeout", type=fit_timeout, default=FIT_TIMEOUT, metavar="SECONDS",
+                   help=f"time budget of each fit; a fit past it is a failed row with that reason "
+                        f"(default {FIT_TIMEOUT:g})")
     p.set_defaults(func=run)
 
 
 def run(args) -> int:
     from ..comparison import compare
+    from ..io import check_target, output_lock
     from ..report import write_report
     from .fit import parse_free
 
-    if args.out.exists() and not args.force:  # fail before the work, not after it
-        raise OutputError(f"{args.out}: output folder exists; choose another --out or pass --force")
     parent = args.out.parent if str(args.out.parent) else Path(".")
     if not parent.is_dir():
         raise OutputError(f"{args.out}: cannot write: {parent} is not an existing folder")
-    if args.jobs < 1:
-        raise OutputError(f"--jobs must be at least 1, got {args.jobs}")
-    if args.bootstrap < 0:
-        raise ParameterError(f"--bootstrap must be 0 (none) or a positive number of resamples, got {args.bootstrap}")
+    if not 1 <= args.jobs <= MAX_JOBS:
+        raise OutputError(f"--jobs must be between 1 and {MAX_JOBS}, got {args.jobs}")
+    if not 0 <= args.bootstrap <= MAX_BOOTSTRAP:
+        raise ParameterError(f"--bootstrap must be 0 (none) or a number of resamples up to {MAX_BOOTSTRAP}, "
+                             f"got {args.bootstrap}")
     if args.seed < 0:
         raise ParameterError(f"--seed must be a non-negative integer, got {args.seed}")
     from ..equivalence import MIN_REPLICATES
@@ -84,14 +90,16 @@ def run(args) -> int:
     if args.replicates < MIN_REPLICATES:
         raise ParameterError(f"--replicates must be at least {MIN_REPLICATES}, got {args.replicates}")
     free = parse_free(args.free)
-    with Progress("compare", quiet=args.quiet) as bar:
-        result = compare(laws=args.laws or None, datasets=args.data or None, solvers=args.solver or None, free=free,
-                         equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar,
-                         bootstrap=args.bootstrap, seed=args.seed, bootstrap_all=args.bootstrap_all,
-                         tolerance=TOLERANCE_RTOLS if args.tolerance else (), replicates=args.replicates,
-                         transfer=args.transfer)
-    with Progress("report", quiet=args.quiet) as bar:
-        out = write_report(result, args.out, force=args.force, progress=bar)
+    with output_lock(args.out):  # a second run to the same --out fails now, not after the work
+        check_target(args.out, args.force)
+        with Progress("compare", quiet=args.quiet) as bar:
+            result = compare(laws=args.laws or None, datasets=args.data or None, solvers=args.solver or None,
+                             free=free, equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar,
+                             bootstrap=args.bootstrap, seed=args.seed, bootstrap_all=args.bootstrap_all,
+                             tolerance=TOLERANCE_RTOLS if args.tolerance else (), fit_timeout=args.fit_timeout,
+                             replicates=args.replicates, transfer=args.transfer)
+        with Progress("report", quiet=args.quiet) as bar:
+            out = write_report(result, args.out, force=args.force, progress=bar)
     ok = sum(f.ok for f in result.fits)
     n_laws, n_data = len(result.laws), len(result.fitted_datasets)
     print(f"compared {n_laws} law{'s' * (n_laws != 1)} on {n_data} dataset{'s' * (n_data != 1)}: {ok} fits, "

@@ -34,6 +34,8 @@ def add_parser(sub):
     p.add_argument("--observable", help="fit this column instead of the dataset's observable (e.g. theta)")
     p.add_argument("--derive", choices=("poly9", "spline"), help="fit omega derived from the theta column")
     p.add_argument("--json", type=Path, metavar="FILE", help="also write the result as JSON")
+    p.add_argument("--fit-timeout", type=fit_timeout, default=FIT_TIMEOUT, metavar="SECONDS",
+                   help=f"time budget of the fit; past it the fit fails with that reason (default {FIT_TIMEOUT:g})")
     p.set_defaults(func=run)
 
 
@@ -57,7 +59,31 @@ def parse_free(items) -> dict:
         if len(parts) not in (2, 3):
             raise ParameterError(f"--free {item!r}: expected NAME=LOWER:UPPER or NAME=LOWER:UPPER:START")
         out[name] = tuple(to_si(x.strip(), SCENE_QUANTITIES[name], f"--free {name}") for x in parts)
+        lo, hi = out[name][:2]
+        if not lo < hi:
+            raise ParameterError(f"--free {name}: lower bound {parts[0].strip()!r} must be below upper {parts[1].strip()!r}")
+        if len(parts) == 3 and not lo <= out[name][2] <= hi:
+            raise ParameterError(f"--free {name}: start {parts[2].strip()!r} is outside its bounds "
+                                 f"[{parts[0].strip()}, {parts[1].strip()}]")
     return out
+
+
+def fit_timeout(value: str) -> float:
+    """--fit-timeout SECONDS: a positive number (argparse type)."""
+    import argparse
+    import math
+
+    try:
+        t = float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {value!r}") from None
+    if not 0 < t < math.inf:
+        raise argparse.ArgumentTypeError(f"expected a positive number of seconds, got {value!r}")
+    return t
+
+
+#: Default time budget of one fit [s]: far above the slowest built-in fit (an ODE fit, seconds).
+FIT_TIMEOUT = 900.0
 
 
 def parse_fix(law, items) -> dict:
@@ -80,7 +106,7 @@ def run(args) -> int:
     if args.json and not args.json.parent.is_dir():  # before the work, not after
         raise OutputError(f"{args.json}: cannot write: folder {args.json.parent} does not exist")
     result = fit(law, args.datasets, solver=args.solver, free=parse_free(args.free), fixed=parse_fix(law, args.fix),
-                 local=args.local, observable=args.observable, derive=args.derive)
+                 local=args.local, observable=args.observable, derive=args.derive, timeout=args.fit_timeout)
     if result.status == "skipped":  # asked for explicitly, an inapplicable solver is an error, not a skip
         raise SolverError(result.reason)
     print(result.summary())

@@ -17,6 +17,10 @@ RPM = 60.0 / (2.0 * math.pi)
 PLOT_POINTS = 501
 
 
+MAX_POINTS = 1_000_000  # simulated times written by --points
+MIN_RTOL = 1e-14  # tighter than this, the ODE solvers give up on round-off
+
+
 def add_parser(sub):
     from ..cli import ListAction, subcommand
 
@@ -59,10 +63,11 @@ def run(args) -> int:
 
     law = get_law(args.law)
     params = parse_params(law, args.param)
-    if not 0 < args.rtol < 1:
-        raise SolverError(f"--rtol: rtol must be a number in (0, 1), got {args.rtol:g}")
-    if args.points is not None and args.points < 2:
-        raise ParameterError(f"--points must be at least 2, got {args.points}")
+    if not MIN_RTOL <= args.rtol < 1:
+        raise SolverError(f"--rtol: rtol must be a number in (0, 1), at least {MIN_RTOL:g} (a float resolves "
+                          f"about 2e-16), got {args.rtol:g}")
+    if args.points is not None and not 2 <= args.points <= MAX_POINTS:
+        raise ParameterError(f"--points must be between 2 and {MAX_POINTS}, got {args.points}")
     ds = load_dataset(args.dataset)
     for path in (args.out, args.plot):
         if path is not None:

@@ -1,0 +1,436 @@
+"""Hardening (issue 13): plugins isolated, fits with a time budget, degenerate data skipped, outputs
+locked and written with the umask, every write error naming its path, worker pools that die with
+the run. The bad-input corpus (tests/bad_inputs/cases.toml) covers the one-line errors; these tests
+cover what a corpus case cannot: real signals and concurrent runs in subprocesses, a full disk, the
+umask, entry-point plugins.
+"""
+from __future__ import annotations
+
+import errno
+import math
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+import warnings
+from pathlib import Path
+
+import pytest
+
+import frictionlab as fl
+from frictionlab import io, registry
+from frictionlab.errors import LawError, OutputError, UnitError
+from frictionlab.law import FrictionLaw, ParamSpec
+
+SLOW_LAW = '''
+import time
+from frictionlab import FrictionLaw, ParamSpec, register_law
+
+@register_law
+class Slow(FrictionLaw):
+    name = "slow-viscous"
+    formula = "F = c u, slowly"
+    citation = "a test of process hygiene"
+    params = (ParamSpec("c", "N s/m", 0.01, 0.0, 1.0, 0.01, "viscous coefficient"),)
+    requires = frozenset({"u"})
+
+    def force(self, p, c):
+        time.sleep(%s)
+        return p["c"] * c.u
+'''
+
+
+# --- quantities -------------------------------------------------------------------------------
+@pytest.mark.parametrize("text, match", [
+    ("9**9**9 g", "a power of a power"),
+    ("10**400 g", "exponent 400"),
+    ("((9**12)**12)**12 g", "a power of a power"),
+    ("1e400 g", "beyond the accepted magnitude"),
+    ("1e200*1e200*1e200 kg", "not finite|accepted magnitudes"),
+])
+def test_hostile_quantities_are_refused_before_pint_evaluates_them(text, match):
+    from frictionlab.units import to_si
+
+    with pytest.raises(UnitError, match=match) as info:
+        to_si(text, "kg", "scene.mass")
+    assert str(info.value).startswith("scene.mass: ")
+
+
+def test_ordinary_quantities_still_convert():
+    from frictionlab.units import to_si, unit_factor
+
+    assert to_si("46 g", "kg", "m") == pytest.approx(0.046)
+    assert to_si("130 mm^2", "m^2", "a") == pytest.approx(1.3e-4)
+    assert to_si("1.81e+06 Pa s/m", "Pa*s/m", "lam") == pytest.approx(1.81e6)
+    assert to_si("2**3 g", "kg", "m") == pytest.approx(0.008)
+    assert to_si("0 m/s", "m/s", "u0") == 0.0
+    assert unit_factor("us", "s", "t") == pytest.approx(1e-6)
+
+
+# --- plugins ----------------------------------------------------------------------------------
+def _law(**spec):
+    values = {"name": "k", "unit": "N s/m", "default": 1.0, "lower": 0.0, "upper": 10.0, "scale": 1.0,
+              "description": "coefficient", **spec}
+
+    class Law(FrictionLaw):
+        name = "probe-law"
+        formula = "F = k u"
+        citation = "a test"
+        params = (ParamSpec(**values),)
+        requires = frozenset({"u"})
+
+        def force(self, p, c):
+            return p["k"] * c.u
+
+    return Law
+
+
+@pytest.mark.parametrize("spec, match", [
+    ({"default": 1.0, "lower": 1.0, "upper": 1.0}, "lower bound 1 must be below upper bound 1"),
+    ({"upper": math.inf}, "upper = inf is not a finite real number"),
+    ({"lower": -math.inf}, "lower = -inf is not a finite real number"),
+    ({"scale": 1e-40}, "scale 1e-40 is out of proportion"),
+])
+def test_degenerate_parameters_are_refused_at_registration_naming_the_plugin(spec, match):
+    with pytest.raises(LawError, match=match) as info:
+        fl.register_law(_law(**spec))
+    assert "law 'probe-law' (run-time registration of " in str(info.value)
+    assert "probe-law" not in fl.available_laws()
+
+
+def test_a_complex_force_is_refused_naming_the_law_without_a_numpy_warning():
+    class Complex(FrictionLaw):
+        name = "complex-law"
+        formula = "F = k u (1 + i)"
+        citation = "a test"
+        params = (ParamSpec("k", "N s/m", 1.0, 0.0, 10.0, 1.0, "coefficient"),)
+        requires = frozenset({"u"})
+
+        def force(self, p, c):
+            return p["k"] * c.u * (1 + 1j)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # numpy's ComplexWarning would fail here
+        with pytest.raises(LawError, match=r"law 'complex-law' .*force\(\) returned complex128 values"):
+            fl.register_law(Complex)
+
+
+def _write_dist(root: Path, modules: dict[str, str], entry_points: str) -> None:
+    for module, code in modules.items():
+        (root / f"{module}.py").write_text(textwrap.dedent(code))
+    info = root / "rude_laws-0.1.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: rude-laws\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text("[frictionlab.laws]\n" + entry_points)
+
+
+def test_a_plugin_that_exits_or_interrupts_at_import_is_skipped_not_the_program(tmp_path, monkeypatch, run_cli):
+    _write_dist(tmp_path, {"exits": "import sys\nsys.exit(0)\n", "interrupts": "raise KeyboardInterrupt\n"},
+                "exits = exits:Law\ninterrupts = interrupts:Law\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            registry.reload_registry()
+        messages = sorted(str(w.message) for w in caught if issubclass(w.category, registry.PluginWarning))
+        assert len(messages) == 2, messages
+        assert "'exits = exits:Law' of rude-laws 0.1: import failed: SystemExit: 0" in messages[0]
+        assert "'interrupts = interrupts:Law' of rude-laws 0.1: import failed: KeyboardInterrupt" in messages[1]
+        assert "wear" in fl.available_laws()
+    finally:
+        monkeypatch.undo()
+        registry.reload_registry()
+    out = run_cli("laws", env={"PYTHONPATH": str(tmp_path)})
+    assert out.returncode == 0 and "wear" in out.stdout, out.stderr
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 2 and all(line.startswith("warning: frictionlab: skipped law plugin") for line in lines)
+
+
+# --- the time budget of a fit --------------------------------------------------------------------
+class _Sluggish(FrictionLaw):
+    """Each evaluation sleeps; above k = 2 a single evaluation never returns (a runaway)."""
+    name = "sluggish"
+    formula = "F = k u"
+    citation = "a test of --fit-timeout"
+    params = (ParamSpec("k", "N s/m", 1.0, 0.0, 100.0, 1.0, "coefficient"),)
+    requires = frozenset({"u"})
+    runaway = False
+
+    def force(self, p, c):
+        time.sleep(0.01)
+        while self.runaway and p["k"] > 2.0:
+            pass
+        return p["k"] * c.u
+
+
+@pytest.mark.parametrize("runaway", [False, True], ids=["slow-calls", "one-call-runs-away"])
+def test_a_fit_past_its_time_budget_is_a_failed_result_with_the_reason(runaway):
+    law = _Sluggish()
+    law.runaway = runaway
+    result = fl.fit(law, "incline-oil-a100", timeout=0.5)
+    assert result.status == "failed"
+    assert "exceeded its time budget of 0.5 s (--fit-timeout)" in result.reason
+    assert result.wall_time < 30  # it stopped: without the budget the runaway never returns
+    assert signal.getitimer(signal.ITIMER_REAL)[0] == 0  # no alarm left armed
+
+
+def test_compare_turns_a_runaway_fit_into_a_failed_row(monkeypatch):
+    fl.register_law(_Sluggish)
+    try:
+        c = fl.compare(laws=["sluggish", "wear"], datasets=["incline-oil-a100"], equivalence=False,
+                       fit_timeout=0.3)
+    finally:
+        registry.unregister_law("sluggish")
+    by_law = {f.law: f for f in c.fits}
+    assert by_law["sluggish"].status == "failed" and "time budget" in by_law["sluggish"].reason
+    assert by_law["wear"].ok
+    assert [r.law for r in c.ranking if r.status != "failed"][:1] == ["wear"]
+
+
+# --- degenerate data ------------------------------------------------------------------------------
+def _tiny(tmp_path, rows: str, name="tiny") -> Path:
+    base = fl.load_dataset("incline-oil-a100").path
+    text = base.read_text().replace('name = "incline-oil-a100"', f'name = "{name}"')
+    (tmp_path / "d.toml").write_text(text.replace('incline = "20 deg"', 'incline = "20 deg"\nduration = "0.5 s"'))
+    (tmp_path / "d.csv").write_text("t,v\n" + rows)
+    return tmp_path / "d.toml"
+
+
+def test_fewer_points_than_parameters_plus_one_is_skipped_never_ranked(tmp_path):
+    data = fl.load_dataset(_tiny(tmp_path, "0.25,0.05\n0.5,0.1\n"))
+    ok = fl.fit("coulomb", data)  # 2 points, 1 parameter: a fit
+    assert ok.status == "ok"
+    short = fl.fit("coulomb", data, free={"u0": (0.0, 1.0)})  # 2 points, 2 parameters: none
+    assert short.status == "skipped"
+    assert short.reason == "tiny: 2 data points for 2 free parameters: a fit needs at least 3"
+    one = fl.load_dataset(_tiny(tmp_path, "0.5,0.1\n", name="one"))
+    c = fl.compare(laws=["coulomb", "wear"], datasets=[one, data], equivalence=False)
+    assert {(f.datasets[0], f.status) for f in c.fits} == {("one", "skipped"), ("tiny", "ok")}
+    assert all(r.dataset != "one" or r.status == "skipped" for r in c.ranking)
+    assert not any(r.dataset == "one" and r.status in ("ok", "best", "tied") for r in c.ranking)
+
+
+# --- output ---------------------------------------------------------------------------------------
+def test_full_disk_names_the_path_and_leaves_nothing(tmp_path, monkeypatch):
+    def full(self, *a, **k):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    out = tmp_path / "report"
+    monkeypatch.setattr(Path, "write_text", full)
+    with pytest.raises(OutputError) as info:
+        with io.atomic_dir(out) as tmp:
+            (tmp / "report.md").write_text("a report")
+    assert str(info.value).startswith(f"{out}: cannot write") and "No space left on device" in str(info.value)
+    assert list(tmp_path.iterdir()) == []
+
+    monkeypatch.undo()
+    real_fdopen = os.fdopen
+
+    class Full:
+        def __init__(self, fh):
+            self.fh = fh
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            self.fh.close()
+
+        def write(self, data):
+            raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(os, "fdopen", lambda fd, *a, **k: Full(real_fdopen(fd, *a, **k)))
+    target = tmp_path / "series.csv"
+    with pytest.raises(OutputError, match=rf"^{target}: cannot write: No space left on device$"):
+        io.atomic_write_text(target, "t,v\n")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_outputs_get_their_permissions_from_the_umask(tmp_path):
+    old = os.umask(0o027)
+    try:
+        with io.atomic_dir(tmp_path / "rep") as tmp:
+            (tmp / "figures").mkdir()
+            (tmp / "figures" / "a.png").write_bytes(b"png")
+        io.atomic_write_text(tmp_path / "one.csv", "t\n")
+    finally:
+        os.umask(old)
+    mode = lambda p: p.stat().st_mode & 0o777  # noqa: E731
+    assert mode(tmp_path / "rep") == 0o750 and mode(tmp_path / "rep" / "figures") == 0o750
+    assert mode(tmp_path / "rep" / "figures" / "a.png") == 0o640 and mode(tmp_path / "rep" / io.MARKER) == 0o640
+    assert mode(tmp_path / "one.csv") == 0o640
+
+
+def test_the_final_move_checks_the_target_again(tmp_path):
+    out = tmp_path / "rep"
+    with pytest.raises(OutputError, match="output folder exists"):
+        with io.atomic_dir(out) as tmp:
+            (tmp / "report.md").write_text("mine")
+            out.mkdir()  # someone else (not frictionlab: no lock) made it meanwhile
+            (out / "theirs.txt").write_text("theirs")
+    assert sorted(p.name for p in out.iterdir()) == ["theirs.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rep"]
+
+
+def test_force_replaces_a_report_or_an_empty_folder_and_nothing_else(tmp_path):
+    out = tmp_path / "rep"
+    for _ in range(2):  # the first creates it, the second replaces a report
+        with io.atomic_dir(out, force=True) as tmp:
+            (tmp / "report.md").write_text("new")
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    with io.atomic_dir(empty, force=True) as tmp:
+        (tmp / "report.md").write_text("new")
+    victim = tmp_path / "notes.txt"
+    victim.write_text("precious")
+    with pytest.raises(OutputError, match="this is not a folder"):
+        with io.atomic_dir(victim, force=True):
+            pass
+    assert victim.read_text() == "precious"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["empty", "notes.txt", "rep"]  # no .old, .tmp, .lock
+
+
+def _hold_lock(path: Path):
+    """A subprocess holding frictionlab's lock on ``path`` until its stdin closes."""
+    code = ("import sys; from frictionlab.io import output_lock\n"
+            f"with output_lock({str(path)!r}):\n    print('held', flush=True); sys.stdin.read()\n")
+    proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    assert proc.stdout.readline().strip() == "held"
+    return proc
+
+
+def test_a_second_run_to_a_locked_output_fails_at_once_and_writes_nothing(tmp_path, capsys):
+    from frictionlab import cli
+
+    out = tmp_path / "rep"
+    holder = _hold_lock(out)  # another process
+    try:
+        rc = cli.main(["compare", "--laws", "wear", "--data", "incline-oil-a100", "--bootstrap", "0",
+                       "--no-tolerance", "--out", str(out)])
+    finally:
+        holder.stdin.close()
+        holder.wait(10)
+    err = capsys.readouterr().err
+    assert rc == 2, err
+    assert err.strip() == (f"frictionlab: error: {out}: another frictionlab run is writing this output "
+                           f"(lock {tmp_path / '.rep.lock'}); wait for it to finish or choose another --out")
+    assert sorted(p.name for p in tmp_path.iterdir()) == []  # the holder removed its lock; nothing else
+
+
+def test_two_concurrent_runs_to_one_output_never_both_succeed(tmp_path):
+    out = tmp_path / "rep"
+    argv = [sys.executable, "-m", "frictionlab", "compare", "--laws", "wear", "--data", "incline-oil-a100",
+            "--bootstrap", "0", "--no-tolerance", "--no-equivalence", "--jobs", "1", "--quiet", "--out", str(out)]
+    procs = [subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+             for _ in range(2)]
+    results = [(p.wait(120), p.stderr.read()) for p in procs]
+    codes = sorted(rc for rc, _ in results)
+    assert codes == [0, 2], results
+    loser = next(err for rc, err in results if rc == 2)
+    assert "another frictionlab run is writing this output" in loser or "output folder exists" in loser, loser
+    assert (out / "report.md").exists() and (out / io.MARKER).exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rep"]
+
+
+# --- signals: no worker outlives the run ---------------------------------------------------------
+def _children(pid: int) -> set[int]:
+    """Process ids whose parent is ``pid`` (from /proc; psutil is not a dependency)."""
+    out = set()
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                stat = Path(f"/proc/{entry}/stat").read_text()
+            except OSError:
+                continue
+            if int(stat.rsplit(")", 1)[1].split()[1]) == pid:
+                out.add(int(entry))
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"  # a zombie has exited; only its exit status is left
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc")
+@pytest.mark.parametrize("sig, code, word", [(signal.SIGTERM, 143, "terminated"), (signal.SIGINT, 130, "interrupted")],
+                         ids=["SIGTERM", "SIGINT"])
+def test_a_signal_during_compare_with_workers_leaves_no_process_and_no_output(sig, code, word, tmp_path):
+    (tmp_path / "slow.py").write_text(SLOW_LAW % "0.005")
+    out = tmp_path / "rep"
+    proc = subprocess.Popen([sys.executable, "-m", "frictionlab", "--load", str(tmp_path / "slow.py"), "compare",
+                             "--laws", "slow-viscous", "--data", "incline-oil-a100,incline-oil-a200,incline-dry-d10",
+                             "--quiet", "--jobs", "2", "--bootstrap", "0", "--no-tolerance",
+                             "--no-equivalence", "--out", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    try:
+        deadline = time.monotonic() + 60
+        workers: set[int] = set()
+        while len(workers) < 2 and time.monotonic() < deadline and proc.poll() is None:
+            workers |= _children(proc.pid)
+            time.sleep(0.05)
+        assert len(workers) >= 2, f"the run made no workers: {proc.poll()} {proc.stderr.read() if proc.poll() else ''}"
+        time.sleep(0.5)  # the workers are fitting now
+        proc.send_signal(sig)
+        rc = proc.wait(30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    stderr = proc.stderr.read()
+    assert rc == code, stderr
+    assert stderr.strip().splitlines()[-1] == f"frictionlab: {word}", stderr
+    assert "Traceback" not in stderr
+    deadline = time.monotonic() + 5
+    while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not [p for p in workers if _alive(p)], "worker processes outlived the run"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["slow.py"]  # no report, no lock, no temporary folder
+
+
+# --- every quantity of a scene at the edges of the accepted range ----------------------------------
+@pytest.mark.parametrize("base", ["impact-golf-v28", "incline-dry-d10", "incline-oil-a100", "impact-outcome-synthetic"])
+def test_quantities_at_the_limits_give_errors_naming_the_field_never_a_class(base, tmp_path):
+    """Every 'key = "number unit"' of a built-in TOML set to the largest, a negative and the smallest
+    accepted magnitude: it loads, or the one-line error names the file, not an internal class."""
+    import re
+
+    from frictionlab.dataset import builtin_dir
+    from frictionlab.errors import FrictionLabError
+
+    text = (builtin_dir() / f"{base}.toml").read_text()
+    (tmp_path / "d.csv").write_bytes((builtin_dir() / f"{base}.csv").read_bytes())
+    fields = list(re.finditer(r'^(\w+) = "([-+0-9.e]+) ([^"]+)"$', text, re.M))
+    assert len(fields) >= 5
+    for m in fields:
+        for value in ("1e100", "-1e100", "1.1e-100"):
+            (tmp_path / "d.toml").write_text(text[:m.start()] + f'{m.group(1)} = "{value} {m.group(3)}"'
+                                             + text[m.end():])
+            try:
+                fl.load_dataset(tmp_path / "d.toml")
+            except FrictionLabError as exc:
+                msg = str(exc)
+                assert msg.startswith(str(tmp_path / "d.")), msg
+                assert not re.search(r"\b[A-Z][a-z]+[A-Z]\w*\.\w+", msg), msg  # like WeightNormal.value
+
+
+def test_a_full_disk_during_compare_is_one_line_naming_the_report(tmp_path, monkeypatch, capsys):
+    from frictionlab import cli
+
+    def full(self, *a, **k):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(Path, "write_bytes", full)
+    monkeypatch.setattr(Path, "write_text", full)
+    monkeypatch.chdir(tmp_path)
+    rc = cli.main(["compare", "--laws", "wear", "--data", "incline-oil-a100", "--bootstrap", "0", "--no-tolerance",
+                   "--no-equivalence", "--jobs", "1", "--quiet", "--out", "rep"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2 and len(err) == 1, err
+    assert err[0].startswith("frictionlab: error: rep: cannot write") and err[0].endswith("No space left on device")
+    assert list(tmp_path.iterdir()) == []
