@@ -30,6 +30,7 @@ class Answer:
     noise_threshold: str  # e.g. "the two laws differ by more than the noise when sigma < 150 rpm"
     series_vs_exact: str  # e.g. "the series' spin falls because its slip crosses zero at 309 us"
     transfer: str = ""  # e.g. "one lambda serves both speeds: no (prediction error 12 sigma)"
+    equivalence_series: str = ""  # one of EQUIVALENCE: the paper's series of lambda A u against mu N + mu eta' dA/dt
     details: dict = attrs.field(factory=dict)  # machine-readable numbers behind the texts (SI), for results.json
 
     def as_dict(self) -> dict:

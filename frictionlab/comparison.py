@@ -8,7 +8,10 @@ skipped with the reason). Contact-area datasets are supporting series and are no
 dataset kind without a predictor is skipped with that reason. Nothing here raises for a fit
 that fails: it becomes a row with status 'failed' and its reason.
 
-Optionally (``bootstrap=N``) every candidate is refitted to N case resamples of its dataset
+The equivalence stage runs the discrimination test (``equivalence.analyze_equivalence``) on the
+pairs of ``equivalence.PAIRS`` per dataset (the paper's pair also with the wear law's series), and
+the transfer stage (``transfer``) predicts across the members of each dataset group and fits one
+parameter set to the group. Optionally (``bootstrap=N``) every candidate is refitted to N case resamples of its dataset
 (``bootstrap.bootstrap_fits``: parameter intervals and how often each candidate ranks first), and
 (``tolerance=rtols``) the laws that need the ODE on one dataset are refitted at looser
 tolerances (``fitcost.tolerance_check``). Every stage runs on one process pool when jobs > 1.
@@ -32,13 +35,15 @@ import numpy as np
 
 from .answers import group_of
 from .dataset import Dataset, builtin_names, load_dataset
-from .equivalence import AREA_RATE, WEAR, EquivalenceResult, analyze_equivalence
+from . import equivalence as _equivalence, transfer as _transfer
+from .equivalence import MIN_REPLICATES, PAIRS, REPLICATES, EquivalenceResult, analyze_equivalence
 from .errors import FrictionLabError, ParameterError, Terminated
 from .bootstrap import bootstrap_fits
 from .fitcost import tolerance_check
 from .fitting import PREDICTORS, FitResult, applicable_solvers, auto_solver, fit
 from .ranking import RankRow, family, rank_fits, rank_groups
 from .registry import available_laws, get_law
+from .transfer import TransferResult, assemble, candidates_by_group, transfer_candidate
 from .verdicts import make_answers
 
 Progress = Callable[[int, int, str], None]
@@ -53,7 +58,7 @@ class Comparison:
     fits: tuple[FitResult, ...]
     ranking: tuple[RankRow, ...]  # per dataset
     groups: tuple[RankRow, ...]  # ALL, ALL[kind] and each dataset group of two or more
-    equivalence: tuple[EquivalenceResult, ...]
+    equivalence: tuple[EquivalenceResult, ...]  # discrimination tests (law A vs law B per dataset)
     skipped_datasets: dict  # name -> reason
     wall_time: float
     versions: dict
@@ -62,6 +67,7 @@ class Comparison:
     bootstrap_skipped: dict = attrs.field(factory=dict)  # dataset -> why it was not bootstrapped
     tolerance: tuple[dict, ...] = ()  # fitcost.tolerance_check rows
     timings: dict = attrs.field(factory=dict)  # stage -> wall-clock seconds
+    transfer: tuple[TransferResult, ...] = ()  # per dataset group with two or more members
     answers: tuple = ()  # answers.Answer per dataset group: the report's first screen (filled by the verdict layer)
 
     def fit_for(self, dataset: str, law: str, solver: str | None = None) -> FitResult | None:
@@ -147,7 +153,13 @@ def _fit_task(args, timeout=None) -> FitResult:
 
 
 def _equivalence_task(args) -> EquivalenceResult:
-    return analyze_equivalence(*args)
+    fa, fb, replicates, seed = args
+    return analyze_equivalence(fa, fb, replicates=replicates, seed=seed)
+
+
+def _transfer_task(args):
+    fits, free = args
+    return transfer_candidate(fits, free)
 
 
 def _worker_init() -> None:
@@ -252,7 +264,8 @@ def select_laws(laws: Sequence[str] | None) -> tuple[str, ...]:
 def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None, solvers: Sequence[str] | None = None,
             *, free: dict | None = None, equivalence: bool = True, jobs: int = 1,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
-            tolerance: Sequence[float] = (), fit_timeout: float | None = None) -> Comparison:
+            tolerance: Sequence[float] = (), fit_timeout: float | None = None, replicates: int = REPLICATES,
+            pairs: Sequence = PAIRS, transfer: bool = True) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
 
     laws: registered names, None for DEFAULT_LAWS, or "all" for every registered law; datasets: built-in names, TOML paths or Datasets
@@ -262,7 +275,10 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     bootstrap: case resamples per dataset (0: none), drawn from ``seed``; datasets where a law
     needs the ODE, or without a time series, are bootstrapped only with bootstrap_all. tolerance: looser ODE tolerances at
     which the ODE laws of one dataset are refitted (empty: no tolerance check). fit_timeout: time
-    budget of each fit in seconds (None: none); a fit past it is a failed row saying so.
+    budget of each fit in seconds (None: none); a fit past it is a failed row saying so. replicates: R per
+    law of the equivalence test's parametric bootstrap (seeded by ``seed``); pairs: (law A, law B)
+    to test (default equivalence.PAIRS); pairs where a law needs the ODE solver, or without a time
+    series, are tested only with bootstrap_all. transfer: run the transfer stage.
     """
     started = time.perf_counter()
     from .solvers import parse_solver
@@ -270,7 +286,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     for s in solvers or ():
         if s != "auto":
             parse_solver(s)  # an unknown solver is an input error, before any work
-    for name, v in (("bootstrap", bootstrap), ("seed", seed)):
+    for name, v in (("bootstrap", bootstrap), ("seed", seed), ("replicates", replicates)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
             raise ParameterError(f"compare: {name} must be a non-negative integer, got {v!r}")
     if fit_timeout is not None and (isinstance(fit_timeout, bool) or not isinstance(fit_timeout, (int, float))
@@ -302,7 +318,9 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                                + "; ".join(f"{k}: {v}" for k, v in skipped_ds.items()))
     # slow (ode) fits first, so that workers finish together
     plan.sort(key=lambda x: not x[2].startswith("ode"))
-    eq_pairs = _equivalence_pairs(law_names, plan) if equivalence else []
+    if equivalence and replicates < MIN_REPLICATES:
+        raise ParameterError(f"compare: replicates must be at least {MIN_REPLICATES}, got {replicates}")
+    eq_pairs = _equivalence_pairs(law_names, plan, pairs) if equivalence else []
     n_boot = len({f.datasets[0] for f in fits} | {t[1].name for t in plan}) if bootstrap else 0
     total = len(plan) + len(eq_pairs) + n_boot + (1 if tolerance else 0)
     label = lambda t: f"{t[0]} [{t[2]}] on {t[1].name}"  # noqa: E731
@@ -323,10 +341,31 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
         if eq_pairs:
             t0 = time.perf_counter()
             lookup = {(f.datasets[0], f.law, f.solver): f for f in fits}
-            tasks = [(lookup[(d, WEAR, s)], lookup[(d, AREA_RATE, sa)]) for d, s, sa in eq_pairs]
+            tasks, slow = [], []
+            for d, (la, sa), (lb, sb) in eq_pairs:
+                fa, fb = lookup[(d, la, sa)], lookup[(d, lb, sb)]
+                why = _slow_pair(fa, fb, replicates) if not bootstrap_all else ""
+                if why:
+                    slow.append(EquivalenceResult(dataset=d, law_a=la, law_b=lb, solver_a=sa, solver_b=sb,
+                                                  status="skipped", reason=why, replicates=replicates, seed=seed))
+                else:
+                    tasks.append((fa, fb, replicates, seed))
             eq_results, done = _run(tasks, _equivalence_task, pool, progress, done, total,
-                                    lambda t: f"equivalence on {t[0].datasets[0]} [{t[0].solver}]")
+                                    lambda t: f"equivalence on {t[0].datasets[0]}: {t[0].law} [{t[0].solver}] "
+                                              f"vs {t[1].law} [{t[1].solver}]")
+            done += len(slow)
+            eq_results += slow
             timings["equivalence"] = time.perf_counter() - t0
+        transfer_results = []
+        if transfer:
+            t0 = time.perf_counter()
+            by_group = candidates_by_group(fits, dss)
+            tasks = [(g, c, fs) for g, cands in by_group.items() for c, fs in cands.items()]
+            parts, _ = _run([(fs, dict(free or {})) for _, _, fs in tasks], _transfer_task, pool, None, 0, 0, str)
+            for g, cands in by_group.items():
+                transfer_results.append(assemble(g, cands, {c: p for (gg, c, _), p in zip(tasks, parts) if gg == g}))
+            if by_group:
+                timings["transfer"] = time.perf_counter() - t0
         step = _Step(progress, done, total)
 
         def tolerance_stage():
@@ -353,18 +392,22 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             side.shutdown(wait=False, cancel_futures=True)
             raise
         side.shutdown(wait=True)
-    eq_results.sort(key=lambda e: (order[e.dataset], family(e.solver) == "series"))
+    eq_results.sort(key=lambda e: (order[e.dataset], _pair_index(pairs, e), "series" in (e.solver_a, e.solver_b)))
     ranking = rank_fits(fits)
     kinds = {d.name: d.kind for d in dss}
     groups = rank_groups(ranking, kinds, named={d.name: group_of(d) for d in dss})
     answers = make_answers([d for d in dss if d.name not in skipped_ds], fits, ranking, groups)
+    # the verdict layer's rows; the equivalence and transfer fields are filled by their producers
+    answers = _transfer.fill_answers(_equivalence.fill_answers(answers, eq_results), transfer_results)
     return Comparison(laws=law_names, datasets=dss, fits=tuple(fits), ranking=tuple(ranking), groups=tuple(groups),
-                      equivalence=tuple(eq_results), skipped_datasets=skipped_ds,
+                      equivalence=tuple(eq_results), transfer=tuple(transfer_results), skipped_datasets=skipped_ds,
                       wall_time=time.perf_counter() - started, versions=versions(),
                       settings={"solvers": list(solvers) if solvers else "default", "jobs": jobs,
                                 "equivalence": equivalence, "free": {k: list(v) for k, v in (free or {}).items()},
                                 "bootstrap": int(bootstrap), "seed": int(seed), "bootstrap_all": bool(bootstrap_all),
-                                "tolerance": [float(r) for r in tolerance], "fit_timeout": fit_timeout},
+                                "tolerance": [float(r) for r in tolerance], "fit_timeout": fit_timeout,
+                                "replicates": int(replicates), "pairs": [list(p) for p in pairs],
+                                "transfer": bool(transfer)},
                       bootstrap=tuple(boots), bootstrap_skipped=boot_skipped, tolerance=tuple(tol_rows),
                       timings=timings, answers=answers)
 
@@ -392,15 +435,45 @@ def _unique_datasets(dss) -> tuple[Dataset, ...]:
     return tuple(out.values())
 
 
-def _equivalence_pairs(law_names, plan) -> list[tuple[str, str, str]]:
-    """(dataset, wear solver, area-rate solver) for every dataset where both laws are fitted."""
-    if WEAR not in law_names or AREA_RATE not in law_names:
-        return []
-    out = []
+def _equivalence_pairs(law_names, plan, pairs) -> list[tuple[str, tuple[str, str], tuple[str, str]]]:
+    """(dataset, (law A, solver), (law B, solver)) for every pair of ``pairs`` whose laws are both
+    fitted on a dataset: each law with its full solver (exact or ode); the paper's pair (the first)
+    also with law A's series."""
+    names = {get_law(n).name for n in law_names}
+    fitted: dict[str, dict[str, list[str]]] = {}
     for law, ds, solver, _ in plan:
-        if law != WEAR:
-            continue
-        ar = [s for (lw, d, s, _) in plan if lw == AREA_RATE and d.name == ds.name]
-        if ar:
-            out.append((ds.name, solver, ar[0]))
+        fitted.setdefault(ds.name, {}).setdefault(law, []).append(solver)
+    out = []
+    for d, laws in fitted.items():
+        for i, (a, b) in enumerate(pairs):
+            a, b = get_law(a).name, get_law(b).name
+            if not {a, b} <= names or a not in laws or b not in laws:
+                continue
+            full_a = [s for s in laws[a] if family(s) == "full"]
+            full_b = [s for s in laws[b] if family(s) == "full"]
+            if not full_b:
+                continue
+            for sa in full_a + ([s for s in laws[a] if s == "series"] if i == 0 else []):
+                out.append((d, (a, sa), (b, full_b[0])))
     return out
+
+
+def _pair_index(pairs, e) -> int:
+    for i, (a, b) in enumerate(pairs):
+        if (get_law(a).name, get_law(b).name) == (e.law_a, e.law_b):
+            return i
+    return len(pairs)
+
+
+def _slow_pair(fa: FitResult, fb: FitResult, replicates: int) -> str:
+    """Why the parametric bootstrap of this pair is slow, or ''."""
+    ode = [f for f in (fa, fb) if f.ok and f.solver.startswith("ode")]
+    if ode:
+        cpu = sum(f.cpu_time for f in ode)
+        return (f"{' and '.join(f'{f.law} [{f.solver}]' for f in ode)} need{'s' * (len(ode) == 1)} the ODE solver "
+                f"(its fit took {cpu:.1f} CPU s; the test refits both laws {4 * replicates} times); add "
+                "--bootstrap-all to include it")
+    if fa.ok and fa.per_dataset[0].target.t is None:
+        return (f"an {fa.per_dataset[0].target.dataset.kind} set simulates every row at each evaluation "
+                f"(the test refits both laws {4 * replicates} times); add --bootstrap-all to include it")
+    return ""

@@ -85,8 +85,10 @@ def test_ranking_csv_and_results_json(report_dir):
     assert fit["statistics"]["observable_unit"] == "rad/s"
     assert "verdict" in fit["identifiability"]
     eq = data["equivalence"]
-    assert {e["solver"] for e in eq} == {"exact", "series"}
-    assert all(e["verdict"] and e["explanation"] and e["decomposition"] for e in eq)
+    assert {(e["law_a"], e["solver_a"], e["law_b"]) for e in eq} == {("wear", "exact", "area-rate"),
+                                                                   ("wear", "series", "area-rate")}
+    assert all(e["verdict"] and e["explanation"] and len(e["t_a"]) >= 10 for e in eq)
+    assert [e["solver_a"] for e in eq if e["decomposition"]] == ["series"]  # never for the exact solution
     assert "poly9" in data["derivations"]["synth-impact"]
 
 

@@ -11,6 +11,9 @@ from .fit import FIT_TIMEOUT, fit_timeout
 #: Default number of bootstrap resamples: about +15 s (idle) to +35 s (busy machine) on 2 cores for the
 #: built-in datasets, on top of 35-60 s without it.
 BOOTSTRAP_N = 150
+#: Replicates per law of the equivalence test (the library's ``equivalence.REPLICATES``, kept here so that
+#: ``--help`` imports no numerical package; a test checks that the two agree).
+REPLICATES = 40
 #: ODE tolerances at which the ODE laws of one dataset are refitted for the report: a looser one
 #: and a tighter one than the fits' default (predict.FIT_RTOL, 1e-6), so the report shows the default converged.
 TOLERANCE_RTOLS = (1e-3, 1e-10)
@@ -31,7 +34,9 @@ def add_parser(sub):
   frictionlab compare --bootstrap 0 --no-tolerance --quiet --out quick   # fastest, no progress lines""")
     p.add_argument("--laws", "--law", action=ListAction, metavar="NAME", help="law names, or 'all' for every registered law "
                    "(default: coulomb, area-rate, wear, couette)")
-    p.add_argument("--data", action=ListAction, metavar="NAME_OR_TOML", help="datasets (default: every built-in)")
+    p.add_argument("--data", action=ListAction, nargs="+", metavar="NAME_OR_TOML",
+                   help="datasets, several after one --data (e.g. a shell glob), comma-separated or repeated "
+                        "(default: every built-in)")
     p.add_argument("--solver", "--solvers", action=ListAction, metavar="SOLVER",
                    help="exact, series, ode[:METHOD] or auto (default: exact where a closed form exists else ode, "
                         "plus series where it applies)")
@@ -41,14 +46,20 @@ def add_parser(sub):
     p.add_argument("--force", action="store_true", help="replace an existing report folder")
     p.add_argument("--jobs", type=int, default=min(os.cpu_count() or 1, 4),
                    help="worker processes (default: number of CPUs, at most 4)")
-    p.add_argument("--no-equivalence", action="store_true", help="skip the equivalence analysis")
+    p.add_argument("--no-equivalence", action="store_true", help="skip the equivalence (discrimination) tests")
+    p.add_argument("--replicates", type=int, default=REPLICATES, metavar="R",
+                   help=f"replicate datasets per law in the equivalence test's parametric bootstrap (default: "
+                        f"{REPLICATES}; at least 20, so that a p-value can fall below 0.05; the Monte-Carlo error of a p-value is about sqrt(p(1-p)/R))")
+    p.add_argument("--no-transfer", dest="transfer", action="store_false",
+                   help="skip predicting across the datasets of a group and the shared-parameter fits")
     p.add_argument("--bootstrap", type=int, default=BOOTSTRAP_N, metavar="N",
                    help=f"case resamples per dataset for confidence intervals and first-place shares "
                         f"(default: {BOOTSTRAP_N}; 0: none)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the bootstrap resamples (default: 0)")
+    p.add_argument("--seed", type=int, default=0,
+                   help="seed of the bootstrap resamples and of the equivalence test's replicates (default: 0)")
     p.add_argument("--bootstrap-all", action="store_true",
-                   help="also bootstrap the slow datasets: where a law needs the ODE solver, and impact-outcome sets "
-                        "(minutes per 100 resamples)")
+                   help="also bootstrap, and run the equivalence test on, the slow datasets: where a law needs the "
+                        "ODE solver, and impact-outcome sets (minutes per 100 resamples)")
     p.add_argument("--no-tolerance", dest="tolerance", action="store_false",
                    help="skip refitting the ODE laws of one dataset at other tolerances "
                         f"({' and '.join(f'{r:.0e}'.replace('e-0', 'e-') for r in TOLERANCE_RTOLS)})")
@@ -74,6 +85,10 @@ def run(args) -> int:
                              f"got {args.bootstrap}")
     if args.seed < 0:
         raise ParameterError(f"--seed must be a non-negative integer, got {args.seed}")
+    from ..equivalence import MIN_REPLICATES
+
+    if args.replicates < MIN_REPLICATES:
+        raise ParameterError(f"--replicates must be at least {MIN_REPLICATES}, got {args.replicates}")
     free = parse_free(args.free)
     with output_lock(args.out):  # a second run to the same --out fails now, not after the work
         check_target(args.out, args.force)
@@ -81,14 +96,15 @@ def run(args) -> int:
             result = compare(laws=args.laws or None, datasets=args.data or None, solvers=args.solver or None,
                              free=free, equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar,
                              bootstrap=args.bootstrap, seed=args.seed, bootstrap_all=args.bootstrap_all,
-                             tolerance=TOLERANCE_RTOLS if args.tolerance else (), fit_timeout=args.fit_timeout)
+                             tolerance=TOLERANCE_RTOLS if args.tolerance else (), fit_timeout=args.fit_timeout,
+                             replicates=args.replicates, transfer=args.transfer)
         with Progress("report", quiet=args.quiet) as bar:
             out = write_report(result, args.out, force=args.force, progress=bar)
     ok = sum(f.ok for f in result.fits)
     n_laws, n_data = len(result.laws), len(result.fitted_datasets)
     print(f"compared {n_laws} law{'s' * (n_laws != 1)} on {n_data} dataset{'s' * (n_data != 1)}: {ok} fits, "
           f"{sum(f.status == 'failed' for f in result.fits)} failed, {sum(f.status == 'skipped' for f in result.fits)} "
-          f"skipped, {len(result.equivalence)} equivalence tests, in {result.wall_time:.1f} s")
+          f"skipped, {sum(e.ok for e in result.equivalence)} equivalence tests, in {result.wall_time:.1f} s")
     for line in answer_lines(result):
         print(line)
     print(f"report: {out / 'report.html'} (also report.md, ranking.csv, results.json, figures/)")

@@ -43,13 +43,18 @@ def add_parser(sub):
     tpl.add_argument("--out", type=Path, default=Path("."), help="folder to write into (default: here)")
     tpl.add_argument("--force", action="store_true", help="replace existing files")
     tpl.set_defaults(func=_template)
-    rb = subcommand(acts, "rebuild", help="regenerate the generated built-in datasets",
-                    description="Regenerate every generated built-in dataset from its command and seed.",
+    rb = subcommand(acts, "rebuild", help="regenerate the generated built-in (or known-truth) datasets",
+                    description="Regenerate every generated built-in dataset from its command and seed; with "
+                                "--known-truth, the known-truth datasets of examples/known-truth instead.",
                     examples="""  frictionlab datasets rebuild --check     # exit 1 if any committed file differs
-  frictionlab datasets rebuild --out /tmp/data""")
+  frictionlab datasets rebuild --out /tmp/data
+  frictionlab datasets rebuild --known-truth --check""")
     rb.add_argument("--out", type=Path, help="rebuild into this folder instead of the built-in one")
     rb.add_argument("--check", action="store_true", help="rebuild into a temporary folder and compare with the "
                     "committed files; exit 1 if any differs")
+    rb.add_argument("--known-truth", action="store_true",
+                    help="rebuild the known-truth datasets (default folder: ./examples/known-truth) instead of the "
+                         "built-in ones")
     rb.set_defaults(func=_rebuild)
 
 
@@ -146,27 +151,29 @@ def _template(args) -> int:
 
 def _rebuild(args) -> int:
     from ..dataset import builtin_dir
-    from ..datagen import rebuild
+    from ..datagen import GENERATORS, KNOWN_TRUTH, KNOWN_TRUTH_DIR, rebuild
 
+    generators = KNOWN_TRUTH if args.known_truth else GENERATORS
+    home = (args.out or KNOWN_TRUTH_DIR) if args.known_truth else builtin_dir()
     if args.check:
         with tempfile.TemporaryDirectory() as tmp:
-            written = rebuild(Path(tmp))
+            written = rebuild(Path(tmp), generators)
             differ = [p.name for p in written
-                      if not (builtin_dir() / p.name).exists() or not filecmp.cmp(p, builtin_dir() / p.name, shallow=False)]
+                      if not (home / p.name).exists() or not filecmp.cmp(p, home / p.name, shallow=False)]
         if differ:
             print(f"differ from the committed files: {', '.join(differ)}")
             return 1
-        print(f"{len(written)} generated files equal the committed ones in {builtin_dir()}")
+        print(f"{len(written)} generated files equal the committed ones in {home}")
         return 0
     from ..errors import OutputError
 
-    out = args.out or builtin_dir()
+    out = args.out or home
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"{out}: cannot create the output folder: {exc.strerror or exc}") from None
     with tempfile.TemporaryDirectory(dir=out) as tmp:
-        written = rebuild(Path(tmp))
+        written = rebuild(Path(tmp), generators)
         for p in written:  # all generated first, then moved: no half-rebuilt folder
             shutil.move(str(p), out / p.name)
     print(f"wrote {len(written)} files to {out}")

@@ -106,16 +106,20 @@ def _fallback_table(sec: Section, c, findings):
     rows = []
     for d in c.fitted_datasets:
         best = [r for r in c.ranking if r.dataset == d.name and r.rank == 1]
-        eq = [f"{e.verdict or e.status} [wear {e.solver}]" for e in c.equivalence
-              if e.dataset == d.name and e.status == "ok"]
+        eq = [f"{e.verdict} [wear {e.solver_a}]" for e in c.equivalence
+              if e.dataset == d.name and e.ok and (e.law_a, e.law_b) == ("wear", "area-rate")]
+        thr = [e.threshold_text() for e in c.equivalence
+               if e.dataset == d.name and e.ok and (e.law_a, e.law_b) == ("wear", "area-rate")]
         f = by_ds.get(d.name)
         ser = "—" if f is None else ("slip crosses zero at " + fmt_time(f.t_cross, f.contact_time)
                                      if f.t_cross is not None else "slip stays positive")
         rows.append([f"**{d.name}** ({group_of(d)}; {d.provenance.kind})", _tied(best),
-                     sig(best[0].redchi) if best else "", "; ".join(eq) or "not tested", ser])
+                     sig(best[0].redchi) if best else "", "; ".join(eq) or "not tested", "; ".join(thr), ser])
     sec.table(["dataset (group; provenance)", "lowest AIC (not a fit test)", "its reduced χ²",
-               "λAu ≡ μN + μη′dA/dt? (equivalence analysis)", "series slip"], rows)
-    sec.p("No data in this comparison for: goodness-of-fit test, noise threshold, transfer.")
+               "λAu ≡ μN + μη′dA/dt? (discrimination test)", "noise threshold", "series slip"], rows)
+    for tr in c.transfer:
+        sec.p(f"Across conditions ({tr.group}): {tr.answer()}.")
+    sec.p("No data in this comparison for: goodness-of-fit test.")
 
 
 def _tied(best) -> str:
@@ -147,9 +151,9 @@ def build(ctx) -> Section:
         _answer_table(sec, c.answers)
     else:
         sec.warn(note + "The verdict layer gave no answers for this comparison (`Comparison.answers` is empty): no "
-                 "law is declared to fit, and no goodness-of-fit test, noise threshold or transfer test is shown. "
+                 "law is declared to fit, and no goodness-of-fit test is shown. "
                  "The table shows what the comparison holds: the lowest AIC (a relative ranking, not a test that "
-                 "the law fits), its reduced χ², and the equivalence analysis' verdict.")
+                 "the law fits), its reduced χ², and the discrimination test's verdict and noise threshold.")
         _fallback_table(sec, c, findings)
     shown = _pick(findings)
     if shown:

@@ -20,13 +20,18 @@ results.json:
                                parameterizations),
     answers[Answer.as_dict()] (answers.py; filled by verdicts.py),
     series_slip_zero_s{dataset: time the fitted truncated series' slip crosses zero, null if never},
-    equivalence[{dataset, solver, area_rate_solver, status, verdict, explanation, reason, checks{},
-                 force_correlation, force_distance, impulse_Ns{}, aic{}, redchi{}, shape{}, fitted{},
-                 cross[{law, to, status, rms, rms_sigma, dchi2, params}],
+    equivalence[EquivalenceResult.as_dict(): {dataset, law_a, law_b, solver_a, solver_b, status, verdict,
+                 explanation, reason, replicates, seed, n_points, chi2{}, k{}, t_obs, t_a[], t_b[], p_a, p_b, q_a, q_b,
+                 p_a_mc_error, p_b_mc_error, power_a, power_b, failed, d_ab, d_ba, sigma, sigma_varies,
+                 observable, threshold, threshold_text, alpha, power_level, critical_dchi2, fitted{},
                  decomposition{b, u0, c_area, c_area_rate, mu, eta_prime, r2} | null}],
+    transfer[TransferResult.as_dict(): {group, datasets[], alpha, predictions[{law, solver, source, target,
+             status, reason, n, chi2, rms_sigma, loglik, own_chi2, params{}}], shared[{law, solver, datasets,
+             status, reason, chi2_shared, k_shared, chi2_separate, k_separate, lr, dk, p_value, delta_aic,
+             shared{}, separate{}, serves, alpha}], ranking[{candidate, chi2, n, rms_sigma, loglik, rank}], answer}],
     derivations{dataset: {method: {rms_vs_omega_column, omega_peak, omega_end, noisy_rms_vs_omega_column,
                                    noisy_omega_peak, noisy_omega_end, noisy_median_sigma}}},
-    timings_s{stage: wall-clock seconds} (fits, equivalence, tolerance, bootstrap),
+    timings_s{stage: wall-clock seconds} (fits, equivalence, transfer, tolerance, bootstrap),
     bootstrap{n (0: not run), seed, method: parametric, level: 0.95, interval: percentile,
               first_place_interval: wilson, all (slow datasets included),
               datasets[{dataset, n_ranked,
@@ -108,19 +113,6 @@ def _row_json(r) -> dict:
             "members": list(r.members), "parameterizations": r.parameterizations}
 
 
-def _equivalence_json(e) -> dict:
-    d = e.decomposition
-    return {"dataset": e.dataset, "solver": e.solver, "area_rate_solver": e.area_rate_solver, "status": e.status,
-            "verdict": e.verdict, "explanation": e.explanation, "reason": e.reason, "checks": e.checks,
-            "force_correlation": e.force_correlation, "force_distance": e.force_distance, "impulse_Ns": e.impulse,
-            "aic": e.aic, "redchi": e.redchi, "shape": e.shape, "fitted": e.fitted,
-            "cross": [{"law": x.law, "to": x.to, "status": x.status, "rms": x.rms, "rms_sigma": x.rms_sigma, "dchi2": x.dchi2,
-                       "params": x.params} for x in e.cross],
-            "decomposition": None if d is None else {"b": d.b, "u0": d.u0, "c_area": d.c_area,
-                                                      "c_area_rate": d.c_area_rate, "mu": d.mu,
-                                                      "eta_prime": d.eta_prime, "r2": d.r2}}
-
-
 def _bootstrap_json(c) -> dict:
     per = [{"dataset": rb.datasets[0], "n_ranked": rb.n_ranked, "first_place": ranking_table(rb),
             "parameters": parameter_table(rb)} for rb in c.bootstrap]
@@ -149,7 +141,8 @@ def results_json(c, extra: dict | None = None) -> dict:
                    "versions": c.versions, "settings": c.settings, "wall_time_s": c.wall_time, "datasets": datasets,
                    "fits": [fit_json(f) for f in c.fits], "ranking": [_row_json(r) for r in c.ranking],
                    "groups": [_row_json(r) for r in c.groups],
-                   "equivalence": [_equivalence_json(e) for e in c.equivalence],
+                   "equivalence": [e.as_dict() for e in c.equivalence],
+                   "transfer": [t.as_dict() for t in c.transfer],
                    "derivations": extra.get("derivations", {}), "timings_s": c.timings,
                    "series_slip_zero_s": extra.get("series_slip_zero_s", {}),
                    "answers": [a.as_dict() for a in c.answers],

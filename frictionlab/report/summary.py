@@ -4,6 +4,7 @@ from __future__ import annotations
 import datetime as _dt
 
 from ..bootstrap import wilson
+from ..equivalence import AREA_RATE, WEAR
 from .doc import Section
 from .text import PROVENANCE_WORDS, pct
 
@@ -85,13 +86,17 @@ def build(ctx) -> Section:
         items.append(f"**Solver tolerance** ({c.tolerance[0]['dataset']}): refitted at " + verdicts[0]
                      + " (see 'What solver tolerance does to a fit')")
     sec.items(items)
-    if c.equivalence:
-        sec.p("Equivalence of λAu and μN + μη′dA/dt per dataset (details under 'Equivalence test'):")
+    paper = [e for e in c.equivalence if (e.law_a, e.law_b) == (WEAR, AREA_RATE)]
+    if paper:
+        sec.p("Equivalence of λAu and μN + μη′dA/dt per dataset (the discrimination test; details under "
+              "'Equivalence test'):")
         verdicts: dict[str, dict[str, str]] = {}
-        for e in c.equivalence:
-            key = "series" if e.solver == "series" else "full"
+        for e in paper:
+            key = "series" if e.solver_a == "series" else "full"
             verdicts.setdefault(e.dataset, {})[key] = (e.verdict or e.status) + ("" if key == "series" else
-                                                                                  f" [{e.solver}]")
+                                                                                  f" [{e.solver_a}]")
         sec.table(["dataset", "wear solved exactly or numerically", "wear by the paper's series"],
                   [[d, v.get("full", ""), v.get("series", "–")] for d, v in verdicts.items()])
+    for tr in c.transfer:
+        sec.p(f"Across conditions ({tr.group}): {tr.answer()}.")
     return sec
