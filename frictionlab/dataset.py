@@ -26,7 +26,7 @@ DATA_KINDS = KINDS + ("contact-area",)
 COLUMN_SI = {
     "t": "s", "omega": "rad/s", "theta": "rad", "u": "m/s", "v": "m/s", "A": "m^2", "N": "N", "x": "m",
     "speed": "m/s", "incidence": "rad", "spin": "rad/s", "rebound_spin": "rad/s", "tangential_cor": "",
-    "rebound_angle": "rad",
+    "rebound_angle": "rad", "mu": "",
 }
 
 

@@ -23,7 +23,7 @@ from .registry import get_law
 from .scene import Scene
 
 #: Trajectory series that a time-series observable reads.
-SERIES = {"omega": "omega", "theta": "theta", "v": "v", "u": "u"}
+SERIES = {"omega": "omega", "theta": "theta", "v": "v", "u": "u", "mu": "load"}
 
 #: Scene quantities that can be freed, with their SI unit (dotted names reach into sub-models).
 SCENE_QUANTITIES = {
@@ -130,6 +130,7 @@ def _predict_outcomes(law, target, scene, params, solver, rtol=FIT_RTOL):
 
 register_predictor("impact", _predict_series)
 register_predictor("incline", _predict_series)
+register_predictor("spring-slider", _predict_series)
 register_predictor("impact-outcome", _predict_outcomes)
 
 

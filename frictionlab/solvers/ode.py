@@ -63,6 +63,8 @@ def phase_scales(plan, p, t0: float, T: float, y0, direction: float) -> np.ndarr
         F = largest_force(np.sign(plan.drive) * reach)
         V = max(V, reach * min(1.0, s.mass * abs(plan.drive) / F) if F > 0 else reach)
     V = V if V > 0 and np.isfinite(V) else 1.0
+    if s.spring is not None:  # the load point sets the speeds
+        V = max(V, max(s.spring.velocities))
     size = {"v": V, "x": V * span, "xi": V * span, **law_state_scales(plan)}
     if plan.has_spin:
         J = min(largest_force((direction or 1.0) * V) * span, (V + abs(plan.drive) * span) / plan.kappa)
@@ -111,24 +113,38 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
             events = [zero_slip]
         s_eval = np.clip(np.asarray(t_out, dtype=float) / tscale, t0 / tscale, T / tscale)
         s_eval, back = np.unique(s_eval, return_inverse=True)  # repeated times (e.g. a resample) solved once
+        # where the right-hand side jumps (a load-point velocity step) the integration restarts
+        cuts = [b / tscale for b in plan.breaks if t0 < b < T] if events is None else []
+        edges = [t0 / tscale] + cuts + [T / tscale]
+        z0, parts, stats = np.asarray(y0, dtype=float) / scale, [], {"nfev": 0, "njev": 0, "nlu": 0}
         try:
-            sol = solve_ivp(f, (t0 / tscale, T / tscale), np.asarray(y0, dtype=float) / scale, method=method,
-                            t_eval=s_eval, rtol=rtol, atol=atol, events=events)
+            for k, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
+                last = k == len(edges) - 2
+                inside = s_eval[(s_eval >= a) & ((s_eval <= b) if last else (s_eval < b))]
+                sol = solve_ivp(f, (a, b), z0, method=method, t_eval=np.append(inside, b) if not last else inside,
+                                rtol=rtol, atol=atol, events=events)
+                if sol.status == -1:
+                    raise SolverError(f"ode:{method}: integration failed for law '{plan.law.name}': {sol.message}")
+                for key in stats:
+                    stats[key] += int(getattr(sol, key))
+                if last:
+                    parts.append(sol.y)
+                else:
+                    parts.append(sol.y[:, :-1])
+                    z0 = sol.y[:, -1]
         except Exception as exc:  # a law raising inside the integrator
             from ..errors import FrictionLabError
 
             if isinstance(exc, FrictionLabError):
                 raise
             raise SolverError(f"ode:{method}: integration failed for law '{plan.law.name}': {exc}") from exc
-        if sol.status == -1:
-            raise SolverError(f"ode:{method}: integration failed for law '{plan.law.name}': {sol.message}")
+        sol.y = np.concatenate(parts, axis=1)
         Y = sol.y[:, back[back < sol.y.shape[1]]] * scale[:, None]  # a stop ends the samples reached
         t_stop = y_stop = None
         if events is not None and sol.t_events[0].size:
             t_stop = float(sol.t_events[0][0]) * tscale
             y_stop = sol.y_events[0][0] * scale
-        info = {"nfev": int(sol.nfev), "njev": int(sol.njev), "nlu": int(sol.nlu), "method": method,
-                "rtol": rtol, "atol": atol}
+        info = {**stats, "method": method, "rtol": rtol, "atol": atol}
         return Y, t_stop, y_stop, info
 
     return slide
