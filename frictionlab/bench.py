@@ -88,6 +88,10 @@ def cases() -> dict:
                         {"lam": 1e4}, dry),
         "impact-oblique": ("Oblique impact: Coulomb with slip coupling, rolls (sticks) mid-contact", "coulomb",
                            {"mu": 0.15}, oblique),
+        # a law with memory: LuGre's bristle state (relaxing in ~1e-6 s) integrated with the motion; stiff
+        "impact-lugre": ("Oblique impact: LuGre (bristle state, stiff), slip coupling, integrated through zero slip",
+                         "lugre", {"mu_c": 0.15, "mu_s": 0.2, "vs": 1.0, "sigma0": 1e4, "sigma1": 0.0, "sigma2": 0.0},
+                         oblique),
     }
 
 

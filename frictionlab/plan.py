@@ -32,9 +32,13 @@ import attrs
 import numpy as np
 from scipy.optimize import brentq
 
-from .errors import SceneError
+from .errors import SceneError, SolverError
 from .law import QUANTITIES, AreaSlipForm, Contact, FrictionLaw, NormalAreaRateForm
 from .scene import G, ConstantNormal, GrowthArea, HertzNormal, Scene
+
+#: A quasi-static spring-slider stops with an error once the slip rate exceeds this multiple of the fastest
+#: load-point velocity (stick-slip events, where inertia would matter).
+QUASI_STATIC_LIMIT = 1e3
 
 #: Prefix of a law's internal states in the plan's state vector ("law:theta" cannot clash with the spin angle).
 LAW_PREFIX = "law:"
@@ -219,6 +223,12 @@ class Plan:
         s = self.scene
         n = len(self.states)
         v = float(y[0])
+        fastest = QUASI_STATIC_LIMIT * max(s.spring.velocities)
+        if abs(v) > fastest:
+            raise SolverError(f"law '{self.law.name}' on a spring-slider: the slip rate reached {v:.3g} m/s at "
+                              f"t = {float(t):.6g} s, beyond {QUASI_STATIC_LIMIT:g} times the fastest load point: an "
+                              "unstable slider (k below the law's critical stiffness), where the quasi-static model "
+                              "no longer holds")
         steps = [1e-5 * abs(v) + 1e-30] + [1e-5 * (abs(float(y[i])) + 1e-3 * spec.scale)
                                            for i, spec in zip(range(1, n), self.law.states)]
         Y = np.repeat(np.asarray(y, dtype=float)[:, None], 2 * n, axis=1)
