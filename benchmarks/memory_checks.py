@@ -18,7 +18,7 @@ RS, K_C = T.RS, T.K_C
 
 for law in ("rate-state-aging", "rate-state-slip"):
     tr = fl.simulate(law, T.slider(5 * K_C, (0.0, 5.0), (1e-6, 1e-5), 30.0), RS, solver="ode", t=np.array([0, 4.99, 30.0]))
-    errs = [tr.load[i] - (RS["mu0"] + (RS["a"] - RS["b"]) * math.log(V / RS["V0"])) for i, V in ((1, 1e-6), (2, 1e-5))]
+    errs = [tr.load[i] - (RS["mu0"] + (RS["a"] - RS["b"]) * math.log(V / T.V0)) for i, V in ((1, 1e-6), (2, 1e-5))]
     print(f"{law}: mu_ss error before / after the 1 -> 10 um/s step: {errs[0]:.2e}, {errs[1]:.2e}")
 
 holds = np.array([3.0, 10.0, 30.0, 100.0])

@@ -13,7 +13,8 @@ from frictionlab.scene import ConstantNormal, Scene, SpringLoad
 from frictionlab.solvers.prescribed import respond
 
 N = 1e4
-RS = dict(TRUTH)  # mu0 0.6, a 0.008, b 0.012, Dc 10 um, V0 1 um/s: k_c = (b - a)/Dc = 400 /m
+RS = dict(TRUTH)  # mu0 0.6, a 0.008, b 0.012, Dc 10 um (V0 = 1 um/s): k_c = (b - a)/Dc = 400 /m
+V0 = 1e-6
 K_C = (RS["b"] - RS["a"]) / RS["Dc"]
 
 
@@ -28,7 +29,7 @@ def test_steady_state_after_a_velocity_step(law):
     t = np.array([0.0, 4.99, 30.0])
     tr = fl.simulate(law, slider(5 * K_C, (0.0, 5.0), (1e-6, 1e-5), 30.0), RS, solver="ode", t=t)
     for mu, V in ((tr.load[1], 1e-6), (tr.load[2], 1e-5)):  # 250 Dc slid at 10 um/s
-        assert mu == pytest.approx(RS["mu0"] + (RS["a"] - RS["b"]) * math.log(V / RS["V0"]), abs=1e-9)
+        assert mu == pytest.approx(RS["mu0"] + (RS["a"] - RS["b"]) * math.log(V / V0), abs=1e-9)
     assert tr.law_states["theta"][2] == pytest.approx(RS["Dc"] / 1e-5, rel=1e-7)
 
 
@@ -96,7 +97,7 @@ def _growth(k, law="rate-state-aging"):
     except SolverError as exc:
         assert "unstable slider" in str(exc)
         return math.inf
-    mu = tr.load - (RS["mu0"] + (RS["a"] - RS["b"]) * math.log(1.05e-5 / RS["V0"]))
+    mu = tr.load - (RS["mu0"] + (RS["a"] - RS["b"]) * math.log(1.05e-5 / V0))
     early, late = np.abs(mu[(t > 10) & (t < 40)]).max(), np.abs(mu[t > 90]).max()
     return late / early
 

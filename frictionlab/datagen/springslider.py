@@ -7,8 +7,8 @@ force) at a load-point velocity that steps 1 -> 10 -> 1 um/s, the classic veloci
 are the same law, so such small steps cannot tell them apart, and a comparison must say so. The measured friction coefficient mu (spring force / N) comes
 from ``frictionlab.simulate`` on the quasi-static spring-slider (plan.py) at rtol 1e-11, plus
 Gaussian noise of 1e-4 from numpy's default_rng(seed), rounded to 7 significant digits. The
-truth (law, mu0, a, b, Dc, V0, k) is recorded in each TOML's [provenance.truth]; V0 is given in
-[fixed] because it trades off exactly with mu0.
+truth (law, mu0, a, b, Dc; V0 = 1 um/s is the laws' fixed reference) is recorded in each TOML's
+[provenance.truth].
 
 k = 2000 /m is five times the critical stiffness (b - a)/Dc = 400 /m: the slider is stable.
 """
@@ -22,7 +22,7 @@ from ..scene import ConstantNormal, Scene, SpringLoad
 from ..solvers import simulate
 from .write import write_pair
 
-TRUTH = dict(mu0=0.6, a=0.008, b=0.012, Dc=1e-5, V0=1e-6)
+TRUTH = dict(mu0=0.6, a=0.008, b=0.012, Dc=1e-5)
 SETUP = dict(k=2000.0, normal=1e4, mass=1.0, times=(0.0, 5.0, 25.0), velocities=(1e-6, 1e-5, 1e-6), t_end=85.0,
              dt=0.2, noise=1e-4)
 #: (name, generating law, seed, changes to SETUP)
@@ -62,7 +62,6 @@ def _velocity_step(out_dir, name, law, seed, changes):
         "scene": {"mass": f"{c['mass']:g} kg", "normal": {"model": "constant", "value": f"{c['normal']:g} N"},
                   "spring": {"stiffness": f"{c['k']:g} 1/m", "times": [f"{x:g} s" for x in c["times"]],
                              "velocities": [f"{v * 1e6:g} um/s" for v in c["velocities"]]}},
-        "fixed": {"V0": f"{TRUTH['V0'] * 1e6:g} um/s"},
         "provenance": {
             "kind": "synthetic",
             "source": "synthetic; the velocity-step test of rate-and-state friction (Dieterich 1979; Marone 1998)",
@@ -72,7 +71,7 @@ def _velocity_step(out_dir, name, law, seed, changes):
             "command": "frictionlab datasets rebuild",
             "seed": seed,
             "truth": {"law": law, "mu0": TRUTH["mu0"], "a": TRUTH["a"], "b": TRUTH["b"],
-                      "Dc": f"{TRUTH['Dc'] * 1e6:g} um", "V0": f"{TRUTH['V0'] * 1e6:g} um/s", "noise": c["noise"]},
+                      "Dc": f"{TRUTH['Dc'] * 1e6:g} um", "noise": c["noise"]},
         },
     }
     return write_pair(out_dir, name, meta, {"t": t, "mu": mu}, 7, __name__)
