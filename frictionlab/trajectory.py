@@ -34,6 +34,7 @@ class Trajectory:
     law_states: dict = attrs.field(factory=dict)
 
     def __getitem__(self, name: str) -> np.ndarray:
+        name = {"mu": "load"}.get(name, name)  # a spring-slider's observable: the spring's load
         value = getattr(self, name, None)
         if not isinstance(value, np.ndarray):
             raise KeyError(f"trajectory has no series '{name}'")

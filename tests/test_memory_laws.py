@@ -114,3 +114,32 @@ def test_critical_stiffness_found_by_bisection():
         lo, hi = (lo, mid) if _growth(mid) < 1.0 else (mid, hi)
     k_found = 0.5 * (lo + hi)
     assert k_found == pytest.approx(K_C, rel=0.03)
+
+
+# --- fitted: each rate-and-state law recovered from its own velocity steps; told apart where the data can ---
+@pytest.fixture(scope="module")
+def rs_fits():
+    return {(law, ds): fl.fit(law, ds) for ds in ("spring-slider-aging", "spring-slider-slip", "spring-slider-small-step")
+            for law in ("rate-state-aging", "rate-state-slip")}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("law, ds", [("rate-state-aging", "spring-slider-aging"), ("rate-state-slip", "spring-slider-slip")])
+def test_rate_state_law_recovered_from_its_own_velocity_steps(rs_fits, law, ds):
+    r = rs_fits[(law, ds)]
+    assert r.ok, r.reason
+    for name in ("mu0", "a", "b", "Dc"):
+        p = r.params[name]
+        assert abs(p.value - RS[name]) < max(4 * p.stderr, 1e-3 * abs(RS[name])), (name, p.value, p.stderr)
+    assert 0.8 < r.stats.redchi < 1.25
+
+
+@pytest.mark.slow
+def test_aging_and_slip_told_apart_by_large_steps_not_by_small_ones(rs_fits):
+    def delta_aic(ds, right, wrong):
+        return rs_fits[(wrong, ds)].stats.aic - rs_fits[(right, ds)].stats.aic
+
+    assert delta_aic("spring-slider-aging", "rate-state-aging", "rate-state-slip") > 10
+    assert delta_aic("spring-slider-slip", "rate-state-slip", "rate-state-aging") > 10
+    # a 10 % step: both laws fit equally well (they agree to first order about steady sliding)
+    assert abs(delta_aic("spring-slider-small-step", "rate-state-aging", "rate-state-slip")) < 2
