@@ -73,8 +73,9 @@ class Plan:
     @property
     def continuous(self) -> bool:
         """Integrated in one phase through zero slip, without stick events: a law with memory (its state
-        carries static friction) or a spring-slider (its drive, the spring, changes with the state)."""
-        return bool(self.law_states) or self.scene.spring is not None
+        carries static friction) unless it jumps at zero slip, or a spring-slider (its drive, the
+        spring, changes with the state)."""
+        return (bool(self.law_states) and not self.law.jumps_at_zero_slip) or self.scene.spring is not None
 
     @property
     def breaks(self) -> tuple[float, ...]:

@@ -40,6 +40,8 @@ class RateState(FrictionLaw):
     )
     requires = frozenset({"u", "N"})
     states = (StateSpec("theta", "s", "steady", 1.0, "state variable (contact age)"),)
+    # at V -> 0 the force turns over from -capacity to +capacity within ~1e-30 m/s: stick there instead
+    jumps_at_zero_slip = True
 
     def mu(self, p, V, theta):
         """Friction coefficient [-] at slip speed V [m/s] and state theta [s] (signed like V)."""

@@ -230,3 +230,16 @@ def test_readme_stateful_law_example_runs_as_written():
         assert F[2] == pytest.approx(3.0) and F[4] == pytest.approx(-3.0 + 6.0 * math.exp(-2.0), rel=1e-6)
     finally:
         fl.unregister_law("lagged-coulomb")
+
+
+def test_rate_state_sticks_at_zero_slip_with_its_state_held():
+    """Rate-and-state's force turns over within ~1e-30 m/s of zero slip: it declares jumps_at_zero_slip,
+    so the ball rolls (slip 0) once slip reaches zero, and theta is held while it does."""
+    law = fl.get_law("rate-state-aging")
+    assert law.jumps_at_zero_slip and not fl.get_law("lugre").jumps_at_zero_slip
+    tr = simulate(law, normal_impact(), solver="ode", t=np.linspace(0.0, 500e-6, 51))
+    assert tr.stick_time is not None and 0 < tr.stick_time < 500e-6
+    after = tr.t > tr.stick_time
+    assert np.all(tr.u[after] == 0.0)
+    assert np.ptp(tr.law_states["theta"][after]) == 0.0
+    assert make_plan(normal_impact(), fl.get_law("lugre")).continuous

@@ -5,10 +5,11 @@ A sliding-phase function has the signature
 where Y_out holds the states at the times t_out (all >= t0, only those reached), t_stop is
 the time slip reached zero (None if it did not before t_out[-1] or the end), y_stop the state there.
 
-A law with memory, and any law on a spring-slider, is integrated in one phase through zero slip
-(direction 0: no stick event; ``Plan.continuous``): a law's internal state carries what static
-friction there is (LuGre's bristles), and a spring's drive changes with the state, which the
-stuck-phase formulas of ``stick`` do not model.
+A law with memory (unless it declares ``jumps_at_zero_slip``), and any law on a spring-slider, is
+integrated in one phase through zero slip (direction 0: no stick event; ``Plan.continuous``): a
+law's internal state carries what static friction there is (LuGre's bristles), and a spring's
+drive changes with the state, which the stuck-phase formulas of ``stick`` do not model. While
+stuck, a law's internal states are held.
 """
 from __future__ import annotations
 
