@@ -171,15 +171,19 @@ def _run_chunk(fit_fns, datasets, models, method, seeds):
     return out
 
 
-def _dispatch(executor, fit_fns, datasets, models, method, seed, n, chunk):
+def _dispatch(executor, fit_fns, datasets, models, method, seed, n, chunk, progress=None):
+    """Rows of _run_chunk over n resamples in batches of ``chunk``; progress(done, n) after each batch."""
     seeds = np.random.SeedSequence(seed).spawn(n)
     chunk = max(1, int(chunk or math.ceil(n / 16)))
     groups = [seeds[i:i + chunk] for i in range(0, n, chunk)]
-    if executor is None:
-        parts = [_run_chunk(fit_fns, datasets, models, method, g) for g in groups]
-    else:
-        futures = [executor.submit(_run_chunk, fit_fns, datasets, models, method, g) for g in groups]
-        parts = [f.result() for f in futures]
+    parts, done = [], 0
+    futures = None if executor is None else [executor.submit(_run_chunk, fit_fns, datasets, models, method, g)
+                                             for g in groups]
+    for i, g in enumerate(groups):
+        parts.append(_run_chunk(fit_fns, datasets, models, method, g) if futures is None else futures[i].result())
+        done += len(g)
+        if progress:
+            progress(done, n)
     return [row for part in parts for row in part]
 
 
@@ -267,12 +271,13 @@ class RankingBootstrap:
 
 def bootstrap_ranking(laws: Sequence, dataset, n: int = 200, seed: int = 0, executor=None, solver: str = "auto",
                       method: str = "case", chunk: int | None = None, tie: float | None = None,
-                      bases: Sequence | None = None, **fit_options) -> RankingBootstrap:
+                      bases: Sequence | None = None, progress=None, **fit_options) -> RankingBootstrap:
     """Fit every law to the same ``n`` resampled copies of ``dataset`` and count first places by AIC.
 
     method 'case' (default) assumes no law's model; 'residual' resamples around the best law's fit.
     laws: names or LawFit objects (distinct labels). tie: AIC difference counted as a tie (default
     ranking.TIE_AIC). bases: the laws' FitResults on the original data, if already made.
+    progress(done, n): called after each batch of resamples.
     """
     from .ranking import TIE_AIC
 
@@ -292,7 +297,8 @@ def bootstrap_ranking(laws: Sequence, dataset, n: int = 200, seed: int = 0, exec
         models = _prepare(fns[best], dataset, "residual", prepared[best][1])[2]
     elif method not in METHODS:
         raise ParameterError(f"bootstrap: method must be one of {', '.join(METHODS)}, got {method!r}")
-    rows = _dispatch(executor, [(p[5], p[3]) for p in prepared], datasets, models, method, seed, n, chunk)
+    rows = _dispatch(executor, [(p[5], p[3]) for p in prepared], datasets, models, method, seed, n, chunk,
+                     progress)
     results = {name: _collect(p[1].law, datasets, method, seed, p[3], p[4], p[1], rows, k)
                for k, (name, p) in enumerate(zip(names, prepared))}
     first = dict.fromkeys(names, 0.0)
@@ -373,6 +379,7 @@ def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, slow: bool = Fals
     reused as the base. Without ``slow``, only datasets whose every fit is one closed-form or series
     solution per evaluation are bootstrapped: not those where a law needs the ODE solver, nor those
     without a time series (an impact-outcome set simulates every impact at each evaluation).
+    progress(dataset, done, n): after each batch of resamples, and (n, n) for a dataset left out.
     Returns (one RankingBootstrap per dataset, {dataset: why it was not bootstrapped})."""
     by_ds: dict = {}
     for f in fits:
@@ -391,11 +398,12 @@ def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, slow: bool = Fals
             fns = [law_fit(f.law, f.solver, **opts) for f in ok]
             try:
                 out.append(bootstrap_ranking(fns, ok[0].per_dataset[0].target.dataset, n=n, seed=seed,
-                                             executor=executor, bases=ok))
+                                             executor=executor, bases=ok, progress=progress and (
+                                                 lambda done, total, name=name: progress(name, done, total))))
             except FrictionLabError as exc:
                 skipped[name] = str(exc)
-        if progress:
-            progress(name)
+        if progress and name in skipped:
+            progress(name, n, n)
     return out, skipped
 
 

@@ -1,7 +1,11 @@
 """The ``frictionlab`` command. Each subcommand lives in ``frictionlab/commands/<name>.py`` and
-exposes ``add_parser(subparsers)`` (which sets ``func``) and its run function.
+exposes ``add_parser(subparsers)`` (which sets ``func``) and its run function; it builds its parser
+with ``subcommand(sub, name, help, description, examples)`` so that every subcommand accepts the
+global options and shows its examples.
 
-Errors are one line on stderr and exit status 2; ``--debug`` shows the traceback.
+One grammar: global options (--load, --debug, --quiet) go before or after the subcommand; a list
+is given by repeating an option or with commas (``ListAction``); errors are one line on stderr and
+exit status 2; ``--debug`` shows the traceback.
 """
 from __future__ import annotations
 
@@ -13,6 +17,43 @@ import warnings
 from .errors import FrictionLabError
 
 COMMANDS = ("laws", "datasets", "simulate", "fit", "compare", "bench")
+
+
+LISTS_HELP = ("Lists: repeat an option or separate values with commas; both work everywhere "
+              "(--laws wear,coulomb is --laws wear --laws coulomb).")
+
+
+class ListAction(argparse.Action):
+    """A list option: repeatable, and each value may hold several items separated by commas."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        items = list(getattr(namespace, self.dest, None) or [])
+        for v in values if isinstance(values, list) else [values]:
+            items += [x.strip() for x in v.split(",") if x.strip()]
+        setattr(namespace, self.dest, items)
+
+
+def add_globals(parser, top: bool) -> None:
+    """--load, --debug and --quiet; on a subcommand they go to separate names merged in main()."""
+    pre = "" if top else "sub_"
+    kw = {} if top else {"default": argparse.SUPPRESS}
+    parser.add_argument("--debug", dest=pre + "debug", action="store_true", help="show tracebacks on errors", **kw)
+    parser.add_argument("--quiet", "-q", dest=pre + "quiet", action="store_true",
+                        help="no progress output (results and errors are still printed)", **kw)
+    parser.add_argument("--load", dest=pre + "load", metavar="FILE.py", action=ListAction,
+                        help="import a Python file first (laws it registers with @register_law become "
+                             "available); repeatable", **({"default": []} if top else kw))
+
+
+def subcommand(sub, name: str, help: str, description: str, examples: str = ""):
+    """A subcommand parser with the global options and an 'examples' epilog."""
+    import textwrap
+
+    p = sub.add_parser(name, help=help, description=textwrap.fill(description, 88),
+                       epilog=("examples:\n" + examples.rstrip() + "\n\n" if examples else "") + LISTS_HELP,
+                       formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_globals(p, top=False)
+    return p
 
 
 class _Parser(argparse.ArgumentParser):
@@ -28,11 +69,14 @@ def one_line(text) -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="frictionlab", description="Compare friction laws against impact and sliding data.")
-    parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
-    parser.add_argument("--load", metavar="FILE.py", action="append", default=[],
-                        help="import a Python file first (laws it registers with @register_law become available)")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    from . import __version__
+
+    parser = _Parser(prog="frictionlab", description="Compare friction laws against impact and sliding data.",
+                     epilog="Global options go before or after the command. " + LISTS_HELP
+                     + " 'frictionlab COMMAND --help' shows a command's options and examples.")
+    parser.add_argument("--version", action="version", version=f"frictionlab {__version__}")
+    add_globals(parser, top=True)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name in COMMANDS:
         try:
             module = importlib.import_module(f"frictionlab.commands.{name}")
@@ -81,6 +125,9 @@ def main(argv=None) -> int:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # argparse already printed its one-line usage error
         return int(exc.code or 0) if exc.code in (0, None) else 2
+    args.load = list(args.load) + list(getattr(args, "sub_load", []))
+    args.debug = args.debug or getattr(args, "sub_debug", False)
+    args.quiet = args.quiet or getattr(args, "sub_quiet", False)
     if not getattr(args, "func", None):
         parser.print_help()
         return 2

@@ -74,6 +74,33 @@ class Comparison:
     def fitted_datasets(self) -> list[Dataset]:
         return [d for d in self.datasets if d.name not in self.skipped_datasets]
 
+    def to_dataframe(self):
+        """The ranking as a tidy pandas DataFrame: one row per dataset and candidate (law, solver), with
+        the observable and the units of rss and rmse; group rows (ALL, ALL[kind]) after them."""
+        from .frames import ranking_frame
+
+        return ranking_frame(self)
+
+    def parameters_dataframe(self):
+        """Every fitted parameter as a tidy pandas DataFrame: dataset, law, solver, parameter, value,
+        stderr, unit, kind, vary, fixed_by, lower, upper."""
+        from .frames import parameters_frame
+
+        return parameters_frame(self.fits)
+
+    def __repr__(self) -> str:
+        ok = sum(f.ok for f in self.fits)
+        best = "; ".join(f"{d.name}: " + " = ".join(r.candidate for r in self.ranking if r.dataset == d.name
+                                                    and r.rank == 1) for d in self.fitted_datasets[:3])
+        more = f"; ... {len(self.fitted_datasets) - 3} more" if len(self.fitted_datasets) > 3 else ""
+        return (f"<Comparison of {len(self.laws)} laws on {len(self.fitted_datasets)} datasets: {ok} fits; "
+                f"lowest AIC: {best}{more}>")
+
+    def _repr_html_(self) -> str:
+        from .frames import comparison_html
+
+        return comparison_html(self)
+
 
 def versions() -> dict:
     import lmfit
@@ -253,8 +280,9 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                 tol_rows = tolerance_stage()
             if bootstrap:
                 t0 = time.perf_counter()
-                boots, boot_skipped = bootstrap_fits(fits, bootstrap, seed, pool, bootstrap_all, free,
-                                                     progress=lambda name: step(f"bootstrap on {name}"))
+                boots, boot_skipped = bootstrap_fits(
+                    fits, bootstrap, seed, pool, bootstrap_all, free,
+                    progress=lambda name, k, n: step(f"bootstrap on {name}: {k}/{n} resamples", advance=k == n))
                 timings["bootstrap"] = time.perf_counter() - t0
             if tol_future is not None:
                 tol_rows = tol_future.result()
@@ -274,13 +302,13 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
 
 
 class _Step:
-    """Advances the progress count by one per finished stage item."""
+    """Advances the progress count by one per finished stage item (``advance=False``: only a new label)."""
 
     def __init__(self, progress, done, total):
         self.progress, self.done, self.total = progress, done, total
 
-    def __call__(self, label: str) -> None:
-        self.done += 1
+    def __call__(self, label: str, advance: bool = True) -> None:
+        self.done += bool(advance)
         if self.progress:
             self.progress(self.done, self.total, label)
 

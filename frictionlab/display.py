@@ -40,7 +40,7 @@ def fmt_time(t: float, ref: float | None = None) -> str:
 
 
 def fmt(x, digits: int = 4) -> str:
-    """A number for a table: '' for None/nan, fixed or scientific by size."""
+    """A number for a table with ``digits`` significant figures: '' for None/nan, fixed or scientific by size."""
     if x is None:
         return ""
     if isinstance(x, (int,)) and not isinstance(x, bool):
@@ -53,8 +53,11 @@ def fmt(x, digits: int = 4) -> str:
         return "" if math.isnan(x) else ("inf" if x > 0 else "-inf")
     if x == 0:
         return "0"
-    if 1e-3 <= abs(x) < 1e5:
-        return f"{x:.{digits}g}"
+    if 1e-3 <= abs(x) < 1e5:  # the same number of significant figures everywhere: 1.000, 12.50, 1234, 10090
+        exp = math.floor(math.log10(abs(x)))
+        if exp >= digits - 1:
+            return f"{round(x, digits - 1 - exp):.0f}"
+        return f"{x:#.{digits}g}".rstrip(".")
     return f"{x:.{digits - 1}e}"
 
 
@@ -83,9 +86,83 @@ def param_text(value: float, err: float | None, unit_: str) -> str:
     return fmt_value(value * f, None if err is None else err * f, name)
 
 
+def param_cells(value: float, err: float | None, unit_: str) -> tuple[str, str, str]:
+    """(value, standard error, unit) as table cells, in the display unit ``param_text`` would use."""
+    name, f = _scale(value, unit_)
+    return fmt(value * f), ("" if err is None else fmt(err * f, 2)), name
+
+
 def interval_text(lo: float, hi: float, unit_: str, like: float | None = None) -> str:
     """'[lo, hi] unit', in the display unit that ``param_text`` uses for a value ``like``."""
     if not (math.isfinite(lo) and math.isfinite(hi)):
         return ""
     name, f = _scale(like if like is not None else hi, unit_)
     return f"[{fmt(lo * f)}, {fmt(hi * f)}]" + (f" {name}" if name else "")
+
+
+
+#: SI unit of scene fields by name (for describing a scene in units a person reads).
+SCENE_FIELD_UNITS = {
+    "mass": "kg", "u0": "m/s", "duration": "s", "radius": "m", "omega0": "rad/s", "incline": "rad",
+    "peak": "m^2", "area": "m^2", "initial": "m^2", "rate": "m^2/m", "contact_time": "s", "impulse": "N*s",
+    "coefficient": "N/m^3", "stiffness": "N/m", "damping": "N*s/m", "reference_speed": "m/s",
+    "slope": "s/m", "modulus": "Pa", "normal_speed": "m/s", "impact_speed": "m/s", "incidence": "rad",
+}
+#: Owner class -> SI unit of its 'value' field.
+VALUE_UNITS = {"WeightNormal": "N", "ConstantNormal": "N"}
+
+
+def quantity_text(value: float, unit_: str) -> str:
+    """A scene value for people: g, mm, deg, rpm, and um/mm^2/us where small; 4 significant figures."""
+    value = float(value)
+    if unit_ == "kg" and abs(value) < 1:
+        value, unit_ = value * 1e3, "g"
+    elif unit_ == "rad":
+        value, unit_ = math.degrees(value), "deg"
+    elif unit_ == "rad/s":
+        value, unit_ = value * 60 / (2 * math.pi), "rpm"
+    elif unit_ == "m" and 1e-3 <= abs(value) < 1:
+        value, unit_ = value * 1e3, "mm"
+    else:
+        name, f = _scale(value, unit_)
+        value, unit_ = value * f, name
+    return f"{value:.4g}" + (f" {unit_}" if unit_ else "")
+
+
+def describe(obj, unit_: str = "") -> list[str]:
+    """Lines describing a scene (or an attrs object, a dict, a number) in units a person reads: the
+    first line is the value or the type, the others (indented) its fields; None fields left out."""
+    import attrs
+    import numpy as np
+
+    if isinstance(obj, (int, float, np.floating, np.integer)) and not isinstance(obj, bool):
+        return [quantity_text(obj, unit_)]
+    if isinstance(obj, (frozenset, set, tuple, list)):
+        return [", ".join(sorted(map(str, obj))) or "none"]
+    if isinstance(obj, np.ndarray):
+        return [f"{obj.size} values from a column"]
+    if type(obj).__name__ == "SpeedLaw":  # value (at a reference speed) scaled with the impact speed
+        if obj.reference_speed is None:
+            return [quantity_text(obj.value, unit_)]
+        ref = quantity_text(obj.reference_speed, "m/s")
+        text = f"{quantity_text(obj.value, unit_)} at normal speed {ref}"
+        if obj.exponent:
+            text += f", scaled by (v_n / {ref})^{obj.exponent:g}"
+        if obj.slope:
+            text += f", {obj.slope:+g} per m/s of v_n above {ref}"
+        return [text]
+    if attrs.has(type(obj)):
+        head, items = type(obj).__name__, [(f.name, getattr(obj, f.name)) for f in attrs.fields(type(obj))]
+    elif isinstance(obj, dict):
+        head, items = obj.get("model", "table"), [(k, v) for k, v in obj.items() if k != "model"]
+    else:
+        return [str(obj)]
+    lines = [str(head)]
+    for name, value in items:
+        if value is None or name == "kind":
+            continue
+        u = VALUE_UNITS.get(head, "") if name == "value" else SCENE_FIELD_UNITS.get(name, "")
+        sub = describe(value, u)
+        lines.append(f"  {name}: {sub[0]}")
+        lines += ["  " + x for x in sub[1:]]
+    return lines

@@ -13,6 +13,8 @@ from .display import NAMES, time_unit, unit
 LAW_COLORS = {"coulomb": "#7f7f7f", "area-rate": "#d95f02", "wear": "#1b9e77", "couette": "#7570b3"}
 EXTRA_COLORS = ["#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#1f78b4"]
 DPI = 110
+#: Two fits are one curve when they differ by at most this fraction of the noise at every data point.
+SAME_CURVE = 1e-3
 
 
 def _plt():
@@ -26,75 +28,159 @@ def _plt():
 
 def _png(fig) -> bytes:
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=DPI, bbox_inches="tight")
+    fig.savefig(buf, format="png", dpi=DPI)  # constrained layout: one draw, no tight bbox pass
     _plt().close(fig)
     return buf.getvalue()
 
 
 def _style(law: str, solver: str, i: int) -> dict:
     color = LAW_COLORS.get(law, EXTRA_COLORS[i % len(EXTRA_COLORS)])
-    ls = "--" if solver == "series" else (":" if law == "couette" else "-")
-    lw = 2.6 if law == "couette" else 1.7  # couette shares wear's form: dotted and wide so both show
-    return {"color": color, "ls": ls, "lw": lw}
+    ls = "--" if solver == "series" else "-"
+    return {"color": color, "ls": ls, "lw": 1.8}
 
 
-def _label(f, rows) -> str:
+def _label(f, rows, laws=None) -> str:
     r = next((r for r in rows if r.law == f.law and r.solver == f.solver), None)
     extra = f", ΔAIC {r.delta_aic:.1f}" if r is not None and r.rank is not None else ""
-    return f"{f.law} [{f.solver}]{extra}"
+    return f"{' = '.join(laws or [f.law])} [{f.solver}]{extra}"
 
 
-def _x_axis(dataset, obs):
-    """(x values [display], label, time factor or None): time if the dataset has it, else its first
-    other column (rows of an impact-outcome set, e.g. incidence), else the row number."""
-    if "t" in dataset.columns:
-        t = dataset.t
-        tname, tf = time_unit(float(t[-1]))
-        return t * tf, f"time [{tname}]", tf
-    for name, values in dataset.columns.items():
-        if name != obs:
-            uname, uf = unit(name)
-            return values * uf, f"{NAMES.get(name, name)} [{uname}]", None
-    return np.arange(len(dataset), dtype=float), "row", None
+def same_curve(a, b) -> bool:
+    """Whether two fits of one dataset with one solver predict the same curve at every data point (within
+    SAME_CURVE sigma): laws of one functional form, or a law whose extra term has no effect there."""
+    if a.solver != b.solver or len(a.per_dataset) != len(b.per_dataset):
+        return False
+    for da, db in zip(a.per_dataset, b.per_dataset):
+        if da.model.shape != db.model.shape or not np.all(np.abs(da.model - db.model) <= SAME_CURVE * da.target.sigma):
+            return False
+    return True
+
+
+def distinct_curves(fits) -> list[tuple[object, list[str]]]:
+    """(representative fit, the laws whose fits are that same curve, sorted) for successful fits, in order."""
+    out: list[tuple[object, list[str]]] = []
+    for f in fits:
+        if not f.ok:
+            continue
+        for rep, laws in out:
+            if same_curve(rep, f):
+                laws.append(f.law)
+                break
+        else:
+            out.append((f, [f.law]))
+    return [(f, sorted(laws)) for f, laws in out]
 
 
 def fit_figure(dataset, fits, rows) -> bytes:
-    """Data with every law's best fit (top) and residuals model - data with the ±1 sigma band (bottom)."""
+    """Data with every distinct best fit (top) and residuals model - data with the ±1 sigma band (bottom).
+    Laws whose fits are the same curve (one functional form) are one entry; a dataset without time
+    (rows are impacts) goes to ``outcome_figure``."""
+    if "t" not in dataset.columns:
+        return outcome_figure(dataset, fits, rows)
     plt = _plt()
-    ok = [f for f in fits if f.ok]
-    target = ok[0].per_dataset[0].target if ok else None
-    obs = target.observable if ok else dataset.observable
+    curves = distinct_curves(fits)
+    target = curves[0][0].per_dataset[0].target if curves else None
+    obs = target.observable if curves else dataset.observable
     uname, uf = unit(obs)
-    x, xlabel, tf = _x_axis(dataset, obs)
-    order = np.argsort(x, kind="stable")
-    fig, (ax, axr) = plt.subplots(2, 1, figsize=(7.6, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 1.6]})
-    y = target.y if ok else dataset.columns[obs]
-    sigma = target.sigma if ok else np.full(x.shape, dataset.noise.get(obs, np.nan))
+    t = dataset.t
+    tname, tf = time_unit(float(t[-1]))
+    fig, (ax, axr) = plt.subplots(2, 1, figsize=(7.6, 6.0), sharex=True, gridspec_kw={"height_ratios": [3, 1.6]},
+                                  layout="constrained")
+    y = target.y if curves else dataset.columns[obs]
+    sigma = target.sigma if curves else np.full(t.shape, dataset.noise.get(obs, np.nan))
     kind = dataset.provenance.kind
-    ax.errorbar(x, y * uf, yerr=sigma * uf, fmt="o", ms=3.2, color="black", ecolor="0.7", elinewidth=0.8,
-                label=f"data ({kind})" + (f", {target.derivation}" if ok and target.derivation else ""), zorder=1)
-    for i, f in enumerate(ok):
+    ax.errorbar(t * tf, y * uf, yerr=sigma * uf, fmt="o", ms=3.2, color="black", ecolor="0.7", elinewidth=0.8,
+                label=f"data ({kind})" + (f", {target.derivation}" if curves and target.derivation else ""), zorder=1)
+    tt = np.linspace(float(t[0]), float(t[-1]), 300)
+    for i, (f, laws) in enumerate(curves):
         d = f.per_dataset[0]
         style = _style(f.law, f.solver, i)
-        tr = None
-        if tf is not None:
-            tr = d.trajectory(f.law, np.linspace(float(dataset.t[0]), float(dataset.t[-1]), 400))
-        if tr is not None:
-            ax.plot(tr.t * tf, tr[obs] * uf, label=_label(f, rows), zorder=3, **style)
-        else:
-            ax.plot(x[order], d.model[order] * uf, label=_label(f, rows), zorder=3, **style)
-        axr.plot(x[order], d.residual[order] * uf, marker=".", ms=3, **style)
-    axr.fill_between(x[order], -sigma[order] * uf, sigma[order] * uf, color="0.85", label="±1σ noise", zorder=0)
+        tr = d.trajectory(f.law, tt)
+        ax.plot(tr.t * tf, tr[obs] * uf, label=_label(f, rows, laws), zorder=3, **style)
+        axr.plot(t * tf, d.residual * uf, marker=".", ms=3, **style)
+    axr.fill_between(t * tf, -sigma * uf, sigma * uf, color="0.85", label="±1σ noise", zorder=0)
     axr.axhline(0, color="0.3", lw=0.8)
     ax.set_ylabel(f"{NAMES.get(obs, obs)} [{uname}]")
     axr.set_ylabel(f"model − data [{uname}]")
-    axr.set_xlabel(xlabel)
+    axr.set_xlabel(f"time [{tname}]")
     ax.set_title(f"{dataset.name}: fits of every law" + ("" if kind == "measured" else f"  ({kind} data)"))
     ax.legend(fontsize=8, loc="best", framealpha=0.9)
     axr.legend(fontsize=8, loc="best")
     for a in (ax, axr):
         a.grid(alpha=0.3)
-    _residual_limits(axr, [f.per_dataset[0].residual * uf for f in ok], sigma * uf)
+    _residual_limits(axr, [f.per_dataset[0].residual * uf for f, _ in curves], sigma * uf)
+    return _png(fig)
+
+
+def column_unit(dataset, name: str) -> tuple[str, float]:
+    """(unit, factor from SI) of column ``name`` as the dataset's file gives it ('' for a plain number)."""
+    from .dataset import COLUMN_SI
+    from .units import unit_factor
+
+    u = dataset.units.get(name, "")
+    si = COLUMN_SI.get(name, "")
+    try:
+        return u, 1.0 / unit_factor(u, si, name)
+    except Exception:  # an odd unit string: show SI
+        return si, 1.0
+
+
+def outcome_figure(dataset, fits, rows) -> bytes:
+    """Impact-outcome rows: each distinct fit's prediction against the observation (left) and the
+    observation against impact angle (right; one line per group of the other inputs, e.g. speed,
+    never joining different groups), in the dataset's own units."""
+    plt = _plt()
+    curves = distinct_curves(fits)
+    obs = dataset.observable
+    uname, uf = column_unit(dataset, obs)
+    ylab = f"{obs.replace('_', ' ')}" + (f" [{uname}]" if uname else "")
+    y = dataset.columns[obs] * uf
+    sigma = dataset.noise.get(obs, 0.0) * uf
+    angle = next((c for c in dataset.columns if c != obs and c in ("incidence", "angle")), None)
+    others = [c for c in dataset.columns if c not in (obs, angle) and c in ("speed", "spin")
+              and len(np.unique(dataset.columns[c])) > 1]
+    fig, (axp, axa) = plt.subplots(1, 2, figsize=(11.0, 4.6), layout="constrained",
+                                   gridspec_kw={"width_ratios": [1, 1.35]})
+    lo, hi = float(np.min(y)), float(np.max(y))
+    for i, (f, laws) in enumerate(curves):
+        st = _style(f.law, f.solver, i)
+        axp.plot(y, f.per_dataset[0].model * uf, "o", ms=4, color=st["color"], alpha=0.85,
+                 label=_label(f, rows, laws))
+        lo, hi = min(lo, float(np.min(f.per_dataset[0].model * uf))), max(hi, float(np.max(f.per_dataset[0].model * uf)))
+    pad = 0.05 * (hi - lo or 1.0)
+    axp.plot([lo - pad, hi + pad], [lo - pad, hi + pad], color="0.3", lw=0.9, label="predicted = observed")
+    axp.set_xlabel(f"observed {ylab}")
+    axp.set_ylabel(f"predicted {ylab}")
+    axp.set_title("predicted against observed", fontsize=10)
+    axp.legend(fontsize=7.5)
+    if angle is not None:
+        au, af = column_unit(dataset, angle)
+        x = dataset.columns[angle] * af
+        keys = [tuple(dataset.columns[c][k] for c in others) for k in range(len(dataset))]
+        groups = list(dict.fromkeys(keys))
+        markers = "osD^v<>"
+        for gi, key in enumerate(groups):
+            idx = np.array([k for k in range(len(dataset)) if keys[k] == key])
+            idx = idx[np.argsort(x[idx], kind="stable")]
+            glabel = ", ".join(f"{c} {key[j] * column_unit(dataset, c)[1]:.3g} {column_unit(dataset, c)[0]}"
+                               for j, c in enumerate(others)) or "data"
+            axa.errorbar(x[idx], y[idx], yerr=sigma, fmt=markers[gi % len(markers)], ms=4, color="black",
+                         ecolor="0.7", elinewidth=0.7, label=f"data: {glabel}", zorder=1)
+            for i, (f, laws) in enumerate(curves):
+                st = _style(f.law, f.solver, i)
+                axa.plot(x[idx], f.per_dataset[0].model[idx] * uf, color=st["color"], ls=st["ls"], lw=1.4,
+                         label=_label(f, rows, laws) if gi == 0 else None, zorder=2)
+        axa.set_xlabel(f"{angle} [{au}]")
+        axa.set_ylabel(ylab)
+        axa.set_title(f"against {angle}" + (f", one line per {' and '.join(others)}" if others else ""), fontsize=10)
+        axa.legend(fontsize=7, ncol=2)
+    else:
+        axa.set_visible(False)
+    for a in (axp, axa):
+        a.grid(alpha=0.3)
+    kind = dataset.provenance.kind
+    fig.suptitle(f"{dataset.name}: fits of every law" + ("" if kind == "measured" else f"  ({kind} data)"),
+                 fontsize=11)
     return _png(fig)
 
 
@@ -110,13 +196,13 @@ def _residual_limits(ax, residuals, sigma):
 def force_figure(dataset, fits) -> bytes:
     """The friction force history of every law's best fit."""
     plt = _plt()
-    ok = [f for f in fits if f.ok and f.per_dataset[0].target.t is not None]
+    curves = [(f, laws) for f, laws in distinct_curves(fits) if f.per_dataset[0].target.t is not None]
     t_end = float(dataset.t[-1])
     tname, tf = time_unit(t_end)
-    fig, ax = plt.subplots(figsize=(7.6, 3.8))
-    for i, f in enumerate(ok):
-        tr = f.per_dataset[0].trajectory(f.law, np.linspace(0.0, t_end, 400))
-        ax.plot(tr.t * tf, tr.force, label=f"{f.law} [{f.solver}]", **_style(f.law, f.solver, i))
+    fig, ax = plt.subplots(figsize=(7.6, 3.8), layout="constrained")
+    for i, (f, laws) in enumerate(curves):
+        tr = f.per_dataset[0].trajectory(f.law, np.linspace(0.0, t_end, 300))
+        ax.plot(tr.t * tf, tr.force, label=f"{' = '.join(laws)} [{f.solver}]", **_style(f.law, f.solver, i))
     ax.axhline(0, color="0.3", lw=0.8)
     ax.set_xlabel(f"time [{tname}]")
     ax.set_ylabel("friction force F [N] (positive opposes slip)")
@@ -126,13 +212,15 @@ def force_figure(dataset, fits) -> bytes:
     return _png(fig)
 
 
-def ranking_figure(rows) -> bytes:
-    """Heat map of delta-AIC, candidates x datasets, with ranks; grey where no fit."""
+def ranking_figure(rows, alias: dict | None = None) -> bytes:
+    """Heat map of delta-AIC, candidates x datasets, with ranks; grey where no fit. ``alias`` maps a law
+    to the label it shares with laws of the same curve everywhere ("couette = wear"): one row for them."""
     plt = _plt()
     from matplotlib.colors import LogNorm
 
+    alias = alias or {}
     datasets = list(dict.fromkeys(r.dataset for r in rows))
-    row_of = lambda r: r.law + (" [series]" if r.solver == "series" else "")  # noqa: E731
+    row_of = lambda r: alias.get(r.law, r.law) + (" [series]" if r.solver == "series" else "")  # noqa: E731
     cands = sorted({row_of(r) for r in rows})
     M = np.full((len(cands), len(datasets)), np.nan)
     text = [["" for _ in datasets] for _ in cands]
@@ -143,7 +231,7 @@ def ranking_figure(rows) -> bytes:
             text[i][j] = f"#{r.rank}\n{r.delta_aic:.1f}" + ("" if r.solver in ("exact", "series") else f"\n{r.solver}")
         else:
             text[i][j] = r.status
-    fig, ax = plt.subplots(figsize=(1.25 * len(datasets) + 3.2, 0.55 * len(cands) + 1.8))
+    fig, ax = plt.subplots(figsize=(1.25 * len(datasets) + 3.2, 0.55 * len(cands) + 1.8), layout="constrained")
     cmap = plt.get_cmap("viridis_r").with_extremes(bad="0.9")
     im = ax.imshow(np.where(np.isnan(M), np.nan, M + 1.0), cmap=cmap, aspect="auto",
                    norm=LogNorm(vmin=1.0, vmax=max(10.0, np.nanmax(M + 1.0) if np.isfinite(M).any() else 10.0)))
@@ -167,7 +255,7 @@ def derivation_figure(dataset, derived: dict, noisy: dict, sigma_theta: float, s
     tname, tf = time_unit(float(t[-1]))
     du, df = unit("omega")
     au, af = unit("theta")
-    fig, axes = plt.subplots(2, 2, figsize=(10.5, 6.6), sharex=True)
+    fig, axes = plt.subplots(2, 2, figsize=(10.5, 6.6), sharex=True, layout="constrained")
     colors = {"poly9": "#d95f02", "spline": "#1b9e77"}
     for col, (title, res) in enumerate((("theta column as given", derived),
                                         (f"with simulated noise σθ = {sigma_theta * af:.2g} {au} (seed {seed})",
@@ -201,7 +289,6 @@ def derivation_figure(dataset, derived: dict, noisy: dict, sigma_theta: float, s
             axw.set_ylim(lo, hi)
     fig.suptitle(f"{dataset.name}: spin derived from rotation angle (shaded: ±1σ each route passes on from θ noise)",
                  fontsize=11)
-    fig.tight_layout()
     return _png(fig)
 
 
@@ -213,7 +300,7 @@ def equivalence_figure(dataset, fw_list, fa, decomps) -> bytes:
     t_end = float(dataset.t[-1])
     tname, tf = time_unit(t_end)
     t = np.linspace(0.0, t_end, 400)
-    fig, axes = plt.subplots(1, max(1, len(fw_list)), figsize=(5.4 * max(1, len(fw_list)), 3.9), squeeze=False)
+    fig, axes = plt.subplots(1, max(1, len(fw_list)), figsize=(5.4 * max(1, len(fw_list)), 3.9), squeeze=False, layout="constrained")
     Fa = fa.per_dataset[0].trajectory(fa.law, t).force
     for ax, fw, dec in zip(axes[0], fw_list, decomps):
         Fw = fw.per_dataset[0].trajectory(fw.law, t).force
@@ -235,7 +322,52 @@ def equivalence_figure(dataset, fw_list, fa, decomps) -> bytes:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
     fig.suptitle(f"{dataset.name}: is λAu equivalent to μN + μη' dA/dt?", fontsize=11)
-    fig.tight_layout()
+    return _png(fig)
+
+
+def finding_figure(findings) -> bytes:
+    """Per finding (report.first_screen.SeriesFinding), one column: the data's spin with the series and the
+    exact fit of the same law (top), the slip u(t) of each (bottom), the series' zero crossing marked."""
+    plt = _plt()
+    n = len(findings)
+    fig, axes = plt.subplots(2, n, figsize=(4.6 * n + 0.4, 4.3), sharex="col", squeeze=False, layout="constrained",
+                             gridspec_kw={"height_ratios": [1.5, 1]})
+    su, sf = unit("omega")
+    for j, f in enumerate(findings):
+        d = f.dataset
+        ax, axu = axes[0, j], axes[1, j]
+        t_end = float(d.t[-1])
+        tname, tf = time_unit(t_end)
+        t = np.linspace(0.0, t_end, 300)
+        obs = f.series.per_dataset[0].target.observable
+        if obs == "omega":
+            target = f.series.per_dataset[0].target
+            ax.errorbar(d.t * tf, target.y * sf, yerr=target.sigma * sf, fmt="o", ms=2.6, color="black",
+                        ecolor="0.75", elinewidth=0.7, label=f"data ({d.provenance.kind})", zorder=1)
+        for fit, color, ls in ((f.full, "#1b9e77", "-"), (f.series, "#d95f02", "--")):
+            tr = fit.per_dataset[0].trajectory(fit.law, t)
+            label = f"{fit.law} [{fit.solver}]" + (" (paper's truncated series)" if fit.solver == "series" else "")
+            ax.plot(t * tf, tr["omega"] * sf, color=color, ls=ls, lw=2, label=label, zorder=3)
+            axu.plot(t * tf, tr["u"], color=color, ls=ls, lw=2, label=label)
+        axu.axhline(0, color="0.3", lw=0.8)
+        if f.t_cross is not None:
+            for a in (ax, axu):
+                a.axvline(f.t_cross * tf, color="#d95f02", ls=":", lw=1.3)
+            axu.annotate(f"series slip = 0 at {f.t_cross * tf:.0f} {tname}:\nfriction reverses, spin falls",
+                         xy=(f.t_cross * tf, 0.0), xytext=(0.03, 0.1), textcoords="axes fraction", fontsize=8,
+                         arrowprops={"arrowstyle": "->", "color": "0.3"})
+        ax.axvline(f.contact_time * tf, color="0.6", lw=0.8)
+        axu.axvline(f.contact_time * tf, color="0.6", lw=0.8)
+        ax.set_title(f"{d.name}" + ("" if d.provenance.kind == "measured" else f" ({d.provenance.kind} data)"),
+                     fontsize=10)
+        ax.set_ylabel(f"spin ω [{su}]")
+        axu.set_ylabel("slip u [m/s]")
+        axu.set_xlabel(f"time [{tname}] (grey line: end of contact t_c)")
+        ax.legend(fontsize=7, loc="lower right")
+        for a in (ax, axu):
+            a.grid(alpha=0.3)
+    fig.suptitle("Why the paper's spin falls: its truncated series' slip turns negative; the exact solution's never does",
+                 fontsize=10.5)
     return _png(fig)
 
 

@@ -134,10 +134,48 @@ class FitResult:
     cpu_time: float = 0.0  # CPU seconds of the fitting thread
     message: str = ""
     notes: tuple[str, ...] = ()
+    #: lmfit's MinimizerResult of the best start, in SI (None when nothing was fitted); its parameter
+    #: names are identifiers ('lam', 'scene_u0__0'); ``params`` holds the display names.
+    minimizer_result: object = attrs.field(default=None, repr=False)
 
     @property
     def ok(self) -> bool:
         return self.status == "ok"
+
+    @property
+    def lmfit_params(self):
+        """The parameters as ``lmfit.Parameters`` in SI (values, standard errors, bounds, correlations),
+        named as in ``params`` with characters lmfit does not accept replaced by '_'."""
+        from .frames import lmfit_parameters
+
+        return lmfit_parameters(self)
+
+    def fit_report(self, **kwargs) -> str:
+        """lmfit's fit report of this fit (SI units, ours statistics first); kwargs go to lmfit.fit_report."""
+        from .frames import fit_report
+
+        return fit_report(self, **kwargs)
+
+    def to_dataframe(self):
+        """The parameters as a tidy pandas DataFrame, one row per parameter, with units."""
+        from .frames import parameters_frame
+
+        return parameters_frame([self])
+
+    def __repr__(self) -> str:
+        on = ", ".join(self.datasets)
+        if not self.ok:
+            return f"<FitResult {self.law} [{self.solver}] on {on}: {self.status}: {self.reason}>"
+        from .display import param_text
+
+        ps = ", ".join(f"{p.name} = {param_text(p.value, p.stderr, p.unit)}" for p in self.params.values()
+                       if p.vary or p.kind == "derived")
+        return f"<FitResult {self.law} [{self.solver}] on {on}: {ps}; reduced chi2 {self.stats.redchi:.3g}>"
+
+    def _repr_html_(self) -> str:
+        from .frames import fit_html
+
+        return fit_html(self)
 
     def value(self, name: str) -> float:
         return self.params[name].value
@@ -346,10 +384,10 @@ def _distinct(scored: list[tuple], n: int) -> list[dict]:
 
 def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: int, max_nfev):
     """Score a grid of starts, refine the best distinct ones with Levenberg-Marquardt, keep the lowest
-    chi-square. Returns (parameters, success, message)."""
+    chi-square. Returns (parameters, success, message, lmfit MinimizerResult or None)."""
     varying = [s for s in slots if s.vary]
     if not varying:
-        return params, True, "nothing to fit: every parameter is held"
+        return params, True, "nothing to fit: every parameter is held", None
     starts = [{s.pname: params[s.pname].value for s in varying}]
     if scan:
         fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
@@ -371,7 +409,7 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
         r = mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
         if best is None or (r.success, -r.chisqr) > (best.success, -best.chisqr):
             best = r
-    return best.params, bool(best.success), str(best.message)
+    return best.params, bool(best.success), str(best.message), best
 
 
 def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[float]] | None = None,
@@ -447,7 +485,8 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
 
     success, message = True, ""
     try:
-        best_params, success, message = _search(lmfit, model, params, slots, solvers, scan, n_starts, max_nfev)
+        best_params, success, message, best = _search(lmfit, model, params, slots, solvers, scan, n_starts,
+                                                      max_nfev)
         values = _si(best_params, slots)
         models = model.models(values)
     except SkipDataset as exc:
@@ -495,7 +534,31 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
                      params=presults, correlations=correl, stats=stats, identifiability=ident,
                      per_dataset=tuple(per), nfev=model.nfev, wall_time=time.perf_counter() - started,
                      cpu_time=time.thread_time() - cpu_started,
-                     message=message, notes=tuple(notes))
+                     message=message, notes=tuple(notes), minimizer_result=_si_result(best, slots))
+
+
+def _si_result(best, slots):
+    """A copy of lmfit's MinimizerResult in SI: the optimizer works on parameters divided by their
+    typical size; values, bounds, errors, start values and the covariance are multiplied back."""
+    if best is None:
+        return None
+    import copy
+
+    scale = {s.pname: s.scale for s in slots}
+    r = copy.copy(best)
+    r.params = best.params.copy()
+    for name, p in r.params.items():
+        f = scale[name]
+        p.set(min=p.min * f, max=p.max * f)  # bounds first: a value is clipped into them
+        p.set(value=p.value * f)
+        p.init_value = None if p.init_value is None else p.init_value * f
+        p.stderr = None if p.stderr is None else p.stderr * f
+    if getattr(best, "covar", None) is not None:
+        d = np.array([scale[n] for n in best.var_names])
+        r.covar = best.covar * np.outer(d, d)
+    r.init_vals = [v * scale[n] for v, n in zip(best.init_vals, best.var_names)]
+    r.init_values = {n: v * scale[n] for n, v in best.init_values.items()}
+    return r
 
 
 def _stats(n, k, k_free, chisqr, per) -> Stats:

@@ -23,6 +23,10 @@ class Identifiability:
     no_effect: tuple[str, ...] = ()
 
 
+#: A parameter is at a bound when within this fraction of its typical size (scale) of it: lam = 1655 with
+#: scale 1e6 is 1.7e-3 scales from 0 and not at the bound; an optimizer pressed against 0 ends far closer.
+AT_BOUND = 1e-4
+
 def jacobian(model, slots, values) -> np.ndarray:
     """Central-difference Jacobian of the weighted residual in scaled units of the free parameters."""
     cols = []
@@ -42,7 +46,7 @@ def find_structure(law, slots, values, J) -> dict:
     (rank of the column-normalized Jacobian)."""
     varying = [s for s in slots if s.vary]
     at_bounds = tuple(s.display for s in varying
-                      if any(math.isfinite(b) and abs(values[s.pname] - b) <= 2e-3 * max(abs(b) * 1e-3, s.scale)
+                      if any(math.isfinite(b) and abs(values[s.pname] - b) <= AT_BOUND * max(abs(b) * 1e-3, s.scale)
                              for b in (s.lower, s.upper)))
     ratios = []
     for a, b in law.ratio_only:

@@ -23,6 +23,13 @@ def check_writable(path) -> Path:
     return path
 
 
+def _umask_mode(mode: int) -> int:
+    """``mode`` as the process umask leaves it (what open() would give a new file or folder)."""
+    umask = os.umask(0)
+    os.umask(umask)
+    return mode & ~umask
+
+
 def atomic_write_bytes(path, data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file in the same folder, then rename."""
     path = check_writable(path)
@@ -31,6 +38,7 @@ def atomic_write_bytes(path, data: bytes) -> None:
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
+        os.chmod(tmp, _umask_mode(0o666))  # mkstemp makes it private; the output is the user's as any file
         os.replace(tmp, path)
     except OSError as exc:
         if tmp is not None and os.path.exists(tmp):
@@ -57,6 +65,7 @@ def atomic_dir(path, force: bool = False):
         raise OutputError(f"{path}: parent folder {parent} does not exist")
     try:
         tmp = Path(tempfile.mkdtemp(dir=parent, prefix=f".{path.name}.", suffix=".tmp"))
+        tmp.chmod(_umask_mode(0o777))  # mkdtemp makes it private; the folder is the user's as any folder
     except OSError as exc:
         raise OutputError(f"{path}: cannot write in {parent}: {exc.strerror or exc}") from None
     try:

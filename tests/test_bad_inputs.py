@@ -106,9 +106,14 @@ def snapshot(folder: Path) -> dict[str, str]:
     return out
 
 
+#: Progress lines on stderr (frictionlab.progress, when stderr is not a terminal) are not error lines.
+PROGRESS_LINE = re.compile(r"^\d{4}-\d\d-\d\d \d\d:\d\d:\d\d [\w-]+: ")
+
+
 def check(case: dict, rc: int, stderr: str, before: dict, tmp: Path) -> None:
     assert "Traceback" not in stderr, stderr
-    lines = [line for line in stderr.splitlines() if line.strip() and not line.startswith("warning: ")]
+    lines = [line for line in stderr.splitlines() if line.strip() and not line.startswith("warning: ")
+             and not PROGRESS_LINE.match(line)]
     assert len(lines) == 1, f"expected one error line, got:\n{stderr}"
     line = lines[0]
     assert ERROR_LINE.match(line), line

@@ -2,6 +2,7 @@
 import csv
 import io
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +13,7 @@ from frictionlab.errors import FrictionLabError
 from _fit_helpers import TRUTH, synthetic
 from frictionlab import compare, write_report
 from frictionlab.cli import main
-from frictionlab.commands.compare import ProgressBar
+from frictionlab.progress import Progress
 from frictionlab.errors import OutputError
 from frictionlab.ranking import COLUMNS
 
@@ -52,14 +53,18 @@ def test_html_is_self_contained(report_dir):
     html = (out / "report.html").read_text()
     n_figs = len(list((out / "figures").glob("*.png")))
     assert html.count("data:image/png;base64,") == n_figs
-    assert "src='figures/" not in html and "<link" not in html and "<script" not in html
-    assert "<table>" in html
+    assert "src='figures/" not in html and 'src="figures/' not in html and "<link" not in html
+    assert "<script src" not in html and html.count("<script>") == 1  # the inline table sorter only
+    assert '<table class="sortable">' in html
 
 
 def test_ranking_csv_and_results_json(report_dir):
     out = report_dir
     rows = list(csv.DictReader(io.StringIO((out / "ranking.csv").read_text())))
-    assert list(rows[0]) == list(COLUMNS)
+    assert list(rows[0]) == list(COLUMNS) + ["observable", "rss_unit", "rmse_unit"]
+    assert {(r["observable"], r["rss_unit"], r["rmse_unit"]) for r in rows if r["dataset"] == "synth-impact"} == {
+        ("omega", "(rad/s)^2", "rad/s")}
+    assert all(r["rmse_unit"] == "" for r in rows if r["dataset"].startswith("ALL"))
     per = [r for r in rows if r["dataset"] == "synth-impact"]
     assert {(r["law"], r["solver"]) for r in per} == {("wear", "exact"), ("wear", "series"), ("area-rate", "exact")}
     best = [r for r in per if r["rank"] == "1"]
@@ -105,11 +110,10 @@ def boot_report(tmp_path_factory):
 
 
 def _bootstrap_tables(c) -> str:
-    from frictionlab.report import Doc, _bootstrap_section
+    from frictionlab.report import bootstrap, build
+    from frictionlab.report.render import markdown
 
-    doc = Doc()
-    _bootstrap_section(doc, c)
-    md = doc.markdown()
+    md = markdown("t", build(c, modules=[bootstrap])[0])
     return md[md.index("### First place under resampling"):]
 
 
@@ -227,7 +231,9 @@ def test_compare_and_fit_commands(tmp_path, capsys):
     assert main(["compare", "--laws", "wear,coulomb", "--data", str(toml), "--out", str(out), "--jobs", "1",
                  "--bootstrap", "5", "--seed", "2"]) == 0
     captured = capsys.readouterr()
-    assert "report:" in captured.out and "[" not in captured.err  # no progress bar when not a terminal
+    assert "report:" in captured.out
+    assert re.search(r"compare: \d+/\d+ \(\d+%\) .*; (ETA|took) ", captured.err)  # progress lines, not a bar
+    assert re.search(r"report: \d+/\d+ \(\d+%\) figure ", captured.err)
     assert (out / "report.html").exists()
     assert "first in 100% of 5 resamples" in (out / "report.md").read_text()
     for bad in (["--bootstrap", "-1"], ["--seed", "-3"]):
@@ -244,18 +250,23 @@ def test_compare_and_fit_commands(tmp_path, capsys):
     assert "unknown law" in capsys.readouterr().err
 
 
-def test_progress_bar_draws_only_on_a_terminal():
+def test_progress_is_a_bar_on_a_terminal_and_timestamped_lines_otherwise():
     class Tty(io.StringIO):
         def isatty(self):
             return True
 
-    tty, pipe = Tty(), io.StringIO()
-    for stream in (tty, pipe):
-        bar = ProgressBar(stream)
-        bar(3, 10, "wear [exact] on x")
-        bar.close()
-    assert "3/10" in tty.getvalue() and tty.getvalue().startswith("\r[######")
-    assert pipe.getvalue() == ""
+    tty, pipe, quiet = Tty(), io.StringIO(), io.StringIO()
+    for stream, q in ((tty, False), (pipe, False), (quiet, True)):
+        with Progress("compare", stream=stream, quiet=q, every=3600) as bar:
+            for k in range(1, 11):
+                bar(k, 10, f"wear [exact] on x{k}")
+    assert "10/10" in tty.getvalue() and "compare" in tty.getvalue()  # tqdm's bar
+    lines = pipe.getvalue().splitlines()
+    assert len(lines) == 2  # the first and the last; the others within the 3600 s interval
+    assert re.match(r"^\d{4}-\d\d-\d\d \d\d:\d\d:\d\d compare: 1/10 \(10%\) wear \[exact\] on x1; ETA \d+:\d\d:\d\d$",
+                    lines[0])
+    assert lines[1].endswith("took 0:00:00") and " 10/10 (100%) " in lines[1]
+    assert quiet.getvalue() == ""
 
 
 def test_a_new_dataset_kind_plugs_in_through_one_predictor(tmp_path, monkeypatch):

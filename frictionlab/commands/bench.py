@@ -5,8 +5,12 @@ import sys
 
 
 def add_parser(sub):
-    p = sub.add_parser("bench", help="work-precision diagrams (error vs time) for every solver and tolerance",
-                       description="Solve each scene kind with RK45, DOP853, LSODA, Radau and BDF at rtol 1e-3..1e-12, "
+    from ..cli import subcommand
+
+    p = subcommand(sub, "bench", help="work-precision diagrams (error vs time) for every solver and tolerance",
+                   examples="""  frictionlab bench --quick --out bench-quick     # a smoke run, about a minute
+  frictionlab bench --out bench --force           # the full study, about 25 minutes""",
+                   description="Solve each scene kind with RK45, DOP853, LSODA, Radau and BDF at rtol 1e-3..1e-12, "
                                    "the closed form, the paper's series and the batch engine; write one PNG per scene "
                                    "kind plus workprecision.csv/.md and environment.json (hardware, versions); "
                                    "then fit laws at each tolerance (fit_tolerance.csv): fitted values, error bars, "
@@ -23,8 +27,13 @@ def run(args) -> int:
     from ..bench import run_bench, write_bench
 
     _check_out(args)
-    result = run_bench(quick=args.quick, fits=args.fits,
-                       progress=lambda msg: print(f"  {msg}", file=sys.stderr, flush=True))
+    import datetime as _dt
+
+    def progress(msg):
+        if not args.quiet:
+            print(f"{_dt.datetime.now():%Y-%m-%d %H:%M:%S} bench: {msg}", file=sys.stderr, flush=True)
+
+    result = run_bench(quick=args.quick, fits=args.fits, progress=progress)
     files = write_bench(args.out, result, force=args.force)
     env = result["env"]
     print(f"wrote {args.out}/: {', '.join(files)}")

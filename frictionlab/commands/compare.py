@@ -2,12 +2,10 @@
 from __future__ import annotations
 
 import os
-import shutil
-import sys
-import time
 from pathlib import Path
 
 from ..errors import OutputError, ParameterError
+from ..progress import Progress
 
 #: Default number of bootstrap resamples: about +15 s (idle) to +35 s (busy machine) on 2 cores for the
 #: built-in datasets, on top of 35-60 s without it.
@@ -17,17 +15,23 @@ TOLERANCE_RTOLS = (1e-3, 1e-6)
 
 
 def add_parser(sub):
-    p = sub.add_parser("compare", help="compare laws on datasets and write a report folder",
-                       description="Fit every law to every dataset (default: the four mission laws, all built-in "
-                                   "datasets), rank them, test the paper's equivalence claim, and write "
-                                   "report.md, report.html, figures/, ranking.csv and results.json.")
-    p.add_argument("--laws", help="comma-separated law names, or 'all' for every registered law (default: "
-                                    "coulomb, area-rate, wear, couette)")
-    p.add_argument("--data", nargs="+", metavar="NAME_OR_TOML", help="datasets (default: every built-in)")
-    p.add_argument("--solver", action="append", metavar="SOLVER",
-                   help="exact, series, ode[:METHOD] or auto; repeat for several (default: exact where a closed "
-                        "form exists else ode, plus series where it applies)")
-    p.add_argument("--free", action="append", default=[], metavar="NAME=LO:HI",
+    from ..cli import ListAction, subcommand
+
+    p = subcommand(sub, "compare", help="compare laws on datasets and write a report folder",
+                   description="Fit every law to every dataset (default: the four mission laws, all "
+                               "built-in datasets), rank them, test the paper's equivalence claim, and write report.md, "
+                               "report.html, figures/, ranking.csv and results.json.",
+                   examples="""  frictionlab compare                          # the four mission laws on every built-in dataset into ./report
+  frictionlab compare --laws wear,area-rate --data impact-golf-v28 --out golf
+  frictionlab compare --data my.toml --data impact-golf-v61 --solver exact --solver series
+  frictionlab compare --bootstrap 0 --no-tolerance --quiet --out quick   # fastest, no progress lines""")
+    p.add_argument("--laws", "--law", action=ListAction, metavar="NAME", help="law names, or 'all' for every registered law "
+                   "(default: coulomb, area-rate, wear, couette)")
+    p.add_argument("--data", action=ListAction, metavar="NAME_OR_TOML", help="datasets (default: every built-in)")
+    p.add_argument("--solver", "--solvers", action=ListAction, metavar="SOLVER",
+                   help="exact, series, ode[:METHOD] or auto (default: exact where a closed form exists else ode, "
+                        "plus series where it applies)")
+    p.add_argument("--free", action=ListAction, default=[], metavar="NAME=LO:HI",
                    help="fit a scene quantity per dataset within bounds, with units, e.g. u0='5 m/s:31 m/s'")
     p.add_argument("--out", type=Path, default=Path("report"), help="report folder (default: ./report)")
     p.add_argument("--force", action="store_true", help="replace an existing report folder")
@@ -47,30 +51,6 @@ def add_parser(sub):
     p.set_defaults(func=run)
 
 
-class ProgressBar:
-    """A one-line progress bar on a terminal; silent when the stream is not one."""
-
-    def __init__(self, stream=None):
-        self.stream = stream or sys.stderr
-        self.active = hasattr(self.stream, "isatty") and self.stream.isatty()
-        self.start = time.perf_counter()
-
-    def __call__(self, done: int, total: int, label: str) -> None:
-        if not self.active:
-            return
-        width = shutil.get_terminal_size((80, 20)).columns
-        frac = done / total if total else 1.0
-        bar = "#" * int(20 * frac) + "." * (20 - int(20 * frac))
-        line = f"[{bar}] {done}/{total} {time.perf_counter() - self.start:5.1f}s {label}"
-        self.stream.write("\r" + line[: width - 1].ljust(width - 1))
-        self.stream.flush()
-
-    def close(self) -> None:
-        if self.active:
-            self.stream.write("\n")
-            self.stream.flush()
-
-
 def run(args) -> int:
     from ..comparison import compare
     from ..report import write_report
@@ -78,6 +58,9 @@ def run(args) -> int:
 
     if args.out.exists() and not args.force:  # fail before the work, not after it
         raise OutputError(f"{args.out}: output folder exists; choose another --out or pass --force")
+    parent = args.out.parent if str(args.out.parent) else Path(".")
+    if not parent.is_dir():
+        raise OutputError(f"{args.out}: cannot write: {parent} is not an existing folder")
     if args.jobs < 1:
         raise OutputError(f"--jobs must be at least 1, got {args.jobs}")
     if args.bootstrap < 0:
@@ -85,18 +68,13 @@ def run(args) -> int:
     if args.seed < 0:
         raise ParameterError(f"--seed must be a non-negative integer, got {args.seed}")
     free = parse_free(args.free)
-    laws = [x.strip() for x in args.laws.split(",") if x.strip()] if args.laws else None
-    bar = ProgressBar()
-    try:
-        result = compare(laws=laws, datasets=args.data, solvers=args.solver, free=free,
+    with Progress("compare", quiet=args.quiet) as bar:
+        result = compare(laws=args.laws or None, datasets=args.data or None, solvers=args.solver or None, free=free,
                          equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar,
                          bootstrap=args.bootstrap, seed=args.seed, bootstrap_all=args.bootstrap_all,
                          tolerance=TOLERANCE_RTOLS if args.tolerance else ())
-    finally:
-        bar.close()
-    if bar.active:
-        print("writing the report ...", file=sys.stderr, flush=True)
-    out = write_report(result, args.out, force=args.force)
+    with Progress("report", quiet=args.quiet) as bar:
+        out = write_report(result, args.out, force=args.force, progress=bar)
     ok = sum(f.ok for f in result.fits)
     n_laws, n_data = len(result.laws), len(result.fitted_datasets)
     print(f"compared {n_laws} law{'s' * (n_laws != 1)} on {n_data} dataset{'s' * (n_data != 1)}: {ok} fits, "

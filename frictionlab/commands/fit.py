@@ -11,18 +11,27 @@ from ..units import to_si
 
 
 def add_parser(sub):
-    p = sub.add_parser("fit", help="fit a law to datasets (several datasets: a global fit)",
-                       description="Fit LAW to one dataset, or to several at once with shared law parameters.")
+    from ..cli import ListAction, subcommand
+
+    p = subcommand(sub, "fit", help="fit a law to datasets (several datasets: a global fit)",
+                   description="Fit LAW to one dataset, or to several at once with shared law parameters. Prints "
+                               "the parameters with standard errors, the fit statistics and what the data cannot "
+                               "determine.",
+                   examples="""  frictionlab fit wear impact-golf-v28
+  frictionlab fit wear impact-golf-v28 --solver series --json fit.json
+  frictionlab fit area-rate impact-golf-v28 impact-golf-v61 --local mu       # a global fit, mu per dataset
+  frictionlab fit couette incline-oil-a100 --fix eta='0.1 Pa s'
+  frictionlab fit wear my.toml --free u0='8 m/s:14 m/s'""")
     p.add_argument("law", help="registered law name (see 'frictionlab laws')")
     p.add_argument("datasets", nargs="+", metavar="DATASET", help="built-in dataset name or TOML path")
     p.add_argument("--solver", default="auto", help="auto (exact where a closed form exists, else ode), exact, "
                    "series, ode or ode:METHOD (default: auto)")
-    p.add_argument("--free", action="append", default=[], metavar="NAME=LO:HI[:START]",
+    p.add_argument("--free", action=ListAction, default=[], metavar="NAME=LO:HI[:START]",
                    help="fit a scene quantity per dataset within bounds, with units, e.g. u0='8 m/s:14 m/s'; "
                         f"names: {', '.join(SCENE_QUANTITIES)}")
-    p.add_argument("--fix", action="append", default=[], metavar="NAME=VALUE",
+    p.add_argument("--fix", action=ListAction, default=[], metavar="NAME=VALUE",
                    help="hold a law parameter, with its unit, e.g. eta='0.1 Pa s'")
-    p.add_argument("--local", action="append", default=[], metavar="NAME",
+    p.add_argument("--local", action=ListAction, default=[], metavar="NAME",
                    help="in a global fit, fit this law parameter separately per dataset")
     p.add_argument("--observable", help="fit this column instead of the dataset's observable (e.g. theta)")
     p.add_argument("--derive", choices=("poly9", "spline"), help="fit omega derived from the theta column")
@@ -61,7 +70,7 @@ def parse_fix(law, items) -> dict:
 
 
 def run(args) -> int:
-    from ..report import _fit_json
+    from ..report import fit_json as _fit_json
 
     law = get_law(args.law)
     if args.json and not args.json.parent.is_dir():  # before the work, not after
@@ -73,7 +82,7 @@ def run(args) -> int:
     print(result.summary())
     if args.json:
         from ..io import atomic_write_text
-        from ..report import _clean
+        from ..report import clean as _clean
 
         atomic_write_text(args.json, json.dumps(_clean(_fit_json(result)), indent=1, allow_nan=False) + "\n")
     return 0 if result.status != "failed" else 1

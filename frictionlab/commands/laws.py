@@ -7,7 +7,13 @@ from ..table import render
 
 
 def add_parser(sub):
-    p = sub.add_parser("laws", help="list the registered friction laws")
+    from ..cli import subcommand
+
+    p = subcommand(sub, "laws", help="list the registered friction laws",
+                   description="List the registered friction laws: formula, what each needs (N, A, dA/dt, u), "
+                               "citation, where it is defined, and its parameters with units, defaults and bounds.",
+                   examples="""  frictionlab laws --brief
+  frictionlab laws --load my_laws.py        # laws registered in your file appear in the list""")
     p.add_argument("--brief", action="store_true", help="one line per law")
     p.set_defaults(func=run)
 

@@ -42,9 +42,9 @@ def _form_and_reason(plan, p):
                           "apply; use --solver ode")
     form = law.form(p)
     if form is None:
-        raise SolverError(f"exact: {name} declares no closed form; use --solver ode")
+        raise SolverError(f"exact: {name} declares no closed form; use the ode solver")
     if "xi" in plan.states:
-        raise SolverError("exact: no closed form with tangential compliance; use --solver ode")
+        raise SolverError("exact: no closed form with tangential compliance; use the ode solver")
     if isinstance(form, AreaSlipForm):
         if isinstance(s.area, HalfSineArea) and plan.drive == 0.0:
             return form

@@ -27,6 +27,16 @@ class SeriesAccuracyWarning(UserWarning):
     """The first-order series is used outside the range where it is accurate."""
 
 
+def slip_zero(t: np.ndarray, u: np.ndarray) -> float | None:
+    """The first time a slip u(t) (positive at first) reaches zero, linearly interpolated; None if it does not.
+    The truncated series' slip passes through zero (it is not a solution that stops there)."""
+    i = np.nonzero(u <= 0.0)[0]
+    if not len(i) or i[0] == 0:
+        return None
+    k = int(i[0])
+    return float(t[k - 1] + (t[k] - t[k - 1]) * u[k - 1] / (u[k - 1] - u[k]))
+
+
 def check(plan, p) -> AreaSlipForm:
     law, s = plan.law, plan.scene
     if law.states:
@@ -35,7 +45,7 @@ def check(plan, p) -> AreaSlipForm:
     form = law.form(p)
     if not isinstance(form, AreaSlipForm):
         raise SolverError(f"series: law '{law.name}' has no series solution (the paper's series, eqs (7)-(11), "
-                          "is for laws of the form F = k A u); use --solver exact or ode")
+                          "is for laws of the form F = k A u); use the exact or ode solver")
     if not isinstance(s.area, HalfSineArea) or plan.drive != 0.0 or plan.coupled or "xi" in plan.states:
         raise SolverError("series: defined only on the paper's impact scene (half-sine area, no gravity, "
                           "no slip coupling, no compliance)")

@@ -1,0 +1,168 @@
+"""The first screen: the verdict table (``Comparison.answers``) and the figure of the central finding.
+
+The verdict table only renders the answers the verdict layer filled (``frictionlab/answers.py``);
+a column without data says so. Without answers it shows what the comparison does hold, labelled
+as such (the AIC ranking's first place and the equivalence analysis' verdict), never a verdict
+of its own. The finding: the paper's truncated series of a F = k A u law against the exact
+solution of the same law, spin above and the slip u(t) of each below, with the time at which the
+series' slip crosses zero (computed here from the fitted series).
+"""
+from __future__ import annotations
+
+import math
+
+import attrs
+import numpy as np
+
+from .. import figures
+from ..answers import group_of
+from ..display import fmt_time
+from ..solvers.series import slip_zero
+from .doc import Section
+from .text import PROVENANCE_WORDS, sig
+
+TITLE = "Answers"
+#: (Answer field, column header) of the verdict table.
+COLUMNS = (("headline", "best law"), ("goodness", "goodness of fit"),
+           ("equivalence", "λAu ≡ μN + μη′dA/dt?"), ("noise_threshold", "noise threshold"),
+           ("series_vs_exact", "series vs exact"), ("transfer", "transfer"))
+
+
+@attrs.frozen
+class SeriesFinding:
+    """The series and the exact (or ODE) fit of one law on one impact, and where the series' slip crosses zero."""
+
+    dataset: object
+    series: object  # FitResult
+    full: object  # FitResult
+    t_cross: float | None  # s; None if the series' slip stays positive
+    contact_time: float  # s
+    full_min_slip: float  # m/s, the smallest slip of the exact (or ODE) solution during contact
+
+
+def series_findings(c, law_order=("wear", "couette")) -> list[SeriesFinding]:
+    """Per impact dataset with a 'series' fit and a non-series fit of the same law: the finding (one law each)."""
+    out = []
+    for d in c.fitted_datasets:
+        if "t" not in d.columns:
+            continue
+        laws = sorted({f.law for f in c.fits_on(d.name) if f.ok and f.solver == "series"},
+                      key=lambda x: (law_order.index(x) if x in law_order else len(law_order), x))
+        for law in laws:
+            ser = c.fit_for(d.name, law, "series")
+            full = next((f for f in c.fits_on(d.name) if f.law == law and f.ok and f.solver != "series"), None)
+            if full is None:
+                continue
+            tc = getattr(d.scene.area, "contact_time", float(d.t[-1]))
+            t = np.linspace(0.0, float(tc), 20001)
+            u = ser.per_dataset[0].trajectory(law, t)["u"]
+            u_full = full.per_dataset[0].trajectory(law, t[::20])["u"]
+            out.append(SeriesFinding(d, ser, full, slip_zero(t, u), float(tc), float(np.min(u_full))))
+            break
+    return out
+
+
+def finding_sentence(f: SeriesFinding) -> str:
+    if f.t_cross is None:
+        return (f"On {f.dataset.name} the truncated series' slip stays positive up to t_c, so it cannot explain "
+                "a fall of the spin by itself.")
+    text = (f"On {f.dataset.name} the paper's truncated series of {f.series.law} has its slip u(t) cross zero at "
+            f"{fmt_time(f.t_cross, f.contact_time)} (t_c = {fmt_time(f.contact_time)}): from there its friction "
+            "pushes the other way and the spin falls.")
+    if f.full_min_slip > 0:
+        text += (f" The {f.full.solver} solution of the same law keeps u > 0 (at least {f.full_min_slip:.3g} m/s), "
+                 "so its spin never falls: the fall comes from the truncation, not from the law.")
+    return text
+
+
+def finding_text(shown) -> str:
+    """The first finding in full, the others by their numbers."""
+    text = finding_sentence(shown[0])
+    more = [f"on {f.dataset.name} at {fmt_time(f.t_cross, f.contact_time)} (t_c {fmt_time(f.contact_time)})"
+            for f in shown[1:] if f.t_cross is not None]
+    return text + (" The same " + ("crossing" if len(more) == 1 else "crossings") + ": " + "; ".join(more) + "."
+                   if more else "")
+
+
+def _answer_table(sec: Section, answers):
+    empty = [head for field, head in COLUMNS if not any(getattr(a, field) for a in answers)]
+    cols = [(field, head) for field, head in COLUMNS if head not in empty]
+    rows = []
+    for a in answers:
+        who = f"**{a.group}** ({', '.join(a.datasets)}; {a.provenance})"
+        cells = [getattr(a, f) or "—" for f, _ in cols]
+        flags = a.details.get("plausibility") if isinstance(a.details, dict) else None
+        if flags:
+            cells[0] += " — implausible: " + "; ".join(map(str, flags if isinstance(flags, (list, tuple))
+                                                           else [flags]))
+        rows.append([who] + cells)
+    sec.table(["dataset group"] + [h for _, h in cols], rows)
+    if empty:
+        sec.p("No data in this comparison for: " + ", ".join(empty) + ".")
+
+
+def _fallback_table(sec: Section, c, findings):
+    by_ds = {f.dataset.name: f for f in findings}
+    rows = []
+    for d in c.fitted_datasets:
+        best = [r for r in c.ranking if r.dataset == d.name and r.rank == 1]
+        eq = [f"{e.verdict or e.status} [wear {e.solver}]" for e in c.equivalence
+              if e.dataset == d.name and e.status == "ok"]
+        f = by_ds.get(d.name)
+        ser = "—" if f is None else ("slip crosses zero at " + fmt_time(f.t_cross, f.contact_time)
+                                     if f.t_cross is not None else "slip stays positive")
+        rows.append([f"**{d.name}** ({group_of(d)}; {d.provenance.kind})", _tied(best),
+                     sig(best[0].redchi) if best else "", "; ".join(eq) or "not tested", ser])
+    sec.table(["dataset (group; provenance)", "lowest AIC (not a fit test)", "its reduced χ²",
+               "λAu ≡ μN + μη′dA/dt? (equivalence analysis)", "series slip"], rows)
+    sec.p("No data in this comparison for: goodness-of-fit test, noise threshold, transfer.")
+
+
+def _tied(best) -> str:
+    """'wear = couette [series]' for tied candidates of one solver (one functional form, one entry)."""
+    if not best:
+        return "no law could be fitted"
+    by_solver: dict[str, list[str]] = {}
+    for r in best:
+        by_solver.setdefault(r.solver, []).append(r.law)
+    return " = ".join(f"{' = '.join(laws)} [{s}]" for s, laws in by_solver.items())
+
+
+def build(ctx) -> Section:
+    c = ctx.c
+    sec = Section(TITLE, open=True)
+    kinds = {}
+    for d in c.fitted_datasets:
+        kinds.setdefault(d.provenance.kind, []).append(d.name)
+    note = ""
+    if set(kinds) - {"measured"}:
+        note = (("No dataset here is a measurement: " if "measured" not in kinds else "Not every dataset is measured: ")
+                + "; ".join(f"{len(v)} {PROVENANCE_WORDS.get(k, k).split(',')[0]}" for k, v in kinds.items())
+                + " (see 'Datasets and provenance'). ")
+    findings = series_findings(c)
+    ctx.json["series_slip_zero_s"] = {f.dataset.name: f.t_cross for f in findings}
+    if c.answers:
+        if note:
+            sec.warn(note)
+        _answer_table(sec, c.answers)
+    else:
+        sec.warn(note + "The verdict layer gave no answers for this comparison (`Comparison.answers` is empty): no "
+                 "law is declared to fit, and no goodness-of-fit test, noise threshold or transfer test is shown. "
+                 "The table shows what the comparison holds: the lowest AIC (a relative ranking, not a test that "
+                 "the law fits), its reduced χ², and the equivalence analysis' verdict.")
+        _fallback_table(sec, c, findings)
+    shown = _pick(findings)
+    if shown:
+        sec.fig("finding.png", "Spin (top) and slip u(t) (bottom) of the truncated series and the exact solution "
+                "of the same law, fitted to the same data; dotted: where the series' slip crosses zero.",
+                lambda: figures.finding_figure(shown), side="**Why the paper's spin falls.** " + finding_text(shown))
+    else:
+        sec.p("Why the paper's spin falls: no dataset here has both the paper's series and an exact solution fitted, "
+              "so this comparison cannot show it.")
+    return sec
+
+
+def _pick(findings, n: int = 2):
+    """At most n findings, those with a zero crossing first (then in dataset order)."""
+    return sorted(findings, key=lambda f: f.t_cross is None)[:n]
+

@@ -1,0 +1,131 @@
+"""'Fits': per dataset the fits of every law, their parameters, warnings and notes, and known truth."""
+from __future__ import annotations
+
+from .. import figures
+from ..display import param_cells, param_text
+from ..errors import FrictionLabError
+from ..registry import get_law
+from ..units import to_si
+from .doc import Section
+
+TITLE = "Fits"
+
+
+def truth_check(d, c) -> str:
+    """For data generated with a known law: where that law ranks and how far its fit lands from the truth."""
+    truth = dict(d.provenance.truth or {})
+    law = truth.pop("law", None)
+    if not law or law not in c.laws:
+        return ""
+    rows = [r for r in c.ranking if r.dataset == d.name and r.law == law and r.rank]
+    parts = []
+    for r in rows:
+        f = c.fit_for(d.name, law, r.solver)
+        found = []
+        for name, text in truth.items():
+            p = f.params.get(name) if f else None
+            if p is None or not p.vary:
+                continue
+            try:
+                value = to_si(text, get_law(law).spec(name).unit, f"{d.name}: provenance.truth.{name}")
+            except FrictionLabError:
+                continue
+            dev = f" ({(p.value - value) / p.stderr:+.1f}σ)" if p.stderr else ""
+            found.append(f"{name}: true {param_text(value, None, p.unit)}, fitted "
+                         f"{param_text(p.value, p.stderr, p.unit)}{dev}")
+        parts.append(f"{law} [{r.solver}] ranks #{r.rank}" + (f" ({r.status} with {', '.join(r.tied_with)})"
+                                                              if r.tied_with else "")
+                     + ("; " + "; ".join(found) if found else ""))
+    if not parts:
+        return ""
+    return f"**Known truth:** generated with {law}. " + ". ".join(parts) + "."
+
+
+def reported_check(d, c) -> str:
+    """Law parameters the source reports for this dataset, beside every fit of a law that has them."""
+    parts = []
+    for name, text in (d.reported or {}).items():
+        for f in c.fits_on(d.name):
+            p = f.params.get(name)
+            if not f.ok or p is None or p.kind != "law" or not p.vary:
+                continue
+            try:
+                value = to_si(text, get_law(f.law).spec(name).unit, f"{d.name}: reported.{name}")
+            except FrictionLabError:
+                continue
+            parts.append(f"{name} reported {param_text(value, None, p.unit)}, fitted by {f.law} [{f.solver}] "
+                         f"{param_text(p.value, p.stderr, p.unit)}")
+    return ("**Reported by the source:** " + "; ".join(parts) + ".") if parts else ""
+
+
+def plausibility(f) -> dict[str, str]:
+    """Parameter -> comment from the verdict layer's plausibility flags, if the fit carries them
+    (``FitResult.plausibility``: a dict name -> text, or texts starting with the name)."""
+    flags = getattr(f, "plausibility", None) or {}
+    if isinstance(flags, dict):
+        return {str(k): str(v) for k, v in flags.items()}
+    out = {}
+    for text in flags:
+        name = str(text).split(" ", 1)[0].rstrip(":")
+        out[name] = (out[name] + "; " if name in out else "") + str(text)
+    return out
+
+
+def param_rows(f) -> list[list[str]]:
+    """One row per parameter of fit ``f``: value, error and unit in separate cells, its role, and a
+    comment where the value means nothing (no effect, only a ratio determined) or is flagged implausible."""
+    ratio_keys = {k for pair in f.identifiability.ratio_only for k in pair}
+    flags = plausibility(f)
+    rows = []
+    for p in f.params.values():
+        role, comment = ("fitted" if p.vary else (p.fixed_by or "held")), ""
+        if p.vary and p.kind == "law" and p.key in ratio_keys:
+            role, comment = "fitted", "arbitrary: only the ratio is determined"
+        elif p.vary and p.name in f.identifiability.no_effect:
+            comment = "arbitrary: it has no effect on these data (the value is where the optimizer stopped)"
+        elif p.vary and p.stderr is None:
+            comment = f"no error bar: {f.identifiability.missing_stderr.get(p.name, 'see warnings')}"
+        if p.name in flags:
+            comment = "; ".join(x for x in (comment, "implausible: " + flags[p.name]) if x)
+        value, err, unit = param_cells(p.value, p.stderr if p.vary or p.kind == "derived" else None, p.unit)
+        rows.append([f"{f.law} [{f.solver}]", p.name, value, err, unit, role, comment])
+    return rows
+
+
+def build(ctx) -> Section:
+    c = ctx.c
+    sec = Section(TITLE)
+    fitted = c.fitted_datasets
+    for d in fitted:
+        fits = c.fits_on(d.name)
+        rows = [r for r in c.ranking if r.dataset == d.name]
+        sec.h3(d.name)
+        if d.description:
+            sec.p(d.description)
+        for check in (truth_check(d, c), reported_check(d, c)):
+            if check:
+                sec.p(check)
+        if any(f.ok for f in fits):
+            sec.fig(f"fit-{d.name}.png", f"{d.name}: data ({d.provenance.kind}) with each law's best fit, and residuals.",
+                    lambda d=d, fits=fits, rows=rows: figures.fit_figure(d, fits, rows))
+            if "t" in d.columns:
+                sec.fig(f"force-{d.name}.png", f"{d.name}: friction force of each best fit.",
+                        lambda d=d, fits=fits: figures.force_figure(d, fits))
+        prow = []
+        for f in fits:
+            if f.ok:
+                prow += param_rows(f)
+        sec.table(["law [solver]", "parameter", "value", "± standard error", "unit", "role", "comment"], prow)
+        warns = [f"{f.law} [{f.solver}]: {w}" for f in fits if f.ok for w in f.identifiability.warnings]
+        notes = [f"{f.law} [{f.solver}]: {n}" for f in fits if f.ok for n in f.notes]
+        bad = [f"{f.law} [{f.solver}]: {f.status}: {f.reason}" for f in fits if not f.ok]
+        if warns:
+            sec.p("**Identifiability:**")
+            sec.items(warns)
+        if notes:
+            sec.p("**Notes:**")
+            sec.items(notes)
+        if bad:
+            sec.p("**Not fitted:**")
+            sec.items(bad)
+    return sec

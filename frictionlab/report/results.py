@@ -1,0 +1,161 @@
+"""results.json, schema ``frictionlab.compare/1``, and ranking.csv.
+
+ranking.csv: columns ``ranking.COLUMNS`` then ``UNIT_COLUMNS`` (observable, rss_unit, rmse_unit); per-dataset
+  rows, then the group rows (ALL, ALL[kind]); rss and rmse in the observable's SI unit, empty for groups.
+results.json:
+    created, versions{package: version}, settings, wall_time_s,
+    datasets[{name, kind, observable, n_points, status: fitted|skipped, reason,
+              provenance{kind, source, method, command, seed, truth}}],
+    fits[{dataset, law, solver, status: ok|failed|skipped, reason, message, nfev, wall_time_s, cpu_time_s,
+          parameters{name: {value, stderr, unit, kind: law|scene|derived, vary, fixed_by, lower, upper}},
+          correlations[{a, b, r}],
+          statistics{observable, observable_unit, n_points, n_params, n_free, chisqr, redchi, rss, rmse,
+                     aic, aicc, bic},
+          identifiability{verdict, warnings[], at_bounds[], missing_stderr{name: reason},
+                          high_correlations[{a, b, r}], ratio_only[[a, b]], no_effect[]},
+          notes[]}],
+    ranking[row], groups[row] (row: the ranking.csv columns plus reason, tied_with),
+    answers[Answer.as_dict()] (answers.py; empty until the verdict layer fills them),
+    series_slip_zero_s{dataset: time the fitted truncated series' slip crosses zero, null if never},
+    equivalence[{dataset, solver, area_rate_solver, status, verdict, explanation, reason, checks{},
+                 force_correlation, force_distance, impulse_Ns{}, aic{}, redchi{}, shape{}, fitted{},
+                 cross[{law, to, status, rms, rms_sigma, dchi2, params}],
+                 decomposition{b, u0, c_area, c_area_rate, mu, eta_prime, r2} | null}],
+    derivations{dataset: {method: {rms_vs_omega_column, omega_peak, omega_end, noisy_rms_vs_omega_column,
+                                   noisy_omega_peak, noisy_omega_end, noisy_median_sigma}}},
+    timings_s{stage: wall-clock seconds} (fits, equivalence, tolerance, bootstrap),
+    bootstrap{n (0: not run), seed, method: case, level: 0.95, interval: percentile,
+              first_place_interval: wilson, all (slow datasets included),
+              datasets[{dataset, n_ranked,
+                        first_place[{datasets, candidate, law, solver, first_fraction, ci_low, ci_high, level,
+                                     first_count, n_ranked, method, seed}],
+                        parameters[{law, solver, datasets, parameter, unit, value, stderr, boot_median, boot_std,
+                                    ci_low, ci_high, level, n_ok, n_failed, method, seed}]}],
+              not_bootstrapped{dataset: reason}},
+    tolerance{default_rtol, rtols[],
+              rows[{dataset, law, solver, rtol, fit_time_s (CPU), reference, ranking, ranking_as_reference,
+                    status, parameter, value, stderr, unit, shift_in_stderr, aic, rank}]}
+  All numbers SI (rad/s, s, m, N) unless the key says otherwise; non-finite numbers are null.
+"""
+from __future__ import annotations
+
+import datetime as _dt
+import math
+
+import numpy as np
+
+from ..bootstrap import parameter_table, ranking_table
+from ..dataset import COLUMN_SI
+from ..predict import FIT_RTOL
+from ..ranking import COLUMNS, to_csv
+
+#: Columns ranking.csv adds after ``ranking.COLUMNS``: what rss and rmse are measured in.
+UNIT_COLUMNS = ("observable", "rss_unit", "rmse_unit")
+
+SCHEMA = "frictionlab.compare/1"
+
+
+def _num(x):
+    if isinstance(x, (float, np.floating)):
+        return float(x) if math.isfinite(x) else None
+    if isinstance(x, np.integer):
+        return int(x)
+    return x
+
+
+def clean(obj):
+    if isinstance(obj, dict):
+        return {str(k): clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [clean(v) for v in obj]
+    return _num(obj)
+
+
+def fit_json(f) -> dict:
+    out = {"dataset": f.datasets[0] if len(f.datasets) == 1 else list(f.datasets), "law": f.law, "solver": f.solver,
+           "status": f.status, "reason": f.reason, "message": f.message, "nfev": f.nfev, "wall_time_s": f.wall_time,
+           "cpu_time_s": f.cpu_time, "notes": list(f.notes)}
+    if f.ok:
+        obs = f.per_dataset[0].target.observable
+        out["parameters"] = {n: {"value": p.value, "stderr": p.stderr, "unit": p.unit, "kind": p.kind, "vary": p.vary,
+                                 "fixed_by": p.fixed_by, "lower": p.lower, "upper": p.upper}
+                             for n, p in f.params.items()}
+        out["correlations"] = [{"a": a, "b": b, "r": r} for (a, b), r in f.correlations.items()]
+        s = f.stats
+        out["statistics"] = {"observable": obs, "observable_unit": COLUMN_SI.get(obs, "SI"), "n_points": s.n_points,
+                             "n_params": s.n_params, "n_free": s.n_free, "chisqr": s.chisqr, "redchi": s.redchi,
+                             "rss": s.rss, "rmse": s.rmse, "aic": s.aic, "aicc": s.aicc, "bic": s.bic}
+        i = f.identifiability
+        out["identifiability"] = {"verdict": i.verdict, "warnings": list(i.warnings), "at_bounds": list(i.at_bounds),
+                                  "missing_stderr": dict(i.missing_stderr),
+                                  "high_correlations": [{"a": a, "b": b, "r": r} for a, b, r in i.high_correlations],
+                                  "ratio_only": [list(p) for p in i.ratio_only], "no_effect": list(i.no_effect)}
+    return out
+
+
+
+
+def _row_json(r) -> dict:
+    return {**{k: getattr(r, k) for k in COLUMNS}, "reason": r.reason, "tied_with": list(r.tied_with)}
+
+
+def _equivalence_json(e) -> dict:
+    d = e.decomposition
+    return {"dataset": e.dataset, "solver": e.solver, "area_rate_solver": e.area_rate_solver, "status": e.status,
+            "verdict": e.verdict, "explanation": e.explanation, "reason": e.reason, "checks": e.checks,
+            "force_correlation": e.force_correlation, "force_distance": e.force_distance, "impulse_Ns": e.impulse,
+            "aic": e.aic, "redchi": e.redchi, "shape": e.shape, "fitted": e.fitted,
+            "cross": [{"law": x.law, "to": x.to, "status": x.status, "rms": x.rms, "rms_sigma": x.rms_sigma, "dchi2": x.dchi2,
+                       "params": x.params} for x in e.cross],
+            "decomposition": None if d is None else {"b": d.b, "u0": d.u0, "c_area": d.c_area,
+                                                      "c_area_rate": d.c_area_rate, "mu": d.mu,
+                                                      "eta_prime": d.eta_prime, "r2": d.r2}}
+
+
+def _bootstrap_json(c) -> dict:
+    per = [{"dataset": rb.datasets[0], "n_ranked": rb.n_ranked, "first_place": ranking_table(rb),
+            "parameters": parameter_table(rb)} for rb in c.bootstrap]
+    return {"n": c.settings.get("bootstrap", 0), "seed": c.settings.get("seed", 0), "method": "case",
+            "level": 0.95, "interval": "percentile", "first_place_interval": "wilson",
+            "all": c.settings.get("bootstrap_all", False), "datasets": per,
+            "not_bootstrapped": dict(c.bootstrap_skipped)}
+
+
+def _tolerance_json(c) -> dict:
+    return {"default_rtol": FIT_RTOL, "rtols": c.settings.get("tolerance", []), "rows": list(c.tolerance)}
+
+
+def results_json(c, extra: dict | None = None) -> dict:
+    """The whole of results.json; ``extra`` holds numbers the report's sections computed (derivations, ...)."""
+    extra = extra or {}
+    datasets = []
+    for d in c.datasets:
+        pv = d.provenance
+        datasets.append({"name": d.name, "kind": d.kind, "observable": d.observable, "n_points": len(d),
+                         "status": "skipped" if d.name in c.skipped_datasets else "fitted",
+                         "reason": c.skipped_datasets.get(d.name, ""),
+                         "provenance": {"kind": pv.kind, "source": pv.source, "method": pv.method,
+                                        "command": pv.command, "seed": pv.seed, "truth": dict(pv.truth)}})
+    return clean({"schema": SCHEMA, "created": _dt.datetime.now().astimezone().isoformat(timespec="seconds"),
+                   "versions": c.versions, "settings": c.settings, "wall_time_s": c.wall_time, "datasets": datasets,
+                   "fits": [fit_json(f) for f in c.fits], "ranking": [_row_json(r) for r in c.ranking],
+                   "groups": [_row_json(r) for r in c.groups],
+                   "equivalence": [_equivalence_json(e) for e in c.equivalence],
+                   "derivations": extra.get("derivations", {}), "timings_s": c.timings,
+                   "series_slip_zero_s": extra.get("series_slip_zero_s", {}),
+                   "answers": [a.as_dict() for a in c.answers],
+                   "bootstrap": _bootstrap_json(c), "tolerance": _tolerance_json(c)})
+
+
+def ranking_csv(c) -> str:
+    """ranking.csv: ``ranking.to_csv`` with the unit columns appended (empty for group rows)."""
+    rows = list(c.ranking) + list(c.groups)
+    obs = {d.name: d.observable for d in c.datasets}
+    lines = to_csv(rows).rstrip("\n").split("\n")
+    out = [lines[0] + "," + ",".join(UNIT_COLUMNS)]
+    for r, line in zip(rows, lines[1:]):
+        o = obs.get(r.dataset, "")
+        u = (COLUMN_SI.get(o, "") or "1") if o and r.dataset in obs and r.rank is not None else ""
+        rss_unit = f"({u})^2" if "/" in u else (f"{u}^2" if u not in ("", "1") else u)
+        out.append(line + "," + ",".join((o, rss_unit, u)))
+    return "\n".join(out) + "\n"

@@ -1,0 +1,81 @@
+"""'Summary': when and how the comparison ran, and per dataset its best candidate in one line."""
+from __future__ import annotations
+
+import datetime as _dt
+
+from ..bootstrap import wilson
+from .doc import Section
+from .text import PROVENANCE_WORDS, pct
+
+TITLE = "Summary"
+
+
+def first_share(rb, best) -> str:
+    """'first in 97% of 200 resamples (95% interval 94-99%)' for the rank-1 candidates ``best``."""
+    if not rb.n_ranked:
+        return "no resample could rank every candidate"
+    k = sum(rb.first.get(r.candidate, 0.0) for r in best)
+    lo, hi = wilson(k, rb.n_ranked)
+    return f"first in {pct(k / rb.n_ranked)} of {rb.n_ranked} resamples, 95% interval {pct(lo)}–{pct(hi)}"
+
+
+def build(ctx) -> Section:
+    from .tolerance import tolerance_verdicts
+
+    c = ctx.c
+    sec = Section(TITLE)
+    fitted = c.fitted_datasets
+    kinds = {}
+    for d in c.datasets:
+        kinds.setdefault(d.provenance.kind, []).append(d.name)
+    jobs = c.settings.get("jobs", 1)
+    sec.p(f"Generated {_dt.datetime.now().astimezone().strftime('%Y-%m-%d %H:%M %Z')} by frictionlab "
+          f"{c.versions.get('frictionlab')}; the comparison took {c.wall_time:.1f} s"
+          + (" (" + ", ".join(f"{k} {v:.1f} s" for k, v in c.timings.items()) + ", partly in parallel)"
+             if len(c.timings) > 1 else "")
+          + f" on {jobs} worker process{'es' * (jobs != 1)}. Laws: {', '.join(c.laws)}. "
+          f"Datasets: {len(c.datasets)} ({len(fitted)} fitted).")
+    if [n for k, v in kinds.items() if k != "measured" for n in v]:
+        parts = [f"{len(v)} {PROVENANCE_WORDS.get(k, k)} ({', '.join(v)})" for k, v in kinds.items()]
+        sec.warn(("No dataset in this report is a measurement. " if "measured" not in kinds else
+                  "Not every dataset in this report is a measurement. ") + "; ".join(parts) + ". Reconstructed "
+                 "series are curves rebuilt to agree with numbers stated in a paper; synthetic series were generated "
+                 "with a known law plus noise. Rankings on them test the method and the claims' internal "
+                 "consistency, not nature.")
+    items = []
+    boot = {rb.datasets[0]: rb for rb in c.bootstrap}
+    for d in fitted:
+        best = [r for r in c.ranking if r.dataset == d.name and r.rank == 1]
+        if best:
+            items.append(f"**{d.name}** ({d.provenance.kind}): best " + " = ".join(r.candidate for r in best)
+                         + f" (Akaike weight {sum(r.akaike_weight for r in best):.2f}"
+                         + (" shared by a tie" if len(best) > 1 else "")
+                         + (f"; {first_share(boot[d.name], best)}" if d.name in boot else
+                            "; not bootstrapped" if d.name in c.bootstrap_skipped else "") + ")")
+        else:
+            items.append(f"**{d.name}**: no law could be fitted")
+    for g in dict.fromkeys(r.dataset for r in c.groups):
+        best = [r.candidate for r in c.groups if r.dataset == g and r.rank == 1]
+        if best:
+            items.append(f"**{g}**: best " + " = ".join(best) + " (summed AIC over the group"
+                         + ("; a tie" if len(best) > 1 else "") + ")")
+    for d in fitted:
+        for law in c.laws:
+            ser = next((r for r in c.ranking if r.dataset == d.name and r.law == law and r.solver == "series"
+                        and r.rank), None)
+            full = next((r for r in c.ranking if r.dataset == d.name and r.law == law and r.solver != "series"
+                         and r.rank), None)
+            if ser and full and abs(ser.aic - full.aic) > 2:
+                better = "better" if ser.aic < full.aic else "worse"
+                items.append(f"**{d.name}**: the paper's truncated series of {law} fits {better} than the {full.solver} "
+                             f"solution of the same law (ΔAIC {abs(ser.aic - full.aic):.1f}): the approximation, not "
+                             "the law, makes that difference (see the notes under Fits)")
+    verdicts = tolerance_verdicts(c)
+    if verdicts:
+        items.append(f"**Solver tolerance** ({c.tolerance[0]['dataset']}): refitted at " + verdicts[0]
+                     + " (see 'What solver tolerance does to a fit')")
+    sec.items(items)
+    if c.equivalence:
+        sec.p("Equivalence of λAu and μN + μη′dA/dt: " + "; ".join(
+            f"{e.dataset} [wear {e.solver}]: **{e.verdict or e.status}**" for e in c.equivalence) + ".")
+    return sec

@@ -1,0 +1,110 @@
+"""The report's first screen: the verdict table from Comparison.answers, the series finding, escaping."""
+import math
+
+import attrs
+import numpy as np
+import pytest
+
+from _fit_helpers import TRUTH, synthetic
+from frictionlab import compare
+from frictionlab.answers import Answer
+from frictionlab.report import build, first_screen
+from frictionlab.report.render import html_page, markdown
+
+
+@pytest.fixture(scope="module")
+def comp():
+    ds = synthetic("wear", {"lam": 1.81e6}, seed=5, n=26, name="impact-<b>bold</b>")
+    ds = attrs.evolve(ds, description="A <script>alert(1)</script> & <i>raw</i> description")
+    return compare(laws=["wear", "area-rate"], datasets=[ds])
+
+
+def _first(c):
+    sections, extra = build(c, modules=[first_screen])
+    return sections, extra
+
+
+def test_series_slip_crosses_zero_where_the_closed_form_says():
+    # u = u0 (1 - b + b cos(phi t)) is zero at cos(phi t) = (b - 1) / b
+    b, tc = 0.81, 500e-6
+    t = np.linspace(0.0, tc, 5001)
+    u = 12.0 * (1 - b + b * np.cos(math.pi / tc * t))
+    expected = math.acos((b - 1) / b) / (math.pi / tc)
+    assert first_screen.slip_zero(t, u) == pytest.approx(expected, abs=1e-9)
+    assert first_screen.slip_zero(t, np.abs(u) + 1.0) is None
+
+
+def test_finding_computed_from_the_fitted_series(comp):
+    (f,) = first_screen.series_findings(comp)
+    b = f.series.per_dataset[0].trajectory("wear", np.array([0.0])).info["b"]
+    expected = math.acos((b - 1) / b) / (math.pi / f.contact_time)
+    assert f.t_cross == pytest.approx(expected, rel=1e-4)
+    assert f.full.solver == "exact" and f.full_min_slip > 0  # the exact slip never reaches zero
+    sections, extra = _first(comp)
+    assert extra["series_slip_zero_s"][f.dataset.name] == f.t_cross
+    md = markdown("t", sections)
+    assert f"cross zero at {f.t_cross * 1e6:.4g} us" in md and "figures/finding.png" in md
+
+
+def test_without_answers_nothing_is_declared_to_fit(comp):
+    md = markdown("t", _first(comp)[0])
+    assert "`Comparison.answers` is empty)" in md and "lowest AIC (not a fit test)" in md
+    assert "No data in this comparison for: goodness-of-fit test, noise threshold, transfer." in md
+
+
+def test_answers_are_rendered_and_empty_columns_said(comp):
+    a = Answer(group="impact", datasets=("impact-x",), provenance="synthetic", best="wear [exact]", fits=True,
+               headline="best: wear [exact]", goodness="chi2 p = 0.41", equivalence="not equivalent",
+               noise_threshold="", series_vs_exact="the series' slip crosses zero at 309 us", transfer="",
+               details={"plausibility": ["eta' = -7.9e11 N s/m^2 is negative"]})
+    md = markdown("t", _first(attrs.evolve(comp, answers=(a,)))[0])
+    head = next(line for line in md.splitlines() if line.startswith("| dataset group"))
+    assert "best law" in head and "goodness of fit" in head and "noise threshold" not in head
+    assert "No data in this comparison for: noise threshold, transfer." in md
+    assert "chi2 p = 0.41" in md and "implausible: eta' = -7.9e11" in md
+    assert "`Comparison.answers` is empty" not in md
+
+
+def test_names_and_descriptions_never_leak_raw_html(comp, tmp_path):
+    sections, _ = build(comp)
+    md = markdown("t", sections)
+    page = html_page("t", sections, {f.name: b"png" for s in sections for f in s.figures})
+    for text in (md, page):
+        assert "<script>alert" not in text and "<b>bold</b>" not in text and "<i>raw</i>" not in text
+    assert "&lt;script&gt;alert(1)&lt;/script&gt;" in md and "impact-&lt;b&gt;bold&lt;/b&gt;" in page
+
+
+def test_one_functional_form_is_one_entry():
+    from frictionlab import figures
+    from frictionlab.report import ranking
+
+    ds = synthetic("wear", {"lam": 1.2e6}, seed=8, n=21, name="impact-forms")
+    c = compare(laws=["wear", "couette", "coulomb"], datasets=[ds], solvers=["exact"], equivalence=False)
+    curves = figures.distinct_curves(c.fits_on("impact-forms"))
+    assert sorted(tuple(sorted(laws)) for _, laws in curves) == [("couette", "wear"), ("coulomb",)]
+    md = markdown("t", build(c, modules=[ranking])[0])
+    rows = [line for line in md.splitlines() if line.startswith("| 1 |") or line.startswith("| 3 |")]
+    assert len(rows) == 2 and "couette = wear [exact]" in rows[0] and "| 1.000 | same curve |" in rows[0]
+    assert ranking.law_aliases(c) == {"couette": "couette = wear", "wear": "couette = wear"}
+
+
+def test_table_numbers_keep_their_significant_figures():
+    from frictionlab.display import fmt
+
+    assert [fmt(x) for x in (1.0, 0.5, 12.5, 1100.0, 10090.4, 3.41391)] == ["1.000", "0.5000", "12.50", "1100",
+                                                                            "10090", "3.414"]
+    assert fmt(-5.349e11) == "-5.349e+11" and fmt(1e-4, 3) == "1.00e-04"
+
+
+def test_a_parameter_far_from_its_bounds_is_not_at_a_bound():
+    """lam = 1655 +/- 84 Pa s/m in [0, 1e13] is 20 standard errors from 0: no bound warning; lam pressed to 0 is."""
+    from frictionlab import fit
+
+    weak = synthetic("wear", {"lam": 1655.0}, seed=4, n=26, rel_noise=0.003, name="weak")
+    f = fit("wear", weak, solver="exact")
+    assert f.ok and f.value("lam") > 10 * f.stderr("lam")
+    assert f.identifiability.at_bounds == () and not any("bound" in w for w in f.identifiability.warnings)
+    none = synthetic("coulomb", {"mu": 0.2}, seed=4, n=26, name="backwards")
+    none = attrs.evolve(none, columns={**none.columns, "omega": -np.abs(none.columns["omega"])})
+    g = fit("wear", none, solver="exact")
+    assert "lam" in g.identifiability.at_bounds

@@ -1,0 +1,95 @@
+"""Render a report's report.html in headless Chromium and save screenshots, to look at as a reader would.
+
+    python tools/screenshot.py REPORT_FOLDER_OR_HTML [--out DIR] [--height 1000 --height 4000]
+
+Writes DIR/screen-<height>.png (default DIR: the report folder) for a 1400 px wide window of each
+height: 1000 px is the first screen. Needs Debian's ``chromium`` (apt-get install chromium).
+"""
+from __future__ import annotations
+
+import argparse
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+WIDTH = 1400
+
+
+def chromium() -> str | None:
+    """The path of a Chromium binary, or None."""
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        found = shutil.which(name)
+        if found:
+            return found
+    return None
+
+
+def screenshot(html: Path, png: Path, height: int = 1000, width: int = WIDTH, timeout: float = 120.0) -> Path:
+    """Save a ``width`` x ``height`` screenshot of ``html`` to ``png`` (a fresh browser profile each time)."""
+    exe = chromium()
+    if exe is None:
+        raise RuntimeError("no chromium found: apt-get install -y chromium")
+    with tempfile.TemporaryDirectory(prefix="frictionlab-chromium-") as profile:
+        cmd = [exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+               "--disable-background-networking", "--disable-component-update", "--disable-sync",
+               "--hide-scrollbars", f"--user-data-dir={profile}", f"--screenshot={Path(png).resolve()}",
+               f"--window-size={width},{height}", Path(html).resolve().as_uri()]
+        subprocess.run(cmd, check=True, timeout=timeout, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    if not Path(png).exists():
+        raise RuntimeError(f"chromium wrote no screenshot for {html}")
+    return Path(png)
+
+
+#: Reports where the first screen's verdict table and figure are, as JSON in <body data-layout>.
+_MEASURE = """<script>window.addEventListener("load", function () {
+  var box = function (q) { var e = document.querySelector(q); if (!e) return null;
+    var r = e.getBoundingClientRect(); return {top: r.top, bottom: r.bottom, width: r.width, height: r.height}; };
+  document.body.dataset.layout = JSON.stringify({table: box("section.first table"), figure: box("section.first img"),
+    window: {width: window.innerWidth, height: window.innerHeight}});
+});</script>"""
+
+
+def first_screen_layout(html: Path, height: int = 1000, width: int = WIDTH, timeout: float = 120.0) -> dict:
+    """Where the verdict table and the finding figure sit in a ``width`` x ``height`` window (CSS px)."""
+    import json
+    import re
+
+    exe = chromium()
+    if exe is None:
+        raise RuntimeError("no chromium found: apt-get install -y chromium")
+    with tempfile.TemporaryDirectory(prefix="frictionlab-chromium-") as profile:
+        probe = Path(profile) / "probe.html"
+        probe.write_text(Path(html).read_text(encoding="utf-8").replace("</body>", _MEASURE + "</body>"),
+                         encoding="utf-8")
+        cmd = [exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+               "--disable-background-networking", "--disable-component-update", "--disable-sync",
+               "--hide-scrollbars", f"--user-data-dir={profile}/p", f"--window-size={width},{height}",
+               "--virtual-time-budget=5000", "--dump-dom", probe.as_uri()]
+        dom = subprocess.run(cmd, check=True, timeout=timeout, capture_output=True, text=True).stdout
+    m = re.search(r'data-layout="([^"]*)"', dom)
+    if not m:
+        raise RuntimeError("chromium did not lay the page out (no data-layout in the dumped DOM)")
+    import html as _html
+
+    return json.loads(_html.unescape(m.group(1)))
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("report", type=Path, help="a report folder or its report.html")
+    ap.add_argument("--out", type=Path, help="folder for the PNGs (default: the report folder)")
+    ap.add_argument("--height", type=int, action="append", help="window height in px (repeatable; default 1000)")
+    args = ap.parse_args(argv)
+    html = args.report / "report.html" if args.report.is_dir() else args.report
+    out = args.out or html.parent
+    out.mkdir(parents=True, exist_ok=True)
+    for h in args.height or [1000]:
+        png = screenshot(html, out / f"screen-{h}.png", h)
+        print(png)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
