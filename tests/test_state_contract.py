@@ -243,3 +243,21 @@ def test_rate_state_sticks_at_zero_slip_with_its_state_held():
     assert np.all(tr.u[after] == 0.0)
     assert np.ptp(tr.law_states["theta"][after]) == 0.0
     assert make_plan(normal_impact(), fl.get_law("lugre")).continuous
+
+
+def test_plugin_with_a_degenerate_state_spec_is_skipped_naming_it(tmp_path, monkeypatch):
+    from frictionlab import registry
+    from test_registry import _write_dist
+
+    bad = STATEFUL_PLUGIN.replace('StateSpec("m", "", 0.0, 0.3,', 'StateSpec("m", "", 0.0, 0.0,')
+    _write_dist(tmp_path, "degenerate-law", bad, "degenerate = degenerate_law:Relaxing\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    try:
+        with pytest.warns(registry.PluginWarning,
+                          match=r"entry point 'degenerate = degenerate_law:Relaxing' of degenerate-law 0.1: "
+                                r"state m: scale must be a positive"):
+            registry.reload_registry()
+        assert "lugre" in fl.available_laws() and "relaxing-third-party" not in fl.available_laws()
+    finally:
+        monkeypatch.undo()
+        registry.reload_registry()
