@@ -1,29 +1,64 @@
 """frictionlab: compare dynamic sliding friction laws against impact and incline-sliding data.
 
 SI floats inside; units only at the edges (dataset files, command line, reports).
+
+The names below are imported on first use (module ``__getattr__``), so that ``frictionlab --help``
+and a law plugin's ``from frictionlab import FrictionLaw`` do not pay for scipy, lmfit and
+matplotlib; ``import frictionlab as fl; fl.fit(...)`` works as if they were imported eagerly.
 """
-from .comparison import Comparison, compare
-from .dataset import Dataset, load_dataset
-from .derive import derive_omega
-from .equivalence import EquivalenceResult, analyze_equivalence
-from .errors import FrictionLabError
-from .fitting import FitResult, ParamResult, Target, fit, make_target, predict, register_predictor
-from .law import AreaSlipForm, Contact, FrictionLaw, NormalAreaRateForm, ParamSpec, StateSpec
-from .plan import make_plan
-from .ranking import RankRow
-from .registry import available_laws, get_law, register_law, unregister_law
-from .report import write_report
-from .scene import Scene
-from .solvers import simulate
-from .trajectory import Trajectory
+from __future__ import annotations
+
+import importlib
+import sys
+import types
 
 __version__ = "0.1.0"
 
-__all__ = [
-    "AreaSlipForm", "Contact", "Dataset", "FrictionLabError", "FrictionLaw", "NormalAreaRateForm", "ParamSpec", "StateSpec",
-    "Scene", "Trajectory", "available_laws", "get_law", "load_dataset", "make_plan", "register_law", "simulate",
-    "unregister_law",
-    # fitting, ranking, comparison, report
-    "Comparison", "EquivalenceResult", "FitResult", "ParamResult", "RankRow", "Target", "analyze_equivalence",
-    "compare", "derive_omega", "fit", "make_target", "predict", "register_predictor", "write_report",
-]
+#: public name -> the submodule that defines it
+_EXPORTS = {
+    "Comparison": "comparison", "compare": "comparison",
+    "Dataset": "dataset", "load_dataset": "dataset",
+    "derive_omega": "derive",
+    "EquivalenceResult": "equivalence", "analyze_equivalence": "equivalence",
+    "FrictionLabError": "errors",
+    "FitResult": "fitting", "ParamResult": "fitting", "Target": "fitting", "fit": "fitting",
+    "make_target": "fitting", "predict": "fitting", "register_predictor": "fitting",
+    "AreaSlipForm": "law", "Contact": "law", "FrictionLaw": "law", "NormalAreaRateForm": "law", "ParamSpec": "law",
+    "StateSpec": "law",
+    "make_plan": "plan",
+    "RankRow": "ranking",
+    "available_laws": "registry", "get_law": "registry", "register_law": "registry", "unregister_law": "registry",
+    "write_report": "report",
+    "Scene": "scene",
+    "simulate": "solvers",
+    "Trajectory": "trajectory",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'frictionlab' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{module}", __name__), name)
+    globals()[name] = value  # later look-ups skip this function
+    return value
+
+
+class _Package(types.ModuleType):
+    """The package's module type: an exported name that is also a submodule's name (``predict``) stays
+    the exported function when that submodule is imported (importing a submodule would otherwise
+    rebind the package attribute to it); the submodule itself is in ``sys.modules`` as always."""
+
+    def __setattr__(self, name, value):
+        if isinstance(value, types.ModuleType) and name in _EXPORTS and _EXPORTS[name] != name:
+            return
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_EXPORTS))

@@ -22,12 +22,13 @@ Tolerances act on the same scaled problem as ``solvers.ode`` (time by the span, 
 with the same method the batch takes the same steps as solve_ivp (tests check the errors match).
 ``simulate_sweep`` runs a batch in chunks on an executor (local, concurrent.futures or Dask).
 
-Why numpy (measured by benchmarks/bench_batch.py): one numpy step over 10,000 scenes costs
-about 25-35 us per scene at rtol 1e-8, 125-250x less CPU than a Python loop of solve_ivp, and
-the cost per scene stops falling beyond ~1,000 scenes, so the interpreter is no longer the
-bottleneck. numba compiles the same inline closed form about 2x faster than bare numpy, but a
-compiled engine would need every law plugin, a plain Python class, written in numba's subset;
-numpy keeps the plugin contract (a force that broadcasts) and needs no compiler.
+Why numpy (measured by benchmarks/bench_batch.py, CPU time on a shared 2-core machine): at 10,000
+scenes and rtol 1e-8 a DOP853 solve costs 25-45 us per scene, about 45x
+less than a loop of solve_ivp on a plain Python right-hand side at the same method, rtol, event
+and accuracy (not the 100x targeted); a third of it fills the outputs from the dense interpolant.
+Beyond CHUNK scenes the batch runs in chunks, so memory stays about 1.4x the results. A compiled
+engine would be faster, but would need every law plugin, a plain Python class, written in
+numba's subset; numpy keeps the plugin contract (a force that broadcasts) and needs no compiler.
 """
 from __future__ import annotations
 
@@ -48,6 +49,9 @@ from .trajectory import Trajectory
 
 SOLVERS = ("auto", "exact") + vecrk.METHODS
 SCAN = 1024  # uniform points scanned for the first zero of slip when it is not provably monotone
+#: Scenes per chunk of ``simulate_batch``: beyond this the batch runs in chunks written into the result,
+#: so working arrays stay those of one chunk (per-scene cost and memory flat in the number of scenes).
+CHUNK = 8192
 MAX_SEGMENTS = 200
 _NONNEGATIVE_N = (HalfSineNormal, HertzNormal, WeightNormal)
 _TOP = ("mass", "u0", "duration", "radius", "inertia_factor", "omega0", "incline")
@@ -252,6 +256,8 @@ def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol:
     nsc = batch.n
     p = batch_params(law, params, nsc)
     tgrid = _time_grid(batch, t, n)
+    if nsc > CHUNK:
+        return _chunked(law, batch, p, tgrid, solver, rtol, atol, n)
     T = np.broadcast_to(tgrid, (nsc, tgrid.shape[-1]))
     plan = make_plan(batch.view(), law, "batch scene")
     if plan.scene.spring is not None:
@@ -277,6 +283,30 @@ def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol:
         out, info = _run_rk(law, batch, p, T, solver, rtol, atol)
     info.update({"rtol": rtol, "atol": rtol if atol is None else atol} if solver != "exact" else {})
     return BatchResult(t=tgrid, solver=solver, law=law.name, info=info, **out)
+
+
+def _chunked(law, batch, p, tgrid, solver, rtol, atol, n) -> BatchResult:
+    """``simulate_batch`` chunk by chunk (CHUNK scenes each), each chunk's arrays copied into the
+    result as it finishes, so only one chunk's working arrays exist at a time."""
+    out, parts = {}, []
+    for start in range(0, batch.n, CHUNK):
+        sl = slice(start, min(start + CHUNK, batch.n))
+        r = simulate_batch(law, batch.subset(sl), _take_params(p, sl), tgrid if tgrid.ndim == 1 else tgrid[sl],
+                           solver, rtol, atol, n)
+        for name in ("u", "v", "omega", "theta", "force", "stick_time", "A", "N"):
+            a = getattr(r, name)
+            if a is None:
+                continue
+            if name not in out:
+                out[name] = np.empty((batch.n,) + a.shape[1:], dtype=a.dtype)
+            out[name][sl] = a
+        parts.append((r.solver, r.info))
+        del r
+    solvers = {s for s, _ in parts}
+    info = {"chunks": len(parts), "nfev": int(sum(i.get("nfev", 0) for _, i in parts)),
+            **({"rtol": rtol, "atol": rtol if atol is None else atol} if "exact" not in solvers else {})}
+    return BatchResult(t=tgrid, solver="+".join(sorted(solvers)), law=law.name, info=info,
+                       **{k: out.get(k) for k in ("u", "v", "omega", "theta", "force", "stick_time", "A", "N")})
 
 
 def simulate_sweep(law, scenes, params=None, t=None, solver: str = "auto", rtol: float = 1e-8,
@@ -344,10 +374,14 @@ def _finish(law, batch, p, T, Y, sliding, need):
     """u, force, A and N on the output grid from the states, as ``segments.run`` does."""
     view = batch.view(column=True)
     plan = _plan(law, view)
-    u = np.where(sliding, plan.rigid_slip(Y), 0.0)
+    stuck = ~sliding
+    u = plan.rigid_slip(Y)  # written in place below (a copy where it would alias the states): memory, not speed
+    u = u.copy() if np.shares_memory(u, Y) else u
+    u[stuck] = 0.0
     c = plan.contact(T, Y, u)
     F = law.evaluate(_take_params(p, slice(None), column=True), c)
-    F = np.where(sliding, F, np.broadcast_to(need, F.shape))
+    F = F if F.flags.writeable and not np.shares_memory(F, u) else F.copy()
+    np.copyto(F, np.broadcast_to(need, F.shape), where=stuck)
     A = c.A if c.A is not None else (view.area(T, None, u)[0] if plan.needs_area else None)
     N = c.N
     omega = Y[plan.index("omega")] if plan.has_spin else np.zeros_like(u)
@@ -440,7 +474,7 @@ def _run_rk(law, batch, p, T, method, rtol, atol):
     d = len(full.states)
     t_end = T[:, -1].copy()
     scale = np.broadcast_to(state_scales(full, t_end), (d, nsc))
-    Y = np.full((d, nsc, m), np.nan)
+    Y = None  # states on the output grid; the first sliding phase's own array when every scene slides
     done = np.zeros((nsc, m), dtype=bool)
     stuck_mask = np.zeros((nsc, m), dtype=bool)
     stick_time = np.full(nsc, np.nan)
@@ -462,6 +496,8 @@ def _run_rk(law, batch, p, T, method, rtol, atol):
                                         last_dir[stuck_ids])
             end = np.where(np.isnan(tb), t_end[stuck_ids], tb)
             held = ~(tb == t0[stuck_ids])  # breakaway at once: the sliding phase owns the outputs at t0
+            if Y is None:
+                Y = np.full((d, nsc, m), np.nan)
             if held.any():
                 h_ids = stuck_ids[held]
                 _fill_stuck(law, batch, h_ids, t0[h_ids], y0[:, h_ids], t0[h_ids], end[held], T, Y, done, stuck_mask)
@@ -486,7 +522,11 @@ def _run_rk(law, batch, p, T, method, rtol, atol):
         iterations += res.iterations
         nfev[slide_ids] += res.nfev
         new = res.reached & ~done[slide_ids]
-        if slide_ids.size == nsc:  # every scene slides (the usual first phase): no gathering
+        if Y is None:  # the first phase and every scene slides: its outputs (NaN where not reached) are Y
+            Y = res.Y
+            Y *= scale[:, :, None]
+            done |= new
+        elif slide_ids.size == nsc:  # every scene slides: no gathering
             np.copyto(Y, res.Y * scale[:, :, None], where=new[None])
             done |= new
         else:
@@ -653,7 +693,11 @@ def _exact_stop(law, batch, p, plan, form, y0, u_s, sgn, T):
         first = np.argmax(bad[ids], axis=1) + 1
         lo, hi = grid[ids, first - 1], grid[ids, first]
     ts = np.full(nsc, np.nan)
-    if ids.size:
+    if ids.size and monotone and exact.closed_stop_applies(plan, form, 0.0):
+        ts[ids] = np.minimum(np.broadcast_to(exact.half_sine_stop(plan, form, u_s[:, None]), (nsc, 1))[ids, 0],
+                             t_end[ids])
+        ts[ids[ts[ids] >= t_end[ids]]] = np.nan
+    elif ids.size:
         def make_fn(rows):
             g = make_g(ids[rows])
             return lambda x: g(x[:, None])[:, 0]

@@ -16,6 +16,7 @@ import attrs
 import numpy as np
 
 from .errors import DatasetError, FrictionLabError
+from .outcome import OUTCOMES, OutcomeScene
 from .scene import KINDS, Scene
 from .units import unit_factor
 
@@ -26,7 +27,8 @@ DATA_KINDS = KINDS + ("contact-area",)
 COLUMN_SI = {
     "t": "s", "omega": "rad/s", "theta": "rad", "u": "m/s", "v": "m/s", "A": "m^2", "N": "N", "x": "m",
     "speed": "m/s", "incidence": "rad", "spin": "rad/s", "rebound_spin": "rad/s", "tangential_cor": "",
-    "rebound_angle": "rad", "mu": "",
+    "rebound_angle": "rad", "cm_tangential_cor": "", "normal_cor": "", "contact_rebound_angle": "rad", "psi1": "",
+    "psi2": "", "mu": "",
 }
 
 
@@ -143,8 +145,6 @@ def from_meta(meta: dict, path: Path) -> Dataset:
     if observable == "t":
         raise DatasetError(f"{path}: observable = 't': the time column cannot be the observable")
     if kind == "impact-outcome":
-        from .outcome import OUTCOMES
-
         if observable not in OUTCOMES:
             raise DatasetError(f"{path}: observable {observable!r} is not an impact outcome ({', '.join(OUTCOMES)})")
     units = _req(meta, "columns", path, dict)
@@ -202,8 +202,6 @@ def from_meta(meta: dict, path: Path) -> Dataset:
             raise DatasetError(f"{path}: missing required table [scene]")
         try:
             if kind == "impact-outcome":
-                from .outcome import OutcomeScene
-
                 scene = OutcomeScene.from_spec(spec, str(path))
             else:
                 scene = Scene.from_spec(spec, kind, str(path), columns, columns.get("t"))

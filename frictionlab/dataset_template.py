@@ -10,8 +10,6 @@ from __future__ import annotations
 
 import tomllib
 
-import numpy as np
-
 from .errors import DatasetError
 
 KINDS = ("impact", "incline", "impact-outcome")
@@ -126,6 +124,8 @@ peak = "150 mm^2"
 
 def template(kind: str, name: str = "my-data") -> tuple[str, str]:
     """(TOML text, CSV text) of a dataset of ``kind`` named ``name`` that loads as it is."""
+    import numpy as np  # here, not at the top: the command line names KINDS in its help without numpy
+
     from .outcome import OutcomeScene, predict_outcomes
     from .scene import Scene
     from .solvers import simulate

@@ -41,6 +41,7 @@ __all__ = ["DatasetFit", "FitResult", "ParamResult", "PREDICTORS", "SCENE_QUANTI
 
 PENALTY = 1e4  # weighted residual per point when the model cannot be evaluated
 ODE_STARTS = 2  # at most this many starts are refined when a dataset needs the (costlier) ODE solver
+VALLEY_R = 0.999  # |correlation| at an ODE fit's optimum above which further starts are not run (see _valley)
 FTOL = 1e-6  # relative chi-square and step tolerances of Levenberg-Marquardt
 
 
@@ -382,12 +383,29 @@ def _distinct(scored: list[tuple], n: int) -> list[dict]:
     return out
 
 
+def _valley(result) -> str:
+    """Why a converged Levenberg-Marquardt run ended in a valley the data do not close ('' if not):
+    two parameters correlated beyond VALLEY_R, or a parameter at a bound. Another start ends in the
+    same valley (the comparison's area-rate fit on a dry incline walks mu -> 0, eta' -> infinity
+    with mu eta' fixed, from either start), so an ODE fit does not pay for it twice."""
+    for p in result.params.values():
+        if not p.vary:
+            continue
+        if any(abs(v - p.value) <= 1e-9 * max(abs(p.value), 1.0) for v in (p.min, p.max) if math.isfinite(v)):
+            return f"{p.name} at a bound"
+        for other, r in (p.correl or {}).items():
+            if abs(r) >= VALLEY_R:
+                return f"{p.name} and {other} correlated at r = {r:.4f}"
+    return ""
+
+
 def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: int, max_nfev):
     """Score a grid of starts, refine the best distinct ones with Levenberg-Marquardt, keep the lowest
-    chi-square. Returns (parameters, success, message, lmfit MinimizerResult or None)."""
+    chi-square. Returns (parameters, success, message, lmfit MinimizerResult or None, notes)."""
     varying = [s for s in slots if s.vary]
     if not varying:
-        return params, True, "nothing to fit: every parameter is held", None
+        return params, True, "nothing to fit: every parameter is held", None, []
+    slow = any(x.startswith("ode") for x in solvers)
     starts = [{s.pname: params[s.pname].value for s in varying}]
     if scan:
         fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
@@ -397,10 +415,9 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
             r = model.residual({s.pname: vals[s.pname] * s.scale for s in slots})
             scored.append((float(r @ r), len(scored), cand))
         scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins
-        slow = any(x.startswith("ode") for x in solvers)
         starts = _distinct(scored, min(n_starts, ODE_STARTS) if slow else n_starts)
-    best = None
-    for start in starts:
+    best, notes = None, []
+    for i, start in enumerate(starts):
         trial = params.copy()
         for k, v in start.items():
             trial[k].set(value=v)
@@ -409,7 +426,12 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
         r = mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
         if best is None or (r.success, -r.chisqr) > (best.success, -best.chisqr):
             best = r
-    return best.params, bool(best.success), str(best.message), best
+        why = _valley(r) if slow and r.success and i + 1 < len(starts) else ""
+        if why:
+            notes.append(f"one Levenberg-Marquardt start of {len(starts)}: the first ended where the data do not "
+                         f"determine the parameters ({why}), where another start ends too")
+            break
+    return best.params, bool(best.success), str(best.message), best, notes
 
 
 def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[float]] | None = None,
@@ -485,8 +507,8 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
 
     success, message = True, ""
     try:
-        best_params, success, message, best = _search(lmfit, model, params, slots, solvers, scan, n_starts,
-                                                      max_nfev)
+        best_params, success, message, best, search_notes = _search(lmfit, model, params, slots, solvers, scan,
+                                                                    n_starts, max_nfev)
         values = _si(best_params, slots)
         models = model.models(values)
     except SkipDataset as exc:
@@ -513,7 +535,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         status, reason = "failed", f"did not converge: {message}"
     elif model.failures and chisqr >= PENALTY**2:
         status, reason = "failed", f"the solver failed at every trial: {model.last_error}"
-    notes = []
+    notes = list(search_notes)
     if model.failures:
         notes.append(f"{model.failures} of {model.nfev} evaluations could not be solved and were penalized "
                      f"(last: {model.last_error})")

@@ -9,7 +9,16 @@ An ``impact-outcome`` dataset has one impact per CSV row (columns ``speed`` [m/s
   tangential_cor  -(v_t2 - r omega_2) / (v_t1 - r omega_1): tangential restitution of the contact
                   point [-]; < 0 still sliding forward at rebound, 0 rolling, > 0 the contact point
                   reversed (possible only with tangential compliance, Maw, Barber and Fawcett 1976)
-  rebound_angle   angle of the outbound velocity [rad], from the same reference as the incidence
+  rebound_angle   angle of the outbound velocity of the centre of mass [rad], from the same
+                  reference as the incidence
+  cm_tangential_cor      v_t2 / v_t1: tangential restitution of the centre of mass [-] (what Kharaz,
+                  Gorham and Salman (2001) and the DEM benchmarks call the tangential restitution)
+  normal_cor      v_n2 / v_n1 = e [-] (from the normal-contact model of the row)
+  contact_rebound_angle  atan(v_c2 / v_n2) [rad], v_c2 = v_t2 - r omega_2: rebound angle of the contact
+                  point, from the normal; negative when the contact point reversed
+  psi1, psi2      Maw, Barber and Fawcett's normalized incidence and rebound angles of the contact point,
+                  (kappa / mu) v_c1 / v_n1 and (kappa / mu) v_c2 / v_n2, kappa = 4 G*/E* from
+                  [scene.materials] and mu the friction coefficient stated there (frictionlab.contact)
 
 Angles: ``incidence`` is measured from the surface normal (0 = head-on), so v_t = V sin(theta)
 and v_n = V cos(theta); with ``angle_reference = "surface"`` in [scene] it is measured from the
@@ -20,17 +29,21 @@ Normal contact per row, ``[scene.normal]``:
       ``restitution``; with ``reference_speed`` v_ref both depend on the normal speed:
       t_c = contact_time (v_n / v_ref)^contact_time_exponent (default -1/5, Hertz's exponent) and
       e = restitution - restitution_slope (v_n - v_ref) [slope in s/m], kept within [0, 1].
-  model = "hertz"  elastic Hertz impact of a sphere (radius r) on a rigid flat: N = K delta^(3/2),
-      K = (4/3) E* sqrt(r), E* the effective ``modulus``; delta(t) = delta_m y(v_n t / delta_m) with
+  model = "hertz"  elastic Hertz impact of a sphere (radius r) on a flat: N = K delta^(3/2),
+      K = (4/3) E* sqrt(r), E* the effective ``modulus`` (or from [scene.materials]); delta(t) = delta_m y(v_n t / delta_m) with
       y'' = -(5/4) y^(3/2), y(0) = 0, y'(0) = 1, delta_m = (5 m v_n^2 / (4 K))^(2/5), contact time
       2.943 delta_m / v_n. The elastic pulse has impulse 2 m v_n; it is scaled by (1 + e)/2 so the
       impulse is m v_n (1 + e) (restitution as for half-sine). Contact area A = pi r delta.
 Contact area, ``[scene.area]`` (for laws that read A or dA/dt):
   model = "half-sine"  A = A0 sin(pi t / t_c) over the row's contact time; with a reference speed,
-      A0 = peak (v_n / v_ref)^peak_exponent (default 4/5: Hertz, A_max = pi r delta_m ~ v_n^(4/5)).
+      A0 = peak (v_n / v_ref)^peak_exponent (default 4/5: Hertz, A_max = pi r delta_m ~ v_n^(4/5)); v_ref is
+      the area's reference_speed, else the normal model's.
   model = "hertz"  A = pi r delta(t) of the Hertz pulse (the default with a Hertz normal force).
 Tangential: the law, with the scene's effects (default spin and slip coupling, so slip stops and
-the ball rolls as the law allows), optional [scene.compliance].
+the ball rolls as the law allows), optional [scene.compliance] (model = "linear" with stiffness and
+damping, or "mindlin": k_t = 8 G* a(t) with G* from [scene.materials] or ``shear_modulus``).
+Materials, ``[scene.materials]``: ball_young, ball_poisson, surface_young, surface_poisson and the
+friction coefficient the source states (``friction``, used only to normalize psi1 and psi2).
 """
 from __future__ import annotations
 
@@ -41,11 +54,13 @@ from collections.abc import Mapping
 import attrs
 import numpy as np
 
+from .contact import Compliance, MindlinCompliance, Pair, compliance_from_spec, materials_from_spec, normalized_angle
 from .errors import DatasetError, SceneError
-from .scene import Compliance, HalfSineArea, HalfSineNormal, Scene, read_effects, spec_reader
+from .scene import HalfSineArea, HalfSineNormal, Scene, read_effects, spec_reader
 
 #: Outcome observables and their SI units.
-OUTCOMES = {"rebound_spin": "rad/s", "tangential_cor": "", "rebound_angle": "rad"}
+OUTCOMES = {"rebound_spin": "rad/s", "tangential_cor": "", "rebound_angle": "rad", "cm_tangential_cor": "",
+            "normal_cor": "", "contact_rebound_angle": "rad", "psi1": "", "psi2": ""}
 ANGLE_REFERENCES = ("normal", "surface")
 
 
@@ -171,9 +186,11 @@ class OutcomeScene:
     area: dict | None = None  # {"model": "half-sine" | "hertz", "peak": SpeedLaw | None}
     inertia_factor: float = 0.4
     effects: frozenset = frozenset({"spin", "slip-coupling"})
-    compliance: Compliance | None = None
+    compliance: Compliance | MindlinCompliance | None = None
     angle_reference: str = "normal"
     kind: str = "impact-outcome"
+    materials: Pair | None = None
+    friction: float | None = None  # the friction coefficient the source states (normalizes psi1, psi2)
 
     def impact(self, speed: float, incidence: float, spin: float = 0.0) -> Inbound:
         """The scene of one impact at ``speed`` [m/s] and ``incidence`` [rad], inbound ``spin`` [rad/s]."""
@@ -217,7 +234,8 @@ class OutcomeScene:
     # -- from a TOML [scene] table --------------------------------------------------------------
     @classmethod
     def from_spec(cls, spec: Mapping, where: str) -> "OutcomeScene":
-        known = {"mass", "radius", "inertia_factor", "effects", "angle_reference", "normal", "area", "compliance"}
+        known = {"mass", "radius", "inertia_factor", "effects", "angle_reference", "normal", "area", "compliance",
+                 "materials"}
         extra = set(spec) - known
         if extra:
             raise SceneError(f"{where}: [scene] of an impact-outcome dataset has unknown key(s) {sorted(extra)}; "
@@ -232,30 +250,34 @@ class OutcomeScene:
             raise SceneError(f"{where}: scene.angle_reference must be 'normal' or 'surface', got {ref!r}")
         mass, radius = q("mass", "kg"), q("radius", "m")
         inertia_factor = q("inertia_factor", "", required=False, default=0.4)
-        for key in ("normal", "area", "compliance"):
+        for key in ("normal", "area", "compliance", "materials"):
             if key in spec and not isinstance(spec[key], Mapping):
                 raise SceneError(f"{where}: scene.{key} must be a table, got {type(spec[key]).__name__}")
         if "normal" not in spec:
             raise SceneError(f"{where}: an impact-outcome [scene] needs a [scene.normal] table "
                              "(model = 'half-sine' with contact_time and restitution, or 'hertz' with modulus)")
-        normal = _normal_spec(spec["normal"], where, q)
+        pair, friction = materials_from_spec(spec["materials"], where, q) if "materials" in spec else (None, None)
+        normal = _normal_spec(spec["normal"], where, q, pair)
         area = _area_spec(spec.get("area"), where, q, normal)
         compliance = None
         if "compliance" in spec:
-            c = spec["compliance"]
-            compliance = Compliance(q("stiffness", "N/m", c, "scene.compliance"),
-                                    q("damping", "N*s/m", c, "scene.compliance"))
+            compliance = compliance_from_spec(spec["compliance"], where, q, pair, radius)
             effects |= {"compliance"}
+            if compliance.model == "mindlin" and area is None:
+                raise SceneError(f"{where}: compliance model 'mindlin' needs the contact area: use "
+                                 "scene.normal.model = 'hertz' or a [scene.area] table")
         elif "compliance" in effects:
-            raise SceneError(f"{where}: effect 'compliance' needs a [scene.compliance] table with 'stiffness' and 'damping'")
+            raise SceneError(f"{where}: effect 'compliance' needs a [scene.compliance] table "
+                             "(model = 'linear' with stiffness and damping, or 'mindlin')")
         try:
             return cls(mass=mass, radius=radius, normal=normal, area=area, inertia_factor=inertia_factor,
-                       effects=effects, compliance=compliance, angle_reference=ref)
+                       effects=effects, compliance=compliance, angle_reference=ref, materials=pair,
+                       friction=friction)
         except SceneError as exc:
             raise SceneError(f"{where}: {exc}") from None
 
 
-def _normal_spec(n, where, q) -> dict:
+def _normal_spec(n, where, q, pair=None) -> dict:
     p = "scene.normal"
     model = n.get("model")
     known = {"model", "contact_time", "restitution", "reference_speed", "contact_time_exponent",
@@ -276,7 +298,9 @@ def _normal_spec(n, where, q) -> dict:
         exponent = q("contact_time_exponent", "", n, p, required=False, positive=False, default=-0.2)
         out["contact_time"] = SpeedLaw(tc, vref, exponent)
     elif model == "hertz":
-        out["modulus"] = q("modulus", "Pa", n, p)
+        out["modulus"] = q("modulus", "Pa", n, p, required=pair is None)
+        if out["modulus"] is None:
+            out["modulus"] = pair.modulus
         if "contact_time" in n:
             raise SceneError(f"{where}: {p}.contact_time: a Hertz contact's duration follows from modulus and speed")
     else:
@@ -289,12 +313,16 @@ def _area_spec(a, where, q, normal) -> dict | None:
     if a is None:
         return {"model": "hertz", "peak": None} if normal["model"] == "hertz" else None
     model = a.get("model")
+    extra = set(a) - {"model", "peak", "peak_exponent", "reference_speed"}
+    if extra:
+        raise SceneError(f"{where}: [{p}] has unknown key(s) {sorted(extra)}; "
+                         "known: model, peak, peak_exponent, reference_speed")
     if model == "hertz":
         if normal["model"] != "hertz":
             raise SceneError(f"{where}: {p}.model = 'hertz' needs a Hertz normal force (scene.normal.model = 'hertz')")
         return {"model": "hertz", "peak": None}
     if model == "half-sine":
-        vref = normal["restitution"].reference_speed
+        vref = q("reference_speed", "m/s", a, p, required=False, default=normal["restitution"].reference_speed)
         peak = q("peak", "m^2", a, p)
         exponent = q("peak_exponent", "", a, p, required=False, positive=False, default=0.8)
         if normal["model"] == "hertz":
@@ -319,17 +347,16 @@ def predict_outcomes(law, dataset_or_scene, params: Mapping[str, float] | None =
 
     dataset_or_scene: an impact-outcome Dataset (its rows and ``[fixed]`` parameters) or an
     OutcomeScene with ``speed`` [m/s], ``incidence`` [rad] (and ``spin`` [rad/s]) arrays.
-    Returns rebound_spin [rad/s], tangential_cor [-], rebound_angle [rad], and per row the
+    Returns every observable of OUTCOMES (psi1 and psi2 only when the scene has [scene.materials]
+    with a stated friction coefficient), and per row the
     speed, incidence, normal_speed, tangential_speed, restitution, contact_time [s],
     rebound_speed_t (v_t2) [m/s] and rolled (slip stopped during contact, bool).
     """
-    from .dataset import Dataset
     from .registry import get_law
-    from .solvers import simulate
 
     law = get_law(law)
     fixed = {}
-    if isinstance(dataset_or_scene, Dataset):
+    if not isinstance(dataset_or_scene, OutcomeScene) and hasattr(dataset_or_scene, "columns"):  # a Dataset
         ds = dataset_or_scene
         if ds.kind != "impact-outcome":
             raise DatasetError(f"dataset '{ds.name}' is a {ds.kind} dataset; predict_outcomes needs an impact-outcome one")
@@ -351,42 +378,62 @@ def predict_outcomes(law, dataset_or_scene, params: Mapping[str, float] | None =
     n = len(rows["speed"])
     out = {k: np.empty(n) for k in ("speed", "incidence", "normal_speed", "tangential_speed", "restitution",
                                      "contact_time", "rebound_spin", "tangential_cor", "rebound_angle",
-                                     "rebound_speed_t")}
+                                     "rebound_speed_t", "cm_tangential_cor", "contact_rebound_angle")}
     out["rolled"] = np.zeros(n, dtype=bool)
     r = template.radius
+    imps = []
     for i in range(n):
         try:
-            imp = template.impact(float(rows["speed"][i]), float(rows["incidence"][i]), float(rows["spin"][i]))
+            imps.append(template.impact(float(rows["speed"][i]), float(rows["incidence"][i]), float(rows["spin"][i])))
         except SceneError as exc:
             raise SceneError(f"row {i + 1}: {exc}") from None
-        tr = simulate(law, imp.scene, p, solver=solver, t=np.array([0.0, imp.contact_time]), rtol=rtol)
-        v2, w2 = float(tr.v[-1]), float(tr.omega[-1])
-        slip_in = imp.tangential_speed - r * imp.spin
-        if slip_in == 0.0:
+        if imps[-1].tangential_speed - r * imps[-1].spin == 0.0:
             raise SceneError(f"row {i + 1}: the contact point does not slip on arrival (v_t = r omega), "
                              "so its tangential restitution is undefined")
+    v2, w2, rolled = _rebounds(law, imps, p, solver, rtol)
+    for i, imp in enumerate(imps):
+        slip_in = imp.tangential_speed - r * imp.spin
         vn2 = imp.restitution * imp.normal_speed
-        angle = math.atan2(v2, vn2) if template.angle_reference == "normal" else math.atan2(vn2, v2)
+        angle = math.atan2(v2[i], vn2) if template.angle_reference == "normal" else math.atan2(vn2, v2[i])
+        cm_cor = v2[i] / imp.tangential_speed if imp.tangential_speed != 0.0 else math.nan
         for k, v in (("speed", rows["speed"][i]), ("incidence", rows["incidence"][i]),
                      ("normal_speed", imp.normal_speed), ("tangential_speed", imp.tangential_speed),
-                     ("restitution", imp.restitution), ("contact_time", imp.contact_time), ("rebound_spin", w2),
-                     ("tangential_cor", 0.0 - (v2 - r * w2) / slip_in), ("rebound_angle", angle), ("rebound_speed_t", v2)):
+                     ("restitution", imp.restitution), ("contact_time", imp.contact_time), ("rebound_spin", w2[i]),
+                     ("tangential_cor", 0.0 - (v2[i] - r * w2[i]) / slip_in), ("rebound_angle", angle),
+                     ("rebound_speed_t", v2[i]), ("cm_tangential_cor", cm_cor),
+                     ("contact_rebound_angle", math.atan2(v2[i] - r * w2[i], vn2))):
             out[k][i] = v
-        out["rolled"][i] = tr.stick_time is not None
+    out["rolled"][:] = rolled
+    out["normal_cor"] = out["restitution"].copy()
+    if template.materials is not None and template.friction is not None:
+        kappa, mu = template.materials.stiffness_ratio, template.friction
+        vc1 = out["tangential_speed"] - r * np.asarray(rows["spin"], dtype=float)
+        out["psi1"] = normalized_angle(vc1, out["normal_speed"], mu, kappa)
+        out["psi2"] = normalized_angle(np.tan(out["contact_rebound_angle"]), 1.0, mu, kappa)
     return out
 
 
-# --- fitting: the impact-outcome predictor ---------------------------------------------------------
-def outcome_predictor(law, target, scene, params, solver, rtol: float | None = None):
-    """Model of an impact-outcome target for ``frictionlab.predict``: the observable outcome per row, SI,
-    row by row through ``predict_outcomes`` (registered for the 'impact-outcome' kind in predict.py),
-    ODEs solved to ``rtol`` (None: FIT_RTOL)."""
-    from .predict import FIT_RTOL, SkipDataset
+def _rebounds(law, imps, p, solver, rtol):
+    """Tangential velocity [m/s] and spin [rad/s] at the end of each impact, and whether its slip stopped.
 
-    if target.observable not in OUTCOMES:
-        raise SkipDataset(f"dataset '{target.name}': '{target.observable}' is not an impact outcome "
-                          f"({', '.join(OUTCOMES)})")
-    rows = rows_of(target.dataset)
-    return predict_outcomes(law, scene, params, solver, speed=rows["speed"], incidence=rows["incidence"],
-                            spin=rows["spin"], rtol=FIT_RTOL if rtol is None else rtol)[target.observable]
+    The closed forms run on the batch engine (``batch.simulate_batch``, one vectorized call for all
+    rows; tests check it equals the row-by-row solve) when the rows' scenes share one structure;
+    otherwise, for the ODE solver, or when the batch refuses, each row is simulated alone (which
+    also names the row in any error)."""
+    from .errors import FrictionLabError
+    from .solvers import simulate
 
+    if solver == "exact" and len(imps) > 1:
+        from .batch import SceneBatch, simulate_batch
+
+        try:
+            t = np.array([[0.0, imp.contact_time] for imp in imps])
+            br = simulate_batch(law, SceneBatch.from_scenes([imp.scene for imp in imps]), p, t=t, solver="exact")
+            return br.v[:, -1], br.omega[:, -1], ~np.isnan(br.stick_time)
+        except FrictionLabError:
+            pass  # the row-by-row path below gives the answer or the error naming the row
+    v2, w2, rolled = (np.empty(len(imps)) for _ in range(3))
+    for i, imp in enumerate(imps):
+        tr = simulate(law, imp.scene, p, solver=solver, t=np.array([0.0, imp.contact_time]), rtol=rtol)
+        v2[i], w2[i], rolled[i] = float(tr.v[-1]), float(tr.omega[-1]), tr.stick_time is not None
+    return v2, w2, rolled.astype(bool)

@@ -4,14 +4,16 @@ State components (each only when called for):
   v      body tangential velocity [m/s]                 always
   omega  spin [rad/s], theta rotation angle [rad]       effect 'spin' or 'slip-coupling'
   x      sliding length [m]                             area model 'growth' and the law uses A or dA/dt
-  xi     tangential spring deflection [m]               effect 'compliance'
+  xi     tangential spring deflection [m]               effect 'compliance' (for 'mindlin' the
+         elastic deflection S / k_t(t) of the spring force S; frictionlab.contact)
   law:NAME  each internal state of a law with memory     the law declares ``states`` (law.py)
 
 Slip u is v, or v - r omega with 'slip-coupling'; with 'compliance' it is the slip of a
 massless contact patch, found from  F(u) = k xi + c (w - u),  w the rigid contact-point velocity;
 the body feels the spring and damper force k xi + c (w - u), which while the patch sticks (u = 0) is
 static friction up to the law's capacity. For the laws' closed-form families the patch slip is
-solved by hand, otherwise by root finding.
+solved by hand, otherwise by root finding. k and c are constants for model 'linear' and follow
+the contact radius for 'mindlin' (``Plan.spring``).
 
 A spring-slider (kind 'spring-slider') is quasi-static, as in the rate-and-state literature and
 rsfmodel: the block's inertia is neglected, so the spring's load per unit normal force always
@@ -129,7 +131,8 @@ class Plan:
         if self.needs_normal:
             N = s.normal(t, A)
         req = self.law.requires
-        state = {n: y[self.index(k)] for n, k in zip(self.law.state_names, self.law_states)} or None
+        state = ({n: y[self.index(k)] for n, k in zip(self.law.state_names, self.law_states)} or None
+                 if self.law.states else None)
         return Contact(t=np.asarray(t, dtype=float), u=np.asarray(u, dtype=float),
                        N=N if "N" in req else None, A=A if "A" in req else None, dAdt=dAdt if "dAdt" in req else None,
                        state=state)
@@ -138,9 +141,17 @@ class Plan:
         c = self.contact(t, y, u)
         return self.law.evaluate(p, c), c
 
+    def spring(self, t, y) -> tuple[float, float, float]:
+        """(k [N/m], c [N s/m], loading rate (da/dt)/a [1/s]) of the tangential compliance at time t."""
+        comp = self.scene.compliance
+        if comp.model == "linear":
+            return comp.stiffness, comp.damping, 0.0
+        A, dAdt = self.area(np.array([t]), y[:, None], np.array([0.0]))
+        return comp.spring(float(A[0]), float(dAdt[0]), 1.0 / self.kappa)
+
     def patch_slip(self, p, t, y) -> float:
         """Slip of the compliant contact patch: the root of F(u) + c u = k xi + c w (scalar state)."""
-        k, c = self.scene.compliance.stiffness, self.scene.compliance.damping
+        k, c, _ = self.spring(t, y)
         w = float(self.rigid_slip(y))
         target = k * y[self.index("xi")] + c * w
         fast = self._patch_slip_closed_form(p, t, y, target, c)
@@ -194,7 +205,7 @@ class Plan:
         if u != 0.0:  # slipping: the balance F(u) = k xi + c (w - u) holds, take the law's value
             f, _ = self.force(p, np.array([t]), y[:, None], np.array([u]))
             return float(f[0]), u
-        k, c = self.scene.compliance.stiffness, self.scene.compliance.damping
+        k, c, _ = self.spring(t, y)
         return k * float(y[self.index("xi")]) + c * float(self.rigid_slip(y)), 0.0
 
     def derivatives(self, p, t, y, direction=0.0) -> np.ndarray:
@@ -204,6 +215,9 @@ class Plan:
         for none: a stage that overshoots zero slip then sees vanishing slip on the phase's side
         (``stick.branch_slip``). Works on batches (y of shape (n_states, ...)).
         """
+        if (not self.law.states and np.ndim(y) == 1 and np.ndim(direction) == 0 and "xi" not in self.states
+                and self.scene.spring is None):
+            return self._one_state(p, t, y, float(direction))
         if "xi" in self.states:
             F, u = self.patch_force(p, t, y)
             c = self.contact(np.asarray(t), y, np.asarray(u)) if self.law_states else None
@@ -245,6 +259,32 @@ class Plan:
         N = float(s.normal(t))
         return (s.spring.stiffness * N * (float(s.spring.velocity(t)) - v) - float(dF[1:] @ dy[1:])) / dF[0]
 
+    def _one_state(self, p, t, y, direction: float) -> np.ndarray:
+        """``derivatives`` for one state vector of a memoryless law without compliance (every scalar ODE
+        solve): the same arithmetic on Python floats, bitwise equal to the general path (tests check it),
+        without its array bookkeeping. The law's force is checked by ``FrictionLaw.evaluate`` (the
+        one-line error) only when it is not a finite number of the right shape."""
+        s = self.scene
+        v = float(y[0])
+        u = v - s.radius * float(y[self.index("omega")]) if self.coupled else v
+        if direction != 0.0 and not direction * u > 0:
+            from .solvers.stick import vanishing_slip
+
+            u = direction * float(vanishing_slip(self))
+        c = self.contact(t, y, u)
+        try:
+            f = self.law.force(p, c)
+            F = float(f) if np.ndim(f) == 0 else math.nan
+        except Exception:
+            F = math.nan
+        if not math.isfinite(F):
+            F = float(self.law.evaluate(p, c))  # raises the law's one-line error, or F was right after all
+        rate = {"v": self.drive - F / s.mass, "x": abs(u)}
+        if self.has_spin:
+            rate["omega"] = F * s.radius / s.inertia
+            rate["theta"] = float(y[self.index("omega")])
+        return np.array([rate[k] for k in self.states])
+
     def _rates(self, p, t, y, F, u, c) -> np.ndarray:
         """Time derivatives of the state for friction force F and slip u (works on batches)."""
         s = self.scene
@@ -260,7 +300,8 @@ class Plan:
             elif name == "x":
                 out.append(np.abs(u))
             elif name == "xi":
-                out.append(self.rigid_slip(y) - u)
+                loading = self.spring(t, y)[2] if s.compliance.model != "linear" else 0.0
+                out.append(self.rigid_slip(y) - u - loading * y[self.index("xi")])
             else:
                 out.append(law_rates[name[len(LAW_PREFIX):]])
         return np.array(np.broadcast_arrays(*out), dtype=float)
@@ -296,8 +337,12 @@ def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan
     if needs_area and isinstance(scene.area, GrowthArea):
         states.append("x")
     if "compliance" in effects:
-        if scene.compliance is None or not scene.compliance.damping > 0:
-            raise SceneError(f"{scene_name}: effect 'compliance' needs a positive stiffness and damping")
+        if scene.compliance is None:
+            raise SceneError(f"{scene_name}: effect 'compliance' needs a compliance model (linear or mindlin)")
+        if scene.compliance.model == "mindlin":
+            if scene.area is None:
+                raise SceneError(f"{scene_name}: compliance model 'mindlin' takes the contact radius from the "
+                                 "contact area: add a [scene.area] model (hertz or half-sine)")
         states.append("xi")
     states += [LAW_PREFIX + n for n in law.state_names]
     return Plan(scene=scene, law=law, states=tuple(states), coupled=coupled, needs_area=needs_area,

@@ -12,6 +12,7 @@ from collections.abc import Mapping
 import attrs
 import numpy as np
 
+from .contact import Compliance, MindlinCompliance, compliance_from_spec, materials_from_spec
 from .errors import SceneError
 from .units import to_si
 
@@ -23,7 +24,8 @@ KINDS = ("impact", "incline", "impact-outcome", "spring-slider")
 EFFECTS = {
     "spin": "integrate spin omega and rotation angle theta from the friction torque (needs radius)",
     "slip-coupling": "contact-point slip u = v - r omega (rigid sphere) instead of u = v",
-    "compliance": "linear tangential spring and damper at the contact (Maw, Barber and Fawcett 1976)",
+    "compliance": ("tangential compliance at the contact (Maw, Barber and Fawcett 1976): [scene.compliance] "
+                   "model = 'linear' (spring and damper) or 'mindlin' (k_t = 8 G* a(t) from [scene.materials])"),
     "gravity": "gravity along an incline, m g sin(alpha), with N = m g cos(alpha)",
 }
 
@@ -219,17 +221,6 @@ class WeightNormal:
         return np.full(np.shape(t), self.value)
 
 
-@attrs.frozen
-class Compliance:
-    """Linear tangential spring [N/m] and damper [N s/m] between the body and a massless contact patch.
-
-    The damper must be positive: it makes the patch slip well defined for every law.
-    """
-
-    stiffness: float = attrs.field(validator=_positive)
-    damping: float = attrs.field(validator=_positive)
-
-
 @attrs.frozen(eq=False)
 class SpringLoad:
     """A spring of stiffness k per unit normal force [1/m] pulled at a load-point velocity that steps.
@@ -279,7 +270,7 @@ class Scene:
     incline: float | None = None  # [rad]
     area: object | None = None
     normal: object | None = None
-    compliance: Compliance | None = None
+    compliance: Compliance | MindlinCompliance | None = None
     effects: frozenset = attrs.field(default=frozenset(), converter=frozenset)
     spring: SpringLoad | None = None  # kind 'spring-slider': the driving spring and its load point
 
@@ -328,7 +319,7 @@ class Scene:
         """Build a scene from a ``[scene]`` table; ``where`` prefixes error messages (file name)."""
         columns = columns or {}
         known = {"mass", "radius", "inertia_factor", "u0", "omega0", "duration", "incline", "effects",
-                 "area", "normal", "compliance", "impact_speed", "incidence", "restitution", "spring"}
+                 "area", "normal", "compliance", "materials", "spring"}
         extra = set(spec) - known
         if extra:
             raise SceneError(f"{where}: [scene] has unknown key(s) {sorted(extra)}; known: {', '.join(sorted(known))}")
@@ -352,22 +343,21 @@ class Scene:
                default=spring.velocities[0] if spring else 0.0)
         omega0 = q("omega0", "rad/s", required=False, positive=False, default=0.0)
 
-        for key in ("area", "normal", "compliance", "spring"):
+        for key in ("area", "normal", "compliance", "materials", "spring"):
             if key in spec and not isinstance(spec[key], Mapping):
                 raise SceneError(f"{where}: scene.{key} must be a table, got {type(spec[key]).__name__} {spec[key]!r}")
+        pair = materials_from_spec(spec["materials"], where, q)[0] if "materials" in spec else None
         area = _area_from_spec(spec.get("area"), where, q, columns, t)
         contact_time = getattr(area, "contact_time", None)
         normal = _normal_from_spec(spec.get("normal"), where, q, columns, t, mass, contact_time, spec, incline)
         contact_time = contact_time if contact_time is not None else getattr(normal, "contact_time", None)
         compliance = None
         if "compliance" in spec:
-            c = spec["compliance"]
-            _known_keys(c, {"stiffness", "damping"}, where, "[scene.compliance]")
-            compliance = Compliance(q("stiffness", "N/m", c, "scene.compliance"),
-                                    q("damping", "N*s/m", c, "scene.compliance"))
+            compliance = compliance_from_spec(spec["compliance"], where, q, pair, radius)
             effects |= {"compliance"}
         elif "compliance" in effects:
-            raise SceneError(f"{where}: effect 'compliance' needs a [scene.compliance] table with 'stiffness' and 'damping'")
+            raise SceneError(f"{where}: effect 'compliance' needs a [scene.compliance] table "
+                             "(model = 'linear' with stiffness and damping, or 'mindlin')")
 
         duration = q("duration", "s", required=False)
         if duration is None:

@@ -86,8 +86,11 @@ def test_datasets_show_in_units_a_person_reads(capsys):
 
 
 def test_series_output_does_not_contradict_itself(capsys):
-    assert main(["simulate", "impact-golf-v28", "--law", "wear", "--param", "lam=1.81e6 Pa s/m",
-                 "--solver", "series"]) == 0
+    from frictionlab.solvers.series import SeriesAccuracyWarning
+
+    with pytest.warns(SeriesAccuracyWarning, match="b = 0.814"):  # the series says it is used beyond its range
+        assert main(["simulate", "impact-golf-v28", "--law", "wear", "--param", "lam=1.81e6 Pa s/m",
+                     "--solver", "series"]) == 0
     out = capsys.readouterr().out
     assert "never reached zero" not in out
     assert "truncated series' slip crosses zero at t = 286.7 us" in out
@@ -114,3 +117,20 @@ def test_quiet_silences_progress(tmp_path, capsys):
     assert capsys.readouterr().err == ""
     assert main(argv + ["--out", str(tmp_path / "r2")]) == 0
     assert "compare: 1/" in capsys.readouterr().err
+
+
+def test_compare_summary_renders_the_answers_only():
+    from frictionlab.answers import Answer
+    from frictionlab.commands.compare import answer_lines
+
+    class C:
+        answers = ()
+
+    assert answer_lines(C()) == ["answers: none (the verdict layer filled no Comparison.answers); see the report's "
+                                 "tables"]
+    a = Answer(group="impact-golf", datasets=("a",), provenance="reconstructed", best="wear [exact]", fits=False,
+               headline="no registered law describes these data", goodness="chi2 p < 1e-6", equivalence="not equivalent",
+               noise_threshold="", series_vs_exact="the series' slip crosses zero at 309 us")
+    C.answers = (a,)
+    assert answer_lines(C())[1] == ("  impact-golf: no registered law describes these data; chi2 p < 1e-6; lambda A u "
+                                    "vs mu N + mu eta' dA/dt: not equivalent; the series' slip crosses zero at 309 us")

@@ -143,3 +143,18 @@ def test_aging_and_slip_told_apart_by_large_steps_not_by_small_ones(rs_fits):
     assert delta_aic("spring-slider-slip", "rate-state-slip", "rate-state-aging") > 10
     # a 10 % step: both laws fit equally well (they agree to first order about steady sliding)
     assert abs(delta_aic("spring-slider-small-step", "rate-state-aging", "rate-state-slip")) < 2
+
+
+def test_memoryless_laws_on_a_spring_slider():
+    """A viscous law drives the quasi-static slider (mu = c A v / N relaxes to the new speed at rate k N/(c A));
+    Coulomb has no slip-rate dependence and is refused with the reason."""
+    from frictionlab.scene import ConstantArea
+
+    scene = slider(2000.0, (0.0, 1.0), (1e-6, 2e-6), 3.0).with_(area=ConstantArea(1e-3))
+    c = 0.6 * N / (1e-3 * 1e-6)  # wear law lam: mu = 0.6 at 1 um/s
+    t = np.linspace(1.0, 3.0, 9)
+    tr = fl.simulate("wear", scene, {"lam": c}, t=np.concatenate([[0.0], t]))
+    rate = 2000.0 * N / (c * 1e-3)
+    assert np.allclose(tr.load[1:], 0.6 * (2 - np.exp(-rate * (t - 1.0))), rtol=1e-7)
+    with pytest.raises(fl.FrictionLabError, match="does not grow with the slip rate"):
+        fl.simulate("coulomb", scene, {"mu": 0.6})

@@ -214,7 +214,7 @@ def test_bad_outcome_datasets(tmp_path, old, new, match):
 def test_registered_predictor_fits_the_synthetic_truth(monkeypatch):
     """With the predictor registered, fitting Coulomb to the synthetic outcomes recovers mu = 0.25."""
     from frictionlab import fitting
-    from frictionlab.outcome import outcome_predictor
+    from frictionlab.predict import outcome_predictor
     from frictionlab.predict import PREDICTORS
 
     monkeypatch.setitem(PREDICTORS, "impact-outcome", outcome_predictor)

@@ -136,7 +136,7 @@ def test_scene_from_toml_spec():
 @pytest.mark.parametrize("spec, match", [
     ({"mass": "46 g", "u0": "1 m/s", "duration": "1 s", "effects": ["spin"]}, "missing 'radius'"),
     ({"mass": "46 g", "u0": "1 m/s", "duration": "1 s", "effects": ["magic"]}, "unknown effect"),
-    ({"mass": "46 g", "u0": "1 m/s", "duration": "1 s", "effects": ["compliance"]}, "stiffness' and 'damping'"),
+    ({"mass": "46 g", "u0": "1 m/s", "duration": "1 s", "effects": ["compliance"]}, "linear' with stiffness and damping"),
     ({"mass": "46", "u0": "1 m/s", "duration": "1 s"}, "scene.mass"),
     ({"mass": "46 g", "u0": "1 m/s"}, "needs 'duration'"),
     ({"mass": "46 g", "u0": "1 m/s", "duration": "1 s", "area": {"model": "column"}}, "time column"),

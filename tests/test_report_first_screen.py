@@ -108,3 +108,13 @@ def test_a_parameter_far_from_its_bounds_is_not_at_a_bound():
     none = attrs.evolve(none, columns={**none.columns, "omega": -np.abs(none.columns["omega"])})
     g = fit("wear", none, solver="exact")
     assert "lam" in g.identifiability.at_bounds
+
+
+def test_plausibility_flags_reach_the_parameter_they_name():
+    from frictionlab.report.fits import flags_on
+
+    class F:
+        flags = ("eta_prime = -7.9e11 N s/m^2 can be set to 0 changing chi2 by 0.3", "slip exceeds 10x u0")
+
+    assert flags_on(F(), "eta_prime") == [F.flags[0]] and flags_on(F(), "eta") == [] and flags_on(F(), "u0") == [
+        F.flags[1]]

@@ -1,9 +1,10 @@
 """Render a report's report.html in headless Chromium and save screenshots, to look at as a reader would.
 
-    python tools/screenshot.py REPORT_FOLDER_OR_HTML [--out DIR] [--height 1000 --height 4000]
+    python tools/screenshot.py REPORT_FOLDER_OR_HTML [--out DIR] [--height 1000 --height 4000] [--open]
 
 Writes DIR/screen-<height>.png (default DIR: the report folder) for a 1400 px wide window of each
-height: 1000 px is the first screen. Needs Debian's ``chromium`` (apt-get install chromium).
+height: 1000 px is the first screen; --open opens every collapsible section first. Needs
+Debian's ``chromium`` (apt-get install chromium).
 """
 from __future__ import annotations
 
@@ -26,15 +27,25 @@ def chromium() -> str | None:
     return None
 
 
-def screenshot(html: Path, png: Path, height: int = 1000, width: int = WIDTH, timeout: float = 120.0) -> Path:
-    """Save a ``width`` x ``height`` screenshot of ``html`` to ``png`` (a fresh browser profile each time)."""
+_OPEN_ALL = "<script>document.querySelectorAll('details').forEach(function (d) { d.open = true; });</script>"
+
+
+def screenshot(html: Path, png: Path, height: int = 1000, width: int = WIDTH, timeout: float = 120.0,
+               open_all: bool = False) -> Path:
+    """Save a ``width`` x ``height`` screenshot of ``html`` to ``png`` (a fresh browser profile each time);
+    ``open_all`` opens every collapsible section first."""
     exe = chromium()
     if exe is None:
         raise RuntimeError("no chromium found: apt-get install -y chromium")
     with tempfile.TemporaryDirectory(prefix="frictionlab-chromium-") as profile:
+        if open_all:
+            probe = Path(profile) / "open.html"
+            probe.write_text(Path(html).read_text(encoding="utf-8").replace("</body>", _OPEN_ALL + "</body>"),
+                             encoding="utf-8")
+            html = probe
         cmd = [exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                "--disable-background-networking", "--disable-component-update", "--disable-sync",
-               "--hide-scrollbars", f"--user-data-dir={profile}", f"--screenshot={Path(png).resolve()}",
+               "--hide-scrollbars", f"--user-data-dir={profile}/p", f"--screenshot={Path(png).resolve()}",
                f"--window-size={width},{height}", Path(html).resolve().as_uri()]
         subprocess.run(cmd, check=True, timeout=timeout, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     if not Path(png).exists():
@@ -81,12 +92,13 @@ def main(argv=None) -> int:
     ap.add_argument("report", type=Path, help="a report folder or its report.html")
     ap.add_argument("--out", type=Path, help="folder for the PNGs (default: the report folder)")
     ap.add_argument("--height", type=int, action="append", help="window height in px (repeatable; default 1000)")
+    ap.add_argument("--open", action="store_true", help="open every collapsible section (screen-open-<height>.png)")
     args = ap.parse_args(argv)
     html = args.report / "report.html" if args.report.is_dir() else args.report
     out = args.out or html.parent
     out.mkdir(parents=True, exist_ok=True)
     for h in args.height or [1000]:
-        png = screenshot(html, out / f"screen-{h}.png", h)
+        png = screenshot(html, out / f"screen-{'open-' if args.open else ''}{h}.png", h, open_all=args.open)
         print(png)
     return 0
 

@@ -6,9 +6,6 @@ import shutil
 import tempfile
 from pathlib import Path
 
-from ..dataset import builtin_dir, builtin_names, load_dataset
-from ..table import render
-
 
 def add_parser(sub):
     from ..cli import subcommand
@@ -57,6 +54,9 @@ def add_parser(sub):
 
 
 def _list(args) -> int:
+    from ..dataset import builtin_dir, builtin_names, load_dataset
+    from ..table import render
+
     rows = []
     for name in builtin_names():
         d = load_dataset(name)
@@ -84,6 +84,7 @@ def _values(table: dict) -> str:
 
 
 def _show(args) -> int:
+    from ..dataset import load_dataset
     from ..display import describe, quantity_text
 
     d = load_dataset(args.name)
@@ -144,6 +145,7 @@ def _template(args) -> int:
 
 
 def _rebuild(args) -> int:
+    from ..dataset import builtin_dir
     from ..datagen import rebuild
 
     if args.check:

@@ -5,9 +5,7 @@ import json
 from pathlib import Path
 
 from ..errors import OutputError, ParameterError, SolverError
-from ..fitting import SCENE_QUANTITIES, fit
-from ..registry import get_law
-from ..units import to_si
+from ..freeable import SCENE_QUANTITIES
 
 
 def add_parser(sub):
@@ -48,6 +46,8 @@ def _split(text: str, what: str) -> tuple[str, str]:
 
 def parse_free(items) -> dict:
     """'u0=8 m/s:14 m/s[:12 m/s]' -> {'u0': (8.0, 14.0[, 12.0])} in SI."""
+    from ..units import to_si
+
     out = {}
     for item in items:
         name, rest = _split(item, "--free")
@@ -61,6 +61,8 @@ def parse_free(items) -> dict:
 
 
 def parse_fix(law, items) -> dict:
+    from ..units import to_si
+
     out = {}
     for item in items:
         name, rest = _split(item, "--fix")
@@ -70,6 +72,8 @@ def parse_fix(law, items) -> dict:
 
 
 def run(args) -> int:
+    from ..fitting import fit
+    from ..registry import get_law
     from ..report import fit_json as _fit_json
 
     law = get_law(args.law)

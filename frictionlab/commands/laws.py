@@ -1,10 +1,6 @@
 """``frictionlab laws``: list the registered laws with parameters, units, bounds, needs and internal states."""
 from __future__ import annotations
 
-from ..law import QUANTITIES
-from ..registry import available_laws, law_source
-from ..table import render
-
 
 def add_parser(sub):
     from ..cli import subcommand
@@ -19,6 +15,10 @@ def add_parser(sub):
 
 
 def run(args) -> int:
+    from ..law import QUANTITIES
+    from ..registry import available_laws, law_source
+    from ..table import render
+
     laws = available_laws()
     if args.brief:
         print(render([{"law": n, "formula": law.formula, "requires": ", ".join(sorted(law.requires)),

@@ -11,12 +11,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import numpy as np
-
-from ..dataset import load_dataset
 from ..errors import ParameterError, SolverError
-from ..registry import get_law
-from ..units import to_si
 
 RPM = 60.0 / (2.0 * math.pi)
 PLOT_POINTS = 501
@@ -46,6 +41,7 @@ def add_parser(sub):
 
 def parse_params(law, items) -> dict[str, float]:
     """['lam=1.81e6 Pa s/m', 'mu=0.2'] -> SI floats, each converted against the law's parameter unit."""
+    from ..units import to_si
     from .fit import _split
 
     out = {}
@@ -57,7 +53,9 @@ def parse_params(law, items) -> dict[str, float]:
 
 
 def run(args) -> int:
+    from ..dataset import load_dataset
     from ..io import atomic_write_bytes, atomic_write_text, check_writable
+    from ..registry import get_law
 
     law = get_law(args.law)
     params = parse_params(law, args.param)
@@ -97,6 +95,7 @@ def _params_text(law, p) -> str:
 
 # --- time series ---------------------------------------------------------------------------------
 def _series(law, ds, params, args):
+    import numpy as np
     from ..solvers import simulate
 
     scene = ds.scene
@@ -122,6 +121,7 @@ def _series(law, ds, params, args):
 
 
 def _summary(law, ds, tr, p) -> str:
+    import numpy as np
     from ..display import fmt_time
 
     T = float(tr.t[-1])
@@ -211,6 +211,7 @@ def _outcomes(law, ds, params, args):
 
 
 def _outcome_figure(law, ds, p, args) -> bytes:
+    import numpy as np
     from ..figures import _plt, _png
     from ..outcome import predict_outcomes
 

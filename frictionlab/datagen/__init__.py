@@ -9,7 +9,7 @@ import importlib
 from pathlib import Path
 
 #: Generator modules, in the order they run.
-GENERATORS = ("golf", "incline", "outcome", "springslider")
+GENERATORS = ("golf", "incline", "outcome", "kharaz", "springslider")
 
 
 def rebuild(out_dir: Path) -> list[Path]:

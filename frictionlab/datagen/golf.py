@@ -76,7 +76,7 @@ def build(out_dir: Path) -> list[Path]:
             "noise": {"omega": f"{NOISE_RPM[speed]} rpm", "theta": f"{NOISE_THETA_DEG} deg"},
             "scene": {
                 "mass": "46 g", "radius": "21.3 mm", "inertia_factor": 0.4,
-                "u0": f"{s['u0']:g} m/s", "impact_speed": f"{speed} m/s", "incidence": "30 deg",
+                "u0": f"{s['u0']:g} m/s",
                 "effects": ["spin"],
                 "area": {"model": "half-sine", "peak": f"{s['A0'] * 1e6:g} mm^2", "contact_time": f"{s['t_c'] * 1e6:g} us"},
                 "normal": {"model": "half-sine", "normal_speed": f"{vn:.4f} m/s", "restitution": RESTITUTION[speed]},
@@ -91,6 +91,7 @@ def build(out_dir: Path) -> list[Path]:
                 "command": "frictionlab datasets rebuild",
             },
             "reported": {
+                "impact_speed": f"{speed} m/s", "incidence": "30 deg",
                 "omega_peak": f"{s['omega_peak'] / RPM:g} rpm", "t_peak": f"{s['t_peak'] * 1e6:g} us",
                 "omega_at_contact_end": f"{s['omega_c'] / RPM:g} rpm", "contact_time": f"{s['t_c'] * 1e6:g} us",
                 "theta_max": f"{math.degrees(s['theta_max']):g} deg", "u0": f"{s['u0']:g} m/s",

@@ -37,7 +37,7 @@ import attrs
 from ..errors import OutputError
 from ..io import atomic_dir
 from . import (bootstrap, datasets, derivation, equivalence, first_screen, fits, identifiability, method, ranking,
-               summary, tolerance)
+               rebound, summary, tolerance)
 from .doc import Section
 from .render import html_page, markdown
 from .results import SCHEMA, clean, fit_json, ranking_csv, results_json
@@ -46,7 +46,7 @@ from .tolerance import tolerance_verdicts
 TITLE = "frictionlab: friction laws compared"
 
 #: The report's sections, in order; the first screen first.
-SECTIONS = (first_screen, summary, datasets, ranking, bootstrap, fits, equivalence, derivation, tolerance,
+SECTIONS = (first_screen, summary, datasets, ranking, bootstrap, fits, rebound, equivalence, derivation, tolerance,
             identifiability, method)
 
 __all__ = ["SCHEMA", "SECTIONS", "Context", "Section", "build", "clean", "fit_json", "results_json",

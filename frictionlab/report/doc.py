@@ -27,6 +27,11 @@ class Table:
     rows: list[list[str]]
 
     @property
+    def short_names(self) -> bool:
+        """The first column holds short names (kept on one line in HTML)."""
+        return all(len(r[0]) <= 30 for r in self.rows if r)
+
+    @property
     def numeric(self) -> list[bool]:
         """Per column: every non-empty cell (ignoring '–' placeholders) is a number."""
         out = []

@@ -1,6 +1,8 @@
 """'Fits': per dataset the fits of every law, their parameters, warnings and notes, and known truth."""
 from __future__ import annotations
 
+import re
+
 from .. import figures
 from ..display import param_cells, param_text
 from ..errors import FrictionLabError
@@ -58,24 +60,16 @@ def reported_check(d, c) -> str:
     return ("**Reported by the source:** " + "; ".join(parts) + ".") if parts else ""
 
 
-def plausibility(f) -> dict[str, str]:
-    """Parameter -> comment from the verdict layer's plausibility flags, if the fit carries them
-    (``FitResult.plausibility``: a dict name -> text, or texts starting with the name)."""
-    flags = getattr(f, "plausibility", None) or {}
-    if isinstance(flags, dict):
-        return {str(k): str(v) for k, v in flags.items()}
-    out = {}
-    for text in flags:
-        name = str(text).split(" ", 1)[0].rstrip(":")
-        out[name] = (out[name] + "; " if name in out else "") + str(text)
-    return out
+def flags_on(f, name: str) -> list[str]:
+    """The verdict layer's plausibility flags of fit ``f`` (``FitResult.flags``, one sentence each) that
+    name parameter ``name``."""
+    return [t for t in getattr(f, "flags", ()) or () if re.search(rf"(?<![\w']){re.escape(name)}(?![\w'])", t)]
 
 
 def param_rows(f) -> list[list[str]]:
     """One row per parameter of fit ``f``: value, error and unit in separate cells, its role, and a
     comment where the value means nothing (no effect, only a ratio determined) or is flagged implausible."""
     ratio_keys = {k for pair in f.identifiability.ratio_only for k in pair}
-    flags = plausibility(f)
     rows = []
     for p in f.params.values():
         role, comment = ("fitted" if p.vary else (p.fixed_by or "held")), ""
@@ -85,8 +79,9 @@ def param_rows(f) -> list[list[str]]:
             comment = "arbitrary: it has no effect on these data (the value is where the optimizer stopped)"
         elif p.vary and p.stderr is None:
             comment = f"no error bar: {f.identifiability.missing_stderr.get(p.name, 'see warnings')}"
-        if p.name in flags:
-            comment = "; ".join(x for x in (comment, "implausible: " + flags[p.name]) if x)
+        flagged = flags_on(f, p.name)
+        if flagged:
+            comment = "; ".join([comment] * bool(comment) + [f"implausible: {t}" for t in flagged])
         value, err, unit = param_cells(p.value, p.stderr if p.vary or p.kind == "derived" else None, p.unit)
         rows.append([f"{f.law} [{f.solver}]", p.name, value, err, unit, role, comment])
     return rows
@@ -119,6 +114,10 @@ def build(ctx) -> Section:
         warns = [f"{f.law} [{f.solver}]: {w}" for f in fits if f.ok for w in f.identifiability.warnings]
         notes = [f"{f.law} [{f.solver}]: {n}" for f in fits if f.ok for n in f.notes]
         bad = [f"{f.law} [{f.solver}]: {f.status}: {f.reason}" for f in fits if not f.ok]
+        flagged = [f"{f.law} [{f.solver}]: {t}" for f in fits if f.ok for t in getattr(f, "flags", ()) or ()]
+        if flagged:
+            sec.p("**Physically implausible (the verdict layer's flags):**")
+            sec.items(flagged)
         if warns:
             sec.p("**Identifiability:**")
             sec.items(warns)

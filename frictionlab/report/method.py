@@ -3,9 +3,11 @@ from __future__ import annotations
 
 import json
 
+from ..predict import FIT_RTOL
 from ..ranking import COLUMNS, TIE_AIC
 from .doc import Section
 from .results import SCHEMA
+from .text import rtol_text
 
 
 def build(ctx) -> list[Section]:
@@ -22,9 +24,9 @@ def build(ctx) -> list[Section]:
         "identifiable directions (rank of the Jacobian): a pair entering only as a ratio counts once, a "
         "parameter without effect not at all.",
         f"Ties: candidates within ΔAIC ≤ {TIE_AIC} share a rank. Akaike weight w = exp(−Δ/2)/Σexp(−Δ/2).",
-        "Solvers: 'exact' where the law and scene admit a closed form, else 'ode' (LSODA, rtol 1e-10; what a "
-        "looser tolerance changes is under 'What solver tolerance does to a fit'); 'series' (the paper's first-order "
-        "expansion, eqs 7-11) in addition wherever it is defined.",
+        "Solvers: 'exact' where the law and scene admit a closed form, else 'ode' (LSODA, rtol "
+        f"{rtol_text(FIT_RTOL)}; what another tolerance changes is under 'What solver tolerance does to a fit'); 'series' "
+        "(the paper's first-order expansion, eqs 7-11) in addition wherever it is defined.",
         "Bootstrap (`--bootstrap N`, `--seed`): case resampling, every candidate refitted to the same resamples; "
         "95% percentile intervals for parameters, 95% Wilson intervals for first-place shares (see 'Bootstrap').",
         f"Settings: {json.dumps(c.settings)}.",

@@ -74,7 +74,6 @@ def group_table(rows) -> tuple[list[str], list[list]]:
             r.status + (f": {r.reason}" if r.reason else "")] for r in rows]
     return headers, out
 
-
 def build(ctx) -> Section:
     c = ctx.c
     sec = Section(TITLE)

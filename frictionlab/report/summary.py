@@ -20,6 +20,7 @@ def first_share(rb, best) -> str:
 
 
 def build(ctx) -> Section:
+    from .ranking import curve_labels
     from .tolerance import tolerance_verdicts
 
     c = ctx.c
@@ -60,14 +61,19 @@ def build(ctx) -> Section:
             items.append(f"**{g}**: best " + " = ".join(best) + " (summed AIC over the group"
                          + ("; a tie" if len(best) > 1 else "") + ")")
     for d in fitted:
+        labels, said = curve_labels(c, d.name), set()
         for law in c.laws:
+            label = labels.get((law, "series"), law)
+            if label in said:  # one functional form (wear = couette): one sentence
+                continue
+            said.add(label)
             ser = next((r for r in c.ranking if r.dataset == d.name and r.law == law and r.solver == "series"
                         and r.rank), None)
             full = next((r for r in c.ranking if r.dataset == d.name and r.law == law and r.solver != "series"
                          and r.rank), None)
             if ser and full and abs(ser.aic - full.aic) > 2:
                 better = "better" if ser.aic < full.aic else "worse"
-                items.append(f"**{d.name}**: the paper's truncated series of {law} fits {better} than the {full.solver} "
+                items.append(f"**{d.name}**: the paper's truncated series of {label} fits {better} than the {full.solver} "
                              f"solution of the same law (ΔAIC {abs(ser.aic - full.aic):.1f}): the approximation, not "
                              "the law, makes that difference (see the notes under Fits)")
     verdicts = tolerance_verdicts(c)
@@ -76,6 +82,12 @@ def build(ctx) -> Section:
                      + " (see 'What solver tolerance does to a fit')")
     sec.items(items)
     if c.equivalence:
-        sec.p("Equivalence of λAu and μN + μη′dA/dt: " + "; ".join(
-            f"{e.dataset} [wear {e.solver}]: **{e.verdict or e.status}**" for e in c.equivalence) + ".")
+        sec.p("Equivalence of λAu and μN + μη′dA/dt per dataset (details under 'Equivalence test'):")
+        verdicts: dict[str, dict[str, str]] = {}
+        for e in c.equivalence:
+            key = "series" if e.solver == "series" else "full"
+            verdicts.setdefault(e.dataset, {})[key] = (e.verdict or e.status) + ("" if key == "series" else
+                                                                                  f" [{e.solver}]")
+        sec.table(["dataset", "wear solved exactly or numerically", "wear by the paper's series"],
+                  [[d, v.get("full", ""), v.get("series", "–")] for d, v in verdicts.items()])
     return sec

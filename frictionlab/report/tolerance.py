@@ -1,4 +1,4 @@
-"""'What solver tolerance does to a fit': the ODE laws of one dataset refitted at looser tolerances."""
+"""'What solver tolerance does to a fit': the ODE laws of one dataset refitted at other tolerances."""
 from __future__ import annotations
 
 import math
@@ -58,7 +58,7 @@ def build(ctx) -> Section:
 
 
 def tolerance_verdicts(c: Comparison) -> list[str]:
-    """Per looser tolerance: whether the ranking changes, the largest parameter shift and AIC change,
+    """Per other tolerance: whether the ranking changes, the largest parameter shift and AIC change,
     and the fit time against the default tolerance's."""
     rows = list(c.tolerance)
     ref = {r["law"]: r for r in rows if r["rtol"] == FIT_RTOL}

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..dataset import Dataset
 from ..errors import SceneError, SolverError
 from ..plan import make_plan
 from ..registry import get_law
@@ -43,7 +42,7 @@ def simulate(law, scene, params=None, solver: str = "ode", t=None, rtol: float =
     law = get_law(law)
     name = "scene"
     fixed = {}
-    if isinstance(scene, Dataset):
+    if not isinstance(scene, Scene) and hasattr(scene, "scene") and hasattr(scene, "fixed"):  # a Dataset
         name = f"dataset '{scene.name}'"
         fixed = {k: v for k, v in scene.fixed.items() if k in law.param_names}
         if scene.kind == "impact-outcome":

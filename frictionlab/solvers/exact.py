@@ -124,17 +124,20 @@ def bessel_integral(b, phi, t) -> np.ndarray:
 
 def _bessel_series(b, phi, t):
     kmax = int(math.ceil(math.sqrt(2.0 * max(float(np.max(b, initial=0.0)), 1.0) * 45.0))) + 20
-    w0 = ive(0, b)
+    # every weight in one call; the series stops at the first k whose term is negligible for every b
+    k = np.arange(kmax + 1, dtype=float).reshape((-1,) + (1,) * np.ndim(b))
+    w = ive(k, b)
+    small = (2.0 * w[1:] <= 1e-17 * k[1:] * w[0]).reshape(kmax, -1).all(axis=1)
+    last = int(np.argmax(small)) + 1 if small.any() else kmax
+    coef = 2.0 * w[1:] / (k[1:] * phi)
     x = phi * t
-    out = w0 * t
+    out = w[0] * t
     two_cos = 2.0 * np.cos(x)
     s_prev, s_k = np.zeros_like(x), np.sin(x)
-    for k in range(1, kmax + 1):
-        w = ive(k, b)
-        out = out + (2.0 * w / (k * phi)) * s_k
-        if np.all(2.0 * w <= 1e-17 * k * w0):
-            break
-        s_prev, s_k = s_k, two_cos * s_k - s_prev
+    for j in range(last):
+        out = out + coef[j] * s_k
+        if j + 1 < last:
+            s_prev, s_k = s_k, two_cos * s_k - s_prev
     return out
 
 
@@ -219,6 +222,25 @@ def _area_integrals(area, t):
     return A, area.peak / phi * (1.0 - np.cos(phi * tau))
 
 
+def closed_stop_applies(plan, form, t0) -> bool:
+    """Whether ``half_sine_stop`` gives the stop: F = s a N (a >= 0, no area term), N a half-sine
+    pulse, no drive, from first contact (Coulomb on an impact)."""
+    return (np.all(t0 == 0.0) and np.all(np.asarray(form.c) == 0.0) and np.all(np.asarray(form.a) >= 0.0)
+            and isinstance(plan.scene.normal, HalfSineNormal) and np.all(np.asarray(plan.drive) == 0.0))
+
+
+def half_sine_stop(plan, form, u_s):
+    """Time [s] at which slip u_s reaches zero under F = s a N, N = Np sin(phi t) (see
+    ``closed_stop_applies``): kappa a IN(t) = |u_s| with IN = (2 Np / phi) sin^2(phi t / 2), so
+    t = (2 / phi) arcsin(sqrt(q / 2)), q = |u_s| phi / (kappa a Np) (the half-angle form keeps early
+    stops accurate); inf where q > 2 (the pulse ends first). Arrays broadcast (a batch)."""
+    n = plan.scene.normal
+    phi = np.pi / np.asarray(n.contact_time, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q = np.abs(u_s) * phi / (plan.kappa * form.a * n.peak)
+        return np.where(q <= 2.0, 2.0 / phi * np.arcsin(np.sqrt(np.minimum(q, 2.0) / 2.0)), np.inf)
+
+
 def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     s = plan.scene
     sgn = direction if direction != 0 else 1.0
@@ -251,6 +273,10 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     # round-off in the slip an ulp after t0 is not a new stop
     s = plan.scene
     margin = SLIP_MARGIN * max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * (s.radius or 0.0), 1e-300)
+    if closed_stop_applies(plan, form, t0):  # slip falls monotonically: a stop iff it has passed zero at T
+        if sgn * slip(T)[0] + margin > 0.0:
+            return J, K, None
+        return J, K, float(min(half_sine_stop(plan, form, u_s), T))
     grid = np.unique(np.concatenate([np.linspace(t0, T, SCAN), t]))
     g = sgn * slip(grid) + margin
     bad = np.nonzero(g[1:] <= 0.0)[0]

@@ -1,16 +1,20 @@
-"""Numerical integration with scipy's solve_ivp, on a scaled problem, with zero slip as an event.
+"""Numerical integration with scipy's ODE solvers, on a scaled problem, with zero slip as an event.
 
 Time is scaled by the simulated span and each state by its typical size, so that one pair of
 tolerances means the same thing for a 1 ns and a 1 s contact, for 1e-12 and 1 m^2 areas.
+``solve`` is scipy's ``solve_ivp`` loop for the one case used here (sorted output times, at most
+one terminal event on a scalar function): the same solver steps, dense output and event root, so
+the same numbers (a test checks them against solve_ivp), without its per-step generality.
 """
 from __future__ import annotations
 
 import numbers
 
 import numpy as np
-from scipy.integrate import solve_ivp
+import scipy.integrate
+from scipy.optimize import brentq
 
-from ..errors import SolverError
+from ..errors import FrictionLabError, SolverError
 
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 
@@ -20,6 +24,45 @@ MAX_NFEV = 20_000
 
 #: Slip, relative to its scale, by which the zero-slip event waits past zero (see zero_slip).
 SLIP_MARGIN = 1e-12
+
+
+def solve(f, s0: float, s1: float, z0, method: str, s_eval, rtol: float, atol: float, event=None,
+          event_direction: float = 0.0, label: str = "integration failed"):
+    """Integrate z' = f(s, z) from s0 to s1 with scipy's ``method`` and return
+    (Z at the times s_eval reached (n_states, k), s_event or None, z_event or None, the solver).
+
+    s_eval: increasing times within [s0, s1]. event(s, z) -> float: a terminal event where it crosses
+    zero in ``event_direction`` (as in solve_ivp: < 0 falling, > 0 rising, 0 either way), located by
+    brentq on the step's dense output to 4 eps, exactly as solve_ivp does. A failed step raises
+    SolverError('{label}: {scipy's message}').
+    """
+    eps = np.finfo(float).eps
+    solver = getattr(scipy.integrate, method)(f, s0, np.asarray(z0, dtype=float), s1, rtol=rtol, atol=atol)
+    s_eval = np.asarray(s_eval, dtype=float)
+    outs, i = [], 0
+    g = event(s0, solver.y) if event is not None else None
+    s_event = z_event = None
+    while True:
+        message = solver.step()
+        if solver.status == "failed":
+            raise SolverError(f"{label}: {message}")
+        s, z, sol = solver.t, solver.y, None
+        if event is not None:
+            g_new = event(s, z)
+            up, down = g <= 0 <= g_new, g >= 0 >= g_new
+            if (up and event_direction > 0) or (down and event_direction < 0) or ((up or down) and event_direction == 0):
+                sol = solver.dense_output()
+                s = s_event = brentq(lambda x: event(x, sol(x)), solver.t_old, s, xtol=4 * eps, rtol=4 * eps)
+                z = z_event = sol(s)
+            g = g_new
+        j = int(np.searchsorted(s_eval, s, side="right"))
+        if j > i:
+            outs.append((sol or solver.dense_output())(s_eval[i:j]))
+            i = j
+        if s_event is not None or solver.status == "finished":
+            break
+    Z = np.hstack(outs) if outs else np.empty((len(z0), 0))
+    return Z, s_event, z_event, solver
 
 
 def state_scales(plan, T: float) -> np.ndarray:
@@ -101,49 +144,43 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
                                   f"evaluations (stopped at t = {s * tscale:.6g} s): too stiff for {method} here")
             return plan.derivatives(p, s * tscale, z * scale, direction) * tscale / scale
 
-        events = None
+        event = None
         if not compliant and direction != 0:
-            def zero_slip(s, z):
-                # fires once slip has passed zero by a hair (SLIP_MARGIN of its scale), so that
-                # round-off at a restart from rest (slip exactly 0) is not taken for a new stop
-                return float(plan.rigid_slip(z * scale)) / scale[0] + direction * SLIP_MARGIN
+            r, iw = (plan.scene.radius, plan.index("omega")) if plan.coupled else (0.0, 0)
+            sv, sw = float(scale[0]), float(scale[iw])
 
-            zero_slip.terminal = True
-            zero_slip.direction = -direction
-            events = [zero_slip]
+            def zero_slip(s, z):
+                # slip / its scale (plan.rigid_slip on the scaled state), fired once slip has passed zero by a
+                # hair (SLIP_MARGIN of its scale), so that round-off at a restart from rest is not a new stop
+                return (z[0] * sv - r * (z[iw] * sw)) / sv + direction * SLIP_MARGIN
+
+            event = zero_slip
         s_eval = np.clip(np.asarray(t_out, dtype=float) / tscale, t0 / tscale, T / tscale)
         s_eval, back = np.unique(s_eval, return_inverse=True)  # repeated times (e.g. a resample) solved once
+        failed = f"ode:{method}: integration failed for law '{plan.law.name}'"
         # where the right-hand side jumps (a load-point velocity step) the integration restarts
-        cuts = [b / tscale for b in plan.breaks if t0 < b < T] if events is None else []
+        cuts = [b / tscale for b in plan.breaks if t0 < b < T] if event is None else []
         edges = [t0 / tscale] + cuts + [T / tscale]
         z0, parts, stats = np.asarray(y0, dtype=float) / scale, [], {"nfev": 0, "njev": 0, "nlu": 0}
         try:
             for k, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
                 last = k == len(edges) - 2
                 inside = s_eval[(s_eval >= a) & ((s_eval <= b) if last else (s_eval < b))]
-                sol = solve_ivp(f, (a, b), z0, method=method, t_eval=np.append(inside, b) if not last else inside,
-                                rtol=rtol, atol=atol, events=events)
-                if sol.status == -1:
-                    raise SolverError(f"ode:{method}: integration failed for law '{plan.law.name}': {sol.message}")
+                Z, s_stop, z_stop, solver = solve(f, a, b, z0, method, inside, rtol, atol, event, -direction, failed)
+                parts.append(Z)
                 for key in stats:
-                    stats[key] += int(getattr(sol, key))
-                if last:
-                    parts.append(sol.y)
-                else:
-                    parts.append(sol.y[:, :-1])
-                    z0 = sol.y[:, -1]
+                    stats[key] += int(getattr(solver, key))
+                z0 = solver.y
+        except FrictionLabError:
+            raise
         except Exception as exc:  # a law raising inside the integrator
-            from ..errors import FrictionLabError
-
-            if isinstance(exc, FrictionLabError):
-                raise
-            raise SolverError(f"ode:{method}: integration failed for law '{plan.law.name}': {exc}") from exc
-        sol.y = np.concatenate(parts, axis=1)
-        Y = sol.y[:, back[back < sol.y.shape[1]]] * scale[:, None]  # a stop ends the samples reached
+            raise SolverError(f"{failed}: {exc}") from exc
+        Z = np.hstack(parts)
+        Y = Z[:, back[back < Z.shape[1]]] * scale[:, None]  # a stop ends the samples reached
         t_stop = y_stop = None
-        if events is not None and sol.t_events[0].size:
-            t_stop = float(sol.t_events[0][0]) * tscale
-            y_stop = sol.y_events[0][0] * scale
+        if s_stop is not None:
+            t_stop = float(s_stop) * tscale
+            y_stop = z_stop * scale
         info = {**stats, "method": method, "rtol": rtol, "atol": atol}
         return Y, t_stop, y_stop, info
 

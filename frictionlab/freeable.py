@@ -1,0 +1,10 @@
+"""The scene quantities a fit can free, with their SI units: a plain table without dependencies,
+so that the command line can name them in its help without importing numpy (``frictionlab --help``)."""
+
+#: Scene quantities that can be freed, with their SI unit (dotted names reach into sub-models).
+SCENE_QUANTITIES = {
+    "u0": "m/s", "omega0": "rad/s", "mass": "kg", "radius": "m", "incline": "rad",
+    "area.peak": "m^2", "area.contact_time": "s", "area.area": "m^2", "area.initial": "m^2", "area.rate": "m^2/m",
+    "normal.impulse": "N*s", "normal.contact_time": "s", "normal.value": "N", "normal.coefficient": "N/m^3",
+    "compliance.stiffness": "N/m", "compliance.damping": "N*s/m",
+}

@@ -1,0 +1,181 @@
+"""The lean fit path gives the answers of the general one: each shortcut against the long way round."""
+import math
+
+import pytest
+
+from _fit_helpers import TRUTH, incline_scene, synthetic
+from frictionlab import fit
+
+
+def test_an_ode_fit_in_a_valley_pays_for_one_start_and_says_so():
+    """Couette's eta and h enter only as eta/h: the first start ends on that valley, a second would too."""
+    data = synthetic("couette", TRUTH["couette"], incline_scene(), n=21, name="incline-couette")
+    one = fit("couette", data, solver="ode")
+    two = fit("couette", data, solver="ode", n_starts=1)  # the general path with a single start, for the count
+    exact = fit("couette", data, solver="exact")
+    assert one.ok and any("one Levenberg-Marquardt start of 2" in n and "correlated" in n for n in one.notes)
+    assert one.nfev == two.nfev  # the second start was not run
+    ratio, ref = one.params["eta/h"], exact.params["eta/h"]
+    assert abs(ratio.value - ref.value) <= 0.01 * ref.stderr
+    assert one.stats.chisqr == pytest.approx(exact.stats.chisqr, rel=1e-6)
+
+
+def test_a_well_determined_ode_fit_still_runs_every_start():
+    data = synthetic("wear", TRUTH["wear"], incline_scene(), n=21, name="incline-wear")
+    r = fit("wear", data, solver="ode")
+    assert r.ok and not any("Levenberg-Marquardt start" in n for n in r.notes)
+    assert math.isclose(r.value("lam"), fit("wear", data, solver="exact").value("lam"), rel_tol=1e-4)
+
+
+@pytest.mark.parametrize("law, params", [("coulomb", {"mu": 0.25}), ("wear", {"lam": 1e6}),
+                                         ("area-rate", {"mu": 0.2, "eta_prime": 1e3}),
+                                         ("couette", {"eta": 0.1, "h": 1e-7})])
+def test_impact_outcomes_on_the_batch_engine_equal_the_row_by_row_solve(law, params):
+    import numpy as np
+
+    from frictionlab import get_law, load_dataset
+    from frictionlab.outcome import _rebounds, rows_of
+
+    ds = load_dataset("impact-outcome-synthetic")
+    rows = rows_of(ds)
+    imps = [ds.scene.impact(float(a), float(b), float(c)) for a, b, c in zip(rows["speed"], rows["incidence"], rows["spin"])]
+    p = get_law(law).resolve(params)
+    v2, w2, rolled = _rebounds(law, imps, p, "exact", 1e-6)  # all rows in one batch
+    alone = [_rebounds(law, [imp], p, "exact", 1e-6) for imp in imps]  # one row at a time: the scalar solver
+    assert np.allclose(v2, [a[0][0] for a in alone], rtol=1e-12, atol=1e-12 * np.max(np.abs(v2)))
+    assert np.allclose(w2, [a[1][0] for a in alone], rtol=1e-12, atol=1e-12 * np.max(np.abs(w2)))
+    assert list(rolled) == [bool(a[2][0]) for a in alone]
+    if law == "coulomb":
+        assert 0 < rolled.sum() < len(imps)  # both kinds of row are exercised
+
+
+def test_a_batch_in_chunks_equals_the_batch_in_one_call(monkeypatch):
+    import numpy as np
+
+    from frictionlab import batch as B
+    from frictionlab.scene import HalfSineNormal, Scene
+
+    rng = np.random.default_rng(3)
+    n = 37
+    tc = rng.uniform(400e-6, 500e-6, n)
+    template = Scene(kind="impact", mass=0.046, u0=1.0, duration=tc[0], radius=0.0213,
+                     normal=HalfSineNormal(1.0, tc[0]), effects=frozenset({"slip-coupling", "spin"}))
+    sb = B.SceneBatch.sweep(template, {"u0": rng.uniform(2, 40, n), "normal.impulse": rng.uniform(0.5, 4, n),
+                                       "normal.contact_time": tc, "duration": tc})
+    mu = rng.uniform(0.1, 0.5, n)
+    for solver in ("exact", "DOP853"):
+        whole = B.simulate_batch("coulomb", sb, {"mu": mu}, solver=solver, n=21)
+        monkeypatch.setattr(B, "CHUNK", 10)
+        parts = B.simulate_batch("coulomb", sb, {"mu": mu}, solver=solver, n=21)
+        monkeypatch.undo()
+        assert parts.info["chunks"] == 4 and whole.solver == parts.solver == solver
+        for name in ("u", "v", "omega", "theta", "force", "N"):
+            assert np.array_equal(getattr(whole, name), getattr(parts, name)), name
+        assert np.array_equal(whole.stick_time, parts.stick_time, equal_nan=True)
+        assert 0 < np.isfinite(whole.stick_time).sum() < n
+
+
+@pytest.mark.parametrize("dataset", ["impact-golf-v28", "incline-dry-d10", "incline-oil-a100"])
+@pytest.mark.parametrize("law", ["coulomb", "area-rate", "wear", "couette", "stribeck"])
+def test_the_one_state_right_hand_side_equals_the_general_one(dataset, law):
+    """Plan.derivatives on one state vector (the scalar ODE's fast path) is bitwise the batch path's."""
+    import numpy as np
+
+    from frictionlab import get_law, load_dataset
+    from frictionlab.plan import make_plan
+
+    ds, lw = load_dataset(dataset), get_law(law)
+    plan = make_plan(ds.scene, lw)
+    p = lw.resolve({k: v for k, v in ds.fixed.items() if k in lw.param_names})
+    rng = np.random.default_rng(5)
+    y0 = plan.initial_state(p)
+    scale = np.maximum(np.abs(y0), 1.0)
+    for t in np.linspace(0.0, ds.scene.duration, 7):
+        for direction in (1.0, -1.0, 0.0):
+            y = y0 + scale * rng.normal(size=y0.shape)
+            fast = plan.derivatives(p, t, y, direction)
+            general = plan.derivatives(p, np.array([t]), y[:, None], np.array([direction]))[:, 0]
+            assert np.array_equal(fast, general), (t, direction)
+
+
+def test_the_one_state_right_hand_side_reports_a_bad_force_as_the_law_does():
+    import numpy as np
+
+    from frictionlab import FrictionLaw, ParamSpec, load_dataset
+    from frictionlab.errors import LawError
+    from frictionlab.plan import make_plan
+
+    class Bad(FrictionLaw):
+        name, formula, citation = "bad-rhs", "F = nan", "test"
+        params = (ParamSpec("k", "", 1.0, 0.0, 2.0, 1.0, "k"),)
+        requires = frozenset({"u"})
+
+        def force(self, p, c):
+            return np.full(np.shape(c.u), np.nan)
+
+    plan = make_plan(load_dataset("incline-dry-d10").scene, Bad())
+    with pytest.raises(LawError, match="NaN or infinite"):
+        plan.derivatives({"k": 1.0}, 0.1, np.full(len(plan.states), 0.1), 1.0)
+
+
+@pytest.mark.parametrize("method", ["LSODA", "DOP853", "RK45", "Radau", "BDF"])
+@pytest.mark.parametrize("stops", [True, False])
+def test_the_ode_loop_equals_solve_ivp(method, stops):
+    """ode.solve is solve_ivp's loop for sorted outputs and one terminal event: the same numbers."""
+    import numpy as np
+    from scipy.integrate import solve_ivp
+
+    from frictionlab.solvers.ode import solve
+
+    def f(s, z):  # a damped oscillator: z[0] crosses zero falling near s = 0.35
+        return np.array([z[1], -20.0 * z[0] - 0.5 * z[1]])
+
+    def crossing(s, z):
+        return z[0] + (0.0 if stops else 5.0)
+
+    crossing.terminal, crossing.direction = True, -1
+    s_eval = np.linspace(0.0, 1.0, 41)
+    ref = solve_ivp(f, (0.0, 1.0), [1.0, 0.0], method=method, t_eval=s_eval, rtol=1e-7, atol=1e-9, events=crossing)
+    Z, s_event, z_event, solver = solve(f, 0.0, 1.0, [1.0, 0.0], method, s_eval, 1e-7, 1e-9, crossing, -1.0)
+    assert np.array_equal(Z, ref.y) and solver.nfev == ref.nfev
+    if stops:
+        assert s_event == ref.t_events[0][0] and np.array_equal(z_event, ref.y_events[0][0]) and Z.shape[1] < 41
+    else:
+        assert s_event is None and ref.t_events[0].size == 0 and Z.shape[1] == 41
+
+
+def test_the_closed_form_stop_of_coulomb_impacts_equals_the_root_finder(monkeypatch):
+    """Coulomb on a half-sine pulse stops where (2/phi) arcsin(sqrt(q/2)) says: scalar and batch
+    closed forms against the general bracketed root search (the fast path switched off)."""
+    import numpy as np
+
+    from frictionlab import batch as B
+    from frictionlab import simulate
+    from frictionlab.scene import HalfSineNormal, Scene
+    from frictionlab.solvers import exact
+
+    rng = np.random.default_rng(11)
+    n = 40
+    tc = rng.uniform(400e-6, 500e-6, n)
+    template = Scene(kind="impact", mass=0.046, u0=1.0, duration=tc[0], radius=0.0213,
+                     normal=HalfSineNormal(1.0, tc[0]), effects=frozenset({"slip-coupling", "spin"}))
+    sb = B.SceneBatch.sweep(template, {"u0": rng.uniform(2, 40, n), "normal.impulse": rng.uniform(0.5, 4, n),
+                                       "normal.contact_time": tc, "duration": tc})
+    mu = rng.uniform(0.1, 0.5, n)
+    t = np.linspace(0.0, 1.0, 41)[None, :] * tc[:, None]
+    fast = B.simulate_batch("coulomb", sb, {"mu": mu}, solver="exact", t=t)
+    scalar_fast = [simulate("coulomb", sb.scene(i), {"mu": mu[i]}, solver="exact", t=t[i]) for i in range(n)]
+    monkeypatch.setattr(exact, "closed_stop_applies", lambda plan, form, t0: False)
+    slow = B.simulate_batch("coulomb", sb, {"mu": mu}, solver="exact", t=t)
+    scalar_slow = [simulate("coulomb", sb.scene(i), {"mu": mu[i]}, solver="exact", t=t[i]) for i in range(n)]
+    stops = np.isfinite(slow.stick_time)
+    assert 0 < stops.sum() < n and np.array_equal(stops, np.isfinite(fast.stick_time))
+    assert np.allclose(fast.stick_time[stops], slow.stick_time[stops], rtol=0, atol=1e-12 * tc.max())
+    for name in ("u", "v", "omega", "theta"):
+        a, b = getattr(fast, name), getattr(slow, name)
+        assert np.allclose(a, b, rtol=1e-10, atol=1e-10 * np.max(np.abs(b))), name
+    for f, s_ in zip(scalar_fast, scalar_slow):
+        assert (f.stick_time is None) == (s_.stick_time is None)
+        if f.stick_time is not None:
+            assert abs(f.stick_time - s_.stick_time) <= 1e-12 * tc.max()
+        assert np.allclose(f.omega, s_.omega, rtol=1e-10, atol=1e-10 * np.max(np.abs(s_.omega)))
