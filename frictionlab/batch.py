@@ -260,6 +260,8 @@ def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol:
         return _chunked(law, batch, p, tgrid, solver, rtol, atol, n)
     T = np.broadcast_to(tgrid, (nsc, tgrid.shape[-1]))
     plan = make_plan(batch.view(), law, "batch scene")
+    if plan.scene.spring is not None:
+        raise SolverError("batch: spring-slider scenes are not supported; use simulate(..., solver='ode')")
     if plan.law_states:
         raise SolverError(f"batch: law '{law.name}' has internal state ({', '.join(law.state_names)}), which the "
                           "explicit batch engine does not integrate (stiff); use simulate(..., solver='ode')")

@@ -5,6 +5,7 @@ import math
 
 #: Display unit and factor (display = SI * factor) per observable / series.
 OBSERVABLE_UNITS = {
+    "mu": ("-", 1.0),
     "omega": ("rpm", 60.0 / (2.0 * math.pi)),
     "theta": ("deg", 180.0 / math.pi),
     "v": ("m/s", 1.0),
@@ -15,7 +16,8 @@ OBSERVABLE_UNITS = {
 }
 
 NAMES = {"omega": "spin omega", "theta": "rotation angle theta", "v": "velocity v", "u": "slip u",
-         "force": "friction force F", "A": "contact area A", "N": "normal force N"}
+         "force": "friction force F", "A": "contact area A", "N": "normal force N",
+         "mu": "friction coefficient mu (spring force / N)"}
 
 
 def unit(name: str) -> tuple[str, float]:

@@ -19,8 +19,11 @@ bristle deflection z or rate-and-state's theta. It declares them and their time 
 The plan adds the states to its state vector (as "law:z") only for such a law, and the ODE
 solver integrates them (default LSODA, which switches to an implicit method where the states are
 stiff, as LuGre's are); closed forms (exact, series) and the explicit batch engine do not apply.
-Such a law is integrated through zero slip without stick events, so its force must be continuous
-in u there. A memoryless law declares nothing of this: ``states`` defaults to ().
+Such a law is integrated through zero slip without stick events (its state carries what static
+friction there is, as LuGre's bristles do), unless it sets ``jumps_at_zero_slip = True``: then, as
+for a memoryless law, slip reaching zero is an event and the contact sticks, its states held, while
+the law's force at vanishing slip can hold it (rate-and-state, whose force turns over within
+1e-30 m/s of zero). A memoryless law declares nothing of this: ``states`` defaults to ().
 """
 from __future__ import annotations
 
@@ -132,6 +135,8 @@ class FrictionLaw:
     ratio_only: ClassVar[tuple[tuple[str, str], ...]] = ()
     #: Internal states of a law with memory (see the module docstring); () for a memoryless law.
     states: ClassVar[tuple[StateSpec, ...]] = ()
+    #: A law with memory whose force jumps at zero slip: stick events instead of integrating through zero.
+    jumps_at_zero_slip: ClassVar[bool] = False
 
     def force(self, p: Mapping[str, float], c: Contact) -> np.ndarray:
         """Friction force [N] at each sample of ``c`` for parameters ``p`` (SI floats)."""

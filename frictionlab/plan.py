@@ -15,6 +15,14 @@ static friction up to the law's capacity. For the laws' closed-form families the
 solved by hand, otherwise by root finding. k and c are constants for model 'linear' and follow
 the contact radius for 'mindlin' (``Plan.spring``).
 
+A spring-slider (kind 'spring-slider') is quasi-static, as in the rate-and-state literature and
+rsfmodel: the block's inertia is neglected, so the spring's load per unit normal force always
+equals the friction coefficient, mu = F(v, s)/N, and d mu/dt = k (V_lp(t) - v) fixes the slip rate:
+    dv/dt = (k N (V_lp - v) - sum_i dF/ds_i ds_i/dt) / (dF/dv),
+the partial derivatives of the law's force by central differences. This needs dF/dv > 0 at fixed
+state (a direct effect: rate-and-state's a > 0, a viscous term); for a law without one (Coulomb,
+Dahl) the quasi-static block has no defined slip rate and the plan says so.
+
 ``Plan.derivatives(p, t, y, direction)`` is the one right-hand side dy/dt of every integrator
 (solvers.ode and the batch engine): callers never assemble slip, force and rates themselves.
 """
@@ -26,9 +34,13 @@ import attrs
 import numpy as np
 from scipy.optimize import brentq
 
-from .errors import SceneError
+from .errors import SceneError, SolverError
 from .law import QUANTITIES, AreaSlipForm, Contact, FrictionLaw, NormalAreaRateForm
-from .scene import G, GrowthArea, HertzNormal, Scene
+from .scene import G, ConstantNormal, GrowthArea, HertzNormal, Scene
+
+#: A quasi-static spring-slider stops with an error once the slip rate exceeds this multiple of the fastest
+#: load-point velocity (stick-slip events, where inertia would matter).
+QUASI_STATIC_LIMIT = 1e3
 
 #: Prefix of a law's internal states in the plan's state vector ("law:theta" cannot clash with the spin angle).
 LAW_PREFIX = "law:"
@@ -61,6 +73,18 @@ class Plan:
         return "omega" in self.states
 
     @property
+    def continuous(self) -> bool:
+        """Integrated in one phase through zero slip, without stick events: a law with memory (its state
+        carries static friction) unless it jumps at zero slip, or a spring-slider (its drive, the
+        spring, changes with the state)."""
+        return (bool(self.law_states) and not self.law.jumps_at_zero_slip) or self.scene.spring is not None
+
+    @property
+    def breaks(self) -> tuple[float, ...]:
+        """Times [s] at which the right-hand side jumps (load-point velocity steps)."""
+        return self.scene.spring.breaks if self.scene.spring is not None else ()
+
+    @property
     def law_states(self) -> tuple[str, ...]:
         """The plan's names of the law's internal states ("law:z", ...); () for a memoryless law."""
         return tuple(LAW_PREFIX + n for n in self.law.state_names)
@@ -77,7 +101,7 @@ class Plan:
         y0 = np.array(np.broadcast_arrays(*[values[k] for k in self.states]), dtype=float)
         if self.law_states:
             if p is None:
-                raise SceneError(f"law '{self.law.name}' has internal states: its initial state needs the parameters")
+                raise SceneError(f"law '{self.law.name}' on {self.scene.kind}: the initial state needs the parameters")
             y = y0.reshape(len(self.states), -1)
             u = np.broadcast_to(self.rigid_slip(y), y.shape[1:])
             c = attrs.evolve(self.contact(np.zeros(u.shape), y, u), state=None)
@@ -191,7 +215,8 @@ class Plan:
         for none: a stage that overshoots zero slip then sees vanishing slip on the phase's side
         (``stick.branch_slip``). Works on batches (y of shape (n_states, ...)).
         """
-        if not self.law.states and np.ndim(y) == 1 and np.ndim(direction) == 0 and "xi" not in self.states:
+        if (not self.law.states and np.ndim(y) == 1 and np.ndim(direction) == 0 and "xi" not in self.states
+                and self.scene.spring is None):
             return self._one_state(p, t, y, float(direction))
         if "xi" in self.states:
             F, u = self.patch_force(p, t, y)
@@ -203,7 +228,36 @@ class Plan:
 
                 u = branch_slip(self, u, direction)
             F, c = self.force(p, np.asarray(t), y, np.asarray(u))
-        return self._rates(p, t, y, F, u, c)
+        dy = self._rates(p, t, y, F, u, c)
+        if self.scene.spring is not None:
+            dy[0] = self._quasi_static_acceleration(p, t, y, dy)
+        return dy
+
+    def _quasi_static_acceleration(self, p, t, y, dy) -> float:
+        """dv/dt of a quasi-static spring-slider: d F(v, s)/dt = k N (V_lp - v), partials by central differences."""
+        s = self.scene
+        n = len(self.states)
+        v = float(y[0])
+        fastest = QUASI_STATIC_LIMIT * max(s.spring.velocities)
+        if abs(v) > fastest:
+            raise SolverError(f"law '{self.law.name}' on a spring-slider: the slip rate reached {v:.3g} m/s at "
+                              f"t = {float(t):.6g} s, beyond {QUASI_STATIC_LIMIT:g} times the fastest load point: an "
+                              "unstable slider (k below the law's critical stiffness), where the quasi-static model "
+                              "no longer holds")
+        steps = [1e-5 * abs(v) + 1e-30] + [1e-5 * (abs(float(y[i])) + 1e-3 * spec.scale)
+                                           for i, spec in zip(range(1, n), self.law.states)]
+        Y = np.repeat(np.asarray(y, dtype=float)[:, None], 2 * n, axis=1)
+        for i, h in enumerate(steps):
+            Y[i, 2 * i] += h
+            Y[i, 2 * i + 1] -= h
+        F, _ = self.force(p, np.full(2 * n, t), Y, Y[0])
+        dF = (F[0::2] - F[1::2]) / (2.0 * np.array(steps))
+        if not dF[0] > 0:
+            raise SceneError(f"law '{self.law.name}' on a spring-slider: its force does not grow with the slip rate "
+                             f"at fixed state (dF/du = {dF[0]:.3g} N s/m at u = {v:.3g} m/s), so the quasi-static "
+                             "block has no slip rate for the spring's load")
+        N = float(s.normal(t))
+        return (s.spring.stiffness * N * (float(s.spring.velocity(t)) - v) - float(dF[1:] @ dy[1:])) / dF[0]
 
     def _one_state(self, p, t, y, direction: float) -> np.ndarray:
         """``derivatives`` for one state vector of a memoryless law without compliance (every scalar ODE
@@ -264,6 +318,8 @@ def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan
         raise SceneError(f"law '{law.name}' needs {what}, which {scene_name} cannot supply: "
                          + "; ".join(sorted({hint[q] for q in missing if q in hint})))
     effects = scene.effects
+    if scene.spring is not None and not isinstance(scene.normal, ConstantNormal):
+        raise SceneError(f"{scene_name}: a spring-slider needs a constant normal force (scene.normal model 'constant')")
     coupled = "slip-coupling" in effects
     spin = "spin" in effects or coupled
     if spin and scene.radius is None:

@@ -25,7 +25,7 @@ from .registry import get_law
 from .scene import Scene
 
 #: Trajectory series that a time-series observable reads.
-SERIES = {"omega": "omega", "theta": "theta", "v": "v", "u": "u"}
+SERIES = {"omega": "omega", "theta": "theta", "v": "v", "u": "u", "mu": "load"}
 
 #: Default ODE tolerance of fits (``fit(..., rtol=None)``). The tolerance check of the built-in
 #: comparison (``fitcost.tolerance_check``, measured in benchmarks/README) finds that refitting at
@@ -134,6 +134,7 @@ def outcome_predictor(law, target, scene, params, solver, rtol=FIT_RTOL):
 
 register_predictor("impact", _predict_series)
 register_predictor("incline", _predict_series)
+register_predictor("spring-slider", _predict_series)
 register_predictor("impact-outcome", outcome_predictor)
 
 

@@ -18,7 +18,7 @@ from .units import to_si
 
 G = 9.80665  # standard gravity [m/s^2]
 
-KINDS = ("impact", "incline", "impact-outcome")
+KINDS = ("impact", "incline", "impact-outcome", "spring-slider")
 
 #: Effects a scene may switch on in its ``effects`` list.
 EFFECTS = {
@@ -202,6 +202,16 @@ class TableNormal:
 
 
 @attrs.frozen
+class ConstantNormal:
+    """A constant normal force [N] (a spring-slider's normal load)."""
+
+    value: float = attrs.field(validator=_positive)
+
+    def __call__(self, t, A=None):
+        return np.full(np.shape(t), self.value)
+
+
+@attrs.frozen
 class WeightNormal:
     """N = m g cos(alpha) on an incline [N]."""
 
@@ -209,6 +219,41 @@ class WeightNormal:
 
     def __call__(self, t, A=None):
         return np.full(np.shape(t), self.value)
+
+
+@attrs.frozen(eq=False)
+class SpringLoad:
+    """A spring of stiffness k per unit normal force [1/m] pulled at a load-point velocity that steps.
+
+    The load point moves at velocities[i] [m/s] from times[i] [s] on (times[0] = 0); a velocity of 0
+    is a hold. The spring force per unit normal force, mu = K (x_lp - x) / N, obeys
+    d mu/dt = k (V_lp - v): k = K / N is the stiffness per unit normal stress of the
+    rate-and-state literature (k_c = (b - a) / Dc). The block is quasi-static (see plan.py).
+    """
+
+    stiffness: float = attrs.field(validator=_positive)
+    times: tuple = attrs.field(converter=lambda x: tuple(float(v) for v in x))
+    velocities: tuple = attrs.field(converter=lambda x: tuple(float(v) for v in x))
+
+    def __attrs_post_init__(self):
+        t, v = np.asarray(self.times), np.asarray(self.velocities)
+        if t.size == 0 or t.size != v.size:
+            raise SceneError(f"SpringLoad: times and velocities must be non-empty lists of one length, got {t.size} "
+                             f"and {v.size}")
+        if t[0] != 0.0 or np.any(np.diff(t) <= 0) or not np.all(np.isfinite(t)):
+            raise SceneError(f"SpringLoad: times must start at 0 s and increase strictly, got {list(self.times)}")
+        if not np.all(np.isfinite(v)) or np.any(v < 0):
+            raise SceneError(f"SpringLoad: velocities must be finite and >= 0, got {list(self.velocities)}")
+
+    def velocity(self, t):
+        """Load-point velocity V_lp(t) [m/s]."""
+        i = np.searchsorted(np.asarray(self.times), np.asarray(t, dtype=float), side="right") - 1
+        return np.asarray(self.velocities)[np.clip(i, 0, len(self.times) - 1)]
+
+    @property
+    def breaks(self) -> tuple[float, ...]:
+        """Times [s] at which the load-point velocity steps (where an integrator should restart)."""
+        return self.times[1:]
 
 
 @attrs.frozen
@@ -227,6 +272,7 @@ class Scene:
     normal: object | None = None
     compliance: Compliance | MindlinCompliance | None = None
     effects: frozenset = attrs.field(default=frozenset(), converter=frozenset)
+    spring: SpringLoad | None = None  # kind 'spring-slider': the driving spring and its load point
 
     def __attrs_post_init__(self):
         if self.kind not in KINDS:
@@ -240,6 +286,8 @@ class Scene:
                 raise SceneError(f"Scene.incline must be between 0 and pi/2 rad, got {self.incline!r}")
         if {"spin", "slip-coupling"} & set(self.effects) and self.radius is None:
             raise SceneError("Scene: effects 'spin' and 'slip-coupling' need a radius")
+        if self.kind == "spring-slider" and (self.spring is None or self.normal is None):
+            raise SceneError("a spring-slider scene needs a spring (SpringLoad) and a normal force model")
         if "gravity" in self.effects:
             if self.incline is None:
                 raise SceneError("effect 'gravity' needs scene.incline")
@@ -271,7 +319,7 @@ class Scene:
         """Build a scene from a ``[scene]`` table; ``where`` prefixes error messages (file name)."""
         columns = columns or {}
         known = {"mass", "radius", "inertia_factor", "u0", "omega0", "duration", "incline", "effects",
-                 "area", "normal", "compliance", "materials"}
+                 "area", "normal", "compliance", "materials", "spring"}
         extra = set(spec) - known
         if extra:
             raise SceneError(f"{where}: [scene] has unknown key(s) {sorted(extra)}; known: {', '.join(sorted(known))}")
@@ -290,10 +338,12 @@ class Scene:
         if not inertia_factor <= 1.0:
             raise SceneError(f"{where}: scene.inertia_factor = {inertia_factor:g}: I = f m r^2 needs f <= 1 "
                              "(0.4 for a solid sphere, 2/3 for a thin shell)")
-        u0 = q("u0", "m/s", required=kind != "impact-outcome", positive=False, default=0.0)
+        spring = _spring_from_spec(spec, where, q, kind)
+        u0 = q("u0", "m/s", required=kind not in ("impact-outcome", "spring-slider"), positive=False,
+               default=spring.velocities[0] if spring else 0.0)
         omega0 = q("omega0", "rad/s", required=False, positive=False, default=0.0)
 
-        for key in ("area", "normal", "compliance", "materials"):
+        for key in ("area", "normal", "compliance", "materials", "spring"):
             if key in spec and not isinstance(spec[key], Mapping):
                 raise SceneError(f"{where}: scene.{key} must be a table, got {type(spec[key]).__name__} {spec[key]!r}")
         pair = materials_from_spec(spec["materials"], where, q)[0] if "materials" in spec else None
@@ -322,7 +372,7 @@ class Scene:
         try:
             return cls(kind=kind, mass=mass, u0=u0, duration=duration, radius=radius, inertia_factor=inertia_factor,
                        omega0=omega0, incline=incline, area=area, normal=normal, compliance=compliance,
-                       effects=effects)
+                       effects=effects, spring=spring)
         except SceneError as exc:
             raise SceneError(f"{where}: {exc}") from None
 
@@ -340,7 +390,7 @@ def _column(columns, name, where, prefix, quantity):
 #: Keys each area and normal-force model reads; anything else is a typo that would be ignored.
 AREA_KEYS = {"half-sine": {"peak", "contact_time"}, "constant": {"area"}, "growth": {"initial", "rate"},
              "column": {"column"}}
-NORMAL_KEYS = {"half-sine": {"contact_time", "impulse", "normal_speed", "restitution"},
+NORMAL_KEYS = {"half-sine": {"contact_time", "impulse", "normal_speed", "restitution"}, "constant": {"value"},
                "hertz": {"coefficient", "modulus", "radius"}, "column": {"column"}, "weight": set()}
 
 
@@ -404,8 +454,35 @@ def _normal_from_spec(n, where, q, columns, t, mass, contact_time, spec, incline
         return HertzNormal(4.0 * modulus / (3.0 * math.pi**1.5 * radius))
     if model == "column":
         return TableNormal(t, _column(columns, n.get("column", "N"), where, p, "N"))
+    if model == "constant":
+        return ConstantNormal(q("value", "N", n, p))
     if model == "weight":
         if incline is None:
             raise SceneError(f"{where}: {p}.model = 'weight' needs scene.incline")
         return WeightNormal(mass * G * math.cos(incline))
-    raise SceneError(f"{where}: {p}.model must be one of half-sine, hertz, column, weight; got {model!r}")
+    raise SceneError(f"{where}: {p}.model must be one of half-sine, hertz, column, weight, constant; got {model!r}")
+
+
+def _spring_from_spec(spec, where, q, kind):
+    """[scene.spring]: stiffness [1/m per unit normal force], times and velocities of the load point."""
+    if "spring" not in spec:
+        if kind == "spring-slider":
+            raise SceneError(f"{where}: a spring-slider needs a [scene.spring] table with 'stiffness', 'times' "
+                             "and 'velocities'")
+        return None
+    if kind != "spring-slider":
+        raise SceneError(f"{where}: [scene.spring] belongs to kind 'spring-slider', not {kind!r}")
+    sp = spec["spring"]
+    if not isinstance(sp, Mapping):
+        raise SceneError(f"{where}: scene.spring must be a table, got {type(sp).__name__}")
+    _known_keys(sp, {"stiffness", "times", "velocities"}, where, "[scene.spring]")
+    lists = {}
+    for key, unit in (("times", "s"), ("velocities", "m/s")):
+        v = sp.get(key)
+        if not isinstance(v, list) or not v:
+            raise SceneError(f"{where}: scene.spring.{key} must be a non-empty list of quantities in {unit}")
+        lists[key] = [to_si(x, unit, f"{where}: scene.spring.{key}[{i}]") for i, x in enumerate(v)]
+    try:
+        return SpringLoad(q("stiffness", "1/m", sp, "scene.spring"), lists["times"], lists["velocities"])
+    except SceneError as exc:
+        raise SceneError(f"{where}: scene.spring: {exc}") from None

@@ -5,7 +5,8 @@ import attrs
 import numpy as np
 
 #: Columns written by ``Trajectory.to_csv``, SI units.
-CSV_UNITS = {"t": "s", "u": "m/s", "v": "m/s", "omega": "rad/s", "theta": "rad", "force": "N", "A": "m^2", "N": "N"}
+CSV_UNITS = {"t": "s", "u": "m/s", "v": "m/s", "omega": "rad/s", "theta": "rad", "force": "N", "A": "m^2", "N": "N",
+             "load": ""}
 
 
 @attrs.frozen(eq=False)
@@ -13,6 +14,7 @@ class Trajectory:
     """Sampled motion: time t [s], slip u [m/s], body velocity v [m/s], spin omega [rad/s],
     rotation angle theta [rad], friction force [N], and contact area A [m^2] and normal force
     N [N] where the plan built them. A body without a spin state has omega = theta = 0.
+    ``load`` is a spring-slider's spring force per unit normal force [-] (the measured friction coefficient).
     ``law_states`` holds a law's internal states by name (SI, e.g. {"z": ...}); empty for a memoryless law.
     """
 
@@ -24,6 +26,7 @@ class Trajectory:
     force: np.ndarray
     A: np.ndarray | None = None
     N: np.ndarray | None = None
+    load: np.ndarray | None = None
     solver: str = ""
     law: str = ""
     stick_time: float | None = None  # first time slip reached zero and stuck [s]
@@ -31,6 +34,7 @@ class Trajectory:
     law_states: dict = attrs.field(factory=dict)
 
     def __getitem__(self, name: str) -> np.ndarray:
+        name = {"mu": "load"}.get(name, name)  # a spring-slider's observable: the spring's load
         value = getattr(self, name, None)
         if not isinstance(value, np.ndarray):
             raise KeyError(f"trajectory has no series '{name}'")
@@ -38,7 +42,7 @@ class Trajectory:
 
     def columns(self) -> dict[str, np.ndarray]:
         out = {k: getattr(self, k) for k in ("t", "u", "v", "omega", "theta", "force")}
-        out.update({k: getattr(self, k) for k in ("A", "N") if getattr(self, k) is not None})
+        out.update({k: getattr(self, k) for k in ("A", "N", "load") if getattr(self, k) is not None})
         return out
 
     def csv_text(self) -> str:

@@ -4,11 +4,16 @@ mu = mu0 + a ln(V/V0) + b ln(V0 theta/Dc),  F = mu N sign(V). Evaluated in the r
 mu = a asinh(V/(2 V0) exp(psi/a)), psi = mu0 + b ln(V0 theta/Dc) (Rice and Ben-Zion 1996), which
 equals the log form to relative exp(-2 mu/a) (1e-50 at mu = 0.6, a = 0.01) and stays finite
 through V = 0. Steady state theta_ss = Dc/|V|, mu_ss = mu0 + (a - b) ln(|V|/V0).
-Software anchor: rsfmodel (Leeman et al., SciPy 2016).
+V0 is a reference speed, not a parameter: mu0 and V0 enter only as mu0 - (a - b) ln V0, so fitting
+both would be degenerate. It is fixed at 1 um/s (a common laboratory reference); mu0 is the steady
+friction there. Software anchor: rsfmodel (Leeman et al., SciPy 2016).
 """
 import numpy as np
 
 from frictionlab.law import FrictionLaw, ParamSpec, StateSpec
+
+#: Reference slip speed V0 [m/s]: mu0 is the steady-state friction coefficient at this speed.
+V0 = 1e-6
 
 #: Slip speed [m/s] below which the steady state is taken at this speed (theta_ss = Dc/|V| is infinite at 0).
 V_FLOOR = 1e-15
@@ -28,21 +33,22 @@ class RateState(FrictionLaw):
     citation = ("Dieterich, J. Geophys. Res. 84 (1979); Ruina, J. Geophys. Res. 88 (1983); Marone, "
                 "Annu. Rev. Earth Planet. Sci. 26 (1998)")
     params = (
-        ParamSpec("mu0", "", 0.6, 0.0, 2.0, 0.1, "steady-state friction at V0"),
+        ParamSpec("mu0", "", 0.6, 0.0, 2.0, 0.1, "steady-state friction at V0 = 1 um/s"),
         ParamSpec("a", "", 0.01, 1e-5, 0.5, 0.01, "direct-effect parameter"),
         ParamSpec("b", "", 0.01, 0.0, 0.5, 0.01, "evolution-effect parameter"),
         ParamSpec("Dc", "m", 1e-5, 1e-9, 1.0, 1e-5, "critical slip distance"),
-        ParamSpec("V0", "m/s", 1e-6, 1e-12, 1e3, 1e-6, "reference slip speed (fix it: it trades off with mu0)"),
     )
     requires = frozenset({"u", "N"})
     states = (StateSpec("theta", "s", "steady", 1.0, "state variable (contact age)"),)
+    # at V -> 0 the force turns over from -capacity to +capacity within ~1e-30 m/s: stick there instead
+    jumps_at_zero_slip = True
 
     def mu(self, p, V, theta):
         """Friction coefficient [-] at slip speed V [m/s] and state theta [s] (signed like V)."""
         V = np.asarray(V, dtype=float)
-        psi = p["mu0"] + p["b"] * np.log(p["V0"] * np.maximum(theta, 1e-300) / p["Dc"])
+        psi = p["mu0"] + p["b"] * np.log(V0 * np.maximum(theta, 1e-300) / p["Dc"])
         with np.errstate(divide="ignore"):
-            L = np.log(np.abs(V) / (2.0 * p["V0"])) + psi / p["a"]
+            L = np.log(np.abs(V) / (2.0 * V0)) + psi / p["a"]
         return p["a"] * np.sign(V) * asinh_exp(L)
 
     def force(self, p, c):

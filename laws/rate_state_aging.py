@@ -6,7 +6,7 @@ from frictionlab.laws.rate_state import RateState
 
 class RateStateAging(RateState):
     name = "rate-state-aging"
-    formula = "mu = mu0 + a ln(V/V0) + b ln(V0 theta/Dc), d theta/dt = 1 - V theta/Dc"
+    formula = "mu = mu0 + a ln(V/V0) + b ln(V0 theta/Dc), V0 = 1 um/s, d theta/dt = 1 - V theta/Dc"
     citation = "Dieterich, J. Geophys. Res. 84, 2161 (1979); " + RateState.citation
 
     def rates(self, p, c):

@@ -8,7 +8,7 @@ from frictionlab.laws.rate_state import RateState
 
 class RateStateSlip(RateState):
     name = "rate-state-slip"
-    formula = "mu = mu0 + a ln(V/V0) + b ln(V0 theta/Dc), d theta/dt = -(V theta/Dc) ln(V theta/Dc)"
+    formula = "mu = mu0 + a ln(V/V0) + b ln(V0 theta/Dc), V0 = 1 um/s, d theta/dt = -(V theta/Dc) ln(V theta/Dc)"
     citation = "Ruina, J. Geophys. Res. 88, 10359 (1983); " + RateState.citation
 
     def rates(self, p, c):

@@ -13,6 +13,8 @@ from frictionlab.errors import LawError, SolverError
 from frictionlab.predict import applicable_solvers
 from frictionlab.scene import G
 
+from frictionlab.solvers.prescribed import respond
+
 from _scenes import incline, normal_impact
 
 
@@ -138,3 +140,124 @@ def test_stateful_law_force_sees_its_state():
     dz = c.u - p["sigma0"] * np.abs(c.u) * c.state["z"] / 0.3  # g(1 m/s) = mu_c for vs = 1 mm/s
     assert law.evaluate_rates(p, c)["z"] == pytest.approx(dz, rel=1e-12)
     assert law.evaluate(p, c) == pytest.approx(10.0 * p["sigma0"] * c.state["z"], rel=1e-12)
+
+
+STATEFUL_PLUGIN = """
+    import numpy as np
+    from frictionlab import FrictionLaw, ParamSpec, StateSpec
+
+    class Relaxing(FrictionLaw):
+        name = "relaxing-third-party"
+        formula = "F = m N, dm/dt = (mu sign(u) - m) |u| / L"
+        citation = "a third-party package"
+        params = (ParamSpec("mu", "", 0.3, 0.0, 5.0, 0.3, "steady friction coefficient"),
+                  ParamSpec("L", "m", 0.5, 1e-6, 10.0, 0.1, "memory length"))
+        requires = frozenset({"u", "N"})
+        states = (StateSpec("m", "", 0.0, 0.3, "friction coefficient carried"),)
+
+        def force(self, p, c):
+            return c.state["m"] * c.N
+
+        def rates(self, p, c):
+            return {"m": (p["mu"] * np.sign(c.u) - c.state["m"]) * np.abs(c.u) / p["L"]}
+"""
+
+
+@pytest.fixture
+def stateful_plugin(tmp_path, monkeypatch):
+    from frictionlab import registry
+    from test_registry import _write_dist
+
+    _write_dist(tmp_path, "relaxing-law", STATEFUL_PLUGIN, "relaxing-third-party = relaxing_law:Relaxing\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    registry.reload_registry()
+    yield tmp_path
+    monkeypatch.undo()
+    registry.reload_registry()
+
+
+def test_third_party_stateful_law_works_as_a_builtin(stateful_plugin, run_cli):
+    """Registered by an entry point; integrated by the plan; listed with its state; joins 'all' only."""
+    from frictionlab.comparison import DEFAULT_LAWS, select_laws
+
+    law = fl.get_law("relaxing-third-party")
+    # a block sliding at constant speed (no drive, huge mass): m(x) = mu (1 - exp(-x / L)), x = u0 t
+    scene = fl.Scene(kind="incline", mass=1e12, u0=1.0, duration=2.0, normal=fl.scene.WeightNormal(10.0))
+    t = np.linspace(0.0, 2.0, 9)
+    tr = simulate(law, scene, {"mu": 0.3, "L": 0.5}, t=t)
+    assert tr.solver == "ode:LSODA"
+    assert np.allclose(tr.law_states["m"], 0.3 * (1 - np.exp(-t / 0.5)), rtol=1e-7, atol=1e-12)
+    assert np.allclose(tr.force, 10.0 * tr.law_states["m"], rtol=1e-12)
+    assert "relaxing-third-party" not in select_laws(None) and select_laws(None) == DEFAULT_LAWS
+    assert "relaxing-third-party" in select_laws("all") and "lugre" in select_laws(["all"])
+    out = run_cli("laws", env={"PYTHONPATH": str(stateful_plugin)})
+    assert out.returncode == 0, out.stderr
+    block = out.stdout.split("relaxing-third-party:")[1].split("\n\n")[0]
+    assert "relaxing-law 0.1" in block and "internal states" in block and "friction coefficient carried" in block
+
+
+def test_laws_command_lists_the_builtin_states(run_cli):
+    out = run_cli("laws", "--brief")
+    assert out.returncode == 0, out.stderr
+    rows = {line.split()[0]: line for line in out.stdout.splitlines()[2:]}
+    for name, state in (("lugre", "z"), ("dahl", "mu_d"), ("rate-state-aging", "theta"), ("rate-state-slip", "theta")):
+        assert rows[name].rstrip().endswith(state)
+    assert rows["stribeck"].rstrip().endswith("-") and rows["coulomb"].rstrip().endswith("-")
+
+
+def _readme_stateful_code() -> str:
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    block = re.search(r"```python\n(import numpy as np\n\nfrom frictionlab import FrictionLaw, ParamSpec, StateSpec.*?)```",
+                      text, re.S)
+    assert block, "README has no stateful law example"
+    return block.group(1)
+
+
+def test_readme_stateful_law_example_runs_as_written():
+    code = _readme_stateful_code()
+    assert len(code.splitlines()) <= 30
+    exec(compile(code, "my_stateful_law.py", "exec"), {})
+    try:
+        # sliding at a constant 1 m/s (no drive, huge mass), started in steady state
+        scene = fl.Scene(kind="incline", mass=1e12, u0=1.0, duration=1e-2, normal=fl.scene.WeightNormal(10.0))
+        tr = simulate("lagged-coulomb", scene, {"mu": 0.3, "L": 1e-3}, t=np.linspace(0, 1e-2, 5))
+        assert np.allclose(tr.force, 3.0, rtol=1e-9)  # started steady, stays steady
+        F, s = respond("lagged-coulomb", {"mu": 0.3, "L": 1e-3}, np.linspace(0, 4e-3, 5),
+                       lambda t: np.where(np.asarray(t) < 2e-3, 1.0, -1.0), N=10.0)
+        assert F[2] == pytest.approx(3.0) and F[4] == pytest.approx(-3.0 + 6.0 * math.exp(-2.0), rel=1e-6)
+    finally:
+        fl.unregister_law("lagged-coulomb")
+
+
+def test_rate_state_sticks_at_zero_slip_with_its_state_held():
+    """Rate-and-state's force turns over within ~1e-30 m/s of zero slip: it declares jumps_at_zero_slip,
+    so the ball rolls (slip 0) once slip reaches zero, and theta is held while it does."""
+    law = fl.get_law("rate-state-aging")
+    assert law.jumps_at_zero_slip and not fl.get_law("lugre").jumps_at_zero_slip
+    tr = simulate(law, normal_impact(), solver="ode", t=np.linspace(0.0, 500e-6, 51))
+    assert tr.stick_time is not None and 0 < tr.stick_time < 500e-6
+    after = tr.t > tr.stick_time
+    assert np.all(tr.u[after] == 0.0)
+    assert np.ptp(tr.law_states["theta"][after]) == 0.0
+    assert make_plan(normal_impact(), fl.get_law("lugre")).continuous
+
+
+def test_plugin_with_a_degenerate_state_spec_is_skipped_naming_it(tmp_path, monkeypatch):
+    from frictionlab import registry
+    from test_registry import _write_dist
+
+    bad = STATEFUL_PLUGIN.replace('StateSpec("m", "", 0.0, 0.3,', 'StateSpec("m", "", 0.0, 0.0,')
+    _write_dist(tmp_path, "degenerate-law", bad, "degenerate = degenerate_law:Relaxing\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    try:
+        with pytest.warns(registry.PluginWarning,
+                          match=r"entry point 'degenerate = degenerate_law:Relaxing' of degenerate-law 0.1: "
+                                r"state m: scale must be a positive"):
+            registry.reload_registry()
+        assert "lugre" in fl.available_laws() and "relaxing-third-party" not in fl.available_laws()
+    finally:
+        monkeypatch.undo()
+        registry.reload_registry()

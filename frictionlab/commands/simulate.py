@@ -178,7 +178,7 @@ def _series_figure(ds, tr, title) -> bytes:
     uname, uf = unit(obs)
     tname, tf = time_unit(float(tr.t[-1]))
     fig, ax = plt.subplots(figsize=(7, 4.2))
-    model = tr[obs] if obs in ("u", "v", "omega", "theta") else tr.columns().get(obs)
+    model = tr[obs] if obs in ("u", "v", "omega", "theta", "mu") else tr.columns().get(obs)
     if model is not None:
         ax.plot(tr.t * tf, model * uf, color="#1b9e77", lw=1.8, label="simulated")
     ax.errorbar(ds.t * tf, ds.y * uf, yerr=ds.sigma * uf, fmt="o", ms=3.5, color="k", ecolor="0.6", lw=0.8,

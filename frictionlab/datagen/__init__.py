@@ -9,7 +9,7 @@ import importlib
 from pathlib import Path
 
 #: Generator modules, in the order they run.
-GENERATORS = ("golf", "incline", "outcome", "kharaz")
+GENERATORS = ("golf", "incline", "outcome", "kharaz", "springslider")
 #: Generators of the known-truth folder (``examples/known-truth``, never built in): datasets the
 #: project's defaults were not tuned on, for checking its verdicts.
 KNOWN_TRUTH = ("knowntruth",)

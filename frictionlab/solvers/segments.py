@@ -5,9 +5,11 @@ A sliding-phase function has the signature
 where Y_out holds the states at the times t_out (all >= t0, only those reached), t_stop is
 the time slip reached zero (None if it did not before t_out[-1] or the end), y_stop the state there.
 
-A law with memory is integrated in one phase through zero slip (direction 0: no stick event): its
-internal state carries what static friction there is (LuGre's bristles), and its force is
-continuous in the slip, so no stuck phase is needed.
+A law with memory (unless it declares ``jumps_at_zero_slip``), and any law on a spring-slider, is
+integrated in one phase through zero slip (direction 0: no stick event; ``Plan.continuous``): a
+law's internal state carries what static friction there is (LuGre's bristles), and a spring's
+drive changes with the state, which the stuck-phase formulas of ``stick`` do not model. While
+stuck, a law's internal states are held.
 """
 from __future__ import annotations
 
@@ -35,7 +37,7 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
     compliant = "xi" in plan.states
     u_start = float(plan.rigid_slip(y0))
     direction = float(np.sign(u_start))
-    if plan.law_states:
+    if plan.continuous:
         phase, direction = "slide", 0.0
     elif compliant or u_start != 0.0:
         phase = "slide"
@@ -100,7 +102,8 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
     for name, arr in (("u", u), ("v", Y[0]), ("omega", omega), ("theta", theta), ("force", F)):
         if not np.all(np.isfinite(arr)):
             raise SolverError(f"{solver_name}: {name} became NaN or infinite for law '{plan.law.name}' with {dict(p)}")
-    return Trajectory(t=t_eval, u=u, v=Y[0].copy(), omega=omega, theta=theta, force=F, A=A, N=c.N,
+    load = F / plan.scene.normal(t_eval) if plan.scene.spring is not None else None  # quasi-static: spring = friction
+    return Trajectory(t=t_eval, u=u, v=Y[0].copy(), omega=omega, theta=theta, force=F, A=A, N=c.N, load=load,
                       solver=solver_name, law=plan.law.name, stick_time=stick_time, info=info,
                       law_states={n: Y[plan.index(k)].copy() for n, k in zip(plan.law.state_names, plan.law_states)})
 
