@@ -1,6 +1,7 @@
 """Datasets: a CSV series plus a TOML sidecar of the same stem, loaded into SI arrays.
 
-The TOML holds ``name``, ``kind``, ``observable``, ``[columns]`` (column -> unit),
+The TOML holds ``name``, optionally ``group`` (datasets of one material and setup compared
+together; default: the name without its last ``-suffix``), ``kind``, ``observable``, ``[columns]`` (column -> unit),
 ``[noise]`` (observable -> quantity, and ``kind = "known" | "assumed"``: whether sigma was
 measured or is a guess; default assumed), ``[scene]``, ``[fixed]`` law parameters,
 ``[provenance]`` and optionally ``[reported]``. Loading validates everything and fails
@@ -65,6 +66,7 @@ class Dataset:
     reported: dict = attrs.field(factory=dict)
     fixed_units: dict = attrs.field(factory=dict)
     noise_kind: str = "assumed"  # NOISE_KINDS: is the [noise] sigma measured ('known') or a guess ('assumed')?
+    group: str = ""  # declared group (TOML 'group'); "" -> answers.group_of derives it from the name
 
     @property
     def t(self) -> np.ndarray:
@@ -138,6 +140,11 @@ def _table(meta, key, path, where=None):
 def from_meta(meta: dict, path: Path) -> Dataset:
     """Build a Dataset from a parsed TOML dict whose CSV sits beside ``path``."""
     name = check_name(_req(meta, "name", path), f"{path}: name")
+    group = meta.get("group", "")
+    if "group" in meta:
+        if not isinstance(group, str) or not group:
+            raise DatasetError(f"{path}: group = {group!r}, expected a name (letters, digits, . _ + -)")
+        group = check_name(group, f"{path}: group")
     kind = _req(meta, "kind", path)
     if kind not in DATA_KINDS:
         raise DatasetError(f"{path}: kind = {kind!r}, expected one of {', '.join(DATA_KINDS)}")
@@ -238,7 +245,7 @@ def from_meta(meta: dict, path: Path) -> Dataset:
                 raise DatasetError(f"{path}: fixed.{key} = {value!r} is outside the bounds of law '{law_name}' "
                                    f"[{spec.lower:g}, {spec.upper:g}] {spec.unit}".rstrip())
 
-    extra = set(meta) - {"name", "kind", "observable", "columns", "noise", "scene", "fixed", "provenance",
+    extra = set(meta) - {"name", "group", "kind", "observable", "columns", "noise", "scene", "fixed", "provenance",
                          "reported", "description"}
     if extra:
         raise DatasetError(f"{path}: unknown top-level key(s) {sorted(extra)}")
@@ -255,7 +262,7 @@ def from_meta(meta: dict, path: Path) -> Dataset:
     return Dataset(name=name, kind=kind, observable=observable, path=path, columns=columns, units=dict(units),
                    noise=noise, scene=scene, fixed=fixed, provenance=provenance,
                    description=meta.get("description", ""), reported=reported,
-                   fixed_units=fixed_units, noise_kind=noise_kind)
+                   fixed_units=fixed_units, noise_kind=noise_kind, group=group)
 
 
 def _check_time_unit(columns, units, spec, kind, scene, path) -> None:

@@ -101,6 +101,8 @@ class TransferResult:
     datasets: tuple[str, ...]
     predictions: tuple[Prediction, ...]
     shared: tuple[SharedFit, ...]
+    status: str = "ok"  # ok | skipped
+    reason: str = ""  # why skipped
 
     def ranking(self) -> list[dict]:
         """Candidates by summed predictive chi2 over every ordered pair, best first (only those that
@@ -123,6 +125,8 @@ class TransferResult:
         """One sentence for the report's first screen: does one parameter set serve the group, and
         which candidate predicts across conditions best."""
         rank = self.ranking()
+        if self.status == "skipped":
+            return f"not tested: {self.reason}"
         if not rank:
             return "not tested: no candidate could predict across the group"
         best = rank[0]
@@ -138,7 +142,8 @@ class TransferResult:
                 f"RMS{detail}").lstrip("; ")
 
     def as_dict(self) -> dict:
-        return {"group": self.group, "datasets": list(self.datasets), "alpha": ALPHA,
+        return {"group": self.group, "datasets": list(self.datasets), "alpha": ALPHA, "status": self.status,
+                "reason": self.reason,
                 "predictions": [p.as_dict() for p in self.predictions], "shared": [s.as_dict() for s in self.shared],
                 "ranking": self.ranking(), "answer": self.answer()}
 
@@ -228,6 +233,32 @@ def transfer_candidate(fits: Sequence[FitResult], free: dict | None = None) -> t
     return preds, shared_fit(fits, free)
 
 
+def _members(datasets, group_of=None) -> dict[str, list]:
+    if group_of is None:
+        from .answers import group_of
+    out: dict[str, list] = {}
+    for ds in datasets:
+        out.setdefault(group_of(ds), []).append(ds)
+    return out
+
+
+def untransferable(datasets) -> str:
+    """Why the members of one group cannot predict each other ("" if they can): a parameter set fitted
+    to one observable is not a prediction of a different observable under other conditions."""
+    obs = dict.fromkeys(d.observable for d in datasets)
+    if len(datasets) > 1 and len(obs) > 1:
+        return (f"its datasets measure different observables ({', '.join(obs)}), so no dataset predicts "
+                "another under other conditions")
+    return ""
+
+
+def skipped(datasets, group_of=None) -> list[TransferResult]:
+    """A skipped TransferResult, with its reason, for each group of ``datasets`` that cannot be transferred."""
+    return [TransferResult(group=g, datasets=tuple(d.name for d in dss), predictions=(), shared=(),
+                           status="skipped", reason=why)
+            for g, dss in _members(datasets, group_of).items() if (why := untransferable(dss))]
+
+
 def candidates_by_group(fits: Sequence[FitResult], datasets: Sequence | None = None,
                         group_of=None) -> dict[str, dict[str, list[FitResult]]]:
     """group -> candidate label -> its single-dataset fits, for every group of ``datasets`` (default:
@@ -237,9 +268,8 @@ def candidates_by_group(fits: Sequence[FitResult], datasets: Sequence | None = N
     ok = [f for f in fits if f.ok and len(f.datasets) == 1]
     if datasets is None:
         datasets = list({f.datasets[0]: f.per_dataset[0].target.dataset for f in ok}.values())
-    members: dict[str, list[str]] = {}
-    for ds in datasets:
-        members.setdefault(group_of(ds), []).append(ds.name)
+    members = {g: [d.name for d in dss] for g, dss in _members(datasets, group_of).items()
+               if not untransferable(dss)}
     by: dict[tuple[str, str], dict[str, FitResult]] = {}
     for f in ok:
         by.setdefault(f"{f.law} [{f.solver}]", {})[f.datasets[0]] = f

@@ -144,6 +144,7 @@ def build(out_dir: Path) -> list[Path]:
                  "angle": f"{math.degrees(sigma):.2g} deg"}[nkey]
         meta = {
             "name": name,
+            "group": "kharaz2001",  # one material and setup, three observables
             "kind": "impact-outcome",
             "observable": obs,
             "description": (f"MEASURED: {what} of 5 mm aluminium oxide spheres striking a soda-lime glass anvil at "

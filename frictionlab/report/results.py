@@ -25,7 +25,7 @@ results.json:
                  p_a_mc_error, p_b_mc_error, power_a, power_b, failed, d_ab, d_ba, sigma, sigma_varies,
                  observable, threshold, threshold_text, alpha, power_level, critical_dchi2, fitted{},
                  decomposition{b, u0, c_area, c_area_rate, mu, eta_prime, r2} | null}],
-    transfer[TransferResult.as_dict(): {group, datasets[], alpha, predictions[{law, solver, source, target,
+    transfer[TransferResult.as_dict(): {group, datasets[], alpha, status (ok|skipped), reason, predictions[{law, solver, source, target,
              status, reason, n, chi2, rms_sigma, loglik, own_chi2, params{}}], shared[{law, solver, datasets,
              status, reason, chi2_shared, k_shared, chi2_separate, k_separate, lr, dk, p_value, delta_aic,
              shared{}, separate{}, serves, alpha}], ranking[{candidate, chi2, n, rms_sigma, loglik, rank}], answer}],

@@ -21,6 +21,8 @@ def build(ctx) -> Section | None:
           f"(one set serves when p ≥ {ALPHA:g}), and ΔAIC = AIC shared − AIC separate (negative: one set is preferred).")
     for tr in c.transfer:
         sec.p(f"**{tr.group}** ({', '.join(tr.datasets)}): {tr.answer()}.")
+        if tr.status != "ok":
+            continue
         rows = []
         for r in tr.ranking():
             preds = [p for p in tr.predictions if p.candidate == r["candidate"]]
