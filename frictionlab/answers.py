@@ -11,6 +11,10 @@ from __future__ import annotations
 
 import attrs
 
+#: Keys of ``Answer.short``, in table order, with the long field each one summarizes.
+SHORT = {"best": "headline", "goodness": "goodness", "equivalence": "equivalence",
+         "threshold": "noise_threshold", "series": "series_vs_exact", "transfer": "transfer"}
+
 #: The equivalence verdicts a row may carry.
 EQUIVALENCE = ("equivalent", "not equivalent", "cannot tell at this noise", "not tested")
 
@@ -32,9 +36,16 @@ class Answer:
     transfer: str = ""  # e.g. "one lambda serves both speeds: no (prediction error 12 sigma)"
     equivalence_series: str = ""  # one of EQUIVALENCE: the paper's series of lambda A u against mu N + mu eta' dA/dt
     details: dict = attrs.field(factory=dict)  # machine-readable numbers behind the texts (SI), for results.json
+    #: a few words per cell with the decisive number, for the first screen's table and the CLI's closing lines;
+    #: keys SHORT (filled by the producer of the matching long field; absent when it gave none)
+    short: dict = attrs.field(factory=dict)
 
     def as_dict(self) -> dict:
         return attrs.asdict(self)
+
+    def cell(self, key: str) -> str:
+        """The short form of ``key`` (a SHORT key), else its long field, else ""."""
+        return self.short.get(key) or getattr(self, SHORT[key]) or ""
 
 
 def group_of(dataset) -> str:

@@ -142,8 +142,8 @@ def from_meta(meta: dict, path: Path) -> Dataset:
     name = check_name(_req(meta, "name", path), f"{path}: name")
     group = meta.get("group", "")
     if "group" in meta:
-        if not isinstance(group, str) or not group:
-            raise DatasetError(f"{path}: group = {group!r}, expected a name (letters, digits, . _ + -)")
+        if not isinstance(group, str):
+            raise DatasetError(f"{path}: group = {group!r}, expected a quoted name (letters, digits, . _ + -)")
         group = check_name(group, f"{path}: group")
     kind = _req(meta, "kind", path)
     if kind not in DATA_KINDS:

@@ -158,6 +158,11 @@ class EquivalenceResult:
         return d
 
 
+def _num2(x: float) -> str:
+    """Two significant figures (whole numbers from 100 on): 1.8, 0.27, 150, 1,200."""
+    return f"{float(f'{x:.2g}'):,.0f}" if abs(x) >= 100 else f"{x:.2g}"
+
+
 def _num(x: float) -> str:
     return f"{x:,.0f}" if abs(x) >= 100 else f"{x:.3g}"
 
@@ -381,6 +386,19 @@ def group_answer(results, datasets, pair: tuple[str, str] = PAIRS[0]) -> dict:
                          f"when sigma < {_num(e.threshold * f)} {name} on {e.dataset} (sigma {_num(e.sigma * f)} {name})")
         return ", ".join(parts)
 
+    def threshold_short(es):
+        """'differ unless σ > 1.8 deg (σ = 0.5 deg)'; members joined by ' / ' in one unit."""
+        es = [e for e in es if math.isfinite(e.threshold)]
+        if not es:
+            return ""
+        if all(e.threshold == 0 for e in es):
+            return "one curve: equal at any noise"
+        name, f = unit(es[0].observable)
+        same = len({e.observable for e in es}) == 1
+        thr = " / ".join(_num2(e.threshold * f) if same else e.threshold_text() for e in es)
+        sig = " / ".join(dict.fromkeys(_num2(e.sigma * f) for e in es))
+        return f"differ unless σ > {thr} {name} (σ = {sig} {name})" if same else f"differ unless σ > {thr}"
+
     text = ""
     if thresholds(full):
         text = f"{pair[0]} and {pair[1]} differ by more than the noise {thresholds(full)}"
@@ -388,7 +406,13 @@ def group_answer(results, datasets, pair: tuple[str, str] = PAIRS[0]) -> dict:
             text += f"; the paper's series of {pair[0]}: {thresholds(series)}"
     elif thresholds(series):
         text = f"the paper's series of {pair[0]} and {pair[1]} differ by more than the noise {thresholds(series)}"
-    return {"equivalence": verdict(full), "equivalence_series": verdict(series), "noise_threshold": text,
+    v_full, v_series = verdict(full), verdict(series)
+    tested = [(v, how) for v, how in ((v_full, "exact"), (v_series, "series")) if v != "not tested"]
+    short = {"equivalence": (f"{v_full} (exact and series)" if len(tested) == 2 and v_full == v_series else
+                             "; ".join(f"{v} ({how})" for v, how in tested) or "not tested")}
+    if threshold_short(full or series):
+        short["threshold"] = threshold_short(full or series) + ("" if full else " [series]")
+    return {"equivalence": v_full, "equivalence_series": v_series, "noise_threshold": text, "short": short,
             "details": {"equivalence": [e.as_dict() | {"t_a": None, "t_b": None} for e in mine]}}
 
 
@@ -398,5 +422,6 @@ def fill_answers(answers, results) -> tuple:
     for a in answers:
         g = group_answer(results, a.datasets)
         out.append(attrs.evolve(a, equivalence=g["equivalence"], equivalence_series=g["equivalence_series"],
-                                noise_threshold=g["noise_threshold"], details={**a.details, **g["details"]}))
+                                noise_threshold=g["noise_threshold"], details={**a.details, **g["details"]},
+                                short={**a.short, **g["short"]}))
     return tuple(out)

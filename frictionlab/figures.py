@@ -330,7 +330,7 @@ def finding_figure(findings) -> bytes:
     exact fit of the same law (top), the slip u(t) of each (bottom), the series' zero crossing marked."""
     plt = _plt()
     n = len(findings)
-    fig, axes = plt.subplots(2, n, figsize=(4.6 * n + 0.4, 4.3), sharex="col", squeeze=False, layout="constrained",
+    fig, axes = plt.subplots(2, n, figsize=(4.6 * n + 0.4, 3.7), sharex="col", squeeze=False, layout="constrained",
                              gridspec_kw={"height_ratios": [1.5, 1]})
     su, sf = unit("omega")
     for j, f in enumerate(findings):
@@ -354,7 +354,8 @@ def finding_figure(findings) -> bytes:
             for a in (ax, axu):
                 a.axvline(f.t_cross * tf, color="#d95f02", ls=":", lw=1.3)
             axu.annotate(f"series slip = 0 at {f.t_cross * tf:.0f} {tname}:\nfriction reverses, spin falls",
-                         xy=(f.t_cross * tf, 0.0), xytext=(0.03, 0.1), textcoords="axes fraction", fontsize=8,
+                         xy=(f.t_cross * tf, 0.0), xytext=(0.03, 0.06), textcoords="axes fraction", fontsize=8,
+                         bbox={"fc": "white", "ec": "none", "alpha": 0.85, "pad": 1},
                          arrowprops={"arrowstyle": "->", "color": "0.3"})
         ax.axvline(f.contact_time * tf, color="0.6", lw=0.8)
         axu.axvline(f.contact_time * tf, color="0.6", lw=0.8)

@@ -59,6 +59,22 @@ class Goodness:
         text = ", ".join(parts) or "no test possible"
         return text + (f"; p Bonferroni-adjusted over {self.members} datasets" if self.members > 1 else "")
 
+    @property
+    def short(self) -> str:
+        """'fits: chi2 p = 0.96' / 'fails: runs p = 8e-10': the verdict and the p-value closest to failing."""
+        ps = [(name, p) for name, p in (("χ²", self.chi2_p), ("runs", self.runs_p)) if math.isfinite(p)]
+        if self.fits is None or not ps:
+            return "not testable"
+        name, p = min(ps, key=lambda x: x[1])
+        return f"{'fits' if self.fits else 'fails'}: {name} p {'' if p == 0 else '= '}{p_short(p)}"
+
+
+def p_short(p: float) -> str:
+    """A p-value in a few characters: 0.96, 0.012, 8e-10 (two figures, one below 0.001), < 1e-300."""
+    if p == 0:
+        return "< 1e-300"  # below the floating-point range
+    return f"{p:.2g}" if p >= 1e-3 else f"{p:.0e}".replace("e-0", "e-")
+
 
 def _p(p: float) -> str:
     return f"{p:.2g}" if p >= 1e-3 else f"{p:.1e}"

@@ -31,6 +31,7 @@ import numpy as np
 
 from .errors import FrictionLabError
 from .fitting import FitResult, fit, predict
+from .goodness import p_short
 
 ALPHA = 0.05  # level of the likelihood-ratio test of shared against separate parameters
 
@@ -141,11 +142,33 @@ class TransferResult:
         return (f"{head}; best prediction across conditions: {best['candidate']}, {best['rms_sigma']:.3g} noise sigmas "
                 f"RMS{detail}").lstrip("; ")
 
+    def short(self, best: str | None = None) -> str:
+        """'one wear [series] fit for both: no (p = 1e-8)': does one parameter set of the group's best law
+        (``best`` as in Answer.best, 'wear = couette [series]'; default: the best-predicting candidate) serve
+        every member, by the shared-against-separate test."""
+        if self.status == "skipped":
+            return "no transfer: " + ("different observables" if "observables" in self.reason else self.reason)
+        sh = {s.candidate: s for s in self.shared if s.status == "ok"}
+        rank = self.ranking()
+        mine = _candidates(best) if best else ([rank[0]["candidate"]] if rank else [])
+        s = next((sh[c] for c in mine if c in sh), None)
+        if s is None:
+            return "no transfer tested"
+        who = "both" if len(self.datasets) == 2 else "all"
+        p = ("" if s.p_value == 0 else "= ") + p_short(s.p_value)
+        return f"one {s.candidate} fit for {who}: {'yes' if s.serves else 'no'} (p {p})"
+
     def as_dict(self) -> dict:
         return {"group": self.group, "datasets": list(self.datasets), "alpha": ALPHA, "status": self.status,
                 "reason": self.reason,
                 "predictions": [p.as_dict() for p in self.predictions], "shared": [s.as_dict() for s in self.shared],
                 "ranking": self.ranking(), "answer": self.answer()}
+
+
+def _candidates(best: str) -> list[str]:
+    """'wear = couette [series]' -> ['wear [series]', 'couette [series]']."""
+    laws, _, solver = best.rpartition(" [")
+    return [f"{law} [{solver}" for law in laws.split(" = ")] if laws else [best]
 
 
 def _p(p: float) -> str:
@@ -309,6 +332,6 @@ def fill_answers(answers, results: Sequence[TransferResult]) -> tuple:
             out.append(a)
             continue
         d = t.as_dict()
-        out.append(attrs.evolve(a, transfer=t.answer(),
+        out.append(attrs.evolve(a, transfer=t.answer(), short={**a.short, "transfer": t.short(a.best)},
                                 details={**a.details, "transfer": {k: d[k] for k in ("ranking", "shared", "alpha")}}))
     return tuple(out)

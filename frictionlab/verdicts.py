@@ -45,21 +45,23 @@ def make_answers(datasets, fits, ranking, groups) -> tuple[Answer, ...]:
             rows = [r for r in pool if r.dataset == "ALL" and r.rank is not None]
         kinds = {d.provenance.kind for d in dss}
         provenance = kinds.pop() if len(kinds) == 1 else "mixed"
-        best, fits_ok, headline, goodness, details = _verdict(rows)
+        best, fits_ok, headline, goodness, details, short = _verdict(rows)
         details["likelihood"] = {f.datasets[0]: {"kind": f.stats.likelihood, "why": f.stats.likelihood_reason}
                                  for f in fits if f.ok and f.datasets[0] in names}
         series_text, series_numbers = series_vs_exact([f for f in fits if f.ok and f.datasets[0] in names])
         details["series_vs_exact"] = series_numbers
+        if series_numbers:
+            short["series"] = series_short(series_numbers)
         out.append(Answer(group=label, datasets=names, provenance=provenance, best=best, fits=fits_ok,
                           headline=headline, goodness=goodness, equivalence="not tested", noise_threshold="",
-                          series_vs_exact=series_text, details=details))
+                          series_vs_exact=series_text, details=details, short=short))
     return tuple(out)
 
 
 def _verdict(rows: list[RankRow]):
-    """(best, fits, headline, goodness text, details) from one group's ranked rows."""
+    """(best, fits, headline, goodness text, details, short forms) from one group's ranked rows."""
     if not rows:
-        return None, False, "no law could be fitted", "", {}
+        return None, False, "no law could be fitted", "", {}, {"best": "no law could be fitted"}
     top = rows[0]
     firsts = [r for r in rows if r.rank == top.rank]
     best = " = ".join(dict.fromkeys(r.candidate for r in firsts))
@@ -71,15 +73,20 @@ def _verdict(rows: list[RankRow]):
     goodness = f"{g.text if g else 'no test'}; {noise}"
     if fits:
         headline = f"best: {best}"
+        short = f"{best} ✓"
         if near:
             headline += (f"; indistinguishable by these data from {', '.join(r.candidate for r in near)} "
                          f"(delta-AIC < {NEAR_TIE:g})")
+            short += " ≈ " + " ≈ ".join(r.candidate for r in near)
     elif top.fits and top.flags:  # every candidate is flagged: the flag is part of the headline
         headline = f"best: {best}, flagged: {top.flags[0]}"
+        short = f"{best} (flagged implausible)"
     elif top.fits is None:  # no test possible (too few points for the runs test and sigma only assumed)
         headline = f"fit not testable (top-ranked by AIC: {best}): {g.reason if g else 'no goodness of fit'}"
+        short = f"untestable (lowest AIC: {best})"
     else:
         headline = f"{POOR} (best of a poor set: {best})"
+        short = f"no law fits (best of a poor set: {best})"
     second = next((r for r in rows if r not in firsts), None)
     details = {"candidate": best, "rank_rows": len(rows), "aic": top.aic, "likelihood": top.likelihood,
                "chi2_p": top.chi2_p, "runs_p": top.runs_p, "lag1": top.lag1, "fits_rule": g.reason if g else "",
@@ -88,7 +95,7 @@ def _verdict(rows: list[RankRow]):
                "indistinguishable_from": [r.candidate for r in near],
                "delta_aic_to_next": (second.aic - top.aic) if second else math.nan,
                "next": second.candidate if second else ""}
-    return best, fits, headline, goodness, details
+    return best, fits, headline, goodness, details, {"best": short, "goodness": g.short if g else "not testable"}
 
 
 def _slip_zero(tr) -> float | None:
@@ -100,6 +107,16 @@ def _slip_zero(tr) -> float | None:
         return None
     i = int(idx[0])
     return float(tr.t[i] - u[i] * (tr.t[i + 1] - tr.t[i]) / (u[i + 1] - u[i]))
+
+
+def series_short(numbers: dict) -> str:
+    """'series slip u = 0 at 309 / 338 us; exact never' from ``series_vs_exact``'s numbers."""
+    def when(key):
+        ts = [v[key] for v in numbers.values()]
+        if all(t is None for t in ts):
+            return "never"
+        return "at " + " / ".join("never" if t is None else f"{t * 1e6:.0f}" for t in ts) + " µs"
+    return f"series slip u = 0 {when('slip_zero_series_s')}; exact {when('slip_zero_exact_s')}"
 
 
 def series_vs_exact(fits) -> tuple[str, dict]:

@@ -139,3 +139,15 @@ def test_cli_error_is_one_line_exit_2(run_cli, golf_copy):
     assert out.stderr.count("\n") == 1 and "scene.mass" in out.stderr and "Traceback" not in out.stderr
     out = run_cli("--debug", "datasets", "show", golf_copy)
     assert out.returncode != 0 and "Traceback" in out.stderr
+
+
+def test_group_key_declares_the_group_and_defaults_to_the_name_stem(golf_copy):
+    from frictionlab.answers import group_of
+
+    d = fl.load_dataset(golf_copy)
+    assert d.group == "" and group_of(d) == d.name.rsplit("-", 1)[0]
+    _edit(golf_copy, 'kind = "impact"', 'group = "golf-balls"\nkind = "impact"')
+    d = fl.load_dataset(golf_copy)
+    assert d.group == "golf-balls" and group_of(d) == "golf-balls"
+    kharaz = [fl.load_dataset(n) for n in builtin_names() if n.startswith("kharaz2001-")]
+    assert len(kharaz) == 3 and {group_of(k) for k in kharaz} == {"kharaz2001"}

@@ -101,13 +101,17 @@ def test_unregistered_law_gets_no_registered_law_and_a_registered_truth_gets_bes
     (a,) = c.answers
     assert not a.fits and a.headline.startswith(POOR) and "best of a poor set" in a.headline
     assert "best:" not in a.headline
+    assert a.short["best"].startswith("no law fits (best of a poor set: ") and a.short["goodness"].startswith("fails: ")
     truth = _incline("couette", {"eta": 0.1, "h": 4e-5}, name="incline-couette")
     c = compare(laws=REGISTERED, datasets=[truth], equivalence=False)
     (a,) = c.answers
     assert a.fits and a.headline == "best: wear = couette [exact]", a.headline
     assert "chi2 p" in a.goodness and "sigma known" in a.goodness
+    assert a.short["best"] == "wear = couette [exact] ✓" and a.short["goodness"].startswith("fits: ")
     both = attrs.evolve(c, answers=c.answers + compare(laws=REGISTERED, datasets=[drag], equivalence=False).answers)
-    assert any("no registered law" in line for line in answer_lines(both))
+    lines = answer_lines(both)
+    assert len(lines) == 3  # a title line, then one short line per group
+    assert "wear = couette [exact] ✓; fits: " in lines[1] and "no law fits (best of a poor set: " in lines[2]
 
 
 def test_builtin_synthetic_inclines_pass_goodness_of_fit_with_the_true_law_best():
@@ -115,6 +119,8 @@ def test_builtin_synthetic_inclines_pass_goodness_of_fit_with_the_true_law_best(
     c = compare(laws=REGISTERED, datasets=names, equivalence=False)
     (a,) = c.answers
     assert a.group == "incline-oil" and a.fits and a.best == "wear = couette [exact]", a.headline
+    assert a.short["best"] == "wear = couette [exact] ✓" and a.short["goodness"].startswith("fits: χ² p = ")
+    assert float(a.short["goodness"].rsplit("= ", 1)[1]) >= FITS_LEVEL
     for name in names:
         row = next(r for r in c.ranking if r.dataset == name and r.rank == 1)
         assert row.fits and row.chi2_p >= FITS_LEVEL and row.runs_p >= FITS_LEVEL
@@ -136,6 +142,8 @@ def test_golf_reconstruction_is_headlined_as_a_poor_set_with_the_series_finding(
     assert b > 0.5 and n["slip_zero_series_s"] == pytest.approx(math.acos(-(1 - b) / b) * t_c / math.pi, rel=2e-3)
     assert n["slip_zero_exact_s"] is None and n["min_exact_slip_over_u0"] > 0
     assert "never does" in a.series_vs_exact and "crosses zero at" in a.series_vs_exact
+    assert a.short["best"].startswith("no law fits") and a.short["goodness"].startswith("fails: runs p = ")
+    assert a.short["series"] == f"series slip u = 0 at {n['slip_zero_series_s'] * 1e6:.0f} µs; exact never"
 
 
 # --- 3. derived observables --------------------------------------------------------------------
@@ -256,5 +264,6 @@ def test_too_few_points_with_assumed_sigma_is_untestable_not_a_poor_set():
     g = goodness(np.array([0.3, -0.2, 0.1, 0.4, -0.5]), 1, "assumed")  # 5 points: no runs test, no chi2
     row = RankRow("d", "coulomb", "exact", 5, 1, 1.0, 1.0, 1.0, 3.0, 3.0, 3.0, rank=1, fits=g.fits, goodness=g,
                   likelihood="assumed")
-    best, fits, headline, _, _ = _verdict([row])
+    best, fits, headline, _, _, short = _verdict([row])
     assert g.fits is None and not fits and headline.startswith("fit not testable") and POOR not in headline
+    assert short == {"best": "untestable (lowest AIC: coulomb)", "goodness": "not testable"}

@@ -112,13 +112,16 @@ def run(args) -> int:
 
 
 def answer_lines(c) -> list[str]:
-    """The report's first screen in a few lines: per dataset group the verdict layer's answer
-    (Comparison.answers); without answers, says so instead of inventing verdicts."""
+    """The report's first screen in a few lines: per dataset group one line of the verdict layer's
+    short answers (Comparison.answers; the full sentences are in the report and results.json);
+    without answers, says so instead of inventing verdicts."""
     if not c.answers:
         return ["answers: none (the verdict layer filled no Comparison.answers); see the report's tables"]
-    out = ["answers:"]
+    out = ["answers (full sentences in report.html and results.json):"]
     for a in c.answers:
-        parts = [a.headline, a.goodness, f"lambda A u vs mu N + mu eta' dA/dt: {a.equivalence}" if a.equivalence
-                 else "", a.series_vs_exact, a.transfer]
+        eq = a.cell("equivalence")
+        parts = [a.cell("best"), a.cell("goodness"),
+                 f"lambda A u vs mu N + mu eta' dA/dt: {eq}" if eq and eq != "not tested" else "", a.cell("threshold"), a.cell("series"),
+                 a.cell("transfer")]
         out.append(f"  {a.group}: " + "; ".join(p for p in parts if p))
     return out

@@ -56,7 +56,7 @@ class Section:
     """One part of the report. ``open`` sections are shown in full; the others are collapsible in HTML."""
 
     title: str
-    blocks: list = attrs.field(factory=list)  # (kind, payload) with kind h3 | p | warn | ul | table | fig
+    blocks: list = attrs.field(factory=list)  # (kind, payload) with kind h3 | p | warn | ul | more | table | fig
     open: bool = False
 
     @property
@@ -76,6 +76,12 @@ class Section:
         items = list(items)
         if items:
             self.blocks.append(("ul", items))
+
+    def more(self, summary: str, items):
+        """A list folded under one line ``summary`` in HTML (opened by a click), a plain list in Markdown."""
+        items = list(items)
+        if items:
+            self.blocks.append(("more", (summary, items)))
 
     def table(self, headers, rows):
         rows = [[("" if c is None else str(c)) for c in r] for r in rows]

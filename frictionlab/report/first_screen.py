@@ -22,10 +22,15 @@ from .doc import Section
 from .text import PROVENANCE_WORDS, sig
 
 TITLE = "Answers"
-#: (Answer field, column header) of the verdict table.
-COLUMNS = (("headline", "best law"), ("goodness", "goodness of fit"),
-           ("equivalence", "λAu ≡ μN + μη′dA/dt?"), ("noise_threshold", "noise threshold"),
-           ("series_vs_exact", "series vs exact"), ("transfer", "transfer"))
+#: (Answer.short key, column header) of the verdict table; each cell is the short form, the full
+#: sentences follow in a folded list right below the table.
+COLUMNS = (("best", "best law"), ("goodness", "goodness of fit"),
+           ("equivalence", "λAu ≡ μN + μη′dA/dt?"), ("threshold", "noise threshold"),
+           ("series", "series vs exact"), ("transfer", "one parameter set for all conditions?"))
+#: (Answer field, label) of the full sentences in the notes below the table.
+NOTES = (("headline", ""), ("goodness", "goodness"), ("equivalence", "λAu against μN + μη′dA/dt, exact"),
+         ("equivalence_series", "the paper's series"), ("noise_threshold", "noise threshold"),
+         ("series_vs_exact", "series vs exact"), ("transfer", "across conditions"))
 
 
 @attrs.frozen
@@ -85,20 +90,31 @@ def finding_text(shown) -> str:
 
 
 def _answer_table(sec: Section, answers):
-    empty = [head for field, head in COLUMNS if not any(getattr(a, field) for a in answers)]
-    cols = [(field, head) for field, head in COLUMNS if head not in empty]
-    rows = []
+    empty = [head for key, head in COLUMNS if not any(a.cell(key) for a in answers)]
+    cols = [(key, head) for key, head in COLUMNS if head not in empty]
+    rows, notes = [], []
     for a in answers:
-        who = f"**{a.group}** ({', '.join(a.datasets)}; {a.provenance})"
-        cells = [getattr(a, f) or "—" for f, _ in cols]
-        flags = a.details.get("plausibility") if isinstance(a.details, dict) else None
+        cells = [a.cell(key) or "—" for key, _ in cols]
+        flags = _flags(a)
+        if flags and "implausible" not in cells[0]:
+            cells[0] += " ⚠ implausible"
+        rows.append([f"**{a.group}**"] + cells)
+        parts = [f"{label}: {getattr(a, field)}" if label else getattr(a, field)
+                 for field, label in NOTES if getattr(a, field) and getattr(a, field) != "not tested"]
         if flags:
-            cells[0] += " — implausible: " + "; ".join(map(str, flags if isinstance(flags, (list, tuple))
-                                                           else [flags]))
-        rows.append([who] + cells)
+            parts.append("implausible: " + "; ".join(flags))
+        notes.append(f"**{a.group}** ({', '.join(a.datasets)}; {a.provenance}): " + ". ".join(parts) + ".")
     sec.table(["dataset group"] + [h for _, h in cols], rows)
+    sec.more("Each verdict in full (datasets, tests, p-values, thresholds per dataset)", notes)
     if empty:
         sec.p("No data in this comparison for: " + ", ".join(empty) + ".")
+
+
+def _flags(a) -> list[str]:
+    flags = a.details.get("plausibility") if isinstance(a.details, dict) else None
+    if not flags:
+        return []
+    return [str(f) for f in (flags if isinstance(flags, (list, tuple)) else [flags])]
 
 
 def _fallback_table(sec: Section, c, findings):
