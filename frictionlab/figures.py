@@ -367,8 +367,8 @@ def finding_figure(findings) -> bytes:
         ax.legend(fontsize=7, loc="lower right")
         for a in (ax, axu):
             a.grid(alpha=0.3)
-    fig.suptitle("Why the paper's spin falls: its truncated series' slip turns negative; the exact solution's never does",
-                 fontsize=10.5)
+    fig.suptitle("Why the paper's spin falls:" + (" " if n > 1 else "\n") + "its truncated series' slip turns negative; "
+                 "the exact solution's never does", fontsize=10.5)
     return _png(fig)
 
 

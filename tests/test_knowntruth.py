@@ -74,6 +74,25 @@ def test_transfer_verdicts_match_the_truth():
     filled = {a.group: a for a in fill_answers(rows, c.transfer)}
     assert filled["kt-speeds"].transfer == tr["kt-speeds"].answer()
     assert filled["kt-twolam"].details["transfer"]["shared"][0]["serves"] is False
+    assert filled["kt-speeds"].short["transfer"].startswith("one wear [exact] fit for both: yes (p = ")
+    assert filled["kt-twolam"].short["transfer"].startswith("one wear [exact] fit for both: no (p = ")
+
+
+def test_a_group_of_different_observables_is_not_transferred_and_says_why():
+    from frictionlab.answers import group_of
+    from frictionlab.transfer import candidates_by_group, skipped
+
+    kharaz = [load_dataset(n) for n in ("kharaz2001-spin", "kharaz2001-tangential-cor")]
+    assert {group_of(d) for d in kharaz} == {"kharaz2001"}  # declared by the TOML key 'group'
+    c = compare(laws=["coulomb"], datasets=kharaz, solvers=["exact"], equivalence=False)
+    assert candidates_by_group(c.fits, kharaz) == {}
+    (t,) = c.transfer
+    assert t.status == "skipped" and "different observables (rebound_spin, cm_tangential_cor)" in t.reason
+    assert t == skipped(kharaz)[0] and not t.predictions and not t.shared
+    (a,) = c.answers
+    assert a.group == "kharaz2001" and a.datasets == ("kharaz2001-spin", "kharaz2001-tangential-cor")
+    assert a.transfer.startswith("not tested: its datasets measure different observables")
+    assert a.short["transfer"] == "no transfer: different observables"
 
 
 def test_unregistered_law_is_fitted_by_no_registered_law():

@@ -61,9 +61,38 @@ def test_answers_are_rendered_and_empty_columns_said(comp):
     md = markdown("t", _first(attrs.evolve(comp, answers=(a,)))[0])
     head = next(line for line in md.splitlines() if line.startswith("| dataset group"))
     assert "best law" in head and "goodness of fit" in head and "noise threshold" not in head
-    assert "No data in this comparison for: noise threshold, transfer." in md
+    assert "No data in this comparison for: noise threshold, one parameter set for all conditions?." in md
     assert "chi2 p = 0.41" in md and "implausible: eta' = -7.9e11" in md
     assert "`Comparison.answers` is empty" not in md
+
+
+def test_cells_are_the_short_forms_and_the_full_sentences_follow_the_table(comp):
+    long_goodness = "runs p = 8.1e-10, lag-1 r = +0.94; p Bonferroni-adjusted over 2 datasets; sigma assumed, profiled"
+    a = Answer(group="impact-golf", datasets=("impact-golf-v28", "impact-golf-v61"), provenance="reconstructed",
+               best="wear = couette [series]", fits=False,
+               headline="no registered law describes these data (best of a poor set: wear = couette [series])",
+               goodness=long_goodness, equivalence="not equivalent", noise_threshold="wear and area-rate differ by "
+               "more than the noise when sigma < 1.82 deg on impact-golf-v28 (sigma 0.5 deg)",
+               series_vs_exact="impact-golf-v28: the series slip crosses zero at 338 us (b = 0.81)", transfer="",
+               equivalence_series="not equivalent",
+               short={"best": "no law fits (best of a poor set: wear = couette [series])",
+                      "goodness": "fails: runs p = 8e-10", "equivalence": "not equivalent (exact and series)",
+                      "threshold": "differ unless σ > 1.8 deg (σ = 0.5 deg)",
+                      "series": "series slip u = 0 at 338 µs; exact never"})
+    sections, _ = _first(attrs.evolve(comp, answers=(a,)))
+    (table,) = [b for kind, b in sections[0].blocks if kind == "table"]
+    (row,) = table.rows
+    assert row[1:6] == [a.short[k] for k in ("best", "goodness", "equivalence", "threshold", "series")]
+    assert all(len(cell) <= 60 for cell in row)  # a few words per cell, not a sentence
+    (notes,) = [b for kind, b in sections[0].blocks if kind == "more"]
+    assert [kind for kind, _ in sections[0].blocks].index("more") == [k for k, _ in sections[0].blocks].index("table") + 1
+    (note,) = notes[1]
+    for text in (a.headline, long_goodness, a.noise_threshold, a.series_vs_exact, "impact-golf-v61"):
+        assert text in note
+    html = html_page("t", sections, {"finding.png": b""})
+    assert '<details class="more">' in html and long_goodness in html
+    md = markdown("t", sections)
+    assert "fails: runs p = 8e-10" in md and long_goodness in md
 
 
 def test_the_verdict_layer_fills_the_first_screen(comp):

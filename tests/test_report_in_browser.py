@@ -34,3 +34,42 @@ def test_screenshot_is_written(report, tmp_path):
     data = png.read_bytes()
     assert data[:8] == b"\x89PNG\r\n\x1a\n"
     assert int.from_bytes(data[16:20], "big") == 1400 and int.from_bytes(data[20:24], "big") == 1000
+
+
+def _answer(group, best, goodness, eq="not tested", thr="", series="", transfer=""):
+    """A row shaped like the built-in data's (seven groups, long sentences behind short cells)."""
+    from frictionlab.answers import Answer
+
+    long = "a sentence of sixty words that explains the verdict in full, with every p-value and number " * 3
+    short = {k: v for k, v in (("best", best), ("goodness", goodness), ("equivalence", eq), ("threshold", thr),
+                               ("series", series), ("transfer", transfer)) if v}
+    return Answer(group=group, datasets=(f"{group}-a", f"{group}-b"), provenance="synthetic", best=best, fits=True,
+                  headline=long, goodness=long, equivalence=eq, noise_threshold=long if thr else "",
+                  series_vs_exact=long if series else "", transfer=long if transfer else "", short=short)
+
+
+def test_seven_groups_of_long_verdicts_still_leave_the_finding_on_the_first_screen(tmp_path):
+    import attrs
+
+
+    ds = synthetic("wear", {"lam": 1.81e6}, seed=2, n=26, name="impact-browser")
+    c = compare(laws=["wear", "coulomb"], datasets=[ds], equivalence=False)
+    rows = (_answer("impact-golf", "no law fits (best of a poor set: wear = couette [series])",
+                    "fails: runs p = 8e-10", "not equivalent (exact and series)",
+                    "differ unless σ > 1.8 / 1.9 deg (σ = 0.5 deg)", "series slip u = 0 at 338 / 369 µs; exact never",
+                    "one wear [series] fit for both: no (p = 2e-78)"),
+            _answer("impact-outcome", "coulomb [exact] ✓", "fits: runs p = 0.84"),
+            _answer("incline-dry", "wear = couette [ode] ✓", "fits: χ² p = 0.2",
+                    transfer="one wear [ode] fit for both: yes (p = 0.051)"),
+            _answer("incline-oil", "wear = couette [exact] ✓", "fits: runs p = 0.66", "not equivalent (exact)",
+                    "differ unless σ > 0.4 / 0.27 / 0.15 m/s (σ = 0.003 m/s)",
+                    transfer="one wear [exact] fit for all: yes (p = 0.44)"),
+            _answer("kharaz2001", "coulomb [exact] ✓", "fits: runs p = 0.11",
+                    transfer="no transfer: different observables"),
+            _answer("spring-slider", "no law fits (best of a poor set: wear = couette [exact+ode])",
+                    "fails: χ² p < 1e-300"),
+            _answer("spring-slider-small", "no law could be fitted", ""))
+    out = write_report(attrs.evolve(c, answers=rows), tmp_path / "rep")
+    box = screenshot.first_screen_layout(out / "report.html", height=1000)
+    assert box["table"] is not None and box["figure"] is not None
+    assert box["table"]["bottom"] <= box["figure"]["top"] < box["figure"]["bottom"] <= 1000, box

@@ -27,6 +27,8 @@ TITLE = "Answers"
 COLUMNS = (("best", "best law"), ("goodness", "goodness of fit"),
            ("equivalence", "λAu ≡ μN + μη′dA/dt?"), ("threshold", "noise threshold"),
            ("series", "series vs exact"), ("transfer", "one parameter set for all conditions?"))
+#: characters a table cell shows (more: cut, the full text is in the notes)
+CELL_LIMIT = 70
 #: (Answer field, label) of the full sentences in the notes below the table.
 NOTES = (("headline", ""), ("goodness", "goodness"), ("equivalence", "λAu against μN + μη′dA/dt, exact"),
          ("equivalence_series", "the paper's series"), ("noise_threshold", "noise threshold"),
@@ -94,7 +96,7 @@ def _answer_table(sec: Section, answers):
     cols = [(key, head) for key, head in COLUMNS if head not in empty]
     rows, notes = [], []
     for a in answers:
-        cells = [a.cell(key) or "—" for key, _ in cols]
+        cells = [_clip(a.cell(key)) or "—" for key, _ in cols]
         flags = _flags(a)
         if flags and "implausible" not in cells[0]:
             cells[0] += " ⚠ implausible"
@@ -108,6 +110,14 @@ def _answer_table(sec: Section, answers):
     sec.more("Each verdict in full (datasets, tests, p-values, thresholds per dataset)", notes)
     if empty:
         sec.p("No data in this comparison for: " + ", ".join(empty) + ".")
+
+
+def _clip(text: str, limit: int = CELL_LIMIT) -> str:
+    """A cell of at most about ``limit`` characters: a long sentence (a producer without a short form) is cut
+    at a word and ends in '…'; it is in full in the notes below the table."""
+    if len(text) <= limit:
+        return text
+    return text[:limit].rsplit(" ", 1)[0].rstrip(",;:") + " …"
 
 
 def _flags(a) -> list[str]:
