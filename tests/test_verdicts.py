@@ -267,3 +267,20 @@ def test_too_few_points_with_assumed_sigma_is_untestable_not_a_poor_set():
     best, fits, headline, _, _, short = _verdict([row])
     assert g.fits is None and not fits and headline.startswith("fit not testable") and POOR not in headline
     assert short == {"best": "untestable (lowest AIC: coulomb [exact])", "goodness": "not testable"}
+
+
+def test_a_group_where_no_law_could_be_fitted_is_not_answered_from_another_group():
+    """A group whose candidates all failed says so; it never borrows the ranking of all datasets."""
+    from types import SimpleNamespace
+
+    from frictionlab.verdicts import make_answers
+
+    prov = SimpleNamespace(kind="synthetic")
+    dss = [SimpleNamespace(name=n, provenance=prov, group="") for n in ("oil-a", "oil-b", "slider-a", "slider-b")]
+    ok = [RankRow(d, "wear", "exact", 10, 1, aic=1.0, rank=1) for d in ("oil-a", "oil-b")]
+    failed = [RankRow(d, "coulomb", "ode", status="failed", reason="x") for d in ("slider-a", "slider-b")]
+    groups = [RankRow("oil", "wear", "exact", 20, 1, aic=2.0, rank=1), RankRow("ALL", "wear", "exact", 20, 1, aic=2.0, rank=1)]
+    answers = {a.group: a for a in make_answers(dss, [], ok + failed, groups)}
+    assert answers["slider"].best is None and answers["slider"].headline == "no law could be fitted"
+    assert answers["oil"].best == "wear [exact]"
+    assert answers["slider"].short["best"] == "no law could be fitted" and "wear [exact]" in answers["oil"].short["best"]
