@@ -156,3 +156,13 @@ def test_plausibility_flags_reach_the_parameter_they_name():
 
     assert flags_on(F(), "eta_prime") == [F.flags[0]] and flags_on(F(), "eta") == [] and flags_on(F(), "u0") == [
         F.flags[1]]
+
+
+def test_a_group_row_shows_its_first_flag_and_counts_the_others():
+    from frictionlab.ranking import RankRow
+    from frictionlab.report.ranking import group_table
+
+    row = RankRow("ALL", "area-rate", "exact", 650, 16, aic=1.0, rank=3,
+                  flags=("a: rests on eta_prime", "b: slip reaches 10.9 u0", "c: rests on eta_prime"))
+    (cells,) = group_table([row])[1]
+    assert cells[-1].endswith("; FLAG: a: rests on eta_prime; 2 more flags: see each dataset's table")

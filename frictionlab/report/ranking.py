@@ -74,8 +74,13 @@ def _fits_cell(r) -> str:
     return f"{'yes' if r.fits else 'no'} ({p(r.chi2_p)}, {p(r.runs_p)}; σ {r.likelihood})"
 
 
-def _flags(r) -> str:
-    return "".join(f"; FLAG: {f}" for f in r.flags)
+def _flags(r, limit: int | None = None) -> str:
+    """'; FLAG: ...' per plausibility flag; with ``limit``, the first ``limit`` and how many more (a group's
+    flags are its members', each in full in that dataset's table)."""
+    shown = r.flags if limit is None else r.flags[:limit]
+    more = len(r.flags) - len(shown)
+    return "".join(f"; FLAG: {f}" for f in shown) + (f"; {more} more flag{'s' * (more > 1)}: see each dataset's table"
+                                                     if more else "")
 
 
 def group_table(rows) -> tuple[list[str], list[list]]:
@@ -83,7 +88,7 @@ def group_table(rows) -> tuple[list[str], list[list]]:
                "Akaike weight", "fits? (χ² p, runs p)", "status"]
     out = [[r.dataset, r.rank or "–", r.candidate, r.n_points or "", r.n_params if r.rank else "", fmt(r.redchi),
             fmt(r.aic), fmt(r.aicc), fmt(r.bic), fixed(r.delta_aic, 2), fixed(r.akaike_weight, 3), _fits_cell(r),
-            r.status + (f": {r.reason}" if r.reason else "") + _flags(r)] for r in rows]
+            r.status + (f": {r.reason}" if r.reason else "") + _flags(r, limit=1)] for r in rows]
     return headers, out
 
 def build(ctx) -> Section:
@@ -91,7 +96,7 @@ def build(ctx) -> Section:
     sec = Section(TITLE)
     sec.p(f"Each law is fitted separately to each dataset and ranked by AIC, unflagged candidates first (a fit "
           "flagged as physically implausible ranks after them, its flag in the status); laws of one closed-form "
-          "family are one candidate (wear = couette); candidates within ΔAIC ≤ {TIE_AIC} share a rank and within "
+          f"family are one candidate (wear = couette); candidates within ΔAIC ≤ {TIE_AIC} share a rank and within "
           "ΔAIC < 2 are indistinguishable by the data. A candidate fits when χ² p ≥ 0.01 (known σ only) and "
           "runs-test p ≥ 0.01. The solver is part of the candidate: where the paper's "
           "truncated series applies it is ranked next to the exact (or numerical) solution of the same law, so the "
