@@ -30,9 +30,9 @@ COLUMNS = (("best", "best law"), ("goodness", "goodness of fit"),
 #: characters a table cell shows (more: cut, the full text is in the notes)
 CELL_LIMIT = 70
 #: (Answer field, label) of the full sentences in the notes below the table.
-NOTES = (("headline", ""), ("goodness", "goodness"), ("equivalence", "λAu against μN + μη′dA/dt, exact"),
-         ("equivalence_series", "the paper's series"), ("noise_threshold", "noise threshold"),
-         ("series_vs_exact", "series vs exact"), ("transfer", "across conditions"))
+NOTES = (("headline", ""), ("goodness", "Goodness"), ("equivalence", "λAu against μN + μη′dA/dt, exact"),
+         ("equivalence_series", "The paper's series"), ("noise_threshold", "Noise threshold"),
+         ("series_vs_exact", "Series vs exact"), ("transfer", "Across conditions"))
 
 
 @attrs.frozen
