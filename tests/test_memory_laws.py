@@ -158,3 +158,19 @@ def test_memoryless_laws_on_a_spring_slider():
     assert np.allclose(tr.load[1:], 0.6 * (2 - np.exp(-rate * (t - 1.0))), rtol=1e-7)
     with pytest.raises(fl.FrictionLabError, match="does not grow with the slip rate"):
         fl.simulate("coulomb", scene, {"mu": 0.6})
+
+
+def test_report_figures_survive_a_curve_the_solver_cannot_draw(monkeypatch):
+    """A stiff law's dense best-fit curve may exceed the ODE budget: the figure keeps the fitted points."""
+    from frictionlab import figures
+    from frictionlab.fitting import DatasetFit
+
+    ds = fl.load_dataset("incline-oil-a100")
+    f = fl.fit("couette", ds, solver="exact")
+
+    def refuse(self, *a, **k):
+        raise SolverError("ode:LSODA: needed more than 50000 right-hand-side evaluations")
+
+    monkeypatch.setattr(DatasetFit, "trajectory", refuse)
+    assert figures.fit_figure(ds, [f], []).startswith(b"\x89PNG")
+    assert figures.force_figure(ds, [f]).startswith(b"\x89PNG")
