@@ -58,7 +58,8 @@ def _velocity_step(out_dir, name, law, seed, changes):
                         f"spring-slider, k = {c['k']:g} /m per unit normal force. SYNTHETIC: generated with the "
                         f"{law} law, not measured."),
         "columns": {"t": "s", "mu": ""},
-        "noise": {"mu": c["noise"]},
+        "group": name,  # each set is its own material (its own generating law): no transfer between them
+        "noise": {"kind": "known", "mu": c["noise"]},
         "scene": {"mass": f"{c['mass']:g} kg", "normal": {"model": "constant", "value": f"{c['normal']:g} N"},
                   "spring": {"stiffness": f"{c['k']:g} 1/m", "times": [f"{x:g} s" for x in c["times"]],
                              "velocities": [f"{v * 1e6:g} um/s" for v in c["velocities"]]}},
