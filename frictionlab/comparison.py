@@ -217,6 +217,11 @@ def _stop(pool: ProcessPoolExecutor) -> None:
         if p.is_alive():
             p.kill()
             p.join()
+    # let the pool's manager thread finish closing its wake-up pipe now: otherwise the interpreter's
+    # exit hook may race it and print "OSError: Bad file descriptor" after our one-line message
+    manager = getattr(pool, "_executor_manager_thread", None)
+    if manager is not None:
+        manager.join(5)
 
 
 def _run(tasks, fn, pool, progress, done, total, label):
