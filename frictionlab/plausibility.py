@@ -115,5 +115,7 @@ def _effects(model, slots, values, likelihood) -> dict[str, float]:
         trial = dict(values)
         trial[s.pname] = 0.0
         r = model.residual(trial)
-        out[s.display] = float(r @ r - chi) / unit if np.all(np.isfinite(r)) else math.inf
+        with np.errstate(over="ignore"):  # an effect too large for a float is simply a large effect
+            effect = float(r @ r - chi) / unit if np.all(np.isfinite(r)) else math.inf
+        out[s.display] = effect if math.isfinite(effect) else math.inf
     return out
