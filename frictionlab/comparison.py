@@ -131,7 +131,13 @@ def candidates(law, dataset: Dataset, solvers: Sequence[str] | None) -> list[tup
     law = get_law(law)
     ok = applicable_solvers(law, dataset.scene)
     if solvers is None:
-        out = [(auto_solver(law, dataset.scene), ok["ode"])]
+        solver = auto_solver(law, dataset.scene)
+        if solver == "ode" and dataset.kind == "impact-outcome" and ok["ode"] is None:
+            # every evaluation integrates every impact of the set: minutes per fit for a stateful law
+            return [("ode", f"law '{law.name}' has no closed form on impact outcomes, and fitting it with the ODE "
+                            "simulates every impact at each evaluation (minutes per fit): name the solver "
+                            "(--solver ode) to fit it")]
+        out = [(solver, ok["ode"])]
         if ok["series"] is None:
             out.append(("series", None))
         return out

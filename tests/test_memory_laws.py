@@ -174,3 +174,16 @@ def test_report_figures_survive_a_curve_the_solver_cannot_draw(monkeypatch):
     monkeypatch.setattr(DatasetFit, "trajectory", refuse)
     assert figures.fit_figure(ds, [f], []).startswith(b"\x89PNG")
     assert figures.force_figure(ds, [f]).startswith(b"\x89PNG")
+
+
+def test_ode_only_laws_skip_impact_outcome_sets_by_default_but_fit_when_the_solver_is_named():
+    """`compare --laws all` stays minutes, not hours: an ODE-only law on an impact-outcome set (every
+    evaluation simulates every impact) is a skipped candidate with the reason, unless the solver is named."""
+    from frictionlab.comparison import candidates
+
+    outcome = fl.load_dataset("impact-outcome-synthetic")
+    (solver, why), = candidates("lugre", outcome, None)
+    assert solver == "ode" and "--solver ode" in why
+    assert candidates("lugre", outcome, ["ode"]) == [("ode", None)]
+    assert candidates("coulomb", outcome, None) == [("exact", None)]  # closed forms are fitted as before
+    assert candidates("lugre", fl.load_dataset("incline-dry-d10"), None) == [("ode", None)]
