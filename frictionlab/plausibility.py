@@ -6,7 +6,7 @@ impact row), law-agnostic:
 
 * range: the slip |u| or the contact speed of the spin r |omega| exceeds ``RANGE`` (10) times the
   speed the experiment starts from (the initial slip, the inbound speed of an impact, or for a body
-  released from rest the largest observed velocity). A friction law only takes speed away; ten
+  released from rest the largest observed velocity; for a spring-slider its fastest load-point velocity). A friction law only takes speed away; ten
   times the starting speed means the law pumped the motion.
 * work: the friction force does net negative work over the record, W = integral of F u dt <
   -``WORK_TOL`` x integral of |F u| dt: friction as a net source of energy.
@@ -38,6 +38,9 @@ def _trajectories(law, d):
     if d.target.t is not None:
         tr = d.trajectory(law, n=401)
         ref = abs(scene.u0)
+        spring = getattr(scene, "spring", None)
+        if spring is not None:  # a spring-slider is driven at its load-point velocities, not only the first
+            ref = max(ref, max(abs(v) for v in spring.velocities))
         if d.target.observable in ("v", "u"):
             ref = max(ref, float(np.max(np.abs(d.target.y))))
         yield tr, ref, d.name

@@ -284,3 +284,16 @@ def test_a_group_where_no_law_could_be_fitted_is_not_answered_from_another_group
     assert answers["slider"].best is None and answers["slider"].headline == "no law could be fitted"
     assert answers["oil"].best == "wear [exact]"
     assert answers["slider"].short["best"] == "no law could be fitted" and "wear [exact]" in answers["oil"].short["best"]
+
+
+def test_a_spring_slider_step_is_measured_against_its_fastest_load_point_velocity():
+    """A velocity step 1 -> 10 um/s makes the slip overshoot 10x the first velocity: physics, not a pumping law."""
+    from frictionlab.plausibility import _trajectories
+    from frictionlab.registry import get_law
+
+    d = load_dataset("spring-slider-aging")
+    r = fit("rate-state-aging", d, initial={"a": 0.008, "b": 0.012, "Dc": 1e-5, "mu0": 0.6})
+    (tr, ref, _), = list(_trajectories(get_law("rate-state-aging"), r.per_dataset[0]))
+    assert ref == max(d.scene.spring.velocities) == pytest.approx(1e-5)
+    assert float(np.max(np.abs(tr.u))) / abs(d.scene.u0) > 10  # the overshoot the old reference flagged
+    assert not [f for f in r.flags if "times the starting speed" in f]
