@@ -53,16 +53,9 @@ def test_a_batch_in_chunks_equals_the_batch_in_one_call(monkeypatch):
     import numpy as np
 
     from frictionlab import batch as B
-    from frictionlab.scene import HalfSineNormal, Scene
 
-    rng = np.random.default_rng(3)
-    n = 37
-    tc = rng.uniform(400e-6, 500e-6, n)
-    template = Scene(kind="impact", mass=0.046, u0=1.0, duration=tc[0], radius=0.0213,
-                     normal=HalfSineNormal(1.0, tc[0]), effects=frozenset({"slip-coupling", "spin"}))
-    sb = B.SceneBatch.sweep(template, {"u0": rng.uniform(2, 40, n), "normal.impulse": rng.uniform(0.5, 4, n),
-                                       "normal.contact_time": tc, "duration": tc})
-    mu = rng.uniform(0.1, 0.5, n)
+    sb, mu, tc = _coulomb_sweep(3, 37)
+    n = len(mu)
     for solver in ("exact", "DOP853"):
         whole = B.simulate_batch("coulomb", sb, {"mu": mu}, solver=solver, n=21)
         monkeypatch.setattr(B, "CHUNK", 10)
@@ -151,17 +144,10 @@ def test_the_closed_form_stop_of_coulomb_impacts_equals_the_root_finder(monkeypa
 
     from frictionlab import batch as B
     from frictionlab import simulate
-    from frictionlab.scene import HalfSineNormal, Scene
     from frictionlab.solvers import exact
 
-    rng = np.random.default_rng(11)
-    n = 40
-    tc = rng.uniform(400e-6, 500e-6, n)
-    template = Scene(kind="impact", mass=0.046, u0=1.0, duration=tc[0], radius=0.0213,
-                     normal=HalfSineNormal(1.0, tc[0]), effects=frozenset({"slip-coupling", "spin"}))
-    sb = B.SceneBatch.sweep(template, {"u0": rng.uniform(2, 40, n), "normal.impulse": rng.uniform(0.5, 4, n),
-                                       "normal.contact_time": tc, "duration": tc})
-    mu = rng.uniform(0.1, 0.5, n)
+    sb, mu, tc = _coulomb_sweep(11, 40)
+    n = len(mu)
     t = np.linspace(0.0, 1.0, 41)[None, :] * tc[:, None]
     fast = B.simulate_batch("coulomb", sb, {"mu": mu}, solver="exact", t=t)
     scalar_fast = [simulate("coulomb", sb.scene(i), {"mu": mu[i]}, solver="exact", t=t[i]) for i in range(n)]
@@ -179,3 +165,19 @@ def test_the_closed_form_stop_of_coulomb_impacts_equals_the_root_finder(monkeypa
         if f.stick_time is not None:
             assert abs(f.stick_time - s_.stick_time) <= 1e-12 * tc.max()
         assert np.allclose(f.omega, s_.omega, rtol=1e-10, atol=1e-10 * np.max(np.abs(s_.omega)))
+
+
+def _coulomb_sweep(seed: int, n: int):
+    """n random golf-ball impacts with Coulomb friction and rolling: (SceneBatch, mu, contact times [s])."""
+    import numpy as np
+
+    from frictionlab import batch as B
+    from frictionlab.scene import HalfSineNormal, Scene
+
+    rng = np.random.default_rng(seed)
+    tc = rng.uniform(400e-6, 500e-6, n)
+    template = Scene(kind="impact", mass=0.046, u0=1.0, duration=tc[0], radius=0.0213,
+                     normal=HalfSineNormal(1.0, tc[0]), effects=frozenset({"slip-coupling", "spin"}))
+    sb = B.SceneBatch.sweep(template, {"u0": rng.uniform(2, 40, n), "normal.impulse": rng.uniform(0.5, 4, n),
+                                       "normal.contact_time": tc, "duration": tc})
+    return sb, rng.uniform(0.1, 0.5, n), tc

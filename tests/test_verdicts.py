@@ -13,22 +13,10 @@ from frictionlab import FrictionLaw, ParamSpec, compare, fit, load_dataset
 from frictionlab.goodness import FITS_LEVEL, runs_test
 from frictionlab.ranking import NEAR_TIE, RankRow, _rank, rank_groups
 from frictionlab.commands.compare import answer_lines
+from frictionlab.datagen.knowntruth import QuadraticDrag  # registered nowhere
 from frictionlab.verdicts import POOR
 
 REGISTERED = ["coulomb", "area-rate", "wear", "couette"]
-
-
-class QuadraticDrag(FrictionLaw):
-    """F = c A u |u|: a law no one registers (not Coulomb, Stribeck, LuGre, Dahl or rate-and-state)."""
-
-    name = "quadratic-drag-test"
-    formula = "F = c A u |u|"
-    citation = "tests"
-    params = (ParamSpec("c", "kg/m^3", 400.0, 0.0, 1e9, 400.0, "drag coefficient per area"),)
-    requires = frozenset({"u", "A"})
-
-    def force(self, p, c):
-        return p["c"] * c.A * c.u * np.abs(c.u)
 
 
 def _incline(law, params, sigma=0.002, seed=11, name=None):
