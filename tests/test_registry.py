@@ -107,14 +107,20 @@ THIRD_PARTY = """
 """
 
 
-@pytest.fixture
-def third_party(tmp_path, monkeypatch):
-    _write_dist(tmp_path, "viscous-law", THIRD_PARTY, "viscous-third-party = viscous_law:Viscous\n")
+def installed_plugin(tmp_path, monkeypatch, dist, source, entry_points):
+    """Generator for a fixture: a package ``dist`` with module ``source`` installed for the registry, then removed."""
+    _write_dist(tmp_path, dist, source, entry_points)
     monkeypatch.syspath_prepend(str(tmp_path))
     registry.reload_registry()
     yield tmp_path
     monkeypatch.undo()
     registry.reload_registry()
+
+
+@pytest.fixture
+def third_party(tmp_path, monkeypatch):
+    yield from installed_plugin(tmp_path, monkeypatch, "viscous-law", THIRD_PARTY,
+                                "viscous-third-party = viscous_law:Viscous\n")
 
 
 def test_third_party_entry_point_registers_and_evaluates(third_party):

@@ -165,15 +165,10 @@ STATEFUL_PLUGIN = """
 
 @pytest.fixture
 def stateful_plugin(tmp_path, monkeypatch):
-    from frictionlab import registry
-    from test_registry import _write_dist
+    from test_registry import installed_plugin
 
-    _write_dist(tmp_path, "relaxing-law", STATEFUL_PLUGIN, "relaxing-third-party = relaxing_law:Relaxing\n")
-    monkeypatch.syspath_prepend(str(tmp_path))
-    registry.reload_registry()
-    yield tmp_path
-    monkeypatch.undo()
-    registry.reload_registry()
+    yield from installed_plugin(tmp_path, monkeypatch, "relaxing-law", STATEFUL_PLUGIN,
+                                "relaxing-third-party = relaxing_law:Relaxing\n")
 
 
 def test_third_party_stateful_law_works_as_a_builtin(stateful_plugin, run_cli):
