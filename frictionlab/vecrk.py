@@ -341,11 +341,13 @@ def _fill_dense(Y, ptr, t_out, idx, pos, t_stop, dense, shared=None):
         x /= dense.h[pos, None]
         np.clip(x, 0.0, 1.0, out=x)  # padding beyond a problem's outputs: evaluated, never stored
         vals = dense(x, None if pos.size == dense.h.size and np.array_equal(pos, np.arange(pos.size)) else pos)
-        flat = idx[:, None] * m + cols
-        if valid.all():
-            Yf[:, flat.ravel()] = vals.reshape(vals.shape[0], -1)
-        else:
-            Yf[:, flat[valid]] = vals[:, valid]
+        flat = (idx[:, None] * m + cols).ravel()
+        vals = vals.reshape(vals.shape[0], -1)
+        if not valid.all():  # integer take and put: several times faster than boolean-mask indexing
+            sel = np.flatnonzero(valid)
+            flat, vals = flat[sel], np.take(vals, sel, axis=1)
+        for j in range(Yf.shape[0]):
+            np.put(Yf[j], flat, vals[j])
         ptr[idx] = start + counts
         return
     within = (np.arange(m)[None, :] >= start[:, None]) & (t_out[idx] <= t_stop[:, None])
