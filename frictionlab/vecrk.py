@@ -395,8 +395,11 @@ def root_bracketed(make_fn, lo, hi, glo, ghi, tol, gtol=0.0):
             mid = (lo * ghi - hi * glo) / (ghi - glo)
         slow = (hi - lo) > 0.5 * widths[0]
         widths = widths[1:] + [hi - lo]
-        bad = ~np.isfinite(mid) | (mid <= lo) | (mid >= hi) | slow | (it >= 30)
+        bad = ~np.isfinite(mid) | slow | (it >= 30)
         mid = np.where(bad, 0.5 * (lo + hi), mid)
+        # at least tol inside the bracket (as Brent's method steps): a secant that lands on an end whose
+        # value is round-off (the root is that end) closes the bracket next time instead of bisecting on
+        mid = np.where(hi - lo > 2 * tol, np.minimum(np.maximum(mid, lo + tol), hi - tol), 0.5 * (lo + hi))
         mid = np.where(open_, mid, hi)
         gm = fn(mid)
         below = (gm <= 0.0) & open_
