@@ -387,7 +387,7 @@ def _finish(law, batch, p, T, Y, sliding, need):
     omega = Y[plan.index("omega")] if plan.has_spin else np.zeros_like(u)
     theta = Y[plan.index("theta")] if plan.has_spin else np.zeros_like(u)
     for name, arr in (("states", Y), ("force", F)):
-        if not np.isfinite(arr).all():
+        if not _all_finite(arr):
             bad = ~np.isfinite(arr) if arr.ndim == 2 else ~np.isfinite(arr).all(axis=0)
             i = int(np.argmax(bad.any(axis=1)))
             raise SolverError(f"batch: {name} became NaN or infinite for law '{law.name}' in scene {i}")
@@ -396,6 +396,12 @@ def _finish(law, batch, p, T, Y, sliding, need):
         return None if a is None else (a if np.shape(a) == u.shape else np.broadcast_to(a, u.shape).copy())
 
     return {"u": u, "v": Y[0], "omega": omega, "theta": theta, "force": F, "A": full(A), "N": full(N)}
+
+
+def _all_finite(a) -> bool:
+    """Every element finite: one summing pass (a sum is finite only if every term is), the elementwise
+    test only when the sum is not (it may overflow)."""
+    return bool(np.isfinite(np.sum(a)) or np.isfinite(a).all())
 
 
 def _root(make_fn, lo, hi, tol, gtol=0.0):
@@ -614,23 +620,26 @@ def _run_exact(law, batch, p, T):
         sgn = np.sign(u_s)
         fallback |= sgn[:, 0] == 0
         sgn = np.where(sgn == 0, 1.0, sgn)
-        J1, K1, _ = exact._normal_area_rate(plan, form, 0.0, y0, 1.0, T, find_stop=False)
-        Y = exact._states(plan, 0.0, y0, T, sgn * J1, sgn * K1)
         ts = _exact_stop(law, batch, p, plan, form, y0, u_s[:, 0], sgn[:, 0], T)
         hit = ~np.isnan(ts) & ~fallback
-        if hit.any():  # stuck states after the stick time, on the whole grid (cheaper than gathering)
+        tcol = np.where(hit, ts, np.inf)[:, None]
+        # the sliding closed form at min(t, stick time): frozen at the stick, where the stuck phase continues
+        tt = np.minimum(T, tcol) if hit.any() else T
+        signed = exact.NormalAreaRateForm(a=sgn * form.a, c=sgn * form.c)  # the slip's sign in the form: no pass
+        J1, K1, _ = exact._normal_area_rate(plan, signed, 0.0, y0, 1.0, tt, find_stop=False)
+        Y = exact._states(plan, 0.0, y0, tt, J1, K1)
+        if hit.any():
             stick_time[hit] = ts[hit]
-            tcol = np.where(hit, ts, 0.0)[:, None]
-            Js, Ks, _ = exact._normal_area_rate(plan, form, 0.0, y0, 1.0, tcol, find_stop=False)
-            ys = exact._states(plan, 0.0, y0, tcol, sgn * Js, sgn * Ks)[:, :, 0]
-            ys = _zero_slip(_plan(law, batch.view()), ys)
             ids = np.nonzero(hit)[0]
+            ys = _zero_slip(_plan(law, batch.view(ids)), Y[:, ids, -1])  # the state at the stick, slip exactly zero
             t_end = T[ids, -1]
-            tb, _, _ = _breakaway(law, batch, p, ids, ts[ids], ys[:, ids], t_end, sgn[ids, 0])
+            tb, _, _ = _breakaway(law, batch, p, ids, ts[ids], ys, t_end, sgn[ids, 0])
             fallback[ids[~np.isnan(tb) & (tb < t_end)]] = True
-            stuck_mask = T > np.where(hit, ts, np.inf)[:, None]
-            Ys, _ = stick.stuck_states(plan, T, tcol, ys[:, :, None])
-            np.copyto(Y, Ys, where=stuck_mask[None])
+            stuck_mask = T > tcol
+            v_stick = np.zeros((nsc, 1))
+            v_stick[ids, 0] = ys[0]
+            np.copyto(Y[0], v_stick, where=stuck_mask)  # zero slip exactly while stuck, as the stick state has it
+            stick.stuck_states(plan, T, tt, Y, out=Y)  # dt = 0 before the stick: those states stay
     need = stick.needed_force(plan)
     out = _finish(law, batch, p, T, np.nan_to_num(Y) if fallback.any() else Y, ~stuck_mask, need)
     for i in np.nonzero(fallback)[0]:
