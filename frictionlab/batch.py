@@ -588,6 +588,11 @@ def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rt
         return g
 
     s_out = T[ids] / span[:, None]
+    # a grid of m points over each scene's span (the default) is one grid in scaled time: snapped to it exactly
+    # (a few ulps), row by row, so the integrator evaluates all scenes' outputs on one grid
+    rel = np.linspace(0.0, 1.0, s_out.shape[1])
+    on_rel = np.all(np.abs(s_out - rel) <= 4 * np.finfo(float).eps * rel, axis=1)
+    s_out[on_rel] = rel
     return vecrk.integrate(make_rhs, t0[ids] / span, y0[:, ids] / sc, 1.0, s_out, method=method, rtol=rtol,
                            atol=atol, make_event=make_event, breaks=_breaks(batch, ids, span))
 

@@ -71,10 +71,7 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
     t_end = np.broadcast_to(np.asarray(t_end, dtype=float), (n,))
     t_out = np.asarray(t_out, dtype=float)
     m = t_out.shape[1]
-    # one output grid for all problems (to a few ulps: per-scene grids scaled by each scene's span)
-    shared = t_out[0] if np.all(np.abs(t_out - t_out[:1]) <= 4 * np.finfo(float).eps * np.abs(t_out[:1])) else None
-    if shared is not None:
-        t_out = np.broadcast_to(shared, t_out.shape)
+    shared = t_out[0] if np.all(t_out == t_out[:1]) else None  # one output grid for all problems
     Y = np.full((d, n, m), np.nan)
     t_event = np.full(n, np.nan)
     y_event = np.full((d, n), np.nan)
@@ -339,7 +336,7 @@ def _fill_dense(Y, ptr, t_out, idx, pos, t_stop, dense, shared=None):
         x = shared[cols]
         x -= dense.t_old[pos, None]
         x /= dense.h[pos, None]
-        np.clip(x, 0.0, 1.0, out=x)  # padding beyond a problem's outputs: evaluated, never stored
+        np.copyto(x, 0.0, where=~valid)  # padding beyond a problem's outputs: evaluated, never stored
         vals = dense(x, None if pos.size == dense.h.size and np.array_equal(pos, np.arange(pos.size)) else pos)
         flat = (idx[:, None] * m + cols).ravel()
         vals = vals.reshape(vals.shape[0], -1)
