@@ -465,10 +465,12 @@ def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask):
     r, c = np.nonzero(sel)
     if r.size == 0:
         return
-    plan = _plan(law, batch.view(ids[r]))
-    Ys, _ = stick.stuck_states(plan, Ts[r, c], ts[r], ys[:, r])
+    plan = _plan(law, batch.view(ids, column=True))  # per scene, broadcast along its times (no per-output gathering)
+    Ys, _ = stick.stuck_states(plan, Ts, ts[:, None], ys[:, :, None])
     flat = ids[r] * T.shape[1] + c
-    Y.reshape(Y.shape[0], -1)[:, flat] = Ys
+    src = r * T.shape[1] + c
+    for j in range(Y.shape[0]):  # integer take and put per state: several times faster than 2-d fancy indexing
+        np.put(Y[j], flat, np.take(Ys[j], src))
     done.reshape(-1)[flat] = True
     stuck_mask.reshape(-1)[flat] = True
 
