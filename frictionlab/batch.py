@@ -291,7 +291,7 @@ def _chunked(law, batch, p, tgrid, solver, rtol, atol, n) -> BatchResult:
     out, parts = {}, []
     for start in range(0, batch.n, CHUNK):
         sl = slice(start, min(start + CHUNK, batch.n))
-        r = simulate_batch(law, batch.subset(sl), _take_params(p, sl), tgrid if tgrid.ndim == 1 else tgrid[sl],
+        r = simulate_batch(law, batch.subset(sl), _take_params(p, sl), _Grid(tgrid if tgrid.ndim == 1 else tgrid[sl]),
                            solver, rtol, atol, n)
         for name in ("u", "v", "omega", "theta", "force", "stick_time", "A", "N"):
             a = getattr(r, name)
@@ -346,6 +346,8 @@ def _concat(parts, tgrid) -> BatchResult:
 
 
 def _time_grid(batch, t, n):
+    if isinstance(t, _Grid):  # a chunk of a grid checked once for the whole batch
+        return t.t
     if t is None:
         dur = batch.values.get("duration")
         if dur is None:
@@ -357,6 +359,13 @@ def _time_grid(batch, t, n):
     if not ok:
         raise SolverError("batch: t must be (n_t,) or (n_scenes, n_t) non-decreasing times >= 0")
     return t
+
+
+@attrs.frozen
+class _Grid:
+    """Sample times already checked by ``_time_grid`` (a chunk's rows), passed to ``simulate_batch`` as t."""
+
+    t: np.ndarray
 
 
 def _plan(law, view) -> Plan:
@@ -572,10 +581,13 @@ def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rt
         plan = _plan(law, batch.view(g_ids))
         pv = _take_params(p, g_ids)
         tsc, ssc = span[k], sc[:, k]
+        fac = tsc / ssc
         dirs = direction[g_ids]
 
         def rhs(s, z):
-            return plan.derivatives(pv, s * tsc, z * ssc, dirs) * tsc / ssc
+            dy = plan.derivatives(pv, s * tsc, z * ssc, dirs)
+            dy *= fac  # a fresh array: scaled in place
+            return dy
 
         return rhs
 
