@@ -601,14 +601,26 @@ def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rt
 
         return g
 
-    s_out = T[ids] / span[:, None]
-    # a grid of m points over each scene's span (the default) is one grid in scaled time: snapped to it exactly
-    # (a few ulps), row by row, so the integrator evaluates all scenes' outputs on one grid
-    rel = np.linspace(0.0, 1.0, s_out.shape[1])
-    on_rel = np.all(np.abs(s_out - rel) <= 4 * np.finfo(float).eps * rel, axis=1)
-    s_out[on_rel] = rel
-    return vecrk.integrate(make_rhs, t0[ids] / span, y0[:, ids] / sc, 1.0, s_out, method=method, rtol=rtol,
-                           atol=atol, make_event=make_event, breaks=_breaks(batch, ids, span))
+    return vecrk.integrate(make_rhs, t0[ids] / span, y0[:, ids] / sc, 1.0, _scaled_grid(T, ids, span), method=method,
+                           rtol=rtol, atol=atol, make_event=make_event, breaks=_breaks(batch, ids, span))
+
+
+def _scaled_grid(T, ids, span):
+    """Output times of scenes ids in units of their spans: one (m,) grid when they share it, else (k, m).
+
+    The default grid, m points over each scene's span, is one grid in scaled time: its rows are taken as
+    exactly linspace(0, 1, m), row by row (so a scene's outputs do not depend on its batch or chunk)."""
+    m = T.shape[1]
+    if T.strides[0] == 0 and np.all(span == span[0]):  # one grid and one span for all
+        return T[0] / span[0]
+    Tid = T[ids]
+    rel = np.linspace(0.0, 1.0, m)
+    on = np.all(Tid == span[:, None] * rel, axis=1)
+    if on.all():
+        return rel
+    s_out = Tid / span[:, None]
+    s_out[on] = rel
+    return s_out
 
 
 def _breaks(batch, ids, span):

@@ -56,7 +56,7 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
 
     make_rhs(idx) returns rhs(t, y) for the problems ``idx`` (t (k,), y (d, k) -> (d, k)); it is
     called once whenever the set of unfinished problems changes. t_out (n, m) holds each
-    problem's increasing output times (entries outside [t0, t_end] are never filled).
+    problem's increasing output times, or (m,) one grid for all of them (entries outside [t0, t_end] are never filled).
     make_event(idx), if given, returns g(t, y) -> (k,); a problem stops where g crosses to <= 0.
     breaks (n, nb), if given, are times where f has a kink or jump (e.g. the end of contact): no step
     crosses one, so a short forcing window before it cannot be stepped over.
@@ -70,14 +70,16 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
     d, n = y.shape
     t_end = np.broadcast_to(np.asarray(t_end, dtype=float), (n,))
     t_out = np.asarray(t_out, dtype=float)
-    m = t_out.shape[1]
-    shared = t_out[0] if np.all(t_out == t_out[:1]) else None  # one output grid for all problems
+    m = t_out.shape[-1]
+    shared = t_out if t_out.ndim == 1 else (t_out[0] if np.all(t_out == t_out[:1]) else None)  # one grid for all
+    if shared is not None:
+        t_out = shared[None, :]  # indexed as row 0 for every problem (``_times``)
     Y = np.full((d, n, m), np.nan)
     t_event = np.full(n, np.nan)
     y_event = np.full((d, n), np.nan)
     nfev = np.zeros(n, dtype=np.int64)
     # next output index per problem: first t_out >= t0 (outputs exactly at t0 are the initial state)
-    ptr = (t_out < t0[:, None]).sum(axis=1)
+    ptr = np.searchsorted(shared, t0, side="left") if shared is not None else (t_out < t0[:, None]).sum(axis=1)
     t = t0.copy()
     active = np.nonzero(t < t_end)[0]
     ptr0 = ptr.copy()  # outputs are filled contiguously from here: reached is [ptr0, ptr) at the end
@@ -227,10 +229,15 @@ def _initial_step(rhs, t0, y0, f0, span, order, rtol, atol):
     return np.minimum(np.minimum(100 * h0, h1), span)
 
 
+def _times(t_out, rows, cols):
+    """t_out[rows, cols] of an (n, m) grid, or of one grid for all problems (a (1, m) row)."""
+    return t_out[0, cols] if t_out.shape[0] == 1 else t_out[rows, cols]
+
+
 def _has_outputs(t_out, ptr, idx, t_new):
     m = t_out.shape[1]
     p = np.minimum(ptr[idx], m - 1)
-    return (ptr[idx] < m) & (t_out[idx, p] <= t_new)
+    return (ptr[idx] < m) & (_times(t_out, idx, p) <= t_new)
 
 
 class _Dense:
@@ -310,7 +317,7 @@ def _fill_at_start(Y, ptr, t_out, t, y):
     rows = np.nonzero((ptr < m))[0]
     if rows.size == 0:
         return
-    at = t_out[rows, ptr[rows]] == t[rows]
+    at = _times(t_out, rows, ptr[rows]) == t[rows]
     r = rows[at]
     Y[:, r, ptr[r]] = y[:, r]
     ptr[r] += 1
