@@ -289,25 +289,27 @@ class Plan:
         return np.array([rate[k] for k in self.states])
 
     def _rates(self, p, t, y, F, u, c) -> np.ndarray:
-        """Time derivatives of the state for friction force F and slip u (works on batches)."""
+        """Time derivatives of the state for friction force F and slip u (works on batches): one output
+        array, each rate written into its row (the same arithmetic as term by term)."""
         s = self.scene
         law_rates = self.law.evaluate_rates(p, c) if self.law_states else {}
-        out = []
-        for name in self.states:
+        out = np.empty((len(self.states),) + np.broadcast_shapes(np.shape(F), np.shape(y)[1:]))
+        for i, name in enumerate(self.states):
             if name == "v":
-                out.append(self.drive - F / s.mass)
+                np.subtract(self.drive, F / s.mass, out=out[i, ...])
             elif name == "omega":
-                out.append(F * s.radius / s.inertia)
+                np.multiply(F, s.radius, out=out[i, ...])
+                out[i] /= s.inertia
             elif name == "theta":
-                out.append(y[self.index("omega")])
+                out[i] = y[self.index("omega")]
             elif name == "x":
-                out.append(np.abs(u))
+                np.abs(u, out=out[i, ...])
             elif name == "xi":
                 loading = self.spring(t, y)[2] if s.compliance.model != "linear" else 0.0
-                out.append(self.rigid_slip(y) - u - loading * y[self.index("xi")])
+                out[i] = self.rigid_slip(y) - u - loading * y[self.index("xi")]
             else:
-                out.append(law_rates[name[len(LAW_PREFIX):]])
-        return np.array(np.broadcast_arrays(*out), dtype=float)
+                out[i] = law_rates[name[len(LAW_PREFIX):]]
+        return out
 
 
 def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan:
