@@ -226,7 +226,7 @@ class Plan:
             c = self.contact(np.asarray(t), y, np.asarray(u)) if self.law_states else None
         else:
             u = self.rigid_slip(y)
-            if np.any(direction):
+            if direction.any() if isinstance(direction, np.ndarray) else direction != 0:
                 from .solvers.stick import branch_slip
 
                 u = branch_slip(self, u, direction)
@@ -292,8 +292,11 @@ class Plan:
         """Time derivatives of the state for friction force F and slip u (works on batches): one output
         array, each rate written into its row (the same arithmetic as term by term)."""
         s = self.scene
-        law_rates = self.law.evaluate_rates(p, c) if self.law_states else {}
-        out = np.empty((len(self.states),) + np.broadcast_shapes(np.shape(F), np.shape(y)[1:]))
+        law_rates = self.law.evaluate_rates(p, c) if self.law.states else {}
+        shape = np.shape(F)
+        if shape != np.shape(y)[1:]:
+            shape = np.broadcast_shapes(shape, np.shape(y)[1:])
+        out = np.empty((len(self.states),) + shape)
         for i, name in enumerate(self.states):
             if name == "v":
                 np.subtract(self.drive, F / s.mass, out=out[i, ...])
