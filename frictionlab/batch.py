@@ -257,7 +257,15 @@ def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol:
     p = batch_params(law, params, nsc)
     tgrid = _time_grid(batch, t, n)
     if nsc > CHUNK:
-        return _chunked(law, batch, p, tgrid, solver, rtol, atol, n)
+        return _chunked(law, batch, p, tgrid, solver, rtol, atol)
+    out, solver, info = _simulate_chunk(law, batch, p, tgrid, solver, rtol, atol)
+    return BatchResult(t=tgrid, solver=solver, law=law.name, info=info, **out)
+
+
+def _simulate_chunk(law, batch, p, tgrid, solver, rtol, atol, into=None):
+    """One chunk: (outputs, solver taken, info). ``into`` (see ``_chunked``) holds the result arrays' rows of
+    these scenes, written in place (the states on the grid are integrated straight into them)."""
+    nsc = batch.n
     T = np.broadcast_to(tgrid, (nsc, tgrid.shape[-1]))
     plan = make_plan(batch.view(), law, "batch scene")
     if plan.scene.spring is not None:
@@ -278,35 +286,37 @@ def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol:
                 raise
             solver = "DOP853"
     if solver == "exact":
-        out, info = _run_exact(law, batch, p, T)
+        out, info = _run_exact(law, batch, p, T, into)
     else:
-        out, info = _run_rk(law, batch, p, T, solver, rtol, atol)
+        out, info = _run_rk(law, batch, p, T, solver, rtol, atol, into)
     info.update({"rtol": rtol, "atol": rtol if atol is None else atol} if solver != "exact" else {})
-    return BatchResult(t=tgrid, solver=solver, law=law.name, info=info, **out)
+    return out, solver, info
 
 
-def _chunked(law, batch, p, tgrid, solver, rtol, atol, n) -> BatchResult:
-    """``simulate_batch`` chunk by chunk (CHUNK scenes each), each chunk's arrays copied into the
-    result as it finishes, so only one chunk's working arrays exist at a time."""
-    out, parts = {}, []
-    for start in range(0, batch.n, CHUNK):
-        sl = slice(start, min(start + CHUNK, batch.n))
-        r = simulate_batch(law, batch.subset(sl), _take_params(p, sl), _Grid(tgrid if tgrid.ndim == 1 else tgrid[sl]),
-                           solver, rtol, atol, n)
-        for name in ("u", "v", "omega", "theta", "force", "stick_time", "A", "N"):
-            a = getattr(r, name)
-            if a is None:
-                continue
-            if name not in out:
-                out[name] = np.empty((batch.n,) + a.shape[1:], dtype=a.dtype)
-            out[name][sl] = a
-        parts.append((r.solver, r.info))
-        del r
+def _chunked(law, batch, p, tgrid, solver, rtol, atol) -> BatchResult:
+    """``simulate_batch`` chunk by chunk (CHUNK scenes each), written in place into the result arrays, so
+    only one chunk's working arrays exist beside the results (per-scene cost and memory flat in n)."""
+    plan = make_plan(batch.view(), law, "batch scene")
+    n, m = batch.n, tgrid.shape[-1]
+    states = np.empty((len(plan.states), n, m))  # the states on the grid: v, omega, theta are rows of it
+    res = {"u": np.empty((n, m)), "force": np.empty((n, m)), "stick_time": np.empty(n),
+           "A": np.empty((n, m)) if plan.needs_area else None,
+           "N": np.empty((n, m)) if "N" in law.requires else None}
+    parts = []
+    for start in range(0, n, CHUNK):
+        sl = slice(start, min(start + CHUNK, n))
+        into = {k: None if a is None else a[sl] for k, a in res.items()} | {"states": states[:, sl]}
+        out, s, info = _simulate_chunk(law, batch.subset(sl), _take_params(p, sl), tgrid if tgrid.ndim == 1 else tgrid[sl],
+                                       solver, rtol, atol, into)
+        res["stick_time"][sl] = out["stick_time"]
+        parts.append((s, info))
     solvers = {s for s, _ in parts}
     info = {"chunks": len(parts), "nfev": int(sum(i.get("nfev", 0) for _, i in parts)),
             **({"rtol": rtol, "atol": rtol if atol is None else atol} if "exact" not in solvers else {})}
-    return BatchResult(t=tgrid, solver="+".join(sorted(solvers)), law=law.name, info=info,
-                       **{k: out.get(k) for k in ("u", "v", "omega", "theta", "force", "stick_time", "A", "N")})
+    spin = plan.has_spin
+    return BatchResult(t=tgrid, solver="+".join(sorted(solvers)), law=law.name, info=info, v=states[0],
+                       omega=states[plan.index("omega")] if spin else np.zeros((n, m)),
+                       theta=states[plan.index("theta")] if spin else np.zeros((n, m)), **res)
 
 
 def simulate_sweep(law, scenes, params=None, t=None, solver: str = "auto", rtol: float = 1e-8,
@@ -346,8 +356,6 @@ def _concat(parts, tgrid) -> BatchResult:
 
 
 def _time_grid(batch, t, n):
-    if isinstance(t, _Grid):  # a chunk of a grid checked once for the whole batch
-        return t.t
     if t is None:
         dur = batch.values.get("duration")
         if dur is None:
@@ -361,13 +369,6 @@ def _time_grid(batch, t, n):
     return t
 
 
-@attrs.frozen
-class _Grid:
-    """Sample times already checked by ``_time_grid`` (a chunk's rows), passed to ``simulate_batch`` as t."""
-
-    t: np.ndarray
-
-
 def _plan(law, view) -> Plan:
     return make_plan(view, law, "batch scene")
 
@@ -379,32 +380,44 @@ def _zero_slip(plan, y):
     return y
 
 
-def _finish(law, batch, p, T, Y, sliding, need):
-    """u, force, A and N on the output grid from the states, as ``segments.run`` does."""
+def _finish(law, batch, p, T, Y, sliding, need, into=None):
+    """u, force, A and N on the output grid from the states, as ``segments.run`` does (written into the
+    result arrays ``into`` when given; Y is then already theirs)."""
     view = batch.view(column=True)
     plan = _plan(law, view)
     stuck = ~sliding
     u = plan.rigid_slip(Y)  # written in place below (a copy where it would alias the states): memory, not speed
-    u = u.copy() if np.shares_memory(u, Y) else u
+    if into is not None:
+        u = np.copyto(into["u"], u) or into["u"]
+    elif np.shares_memory(u, Y):
+        u = u.copy()
     u[stuck] = 0.0
     c = plan.contact(T, Y, u)
     F = law.evaluate(_take_params(p, slice(None), column=True), c)
-    F = F if F.flags.writeable and not np.shares_memory(F, u) else F.copy()
+    if into is not None:
+        F = np.copyto(into["force"], F) or into["force"]
+    elif not F.flags.writeable or np.shares_memory(F, u):
+        F = F.copy()
     np.copyto(F, np.broadcast_to(need, F.shape), where=stuck)
     A = c.A if c.A is not None else (view.area(T, None, u)[0] if plan.needs_area else None)
     N = c.N
-    omega = Y[plan.index("omega")] if plan.has_spin else np.zeros_like(u)
-    theta = Y[plan.index("theta")] if plan.has_spin else np.zeros_like(u)
     for name, arr in (("states", Y), ("force", F)):
         if not _all_finite(arr):
             bad = ~np.isfinite(arr) if arr.ndim == 2 else ~np.isfinite(arr).all(axis=0)
             i = int(np.argmax(bad.any(axis=1)))
             raise SolverError(f"batch: {name} became NaN or infinite for law '{law.name}' in scene {i}")
 
-    def full(a):
-        return None if a is None else (a if np.shape(a) == u.shape else np.broadcast_to(a, u.shape).copy())
+    def full(a, name):
+        if a is None:
+            return None
+        if into is not None:
+            np.copyto(into[name], a)
+            return into[name]
+        return a if np.shape(a) == u.shape else np.broadcast_to(a, u.shape).copy()
 
-    return {"u": u, "v": Y[0], "omega": omega, "theta": theta, "force": F, "A": full(A), "N": full(N)}
+    omega = Y[plan.index("omega")] if plan.has_spin else np.zeros_like(u)
+    theta = Y[plan.index("theta")] if plan.has_spin else np.zeros_like(u)
+    return {"u": u, "v": Y[0], "omega": omega, "theta": theta, "force": F, "A": full(A, "A"), "N": full(N, "N")}
 
 
 def _all_finite(a) -> bool:
@@ -468,7 +481,7 @@ def _breakaway(law, batch, p, ids, ts, ys, t_end, last_dir):
 
 def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask):
     """Stuck-phase states (``solvers.stick.stuck_states``) at outputs in [t_from, t_to] not yet filled."""
-    assert Y.flags.c_contiguous and done.flags.c_contiguous  # written through flat views
+    assert all(y.flags.c_contiguous for y in Y) and done.flags.c_contiguous  # written through flat views
     Ts = T[ids]
     sel = (Ts >= t_from[:, None]) & (Ts <= t_to[:, None]) & ~done[ids]
     r, c = np.nonzero(sel)
@@ -485,7 +498,7 @@ def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask):
 
 
 # --- the vectorized Runge-Kutta path ----------------------------------------------------------
-def _run_rk(law, batch, p, T, method, rtol, atol):
+def _run_rk(law, batch, p, T, method, rtol, atol, into=None):
     nsc, m = T.shape
     full = _plan(law, batch.view())
     d = len(full.states)
@@ -514,7 +527,8 @@ def _run_rk(law, batch, p, T, method, rtol, atol):
             end = np.where(np.isnan(tb), t_end[stuck_ids], tb)
             held = ~(tb == t0[stuck_ids])  # breakaway at once: the sliding phase owns the outputs at t0
             if Y is None:
-                Y = np.full((d, nsc, m), np.nan)
+                Y = np.full((d, nsc, m), np.nan) if into is None else into["states"]
+                Y.fill(np.nan)
             if held.any():
                 h_ids = stuck_ids[held]
                 _fill_stuck(law, batch, h_ids, t0[h_ids], y0[:, h_ids], t0[h_ids], end[held], T, Y, done, stuck_mask)
@@ -535,7 +549,9 @@ def _run_rk(law, batch, p, T, method, rtol, atol):
             i = int(np.argmax(segments > MAX_SEGMENTS))
             raise SolverError(f"batch {method}: slip changed between sliding and sticking more than {MAX_SEGMENTS} times "
                               f"in scene {i} (chatter); the law is not suited to this scene")
-        res = _slide_rk(law, batch, p, slide_ids, t0, y0, direction, T, t_end, scale, method, rtol, atol)
+        first_all = Y is None and slide_ids.size == nsc and into is not None  # integrated straight into the result
+        res = _slide_rk(law, batch, p, slide_ids, t0, y0, direction, T, t_end, scale, method, rtol, atol,
+                        into["states"] if first_all else None)
         iterations += res.iterations
         nfev[slide_ids] += res.nfev
         new = res.reached & ~done[slide_ids]
@@ -565,13 +581,13 @@ def _run_rk(law, batch, p, T, method, rtol, atol):
         i = int(np.argmax(~done.all(axis=1)))
         raise SolverError(f"batch {method}: scene {i} ended before its last requested time")
     need = stick.needed_force(_plan(law, batch.view(column=True)))
-    out = _finish(law, batch, p, T, Y, ~stuck_mask, need)
+    out = _finish(law, batch, p, T, Y, ~stuck_mask, need, into)
     out["stick_time"] = stick_time
     return out, {"nfev": int(nfev.sum()), "nfev_per_scene": nfev, "iterations": iterations,
                  "segments": int(segments.max(initial=0)), "method": method}
 
 
-def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rtol, atol):
+def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rtol, atol, out=None):
     """One sliding phase for scenes ``ids`` on the scaled problem (time / span, states / scale)."""
     span = t_end[ids]
     sc = scale[:, ids]
@@ -602,7 +618,7 @@ def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rt
         return g
 
     return vecrk.integrate(make_rhs, t0[ids] / span, y0[:, ids] / sc, 1.0, _scaled_grid(T, ids, span), method=method,
-                           rtol=rtol, atol=atol, make_event=make_event, breaks=_breaks(batch, ids, span))
+                           rtol=rtol, atol=atol, make_event=make_event, breaks=_breaks(batch, ids, span), out=out)
 
 
 def _scaled_grid(T, ids, span):
@@ -632,7 +648,7 @@ def _breaks(batch, ids, span):
 
 
 # --- the vectorized closed forms -------------------------------------------------------------
-def _run_exact(law, batch, p, T):
+def _run_exact(law, batch, p, T, into=None):
     nsc, m = T.shape
     view = batch.view(column=True)
     plan = _plan(law, view)
@@ -645,7 +661,7 @@ def _run_exact(law, batch, p, T):
     fallback = np.zeros(nsc, dtype=bool)
     if isinstance(form, exact.AreaSlipForm):
         J, K = exact._area_slip(plan, form.k, 0.0, y0, T)
-        Y = exact._states(plan, 0.0, y0, T, J, K)
+        Y = exact._states(plan, 0.0, y0, T, J, K, out=None if into is None else into["states"])
     else:
         u_s = np.broadcast_to(plan.rigid_slip(y0), (nsc, 1))
         sgn = np.sign(u_s)
@@ -658,7 +674,7 @@ def _run_exact(law, batch, p, T):
         tt = np.minimum(T, tcol) if hit.any() else T
         signed = exact.NormalAreaRateForm(a=sgn * form.a, c=sgn * form.c)  # the slip's sign in the form: no pass
         J1, K1, _ = exact._normal_area_rate(plan, signed, 0.0, y0, 1.0, tt, find_stop=False)
-        Y = exact._states(plan, 0.0, y0, tt, J1, K1)
+        Y = exact._states(plan, 0.0, y0, tt, J1, K1, out=None if into is None else into["states"])
         if hit.any():
             stick_time[hit] = ts[hit]
             ids = np.nonzero(hit)[0]
@@ -672,7 +688,7 @@ def _run_exact(law, batch, p, T):
             np.copyto(Y[0], v_stick, where=stuck_mask)  # zero slip exactly while stuck, as the stick state has it
             stick.stuck_states(plan, T, tt, Y, out=Y)  # dt = 0 before the stick: those states stay
     need = stick.needed_force(plan)
-    out = _finish(law, batch, p, T, np.nan_to_num(Y) if fallback.any() else Y, ~stuck_mask, need)
+    out = _finish(law, batch, p, T, np.nan_to_num(Y, copy=into is None) if fallback.any() else Y, ~stuck_mask, need, into)
     for i in np.nonzero(fallback)[0]:
         _scalar_into(out, stick_time, law, batch, p, T, i)
     out["stick_time"] = stick_time

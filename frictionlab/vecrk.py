@@ -36,14 +36,29 @@ class Result:
 
 
 def _rows_dot(M, K, out=None):
-    """M @ K by numpy's own loops (einsum): BLAS may start threads for these sizes, which on a shared
-    2-core machine cost several times the CPU they save (measured), and erratically."""
-    return np.einsum("ij,jn->in", M, K, out=out)
+    """M @ K, row by row (see ``_vec_dot``)."""
+    out = np.empty((M.shape[0], K.shape[1])) if out is None else out
+    for i, row in enumerate(M):
+        _vec_dot(row, K, out[i])
+    return out
 
 
-def _vec_dot(a, K):
-    """a @ K, a (s,), K (s, n), without BLAS (see _rows_dot)."""
-    return np.einsum("j,jn->n", a, K)
+def _vec_dot(a, K, out=None):
+    """a @ K for a (s,), K (s, n): the terms of nonzero coefficients added in order, in place.
+
+    Not BLAS or einsum: those may start threads (on a shared machine costing several times the CPU they
+    save) and sum in an order that depends on n, so a scene's result would depend on its batch's size."""
+    nz = np.flatnonzero(a)
+    out = np.empty(K.shape[1]) if out is None else out
+    if nz.size == 0:
+        out.fill(0.0)
+        return out
+    np.multiply(K[nz[0]], a[nz[0]], out=out)
+    tmp = np.empty_like(out)
+    for j in nz[1:]:
+        np.multiply(K[j], a[j], out=tmp)
+        out += tmp
+    return out
 
 
 def _rms(x):
@@ -51,7 +66,7 @@ def _rms(x):
 
 
 def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: float = 1e-8, atol: float | None = None,
-              make_event=None, breaks=None) -> Result:
+              make_event=None, breaks=None, out=None) -> Result:
     """Integrate n problems y' = f(t, y) from t0 (n,) with y0 (d, n) to t_end (n,).
 
     make_rhs(idx) returns rhs(t, y) for the problems ``idx`` (t (k,), y (d, k) -> (d, k)); it is
@@ -59,7 +74,8 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
     problem's increasing output times, or (m,) one grid for all of them (entries outside [t0, t_end] are never filled).
     make_event(idx), if given, returns g(t, y) -> (k,); a problem stops where g crosses to <= 0.
     breaks (n, nb), if given, are times where f has a kink or jump (e.g. the end of contact): no step
-    crosses one, so a short forcing window before it cannot be stepped over.
+    crosses one, so a short forcing window before it cannot be stepped over. out (n_states, n, m), each
+    out[j] C-contiguous, if given, receives the outputs (a view into a caller's larger array).
     """
     if method not in METHODS:
         raise SolverError(f"batch: unknown method {method!r}; choose one of {', '.join(METHODS)}")
@@ -74,7 +90,10 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
     shared = t_out if t_out.ndim == 1 else (t_out[0] if np.all(t_out == t_out[:1]) else None)  # one grid for all
     if shared is not None:
         t_out = shared[None, :]  # indexed as row 0 for every problem (``_times``)
-    Y = np.full((d, n, m), np.nan)
+    Y = np.full((d, n, m), np.nan) if out is None else out
+    if out is not None:
+        assert out.shape == (d, n, m) and all(o.flags.c_contiguous for o in out)  # written through flat views
+        Y.fill(np.nan)
     t_event = np.full(n, np.nan)
     y_event = np.full((d, n), np.nan)
     nfev = np.zeros(n, dtype=np.int64)
@@ -206,8 +225,8 @@ def _error_norm(cls, errs, h, scale):
     if cls is DOP853:
         err5 = errs[0] / scale
         err3 = errs[1] / scale
-        e5 = np.einsum("ij,ij->j", err5, err5)
-        e3 = np.einsum("ij,ij->j", err3, err3)
+        e5 = np.sum(err5 * err5, axis=0)  # row by row: the same order whatever the batch's size
+        e3 = np.sum(err3 * err3, axis=0)
         denom = e5 + 0.01 * e3
         with np.errstate(invalid="ignore", divide="ignore"):
             out = np.abs(h) * e5 / np.sqrt(denom * scale.shape[0])
@@ -327,7 +346,7 @@ def _fill_dense(Y, ptr, t_out, idx, pos, t_stop, dense, shared=None):
     """Fill every output t_out[i, ptr_i:] <= t_stop_i of problems idx (rows pos of the dense output)."""
     start = ptr[idx]
     m = t_out.shape[1]
-    Yf = Y.reshape(Y.shape[0], -1)  # Y is C-contiguous (d, n, m)
+    Yf = [y.reshape(-1) for y in Y]  # each Y[j] C-contiguous (n, m): flat views
     if shared is not None:  # one grid for all problems: each problem's outputs here are columns start..stop-1
         stop = np.maximum(np.searchsorted(shared, t_stop, side="right"), start)
         counts = stop - start
@@ -350,7 +369,7 @@ def _fill_dense(Y, ptr, t_out, idx, pos, t_stop, dense, shared=None):
         if not valid.all():  # integer take and put: several times faster than boolean-mask indexing
             sel = np.flatnonzero(valid)
             flat, vals = flat[sel], np.take(vals, sel, axis=1)
-        for j in range(Yf.shape[0]):
+        for j in range(len(Yf)):
             np.put(Yf[j], flat, vals[j])
         ptr[idx] = start + counts
         return
@@ -362,7 +381,9 @@ def _fill_dense(Y, ptr, t_out, idx, pos, t_stop, dense, shared=None):
     tq = t_out[idx[rows], cols]
     p = pos[rows]
     x = (tq - dense.t_old[p]) / dense.h[p]
-    Yf[:, idx[rows] * m + cols] = dense(x, p)
+    vals, flat = dense(x, p), idx[rows] * m + cols
+    for j in range(len(Yf)):
+        np.put(Yf[j], flat, vals[j])
     ptr[idx] = np.maximum(ptr[idx], stop)
 
 

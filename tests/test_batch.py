@@ -312,3 +312,24 @@ def test_root_at_a_bracket_end_closes_in_a_few_evaluations(monkeypatch):
     rolled = ~np.isnan(ex.stick_time)
     assert np.array_equal(rolled, ~np.isnan(br.stick_time)) and rolled.sum() > n // 2
     assert np.allclose(br.stick_time[rolled], ex.stick_time[rolled], rtol=1e-7)
+
+
+def test_chunks_written_in_place_equal_one_call(monkeypatch, rng):
+    """Chunks integrated straight into the result arrays: scenes that start stuck and break away, stick again,
+    and closed forms that hand a scene to the scalar solver give the one-call result bitwise."""
+    from frictionlab import batch as B
+
+    cases = [("coulomb", [incline(u0) for u0 in (0.0, 0.05, 0.0, 0.2, 0.1, 0.0, 0.3)],
+              [{"mu": m} for m in (0.1, 0.5, 0.4, 0.2, 0.6, 0.2, 0.3)], ("exact", "RK45")),
+             ("area-rate", [oblique(rng.uniform(20, 60), rng.uniform(0.1, 1.3), duration=540e-6) for _ in range(7)],
+              [{"mu": rng.uniform(0.1, 0.5), "eta_prime": rng.uniform(-2e3, 2e3)} for _ in range(7)], ("exact", "DOP853"))]
+    for law, scenes, params, solvers in cases:
+        for solver in solvers:
+            whole = simulate_batch(law, scenes, params, solver=solver, n=17)
+            monkeypatch.setattr(B, "CHUNK", 3)
+            parts = simulate_batch(law, scenes, params, solver=solver, n=17)
+            monkeypatch.undo()
+            assert parts.info["chunks"] == 3
+            for name in ("u", "v", "omega", "theta", "force", "stick_time", "A", "N"):
+                a, b = getattr(whole, name), getattr(parts, name)
+                assert (a is None and b is None) or np.array_equal(a, b, equal_nan=True), (law, solver, name)

@@ -81,12 +81,13 @@ def make_slide():
     return slide
 
 
-def _states(plan, t0, y0, t, J, K):
+def _states(plan, t0, y0, t, J, K, out=None):
     """States at times t from the friction impulse J and its integral K (terms that vanish skipped: a batch
     evaluates this on large grids)."""
     s = plan.scene
     dt = t - t0
-    out = np.empty((len(plan.states),) + np.broadcast_shapes(np.shape(J), np.shape(dt)))
+    if out is None:
+        out = np.empty((len(plan.states),) + np.broadcast_shapes(np.shape(J), np.shape(dt)))
     for i, name in enumerate(plan.states):
         if name == "v":
             np.divide(J, -s.mass, out=out[i])
