@@ -479,22 +479,27 @@ def _breakaway(law, batch, p, ids, ts, ys, t_end, last_dir):
     return tb, hold, need
 
 
-def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask):
-    """Stuck-phase states (``solvers.stick.stuck_states``) at outputs in [t_from, t_to] not yet filled."""
+def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask, block=2048):
+    """Stuck-phase states (``solvers.stick.stuck_states``) at outputs in [t_from, t_to] not yet filled; per
+    scene on its whole grid row, ``block`` scenes at a time (working memory bounded, not per output point)."""
     assert all(y.flags.c_contiguous for y in Y) and done.flags.c_contiguous  # written through flat views
-    Ts = T[ids]
-    sel = (Ts >= t_from[:, None]) & (Ts <= t_to[:, None]) & ~done[ids]
-    r, c = np.nonzero(sel)
-    if r.size == 0:
-        return
-    plan = _plan(law, batch.view(ids, column=True))  # per scene, broadcast along its times (no per-output gathering)
-    Ys, _ = stick.stuck_states(plan, Ts, ts[:, None], ys[:, :, None])
-    flat = ids[r] * T.shape[1] + c
-    src = r * T.shape[1] + c
-    for j in range(Y.shape[0]):  # integer take and put per state: several times faster than 2-d fancy indexing
-        np.put(Y[j], flat, np.take(Ys[j], src))
-    done.reshape(-1)[flat] = True
-    stuck_mask.reshape(-1)[flat] = True
+    m = T.shape[1]
+    for b in range(0, ids.size, block):
+        bi = slice(b, b + block)
+        rows = ids[bi]
+        Ts = T[rows]
+        sel = (Ts >= t_from[bi, None]) & (Ts <= t_to[bi, None]) & ~done[rows]
+        r, c = np.nonzero(sel)
+        if r.size == 0:
+            continue
+        plan = _plan(law, batch.view(rows, column=True))  # per scene, broadcast along its times
+        Ys, _ = stick.stuck_states(plan, Ts, ts[bi, None], ys[:, bi, None])
+        flat = rows[r] * m + c
+        src = r * m + c
+        for j in range(Y.shape[0]):  # integer take and put per state: several times faster than 2-d fancy indexing
+            np.put(Y[j], flat, np.take(Ys[j], src))
+        done.reshape(-1)[flat] = True
+        stuck_mask.reshape(-1)[flat] = True
 
 
 # --- the vectorized Runge-Kutta path ----------------------------------------------------------
