@@ -17,6 +17,10 @@ their 1.2558, checked in tests/test_contact.py):
     Psi1 = (kappa / mu) * v_c1 / v_n1     (incidence of the contact point, v_c1 = v_t1 - r omega_1)
     Psi2 = (kappa / mu) * v_c2 / v_n2     (rebound of the contact point, v_n2 = e v_n1)
     chi  = (kappa / 2) (1 + m r^2 / I)    (= (1 - nu)(1 + r^2/k^2)/(2 - nu) for like materials, as in MBF)
+Tangential compliance models (``[scene.compliance] model``): 'linear' (constant spring and damper),
+'mindlin' (k_t = 8 G* a(t), Thornton's one-state history simplification, any law, ODE solvers) and
+'mindlin-deresiewicz' (microslip and the full loading history by the Method of Dimensionality
+Reduction, frictionlab.mdr; Coulomb-form laws, impact outcomes).
 Rigid-body Coulomb theory (``rigid_psi2``): the contact point slides throughout when
 Psi1 >= 2 chi (1 + e), then Psi2 = (Psi1 - 2 chi (1 + e)) / e; below that it stops and rolls, Psi2 = 0.
 """

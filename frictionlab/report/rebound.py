@@ -58,7 +58,7 @@ def build(ctx):
     speed = float(np.median(first.columns["speed"]))
 
     def draw():
-        curves = rebound.psi_curves(first.scene, speed, np.linspace(1.0, 50.0, 16))
+        curves = rebound.psi_curves(first.scene, speed, np.linspace(1.0, 50.0, 22))
         return rebound.psi_figure(curves, rebound.measured_psi(first),
                                   f"{first.name}: Ψ2 against Ψ1, μ = {first.scene.friction:g}, {speed:g} m/s")
 
