@@ -32,7 +32,13 @@ properties", friction "the same used in the MFIX documentation", i.e. MFIX DEM05
 Kharaz et al.'s data). Normal restitution 0.98: the YADE script of Chung and Ooi's Test 4
 (en = 0.98 for aluminium oxide at vn_ini = 3.9 m/s, mu = tan(atan(0.092))).
 
-Which anvil (checked for this round). Gorham and Kharaz, Powder Technology 112 (2000) 193-202, measured
+Which anvil and which angle (checked for this round). The 2001 paper's abstract (as reproduced in a
+public BibTeX entry of the paper) says: "5-mm aluminium oxide spheres impacting a thick soda-lime glass
+anvil, for impact angles from normal to very near glancing incidence", its measurements "show very close
+agreement with the numerical work of Maw et al. which takes into account the effects of sticking,
+microslip and tangential compliance", and "for impacts with a greater obliqueness than about 30 deg from
+the normal" with rigid-body sliding: angles from the normal, glass anvil. Gorham and Kharaz, Powder
+Technology 112 (2000) 193-202, measured
 the same 5 mm alumina spheres on two anvils: "a thick soda-lime glass anvil (fully elastic response)
 and an aluminium alloy anvil (involving some plastic deformation)" (abstract). The 2001 paper studies
 the elastic rebound, i.e. the glass anvil, which is what MFIX DEM05 and Lethe model (glass wall, 70 GPa,
