@@ -416,6 +416,23 @@ def predict_outcomes(law, dataset_or_scene, params: Mapping[str, float] | None =
     return out
 
 
+MDR_NEEDS_COULOMB = ("compliance model 'mindlin-deresiewicz' gives every point of the contact its own Coulomb limit "
+                     "(mu times the local pressure); law '{law}' is not of the Coulomb form F = mu N")
+
+
+def mdr_solvers(law) -> dict[str, str | None]:
+    """``predict.applicable_solvers`` for a template with Mindlin-Deresiewicz compliance: its own fixed-step
+    integrator (frictionlab.mdr) runs under the name 'ode' for laws of the Coulomb form; nothing else applies."""
+    from .law import NormalAreaRateForm
+
+    form = law.form(law.defaults())
+    if not (isinstance(form, NormalAreaRateForm) and form.c == 0.0):
+        why = MDR_NEEDS_COULOMB.format(law=law.name)
+        return {"exact": why, "series": why, "ode": why}
+    why = "compliance model 'mindlin-deresiewicz' is integrated by frictionlab.mdr (solver 'ode')"
+    return {"exact": why, "series": why, "ode": None}
+
+
 def _mdr_rebounds(law, imps, p, template):
     """End-of-contact tangential velocity [m/s] and spin [rad/s] of every row with Mindlin-Deresiewicz
     compliance (frictionlab.mdr, all rows in one vectorized integration), and whether the contact point
@@ -425,8 +442,7 @@ def _mdr_rebounds(law, imps, p, template):
 
     form = law.form(p)
     if not (isinstance(form, NormalAreaRateForm) and form.c == 0.0 and form.a >= 0.0):
-        raise SceneError(f"compliance model 'mindlin-deresiewicz' gives every point of the contact its own Coulomb "
-                         f"limit (mu times the local pressure); law '{law.name}' is not of the Coulomb form F = mu N")
+        raise SceneError(MDR_NEEDS_COULOMB.format(law=law.name))
     r, m = template.radius, template.mass
     inertia = template.inertia_factor * m * r * r
     tc = np.array([imp.contact_time for imp in imps])

@@ -224,6 +224,11 @@ def test_mdr_needs_a_coulomb_law_and_is_not_a_trajectory_model(tmp_path):
 
     with pytest.raises(SceneError, match="impact outcomes only"):
         make_plan(ds.scene.impact(V, 0.3).scene, get_law("coulomb"))
+    from frictionlab.predict import applicable_solvers
+
+    ok = applicable_solvers("coulomb", ds.scene)
+    assert ok["ode"] is None and "frictionlab.mdr" in ok["exact"]  # fits run it under the name 'ode'
+    assert all("not of the Coulomb form" in why for why in applicable_solvers("wear", ds.scene).values())
 
 
 # --- published measurements, predicted from the stated friction coefficient and material data ---------
