@@ -16,6 +16,9 @@ depending on the tangential one: Dundurs' constant zero) this reproduces exactly
 under constant normal force, Mindlin-Deresiewicz under any history of normal and tangential load,
 and microslip (the stick zone is the set of springs below their limit).
 
+The normal-tangential coupling of dissimilar materials (Dundurs' beta, -0.23 for alumina on soda-lime
+glass) is neglected, as in Maw, Barber and Fawcett (1976) and in DEM contact models.
+
 Here the local normal load is distributed over the springs as the Hertz pressure of the 1D model,
 q(x) proportional to (a^2 - x^2), and normalized to the normal force N(t) the scene's normal model
 gives, so that the springs' limits sum to mu N exactly and the rigid sliding branch is reproduced

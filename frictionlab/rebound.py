@@ -51,6 +51,31 @@ def stated_predictions(dataset, models=MODELS) -> dict[str, np.ndarray]:
     return out
 
 
+def spin_from_restitution(incidence, cor_incidence, cor, speed, radius: float, inertia_factor: float = 0.4):
+    """Rebound spin [rad/s] implied by a centre-of-mass tangential restitution e_t = v_t2/v_t1 measured at
+    ``cor_incidence`` (same units as ``incidence``, from the normal), linearly interpolated at ``incidence``
+    [deg]: the tangential impulse J gives m dv_t = -J and I domega = r J, so for no inbound spin
+    omega_2 = (1 - e_t) V sin(theta) / (f r), f = I / (m r^2). A check between two published figures."""
+    inc = np.asarray(incidence, dtype=float)
+    et = np.interp(inc, np.asarray(cor_incidence, dtype=float), np.asarray(cor, dtype=float))
+    return (1.0 - et) * np.asarray(speed, dtype=float) * np.sin(np.radians(inc)) / (inertia_factor * radius)
+
+
+def consistency(spin_ds, cor_ds) -> np.ndarray | None:
+    """Spin implied by ``cor_ds`` (centre-of-mass tangential restitution) at ``spin_ds``'s rows, when both
+    come from one experiment (same group, one speed, no inbound spin); else None."""
+    if (spin_ds.observable != "rebound_spin" or cor_ds.observable != "cm_tangential_cor" or not spin_ds.group
+            or spin_ds.group != cor_ds.group or "spin" in spin_ds.columns):
+        return None
+    speeds = np.concatenate([spin_ds.columns["speed"], cor_ds.columns["speed"]])
+    if np.ptp(speeds) > 1e-9 * np.max(speeds):
+        return None
+    s = spin_ds.scene
+    return spin_from_restitution(np.degrees(spin_ds.columns["incidence"]), np.degrees(cor_ds.columns["incidence"]),
+                                 cor_ds.columns["cm_tangential_cor"], spin_ds.columns["speed"], s.radius,
+                                 s.inertia_factor)
+
+
 def comparison_rows(dataset) -> list[dict]:
     """Predicted against measured per row: incidence [deg], measured, each model's value and residual (SI)."""
     pred = stated_predictions(dataset)

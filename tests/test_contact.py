@@ -369,6 +369,11 @@ def test_report_section_shows_predictions_and_the_criterion():
     assert [f.name for f in sec.figures] == ["psi2-psi1.png"]
     assert len(ctx.json["rebound_predictions"]["kharaz2001-spin"]) == 7
     assert section.build(Context(SimpleNamespace(datasets=[load_dataset("impact-outcome-synthetic")]))) is None
+    assert "Consistency" not in text  # needs the same experiment's restitution
+    both = section.build(Context(SimpleNamespace(datasets=[load_dataset("kharaz2001-spin"),
+                                                            load_dataset("kharaz2001-tangential-cor")])))
+    text = " ".join(str(payload) for _, payload in both.blocks)
+    assert "implies 119.1 rad/s at 6.1 deg (-12.6 % from the measured spin)" in text
 
 
 def test_time_series_scene_takes_mindlin_from_materials():

@@ -130,9 +130,10 @@ def transcription_noise() -> dict[str, float]:
 def implied_spin() -> tuple[np.ndarray, np.ndarray]:
     """(incidence [deg], spin [rad/s]) implied by the tangential-restitution transcription at the spin
     transcription's angles: omega_2 = (1 - e_t) V sin(theta) / (0.4 r), e_t interpolated linearly."""
+    from ..rebound import spin_from_restitution
+
     inc = np.asarray(LETHE_SPIN[0])
-    et = np.interp(inc, *LETHE_COR)
-    return inc, (1.0 - et) * SPEED * np.sin(np.radians(inc)) / (0.4 * RADIUS)
+    return inc, spin_from_restitution(inc, *LETHE_COR, SPEED, RADIUS, 0.4)
 
 
 def hertz_pulse(speed: float = SPEED) -> tuple[float, float]:

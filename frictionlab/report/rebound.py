@@ -51,6 +51,15 @@ def build(ctx):
             mid = [r for r in rows if 30 <= r["incidence_deg"] <= 60]
             ok_low = sum(abs(r[md + "_relative"]) < 0.15 for r in low)
             ok_mid = sum(abs(r["rigid_relative"]) < 0.10 for r in mid)
+            cors = [c for c in sets if c.observable == "cm_tangential_cor"]
+            implied = next((w for w in (rebound.consistency(d, c) for c in cors) if w is not None), None)
+            if implied is not None:
+                low_i = [i for i, r in enumerate(rows) if r["incidence_deg"] < 30]
+                sec.p("Consistency of the measurements: by momentum balance (omega_2 = (1 - e_t) v_t1 / (f r)) the "
+                      "same experiment's tangential restitution implies " +
+                      ", ".join(f"{implied[i]:.4g} rad/s at {rows[i]['incidence_deg']:.1f} deg "
+                                f"({100 * (implied[i] / rows[i]['measured'] - 1):+.1f} % from the measured spin)"
+                                for i in low_i) + ": no model can match both figures closer than that.")
             sec.p(f"Below 30 deg the Mindlin-Deresiewicz model is within 15 % of the measured spin at {ok_low} of {len(low)} "
                   f"impact angles; from 30 to 60 deg the rigid model is within 10 % at {ok_mid} of {len(mid)}.")
     ctx.json["rebound_predictions"] = summary
