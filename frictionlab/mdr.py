@@ -34,8 +34,10 @@ import numpy as np
 #: Springs over [0, a_max] and the smallest number of time steps of one impact.
 SPRINGS = 400
 MIN_STEPS = 1000
-#: Time steps per period of the sticking tangential oscillation sqrt(8 G* a_max / m_eff).
+#: Time steps per period of the sticking tangential oscillation sqrt(8 G* a_max / m_eff), and the most
+#: one impact may take (beyond it the contact is stiff enough to be treated as rigid).
 STEPS_PER_PERIOD = 120
+MAX_STEPS = 200_000
 
 
 def grid(n: int = SPRINGS) -> np.ndarray:
@@ -77,7 +79,11 @@ def tangential_force(a, N, w, shear: float, mu: float, springs: int = 2000) -> n
 def steps_for(shear: float, amax, meff, duration) -> int:
     """Time steps of one impact: STEPS_PER_PERIOD per sticking tangential period, at least MIN_STEPS."""
     omega = np.sqrt(8.0 * shear * np.asarray(amax) / meff)
-    return int(max(MIN_STEPS, math.ceil(STEPS_PER_PERIOD * float(np.max(omega * np.asarray(duration))) / (2 * math.pi))))
+    periods = float(np.max(omega * np.asarray(duration))) / (2 * math.pi)
+    if not math.isfinite(periods) or STEPS_PER_PERIOD * periods > MAX_STEPS:
+        raise ValueError(f"the tangential contact oscillates {periods:.3g} times per impact (G* = {shear:.3g} Pa): "
+                         f"more than {MAX_STEPS} explicit steps; so stiff a contact is rigid: use no compliance")
+    return int(max(MIN_STEPS, math.ceil(STEPS_PER_PERIOD * periods)))
 
 
 def impacts(t, N, A, mu: float, shear: float, mass: float, radius: float, inertia: float, v0, omega0,

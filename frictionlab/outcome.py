@@ -449,14 +449,20 @@ def _mdr_rebounds(law, imps, p, template):
     probe = np.linspace(0.0, 1.0, 201)[None, :] * tc[:, None]
     amax = np.sqrt(np.array([np.max(imp.scene.area(probe[i])[0]) for i, imp in enumerate(imps)]) / math.pi)
     meff = inertia / (r * r + inertia / m)  # effective mass of the contact point, m f / (1 + f)
-    steps = mdr.steps_for(template.compliance.shear, amax, meff, tc)
+    try:
+        steps = mdr.steps_for(template.compliance.shear, amax, meff, tc)
+    except ValueError as exc:
+        raise SceneError(f"compliance model 'mindlin-deresiewicz': {exc}") from None
     t = np.linspace(0.0, 1.0, steps + 1)[None, :] * tc[:, None]
     N = np.array([imp.scene.normal(t[i]) for i, imp in enumerate(imps)])
     A = np.array([imp.scene.area(t[i])[0] for i, imp in enumerate(imps)])
     v0 = np.array([imp.tangential_speed for imp in imps])
     w0 = np.array([imp.spin for imp in imps])
-    v2, w2 = mdr.impacts(t, N, A, form.a, template.compliance.shear, m, r, inertia, v0, w0,
-                         springs=template.compliance.springs)
+    try:
+        v2, w2 = mdr.impacts(t, N, A, form.a, template.compliance.shear, m, r, inertia, v0, w0,
+                             springs=template.compliance.springs)
+    except ValueError as exc:
+        raise SceneError(f"compliance model 'mindlin-deresiewicz': {exc}") from None
     if not (np.all(np.isfinite(v2)) and np.all(np.isfinite(w2))):
         raise SceneError("compliance model 'mindlin-deresiewicz': the integration gave a non-finite rebound")
     rolled = np.abs(v2 - r * w2) <= 1e-6 * np.abs(v0 - r * w0)

@@ -209,6 +209,21 @@ def test_mdr_psi2_against_psi1_has_the_features_maw_barber_and_fawcett_found():
     assert np.all(k["psi2"] < -0.5) and np.all(k["contact_rebound_angle"] < 0)
 
 
+def test_mdr_hard_cases_are_finite_or_a_clear_error():
+    sc = ball("mindlin-deresiewicz")
+    free = predict_outcomes("coulomb", sc, {"mu": 0.0}, speed=V, incidence=np.radians([5.0, 60.0]))
+    np.testing.assert_array_equal(free["rebound_spin"], 0.0)  # no friction, no spin, v_t kept
+    np.testing.assert_allclose(free["cm_tangential_cor"], 1.0, rtol=1e-12)
+    edge = predict_outcomes("coulomb", sc, {"mu": 5.0}, speed=V, incidence=np.radians([0.01, 89.9]))
+    assert np.all(np.isfinite(edge["rebound_spin"])) and np.all(np.isfinite(edge["psi2"]))
+    soft = predict_outcomes("coulomb", ball("mindlin-deresiewicz", shear=1.0), {"mu": MU}, speed=V,
+                            incidence=np.radians([10.0]))
+    assert abs(soft["rebound_spin"][0]) < 1e-3  # a 1 Pa contact passes no tangential force
+    with pytest.raises(SceneError, match="so stiff a contact is rigid"):
+        predict_outcomes("coulomb", ball("mindlin-deresiewicz", shear=1e20), {"mu": MU}, speed=V,
+                         incidence=np.radians([10.0]))
+
+
 def test_mdr_needs_a_coulomb_law_and_is_not_a_trajectory_model(tmp_path):
     with pytest.raises(SceneError, match="not of the Coulomb form"):
         predict_outcomes("wear", ball("mindlin-deresiewicz"), {"lam": 1e6}, speed=V, incidence=np.radians([10.0]))
