@@ -6,7 +6,10 @@ iteration advances every unfinished problem by one step attempt with array opera
 the batch. Output at requested times comes from each method's dense output, and a terminal
 event g(t, y) = 0 (crossing from g > 0 to g <= 0) is located per problem on the dense output.
 The Butcher tableaus are scipy's (``scipy.integrate.RK45`` and ``DOP853`` class attributes),
-so the same tolerances mean the same local error control. Knows nothing about friction.
+so the same tolerances mean the same local error control. Stage combinations add the nonzero terms
+in order (not BLAS or einsum, whose order depends on the batch's size), so a problem's numbers do
+not depend on the other problems in its batch. With one output grid for all problems, each step's
+outputs are one padded block of dense-output evaluations. Knows nothing about friction.
 """
 from __future__ import annotations
 
