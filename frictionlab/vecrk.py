@@ -38,29 +38,36 @@ class Result:
     iterations: int
 
 
-def _rows_dot(M, K, out=None):
+def _rows_dot(M, K, out=None, tmp=None):
     """M @ K, row by row (see ``_vec_dot``)."""
     out = np.empty((M.shape[0], K.shape[1])) if out is None else out
+    tmp = np.empty(K.shape[1]) if tmp is None else tmp
     for i, row in enumerate(M):
-        _vec_dot(row, K, out[i])
+        _vec_dot(row, K, out[i], tmp)
     return out
 
 
-def _vec_dot(a, K, out=None):
-    """a @ K for a (s,), K (s, n): the terms of nonzero coefficients added in order, in place.
+def _vec_dot(a, K, out=None, tmp=None):
+    """a @ K for a (s,), K (s, n): the terms of nonzero coefficients added in order, in place (tmp: a
+    scratch row).
 
     Not BLAS or einsum: those may start threads (on a shared machine costing several times the CPU they
     save) and sum in an order that depends on n, so a scene's result would depend on its batch's size."""
-    nz = np.flatnonzero(a)
     out = np.empty(K.shape[1]) if out is None else out
-    if nz.size == 0:
+    first = True
+    for j, c in enumerate(a.tolist()):
+        if c == 0.0:
+            continue
+        if first:
+            np.multiply(K[j], c, out=out)
+            first = False
+        else:
+            if tmp is None:
+                tmp = np.empty_like(out)
+            np.multiply(K[j], c, out=tmp)
+            out += tmp
+    if first:
         out.fill(0.0)
-        return out
-    np.multiply(K[nz[0]], a[nz[0]], out=out)
-    tmp = np.empty_like(out)
-    for j in nz[1:]:
-        np.multiply(K[j], a[j], out=tmp)
-        out += tmp
     return out
 
 
@@ -152,13 +159,14 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
         # stages as scipy's rk_step takes them: dy = h (K[:s]^T a), one matrix product per stage
         K = np.empty((nk, d, k))
         Kf = K.reshape(nk, d * k)
+        tmp = np.empty(d * k)  # scratch row of the stage combinations
         np.take(F, active, axis=1, out=K[0])
         for s in range(1, ns):
-            dy = _vec_dot(A[s, :s], Kf[:s]).reshape(d, k)
+            dy = _vec_dot(A[s, :s], Kf[:s], tmp=tmp).reshape(d, k)
             dy *= ha
             dy += ya
             K[s] = rhs(ta + C[s] * ha, dy)
-        y_new = _vec_dot(B, Kf[:ns]).reshape(d, k)
+        y_new = _vec_dot(B, Kf[:ns], tmp=tmp).reshape(d, k)
         y_new *= ha
         y_new += ya
         t_new = ta + ha
@@ -167,7 +175,7 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
         scale = np.maximum(np.abs(ya), np.abs(y_new))
         scale *= rtol
         scale += atol
-        err = _error_norm(cls, _rows_dot(E, Kf[: ns + 1]).reshape(len(E), d, k), ha, scale)
+        err = _error_norm(cls, _rows_dot(E, Kf[: ns + 1], tmp=tmp).reshape(len(E), d, k), ha, scale)
         ok = err < 1.0
         with np.errstate(divide="ignore"):
             factor = np.where(err == 0.0, MAX_FACTOR, SAFETY * err**exponent)
