@@ -30,6 +30,7 @@ import argparse
 import math
 import os
 import platform
+import resource
 import time
 
 import numpy as np
@@ -312,8 +313,10 @@ def scaling(args, rng):
         per = {}
         for n in args.scaling:
             b, p = fam(n, rng)
+            sys0 = resource.getrusage(resource.RUSAGE_SELF).ru_stime
             times = [median_time(lambda: simulate_batch(law, b, p, solver="DOP853", rtol=args.rtol, n=NT), 1)[0]
                      for _ in range(args.repeats)]  # every size alike: the first run pays the results' page faults
+            sys_time = (resource.getrusage(resource.RUSAGE_SELF).ru_stime - sys0) / len(times)
             t = float(np.median(times))
             tracemalloc.start()
             r = simulate_batch(law, b, p, solver="DOP853", rtol=args.rtol, n=NT)
@@ -322,7 +325,8 @@ def scaling(args, rng):
             size = sum(a.nbytes for a in (r.u, r.v, r.omega, r.theta, r.force, r.stick_time, r.A, r.N) if a is not None)
             per[n] = t / n
             print(f"  {law:8s} n = {n:>7}: {t / n * 1e6:7.1f} us/scene (median of {len(times)}, "
-                  f"{min(times) / n * 1e6:.1f}-{max(times) / n * 1e6:.1f}); peak {peak / 2**20:7.0f} MiB for "
+                  f"{min(times) / n * 1e6:.1f}-{max(times) / n * 1e6:.1f}; system time {sys_time / n * 1e6:.1f} on average, "
+                  f"page faults); peak {peak / 2**20:7.0f} MiB for "
                   f"{size / 2**20:6.0f} MiB of results = {peak / size:.2f}x (target <= 2x: "
                   f"{'met' if peak <= 2 * size else 'NOT met'})")
             del r
