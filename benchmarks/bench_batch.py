@@ -208,6 +208,8 @@ def rk_vs_plain(name, law, batch, params, args, rng):
     batch_times, loop_time, errs = [], 0.0, []
     br = None
     for chunk in chunks:
+        br = None  # the previous run's results are freed first, as a loop over batches would (else each run pays
+        # page faults for 2x the results' memory)
         t, br = median_time(lambda: simulate_batch(law, batch, params, solver="DOP853", rtol=args.rtol, n=NT), 1)
         batch_times.append(t)
         t0 = clock()
@@ -241,6 +243,7 @@ def exact_vs_bare(name, law, batch, params, bare, args, rng):
     n = batch.n
     tb, tr_, br, out = [], [], None, None
     for _ in range(max(args.repeats, 5)):  # alternate, so load spells hit both alike
+        br = out = None  # previous results freed first, on both sides
         t, br = median_time(lambda: simulate_batch(law, batch, params, solver="exact", n=NT), 1)
         tb.append(t)
         t, out = median_time(lambda: bare(batch, next(iter(params.values()))), 1)
