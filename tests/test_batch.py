@@ -238,6 +238,10 @@ def test_normal_integrals_in_place_equal_the_plain_expressions():
         c = a * normal.peak / phi
         assert np.allclose(J, c * (1 - np.cos(phi * tau)), rtol=1e-14, atol=0)
         assert np.allclose(K, c * (tau - np.sin(phi * tau) / phi) + 2 * c * np.maximum(t - tc, 0), rtol=1e-14, atol=0)
+        shuffled = rng.permuted(t, axis=1)  # times in any order: the after-contact term is not skipped
+        Js, Ks = exact._normal_integrals(normal, shuffled, a)
+        order = np.argsort(shuffled, axis=1)
+        assert np.array_equal(np.take_along_axis(Ks, order, axis=1), K) and np.array_equal(np.take_along_axis(Js, order, axis=1), J)
         # one time at a time (the plain branch) gives the same numbers
         Jp, Kp = exact._normal_integrals(HalfSineNormal(float(normal.impulse[2, 0]), float(tc[2, 0])), t[2, 7], float(a[2, 0]))
         assert Jp == pytest.approx(J[2, 7], rel=1e-14) and Kp == pytest.approx(K[2, 7], rel=1e-14)

@@ -216,7 +216,7 @@ def _normal_integrals(normal, t, a=1.0):
     tc = normal.contact_time
     phi = math.pi / tc
     c = a * normal.peak / phi
-    after = t.ndim == 0 or bool(np.any(t[..., -1:] > tc))  # grids are non-decreasing: the last column decides
+    after = bool(np.any((np.max(t, axis=-1, keepdims=True) if t.ndim else t) > tc))  # each row's latest time
     tau = np.minimum(t, tc) if after else t
     x = phi * tau
     if x.ndim == 0 or np.broadcast_shapes(x.shape, np.shape(c)) != x.shape:  # small inputs: plainly
