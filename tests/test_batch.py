@@ -5,6 +5,9 @@ import numpy as np
 import pytest
 
 import frictionlab as fl
+from frictionlab.plan import make_plan
+from frictionlab.registry import get_law
+from frictionlab.solvers import stick
 from frictionlab.batch import SceneBatch, simulate_batch
 from frictionlab.errors import FrictionLabError, ParameterError, SceneError, SolverError
 from frictionlab.scene import G, ConstantArea, GrowthArea, HalfSineArea, HalfSineNormal, HertzNormal, Scene, WeightNormal
@@ -106,6 +109,49 @@ def test_zero_initial_slip_and_breakaway_area_rate(rng):
     br = check("area-rate", imp, ap, "exact", "exact", 1e-11)
     check("area-rate", imp, ap, "DOP853", "exact", 1e-6)
     assert br.info["scalar_fallback"] >= 0
+
+
+def unloading_incline(u0, tc, mu_alpha=0.3, mass=0.02, A0=1e-4, duration=0.2):
+    """Block on an incline under a half-sine contact area: with eta' > 0 the area-rate law's capacity
+    mu (N + eta' dA/dt) dips below the drive while the area shrinks and recovers once it is gone."""
+    return Scene(kind="incline", mass=mass, u0=u0, duration=duration, incline=mu_alpha, area=HalfSineArea(A0, tc),
+                 normal=WeightNormal(mass * G * math.cos(mu_alpha)), effects=frozenset({"gravity"}))
+
+
+def test_exact_breakaway_phases_vectorized_match_scalar(rng):
+    """Closed forms after a breakaway run vectorized (no scalar fallback) and equal the scalar exact solver to
+    1e-10 of each output's scale, with the same stick and breakaway times and number of phases: a mixture
+    of rows that never stick, stick for good, stick and break away, and break away and stick again."""
+    imp = [oblique(rng.uniform(10, 60), rng.uniform(0.1, 1.3), duration=540e-6) for _ in range(12)]
+    ip = [{"mu": rng.uniform(0.1, 0.5), "eta_prime": rng.uniform(-3e3, 3e3)} for _ in range(12)]
+    inc = [unloading_incline(rng.uniform(0.05, 0.3), rng.uniform(0.05, 0.1)) for _ in range(8)]
+    cp = [{"mu": rng.uniform(0.4, 0.6), "eta_prime": rng.uniform(0.0, 200.0)} for _ in range(8)]
+    seen = set()
+    for scenes, params in ((imp, ip), (inc, cp)):
+        br = simulate_batch("area-rate", scenes, params, solver="exact", n=301)
+        assert br.info["scalar_fallback"] == 0
+        for i, s in enumerate(scenes):
+            tr = fl.simulate("area-rate", s, params[i], solver="exact", t=br.t)
+            V = max(abs(s.u0), 1e-3)
+            r = s.radius or 1.0
+            for name, scale in (("u", V), ("v", V), ("omega", V / r), ("theta", V * s.duration / r),
+                                ("force", np.max(np.abs(tr.force)))):
+                err = np.max(np.abs(getattr(br, name)[i] - getattr(tr, name)))
+                assert err <= 1e-10 * scale, (i, name, err / scale)
+            segs = int(br.info["segments_per_scene"][i])
+            assert segs == tr.info["segments"]
+            seen.add(segs)
+            if tr.stick_time is None:
+                assert math.isnan(br.stick_time[i])
+                continue
+            assert br.stick_time[i] == pytest.approx(tr.stick_time, rel=1e-10)
+            tb = br.info["breakaway_time"][i]
+            assert math.isnan(tb) == (segs == 2)
+            if segs > 2:  # the scalar solver's breakaway from its own stick (capacity reads t only, not the state)
+                plan = make_plan(s, get_law("area-rate"))
+                tb_s = stick.breakaway(plan, params[i], tr.stick_time, s.duration, plan.initial_state(), math.copysign(1, s.u0))
+                assert tb == pytest.approx(tb_s, rel=1e-10)
+    assert seen == {1, 2, 3, 4}  # never sticks, sticks for good, breaks away, breaks away and sticks again
 
 
 def test_lubricated_and_dry_inclines_match_ode(rng):
@@ -326,7 +372,11 @@ def test_chunks_written_in_place_equal_one_call(monkeypatch, rng):
     cases = [("coulomb", [incline(u0) for u0 in (0.0, 0.05, 0.0, 0.2, 0.1, 0.0, 0.3)],
               [{"mu": m} for m in (0.1, 0.5, 0.4, 0.2, 0.6, 0.2, 0.3)], ("exact", "RK45")),
              ("area-rate", [oblique(rng.uniform(20, 60), rng.uniform(0.1, 1.3), duration=540e-6) for _ in range(7)],
-              [{"mu": rng.uniform(0.1, 0.5), "eta_prime": rng.uniform(-2e3, 2e3)} for _ in range(7)], ("exact", "DOP853"))]
+              [{"mu": rng.uniform(0.1, 0.5), "eta_prime": rng.uniform(-2e3, 2e3)} for _ in range(7)], ("exact", "DOP853")),
+             ("area-rate", [unloading_incline(u0, tc) for u0, tc in zip((0.1, 0.0, 0.2, 0.25, 0.05, 0.15, 0.3),
+                                                                         (0.09, 0.06, 0.07, 0.05, 0.08, 0.1, 0.06))],
+              [{"mu": m, "eta_prime": e} for m, e in zip((0.5, 0.45, 0.6, 0.4, 0.55, 0.5, 0.45), (150, 20, 180, 100, 0, 60, 200))],
+              ("exact",))]
     for law, scenes, params, solvers in cases:
         for solver in solvers:
             whole = simulate_batch(law, scenes, params, solver=solver, n=17)

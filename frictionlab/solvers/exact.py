@@ -267,22 +267,27 @@ def half_sine_stop(plan, form, u_s):
 
 
 def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
+    """Friction impulse J and its integral K from t0 at times t (and, with find_stop, the stop).
+
+    t0 and direction are floats, or (with find_stop=False) per-scene columns (k, 1) of a batch
+    broadcasting against t (k, q): a batch restarts its scenes' sliding phases at their own times."""
     s = plan.scene
-    sgn = direction if direction != 0 else 1.0
+    sgn = np.where(np.asarray(direction) != 0, direction, 1.0)
     area = s.area if np.any(np.asarray(form.c) != 0.0) else None
+    t0_ = np.atleast_1d(np.asarray(t0, dtype=float))  # (1,) for a float: broadcasts against t as before
 
     def JK(tt):
         # terms that vanish (no area term; start at first contact) are skipped: a batch of many
         # scenes evaluates this on large grids
         J, K = _normal_integrals(s.normal, tt, form.a)
-        if t0 != 0.0:
-            IN0, IIN0 = _normal_integrals(s.normal, np.array([t0]), form.a)
+        if np.any(t0_ != 0.0):
+            IN0, IIN0 = _normal_integrals(s.normal, t0_, form.a)
             J, K = J - IN0, K - (IIN0 + IN0 * (tt - t0))
         if area is not None:
             A, IA = _area_integrals(area, tt)
-            A0, IA0 = _area_integrals(area, np.array([t0]))
+            A0, IA0 = _area_integrals(area, t0_)
             J, K = J + form.c * (A - A0), K + form.c * (IA - IA0 - A0 * (tt - t0))
-        return (J, K) if sgn == 1.0 else (sgn * J, sgn * K)
+        return (J, K) if np.all(sgn == 1.0) else (sgn * J, sgn * K)
 
     J, K = JK(t)
     if not find_stop or t.size == 0:
