@@ -12,8 +12,10 @@ parameters (every built-in law does: its force is arithmetic on the parameter va
 
 Solvers:
   'exact'   the closed forms of ``solvers.exact`` over the whole batch; stick located per scene by
-            vectorized bracketed root finding (``vecrk.root_bracketed``). A scene that breaks away after sticking (rare: it needs a law whose
-            holding capacity drops below the drive) is re-run alone with the scalar exact solver.
+            vectorized bracketed root finding (``vecrk.root_bracketed``). Scenes that break away after sticking
+            (the area-rate law with eta' > 0 on an unloading contact) go on phase by phase, sliding from
+            rest in closed form and perhaps sticking again, with the scenes still going in each round
+            (``_exact_phases``); only a scene that starts at zero slip is re-run alone with the scalar solver.
   'RK45', 'DOP853'  ``frictionlab.vecrk``: scipy's tableaus, per-scene adaptive steps, dense output,
             zero slip located per scene; stuck phases and breakaway handled per scene.
   'auto'    'exact' where the law and scene admit a closed form, else 'DOP853'.
@@ -732,8 +734,9 @@ def _exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts, ys, last_dir, segs, 
         tb_first[ids] = np.where(np.isnan(tb_first[ids]), tb, tb_first[ids])
         segs[ids] += 2
         if np.any(segs[ids] > MAX_SEGMENTS):
+            i = int(ids[np.argmax(segs[ids] > MAX_SEGMENTS)])
             raise SolverError(f"batch exact: slip changed between sliding and sticking more than {MAX_SEGMENTS} "
-                              f"times in scene {int(ids[np.argmax(segs[ids] > MAX_SEGMENTS)])} (chatter); the law is not suited to this scene")
+                              f"times in scene {i} (chatter); the law is not suited to this scene")
         plan = _plan(law, batch.view(ids, column=True))
         form = law.form(_take_params(p, ids, column=True))
         t0, h = tb[:, None], hold[:, None]
@@ -763,7 +766,6 @@ def _exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts, ys, last_dir, segs, 
         segs[ids[~stops]] -= 1  # slid to the end: no stuck phase after it
         ids, ts, ys, last_dir = ids[stops], t_stop[stops], y_stop[:, stops, 0], hold[stops]
     return dirs
-
 
 
 def _known_capacity(law, plan, pc, k, ts, need):
@@ -858,7 +860,7 @@ def _exact_stop(law, batch, p, ids, plan, form, t0, y0, u_s, sgn, t_end):
 
 
 def _scalar_into(out, stick_time, law, batch, p, T, i, info):
-    """Re-run scene i with the scalar exact solver (breakaway after stick, or zero initial slip)."""
+    """Re-run scene i with the scalar exact solver (it starts at zero slip)."""
     from .solvers import simulate
 
     pi = {k: v if isinstance(v, float) else float(v[i]) for k, v in p.items()}
