@@ -440,12 +440,15 @@ def _all_finite(a) -> bool:
     return bool(np.isfinite(np.sum(a)) or np.isfinite(a).all())
 
 
-def _root(make_fn, lo, hi, tol, gtol=0.0):
+def _root(make_fn, lo, hi, tol, gtol=0.0, glo=None, ghi=None):
     """First root of a per-scene sign change, fn > 0 at lo and <= 0 at hi; returns the hi side.
 
-    make_fn(rows) gives fn for scenes rows (positions in lo/hi), see ``vecrk.root_bracketed``."""
-    fn = make_fn(np.arange(np.size(lo)))
-    return vecrk.root_bracketed(make_fn, lo, hi, fn(lo), fn(hi), tol, gtol)
+    make_fn(rows) gives fn for scenes rows (positions in lo/hi), see ``vecrk.root_bracketed``;
+    glo, ghi: fn at lo and hi when a scan has them already."""
+    if glo is None:
+        fn = make_fn(np.arange(np.size(lo)))
+        glo, ghi = fn(lo), fn(hi)
+    return vecrk.root_bracketed(make_fn, lo, hi, glo, ghi, tol, gtol)
 
 
 # --- stuck phases ----------------------------------------------------------------------------
@@ -468,7 +471,8 @@ def _breakaway(law, batch, p, ids, ts, ys, t_end, last_dir):
 
     frac = np.linspace(0.0, 1.0, stick.GRID)
     grid = ts[:, None] + (t_end - ts)[:, None] * frac[None, :]
-    bad = margin(grid) < 0
+    mg = margin(grid)
+    bad = mg < 0
     first = np.argmax(bad, axis=1)
     tb = np.full(ids.size, np.nan)
     anyb = bad.any(axis=1)
@@ -489,7 +493,8 @@ def _breakaway(law, batch, p, ids, ts, ys, t_end, last_dir):
 
         lo = grid[ref, first[ref] - 1]
         hi = grid[ref, first[ref]]
-        tb[ref] = _root(make_fn, lo, hi, 1e-15 * np.maximum(t_end[ref], 1e-300))
+        tb[ref] = _root(make_fn, lo, hi, 1e-15 * np.maximum(t_end[ref], 1e-300), 0.0, mg[ref, first[ref] - 1],
+                        mg[ref, first[ref]])
     return tb, hold, need
 
 
@@ -820,6 +825,7 @@ def _exact_stop(law, batch, p, ids, plan, form, t0, y0, u_s, sgn, t_end):
         g_end = make_g(None)(t_end[:, None])[:, 0]
         rows = np.nonzero(g_end <= 0.0)[0]
         lo, hi = np.zeros(rows.size), t_end[rows]
+        glo = ghi = None
     else:
         frac = np.linspace(0.0, 1.0, SCAN)[None, :]
         grid = t0c + (t_end - t0)[:, None] * frac if restart else t_end[:, None] * frac
@@ -834,15 +840,14 @@ def _exact_stop(law, batch, p, ids, plan, form, t0, y0, u_s, sgn, t_end):
             margin = np.zeros(k)
         bad = gg[:, 1:] + margin[:, None] <= 0.0
         rows = np.nonzero(bad.any(axis=1))[0]
-        first = np.argmax(bad[rows], axis=1) + 1
-        lo, hi = grid[rows, first - 1], grid[rows, first]
+        ihi = np.argmax(bad[rows], axis=1) + 1
         if restart and rows.size:  # the zero of slip after the last time it was of the phase's sign, if any
-            ahead = (gg[rows] > 0.0) & (np.arange(SCAN)[None, :] < first[:, None])
+            ahead = (gg[rows] > 0.0) & (np.arange(SCAN)[None, :] < ihi[:, None])
             has = ahead.any(axis=1)
-            j = SCAN - 1 - np.argmax(ahead[:, ::-1], axis=1)
-            lo = np.where(has, grid[rows, j], lo)
-            hi = np.where(has, grid[rows, np.minimum(j + 1, SCAN - 1)], hi)
+            ihi = np.where(has, SCAN - np.argmax(ahead[:, ::-1], axis=1), ihi)
             offset[rows] = np.where(has, 0.0, margin[rows])
+        lo, hi = grid[rows, ihi - 1], grid[rows, ihi]
+        glo, ghi = gg[rows, ihi - 1] + offset[rows], gg[rows, ihi] + offset[rows]  # fn at the bracket, from the scan
     ts = np.full(k, np.nan)
     if rows.size and monotone and exact.closed_stop_applies(plan, form, 0.0):
         ts[rows] = np.minimum(np.broadcast_to(exact.half_sine_stop(plan, form, u_s[:, None]), (k, 1))[rows, 0],
@@ -853,7 +858,7 @@ def _exact_stop(law, batch, p, ids, plan, form, t0, y0, u_s, sgn, t_end):
             g, o = make_g(rows[r]), offset[rows[r]]
             return lambda x: g(x[:, None])[:, 0] + o
 
-        ts[rows] = _root(make_fn, lo, hi, 1e-15 * np.maximum(t_end[rows], 1e-300), noise[rows])
+        ts[rows] = _root(make_fn, lo, hi, 1e-15 * np.maximum(t_end[rows], 1e-300), noise[rows], glo, ghi)
         ts[rows[ts[rows] >= t_end[rows]]] = np.nan
     return ts
 
