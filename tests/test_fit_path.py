@@ -181,3 +181,14 @@ def _coulomb_sweep(seed: int, n: int):
     sb = B.SceneBatch.sweep(template, {"u0": rng.uniform(2, 40, n), "normal.impulse": rng.uniform(0.5, 4, n),
                                        "normal.contact_time": tc, "duration": tc})
     return sb, rng.uniform(0.1, 0.5, n), tc
+
+
+def test_a_fit_without_checks_gives_the_same_numbers_as_the_full_fit():
+    """fit(checks=False), the replicate refits' path, skips only the plausibility flags and lmfit's SI copy."""
+    data = synthetic("area-rate", TRUTH["area-rate"], incline_scene(), n=21, name="incline-area-rate")
+    full, lean = fit("area-rate", data, solver="exact"), fit("area-rate", data, solver="exact", checks=False)
+    assert full.ok and lean.ok and full.minimizer_result is not None and lean.minimizer_result is None
+    assert full.plausibility and not lean.plausibility and lean.flags == ()
+    assert lean.stats == full.stats and lean.nfev == full.nfev
+    assert {k: (p.value, p.stderr) for k, p in lean.params.items()} == \
+        {k: (p.value, p.stderr) for k, p in full.params.items()}
