@@ -21,6 +21,7 @@ from __future__ import annotations
 import functools
 import os
 import platform
+import re
 import signal
 import threading
 import time
@@ -44,7 +45,7 @@ from .fitting import PREDICTORS, FitResult, applicable_solvers, auto_solver, fit
 from .ranking import RankRow, family, rank_fits, rank_groups
 from .registry import available_laws, get_law
 from .transfer import TransferResult, assemble, candidates_by_group, transfer_candidate
-from .verdicts import make_answers
+from .verdicts import make_answers, not_fitted_answers
 
 Progress = Callable[[int, int, str], None]
 
@@ -148,6 +149,24 @@ def candidates(law, dataset: Dataset, solvers: Sequence[str] | None) -> list[tup
         else:
             out.append((s, ok.get(s.partition(":")[0])))
     return list(dict.fromkeys(out))  # 'auto' and the solver it picks name one candidate
+
+
+def no_law_applies(dataset: Dataset, skipped, solvers=None) -> str:
+    """The one reason a dataset is left out when no law compared can be fitted to it: the laws grouped by
+    why not, and the registered laws that could be (skipped: (law, solver, reason) per candidate)."""
+    by_reason: dict[str, list[str]] = {}
+    for law, _, why in skipped:
+        why = re.sub(rf"^law '{re.escape(law)}' (on an? [\w-]+: )?", "", why)
+        why = re.sub(r", which \w+ cannot supply:.*$", ", which it does not have", why)
+        by_reason.setdefault(why, [])
+        if law not in by_reason[why]:
+            by_reason[why].append(law)
+    compared = set(law for law, _, _ in skipped)
+    able = [n for n in available_laws() if n not in compared
+            and any(why is None for _, why in candidates(n, dataset, solvers))]
+    text = (f"none of the {len(compared)} laws compared applies to this {dataset.kind} set ("
+            + "; ".join(f"{', '.join(laws)}: {why}" for why, laws in by_reason.items()) + ")")
+    return text + (f"; registered laws that apply: {', '.join(able)} (--laws {','.join(able)})" if able else "")
 
 
 def _fit_task(args, timeout=None) -> FitResult:
@@ -310,7 +329,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     dss = _unique_datasets(load_dataset(d) for d in (datasets if datasets is not None else builtin_names()))
     if not dss:
         raise FrictionLabError("compare: no datasets to compare")
-    skipped_ds, plan, fits = {}, [], []
+    skipped_ds, plan, fits, no_law = {}, [], [], set()
     for ds in dss:
         if ds.kind == "contact-area":
             skipped_ds[ds.name] = "contact-area series: supporting data (the area model of a scene), not fitted"
@@ -318,12 +337,16 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
         if ds.kind not in PREDICTORS:
             skipped_ds[ds.name] = f"no predictor for dataset kind '{ds.kind}' yet"
             continue
-        for law in law_names:
-            for solver, why in candidates(law, ds, solvers):
-                if why:
-                    fits.append(FitResult(law=law, solver=solver, datasets=(ds.name,), status="skipped", reason=why))
-                else:
-                    plan.append((law, ds, solver, dict(free or {})))
+        mine = [(law, solver, why) for law in law_names for solver, why in candidates(law, ds, solvers)]
+        if mine and all(why for _, _, why in mine):  # nothing to fit: one reason for the dataset, not a row per law
+            skipped_ds[ds.name] = no_law_applies(ds, mine, solvers)
+            no_law.add(ds.name)
+            continue
+        for law, solver, why in mine:
+            if why:
+                fits.append(FitResult(law=law, solver=solver, datasets=(ds.name,), status="skipped", reason=why))
+            else:
+                plan.append((law, ds, solver, dict(free or {})))
     if len(skipped_ds) == len(dss):
         raise FrictionLabError("compare: none of the datasets can be fitted: "
                                + "; ".join(f"{k}: {v}" for k, v in skipped_ds.items()))
@@ -411,6 +434,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     answers = make_answers([d for d in dss if d.name not in skipped_ds], fits, ranking, groups)
     # the verdict layer's rows; the equivalence and transfer fields are filled by their producers
     answers = _transfer.fill_answers(_equivalence.fill_answers(answers, eq_results), transfer_results)
+    answers += not_fitted_answers(dss, {k: v for k, v in skipped_ds.items() if k in no_law},
+                                  [d for d in dss if d.name not in skipped_ds])
     return Comparison(laws=law_names, datasets=dss, fits=tuple(fits), ranking=tuple(ranking), groups=tuple(groups),
                       equivalence=tuple(eq_results), transfer=tuple(transfer_results), skipped_datasets=skipped_ds,
                       wall_time=time.perf_counter() - started, versions=versions(),
