@@ -23,6 +23,7 @@ import os
 import platform
 import re
 import signal
+import sys
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -187,10 +188,20 @@ def _transfer_task(args):
     return transfer_candidate(fits, free)
 
 
-def _worker_init() -> None:
-    """In a worker: ^C goes to the parent, which stops the pool; SIGTERM ends the worker at once."""
+def _worker_init(parent: int) -> None:
+    """In a worker: ^C goes to the parent, which stops the pool; SIGTERM ends the worker at once;
+    and (on Linux) the worker gets SIGTERM when the parent dies, even by SIGKILL, so no worker
+    outlives its run or keeps holding the output lock it inherited."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+            ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGTERM))  # 1 = PR_SET_PDEATHSIG
+        except (OSError, AttributeError):
+            return
+        if os.getppid() != parent:  # the parent died before the request took effect
+            os._exit(1)
 
 
 def _on_sigterm(signum, frame):
@@ -217,7 +228,8 @@ def _pool(jobs: int):
               and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL)
     if handle:
         signal.signal(signal.SIGTERM, _on_sigterm)
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init)
+    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init,
+                               initargs=(os.getpid(),))
     try:
         yield pool
     except BaseException:

@@ -393,6 +393,42 @@ def test_a_signal_during_compare_with_workers_leaves_no_process_and_no_output(si
     assert sorted(p.name for p in tmp_path.iterdir()) == ["slow.py"]  # no report, no lock, no temporary folder
 
 
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="parent-death signal is Linux only")
+def test_workers_do_not_outlive_a_killed_run_and_the_output_can_be_written_again(tmp_path):
+    """SIGKILL cannot be caught: the workers must notice their parent's death themselves (they
+    share the output lock they inherited, so an orphan would also block the next run)."""
+    (tmp_path / "slow.py").write_text(SLOW_LAW % "0.005")
+    out = tmp_path / "rep"
+    args = [sys.executable, "-m", "frictionlab", "--load", str(tmp_path / "slow.py"), "compare",
+            "--laws", "slow-viscous", "--quiet", "--bootstrap", "0", "--no-tolerance", "--no-equivalence",
+            "--out", str(out)]
+    proc = subprocess.Popen(args + ["--data", "incline-oil-a100,incline-oil-a200,incline-dry-d10", "--jobs", "2"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    try:
+        deadline = time.monotonic() + 60
+        workers: set[int] = set()
+        while len(workers) < 2 and time.monotonic() < deadline and proc.poll() is None:
+            workers |= _children(proc.pid)
+            time.sleep(0.05)
+        assert len(workers) >= 2, f"the run made no workers: {proc.poll()}"
+        time.sleep(0.5)
+        proc.kill()
+        proc.wait(30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    deadline = time.monotonic() + 10
+    while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not [p for p in workers if _alive(p)], "worker processes outlived a killed run"
+    assert not out.exists()  # written whole or not at all
+    again = subprocess.run(args + ["--data", "incline-oil-a100", "--jobs", "1"], capture_output=True, text=True,
+                           cwd=tmp_path, timeout=120)
+    assert again.returncode == 0, again.stderr
+    assert (out / "report.md").is_file()
+
+
 # --- every quantity of a scene at the edges of the accepted range ----------------------------------
 @pytest.mark.parametrize("base", ["impact-golf-v28", "incline-dry-d10", "incline-oil-a100", "impact-outcome-synthetic"])
 def test_quantities_at_the_limits_give_errors_naming_the_field_never_a_class(base, tmp_path):
