@@ -22,15 +22,10 @@ import functools
 import os
 import platform
 import re
-import signal
-import sys
-import threading
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
-from contextlib import contextmanager
-from multiprocessing import get_context
 
 import attrs
 import numpy as np
@@ -39,7 +34,7 @@ from .answers import group_of
 from .dataset import Dataset, builtin_names, load_dataset
 from . import equivalence as _equivalence, transfer as _transfer
 from .equivalence import MIN_REPLICATES, PAIRS, REPLICATES, EquivalenceResult, analyze_equivalence
-from .errors import FrictionLabError, ParameterError, Terminated
+from .errors import FrictionLabError, ParameterError
 from .bootstrap import bootstrap_fits
 from .fitcost import tolerance_check
 from .fitting import PREDICTORS, FitResult, applicable_solvers, auto_solver, fit
@@ -47,6 +42,7 @@ from .ranking import RankRow, family, rank_fits, rank_groups
 from .registry import available_laws, get_law
 from .transfer import TransferResult, assemble, candidates_by_group, transfer_candidate
 from .verdicts import make_answers, not_fitted_answers
+from .workers import process_pool
 
 Progress = Callable[[int, int, str], None]
 
@@ -188,79 +184,6 @@ def _transfer_task(args):
     return transfer_candidate(fits, free)
 
 
-def _worker_init(parent: int) -> None:
-    """In a worker: ^C goes to the parent, which stops the pool; SIGTERM ends the worker at once;
-    and (on Linux) the worker gets SIGTERM when the parent dies, even by SIGKILL, so no worker
-    outlives its run or keeps holding the output lock it inherited."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    if sys.platform.startswith("linux"):
-        try:
-            import ctypes
-            ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGTERM))  # 1 = PR_SET_PDEATHSIG
-        except (OSError, AttributeError):
-            return
-        if os.getppid() != parent:  # the parent died before the request took effect
-            os._exit(1)
-
-
-def _on_sigterm(signum, frame):
-    raise Terminated(signum)
-
-
-@contextmanager
-def _pool(jobs: int):
-    """A process pool of ``jobs`` forked workers, or None (run here) for one job or without fork.
-
-    On any exception, ^C (KeyboardInterrupt) and SIGTERM included, the workers are terminated and
-    reaped before the exception goes on: no worker outlives the call. SIGTERM becomes the exception
-    ``errors.Terminated`` while the pool lives (when called from the main thread and nothing else
-    handles SIGTERM).
-    """
-    try:
-        ctx = get_context("fork") if jobs > 1 else None
-    except ValueError:  # no fork on this platform: run serially
-        ctx = None
-    if ctx is None:
-        yield None
-        return
-    handle = (threading.current_thread() is threading.main_thread()
-              and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL)
-    if handle:
-        signal.signal(signal.SIGTERM, _on_sigterm)
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init,
-                               initargs=(os.getpid(),))
-    try:
-        yield pool
-    except BaseException:
-        _stop(pool)
-        raise
-    else:
-        pool.shutdown(wait=True)
-    finally:
-        if handle:
-            signal.signal(signal.SIGTERM, signal.SIG_DFL)
-
-
-def _stop(pool: ProcessPoolExecutor) -> None:
-    """Cancel what is queued, terminate the workers (SIGTERM, then SIGKILL after 5 s) and reap them."""
-    procs = list((getattr(pool, "_processes", None) or {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
-    for p in procs:
-        if p.is_alive():
-            p.terminate()
-    for p in procs:
-        p.join(5)
-        if p.is_alive():
-            p.kill()
-            p.join()
-    # let the pool's manager thread finish closing its wake-up pipe now: otherwise the interpreter's
-    # exit hook may race it and print "OSError: Bad file descriptor" after our one-line message
-    manager = getattr(pool, "_executor_manager_thread", None)
-    if manager is not None:
-        manager.join(5)
-
-
 def _run(tasks, fn, pool, progress, done, total, label):
     """Run fn over tasks, on the pool if there is one; results in task order."""
     results = [None] * len(tasks)
@@ -372,7 +295,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     label = lambda t: f"{t[0]} [{t[2]}] on {t[1].name}"  # noqa: E731
     timings, boots, boot_skipped, tol_rows = {}, [], {}, []
     order = {d.name: i for i, d in enumerate(dss)}
-    with _pool(jobs) as pool:
+    with process_pool(jobs) as pool:
         t0 = time.perf_counter()
         results, done = _run(plan, functools.partial(_fit_task, timeout=fit_timeout), pool, progress, 0, total,
                              label)
