@@ -383,7 +383,7 @@ def discrimination_figure(dataset: str, results) -> bytes:
     """One panel per tested pair on ``dataset``: the distribution of T = chi2_A - chi2_B over the
     replicates of each law's fit, and the observed T."""
     plt = _plt()
-    fig, axes = plt.subplots(1, len(results), figsize=(4.6 * len(results), 3.4), squeeze=False)
+    fig, axes = plt.subplots(1, len(results), figsize=(4.6 * len(results), 3.4), squeeze=False, layout="constrained")
     for ax, e in zip(axes[0], results):
         both = np.concatenate([e.t_a, e.t_b, [e.t_obs]])
         span = float(np.ptp(both))
@@ -393,7 +393,8 @@ def discrimination_figure(dataset: str, results) -> bytes:
         else:
             bins = np.linspace(both.min() - 0.02 * span, both.max() + 0.02 * span, 40)
             for t, law, solver in ((e.t_a, e.law_a, e.solver_a), (e.t_b, e.law_b, e.solver_b)):
-                ax.hist(t, bins=bins, alpha=0.6, color=LAW_COLORS.get(law, "0.5"), label=f"data from {law} [{solver}]")
+                ax.hist(t, bins=bins, alpha=0.6, color=LAW_COLORS.get(law, "0.5"), histtype="stepfilled",
+                        label=f"data from {law} [{solver}]")
             ax.axvline(e.t_obs, color="k", lw=1.5, label="observed T")
             ax.legend(fontsize=7)
         ax.set_xlabel(f"T = χ²({e.law_a}) − χ²({e.law_b})")
@@ -401,7 +402,6 @@ def discrimination_figure(dataset: str, results) -> bytes:
         ax.set_title(f"{e.law_a} [{e.solver_a}] vs {e.law_b} [{e.solver_b}]: {e.verdict}", fontsize=9)
         ax.grid(alpha=0.3)
     fig.suptitle(f"{dataset}: the discrimination test (parametric bootstrap)", fontsize=11)
-    fig.tight_layout()
     return _png(fig)
 
 
