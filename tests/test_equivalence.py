@@ -33,6 +33,24 @@ def test_wear_and_couette_are_equivalent():
     assert e.power_a == e.power_b == 0.0
 
 
+def test_one_closed_form_family_needs_no_refits_and_gives_the_refits_answer(monkeypatch):
+    """Wear and Couette span one family (F = k A u): the shortcut's T* = 0 is what refitting both laws to every
+    replicate gives (to the optimizer's resolution), with the same p-values, powers and verdict."""
+    from frictionlab import equivalence
+
+    ds = synthetic("wear", TRUTH["wear"], seed=4)
+    fw, fc = fit("wear", ds), fit("couette", ds)
+    fast = analyze_equivalence(fw, fc, replicates=R)
+    monkeypatch.setattr(equivalence, "one_family", lambda a, b: False)
+    slow = analyze_equivalence(fw, fc, replicates=R)
+    assert np.all(fast.t_a == 0.0) and np.all(fast.t_b == 0.0) and "without refitting" in fast.explanation
+    tol = equivalence.TIE_REL * max(fast.n_points, fw.stats.chisqr)
+    assert np.max(np.abs(slow.t_a)) <= tol and np.max(np.abs(slow.t_b)) <= tol
+    for k in ("verdict", "p_a", "p_b", "q_a", "q_b", "power_a", "power_b", "threshold"):
+        assert getattr(fast, k) == getattr(slow, k), k
+    assert not equivalence.one_family(fw, fit("coulomb", ds))
+
+
 def test_coulomb_against_wear_is_not_equivalent_and_names_the_rejected_law(coulomb_data):
     ds, fc, fw, e = coulomb_data
     assert e.verdict == "not equivalent", e.explanation
