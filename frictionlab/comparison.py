@@ -295,6 +295,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     label = lambda t: f"{t[0]} [{t[2]}] on {t[1].name}"  # noqa: E731
     timings, boots, boot_skipped, tol_rows = {}, [], {}, []
     order = {d.name: i for i, d in enumerate(dss)}
+    if jobs > 1:
+        import lmfit  # noqa: F401  (imported once here, before the workers fork, instead of once in each)
     with process_pool(jobs) as pool:
         t0 = time.perf_counter()
         results, done = _run(plan, functools.partial(_fit_task, timeout=fit_timeout), pool, progress, 0, total,

@@ -87,6 +87,10 @@ def _drawn(figs, jobs: int):
     from ..workers import process_pool
 
     _FIGURES[:] = figs
+    if jobs > 1:
+        from ..figures import _plt
+
+        _plt()  # pyplot imported once here, before the workers fork, instead of once in each
     try:
         with process_pool(jobs if len(figs) > 1 else 1) as pool:
             if pool is None:
