@@ -3,6 +3,7 @@
     python benchmarks/bench_compare.py [--repeat R] [--keep DIR] [--reference-solves 1000]
 
 Runs README command 1 as a user does: ``frictionlab compare --out DIR --force`` in a fresh process
+(``--jobs 1``: one process, so that each stage's wall time is its CPU time)
 (every law on every built-in dataset, the bootstrap and the tolerance check, the report written).
 Prints its wall time and its CPU time (the process and its worker processes, user + system), the
 wall time of each stage (fits, equivalence, tolerance check, bootstrap, report and start-up) and the
@@ -62,10 +63,11 @@ def reference_solves(n: int) -> tuple[float, float]:
     return time.process_time() - t0, float(sol.y[1, -1])
 
 
-def run_compare(out: Path) -> dict:
+def run_compare(out: Path, jobs: int | None = None) -> dict:
     exe = shutil.which("frictionlab", path=os.path.dirname(sys.executable)) or "frictionlab"
     c0, w0 = children_cpu(), time.perf_counter()
-    subprocess.run([exe, "compare", "--out", str(out), "--force"], check=True, stdout=subprocess.DEVNULL)
+    subprocess.run([exe, "compare", "--out", str(out), "--force"] + (["--jobs", str(jobs)] if jobs else []),
+                   check=True, stdout=subprocess.DEVNULL)
     wall, cpu = time.perf_counter() - w0, children_cpu() - c0
     res = json.loads((out / "results.json").read_text())
     return {"wall": wall, "cpu": cpu, "results": res}
@@ -76,6 +78,8 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=1)
     ap.add_argument("--keep", type=Path, help="write the (last) report here instead of a temporary folder")
     ap.add_argument("--reference-solves", type=int, default=1000)
+    ap.add_argument("--jobs", type=int, help="compare's --jobs (default: its own); 1 makes each stage's wall time "
+                                              "its CPU time, for finding where the CPU goes")
     args = ap.parse_args()
     ref_cpu, spin = reference_solves(args.reference_solves)
     print(f"reference: {args.reference_solves} plain solve_ivp DOP853 solves of the paper's impact (rtol 1e-10): "
@@ -86,7 +90,7 @@ def main() -> None:
         tmp = Path(tempfile.mkdtemp(prefix="bench-compare-"))
         out = args.keep if (args.keep and i == args.repeat - 1) else tmp / "report"
         try:
-            r = run_compare(out)
+            r = run_compare(out, args.jobs)
         finally:
             shutil.rmtree(tmp, ignore_errors=True)
         runs.append(r)

@@ -285,8 +285,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     if len(skipped_ds) == len(dss):
         raise FrictionLabError("compare: none of the datasets can be fitted: "
                                + "; ".join(f"{k}: {v}" for k, v in skipped_ds.items()))
-    # slow (ode) fits first, so that workers finish together
-    plan.sort(key=lambda x: not x[2].startswith("ode"))
+    # slow fits first (ode, then sets without a time series, which simulate every row), so that workers finish together
+    plan.sort(key=lambda x: (not x[2].startswith("ode"), x[1].scene is None or "t" in x[1].columns))
     if equivalence and replicates < MIN_REPLICATES:
         raise ParameterError(f"compare: replicates must be at least {MIN_REPLICATES}, got {replicates}")
     eq_pairs = _equivalence_pairs(law_names, plan, pairs) if equivalence else []
