@@ -74,7 +74,7 @@ def not_fitted_answers(datasets, reasons: dict[str, str], fitted=()) -> tuple[An
         out.append(Answer(group=label, datasets=tuple(d.name for d in dss), provenance=kinds.pop() if len(kinds) == 1
                           else "mixed", best=None, fits=False, headline="not fitted: " + "; ".join(why), goodness="",
                           equivalence="not tested", noise_threshold="", series_vs_exact="",
-                          details={"not_fitted": why}, short={"best": "not fitted: no law compared applies"}))
+                          equivalence_series="not tested", details={"not_fitted": why}, short={"best": "not fitted: no law compared applies"}))
     return tuple(out)
 
 
