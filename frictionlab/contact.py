@@ -17,6 +17,10 @@ their 1.2558, checked in tests/test_contact.py):
     Psi1 = (kappa / mu) * v_c1 / v_n1     (incidence of the contact point, v_c1 = v_t1 - r omega_1)
     Psi2 = (kappa / mu) * v_c2 / v_n2     (rebound of the contact point, v_n2 = e v_n1)
     chi  = (kappa / 2) (1 + m r^2 / I)    (= (1 - nu)(1 + r^2/k^2)/(2 - nu) for like materials, as in MBF)
+Tangential compliance models (``[scene.compliance] model``): 'linear' (constant spring and damper),
+'mindlin' (k_t = 8 G* a(t), Thornton's one-state history simplification, any law, ODE solvers) and
+'mindlin-deresiewicz' (microslip and the full loading history by the Method of Dimensionality
+Reduction, frictionlab.mdr; Coulomb-form laws, impact outcomes).
 Rigid-body Coulomb theory (``rigid_psi2``): the contact point slides throughout when
 Psi1 >= 2 chi (1 + e), then Psi2 = (Psi1 - 2 chi (1 + e)) / e; below that it stops and rolls, Psi2 = 0.
 """
@@ -158,16 +162,33 @@ class MindlinCompliance:
         return k, c, loading
 
 
+@attrs.frozen
+class MindlinDeresiewiczCompliance:
+    """Mindlin-Deresiewicz tangential contact with microslip and the full loading history, solved by the
+    Method of Dimensionality Reduction (frictionlab.mdr): ``springs`` independent springs over the
+    contact, each with stiffness 4 G* dx and its own Coulomb limit mu times its share of N(t).
+
+    The local Coulomb limit needs a friction coefficient: it works with laws of the Coulomb form
+    (F = mu N while sliding). Impact outcomes are integrated by ``frictionlab.mdr.impacts`` (all rows
+    at once); the trajectory solvers take 'linear' or 'mindlin' only.
+    """
+
+    shear: float = attrs.field(validator=_positive("shear"))  # G* [Pa]
+    springs: int = attrs.field(default=400, validator=_positive("springs"))  # [-]
+    model = "mindlin-deresiewicz"
+
+
 COMPLIANCE_KEYS = {"linear": {"model", "stiffness", "damping"},
-                   "mindlin": {"model", "shear_modulus", "damping_ratio"}}
+                   "mindlin": {"model", "shear_modulus", "damping_ratio"},
+                   "mindlin-deresiewicz": {"model", "shear_modulus", "springs"}}
 
 
 def compliance_from_spec(c, where: str, q, pair: Pair | None, radius: float | None):
-    """A compliance model from a ``[scene.compliance]`` table (model 'linear' or 'mindlin')."""
+    """A compliance model from a ``[scene.compliance]`` table (model 'linear', 'mindlin' or 'mindlin-deresiewicz')."""
     p = "scene.compliance"
     model = c.get("model", "linear")
     if model not in COMPLIANCE_KEYS:
-        raise SceneError(f"{where}: {p}.model must be 'linear' or 'mindlin', got {model!r}")
+        raise SceneError(f"{where}: {p}.model must be one of {', '.join(map(repr, COMPLIANCE_KEYS))}, got {model!r}")
     extra = set(c) - COMPLIANCE_KEYS[model]
     if extra:
         raise SceneError(f"{where}: [{p}] with model {model!r} has unknown key(s) {sorted(extra)}; "
@@ -177,6 +198,11 @@ def compliance_from_spec(c, where: str, q, pair: Pair | None, radius: float | No
     shear = q("shear_modulus", "Pa", c, p, required=pair is None)
     if shear is None:
         shear = pair.shear
+    if model == "mindlin-deresiewicz":
+        n = c.get("springs", 400)
+        if isinstance(n, bool) or not isinstance(n, int) or not 10 <= n <= 100_000:
+            raise SceneError(f"{where}: {p}.springs must be an integer from 10 to 100000, got {n!r}")
+        return MindlinDeresiewiczCompliance(shear, n)
     ratio = q("damping_ratio", "", c, p, required=False, default=0.01)
     floor = 1e-9 * radius if radius else 1e-12
     return MindlinCompliance(shear, ratio, floor)

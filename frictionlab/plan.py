@@ -342,6 +342,9 @@ def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan
     if "compliance" in effects:
         if scene.compliance is None:
             raise SceneError(f"{scene_name}: effect 'compliance' needs a compliance model (linear or mindlin)")
+        if scene.compliance.model == "mindlin-deresiewicz":
+            raise SceneError(f"{scene_name}: compliance model 'mindlin-deresiewicz' is integrated for impact outcomes "
+                             "only (frictionlab.mdr); the trajectory solvers take 'linear' or 'mindlin'")
         if scene.compliance.model == "mindlin":
             if scene.area is None:
                 raise SceneError(f"{scene_name}: compliance model 'mindlin' takes the contact radius from the "

@@ -47,6 +47,8 @@ def _trajectories(law, d):
         return
     if not hasattr(scene, "impact"):
         return
+    if getattr(scene.compliance, "model", None) == "mindlin-deresiewicz":
+        return  # frictionlab.mdr gives outcomes, not trajectories; its springs hold the Coulomb limit by construction
     from .outcome import rows_of
 
     rows = rows_of(d.target.dataset)

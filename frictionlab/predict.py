@@ -162,6 +162,10 @@ def applicable_solvers(law, scene: Scene) -> dict[str, str | None]:
 
     law = get_law(law)
     if hasattr(scene, "example"):  # an impact-outcome template: check on one of its impacts
+        if getattr(scene.compliance, "model", None) == "mindlin-deresiewicz":
+            from .outcome import mdr_solvers
+
+            return mdr_solvers(law)
         scene = scene.example()
     try:
         plan = make_plan(scene, law)

@@ -1,4 +1,4 @@
-"""Rebound of elastic spheres: rigid and Mindlin-compliant predictions from stated material data, the
+"""Rebound of elastic spheres: rigid and compliant predictions from stated material data, the
 Psi2-Psi1 curves of Maw, Barber and Fawcett, and predicted-against-measured tables for measured
 impact-outcome datasets. Nothing here fits: the friction coefficient is the one the source states.
 """
@@ -9,23 +9,31 @@ import io
 import attrs
 import numpy as np
 
-from .contact import MindlinCompliance, chi, rigid_psi2
+from .contact import MindlinCompliance, MindlinDeresiewiczCompliance, chi, rigid_psi2
 from .outcome import OutcomeScene, predict_outcomes, rows_of
 
-#: The two tangential models compared: rigid sphere (slip, then roll) and Mindlin compliance.
-MODELS = ("rigid", "mindlin")
+#: The tangential models compared by default: rigid sphere (slip, then roll) and Mindlin-Deresiewicz
+#: compliance with microslip. 'mindlin' (the one-state simplification) is available by name.
+MODELS = ("rigid", "mindlin-deresiewicz")
+LABELS = {"rigid": "rigid", "mindlin": "Mindlin (one-state)", "mindlin-deresiewicz": "Mindlin-Deresiewicz"}
 
 
 def variant(scene: OutcomeScene, model: str, damping_ratio: float = 0.01) -> OutcomeScene:
     """The scene as a Hertz contact from its materials (E*, restitution kept), with a rigid tangential
-    contact or with Mindlin compliance (G*)."""
+    contact ('rigid'), Mindlin-Deresiewicz compliance with microslip ('mindlin-deresiewicz', frictionlab.mdr)
+    or the one-state Mindlin simplification ('mindlin'), G* from the materials."""
     if scene.materials is None:
         raise ValueError("a prediction from material data needs [scene.materials]")
     normal = {**scene.normal, "model": "hertz", "modulus": scene.materials.modulus, "contact_time": None}
     hertz = attrs.evolve(scene, normal=normal, area={"model": "hertz", "peak": None})
     if model == "rigid":
         return attrs.evolve(hertz, compliance=None, effects=scene.effects - {"compliance"})
-    comp = MindlinCompliance(scene.materials.shear, damping_ratio, 1e-9 * scene.radius)
+    if model == "mindlin-deresiewicz":
+        comp = MindlinDeresiewiczCompliance(scene.materials.shear)
+    elif model == "mindlin":
+        comp = MindlinCompliance(scene.materials.shear, damping_ratio, 1e-9 * scene.radius)
+    else:
+        raise ValueError(f"unknown tangential model {model!r}; known: rigid, mindlin, mindlin-deresiewicz")
     return attrs.evolve(hertz, compliance=comp, effects=scene.effects | {"compliance"})
 
 
@@ -43,6 +51,31 @@ def stated_predictions(dataset, models=MODELS) -> dict[str, np.ndarray]:
     return out
 
 
+def spin_from_restitution(incidence, cor_incidence, cor, speed, radius: float, inertia_factor: float = 0.4):
+    """Rebound spin [rad/s] implied by a centre-of-mass tangential restitution e_t = v_t2/v_t1 measured at
+    ``cor_incidence`` (same units as ``incidence``, from the normal), linearly interpolated at ``incidence``
+    [deg]: the tangential impulse J gives m dv_t = -J and I domega = r J, so for no inbound spin
+    omega_2 = (1 - e_t) V sin(theta) / (f r), f = I / (m r^2). A check between two published figures."""
+    inc = np.asarray(incidence, dtype=float)
+    et = np.interp(inc, np.asarray(cor_incidence, dtype=float), np.asarray(cor, dtype=float))
+    return (1.0 - et) * np.asarray(speed, dtype=float) * np.sin(np.radians(inc)) / (inertia_factor * radius)
+
+
+def consistency(spin_ds, cor_ds) -> np.ndarray | None:
+    """Spin implied by ``cor_ds`` (centre-of-mass tangential restitution) at ``spin_ds``'s rows, when both
+    come from one experiment (same group, one speed, no inbound spin); else None."""
+    if (spin_ds.observable != "rebound_spin" or cor_ds.observable != "cm_tangential_cor" or not spin_ds.group
+            or spin_ds.group != cor_ds.group or "spin" in spin_ds.columns):
+        return None
+    speeds = np.concatenate([spin_ds.columns["speed"], cor_ds.columns["speed"]])
+    if np.ptp(speeds) > 1e-9 * np.max(speeds):
+        return None
+    s = spin_ds.scene
+    return spin_from_restitution(np.degrees(spin_ds.columns["incidence"]), np.degrees(cor_ds.columns["incidence"]),
+                                 cor_ds.columns["cm_tangential_cor"], spin_ds.columns["speed"], s.radius,
+                                 s.inertia_factor)
+
+
 def comparison_rows(dataset) -> list[dict]:
     """Predicted against measured per row: incidence [deg], measured, each model's value and residual (SI)."""
     pred = stated_predictions(dataset)
@@ -58,12 +91,12 @@ def comparison_rows(dataset) -> list[dict]:
     return rows
 
 
-def psi_curves(scene: OutcomeScene, speed: float, incidence_deg=None) -> dict[str, np.ndarray]:
-    """Psi1 and Psi2 of rigid and Mindlin spheres over incidences [deg] at ``speed`` [m/s], with the
+def psi_curves(scene: OutcomeScene, speed: float, incidence_deg=None, models=MODELS) -> dict[str, np.ndarray]:
+    """Psi1 and Psi2 of the models' spheres over incidences [deg] at ``speed`` [m/s], with the
     rigid closed form; Coulomb friction at the scene's stated mu."""
     inc = np.radians(np.linspace(1.0, 50.0, 22) if incidence_deg is None else np.asarray(incidence_deg, dtype=float))
     out = {}
-    for model in MODELS:
+    for model in models:
         o = predict_outcomes("coulomb", variant(scene, model), {"mu": scene.friction}, "ode",
                              speed=np.full(inc.shape, speed), incidence=inc, rtol=1e-8)
         out["psi1"], out[model] = o["psi1"], o["psi2"]
@@ -84,7 +117,11 @@ def psi_figure(curves: dict[str, np.ndarray], measured: tuple[np.ndarray, np.nda
     p1 = curves["psi1"]
     ax.plot(p1, curves["closed_form"], color="#7f7f7f", lw=3, alpha=0.5, label="rigid sphere, closed form")
     ax.plot(p1, curves["rigid"], color="#1b9e77", ls="--", lw=1.5, label="rigid sphere, simulated")
-    ax.plot(p1, curves["mindlin"], color="#d95f02", lw=1.8, label="Mindlin compliance (k_t = 8 G* a)")
+    if "mindlin" in curves:
+        ax.plot(p1, curves["mindlin"], color="#7570b3", lw=1.2, ls=":", label="Mindlin, one-state history")
+    if "mindlin-deresiewicz" in curves:
+        ax.plot(p1, curves["mindlin-deresiewicz"], color="#d95f02", lw=1.8,
+                label="Mindlin-Deresiewicz with microslip (MDR)")
     if measured is not None:
         inside = measured[0] <= 1.05 * np.max(p1)
         ax.plot(measured[0][inside], measured[1][inside], "ks", ms=5, label="measured")

@@ -25,7 +25,8 @@ EFFECTS = {
     "spin": "integrate spin omega and rotation angle theta from the friction torque (needs radius)",
     "slip-coupling": "contact-point slip u = v - r omega (rigid sphere) instead of u = v",
     "compliance": ("tangential compliance at the contact (Maw, Barber and Fawcett 1976): [scene.compliance] "
-                   "model = 'linear' (spring and damper) or 'mindlin' (k_t = 8 G* a(t) from [scene.materials])"),
+                   "model = 'linear' (spring and damper), 'mindlin' (k_t = 8 G* a(t) from [scene.materials]) or "
+                   "'mindlin-deresiewicz' (microslip and loading history, impact outcomes; frictionlab.mdr)"),
     "gravity": "gravity along an incline, m g sin(alpha), with N = m g cos(alpha)",
 }
 

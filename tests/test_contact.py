@@ -13,8 +13,9 @@ import attrs
 import numpy as np
 import pytest
 
-from frictionlab.contact import (Material, MindlinCompliance, Pair, chi, contact_radius, hertz_force,
-                                 mindlin_stiffness, rigid_psi2)
+from frictionlab import mdr
+from frictionlab.contact import (Material, MindlinCompliance, MindlinDeresiewiczCompliance, Pair, chi, contact_radius,
+                                 hertz_force, mindlin_stiffness, rigid_psi2)
 from frictionlab.dataset import load_dataset
 from frictionlab.errors import DatasetError, SceneError
 from frictionlab.outcome import OutcomeScene, SpeedLaw, predict_outcomes
@@ -47,18 +48,21 @@ def test_effective_moduli_follow_the_formulas():
         == pytest.approx(kn, rel=1e-5)
 
 
-def ball(model="rigid", normal="hertz", shear=None, damping=0.01):
-    n = ({"model": "hertz", "modulus": PAIR.modulus, "contact_time": None, "restitution": SpeedLaw(E)}
+def ball(model="rigid", normal="hertz", shear=None, damping=0.01, pair=PAIR, inertia_factor=0.4, e=E):
+    n = ({"model": "hertz", "modulus": pair.modulus, "contact_time": None, "restitution": SpeedLaw(e)}
          if normal == "hertz" else
-         {"model": "half-sine", "modulus": None, "contact_time": SpeedLaw(12.8e-6, V, -0.2), "restitution": SpeedLaw(E)})
+         {"model": "half-sine", "modulus": None, "contact_time": SpeedLaw(12.8e-6, V, -0.2), "restitution": SpeedLaw(e)})
     area = {"model": "hertz", "peak": None} if normal == "hertz" else {"model": "half-sine", "peak": SpeedLaw(0.133e-6, V, 0.8)}
     effects = {"spin", "slip-coupling"}
     comp = None
     if model == "mindlin":
-        comp = MindlinCompliance(shear or PAIR.shear, damping, 1e-9 * R)
+        comp = MindlinCompliance(shear or pair.shear, damping, 1e-9 * R)
+    elif model == "mindlin-deresiewicz":
+        comp = MindlinDeresiewiczCompliance(shear or pair.shear)
+    if comp is not None:
         effects.add("compliance")
     return OutcomeScene(mass=M, radius=R, normal=n, area=area, effects=frozenset(effects), compliance=comp,
-                        materials=PAIR, friction=MU)
+                        materials=pair, friction=MU, inertia_factor=inertia_factor)
 
 
 def test_rigid_coulomb_limit_matches_the_closed_form_on_both_branches():
@@ -111,6 +115,137 @@ def test_stiff_compliance_tends_to_the_rigid_sphere():
     assert errs[1] < 0.02 < errs[0]  # ... and a 1000x stiffer contact is nearly rigid
 
 
+# --- Mindlin-Deresiewicz with microslip by the Method of Dimensionality Reduction (frictionlab.mdr) -----
+A_FIXED, N_FIXED = 1e-4, 50.0  # contact radius [m] and normal force [N] of the quasi-static checks
+USTAR = 3 * MU * N_FIXED / (2 * 8 * PAIR.shear * A_FIXED)  # displacement of gross slip: 3 mu N / (2 k_t)
+
+
+def test_mdr_reproduces_cattaneo_mindlin_under_constant_normal_force():
+    """Monotone tangential loading: F = mu N (1 - (1 - w/u*)^(3/2)), u* = 3 mu N / (2 * 8 G* a)."""
+    w = np.linspace(0.0, 1.2 * USTAR, 121)
+    F = mdr.tangential_force(np.full(w.shape, A_FIXED), np.full(w.shape, N_FIXED), w, PAIR.shear, MU)
+    exact = MU * N_FIXED * (1 - np.clip(1 - w / USTAR, 0, None) ** 1.5)
+    np.testing.assert_allclose(F, exact, atol=2e-3 * MU * N_FIXED)
+    tiny = mdr.tangential_force([A_FIXED], [N_FIXED], [1e-6 * USTAR], PAIR.shear, MU)[0] / (1e-6 * USTAR)
+    assert tiny == pytest.approx(8 * PAIR.shear * A_FIXED, rel=1e-9)  # initial stiffness: Mindlin's 8 G* a
+    np.testing.assert_allclose(F[w >= USTAR], MU * N_FIXED, rtol=1e-12)  # gross slip at the Coulomb limit
+
+
+def test_mdr_reproduces_the_mindlin_deresiewicz_hysteresis_loop():
+    """Unloading from w* < u* to -w* and reloading: F = F* - 2 mu N (1 - (1 - (w* - w)/(2 u*))^(3/2)) on the way
+    down (Mindlin and Deresiewicz 1953; Johnson, Contact Mechanics, eq. 7.60), the mirror image on the way
+    back, and the loop closes."""
+    wmax = 0.6 * USTAR
+    up = np.linspace(0.0, wmax, 61)
+    down = np.linspace(wmax, -wmax, 121)[1:]
+    back = np.linspace(-wmax, wmax, 121)[1:]
+    w = np.concatenate([up, down, back])
+    F = mdr.tangential_force(np.full(w.shape, A_FIXED), np.full(w.shape, N_FIXED), w, PAIR.shear, MU)
+    mun = MU * N_FIXED
+    fstar = mun * (1 - (1 - wmax / USTAR) ** 1.5)
+    exact_down = fstar - 2 * mun * (1 - (1 - (wmax - down) / (2 * USTAR)) ** 1.5)
+    exact_back = -fstar + 2 * mun * (1 - (1 - (back + wmax) / (2 * USTAR)) ** 1.5)
+    np.testing.assert_allclose(F[len(up):len(up) + len(down)], exact_down, atol=2e-3 * mun)
+    np.testing.assert_allclose(F[len(up) + len(down):], exact_back, atol=2e-3 * mun)
+    assert F[-1] == pytest.approx(fstar, abs=2e-3 * mun)
+    # energy dissipated per cycle (Johnson eq. 7.61, W = 9 mu^2 P^2 (2 - nu) / (10 G a) [...], with the
+    # contact's stiffness 8 G a / (2 - nu) = k_t): the loop is traversed clockwise, work done on the contact > 0
+    area = np.trapezoid(F[len(up) - 1:], w[len(up) - 1:])
+    assert area == pytest.approx(9 * 8 * mun**2 / (10 * 8 * PAIR.shear * A_FIXED) *
+                                  (1 - (1 - fstar / mun) ** (5 / 3) - 5 * fstar / (6 * mun) *
+                                   (1 + (1 - fstar / mun) ** (2 / 3))), rel=2e-2)
+
+
+def test_mdr_impacts_balance_impulse_and_lose_energy_only_to_slip():
+    inc = np.radians([3.0, 8.0, 20.0, 45.0])
+    o = predict_outcomes("coulomb", ball("mindlin-deresiewicz"), {"mu": MU}, speed=V, incidence=inc)
+    inertia = 0.4 * M * R**2
+    np.testing.assert_allclose(M * R * o["rebound_speed_t"] + inertia * o["rebound_spin"],
+                               M * R * o["tangential_speed"], rtol=1e-12)  # angular momentum about the contact point
+    K1 = 0.5 * M * o["tangential_speed"] ** 2
+    K2 = 0.5 * M * o["rebound_speed_t"] ** 2 + 0.5 * inertia * o["rebound_spin"] ** 2
+    assert np.all(K2 <= K1 * (1 + 1e-9)) and np.all(K2 > 0.5 * K1)
+    # converged in springs and steps: 4x of each changes the spin by less than 0.1 %
+    fine = attrs.evolve(ball("mindlin-deresiewicz"), compliance=MindlinDeresiewiczCompliance(PAIR.shear, 1600))
+    steps = mdr.STEPS_PER_PERIOD
+    try:
+        mdr.STEPS_PER_PERIOD = 4 * steps
+        f = predict_outcomes("coulomb", fine, {"mu": MU}, speed=V, incidence=inc)
+    finally:
+        mdr.STEPS_PER_PERIOD = steps
+    np.testing.assert_allclose(f["rebound_spin"], o["rebound_spin"], rtol=1e-3)
+
+
+def test_mdr_tends_to_the_rigid_sphere_when_stiff_and_to_gross_slip_at_large_psi1():
+    inc = np.radians([10.0, 25.0, 50.0])
+    rigid = predict_outcomes("coulomb", ball(), {"mu": MU}, "ode", speed=V, incidence=inc, rtol=1e-10)
+    real = predict_outcomes("coulomb", ball("mindlin-deresiewicz"), {"mu": MU}, speed=V, incidence=inc)
+    stiff = predict_outcomes("coulomb", ball("mindlin-deresiewicz", shear=1e3 * PAIR.shear), {"mu": MU},
+                             speed=V, incidence=inc)
+    assert np.max(np.abs(real["rebound_spin"] / rigid["rebound_spin"] - 1)) > 0.2  # compliance matters at 10 deg
+    np.testing.assert_allclose(stiff["rebound_spin"], rigid["rebound_spin"], rtol=0.01)
+    # sliding throughout (Psi1 beyond 2 chi (1 + e)): the compliant contact joins the rigid closed form
+    assert real["psi1"][2] > 2 * chi(PAIR.stiffness_ratio) * (1 + E)
+    assert real["rebound_spin"][2] == pytest.approx(rigid["rebound_spin"][2], rel=1e-6)
+
+
+def test_mdr_psi2_against_psi1_has_the_features_maw_barber_and_fawcett_found():
+    """MBF (1976), Fig. 1, thin diametral slice (chi = 1.2558, nu = 0.28, k^2 = r^2/2, e = 1): 'Psi2 is negative
+    for low values of Psi1', and gross slip throughout extends beyond the rigid theory's Psi1 = 4 chi, joining
+    the rigid line Psi2 = Psi1 - 4 chi at large Psi1."""
+    like = Pair(Material(380e9, 0.28), Material(380e9, 0.28))
+    sc = ball("mindlin-deresiewicz", pair=like, inertia_factor=0.5, e=1.0)
+    x = chi(like.stiffness_ratio, 0.5)
+    inc = np.radians(np.linspace(0.5, 45.0, 40))
+    o = predict_outcomes("coulomb", sc, {"mu": MU}, speed=V, incidence=inc)
+    low = (o["psi1"] > 0.1) & (o["psi1"] < 4.0)
+    assert low.sum() >= 10 and np.all(o["psi2"][low] < 0)
+    assert o["psi2"].min() < -1.0  # a strong reversal, as in MBF's figure
+    far = o["psi1"] > 4 * x * 1.3
+    assert far.sum() >= 5
+    np.testing.assert_allclose(o["psi2"][far], o["psi1"][far] - 4 * x, atol=1e-6 * o["psi1"].max())
+    # for the Kharaz sphere (chi = 1.50) the same: reversal at Psi1 about 2 to 3.4, where the rigid sphere rolls
+    k = predict_outcomes("coulomb", ball("mindlin-deresiewicz"), {"mu": MU}, speed=V, incidence=np.radians([12.0, 20.0]))
+    assert np.all(k["psi2"] < -0.5) and np.all(k["contact_rebound_angle"] < 0)
+
+
+def test_mdr_hard_cases_are_finite_or_a_clear_error():
+    sc = ball("mindlin-deresiewicz")
+    free = predict_outcomes("coulomb", sc, {"mu": 0.0}, speed=V, incidence=np.radians([5.0, 60.0]))
+    np.testing.assert_array_equal(free["rebound_spin"], 0.0)  # no friction, no spin, v_t kept
+    np.testing.assert_allclose(free["cm_tangential_cor"], 1.0, rtol=1e-12)
+    edge = predict_outcomes("coulomb", sc, {"mu": 5.0}, speed=V, incidence=np.radians([0.01, 89.9]))
+    assert np.all(np.isfinite(edge["rebound_spin"])) and np.all(np.isfinite(edge["psi2"]))
+    soft = predict_outcomes("coulomb", ball("mindlin-deresiewicz", shear=1.0), {"mu": MU}, speed=V,
+                            incidence=np.radians([10.0]))
+    assert abs(soft["rebound_spin"][0]) < 1e-3  # a 1 Pa contact passes no tangential force
+    with pytest.raises(SceneError, match="so stiff a contact is rigid"):
+        predict_outcomes("coulomb", ball("mindlin-deresiewicz", shear=1e20), {"mu": MU}, speed=V,
+                         incidence=np.radians([10.0]))
+
+
+def test_mdr_needs_a_coulomb_law_and_is_not_a_trajectory_model(tmp_path):
+    with pytest.raises(SceneError, match="not of the Coulomb form"):
+        predict_outcomes("wear", ball("mindlin-deresiewicz"), {"lam": 1e6}, speed=V, incidence=np.radians([10.0]))
+    ds = load_dataset(_outcome_toml(tmp_path, '[scene.normal]\nmodel = "hertz"\nrestitution = 0.98\n'
+                                    '[scene.compliance]\nmodel = "mindlin-deresiewicz"\nsprings = 300\n'
+                                    '[scene.materials]\nball_young = "380 GPa"\nball_poisson = 0.23\n'
+                                    'surface_young = "70 GPa"\nsurface_poisson = 0.25\nfriction = 0.092'))
+    assert ds.scene.compliance == MindlinDeresiewiczCompliance(PAIR.shear, 300)
+    out = predict_outcomes("coulomb", ds, {"mu": MU})
+    assert np.all(np.isfinite(out["rebound_spin"]))
+    from frictionlab.plan import make_plan
+    from frictionlab.registry import get_law
+
+    with pytest.raises(SceneError, match="impact outcomes only"):
+        make_plan(ds.scene.impact(V, 0.3).scene, get_law("coulomb"))
+    from frictionlab.predict import applicable_solvers
+
+    ok = applicable_solvers("coulomb", ds.scene)
+    assert ok["ode"] is None and "frictionlab.mdr" in ok["exact"]  # fits run it under the name 'ode'
+    assert all("not of the Coulomb form" in why for why in applicable_solvers("wear", ds.scene).values())
+
+
 # --- published measurements, predicted from the stated friction coefficient and material data ---------
 @pytest.fixture(scope="module")
 def kharaz_spin():
@@ -128,22 +263,39 @@ def test_rigid_model_predicts_measured_spin_from_30_to_60_deg(kharaz_spin):
 
 
 def test_compliant_model_predicts_measured_spin_below_30_deg(kharaz_spin):
-    """Within 15 % at 11 and 21 deg, where the rigid model is 20 and 30 % low."""
+    """Mindlin-Deresiewicz with microslip (MDR), stated mu and materials, nothing fitted: within 15 % at every
+    measured angle below 30 deg (6.1, 11 and 21 deg: -13.7, +6.3, -1.7 %), where the rigid model is 20 and 30 %
+    low at 11 and 21 deg."""
     ds, pred = kharaz_spin
     inc = np.degrees(ds.columns["incidence"])
     y = ds.columns["rebound_spin"]
-    band = (inc > 8) & (inc < 30)
-    assert band.sum() == 2
-    assert np.all(np.abs(pred["mindlin"][band] / y[band] - 1) < 0.15)
-    assert np.all(np.abs(pred["rigid"][band] / y[band] - 1) > 0.15)
+    band = inc < 30
+    assert band.sum() == 3
+    assert np.all(np.abs(pred["mindlin-deresiewicz"][band] / y[band] - 1) < 0.15), pred["mindlin-deresiewicz"][band]
+    assert np.all(np.abs(pred["rigid"][band & (inc > 8)] / y[band & (inc > 8)] - 1) > 0.15)
 
 
-@pytest.mark.xfail(strict=True, reason="at 6.1 deg the Mindlin model (Thornton's history simplification) "
-                   "predicts 67 rad/s against 136 measured: not met")
 def test_compliant_model_predicts_measured_spin_at_6_deg(kharaz_spin):
+    """At 6.1 deg (Psi1 = 1.0, where initial gross slip gives way to initial stick with microslip) the model
+    gives 117.5 rad/s against 136 measured (-13.7 %). The same paper's tangential restitution at that angle
+    implies 119.1 rad/s (frictionlab.datagen.kharaz.implied_spin), 1.3 % from the model: the spin marker is
+    14 % above what the restitution figure implies. With nu = 0.22 for the glass the model gives -16 %."""
     ds, pred = kharaz_spin
     i = int(np.argmin(ds.columns["incidence"]))
-    assert abs(pred["mindlin"][i] / ds.columns["rebound_spin"][i] - 1) < 0.15
+    assert abs(pred["mindlin-deresiewicz"][i] / ds.columns["rebound_spin"][i] - 1) < 0.15
+
+
+def test_the_two_kharaz_figures_are_compared_by_momentum_balance(kharaz_spin):
+    """omega_2 = (1 - e_t) v_t1 / (0.4 r) from the restitution figure: the spin figure's 6.1 deg marker is 12.6 %
+    above it (the data's own inconsistency), and the model is within 2 % of the restitution figure there."""
+    from frictionlab.datagen.kharaz import implied_spin
+
+    ds, pred = kharaz_spin
+    inc, w = implied_spin()
+    np.testing.assert_allclose(inc, np.degrees(ds.columns["incidence"]), atol=1e-9)
+    rel = w / ds.columns["rebound_spin"] - 1
+    assert rel[0] == pytest.approx(-0.126, abs=0.002) and np.all(np.abs(rel[1:3]) < 0.06)
+    assert abs(pred["mindlin-deresiewicz"][0] / w[0] - 1) < 0.02
 
 
 def test_measured_datasets_are_labelled_and_selectable():
@@ -194,6 +346,10 @@ radius = "2.5 mm"
      'ball_poisson = 0.7\nsurface_young = "70 GPa"\nsurface_poisson = 0.25', r"Poisson ratio must be in"),
     ('[scene.normal]\nmodel = "hertz"\nmodulus = "60 GPa"\nrestitution = 0.9\n[scene.compliance]\nmodel = "mindlin"',
      r"scene.compliance\] is missing 'shear_modulus'"),
+    ('[scene.normal]\nmodel = "hertz"\nmodulus = "60 GPa"\nrestitution = 0.9\n[scene.compliance]\n'
+     'model = "mindlin-deresiewicz"\nshear_modulus = "13 GPa"\nsprings = 2.5', r"springs must be an integer"),
+    ('[scene.normal]\nmodel = "hertz"\nmodulus = "60 GPa"\nrestitution = 0.9\n[scene.compliance]\nmodel = "hooke"',
+     r"scene.compliance.model must be one of 'linear', 'mindlin', 'mindlin-deresiewicz'"),
 ])
 def test_unknown_or_bad_scene_keys_are_one_line_errors(tmp_path, extra, match):
     with pytest.raises(DatasetError, match=match) as info:
@@ -224,10 +380,15 @@ def test_report_section_shows_predictions_and_the_criterion():
     sec = section.build(ctx)
     text = " ".join(str(payload) for _, payload in sec.blocks)
     assert "rigid model is within 10 % at 3 of 3" in text
-    assert "Mindlin model is within 15 % of the measured spin at 2 of 3" in text
+    assert "Mindlin-Deresiewicz model is within 15 % of the measured spin at 3 of 3" in text
     assert [f.name for f in sec.figures] == ["psi2-psi1.png"]
     assert len(ctx.json["rebound_predictions"]["kharaz2001-spin"]) == 7
     assert section.build(Context(SimpleNamespace(datasets=[load_dataset("impact-outcome-synthetic")]))) is None
+    assert "Consistency" not in text  # needs the same experiment's restitution
+    both = section.build(Context(SimpleNamespace(datasets=[load_dataset("kharaz2001-spin"),
+                                                            load_dataset("kharaz2001-tangential-cor")])))
+    text = " ".join(str(payload) for _, payload in both.blocks)
+    assert "implies 119.1 rad/s at 6.1 deg (-12.6 % from the measured spin)" in text
 
 
 def test_time_series_scene_takes_mindlin_from_materials():

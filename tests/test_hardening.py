@@ -357,17 +357,20 @@ def _alive(pid: int) -> bool:
     return state != "Z"  # a zombie has exited; only its exit status is left
 
 
-@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc")
-@pytest.mark.parametrize("sig, code, word", [(signal.SIGTERM, 143, "terminated"), (signal.SIGINT, 130, "interrupted")],
-                         ids=["SIGTERM", "SIGINT"])
-def test_a_signal_during_compare_with_workers_leaves_no_process_and_no_output(sig, code, word, tmp_path):
+def _compare_with_workers(tmp_path):
+    """The command line of a compare run with a slow law (three datasets, two workers) and its output folder."""
     (tmp_path / "slow.py").write_text(SLOW_LAW % "0.005")
     out = tmp_path / "rep"
-    proc = subprocess.Popen([sys.executable, "-m", "frictionlab", "--load", str(tmp_path / "slow.py"), "compare",
-                             "--laws", "slow-viscous", "--data", "incline-oil-a100,incline-oil-a200,incline-dry-d10",
-                             "--quiet", "--jobs", "2", "--bootstrap", "0", "--no-tolerance",
-                             "--no-equivalence", "--out", str(out)],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    return [sys.executable, "-m", "frictionlab", "--load", str(tmp_path / "slow.py"), "compare",
+            "--laws", "slow-viscous", "--quiet", "--bootstrap", "0", "--no-tolerance", "--no-equivalence",
+            "--out", str(out)], out
+
+
+def _signal_while_fitting(args, sig, cwd) -> tuple[subprocess.Popen, set[int]]:
+    """Start ``args`` with two workers, send ``sig`` once both are fitting, and wait until the run and its
+    workers are gone (at most 10 s for the workers); returns the finished process and the workers' pids."""
+    proc = subprocess.Popen(args + ["--data", "incline-oil-a100,incline-oil-a200,incline-dry-d10", "--jobs", "2"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=cwd)
     try:
         deadline = time.monotonic() + 60
         workers: set[int] = set()
@@ -377,42 +380,6 @@ def test_a_signal_during_compare_with_workers_leaves_no_process_and_no_output(si
         assert len(workers) >= 2, f"the run made no workers: {proc.poll()} {proc.stderr.read() if proc.poll() else ''}"
         time.sleep(0.5)  # the workers are fitting now
         proc.send_signal(sig)
-        rc = proc.wait(30)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-    stderr = proc.stderr.read()
-    assert rc == code, stderr
-    assert stderr.strip().splitlines()[-1] == f"frictionlab: {word}", stderr
-    assert "Traceback" not in stderr
-    deadline = time.monotonic() + 5
-    while any(_alive(p) for p in workers) and time.monotonic() < deadline:
-        time.sleep(0.05)
-    assert not [p for p in workers if _alive(p)], "worker processes outlived the run"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["slow.py"]  # no report, no lock, no temporary folder
-
-
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="parent-death signal is Linux only")
-def test_workers_do_not_outlive_a_killed_run_and_the_output_can_be_written_again(tmp_path):
-    """SIGKILL cannot be caught: the workers must notice their parent's death themselves (they
-    share the output lock they inherited, so an orphan would also block the next run)."""
-    (tmp_path / "slow.py").write_text(SLOW_LAW % "0.005")
-    out = tmp_path / "rep"
-    args = [sys.executable, "-m", "frictionlab", "--load", str(tmp_path / "slow.py"), "compare",
-            "--laws", "slow-viscous", "--quiet", "--bootstrap", "0", "--no-tolerance", "--no-equivalence",
-            "--out", str(out)]
-    proc = subprocess.Popen(args + ["--data", "incline-oil-a100,incline-oil-a200,incline-dry-d10", "--jobs", "2"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
-    try:
-        deadline = time.monotonic() + 60
-        workers: set[int] = set()
-        while len(workers) < 2 and time.monotonic() < deadline and proc.poll() is None:
-            workers |= _children(proc.pid)
-            time.sleep(0.05)
-        assert len(workers) >= 2, f"the run made no workers: {proc.poll()}"
-        time.sleep(0.5)
-        proc.kill()
         proc.wait(30)
     finally:
         if proc.poll() is None:
@@ -421,6 +388,29 @@ def test_workers_do_not_outlive_a_killed_run_and_the_output_can_be_written_again
     deadline = time.monotonic() + 10
     while any(_alive(p) for p in workers) and time.monotonic() < deadline:
         time.sleep(0.05)
+    return proc, workers
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc")
+@pytest.mark.parametrize("sig, code, word", [(signal.SIGTERM, 143, "terminated"), (signal.SIGINT, 130, "interrupted")],
+                         ids=["SIGTERM", "SIGINT"])
+def test_a_signal_during_compare_with_workers_leaves_no_process_and_no_output(sig, code, word, tmp_path):
+    args, _ = _compare_with_workers(tmp_path)
+    proc, workers = _signal_while_fitting(args, sig, tmp_path)
+    stderr = proc.stderr.read()
+    assert proc.returncode == code, stderr
+    assert stderr.strip().splitlines()[-1] == f"frictionlab: {word}", stderr
+    assert "Traceback" not in stderr
+    assert not [p for p in workers if _alive(p)], "worker processes outlived the run"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["slow.py"]  # no report, no lock, no temporary folder
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="parent-death signal is Linux only")
+def test_workers_do_not_outlive_a_killed_run_and_the_output_can_be_written_again(tmp_path):
+    """SIGKILL cannot be caught: the workers must notice their parent's death themselves (they
+    share the output lock they inherited, so an orphan would also block the next run)."""
+    args, out = _compare_with_workers(tmp_path)
+    _, workers = _signal_while_fitting(args, signal.SIGKILL, tmp_path)
     assert not [p for p in workers if _alive(p)], "worker processes outlived a killed run"
     assert not out.exists()  # written whole or not at all
     again = subprocess.run(args + ["--data", "incline-oil-a100", "--jobs", "1"], capture_output=True, text=True,
