@@ -192,3 +192,30 @@ def test_a_fit_without_checks_gives_the_same_numbers_as_the_full_fit():
     assert lean.stats == full.stats and lean.nfev == full.nfev
     assert {k: (p.value, p.stderr) for k, p in lean.params.items()} == \
         {k: (p.value, p.stderr) for k, p in full.params.items()}
+
+
+def test_impact_outcome_rows_are_built_once_per_scene_and_rows_with_the_same_answers():
+    """predict_outcomes keeps the last rows' impacts (and their batch) for the same scene object: a second call
+    reuses them and gives the same outcomes as a fresh build; another scene object (a freed quantity) is its own."""
+    import attrs
+    import numpy as np
+
+    from frictionlab import load_dataset, outcome
+
+    ds = load_dataset("impact-outcome-synthetic")
+    rows = outcome.rows_of(ds)
+    outcome._INBOUND.clear()
+    outcome._BATCHES.clear()
+    first = outcome.predict_outcomes("area-rate", ds.scene, {"mu": 0.2, "eta_prime": 400.0}, "exact", **rows)
+    imps = outcome._inbound(ds.scene, rows)
+    again = outcome.predict_outcomes("area-rate", ds.scene, {"mu": 0.2, "eta_prime": 400.0}, "exact", **rows)
+    assert outcome._inbound(ds.scene, rows) is imps and len(outcome._BATCHES) == 1
+    heavier = attrs.evolve(ds.scene, mass=2 * ds.scene.mass)
+    assert outcome._inbound(heavier, rows) is not imps
+    outcome._INBOUND.clear()
+    outcome._BATCHES.clear()
+    fresh = outcome.predict_outcomes("area-rate", ds.scene, {"mu": 0.2, "eta_prime": 400.0}, "exact", **rows)
+    for k in ("rebound_spin", "tangential_cor", "rebound_angle", "rolled"):
+        assert np.array_equal(first[k], again[k]) and np.array_equal(first[k], fresh[k]), k
+    assert not np.array_equal(outcome.predict_outcomes("area-rate", heavier, {"mu": 0.2, "eta_prime": 400.0}, "exact",
+                                                       **rows)["rebound_spin"], first["rebound_spin"])
