@@ -161,7 +161,9 @@ def no_law_applies(dataset: Dataset, skipped, solvers=None) -> str:
     compared = set(law for law, _, _ in skipped)
     able = [n for n in available_laws() if n not in compared
             and any(why is None for _, why in candidates(n, dataset, solvers))]
-    text = (f"none of the {len(compared)} laws compared applies to this {dataset.kind} set ("
+    which = ("the one law compared does not apply" if len(compared) == 1
+             else f"none of the {len(compared)} laws compared applies")
+    text = (f"{which} to this {dataset.kind} set ("
             + "; ".join(f"{', '.join(laws)}: {why}" for why, laws in by_reason.items()) + ")")
     return text + (f"; registered laws that apply: {', '.join(able)} (--laws {','.join(able)})" if able else "")
 
