@@ -30,6 +30,7 @@ and add ``mysection`` to ``SECTIONS`` at the place it belongs. Return None to le
 from __future__ import annotations
 
 import json
+import threading
 from concurrent.futures import as_completed
 from pathlib import Path
 
@@ -82,26 +83,33 @@ def _draw(i: int) -> bytes:
     return _FIGURES[i].draw()
 
 
+_DRAWING = threading.Lock()  # one report at a time hands its figures to forked workers through _FIGURES
+
+
 def _drawn(figs, jobs: int):
     """(index, PNG bytes) of every figure, in the order they finish: on ``jobs`` forked workers when jobs > 1."""
     from ..workers import process_pool
 
-    _FIGURES[:] = figs
-    if jobs > 1:
-        from ..figures import _plt
+    if jobs <= 1 or len(figs) <= 1:
+        for i, f in enumerate(figs):
+            yield i, f.draw()
+        return
+    from ..figures import _plt
 
-        _plt()  # pyplot imported once here, before the workers fork, instead of once in each
-    try:
-        with process_pool(jobs if len(figs) > 1 else 1) as pool:
-            if pool is None:
-                for i, f in enumerate(figs):
-                    yield i, f.draw()
-                return
-            futures = {pool.submit(_draw, i): i for i in range(len(figs))}
-            for fut in as_completed(futures):
-                yield futures[fut], fut.result()
-    finally:
-        _FIGURES.clear()
+    _plt()  # pyplot imported once here, before the workers fork, instead of once in each
+    with _DRAWING:
+        _FIGURES[:] = figs
+        try:
+            with process_pool(jobs) as pool:
+                if pool is None:  # no fork on this platform
+                    for i, f in enumerate(figs):
+                        yield i, f.draw()
+                    return
+                futures = {pool.submit(_draw, i): i for i in range(len(figs))}
+                for fut in as_completed(futures):
+                    yield futures[fut], fut.result()
+        finally:
+            _FIGURES.clear()
 
 
 def write_report(c, out, force: bool = False, progress=None, jobs: int = 1) -> Path:
