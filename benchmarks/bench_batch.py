@@ -19,8 +19,9 @@ them far less than wall time. Scene families (random, seeded):
    error itself); otherwise the benchmark says so and prints no ratio. Target >= 100x.
 2. Batch closed forms against bare numpy of the same expressions (the same sine recurrence and
    Bessel weights on both sides). Target: within 1.5x.
-3. Per-scene CPU and peak memory (tracemalloc: numpy's allocations) by batch size, against the size of
-   the results. Targets: per-scene cost flat within 1.2x from 1k to 100k scenes; peak <= 2x the results.
+3. Per-scene CPU (median of the repeats at every size) and peak memory (tracemalloc: numpy's
+   allocations) by batch size, against the size of the results. Targets: per-scene cost flat within
+   1.2x from 1k to 100k scenes; peak <= 2x the results.
 4. The share of batch time spent filling outputs from the dense interpolant.
 """
 from __future__ import annotations
@@ -29,6 +30,7 @@ import argparse
 import math
 import os
 import platform
+import resource
 import time
 
 import numpy as np
@@ -206,6 +208,8 @@ def rk_vs_plain(name, law, batch, params, args, rng):
     batch_times, loop_time, errs = [], 0.0, []
     br = None
     for chunk in chunks:
+        br = None  # the previous run's results are freed first, as a loop over batches would (else each run pays
+        # page faults for 2x the results' memory)
         t, br = median_time(lambda: simulate_batch(law, batch, params, solver="DOP853", rtol=args.rtol, n=NT), 1)
         batch_times.append(t)
         t0 = clock()
@@ -239,6 +243,7 @@ def exact_vs_bare(name, law, batch, params, bare, args, rng):
     n = batch.n
     tb, tr_, br, out = [], [], None, None
     for _ in range(max(args.repeats, 5)):  # alternate, so load spells hit both alike
+        br = out = None  # previous results freed first, on both sides
         t, br = median_time(lambda: simulate_batch(law, batch, params, solver="exact", n=NT), 1)
         tb.append(t)
         t, out = median_time(lambda: bare(batch, next(iter(params.values()))), 1)
@@ -311,15 +316,20 @@ def scaling(args, rng):
         per = {}
         for n in args.scaling:
             b, p = fam(n, rng)
-            reps = args.repeats if n <= 20_000 else 1
-            t, _ = median_time(lambda: simulate_batch(law, b, p, solver="DOP853", rtol=args.rtol, n=NT), reps)
+            sys0 = resource.getrusage(resource.RUSAGE_SELF).ru_stime
+            times = [median_time(lambda: simulate_batch(law, b, p, solver="DOP853", rtol=args.rtol, n=NT), 1)[0]
+                     for _ in range(args.repeats)]  # every size alike: the first run pays the results' page faults
+            sys_time = (resource.getrusage(resource.RUSAGE_SELF).ru_stime - sys0) / len(times)
+            t = float(np.median(times))
             tracemalloc.start()
             r = simulate_batch(law, b, p, solver="DOP853", rtol=args.rtol, n=NT)
             peak = tracemalloc.get_traced_memory()[1]
             tracemalloc.stop()
             size = sum(a.nbytes for a in (r.u, r.v, r.omega, r.theta, r.force, r.stick_time, r.A, r.N) if a is not None)
             per[n] = t / n
-            print(f"  {law:8s} n = {n:>7}: {t / n * 1e6:7.1f} us/scene; peak {peak / 2**20:7.0f} MiB for "
+            print(f"  {law:8s} n = {n:>7}: {t / n * 1e6:7.1f} us/scene (median of {len(times)}, "
+                  f"{min(times) / n * 1e6:.1f}-{max(times) / n * 1e6:.1f}; system time {sys_time / n * 1e6:.1f} on average, "
+                  f"page faults); peak {peak / 2**20:7.0f} MiB for "
                   f"{size / 2**20:6.0f} MiB of results = {peak / size:.2f}x (target <= 2x: "
                   f"{'met' if peak <= 2 * size else 'NOT met'})")
             del r
@@ -374,6 +384,7 @@ def main(argv=None):
           f"{', '.join(f'{x:.1f}' for x in os.getloadavg())} on {os.cpu_count()} cores")
     print(f"n = {args.n} scenes per family, loop timed on {args.sample}, rtol = {args.rtol:g}, "
           f"median of {args.repeats} repeats, seed {args.seed}")
+    print("batch path timed: frictionlab.vecrk in plain numpy (the only engine; no compiled path), laws in plain Python")
     cb, cp = coulomb_family(args.n, rng)
     wb, wp = wear_family(args.n, rng)
     rk_vs_plain("coulomb-roll", "coulomb", cb, cp, args, rng)
@@ -382,6 +393,7 @@ def main(argv=None):
     exact_vs_bare("wear-paper", "wear", wb, wp, bare_wear, args, rng)
     dense_share(args, rng)
     scaling(args, rng)
+    print(f"\nload average at end {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
 
 
 if __name__ == "__main__":

@@ -22,13 +22,19 @@ Tolerances act on the same scaled problem as ``solvers.ode`` (time by the span, 
 with the same method the batch takes the same steps as solve_ivp (tests check the errors match).
 ``simulate_sweep`` runs a batch in chunks on an executor (local, concurrent.futures or Dask).
 
-Why numpy (measured by benchmarks/bench_batch.py, CPU time on a shared 2-core machine): at 10,000
-scenes and rtol 1e-8 a DOP853 solve costs 25-45 us per scene, about 45x
-less than a loop of solve_ivp on a plain Python right-hand side at the same method, rtol, event
-and accuracy (not the 100x targeted); a third of it fills the outputs from the dense interpolant.
-Beyond CHUNK scenes the batch runs in chunks, so memory stays about 1.4x the results. A compiled
-engine would be faster, but would need every law plugin, a plain Python class, written in
-numba's subset; numpy keeps the plugin contract (a force that broadcasts) and needs no compiler.
+Outputs: the default grid (n points over each scene's span) is one grid in scaled time, so the
+integrator evaluates each step's outputs as one block; beyond CHUNK scenes the batch runs in chunks
+integrated and finished straight into the result arrays (v, omega, theta are rows of one states
+block), so memory stays below 2x the results and no chunk is copied.
+
+Why numpy (measured by benchmarks/bench_batch.py, CPU time on a shared 2-core machine, load 1.2-1.6):
+at 10,000 scenes and rtol 1e-8 a DOP853 solve costs 14-20 us per scene, 30x to 65x less than a loop
+of solve_ivp on a plain Python right-hand side at the same method, rtol, event and accuracy (not the
+100x targeted); a quarter to a third of it fills the outputs from the dense interpolant, a sixth is
+the sine of the half-sine contact models, and a fixed 5-7 ms per batch is interpreter overhead per
+step (so 1,000 scenes cost 1.3x to 1.5x per scene what 10,000 do). A compiled engine would be
+faster, but would need every law plugin, a plain Python class, written in numba's subset; numpy
+keeps the plugin contract (a force that broadcasts) and needs no compiler.
 """
 from __future__ import annotations
 
@@ -257,7 +263,15 @@ def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol:
     p = batch_params(law, params, nsc)
     tgrid = _time_grid(batch, t, n)
     if nsc > CHUNK:
-        return _chunked(law, batch, p, tgrid, solver, rtol, atol, n)
+        return _chunked(law, batch, p, tgrid, solver, rtol, atol)
+    out, solver, info = _simulate_chunk(law, batch, p, tgrid, solver, rtol, atol)
+    return BatchResult(t=tgrid, solver=solver, law=law.name, info=info, **out)
+
+
+def _simulate_chunk(law, batch, p, tgrid, solver, rtol, atol, into=None):
+    """One chunk: (outputs, solver taken, info). ``into`` (see ``_chunked``) holds the result arrays' rows of
+    these scenes, written in place (the states on the grid are integrated straight into them)."""
+    nsc = batch.n
     T = np.broadcast_to(tgrid, (nsc, tgrid.shape[-1]))
     plan = make_plan(batch.view(), law, "batch scene")
     if plan.scene.spring is not None:
@@ -278,35 +292,37 @@ def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol:
                 raise
             solver = "DOP853"
     if solver == "exact":
-        out, info = _run_exact(law, batch, p, T)
+        out, info = _run_exact(law, batch, p, T, into)
     else:
-        out, info = _run_rk(law, batch, p, T, solver, rtol, atol)
+        out, info = _run_rk(law, batch, p, T, solver, rtol, atol, into)
     info.update({"rtol": rtol, "atol": rtol if atol is None else atol} if solver != "exact" else {})
-    return BatchResult(t=tgrid, solver=solver, law=law.name, info=info, **out)
+    return out, solver, info
 
 
-def _chunked(law, batch, p, tgrid, solver, rtol, atol, n) -> BatchResult:
-    """``simulate_batch`` chunk by chunk (CHUNK scenes each), each chunk's arrays copied into the
-    result as it finishes, so only one chunk's working arrays exist at a time."""
-    out, parts = {}, []
-    for start in range(0, batch.n, CHUNK):
-        sl = slice(start, min(start + CHUNK, batch.n))
-        r = simulate_batch(law, batch.subset(sl), _take_params(p, sl), tgrid if tgrid.ndim == 1 else tgrid[sl],
-                           solver, rtol, atol, n)
-        for name in ("u", "v", "omega", "theta", "force", "stick_time", "A", "N"):
-            a = getattr(r, name)
-            if a is None:
-                continue
-            if name not in out:
-                out[name] = np.empty((batch.n,) + a.shape[1:], dtype=a.dtype)
-            out[name][sl] = a
-        parts.append((r.solver, r.info))
-        del r
+def _chunked(law, batch, p, tgrid, solver, rtol, atol) -> BatchResult:
+    """``simulate_batch`` chunk by chunk (CHUNK scenes each), written in place into the result arrays, so
+    only one chunk's working arrays exist beside the results (memory below 2x the results at any n)."""
+    plan = make_plan(batch.view(), law, "batch scene")
+    n, m = batch.n, tgrid.shape[-1]
+    states = np.empty((len(plan.states), n, m))  # the states on the grid: v, omega, theta are rows of it
+    res = {"u": np.empty((n, m)), "force": np.empty((n, m)), "stick_time": np.empty(n),
+           "A": np.empty((n, m)) if plan.needs_area else None,
+           "N": np.empty((n, m)) if "N" in law.requires else None}
+    parts = []
+    for start in range(0, n, CHUNK):
+        sl = slice(start, min(start + CHUNK, n))
+        into = {k: None if a is None else a[sl] for k, a in res.items()} | {"states": states[:, sl]}
+        out, s, info = _simulate_chunk(law, batch.subset(sl), _take_params(p, sl), tgrid if tgrid.ndim == 1 else tgrid[sl],
+                                       solver, rtol, atol, into)
+        res["stick_time"][sl] = out["stick_time"]
+        parts.append((s, info))
     solvers = {s for s, _ in parts}
     info = {"chunks": len(parts), "nfev": int(sum(i.get("nfev", 0) for _, i in parts)),
             **({"rtol": rtol, "atol": rtol if atol is None else atol} if "exact" not in solvers else {})}
-    return BatchResult(t=tgrid, solver="+".join(sorted(solvers)), law=law.name, info=info,
-                       **{k: out.get(k) for k in ("u", "v", "omega", "theta", "force", "stick_time", "A", "N")})
+    spin = plan.has_spin
+    return BatchResult(t=tgrid, solver="+".join(sorted(solvers)), law=law.name, info=info, v=states[0],
+                       omega=states[plan.index("omega")] if spin else np.zeros((n, m)),
+                       theta=states[plan.index("theta")] if spin else np.zeros((n, m)), **res)
 
 
 def simulate_sweep(law, scenes, params=None, t=None, solver: str = "auto", rtol: float = 1e-8,
@@ -370,32 +386,52 @@ def _zero_slip(plan, y):
     return y
 
 
-def _finish(law, batch, p, T, Y, sliding, need):
-    """u, force, A and N on the output grid from the states, as ``segments.run`` does."""
+def _finish(law, batch, p, T, Y, sliding, need, into=None):
+    """u, force, A and N on the output grid from the states, as ``segments.run`` does (written into the
+    result arrays ``into`` when given; Y is then already theirs)."""
     view = batch.view(column=True)
     plan = _plan(law, view)
     stuck = ~sliding
     u = plan.rigid_slip(Y)  # written in place below (a copy where it would alias the states): memory, not speed
-    u = u.copy() if np.shares_memory(u, Y) else u
+    if into is not None:
+        np.copyto(into["u"], u)
+        u = into["u"]
+    elif np.shares_memory(u, Y):
+        u = u.copy()
     u[stuck] = 0.0
     c = plan.contact(T, Y, u)
     F = law.evaluate(_take_params(p, slice(None), column=True), c)
-    F = F if F.flags.writeable and not np.shares_memory(F, u) else F.copy()
+    if into is not None:
+        np.copyto(into["force"], F)
+        F = into["force"]
+    elif not F.flags.writeable or np.shares_memory(F, u):
+        F = F.copy()
     np.copyto(F, np.broadcast_to(need, F.shape), where=stuck)
     A = c.A if c.A is not None else (view.area(T, None, u)[0] if plan.needs_area else None)
     N = c.N
-    omega = Y[plan.index("omega")] if plan.has_spin else np.zeros_like(u)
-    theta = Y[plan.index("theta")] if plan.has_spin else np.zeros_like(u)
     for name, arr in (("states", Y), ("force", F)):
-        if not np.isfinite(arr).all():
+        if not _all_finite(arr):
             bad = ~np.isfinite(arr) if arr.ndim == 2 else ~np.isfinite(arr).all(axis=0)
             i = int(np.argmax(bad.any(axis=1)))
             raise SolverError(f"batch: {name} became NaN or infinite for law '{law.name}' in scene {i}")
 
-    def full(a):
-        return None if a is None else (a if np.shape(a) == u.shape else np.broadcast_to(a, u.shape).copy())
+    def full(a, name):
+        if a is None:
+            return None
+        if into is not None:
+            np.copyto(into[name], a)
+            return into[name]
+        return a if np.shape(a) == u.shape else np.broadcast_to(a, u.shape).copy()
 
-    return {"u": u, "v": Y[0], "omega": omega, "theta": theta, "force": F, "A": full(A), "N": full(N)}
+    omega = Y[plan.index("omega")] if plan.has_spin else np.zeros_like(u)
+    theta = Y[plan.index("theta")] if plan.has_spin else np.zeros_like(u)
+    return {"u": u, "v": Y[0], "omega": omega, "theta": theta, "force": F, "A": full(A, "A"), "N": full(N, "N")}
+
+
+def _all_finite(a) -> bool:
+    """Every element finite: one summing pass (a sum is finite only if every term is), the elementwise
+    test only when the sum is not (it may overflow)."""
+    return bool(np.isfinite(np.sum(a)) or np.isfinite(a).all())
 
 
 def _root(make_fn, lo, hi, tol, gtol=0.0):
@@ -451,24 +487,31 @@ def _breakaway(law, batch, p, ids, ts, ys, t_end, last_dir):
     return tb, hold, need
 
 
-def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask):
-    """Stuck-phase states (``solvers.stick.stuck_states``) at outputs in [t_from, t_to] not yet filled."""
-    assert Y.flags.c_contiguous and done.flags.c_contiguous  # written through flat views
-    Ts = T[ids]
-    sel = (Ts >= t_from[:, None]) & (Ts <= t_to[:, None]) & ~done[ids]
-    r, c = np.nonzero(sel)
-    if r.size == 0:
-        return
-    plan = _plan(law, batch.view(ids[r]))
-    Ys, _ = stick.stuck_states(plan, Ts[r, c], ts[r], ys[:, r])
-    flat = ids[r] * T.shape[1] + c
-    Y.reshape(Y.shape[0], -1)[:, flat] = Ys
-    done.reshape(-1)[flat] = True
-    stuck_mask.reshape(-1)[flat] = True
+def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask, block=2048):
+    """Stuck-phase states (``solvers.stick.stuck_states``) at outputs in [t_from, t_to] not yet filled; per
+    scene on its whole grid row, ``block`` scenes at a time (working memory bounded, not per output point)."""
+    assert all(y.flags.c_contiguous for y in Y) and done.flags.c_contiguous  # written through flat views
+    m = T.shape[1]
+    for b in range(0, ids.size, block):
+        bi = slice(b, b + block)
+        rows = ids[bi]
+        Ts = T[rows]
+        sel = (Ts >= t_from[bi, None]) & (Ts <= t_to[bi, None]) & ~done[rows]
+        r, c = np.nonzero(sel)
+        if r.size == 0:
+            continue
+        plan = _plan(law, batch.view(rows, column=True))  # per scene, broadcast along its times
+        Ys, _ = stick.stuck_states(plan, Ts, ts[bi, None], ys[:, bi, None])
+        flat = rows[r] * m + c
+        src = r * m + c
+        for j in range(Y.shape[0]):  # integer take and put per state: several times faster than 2-d fancy indexing
+            np.put(Y[j], flat, np.take(Ys[j], src))
+        done.reshape(-1)[flat] = True
+        stuck_mask.reshape(-1)[flat] = True
 
 
 # --- the vectorized Runge-Kutta path ----------------------------------------------------------
-def _run_rk(law, batch, p, T, method, rtol, atol):
+def _run_rk(law, batch, p, T, method, rtol, atol, into=None):
     nsc, m = T.shape
     full = _plan(law, batch.view())
     d = len(full.states)
@@ -497,7 +540,8 @@ def _run_rk(law, batch, p, T, method, rtol, atol):
             end = np.where(np.isnan(tb), t_end[stuck_ids], tb)
             held = ~(tb == t0[stuck_ids])  # breakaway at once: the sliding phase owns the outputs at t0
             if Y is None:
-                Y = np.full((d, nsc, m), np.nan)
+                Y = np.full((d, nsc, m), np.nan) if into is None else into["states"]
+                Y.fill(np.nan)
             if held.any():
                 h_ids = stuck_ids[held]
                 _fill_stuck(law, batch, h_ids, t0[h_ids], y0[:, h_ids], t0[h_ids], end[held], T, Y, done, stuck_mask)
@@ -518,7 +562,9 @@ def _run_rk(law, batch, p, T, method, rtol, atol):
             i = int(np.argmax(segments > MAX_SEGMENTS))
             raise SolverError(f"batch {method}: slip changed between sliding and sticking more than {MAX_SEGMENTS} times "
                               f"in scene {i} (chatter); the law is not suited to this scene")
-        res = _slide_rk(law, batch, p, slide_ids, t0, y0, direction, T, t_end, scale, method, rtol, atol)
+        first_all = Y is None and slide_ids.size == nsc and into is not None  # integrated straight into the result
+        res = _slide_rk(law, batch, p, slide_ids, t0, y0, direction, T, t_end, scale, method, rtol, atol,
+                        into["states"] if first_all else None)
         iterations += res.iterations
         nfev[slide_ids] += res.nfev
         new = res.reached & ~done[slide_ids]
@@ -548,13 +594,13 @@ def _run_rk(law, batch, p, T, method, rtol, atol):
         i = int(np.argmax(~done.all(axis=1)))
         raise SolverError(f"batch {method}: scene {i} ended before its last requested time")
     need = stick.needed_force(_plan(law, batch.view(column=True)))
-    out = _finish(law, batch, p, T, Y, ~stuck_mask, need)
+    out = _finish(law, batch, p, T, Y, ~stuck_mask, need, into)
     out["stick_time"] = stick_time
     return out, {"nfev": int(nfev.sum()), "nfev_per_scene": nfev, "iterations": iterations,
                  "segments": int(segments.max(initial=0)), "method": method}
 
 
-def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rtol, atol):
+def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rtol, atol, out=None):
     """One sliding phase for scenes ``ids`` on the scaled problem (time / span, states / scale)."""
     span = t_end[ids]
     sc = scale[:, ids]
@@ -564,10 +610,13 @@ def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rt
         plan = _plan(law, batch.view(g_ids))
         pv = _take_params(p, g_ids)
         tsc, ssc = span[k], sc[:, k]
+        fac = tsc / ssc
         dirs = direction[g_ids]
 
         def rhs(s, z):
-            return plan.derivatives(pv, s * tsc, z * ssc, dirs) * tsc / ssc
+            dy = plan.derivatives(pv, s * tsc, z * ssc, dirs)
+            dy *= fac  # a fresh array: scaled in place
+            return dy
 
         return rhs
 
@@ -581,9 +630,26 @@ def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rt
 
         return g
 
-    s_out = T[ids] / span[:, None]
-    return vecrk.integrate(make_rhs, t0[ids] / span, y0[:, ids] / sc, 1.0, s_out, method=method, rtol=rtol,
-                           atol=atol, make_event=make_event, breaks=_breaks(batch, ids, span))
+    return vecrk.integrate(make_rhs, t0[ids] / span, y0[:, ids] / sc, 1.0, _scaled_grid(T, ids, span), method=method,
+                           rtol=rtol, atol=atol, make_event=make_event, breaks=_breaks(batch, ids, span), out=out)
+
+
+def _scaled_grid(T, ids, span):
+    """Output times of scenes ids in units of their spans: one (m,) grid when they share it, else (k, m).
+
+    The default grid, m points over each scene's span, is one grid in scaled time: its rows are taken as
+    exactly linspace(0, 1, m), row by row (so a scene's outputs do not depend on its batch or chunk)."""
+    m = T.shape[1]
+    if T.strides[0] == 0 and np.all(span == span[0]):  # one grid and one span for all
+        return T[0] / span[0]
+    Tid = T[ids]
+    rel = np.linspace(0.0, 1.0, m)
+    on = np.all(Tid == span[:, None] * rel, axis=1)
+    if on.all():
+        return rel
+    s_out = Tid / span[:, None]
+    s_out[on] = rel
+    return s_out
 
 
 def _breaks(batch, ids, span):
@@ -595,7 +661,7 @@ def _breaks(batch, ids, span):
 
 
 # --- the vectorized closed forms -------------------------------------------------------------
-def _run_exact(law, batch, p, T):
+def _run_exact(law, batch, p, T, into=None):
     nsc, m = T.shape
     view = batch.view(column=True)
     plan = _plan(law, view)
@@ -608,31 +674,34 @@ def _run_exact(law, batch, p, T):
     fallback = np.zeros(nsc, dtype=bool)
     if isinstance(form, exact.AreaSlipForm):
         J, K = exact._area_slip(plan, form.k, 0.0, y0, T)
-        Y = exact._states(plan, 0.0, y0, T, J, K)
+        Y = exact._states(plan, 0.0, y0, T, J, K, out=None if into is None else into["states"])
     else:
         u_s = np.broadcast_to(plan.rigid_slip(y0), (nsc, 1))
         sgn = np.sign(u_s)
         fallback |= sgn[:, 0] == 0
         sgn = np.where(sgn == 0, 1.0, sgn)
-        J1, K1, _ = exact._normal_area_rate(plan, form, 0.0, y0, 1.0, T, find_stop=False)
-        Y = exact._states(plan, 0.0, y0, T, sgn * J1, sgn * K1)
         ts = _exact_stop(law, batch, p, plan, form, y0, u_s[:, 0], sgn[:, 0], T)
         hit = ~np.isnan(ts) & ~fallback
-        if hit.any():  # stuck states after the stick time, on the whole grid (cheaper than gathering)
+        tcol = np.where(hit, ts, np.inf)[:, None]
+        # the sliding closed form at min(t, stick time): frozen at the stick, where the stuck phase continues
+        tt = np.minimum(T, tcol) if hit.any() else T
+        signed = exact.NormalAreaRateForm(a=sgn * form.a, c=sgn * form.c)  # the slip's sign in the form: no pass
+        J1, K1, _ = exact._normal_area_rate(plan, signed, 0.0, y0, 1.0, tt, find_stop=False)
+        Y = exact._states(plan, 0.0, y0, tt, J1, K1, out=None if into is None else into["states"])
+        if hit.any():
             stick_time[hit] = ts[hit]
-            tcol = np.where(hit, ts, 0.0)[:, None]
-            Js, Ks, _ = exact._normal_area_rate(plan, form, 0.0, y0, 1.0, tcol, find_stop=False)
-            ys = exact._states(plan, 0.0, y0, tcol, sgn * Js, sgn * Ks)[:, :, 0]
-            ys = _zero_slip(_plan(law, batch.view()), ys)
             ids = np.nonzero(hit)[0]
+            ys = _zero_slip(_plan(law, batch.view(ids)), Y[:, ids, -1])  # the state at the stick, slip exactly zero
             t_end = T[ids, -1]
-            tb, _, _ = _breakaway(law, batch, p, ids, ts[ids], ys[:, ids], t_end, sgn[ids, 0])
+            tb, _, _ = _breakaway(law, batch, p, ids, ts[ids], ys, t_end, sgn[ids, 0])
             fallback[ids[~np.isnan(tb) & (tb < t_end)]] = True
-            stuck_mask = T > np.where(hit, ts, np.inf)[:, None]
-            Ys, _ = stick.stuck_states(plan, T, tcol, ys[:, :, None])
-            np.copyto(Y, Ys, where=stuck_mask[None])
+            stuck_mask = T > tcol
+            v_stick = np.zeros((nsc, 1))
+            v_stick[ids, 0] = ys[0]
+            np.copyto(Y[0], v_stick, where=stuck_mask)  # zero slip exactly while stuck, as the stick state has it
+            stick.stuck_states(plan, T, tt, Y, out=Y)  # dt = 0 before the stick: those states stay
     need = stick.needed_force(plan)
-    out = _finish(law, batch, p, T, np.nan_to_num(Y) if fallback.any() else Y, ~stuck_mask, need)
+    out = _finish(law, batch, p, T, np.nan_to_num(Y, copy=into is None) if fallback.any() else Y, ~stuck_mask, need, into)
     for i in np.nonzero(fallback)[0]:
         _scalar_into(out, stick_time, law, batch, p, T, i)
     out["stick_time"] = stick_time

@@ -126,11 +126,14 @@ class Plan:
         """The contact quantities the law requires, and only those, at times t for states y."""
         s = self.scene
         A = dAdt = N = None
+        req = self.law.requires
         if self.needs_area:
-            A, dAdt = self.area(t, y, u)
+            if "dAdt" in req or not hasattr(s.area, "value"):
+                A, dAdt = self.area(t, y, u)
+            else:  # the area alone, where the model offers it (half the cost of a half-sine's area and rate)
+                A = s.area.value(t)
         if self.needs_normal:
             N = s.normal(t, A)
-        req = self.law.requires
         state = ({n: y[self.index(k)] for n, k in zip(self.law.state_names, self.law_states)} or None
                  if self.law.states else None)
         return Contact(t=np.asarray(t, dtype=float), u=np.asarray(u, dtype=float),
@@ -223,7 +226,7 @@ class Plan:
             c = self.contact(np.asarray(t), y, np.asarray(u)) if self.law_states else None
         else:
             u = self.rigid_slip(y)
-            if np.any(direction):
+            if direction.any() if isinstance(direction, np.ndarray) else direction != 0:
                 from .solvers.stick import branch_slip
 
                 u = branch_slip(self, u, direction)
@@ -286,25 +289,30 @@ class Plan:
         return np.array([rate[k] for k in self.states])
 
     def _rates(self, p, t, y, F, u, c) -> np.ndarray:
-        """Time derivatives of the state for friction force F and slip u (works on batches)."""
+        """Time derivatives of the state for friction force F and slip u (works on batches): one output
+        array, each rate written into its row (the same arithmetic as term by term)."""
         s = self.scene
-        law_rates = self.law.evaluate_rates(p, c) if self.law_states else {}
-        out = []
-        for name in self.states:
+        law_rates = self.law.evaluate_rates(p, c) if self.law.states else {}
+        shape = np.shape(F)
+        if shape != np.shape(y)[1:]:
+            shape = np.broadcast_shapes(shape, np.shape(y)[1:])
+        out = np.empty((len(self.states),) + shape)
+        for i, name in enumerate(self.states):
             if name == "v":
-                out.append(self.drive - F / s.mass)
+                np.subtract(self.drive, F / s.mass, out=out[i, ...])
             elif name == "omega":
-                out.append(F * s.radius / s.inertia)
+                np.multiply(F, s.radius, out=out[i, ...])
+                out[i] /= s.inertia
             elif name == "theta":
-                out.append(y[self.index("omega")])
+                out[i] = y[self.index("omega")]
             elif name == "x":
-                out.append(np.abs(u))
+                np.abs(u, out=out[i, ...])
             elif name == "xi":
                 loading = self.spring(t, y)[2] if s.compliance.model != "linear" else 0.0
-                out.append(self.rigid_slip(y) - u - loading * y[self.index("xi")])
+                out[i] = self.rigid_slip(y) - u - loading * y[self.index("xi")]
             else:
-                out.append(law_rates[name[len(LAW_PREFIX):]])
-        return np.array(np.broadcast_arrays(*out), dtype=float)
+                out[i] = law_rates[name[len(LAW_PREFIX):]]
+        return out
 
 
 def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan:

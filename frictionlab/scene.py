@@ -100,6 +100,12 @@ class HalfSineArea:
         inside = (t >= 0) & (t <= self.contact_time)
         return np.where(inside, self.peak * np.sin(phi * t), 0.0), np.where(inside, self.peak * phi * np.cos(phi * t), 0.0)
 
+    def value(self, t):
+        """A(t) alone [m^2], bitwise the first of ``__call__``: a law that needs no dA/dt skips the cosine."""
+        t = np.asarray(t, dtype=float)
+        inside = (t >= 0) & (t <= self.contact_time)
+        return np.where(inside, self.peak * np.sin(math.pi / self.contact_time * t), 0.0)
+
 
 @attrs.frozen
 class ConstantArea:

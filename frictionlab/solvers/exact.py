@@ -81,20 +81,31 @@ def make_slide():
     return slide
 
 
-def _states(plan, t0, y0, t, J, K):
+def _states(plan, t0, y0, t, J, K, out=None):
+    """States at times t from the friction impulse J and its integral K (terms that vanish skipped: a batch
+    evaluates this on large grids)."""
     s = plan.scene
     dt = t - t0
-    out = []
+    if out is None:
+        out = np.empty((len(plan.states),) + np.broadcast_shapes(np.shape(J), np.shape(dt)))
     for i, name in enumerate(plan.states):
         if name == "v":
-            out.append(y0[i] + plan.drive * dt - J / s.mass)
+            np.divide(J, -s.mass, out=out[i])
+            out[i] += y0[i]
+            if np.any(plan.drive):
+                out[i] += plan.drive * dt
         elif name == "omega":
-            out.append(y0[i] + s.radius * J / s.inertia)
+            np.multiply(J, s.radius / s.inertia, out=out[i])
+            out[i] += y0[i]
         elif name == "theta":
-            out.append(y0[i] + y0[plan.index("omega")] * dt + s.radius * K / s.inertia)
+            np.multiply(K, s.radius / s.inertia, out=out[i])
+            out[i] += y0[i]
+            w0 = y0[plan.index("omega")]
+            if np.any(w0):
+                out[i] += w0 * dt
         else:  # pragma: no cover - guarded by check()
             raise SolverError(f"exact: state '{name}' has no closed form")
-    return np.array(out)
+    return out
 
 
 # --- F = k A u ------------------------------------------------------------------------
@@ -196,16 +207,30 @@ def _area_slip(plan, k, t0, y0, t):
 
 
 # --- F = s (a N + c dA/dt) --------------------------------------------------------------
-def _normal_integrals(normal, t):
-    """IN = int_0^t N, IIN = int_0^t IN, for half-sine or constant N."""
+def _normal_integrals(normal, t, a=1.0):
+    """a IN and a IIN: IN = int_0^t N, IIN = int_0^t IN, for half-sine or constant N (a: a factor per
+    scene, folded into the coefficients; the term of times after contact skipped when there are none)."""
+    t = np.asarray(t, dtype=float)
     if isinstance(normal, WeightNormal):
-        return normal.value * t, normal.value * t * t / 2.0
+        return a * normal.value * t, a * normal.value * t * t / 2.0
     tc = normal.contact_time
     phi = math.pi / tc
-    tau = np.minimum(t, tc)
-    Np = normal.peak
-    IN = Np / phi * (1.0 - np.cos(phi * tau))
-    IIN = Np / phi * (tau - np.sin(phi * tau) / phi) + (2.0 * Np / phi) * np.maximum(t - tc, 0.0)
+    c = a * normal.peak / phi
+    after = bool(np.any((np.max(t, axis=-1, keepdims=True) if t.ndim else t) > tc))  # each row's latest time
+    tau = np.minimum(t, tc) if after else t
+    x = phi * tau
+    if x.ndim == 0 or np.broadcast_shapes(x.shape, np.shape(c)) != x.shape:  # small inputs: plainly
+        IN, IIN = c * (1.0 - np.cos(x)), c * (tau - np.sin(x) / phi)
+    else:  # large grids: in place, no temporaries
+        IN = np.cos(x)
+        np.subtract(1.0, IN, out=IN)
+        IN *= c
+        IIN = np.sin(x, out=x)
+        IIN /= -phi
+        IIN += tau
+        IIN *= c
+    if after:
+        IIN = IIN + (2.0 * c) * np.maximum(t - tc, 0.0)
     return IN, IIN
 
 
@@ -249,11 +274,10 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     def JK(tt):
         # terms that vanish (no area term; start at first contact) are skipped: a batch of many
         # scenes evaluates this on large grids
-        IN, IIN = _normal_integrals(s.normal, tt)
-        J, K = form.a * IN, form.a * IIN
+        J, K = _normal_integrals(s.normal, tt, form.a)
         if t0 != 0.0:
-            IN0, IIN0 = _normal_integrals(s.normal, np.array([t0]))
-            J, K = J - form.a * IN0, K - form.a * (IIN0 + IN0 * (tt - t0))
+            IN0, IIN0 = _normal_integrals(s.normal, np.array([t0]), form.a)
+            J, K = J - IN0, K - (IIN0 + IN0 * (tt - t0))
         if area is not None:
             A, IA = _area_integrals(area, tt)
             A0, IA0 = _area_integrals(area, np.array([t0]))

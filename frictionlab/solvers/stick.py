@@ -66,22 +66,31 @@ def breakaway(plan, p, t0: float, t1: float, y0, slip_before: float) -> float | 
     return brentq(g, grid[i - 1], grid[i], xtol=1e-15 * max(t1, 1e-300))
 
 
-def stuck_states(plan, t, ts, ys):
-    """States at times t during a stuck phase that began at ts in state ys (closed form)."""
+def stuck_states(plan, t, ts, ys, out=None):
+    """States at times t during a stuck phase that began at ts in state ys (closed form), and the force
+    holding it (a read-only array of t's shape). Terms of a zero force or drive are skipped (a batch
+    evaluates this on large grids; a rolling sphere needs neither); ``out`` may be ys itself."""
     s = plan.scene
     F = needed_force(plan)
     dt = np.asarray(t, dtype=float) - ts
-    out = {}
     # without slip coupling the stuck body does not move (v = 0 exactly); with it the slip
     # v - r omega stays zero while both change
     a_v = plan.drive - F / s.mass if plan.coupled else 0.0
-    for i, name in enumerate(plan.states):
-        if name == "v":
-            out[name] = ys[i] + a_v * dt
-        elif name == "omega":
-            out[name] = ys[i] + F * s.radius / s.inertia * dt
-        elif name == "theta":
-            out[name] = ys[i] + ys[plan.index("omega")] * dt + 0.5 * F * s.radius / s.inertia * dt**2
-        else:
-            out[name] = np.full(dt.shape, ys[i])
-    return np.array([out[k] for k in plan.states]), np.full(dt.shape, F)
+    spin = F * s.radius / s.inertia if plan.has_spin else 0.0
+    out = np.empty((len(plan.states),) + dt.shape) if out is None else out
+    # theta first: it reads the stuck phase's initial spin, which ``out`` may overwrite
+    for i in sorted(range(len(plan.states)), key=lambda j: plan.states[j] != "theta"):
+        name = plan.states[i]
+        if name == "theta":
+            w = ys[plan.index("omega")] * dt
+            w += ys[i]
+            if np.any(spin):
+                w += 0.5 * spin * dt**2
+            out[i] = w
+        elif name == "v" and np.any(a_v):
+            out[i] = ys[i] + a_v * dt
+        elif name == "omega" and np.any(spin):
+            out[i] = ys[i] + spin * dt
+        elif out is not ys:
+            out[i] = ys[i]
+    return out, np.broadcast_to(F, dt.shape)
