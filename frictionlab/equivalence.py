@@ -209,7 +209,7 @@ def _refit_options(f: FitResult) -> dict:
 
 def _refit(law: str, opts: dict, target: Target, scan: int = 0, n_starts: int = 1) -> FitResult:
     return fit(law, target, solver=opts["solver"], initial=opts["initial"], fixed=opts["fixed"] or None,
-               free=opts["free"] or None, scan=scan, n_starts=n_starts, checks=False)
+               free=opts["free"] or None, scan=scan, n_starts=n_starts, checks=False, errors=False)
 
 
 def _with_y(target: Target, y: np.ndarray, what: str) -> Target:

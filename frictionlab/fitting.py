@@ -501,7 +501,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         fixed: Mapping[str, float] | None = None, local: Sequence[str] = (),
         initial: Mapping[str, float] | None = None, observable: str | None = None, derive: str | None = None,
         scan: int = 125, n_starts: int = 3, max_nfev: int | None = None, rtol: float | None = None,
-        timeout: float | None = None, checks: bool = True) -> FitResult:
+        timeout: float | None = None, checks: bool = True, errors: bool = True) -> FitResult:
     """Fit ``law`` to one dataset or a group of them (a global fit) and return a FitResult.
 
     law: name or FrictionLaw. datasets: a Dataset, name, path or Target, or a list of them.
@@ -519,6 +519,9 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     checks: False skips the plausibility flags and the SI copy of lmfit's result (``minimizer_result``
     None): for replicate refits (equivalence, bootstrap, transfer) that read only the values, their
     error bars, the chi-square and the information criteria, which are the same either way.
+    errors: False skips the error analysis beyond lmfit's (the Jacobian, and what it shows: parameters
+    without effect, ratio-only pairs, identifiable directions; every free parameter counts in k): for
+    refits that read only the values and the chi-square (the equivalence test's replicates).
     """
     import lmfit  # slow to import: only when fitting
 
@@ -599,8 +602,12 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     except Exception as exc:  # an optimizer or law crash is a failed fit, not a crashed comparison
         return give_up("failed", f"{type(exc).__name__}: {exc}", nfev=model.nfev)
 
-    J = jacobian(model, slots, values)
-    structure = find_structure(law, slots, values, J)
+    if errors:
+        J = jacobian(model, slots, values)
+        structure = find_structure(law, slots, values, J)
+    else:
+        n_free = len(varying)
+        structure = {"at_bounds": (), "ratios": (), "no_effect": (), "k_eff": n_free, "n_free": n_free}
     k_each = structure["k_eff"] / len(targets)  # a group's parameters shared out for each member's test
     per = []
     for tg, solver_i, (p, scene), m in zip(targets, solvers, model.split(values), models):
@@ -622,7 +629,8 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         notes.append(f"{model.failures} of {model.nfev} evaluations could not be solved and were penalized "
                      f"(last: {model.last_error})")
     notes += _series_notes(law, per)
-    jac = jacobian_errors(slots, values, J, structure, stats.redchi if likelihood != "known" else 1.0)
+    jac = (jacobian_errors(slots, values, J, structure, stats.redchi if likelihood != "known" else 1.0) if errors
+           else {"errors": {}, "derived": {}, "correl": {}})
     presults = _param_results(slots, best_params, targets, structure, jac)
     if likelihood == "none":  # error bars rest on independent points: a smoothed series has none to give
         presults = {k: attrs.evolve(p, stderr=None) for k, p in presults.items()}

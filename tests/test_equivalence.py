@@ -167,3 +167,14 @@ def test_command_line_defaults_agree_with_the_library():
     from frictionlab.equivalence import MIN_REPLICATES, REPLICATES
 
     assert cmd.REPLICATES == REPLICATES and MIN_REPLICATES == 20
+
+
+def test_replicate_refits_without_error_analysis_give_the_same_statistic(coulomb_data, monkeypatch):
+    """The replicates' refits skip the Jacobian (fit(errors=False)): T on every replicate is what full fits give."""
+    from frictionlab import equivalence, fitting
+
+    _, fc, fw, e = coulomb_data
+    monkeypatch.setattr(equivalence, "fit", lambda *a, errors=True, **k: fitting.fit(*a, **k))
+    full = analyze_equivalence(fc, fw, replicates=R)
+    assert np.array_equal(full.t_a, e.t_a) and np.array_equal(full.t_b, e.t_b)
+    assert (full.d_ab, full.d_ba, full.verdict) == (e.d_ab, e.d_ba, e.verdict)

@@ -219,3 +219,15 @@ def test_impact_outcome_rows_are_built_once_per_scene_and_rows_with_the_same_ans
         assert np.array_equal(first[k], again[k]) and np.array_equal(first[k], fresh[k]), k
     assert not np.array_equal(outcome.predict_outcomes("area-rate", heavier, {"mu": 0.2, "eta_prime": 400.0}, "exact",
                                                        **rows)["rebound_spin"], first["rebound_spin"])
+
+
+def test_a_fit_without_error_analysis_gives_the_same_values_and_chi_square():
+    """fit(errors=False), the equivalence test's replicate refits: no Jacobian (2 evaluations per free
+    parameter fewer), the same search, values and chi-square; every free parameter counted in k."""
+    data = synthetic("couette", TRUTH["couette"], incline_scene(), n=21, name="incline-couette")
+    full, lean = fit("couette", data, solver="exact"), fit("couette", data, solver="exact", errors=False)
+    assert full.ok and lean.ok and lean.stats.chisqr == full.stats.chisqr
+    assert lean.nfev == full.nfev - 2 * 2  # eta and h: a central difference each
+    assert {k: p.value for k, p in lean.params.items() if p.kind != "derived"} == \
+        {k: p.value for k, p in full.params.items() if p.kind != "derived"}
+    assert full.stats.n_params == 1 and lean.stats.n_params == 2  # eta/h only: the structure is not looked for
