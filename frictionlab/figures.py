@@ -204,18 +204,24 @@ def force_figure(dataset, fits) -> bytes:
     t_end = float(dataset.t[-1])
     tname, tf = time_unit(t_end)
     fig, ax = plt.subplots(figsize=(7.6, 3.8), layout="constrained")
+    drawn = 0
     for i, (f, laws) in enumerate(curves):
         try:
             tr = f.per_dataset[0].trajectory(f.law, np.linspace(0.0, t_end, 300))
         except FrictionLabError:  # a stiff law whose dense curve exceeds the solver's budget: left out
             continue
         ax.plot(tr.t * tf, tr.force, label=f"{' = '.join(laws)} [{f.solver}]", **_style(f.law, f.solver, i))
+        drawn += 1
     ax.axhline(0, color="0.3", lw=0.8)
     ax.set_xlabel(f"time [{tname}]")
     ax.set_ylabel("friction force F [N] (positive opposes slip)")
     ax.set_title(f"{dataset.name}: friction force of each best fit")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    if drawn:
+        ax.legend(fontsize=8)
+    else:
+        ax.text(0.5, 0.5, "no fit's force history could be drawn\n(each exceeded the solver's budget)",
+                transform=ax.transAxes, ha="center", va="center", color="0.3")
     return _png(fig)
 
 
