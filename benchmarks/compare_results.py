@@ -6,7 +6,8 @@ For each fit present in both (dataset, law, solver) and each fitted or derived p
 eta/h), prints the shift |after - before| in units of the larger of the two standard errors, and
 each fit's status and chi-square. A parameter with an error bar on neither side is one the data do
 not determine (eta and h apart, a parameter without effect): it is listed as such, not compared.
-Exit 1 if a shift exceeds --tol standard errors, a fit's status changed, or a fit is missing on one side.
+Exit 1 if a shift exceeds --tol standard errors, a fit's status changed, or a fit is missing on one
+side (a failed or skipped fit before that is not listed after is only named: it had no values).
 """
 from __future__ import annotations
 
@@ -29,9 +30,12 @@ def main() -> int:
     ap.add_argument("--tol", type=float, default=1.0, help="largest shift allowed, in standard errors (default 1)")
     args = ap.parse_args()
     old, new = fits_by_key(args.before), fits_by_key(args.after)
-    bad = []
+    bad, gone = [], []
     for key in sorted(set(old) - set(new)):
-        bad.append(f"missing after: {key}")
+        if old[key]["status"] == "ok":
+            bad.append(f"missing after: {key}")
+        else:  # nothing was fitted before either (a dataset now left out before fitting, with its reason)
+            gone.append(f"{key} ({old[key]['status']} before)")
     added = sorted(set(new) - set(old))
     rows = []
     for key in sorted(set(old) & set(new)):
@@ -63,6 +67,8 @@ def main() -> int:
           f"{max((r[0] for r in rows if r[5] == 'se'), default=0):.3g} standard errors")
     for key in added:
         print("new fit, not compared:", key)
+    for line in gone:
+        print("not fitted before, not listed after:", line)
     for line in bad:
         print("DIFFERS:", line)
     print("agree within" if not bad else "do NOT agree within", f"{args.tol:g} standard errors")

@@ -44,8 +44,8 @@ class LawFit:
     """A picklable fit function: ``fitting.fit(law, data, solver, **options)``.
 
     ``warm(values)`` returns a copy that starts from ``values`` with no grid scan and one
-    Levenberg-Marquardt run: replicates start at the original best fit, which is where the
-    bootstrap asks how far the optimum moves.
+    Levenberg-Marquardt run, without the plausibility flags (``fit(checks=False)``): replicates
+    start at the original best fit, which is where the bootstrap asks how far the optimum moves.
     """
 
     law: str
@@ -58,8 +58,8 @@ class LawFit:
         from .fitting import fit
 
         kw = dict(self.options)
-        if self.start:
-            kw.update(initial={**dict(kw.get("initial") or {}), **dict(self.start)}, scan=0, n_starts=1)
+        if self.start:  # a replicate: only its values and AIC are read, so no plausibility flags
+            kw.update(initial={**dict(kw.get("initial") or {}), **dict(self.start)}, scan=0, n_starts=1, checks=False)
         return fit(self.law, data, solver=self.solver, **kw)
 
     def warm(self, values: Mapping[str, float]) -> "LawFit":

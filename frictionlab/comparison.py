@@ -21,15 +21,11 @@ from __future__ import annotations
 import functools
 import os
 import platform
-import signal
-import sys
-import threading
+import re
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
-from contextlib import contextmanager
-from multiprocessing import get_context
 
 import attrs
 import numpy as np
@@ -38,14 +34,15 @@ from .answers import group_of
 from .dataset import Dataset, builtin_names, load_dataset
 from . import equivalence as _equivalence, transfer as _transfer
 from .equivalence import MIN_REPLICATES, PAIRS, REPLICATES, EquivalenceResult, analyze_equivalence
-from .errors import FrictionLabError, ParameterError, Terminated
+from .errors import FrictionLabError, ParameterError
 from .bootstrap import bootstrap_fits
 from .fitcost import tolerance_check
 from .fitting import PREDICTORS, FitResult, applicable_solvers, auto_solver, fit
 from .ranking import RankRow, family, rank_fits, rank_groups
 from .registry import available_laws, get_law
 from .transfer import TransferResult, assemble, candidates_by_group, transfer_candidate
-from .verdicts import make_answers
+from .verdicts import make_answers, not_fitted_answers
+from .workers import process_pool
 
 Progress = Callable[[int, int, str], None]
 
@@ -151,6 +148,26 @@ def candidates(law, dataset: Dataset, solvers: Sequence[str] | None) -> list[tup
     return list(dict.fromkeys(out))  # 'auto' and the solver it picks name one candidate
 
 
+def no_law_applies(dataset: Dataset, skipped, solvers=None) -> str:
+    """The one reason a dataset is left out when no law compared can be fitted to it: the laws grouped by
+    why not, and the registered laws that could be (skipped: (law, solver, reason) per candidate)."""
+    by_reason: dict[str, list[str]] = {}
+    for law, _, why in skipped:
+        why = re.sub(rf"^law '{re.escape(law)}' (on an? [\w-]+: )?", "", why)
+        why = re.sub(r", which \w+ cannot supply:.*$", ", which it does not have", why)
+        by_reason.setdefault(why, [])
+        if law not in by_reason[why]:
+            by_reason[why].append(law)
+    compared = set(law for law, _, _ in skipped)
+    able = [n for n in available_laws() if n not in compared
+            and any(why is None for _, why in candidates(n, dataset, solvers))]
+    which = ("the one law compared does not apply" if len(compared) == 1
+             else f"none of the {len(compared)} laws compared applies")
+    text = (f"{which} to this {dataset.kind} set ("
+            + "; ".join(f"{', '.join(laws)}: {why}" for why, laws in by_reason.items()) + ")")
+    return text + (f"; registered laws that apply: {', '.join(able)} (--laws {','.join(able)})" if able else "")
+
+
 def _fit_task(args, timeout=None) -> FitResult:
     law, dataset, solver, free = args
     try:
@@ -167,79 +184,6 @@ def _equivalence_task(args) -> EquivalenceResult:
 def _transfer_task(args):
     fits, free = args
     return transfer_candidate(fits, free)
-
-
-def _worker_init(parent: int) -> None:
-    """In a worker: ^C goes to the parent, which stops the pool; SIGTERM ends the worker at once;
-    and (on Linux) the worker gets SIGTERM when the parent dies, even by SIGKILL, so no worker
-    outlives its run or keeps holding the output lock it inherited."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    if sys.platform.startswith("linux"):
-        try:
-            import ctypes
-            ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGTERM))  # 1 = PR_SET_PDEATHSIG
-        except (OSError, AttributeError):
-            return
-        if os.getppid() != parent:  # the parent died before the request took effect
-            os._exit(1)
-
-
-def _on_sigterm(signum, frame):
-    raise Terminated(signum)
-
-
-@contextmanager
-def _pool(jobs: int):
-    """A process pool of ``jobs`` forked workers, or None (run here) for one job or without fork.
-
-    On any exception, ^C (KeyboardInterrupt) and SIGTERM included, the workers are terminated and
-    reaped before the exception goes on: no worker outlives the call. SIGTERM becomes the exception
-    ``errors.Terminated`` while the pool lives (when called from the main thread and nothing else
-    handles SIGTERM).
-    """
-    try:
-        ctx = get_context("fork") if jobs > 1 else None
-    except ValueError:  # no fork on this platform: run serially
-        ctx = None
-    if ctx is None:
-        yield None
-        return
-    handle = (threading.current_thread() is threading.main_thread()
-              and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL)
-    if handle:
-        signal.signal(signal.SIGTERM, _on_sigterm)
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init,
-                               initargs=(os.getpid(),))
-    try:
-        yield pool
-    except BaseException:
-        _stop(pool)
-        raise
-    else:
-        pool.shutdown(wait=True)
-    finally:
-        if handle:
-            signal.signal(signal.SIGTERM, signal.SIG_DFL)
-
-
-def _stop(pool: ProcessPoolExecutor) -> None:
-    """Cancel what is queued, terminate the workers (SIGTERM, then SIGKILL after 5 s) and reap them."""
-    procs = list((getattr(pool, "_processes", None) or {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
-    for p in procs:
-        if p.is_alive():
-            p.terminate()
-    for p in procs:
-        p.join(5)
-        if p.is_alive():
-            p.kill()
-            p.join()
-    # let the pool's manager thread finish closing its wake-up pipe now: otherwise the interpreter's
-    # exit hook may race it and print "OSError: Bad file descriptor" after our one-line message
-    manager = getattr(pool, "_executor_manager_thread", None)
-    if manager is not None:
-        manager.join(5)
 
 
 def _run(tasks, fn, pool, progress, done, total, label):
@@ -322,7 +266,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     dss = _unique_datasets(load_dataset(d) for d in (datasets if datasets is not None else builtin_names()))
     if not dss:
         raise FrictionLabError("compare: no datasets to compare")
-    skipped_ds, plan, fits = {}, [], []
+    skipped_ds, plan, fits, no_law = {}, [], [], set()
     for ds in dss:
         if ds.kind == "contact-area":
             skipped_ds[ds.name] = "contact-area series: supporting data (the area model of a scene), not fitted"
@@ -330,17 +274,21 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
         if ds.kind not in PREDICTORS:
             skipped_ds[ds.name] = f"no predictor for dataset kind '{ds.kind}' yet"
             continue
-        for law in law_names:
-            for solver, why in candidates(law, ds, solvers):
-                if why:
-                    fits.append(FitResult(law=law, solver=solver, datasets=(ds.name,), status="skipped", reason=why))
-                else:
-                    plan.append((law, ds, solver, dict(free or {})))
+        mine = [(law, solver, why) for law in law_names for solver, why in candidates(law, ds, solvers)]
+        if mine and all(why for _, _, why in mine):  # nothing to fit: one reason for the dataset, not a row per law
+            skipped_ds[ds.name] = no_law_applies(ds, mine, solvers)
+            no_law.add(ds.name)
+            continue
+        for law, solver, why in mine:
+            if why:
+                fits.append(FitResult(law=law, solver=solver, datasets=(ds.name,), status="skipped", reason=why))
+            else:
+                plan.append((law, ds, solver, dict(free or {})))
     if len(skipped_ds) == len(dss):
         raise FrictionLabError("compare: none of the datasets can be fitted: "
                                + "; ".join(f"{k}: {v}" for k, v in skipped_ds.items()))
-    # slow (ode) fits first, so that workers finish together
-    plan.sort(key=lambda x: not x[2].startswith("ode"))
+    # slow fits first (ode, then sets without a time series, which simulate every row), so that workers finish together
+    plan.sort(key=lambda x: (not x[2].startswith("ode"), x[1].scene is None or "t" in x[1].columns))
     if equivalence and replicates < MIN_REPLICATES:
         raise ParameterError(f"compare: replicates must be at least {MIN_REPLICATES}, got {replicates}")
     eq_pairs = _equivalence_pairs(law_names, plan, pairs) if equivalence else []
@@ -349,7 +297,9 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     label = lambda t: f"{t[0]} [{t[2]}] on {t[1].name}"  # noqa: E731
     timings, boots, boot_skipped, tol_rows = {}, [], {}, []
     order = {d.name: i for i, d in enumerate(dss)}
-    with _pool(jobs) as pool:
+    if jobs > 1:
+        import lmfit  # noqa: F401  (imported once here, before the workers fork, instead of once in each)
+    with process_pool(jobs) as pool:
         t0 = time.perf_counter()
         results, done = _run(plan, functools.partial(_fit_task, timeout=fit_timeout), pool, progress, 0, total,
                              label)
@@ -423,6 +373,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     answers = make_answers([d for d in dss if d.name not in skipped_ds], fits, ranking, groups)
     # the verdict layer's rows; the equivalence and transfer fields are filled by their producers
     answers = _transfer.fill_answers(_equivalence.fill_answers(answers, eq_results), transfer_results)
+    answers += not_fitted_answers(dss, {k: v for k, v in skipped_ds.items() if k in no_law},
+                                  [d for d in dss if d.name not in skipped_ds])
     return Comparison(laws=law_names, datasets=dss, fits=tuple(fits), ranking=tuple(ranking), groups=tuple(groups),
                       equivalence=tuple(eq_results), transfer=tuple(transfer_results), skipped_datasets=skipped_ds,
                       wall_time=time.perf_counter() - started, versions=versions(),

@@ -204,18 +204,24 @@ def force_figure(dataset, fits) -> bytes:
     t_end = float(dataset.t[-1])
     tname, tf = time_unit(t_end)
     fig, ax = plt.subplots(figsize=(7.6, 3.8), layout="constrained")
+    drawn = 0
     for i, (f, laws) in enumerate(curves):
         try:
             tr = f.per_dataset[0].trajectory(f.law, np.linspace(0.0, t_end, 300))
         except FrictionLabError:  # a stiff law whose dense curve exceeds the solver's budget: left out
             continue
         ax.plot(tr.t * tf, tr.force, label=f"{' = '.join(laws)} [{f.solver}]", **_style(f.law, f.solver, i))
+        drawn += 1
     ax.axhline(0, color="0.3", lw=0.8)
     ax.set_xlabel(f"time [{tname}]")
     ax.set_ylabel("friction force F [N] (positive opposes slip)")
     ax.set_title(f"{dataset.name}: friction force of each best fit")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    if drawn:
+        ax.legend(fontsize=8)
+    else:
+        ax.text(0.5, 0.5, "no fit's force history could be drawn\n(each exceeded the solver's budget)",
+                transform=ax.transAxes, ha="center", va="center", color="0.3")
     return _png(fig)
 
 
@@ -383,7 +389,7 @@ def discrimination_figure(dataset: str, results) -> bytes:
     """One panel per tested pair on ``dataset``: the distribution of T = chi2_A - chi2_B over the
     replicates of each law's fit, and the observed T."""
     plt = _plt()
-    fig, axes = plt.subplots(1, len(results), figsize=(4.6 * len(results), 3.4), squeeze=False)
+    fig, axes = plt.subplots(1, len(results), figsize=(4.6 * len(results), 3.4), squeeze=False, layout="constrained")
     for ax, e in zip(axes[0], results):
         both = np.concatenate([e.t_a, e.t_b, [e.t_obs]])
         span = float(np.ptp(both))
@@ -393,7 +399,8 @@ def discrimination_figure(dataset: str, results) -> bytes:
         else:
             bins = np.linspace(both.min() - 0.02 * span, both.max() + 0.02 * span, 40)
             for t, law, solver in ((e.t_a, e.law_a, e.solver_a), (e.t_b, e.law_b, e.solver_b)):
-                ax.hist(t, bins=bins, alpha=0.6, color=LAW_COLORS.get(law, "0.5"), label=f"data from {law} [{solver}]")
+                ax.hist(t, bins=bins, alpha=0.6, color=LAW_COLORS.get(law, "0.5"), histtype="stepfilled",
+                        label=f"data from {law} [{solver}]")
             ax.axvline(e.t_obs, color="k", lw=1.5, label="observed T")
             ax.legend(fontsize=7)
         ax.set_xlabel(f"T = χ²({e.law_a}) − χ²({e.law_b})")
@@ -401,7 +408,6 @@ def discrimination_figure(dataset: str, results) -> bytes:
         ax.set_title(f"{e.law_a} [{e.solver_a}] vs {e.law_b} [{e.solver_b}]: {e.verdict}", fontsize=9)
         ax.grid(alpha=0.3)
     fig.suptitle(f"{dataset}: the discrimination test (parametric bootstrap)", fontsize=11)
-    fig.tight_layout()
     return _png(fig)
 
 

@@ -501,7 +501,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         fixed: Mapping[str, float] | None = None, local: Sequence[str] = (),
         initial: Mapping[str, float] | None = None, observable: str | None = None, derive: str | None = None,
         scan: int = 125, n_starts: int = 3, max_nfev: int | None = None, rtol: float | None = None,
-        timeout: float | None = None) -> FitResult:
+        timeout: float | None = None, checks: bool = True, errors: bool = True) -> FitResult:
     """Fit ``law`` to one dataset or a group of them (a global fit) and return a FitResult.
 
     law: name or FrictionLaw. datasets: a Dataset, name, path or Target, or a list of them.
@@ -516,6 +516,12 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     rtol: relative (and scaled absolute) tolerance of every ODE solve in the fit, in (0, 1);
     None uses FIT_RTOL (1e-10). Closed forms and the series ignore it.
     timeout: time budget of the fit in seconds (None: none); past it the fit is 'failed'.
+    checks: False skips the plausibility flags and the SI copy of lmfit's result (``minimizer_result``
+    None): for replicate refits (equivalence, bootstrap, transfer) that read only the values, their
+    error bars, the chi-square and the information criteria, which are the same either way.
+    errors: False skips the error analysis beyond lmfit's (the Jacobian, and what it shows: parameters
+    without effect, ratio-only pairs, identifiable directions; every free parameter counts in k): for
+    refits that read only the values and the chi-square (the equivalence test's replicates).
     """
     import lmfit  # slow to import: only when fitting
 
@@ -524,7 +530,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     items = datasets if isinstance(datasets, (list, tuple)) else [datasets]
     if not items:
         raise DatasetError("fit: no datasets given")
-    names = tuple(getattr(d, "name", str(d)) for d in items)
+    names = tuple(d.name if hasattr(d, "name") else str(d) for d in items)  # str() of a Target prints its arrays
 
     def give_up(status, reason, **kw):
         return FitResult(law=law.name, solver=solver, datasets=names, status=status, reason=reason,
@@ -596,8 +602,12 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     except Exception as exc:  # an optimizer or law crash is a failed fit, not a crashed comparison
         return give_up("failed", f"{type(exc).__name__}: {exc}", nfev=model.nfev)
 
-    J = jacobian(model, slots, values)
-    structure = find_structure(law, slots, values, J)
+    if errors:
+        J = jacobian(model, slots, values)
+        structure = find_structure(law, slots, values, J)
+    else:
+        n_free = len(varying)
+        structure = {"at_bounds": (), "ratios": (), "no_effect": (), "k_eff": n_free, "n_free": n_free}
     k_each = structure["k_eff"] / len(targets)  # a group's parameters shared out for each member's test
     per = []
     for tg, solver_i, (p, scene), m in zip(targets, solvers, model.split(values), models):
@@ -619,7 +629,8 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         notes.append(f"{model.failures} of {model.nfev} evaluations could not be solved and were penalized "
                      f"(last: {model.last_error})")
     notes += _series_notes(law, per)
-    jac = jacobian_errors(slots, values, J, structure, stats.redchi if likelihood != "known" else 1.0)
+    jac = (jacobian_errors(slots, values, J, structure, stats.redchi if likelihood != "known" else 1.0) if errors
+           else {"errors": {}, "derived": {}, "correl": {}})
     presults = _param_results(slots, best_params, targets, structure, jac)
     if likelihood == "none":  # error bars rest on independent points: a smoothed series has none to give
         presults = {k: attrs.evolve(p, stderr=None) for k, p in presults.items()}
@@ -636,14 +647,14 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
                     correl[(s.display, o.display)] = float(r)
     ident = make_verdict(structure, presults, correl)
     flags, numbers, nfev = (), {}, model.nfev
-    if status == "ok":
+    if status == "ok" and checks:
         flags, numbers = check_plausibility(law, per, model, slots, values, likelihood)
     return FitResult(law=law.name, solver=solver_label, datasets=names, status=status, reason=reason,
                      params=presults, correlations=correl, stats=stats, identifiability=ident,
                      per_dataset=tuple(per), nfev=nfev, wall_time=time.perf_counter() - started,
                      cpu_time=time.thread_time() - cpu_started,
                      message=message, notes=tuple(notes), goodness=combine([d.goodness for d in per]),
-                     flags=tuple(flags), plausibility=numbers, minimizer_result=_si_result(best, slots))
+                     flags=tuple(flags), plausibility=numbers, minimizer_result=_si_result(best, slots) if checks else None)
 
 
 def _likelihood(targets) -> str:

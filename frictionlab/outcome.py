@@ -381,15 +381,7 @@ def predict_outcomes(law, dataset_or_scene, params: Mapping[str, float] | None =
                                      "rebound_speed_t", "cm_tangential_cor", "contact_rebound_angle")}
     out["rolled"] = np.zeros(n, dtype=bool)
     r = template.radius
-    imps = []
-    for i in range(n):
-        try:
-            imps.append(template.impact(float(rows["speed"][i]), float(rows["incidence"][i]), float(rows["spin"][i])))
-        except SceneError as exc:
-            raise SceneError(f"row {i + 1}: {exc}") from None
-        if imps[-1].tangential_speed - r * imps[-1].spin == 0.0:
-            raise SceneError(f"row {i + 1}: the contact point does not slip on arrival (v_t = r omega), "
-                             "so its tangential restitution is undefined")
+    imps = _inbound(template, rows)
     if getattr(template.compliance, "model", None) == "mindlin-deresiewicz":
         v2, w2, rolled = _mdr_rebounds(law, imps, p, template)
     else:
@@ -469,6 +461,48 @@ def _mdr_rebounds(law, imps, p, template):
     return v2, w2, rolled
 
 
+#: The last few (template, rows) -> per-row impacts: a fit evaluates the same rows of one scene at every step.
+_INBOUND: dict = {}
+
+
+def _inbound(template: OutcomeScene, rows) -> tuple[Inbound, ...]:
+    """Each row's Inbound (its scene), checked; the same tuple again for the same template object and rows."""
+    key = (id(template),) + tuple(np.asarray(rows[k], dtype=float).tobytes() for k in ("speed", "incidence", "spin"))
+    hit = _INBOUND.get(key)
+    if hit is not None and hit[0] is template:  # the entry holds the template, so its id is not reused meanwhile
+        return hit[1]
+    imps = []
+    for i in range(len(rows["speed"])):
+        try:
+            imps.append(template.impact(float(rows["speed"][i]), float(rows["incidence"][i]), float(rows["spin"][i])))
+        except SceneError as exc:
+            raise SceneError(f"row {i + 1}: {exc}") from None
+        if imps[-1].tangential_speed - template.radius * imps[-1].spin == 0.0:
+            raise SceneError(f"row {i + 1}: the contact point does not slip on arrival (v_t = r omega), "
+                             "so its tangential restitution is undefined")
+    if len(_INBOUND) >= 8:
+        _INBOUND.pop(next(iter(_INBOUND)))
+    _INBOUND[key] = (template, tuple(imps))
+    return _INBOUND[key][1]
+
+
+_BATCHES: dict = {}  # id(impacts) -> (impacts, SceneBatch), beside _INBOUND
+
+
+def _scene_batch(imps: tuple):
+    """The batch engine's SceneBatch of the rows' scenes: built once for the tuple ``_inbound`` returns."""
+    from .batch import SceneBatch
+
+    hit = _BATCHES.get(id(imps))
+    if hit is not None and hit[0] is imps:
+        return hit[1]
+    batch = SceneBatch.from_scenes([imp.scene for imp in imps])  # may refuse: the caller falls back, nothing kept
+    if len(_BATCHES) >= 8:
+        _BATCHES.pop(next(iter(_BATCHES)))
+    _BATCHES[id(imps)] = (imps, batch)
+    return batch
+
+
 def _rebounds(law, imps, p, solver, rtol):
     """Tangential velocity [m/s] and spin [rad/s] at the end of each impact, and whether its slip stopped.
 
@@ -484,7 +518,7 @@ def _rebounds(law, imps, p, solver, rtol):
 
         try:
             t = np.array([[0.0, imp.contact_time] for imp in imps])
-            br = simulate_batch(law, SceneBatch.from_scenes([imp.scene for imp in imps]), p, t=t, solver="exact")
+            br = simulate_batch(law, _scene_batch(imps), p, t=t, solver="exact")
             return br.v[:, -1], br.omega[:, -1], ~np.isnan(br.stick_time)
         except FrictionLabError:
             pass  # the row-by-row path below gives the answer or the error naming the row

@@ -328,6 +328,9 @@ def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan
     effects = scene.effects
     if scene.spring is not None and not isinstance(scene.normal, ConstantNormal):
         raise SceneError(f"{scene_name}: a spring-slider needs a constant normal force (scene.normal model 'constant')")
+    if scene.spring is not None and isinstance(law.form(law.defaults()), NormalAreaRateForm):
+        raise SceneError(f"law '{law.name}' on a spring-slider: its force sign(u) (a N + c dA/dt) does not grow with "
+                         "the slip rate, so the quasi-static block has no slip rate for the spring's load")
     coupled = "slip-coupling" in effects
     spin = "spin" in effects or coupled
     if spin and scene.radius is None:

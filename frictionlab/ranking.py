@@ -132,7 +132,7 @@ def fit_row(f: FitResult) -> RankRow:
                    members=(f.law,))
 
 
-def _family_key(f: FitResult):
+def family_key(f: FitResult):
     """(form class, solver) if the law spans its whole closed-form family on this fit, else None."""
     from .registry import get_law
 
@@ -162,7 +162,7 @@ def merge_identical(fits: list[FitResult]) -> list[tuple[FitResult, tuple[str, .
     groups: dict = {}
     order = []
     for f in fits:
-        key = _family_key(f)
+        key = family_key(f)
         key = (f.datasets, key) if key else (f.datasets, id(f))
         if key not in groups:
             groups[key] = []

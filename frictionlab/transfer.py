@@ -235,7 +235,8 @@ def shared_fit(fits: Sequence[FitResult], free: dict | None = None) -> SharedFit
     best = None
     for f in sorted(fits, key=lambda f: f.stats.chisqr):
         start = {p.key: p.value for p in f.params.values() if p.kind == "law" and p.vary}
-        r = fit(law, targets, solver=f.per_dataset[0].solver, initial=start, scan=0, n_starts=1, free=free or None)
+        r = fit(law, targets, solver=f.per_dataset[0].solver, initial=start, scan=0, n_starts=1, free=free or None,
+                checks=False)
         if r.ok and (best is None or r.stats.chisqr < best.stats.chisqr):
             best = r
     if best is None:

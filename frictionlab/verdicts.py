@@ -58,6 +58,26 @@ def make_answers(datasets, fits, ranking, groups) -> tuple[Answer, ...]:
     return tuple(out)
 
 
+def not_fitted_answers(datasets, reasons: dict[str, str], fitted=()) -> tuple[Answer, ...]:
+    """One Answer per group none of whose datasets was fitted because no law compared applies to them:
+    the reason (``reasons``: dataset name -> why) as its headline. Groups with a fitted member are
+    answered by ``make_answers``; their left-out members are named in the report's dataset list."""
+    fitted_groups = {group_of(d) for d in fitted}
+    members: dict[str, list] = {}
+    for ds in datasets:
+        if ds.name in reasons and group_of(ds) not in fitted_groups:
+            members.setdefault(group_of(ds), []).append(ds)
+    out = []
+    for label, dss in members.items():
+        why = list(dict.fromkeys(reasons[d.name] for d in dss))
+        kinds = {d.provenance.kind for d in dss}
+        out.append(Answer(group=label, datasets=tuple(d.name for d in dss), provenance=kinds.pop() if len(kinds) == 1
+                          else "mixed", best=None, fits=False, headline="not fitted: " + "; ".join(why), goodness="",
+                          equivalence="not tested", noise_threshold="", series_vs_exact="",
+                          equivalence_series="not tested", details={"not_fitted": why}, short={"best": "not fitted: no law compared applies"}))
+    return tuple(out)
+
+
 def _verdict(rows: list[RankRow]):
     """(best, fits, headline, goodness text, details, short forms) from one group's ranked rows."""
     if not rows:

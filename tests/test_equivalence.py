@@ -33,6 +33,24 @@ def test_wear_and_couette_are_equivalent():
     assert e.power_a == e.power_b == 0.0
 
 
+def test_one_closed_form_family_needs_no_refits_and_gives_the_refits_answer(monkeypatch):
+    """Wear and Couette span one family (F = k A u): the shortcut's T* = 0 is what refitting both laws to every
+    replicate gives (to the optimizer's resolution), with the same p-values, powers and verdict."""
+    from frictionlab import equivalence
+
+    ds = synthetic("wear", TRUTH["wear"], seed=4)
+    fw, fc = fit("wear", ds), fit("couette", ds)
+    fast = analyze_equivalence(fw, fc, replicates=R)
+    monkeypatch.setattr(equivalence, "one_family", lambda a, b: False)
+    slow = analyze_equivalence(fw, fc, replicates=R)
+    assert np.all(fast.t_a == 0.0) and np.all(fast.t_b == 0.0) and "without refitting" in fast.explanation
+    tol = equivalence.TIE_REL * max(fast.n_points, fw.stats.chisqr)
+    assert np.max(np.abs(slow.t_a)) <= tol and np.max(np.abs(slow.t_b)) <= tol
+    for k in ("verdict", "p_a", "p_b", "q_a", "q_b", "power_a", "power_b", "threshold"):
+        assert getattr(fast, k) == getattr(slow, k), k
+    assert not equivalence.one_family(fw, fit("coulomb", ds))
+
+
 def test_coulomb_against_wear_is_not_equivalent_and_names_the_rejected_law(coulomb_data):
     ds, fc, fw, e = coulomb_data
     assert e.verdict == "not equivalent", e.explanation
@@ -149,3 +167,14 @@ def test_command_line_defaults_agree_with_the_library():
     from frictionlab.equivalence import MIN_REPLICATES, REPLICATES
 
     assert cmd.REPLICATES == REPLICATES and MIN_REPLICATES == 20
+
+
+def test_replicate_refits_without_error_analysis_give_the_same_statistic(coulomb_data, monkeypatch):
+    """The replicates' refits skip the Jacobian (fit(errors=False)): T on every replicate is what full fits give."""
+    from frictionlab import equivalence, fitting
+
+    _, fc, fw, e = coulomb_data
+    monkeypatch.setattr(equivalence, "fit", lambda *a, errors=True, **k: fitting.fit(*a, **k))
+    full = analyze_equivalence(fc, fw, replicates=R)
+    assert np.array_equal(full.t_a, e.t_a) and np.array_equal(full.t_b, e.t_b)
+    assert (full.d_ab, full.d_ba, full.verdict) == (e.d_ab, e.d_ba, e.verdict)

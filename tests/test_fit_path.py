@@ -181,3 +181,53 @@ def _coulomb_sweep(seed: int, n: int):
     sb = B.SceneBatch.sweep(template, {"u0": rng.uniform(2, 40, n), "normal.impulse": rng.uniform(0.5, 4, n),
                                        "normal.contact_time": tc, "duration": tc})
     return sb, rng.uniform(0.1, 0.5, n), tc
+
+
+def test_a_fit_without_checks_gives_the_same_numbers_as_the_full_fit():
+    """fit(checks=False), the replicate refits' path, skips only the plausibility flags and lmfit's SI copy."""
+    data = synthetic("area-rate", TRUTH["area-rate"], incline_scene(), n=21, name="incline-area-rate")
+    full, lean = fit("area-rate", data, solver="exact"), fit("area-rate", data, solver="exact", checks=False)
+    assert full.ok and lean.ok and full.minimizer_result is not None and lean.minimizer_result is None
+    assert full.plausibility and not lean.plausibility and lean.flags == ()
+    assert lean.stats == full.stats and lean.nfev == full.nfev
+    assert {k: (p.value, p.stderr) for k, p in lean.params.items()} == \
+        {k: (p.value, p.stderr) for k, p in full.params.items()}
+
+
+def test_impact_outcome_rows_are_built_once_per_scene_and_rows_with_the_same_answers():
+    """predict_outcomes keeps the last rows' impacts (and their batch) for the same scene object: a second call
+    reuses them and gives the same outcomes as a fresh build; another scene object (a freed quantity) is its own."""
+    import attrs
+    import numpy as np
+
+    from frictionlab import load_dataset, outcome
+
+    ds = load_dataset("impact-outcome-synthetic")
+    rows = outcome.rows_of(ds)
+    outcome._INBOUND.clear()
+    outcome._BATCHES.clear()
+    first = outcome.predict_outcomes("area-rate", ds.scene, {"mu": 0.2, "eta_prime": 400.0}, "exact", **rows)
+    imps = outcome._inbound(ds.scene, rows)
+    again = outcome.predict_outcomes("area-rate", ds.scene, {"mu": 0.2, "eta_prime": 400.0}, "exact", **rows)
+    assert outcome._inbound(ds.scene, rows) is imps and len(outcome._BATCHES) == 1
+    heavier = attrs.evolve(ds.scene, mass=2 * ds.scene.mass)
+    assert outcome._inbound(heavier, rows) is not imps
+    outcome._INBOUND.clear()
+    outcome._BATCHES.clear()
+    fresh = outcome.predict_outcomes("area-rate", ds.scene, {"mu": 0.2, "eta_prime": 400.0}, "exact", **rows)
+    for k in ("rebound_spin", "tangential_cor", "rebound_angle", "rolled"):
+        assert np.array_equal(first[k], again[k]) and np.array_equal(first[k], fresh[k]), k
+    assert not np.array_equal(outcome.predict_outcomes("area-rate", heavier, {"mu": 0.2, "eta_prime": 400.0}, "exact",
+                                                       **rows)["rebound_spin"], first["rebound_spin"])
+
+
+def test_a_fit_without_error_analysis_gives_the_same_values_and_chi_square():
+    """fit(errors=False), the equivalence test's replicate refits: no Jacobian (2 evaluations per free
+    parameter fewer), the same search, values and chi-square; every free parameter counted in k."""
+    data = synthetic("couette", TRUTH["couette"], incline_scene(), n=21, name="incline-couette")
+    full, lean = fit("couette", data, solver="exact"), fit("couette", data, solver="exact", errors=False)
+    assert full.ok and lean.ok and lean.stats.chisqr == full.stats.chisqr
+    assert lean.nfev == full.nfev - 2 * 2  # eta and h: a central difference each
+    assert {k: p.value for k, p in lean.params.items() if p.kind != "derived"} == \
+        {k: p.value for k, p in full.params.items() if p.kind != "derived"}
+    assert full.stats.n_params == 1 and lean.stats.n_params == 2  # eta/h only: the structure is not looked for

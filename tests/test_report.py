@@ -197,6 +197,24 @@ def test_a_failure_while_writing_leaves_nothing_behind(comparison, tmp_path, mon
     assert list(tmp_path.iterdir()) == []
 
 
+def test_figures_drawn_by_worker_processes_are_the_ones_drawn_here(comparison, report_dir, tmp_path, monkeypatch):
+    """write_report(jobs=2) draws the figures on forked workers: the same files, byte for byte; a figure that
+    fails there fails the report as it does here, leaving nothing behind."""
+    par = write_report(comparison, tmp_path / "par", jobs=2)
+    names = sorted(p.name for p in (report_dir / "figures").iterdir())
+    assert len(names) > 2 and names == sorted(p.name for p in (par / "figures").iterdir())
+    for name in names:
+        assert (par / "figures" / name).read_bytes() == (report_dir / "figures" / name).read_bytes(), name
+    html = lambda d: (d / "report.html").read_text()  # noqa: E731
+    assert html(par) == html(report_dir)
+    from frictionlab import figures
+
+    monkeypatch.setattr(figures, "force_figure", lambda *a, **k: 1 / 0)
+    with pytest.raises(ZeroDivisionError):
+        write_report(comparison, tmp_path / "bad", jobs=2)
+    assert not (tmp_path / "bad").exists()
+
+
 def _write_dataset(folder: Path) -> Path:
     ds = synthetic("wear", {"lam": 1.2e6}, seed=4, n=21)
     t = ds.t * 1e6

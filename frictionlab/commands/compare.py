@@ -99,7 +99,7 @@ def run(args) -> int:
                              tolerance=TOLERANCE_RTOLS if args.tolerance else (), fit_timeout=args.fit_timeout,
                              replicates=args.replicates, transfer=args.transfer)
         with Progress("report", quiet=args.quiet) as bar:
-            out = write_report(result, args.out, force=args.force, progress=bar)
+            out = write_report(result, args.out, force=args.force, progress=bar, jobs=args.jobs)
     ok = sum(f.ok for f in result.fits)
     n_laws, n_data = len(result.laws), len(result.fitted_datasets)
     print(f"compared {n_laws} law{'s' * (n_laws != 1)} on {n_data} dataset{'s' * (n_data != 1)}: {ok} fits, "

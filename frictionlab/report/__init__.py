@@ -30,6 +30,8 @@ and add ``mysection`` to ``SECTIONS`` at the place it belongs. Return None to le
 from __future__ import annotations
 
 import json
+import threading
+from concurrent.futures import as_completed
 from pathlib import Path
 
 import attrs
@@ -73,10 +75,48 @@ def build(c, modules=SECTIONS) -> tuple[list[Section], dict]:
     return out, ctx.json
 
 
-def write_report(c, out, force: bool = False, progress=None) -> Path:
+#: The figures being drawn, for forked workers: their draw functions are closures, which do not pickle.
+_FIGURES: list = []
+
+
+def _draw(i: int) -> bytes:
+    return _FIGURES[i].draw()
+
+
+_DRAWING = threading.Lock()  # one report at a time hands its figures to forked workers through _FIGURES
+
+
+def _drawn(figs, jobs: int):
+    """(index, PNG bytes) of every figure, in the order they finish: on ``jobs`` forked workers when jobs > 1."""
+    from ..workers import process_pool
+
+    if jobs <= 1 or len(figs) <= 1:
+        for i, f in enumerate(figs):
+            yield i, f.draw()
+        return
+    from ..figures import _plt
+
+    _plt()  # pyplot imported once here, before the workers fork, instead of once in each
+    with _DRAWING:
+        _FIGURES[:] = figs
+        try:
+            with process_pool(jobs) as pool:
+                if pool is None:  # no fork on this platform
+                    for i, f in enumerate(figs):
+                        yield i, f.draw()
+                    return
+                futures = {pool.submit(_draw, i): i for i in range(len(figs))}
+                for fut in as_completed(futures):
+                    yield futures[fut], fut.result()
+        finally:
+            _FIGURES.clear()
+
+
+def write_report(c, out, force: bool = False, progress=None, jobs: int = 1) -> Path:
     """Write the report folder ``out`` whole or not at all; an existing folder is replaced only with force=True.
 
-    progress(done, total, label), if given, is called after each figure and file.
+    progress(done, total, label), if given, is called after each figure and file. jobs: worker
+    processes drawing the figures (the same PNG bytes as one process draws).
     """
     out = Path(out)
     if out.exists() and not force:  # said in Python's terms; the command line checks before its work
@@ -86,11 +126,12 @@ def write_report(c, out, force: bool = False, progress=None) -> Path:
         figs = [f for s in sections for f in s.figures]
         total, images = len(figs) + 1, {}
         (tmp / "figures").mkdir()
-        for i, f in enumerate(figs, 1):
-            images[f.name] = f.draw()
-            (tmp / "figures" / f.name).write_bytes(images[f.name])
+        for done, (i, png) in enumerate(_drawn(figs, jobs), 1):
+            images[figs[i].name] = png
+            (tmp / "figures" / figs[i].name).write_bytes(png)
             if progress:
-                progress(i, total, f"figure {f.name}")
+                progress(done, total, f"figure {figs[i].name}")
+        images = {f.name: images[f.name] for f in figs}  # in report order
         (tmp / "report.md").write_text(markdown(TITLE, sections), encoding="utf-8")
         (tmp / "report.html").write_text(html_page(TITLE, sections, images), encoding="utf-8")
         (tmp / "ranking.csv").write_text(ranking_csv(c), encoding="utf-8")

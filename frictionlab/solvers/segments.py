@@ -95,7 +95,7 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
     u[~sliding] = 0.0
     c = plan.contact(t_eval, Y, u)
     if sliding.any() and not compliant:
-        F[sliding] = plan.law.evaluate(p, _subset(c, sliding))
+        F[sliding] = plan.law.evaluate(p, c if sliding.all() else _subset(c, sliding))
     A = c.A if c.A is not None else (plan.area(t_eval, Y, u)[0] if plan.needs_area else None)
     omega = Y[plan.index("omega")] if plan.has_spin else np.zeros(n)
     theta = Y[plan.index("theta")] if plan.has_spin else np.zeros(n)
