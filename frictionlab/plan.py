@@ -239,7 +239,6 @@ class Plan:
     def _quasi_static_acceleration(self, p, t, y, dy) -> float:
         """dv/dt of a quasi-static spring-slider: d F(v, s)/dt = k N (V_lp - v), partials by central differences."""
         s = self.scene
-        n = len(self.states)
         v = float(y[0])
         fastest = QUASI_STATIC_LIMIT * max(s.spring.velocities)
         if abs(v) > fastest:
@@ -247,6 +246,16 @@ class Plan:
                               f"t = {float(t):.6g} s, beyond {QUASI_STATIC_LIMIT:g} times the fastest load point: an "
                               "unstable slider (k below the law's critical stiffness), where the quasi-static model "
                               "no longer holds")
+        dF = self.slip_rate_partials(p, t, y)
+        N = float(s.normal(t))
+        return (s.spring.stiffness * N * (float(s.spring.velocity(t)) - v) - float(dF[1:] @ dy[1:])) / dF[0]
+
+    def slip_rate_partials(self, p, t, y) -> np.ndarray:
+        """Partials of the friction force [N] of a spring-slider's one state vector y by its slip rate
+        (first, N s/m) and by each law state, by central differences; error if dF/du is not positive
+        (the quasi-static block then has no slip rate for the spring's load)."""
+        n = len(self.states)
+        v = float(y[0])
         steps = [1e-5 * abs(v) + 1e-30] + [1e-5 * (abs(float(y[i])) + 1e-3 * spec.scale)
                                            for i, spec in zip(range(1, n), self.law.states)]
         Y = np.repeat(np.asarray(y, dtype=float)[:, None], 2 * n, axis=1)
@@ -259,8 +268,7 @@ class Plan:
             raise SceneError(f"law '{self.law.name}' on a spring-slider: its force does not grow with the slip rate "
                              f"at fixed state (dF/du = {dF[0]:.3g} N s/m at u = {v:.3g} m/s), so the quasi-static "
                              "block has no slip rate for the spring's load")
-        N = float(s.normal(t))
-        return (s.spring.stiffness * N * (float(s.spring.velocity(t)) - v) - float(dF[1:] @ dy[1:])) / dF[0]
+        return dF
 
     def _one_state(self, p, t, y, direction: float) -> np.ndarray:
         """``derivatives`` for one state vector of a memoryless law without compliance (every scalar ODE
@@ -359,5 +367,9 @@ def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan
                                  "contact area: add a [scene.area] model (hertz or half-sine)")
         states.append("xi")
     states += [LAW_PREFIX + n for n in law.state_names]
-    return Plan(scene=scene, law=law, states=tuple(states), coupled=coupled, needs_area=needs_area,
+    plan = Plan(scene=scene, law=law, states=tuple(states), coupled=coupled, needs_area=needs_area,
                 needs_normal=needs_normal)
+    if scene.spring is not None:  # a law that cannot drive a quasi-static slider at all (Dahl: F depends on its state
+        defaults = law.defaults()  # only) is refused here, not found out at every evaluation of a fit
+        plan.slip_rate_partials(defaults, 0.0, plan.initial_state(defaults))
+    return plan

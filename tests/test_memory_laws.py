@@ -160,6 +160,21 @@ def test_memoryless_laws_on_a_spring_slider():
         fl.simulate("coulomb", scene, {"mu": 0.6})
 
 
+def test_a_law_whose_force_ignores_the_slip_rate_is_refused_by_the_plan_and_skipped_by_a_fit():
+    """Dahl's force depends on its state only (dF/du = 0 at fixed state, whatever its parameters): the plan
+    refuses it on a spring-slider up front, so a fit is 'skipped' with that reason, not a failed search."""
+    from frictionlab.dataset import load_dataset
+    from frictionlab.plan import make_plan
+    from frictionlab.registry import get_law
+
+    ds = load_dataset("spring-slider-aging")
+    with pytest.raises(fl.FrictionLabError, match="'dahl' on a spring-slider: its force does not grow"):
+        make_plan(ds.scene, get_law("dahl"))
+    make_plan(ds.scene, get_law("rate-state-aging"))  # a direct effect a > 0: accepted
+    res = fl.fit("dahl", ds)
+    assert res.status == "skipped" and "does not grow with the slip rate" in res.reason
+
+
 def test_report_figures_survive_a_curve_the_solver_cannot_draw(monkeypatch):
     """A stiff law's dense best-fit curve may exceed the ODE budget: the figure keeps the fitted points."""
     from frictionlab import figures
