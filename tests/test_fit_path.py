@@ -231,3 +231,20 @@ def test_a_fit_without_error_analysis_gives_the_same_values_and_chi_square():
     assert {k: p.value for k, p in lean.params.items() if p.kind != "derived"} == \
         {k: p.value for k, p in full.params.items() if p.kind != "derived"}
     assert full.stats.n_params == 1 and lean.stats.n_params == 2  # eta/h only: the structure is not looked for
+
+
+@pytest.mark.parametrize("law, solver", [("wear", "exact"), ("area-rate", "exact"), ("wear", "ode")])
+def test_the_best_fit_model_taken_from_the_last_evaluation_equals_a_fresh_prediction(law, solver):
+    """fit() reuses lmfit's last evaluation (at its best values) for the best-fit model: the same numbers as a
+    prediction made afresh at the fitted parameters; and a fit with several starts gives the same answer."""
+    import numpy as np
+
+    from frictionlab.predict import predict
+
+    data = synthetic(law, TRUTH[law], n=21, name=f"reuse-{law}")
+    r = fit(law, data, solver=solver)
+    assert r.ok
+    d = r.per_dataset[0]
+    fresh = predict(law, d.target, d.params, d.solver, d.scene, None)
+    assert np.array_equal(d.model, fresh)
+    assert d.chisqr == float(np.sum(((fresh - d.target.y) / d.target.sigma) ** 2))
