@@ -394,7 +394,7 @@ class _Model:
         for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values)):
             try:
                 m = predict(self.law, tg, p, solver, scene, self.rtol)
-                if m.shape != tg.y.shape or not np.all(np.isfinite(m)):
+                if m.shape != tg.y.shape or not np.isfinite(m).all():
                     raise SolverError(f"prediction for '{tg.name}' is not finite or has the wrong shape")
                 out.append((m - tg.y) / tg.sigma)
                 ms.append(m)

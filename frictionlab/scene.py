@@ -34,7 +34,7 @@ EFFECTS = {
 # --- validation of Python-built models: no NaN or negative size slips through ----------
 def _number(test, words):
     def check(instance, attribute, value):
-        if type(value) is float and math.isfinite(value) and test(value):  # the common case, without numpy
+        if isinstance(value, float) and math.isfinite(value) and test(value):  # the common case (float, np.float64)
             return
         # a batch view (frictionlab.batch) puts arrays over scenes in these fields: check every element
         v = None if isinstance(value, (bool, np.bool_)) else np.asarray(value)
