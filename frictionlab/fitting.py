@@ -360,8 +360,7 @@ class _Model:
         self.failures = 0
         self.last_error = ""
         self.nfev = 0
-        self._last = None  # (values, models) of the last evaluation that solved every target
-
+        self._last = None  # (values, models, residual) of the last evaluation that solved every target
 
     def split(self, values: Mapping[str, float]):
         """Per-target law parameters and scenes for SI slot values (by lmfit name)."""
@@ -388,6 +387,8 @@ class _Model:
     def residual(self, values) -> np.ndarray:
         if self.deadline is not None and time.monotonic() > self.deadline:
             raise FitTimeout()
+        if self._last is not None and self._last[0] == values:  # scipy's leastsq calls at the start point twice
+            return self._last[2].copy()
         self.nfev += 1
         self._last = None
         out, ms = [], []
@@ -404,9 +405,10 @@ class _Model:
                 self.failures += 1
                 self.last_error = str(exc)
                 out.append(np.full(tg.y.shape, PENALTY))
+        r = np.concatenate(out)
         if len(ms) == len(self.targets):
-            self._last = (dict(values), ms)
-        return np.concatenate(out)
+            self._last = (dict(values), ms, r.copy())
+        return r
 
 
 def _si(params, slots) -> dict[str, float]:

@@ -248,3 +248,29 @@ def test_the_best_fit_model_taken_from_the_last_evaluation_equals_a_fresh_predic
     fresh = predict(law, d.target, d.params, d.solver, d.scene, None)
     assert np.array_equal(d.model, fresh)
     assert d.chisqr == float(np.sum(((fresh - d.target.y) / d.target.sigma) ** 2))
+
+
+@pytest.mark.parametrize("law, solver, options", [("area-rate", "exact", {}), ("wear", "exact", {"scan": 0}),
+                                                  ("couette", "ode", {})])
+def test_a_repeated_evaluation_reused_gives_the_fit_of_the_general_path(law, solver, options, monkeypatch):
+    """The residual at the values of the last evaluation (scipy's leastsq asks for its start twice) and the
+    best-fit model are reused: the same fit, number for number, as when every call evaluates afresh."""
+    import numpy as np
+
+    from frictionlab import fitting
+
+    data = synthetic(law, TRUTH[law], n=21, name=f"reuse2-{law}")
+    fast = fit(law, data, solver=solver, **options)
+    fresh = fitting._Model.residual
+
+    def always_fresh(self, values):
+        self._last = None
+        return fresh(self, values)
+
+    monkeypatch.setattr(fitting._Model, "residual", always_fresh)
+    slow = fit(law, data, solver=solver, **options)
+    assert fast.ok and slow.ok
+    assert {k: p.value for k, p in fast.params.items()} == {k: p.value for k, p in slow.params.items()}
+    assert {k: p.stderr for k, p in fast.params.items()} == {k: p.stderr for k, p in slow.params.items()}
+    assert fast.stats.chisqr == slow.stats.chisqr and np.array_equal(fast.per_dataset[0].model, slow.per_dataset[0].model)
+    assert fast.nfev < slow.nfev  # evaluations saved, counted as such
