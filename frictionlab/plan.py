@@ -54,13 +54,15 @@ class Plan:
     coupled: bool
     needs_area: bool
     needs_normal: bool
+    #: Tangential acceleration of the body from gravity along the incline [m/s^2] (an array for a batch view);
+    #: computed once here, since every right-hand-side evaluation reads it.
+    drive: float = attrs.field(init=False)
+
+    def __attrs_post_init__(self):
+        s = self.scene
+        object.__setattr__(self, "drive", G * np.sin(s.incline) if "gravity" in s.effects else 0.0)
 
     # -- constants ----------------------------------------------------------------
-    @property
-    def drive(self) -> float:
-        """Tangential acceleration of the body from gravity along the incline [m/s^2] (an array for a batch view)."""
-        s = self.scene
-        return G * np.sin(s.incline) if "gravity" in s.effects else 0.0
 
     @property
     def kappa(self) -> float:
