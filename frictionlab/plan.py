@@ -238,6 +238,14 @@ class Plan:
             dy[0] = self._quasi_static_acceleration(p, t, y, dy)
         return dy
 
+    def bound(self, p, direction: float = 0.0):
+        """``derivatives`` bound to law parameters p and a scalar direction, as f(t, y) for one state vector y
+        (a scalar integrator's right-hand side): the dispatch to ``_one_state`` decided once, not per call."""
+        direction = float(direction)
+        if not self.law.states and "xi" not in self.states and self.scene.spring is None:
+            return lambda t, y: self._one_state(p, t, y, direction)
+        return lambda t, y: self.derivatives(p, t, y, direction)
+
     def _quasi_static_acceleration(self, p, t, y, dy) -> float:
         """dv/dt of a quasi-static spring-slider: d F(v, s)/dt = k N (V_lp - v), partials by central differences."""
         s = self.scene

@@ -89,6 +89,7 @@ def test_the_one_state_right_hand_side_equals_the_general_one(dataset, law):
             fast = plan.derivatives(p, t, y, direction)
             general = plan.derivatives(p, np.array([t]), y[:, None], np.array([direction]))[:, 0]
             assert np.array_equal(fast, general), (t, direction)
+            assert np.array_equal(plan.bound(p, direction)(t, y), general), (t, direction)  # the ODE's bound form
 
 
 def test_the_one_state_right_hand_side_reports_a_bad_force_as_the_law_does():
