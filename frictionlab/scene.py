@@ -39,7 +39,7 @@ def _number(test, words):
         # a batch view (frictionlab.batch) puts arrays over scenes in these fields: check every element
         v = None if isinstance(value, (bool, np.bool_)) else np.asarray(value)
         ok = v is not None and v.dtype.kind in "fi"
-        if not ok or not np.all(np.isfinite(v)) or not np.all(test(v)):
+        if not ok or not np.isfinite(v).all() or not np.asarray(test(v)).all():
             raise SceneError(f"{type(instance).__name__}.{attribute.name} must be {words}, got {value!r}")
     return check
 
