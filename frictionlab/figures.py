@@ -28,8 +28,16 @@ def _plt():
 
 
 def _png(fig) -> bytes:
+    """The figure as PNG bytes at DPI. A layout engine (constrained layout) is run here, at the
+    saving DPI, and then switched off: savefig would otherwise draw the whole figure once more
+    (without rendering) just to run it. The same bytes as a plain savefig (tests/test_report.py)."""
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=DPI)  # constrained layout: one draw, no tight bbox pass
+    engine = fig.get_layout_engine()
+    if engine is not None:
+        fig.set_dpi(DPI)
+        engine.execute(fig)
+        fig.set_layout_engine(None)
+    fig.savefig(buf, format="png", dpi=DPI)
     _plt().close(fig)
     return buf.getvalue()
 

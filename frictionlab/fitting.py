@@ -360,6 +360,7 @@ class _Model:
         self.failures = 0
         self.last_error = ""
         self.nfev = 0
+        self._last = None  # (values, models, residual) of the last evaluation that solved every target
 
     def split(self, values: Mapping[str, float]):
         """Per-target law parameters and scenes for SI slot values (by lmfit name)."""
@@ -376,27 +377,38 @@ class _Model:
         return out
 
     def models(self, values):
+        """Each target's model at SI slot values; the last evaluation's when it was at these values
+        (lmfit's last call is at its best values, where the fit reads the models next)."""
+        if self._last is not None and self._last[0] == values:
+            return list(self._last[1])
         return [predict(self.law, tg, p, solver, scene, self.rtol)
                 for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values))]
 
     def residual(self, values) -> np.ndarray:
         if self.deadline is not None and time.monotonic() > self.deadline:
             raise FitTimeout()
+        if self._last is not None and self._last[0] == values:  # scipy's leastsq calls at the start point twice
+            return self._last[2].copy()
         self.nfev += 1
-        out = []
+        self._last = None
+        out, ms = [], []
         for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values)):
             try:
                 m = predict(self.law, tg, p, solver, scene, self.rtol)
-                if m.shape != tg.y.shape or not np.all(np.isfinite(m)):
+                if m.shape != tg.y.shape or not np.isfinite(m).all():
                     raise SolverError(f"prediction for '{tg.name}' is not finite or has the wrong shape")
                 out.append((m - tg.y) / tg.sigma)
+                ms.append(m)
             except SkipDataset:
                 raise
             except FrictionLabError as exc:
                 self.failures += 1
                 self.last_error = str(exc)
                 out.append(np.full(tg.y.shape, PENALTY))
-        return np.concatenate(out)
+        r = np.concatenate(out)
+        if len(ms) == len(self.targets):
+            self._last = (dict(values), ms, r.copy())
+        return r
 
 
 def _si(params, slots) -> dict[str, float]:
@@ -481,10 +493,9 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
         starts = _distinct(scored, min(n_starts, ODE_STARTS) if slow else n_starts)
     best, notes = None, []
     for i, start in enumerate(starts):
-        trial = params.copy()
-        for k, v in start.items():
-            trial[k].set(value=v)
-        mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), trial, scale_covar=scale_covar,
+        for k, v in start.items():  # every varying parameter; lmfit works on its own copy
+            params[k].set(value=v)
+        mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), params, scale_covar=scale_covar,
                                max_nfev=max_nfev or 200 * (len(varying) + 1))
         r = mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
         if best is None or (r.success, -r.chisqr) > (best.success, -best.chisqr):

@@ -54,13 +54,15 @@ class Plan:
     coupled: bool
     needs_area: bool
     needs_normal: bool
+    #: Tangential acceleration of the body from gravity along the incline [m/s^2] (an array for a batch view);
+    #: computed once here, since every right-hand-side evaluation reads it.
+    drive: float = attrs.field(init=False)
+
+    def __attrs_post_init__(self):
+        s = self.scene
+        object.__setattr__(self, "drive", G * np.sin(s.incline) if "gravity" in s.effects else 0.0)
 
     # -- constants ----------------------------------------------------------------
-    @property
-    def drive(self) -> float:
-        """Tangential acceleration of the body from gravity along the incline [m/s^2] (an array for a batch view)."""
-        s = self.scene
-        return G * np.sin(s.incline) if "gravity" in s.effects else 0.0
 
     @property
     def kappa(self) -> float:
@@ -235,6 +237,14 @@ class Plan:
         if self.scene.spring is not None:
             dy[0] = self._quasi_static_acceleration(p, t, y, dy)
         return dy
+
+    def bound(self, p, direction: float = 0.0):
+        """``derivatives`` bound to law parameters p and a scalar direction, as f(t, y) for one state vector y
+        (a scalar integrator's right-hand side): the dispatch to ``_one_state`` decided once, not per call."""
+        direction = float(direction)
+        if not self.law.states and "xi" not in self.states and self.scene.spring is None:
+            return lambda t, y: self._one_state(p, t, y, direction)
+        return lambda t, y: self.derivatives(p, t, y, direction)
 
     def _quasi_static_acceleration(self, p, t, y, dy) -> float:
         """dv/dt of a quasi-static spring-slider: d F(v, s)/dt = k N (V_lp - v), partials by central differences."""

@@ -34,12 +34,12 @@ EFFECTS = {
 # --- validation of Python-built models: no NaN or negative size slips through ----------
 def _number(test, words):
     def check(instance, attribute, value):
-        if type(value) is float and math.isfinite(value) and test(value):  # the common case, without numpy
+        if isinstance(value, float) and math.isfinite(value) and test(value):  # the common case (float, np.float64)
             return
         # a batch view (frictionlab.batch) puts arrays over scenes in these fields: check every element
         v = None if isinstance(value, (bool, np.bool_)) else np.asarray(value)
         ok = v is not None and v.dtype.kind in "fi"
-        if not ok or not np.all(np.isfinite(v)) or not np.all(test(v)):
+        if not ok or not np.isfinite(v).all() or not np.asarray(test(v)).all():
             raise SceneError(f"{type(instance).__name__}.{attribute.name} must be {words}, got {value!r}")
     return check
 

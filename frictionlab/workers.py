@@ -7,6 +7,7 @@ not picklable can be reached through module state set before then).
 """
 from __future__ import annotations
 
+import gc
 import os
 import signal
 import sys
@@ -58,6 +59,9 @@ def process_pool(jobs: int):
               and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL)
     if handle:
         signal.signal(signal.SIGTERM, _on_sigterm)
+    # what the parent has built is shared with the forked workers: frozen, the garbage collector's full
+    # passes (the workers' and the parent's) skip it instead of touching, and so copying, every page of it
+    gc.freeze()
     pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init,
                                initargs=(os.getpid(),))
     try:
@@ -68,6 +72,7 @@ def process_pool(jobs: int):
     else:
         pool.shutdown(wait=True)
     finally:
+        gc.unfreeze()
         if handle:
             signal.signal(signal.SIGTERM, signal.SIG_DFL)
 

@@ -89,6 +89,7 @@ def test_the_one_state_right_hand_side_equals_the_general_one(dataset, law):
             fast = plan.derivatives(p, t, y, direction)
             general = plan.derivatives(p, np.array([t]), y[:, None], np.array([direction]))[:, 0]
             assert np.array_equal(fast, general), (t, direction)
+            assert np.array_equal(plan.bound(p, direction)(t, y), general), (t, direction)  # the ODE's bound form
 
 
 def test_the_one_state_right_hand_side_reports_a_bad_force_as_the_law_does():
@@ -231,3 +232,46 @@ def test_a_fit_without_error_analysis_gives_the_same_values_and_chi_square():
     assert {k: p.value for k, p in lean.params.items() if p.kind != "derived"} == \
         {k: p.value for k, p in full.params.items() if p.kind != "derived"}
     assert full.stats.n_params == 1 and lean.stats.n_params == 2  # eta/h only: the structure is not looked for
+
+
+@pytest.mark.parametrize("law, solver", [("wear", "exact"), ("area-rate", "exact"), ("wear", "ode")])
+def test_the_best_fit_model_taken_from_the_last_evaluation_equals_a_fresh_prediction(law, solver):
+    """fit() reuses lmfit's last evaluation (at its best values) for the best-fit model: the same numbers as a
+    prediction made afresh at the fitted parameters; and a fit with several starts gives the same answer."""
+    import numpy as np
+
+    from frictionlab.predict import predict
+
+    data = synthetic(law, TRUTH[law], n=21, name=f"reuse-{law}")
+    r = fit(law, data, solver=solver)
+    assert r.ok
+    d = r.per_dataset[0]
+    fresh = predict(law, d.target, d.params, d.solver, d.scene, None)
+    assert np.array_equal(d.model, fresh)
+    assert d.chisqr == float(np.sum(((fresh - d.target.y) / d.target.sigma) ** 2))
+
+
+@pytest.mark.parametrize("law, solver, options", [("area-rate", "exact", {}), ("wear", "exact", {"scan": 0}),
+                                                  ("couette", "ode", {})])
+def test_a_repeated_evaluation_reused_gives_the_fit_of_the_general_path(law, solver, options, monkeypatch):
+    """The residual at the values of the last evaluation (scipy's leastsq asks for its start twice) and the
+    best-fit model are reused: the same fit, number for number, as when every call evaluates afresh."""
+    import numpy as np
+
+    from frictionlab import fitting
+
+    data = synthetic(law, TRUTH[law], n=21, name=f"reuse2-{law}")
+    fast = fit(law, data, solver=solver, **options)
+    fresh = fitting._Model.residual
+
+    def always_fresh(self, values):
+        self._last = None
+        return fresh(self, values)
+
+    monkeypatch.setattr(fitting._Model, "residual", always_fresh)
+    slow = fit(law, data, solver=solver, **options)
+    assert fast.ok and slow.ok
+    assert {k: p.value for k, p in fast.params.items()} == {k: p.value for k, p in slow.params.items()}
+    assert {k: p.stderr for k, p in fast.params.items()} == {k: p.stderr for k, p in slow.params.items()}
+    assert fast.stats.chisqr == slow.stats.chisqr and np.array_equal(fast.per_dataset[0].model, slow.per_dataset[0].model)
+    assert fast.nfev < slow.nfev  # evaluations saved, counted as such

@@ -460,3 +460,27 @@ def test_a_full_disk_during_compare_is_one_line_naming_the_report(tmp_path, monk
     assert rc == 2 and len(err) == 1, err
     assert err[0].startswith("frictionlab: error: rep: cannot write") and err[0].endswith("No space left on device")
     assert list(tmp_path.iterdir()) == []
+
+
+def _freeze_count(_):
+    import gc
+
+    return gc.get_freeze_count()
+
+
+def test_the_pool_freezes_what_its_workers_inherit_and_unfreezes_it_after():
+    """process_pool freezes the parent's objects for the forked workers (their collector leaves those pages
+    alone) and unfreezes them when the pool closes, also after an error: nothing stays immortal."""
+    import gc
+
+    from frictionlab.workers import process_pool
+
+    assert gc.get_freeze_count() == 0
+    with process_pool(2) as pool:
+        assert gc.get_freeze_count() > 0
+        assert pool.submit(_freeze_count, None).result() > 0  # the worker inherited the frozen objects
+    assert gc.get_freeze_count() == 0
+    with pytest.raises(ZeroDivisionError):
+        with process_pool(2):
+            1 / 0
+    assert gc.get_freeze_count() == 0

@@ -303,3 +303,25 @@ def test_a_dataset_no_compared_law_applies_to_is_left_out_before_fitting_with_on
     from frictionlab.comparison import candidates
 
     assert candidates("rate-state-slip", load_dataset("spring-slider-slip"), None) == [("ode", None)]  # still fitted
+
+
+def test_goodness_p_values_are_scipy_stats_own():
+    """goodness calls the special functions behind scipy.stats' chi2.sf, norm.cdf and norm.sf: the same
+    numbers on residuals of many shapes (runs test, lag-1 correlation) and on a chi-square grid."""
+    from scipy.stats import chi2, norm
+
+    from frictionlab.goodness import RUNS_MIN, chi2_pvalue, lag1
+
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        n = int(rng.integers(RUNS_MIN, 80))
+        z = rng.normal(size=n) + rng.normal() * np.sin(np.arange(n) * rng.uniform(0.01, 3.0))  # runs of many lengths
+        runs, mean, p = runs_test(z)
+        n1, n2 = int(np.sum(z > 0)), int(np.sum(z < 0))
+        var = 2 * n1 * n2 * (2 * n1 * n2 - n) / (n * n * (n - 1))
+        assert p == float(norm.cdf((runs - mean + 0.5) / math.sqrt(var)))
+        r, p1 = lag1(z)
+        assert p1 == float(norm.sf(r * math.sqrt(z.size)))
+    for dof in (1, 2, 5, 49, 300):
+        for c in np.linspace(0.0, 900.0, 901):
+            assert chi2_pvalue(float(c), dof) == float(chi2.sf(c, dof))

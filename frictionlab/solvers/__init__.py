@@ -60,7 +60,7 @@ def simulate(law, scene, params=None, solver: str = "ode", t=None, rtol: float =
     if t is None:
         t = np.linspace(0.0, scene.duration, n)
     t = np.asarray(t, dtype=float)
-    if t.ndim != 1 or t.size == 0 or np.any(np.diff(t) < 0) or t[0] < 0 or not np.all(np.isfinite(t)):
+    if t.ndim != 1 or t.size == 0 or (np.diff(t) < 0).any() or t[0] < 0 or not np.isfinite(t).all():
         raise SolverError("simulate: t must be a non-empty, non-decreasing 1-D array of times >= 0")
     plan = make_plan(scene, law, name)
     kind, method = parse_solver(solver)

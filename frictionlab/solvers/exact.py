@@ -92,7 +92,7 @@ def _states(plan, t0, y0, t, J, K, out=None):
         if name == "v":
             np.divide(J, -s.mass, out=out[i])
             out[i] += y0[i]
-            if np.any(plan.drive):
+            if np.asarray(plan.drive).any():
                 out[i] += plan.drive * dt
         elif name == "omega":
             np.multiply(J, s.radius / s.inertia, out=out[i])
@@ -101,7 +101,7 @@ def _states(plan, t0, y0, t, J, K, out=None):
             np.multiply(K, s.radius / s.inertia, out=out[i])
             out[i] += y0[i]
             w0 = y0[plan.index("omega")]
-            if np.any(w0):
+            if np.asarray(w0).any():
                 out[i] += w0 * dt
         else:  # pragma: no cover - guarded by check()
             raise SolverError(f"exact: state '{name}' has no closed form")
@@ -125,9 +125,9 @@ def bessel_integral(b, phi, t) -> np.ndarray:
     """
     b, phi, t = (np.asarray(v, dtype=float) for v in (b, phi, t))
     big = b > B_LAPLACE
-    if not np.any(big):
+    if not big.any():
         return _bessel_series(b, phi, t)
-    if np.all(big):
+    if big.all():
         return _laplace_integral(b, phi, t)
     return np.where(big, _laplace_integral(np.where(big, b, 2 * B_LAPLACE), phi, t),
                     _bessel_series(np.where(big, 0.0, b), phi, t))
@@ -216,7 +216,7 @@ def _normal_integrals(normal, t, a=1.0):
     tc = normal.contact_time
     phi = math.pi / tc
     c = a * normal.peak / phi
-    after = bool(np.any((np.max(t, axis=-1, keepdims=True) if t.ndim else t) > tc))  # each row's latest time
+    after = bool(((t.max(axis=-1, keepdims=True) if t.ndim else t) > tc).any())  # each row's latest time
     tau = np.minimum(t, tc) if after else t
     x = phi * tau
     if x.ndim == 0 or np.broadcast_shapes(x.shape, np.shape(c)) != x.shape:  # small inputs: plainly
@@ -250,8 +250,8 @@ def _area_integrals(area, t):
 def closed_stop_applies(plan, form, t0) -> bool:
     """Whether ``half_sine_stop`` gives the stop: F = s a N (a >= 0, no area term), N a half-sine
     pulse, no drive, from first contact (Coulomb on an impact)."""
-    return (np.all(t0 == 0.0) and np.all(np.asarray(form.c) == 0.0) and np.all(np.asarray(form.a) >= 0.0)
-            and isinstance(plan.scene.normal, HalfSineNormal) and np.all(np.asarray(plan.drive) == 0.0))
+    return bool((np.asarray(t0) == 0.0).all() and (np.asarray(form.c) == 0.0).all() and (np.asarray(form.a) >= 0.0).all()
+                and isinstance(plan.scene.normal, HalfSineNormal) and (np.asarray(plan.drive) == 0.0).all())
 
 
 def half_sine_stop(plan, form, u_s):
@@ -273,21 +273,21 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     broadcasting against t (k, q): a batch restarts its scenes' sliding phases at their own times."""
     s = plan.scene
     sgn = np.where(np.asarray(direction) != 0, direction, 1.0)
-    area = s.area if np.any(np.asarray(form.c) != 0.0) else None
+    area = s.area if (np.asarray(form.c) != 0.0).any() else None
     t0_ = np.atleast_1d(np.asarray(t0, dtype=float))  # (1,) for a float: broadcasts against t as before
 
     def JK(tt):
         # terms that vanish (no area term; start at first contact) are skipped: a batch of many
         # scenes evaluates this on large grids
         J, K = _normal_integrals(s.normal, tt, form.a)
-        if np.any(t0_ != 0.0):
+        if (t0_ != 0.0).any():
             IN0, IIN0 = _normal_integrals(s.normal, t0_, form.a)
             J, K = J - IN0, K - (IIN0 + IN0 * (tt - t0))
         if area is not None:
             A, IA = _area_integrals(area, tt)
             A0, IA0 = _area_integrals(area, t0_)
             J, K = J + form.c * (A - A0), K + form.c * (IA - IA0 - A0 * (tt - t0))
-        return (J, K) if np.all(sgn == 1.0) else (sgn * J, sgn * K)
+        return (J, K) if (sgn == 1.0).all() else (sgn * J, sgn * K)
 
     J, K = JK(t)
     if not find_stop or t.size == 0:

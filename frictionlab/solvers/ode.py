@@ -136,13 +136,14 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
         compliant = "xi" in plan.states
 
         calls = [0]
+        rates = plan.bound(p, direction)
 
         def f(s, z):
             calls[0] += 1
             if calls[0] > MAX_NFEV:
                 raise SolverError(f"ode:{method}: law '{plan.law.name}' needed more than {MAX_NFEV} right-hand-side "
                                   f"evaluations (stopped at t = {s * tscale:.6g} s): too stiff for {method} here")
-            return plan.derivatives(p, s * tscale, z * scale, direction) * tscale / scale
+            return rates(s * tscale, z * scale) * tscale / scale
 
         event = None
         if not compliant and direction != 0:

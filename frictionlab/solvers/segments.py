@@ -100,7 +100,7 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
     omega = Y[plan.index("omega")] if plan.has_spin else np.zeros(n)
     theta = Y[plan.index("theta")] if plan.has_spin else np.zeros(n)
     for name, arr in (("u", u), ("v", Y[0]), ("omega", omega), ("theta", theta), ("force", F)):
-        if not np.all(np.isfinite(arr)):
+        if not np.isfinite(arr).all():
             raise SolverError(f"{solver_name}: {name} became NaN or infinite for law '{plan.law.name}' with {dict(p)}")
     load = F / plan.scene.normal(t_eval) if plan.scene.spring is not None else None  # quasi-static: spring = friction
     return Trajectory(t=t_eval, u=u, v=Y[0].copy(), omega=omega, theta=theta, force=F, A=A, N=c.N, load=load,
