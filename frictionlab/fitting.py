@@ -43,6 +43,7 @@ import attrs
 import numpy as np
 
 from .errors import DatasetError, FrictionLabError, ParameterError, SolverError
+from . import levmar
 from .goodness import combine, goodness
 from .identifiability import Identifiability, find_structure, in_ratio, jacobian, jacobian_errors, make_verdict
 from .predict import (PREDICTORS, SCENE_QUANTITIES, SkipDataset, Target, applicable_solvers,
@@ -473,10 +474,13 @@ def _valley(result) -> str:
     return ""
 
 
-def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: int, max_nfev, scale_covar: bool = True):
+def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: int, max_nfev, scale_covar: bool = True,
+            direct: bool = False):
     """Score a grid of starts, refine the best distinct ones with Levenberg-Marquardt, keep the lowest
     chi-square. Returns (parameters, success, message, lmfit MinimizerResult or None, notes). scale_covar:
-    scale lmfit's error bars by sqrt(reduced chi2) (only when sigma is not known)."""
+    scale lmfit's error bars by sqrt(reduced chi2) (only when sigma is not known). direct: run lmfit's
+    Levenberg-Marquardt through ``levmar.leastsq`` (the same numbers without lmfit's bookkeeping; its
+    result is not a MinimizerResult), lmfit itself where that declines."""
     varying = [s for s in slots if s.vary]
     if not varying:
         return params, True, "nothing to fit: every parameter is held", None, []
@@ -495,9 +499,18 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
     for i, start in enumerate(starts):
         for k, v in start.items():  # every varying parameter; lmfit works on its own copy
             params[k].set(value=v)
-        mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), params, scale_covar=scale_covar,
-                               max_nfev=max_nfev or 200 * (len(varying) + 1))
-        r = mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
+        budget = max_nfev or 200 * (len(varying) + 1)
+        r = None
+        if direct:
+            before = model.nfev, model.failures, model.last_error, model._last
+            r = levmar.leastsq(lambda v: model.residual({s.pname: v[s.pname] * s.scale for s in slots}), params,
+                               scale_covar, budget, epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
+            if r is None:  # lmfit takes another path here: run it, from the same state of the model
+                model.nfev, model.failures, model.last_error, model._last = before
+        if r is None:
+            mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), params, scale_covar=scale_covar,
+                                   max_nfev=budget)
+            r = mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
         if best is None or (r.success, -r.chisqr) > (best.success, -best.chisqr):
             best = r
         why = _valley(r) if slow and r.success and i + 1 < len(starts) else ""
@@ -599,7 +612,8 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         with _alarm(timeout):
             best_params, success, message, best, search_notes = _search(lmfit, model, params, slots, solvers, scan,
                                                                         n_starts, max_nfev,
-                                                                        scale_covar=likelihood != "known")
+                                                                        scale_covar=likelihood != "known",
+                                                                        direct=not checks)
             values = _si(best_params, slots)
             models = model.models(values)
         model.deadline = None  # the error analysis below is bounded work

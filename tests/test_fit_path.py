@@ -275,3 +275,53 @@ def test_a_repeated_evaluation_reused_gives_the_fit_of_the_general_path(law, sol
     assert {k: p.stderr for k, p in fast.params.items()} == {k: p.stderr for k, p in slow.params.items()}
     assert fast.stats.chisqr == slow.stats.chisqr and np.array_equal(fast.per_dataset[0].model, slow.per_dataset[0].model)
     assert fast.nfev < slow.nfev  # evaluations saved, counted as such
+
+
+def _numbers(r):
+    return (r.status, r.message, r.nfev, r.stats.chisqr, r.stats.aic, sorted(r.correlations.items()),
+            {k: (p.value, p.stderr) for k, p in r.params.items()})
+
+
+@pytest.mark.parametrize("law, options", [
+    ("area-rate", {"scan": 0, "n_starts": 1}),  # a bootstrap replicate: warm start, error analysis
+    ("wear", {"scan": 0, "n_starts": 1, "errors": False}),  # an equivalence replicate
+    ("couette", {"scan": 25, "n_starts": 2, "errors": False}),  # cross_chi2: two starts, eta and h held apart
+    ("area-rate", {"free": {"u0": (5.0, 30.0)}}),  # a scene quantity fitted beside the law's
+    ("coulomb", {"fixed": {"mu": 0.2}, "free": {"u0": (5.0, 30.0)}}),  # a held law parameter
+    ("wear", {"initial": {"lam": 5e8}, "scan": 0, "n_starts": 1}),  # a start far away: the fit walks
+])
+def test_refits_run_levenberg_marquardt_directly_with_lmfits_numbers(law, options, monkeypatch):
+    """fit(checks=False) runs lmfit's Levenberg-Marquardt through levmar.leastsq: values, error bars,
+    correlations, chi-square, messages and evaluation counts are those of lmfit itself, bit for bit."""
+    from frictionlab import levmar
+
+    data = synthetic(law, TRUTH[law], n=21, name=f"direct-{law}", rel_noise=0.03)
+    calls = []
+    direct_run = levmar.leastsq
+    monkeypatch.setattr(levmar, "leastsq", lambda *a, **k: calls.append(1) or direct_run(*a, **k))
+    direct = fit(law, data, solver="exact", checks=False, **options)
+    monkeypatch.setattr(levmar, "leastsq", lambda *a, **k: None)  # declined: lmfit runs
+    general = fit(law, data, solver="exact", checks=False, **options)
+    assert calls and direct.ok and general.ok
+    assert _numbers(direct) == _numbers(general)
+
+
+def test_levenberg_marquardt_directly_declines_where_lmfit_goes_another_way():
+    """A residual that is not finite, or the evaluation budget reached: None, so that lmfit runs (and says
+    what it says there); an error bar that cannot be estimated is said as lmfit says it."""
+    import numpy as np
+
+    from frictionlab import levmar
+
+    params = {"a": levmar.Param("a", 1.0, 0.0, 10.0, True)}
+    assert levmar.leastsq(lambda v: np.array([np.nan, 1.0]), params, True, 50) is None
+    assert levmar.leastsq(lambda v: np.array([v["a"] - 3.0, 1e-3 * math.sin(50 * v["a"])]), params, True, 1,
+                          ftol=1e-15, xtol=1e-15) is None
+    import lmfit
+
+    flat = levmar.leastsq(lambda v: np.array([1.0, 2.0]), params, True, 50)
+    ps = lmfit.Parameters()
+    ps.add("a", value=1.0, min=0.0, max=10.0)
+    ref = lmfit.Minimizer(lambda p: np.array([1.0, 2.0]), ps, max_nfev=50).minimize(method="leastsq")
+    assert (flat.success, flat.message, flat.params["a"].stderr) == (ref.success, ref.message, ref.params["a"].stderr)
+    assert "Could not estimate error-bars" in flat.message

@@ -73,6 +73,7 @@ def run(args) -> int:
     from ..comparison import compare
     from ..io import check_target, output_lock
     from ..report import write_report
+    from ..workers import long_run_gc
     from .fit import parse_free
 
     parent = args.out.parent if str(args.out.parent) else Path(".")
@@ -90,7 +91,7 @@ def run(args) -> int:
     if args.replicates < MIN_REPLICATES:
         raise ParameterError(f"--replicates must be at least {MIN_REPLICATES}, got {args.replicates}")
     free = parse_free(args.free)
-    with output_lock(args.out):  # a second run to the same --out fails now, not after the work
+    with output_lock(args.out), long_run_gc():  # a second run to the same --out fails now, not after the work
         check_target(args.out, args.force)
         with Progress("compare", quiet=args.quiet) as bar:
             result = compare(laws=args.laws or None, datasets=args.data or None, solvers=args.solver or None,
