@@ -508,8 +508,8 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
             if r is None:  # lmfit takes another path here: run it, from the same state of the model
                 model.nfev, model.failures, model.last_error, model._last = before
         if r is None:
-            mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), params, scale_covar=scale_covar,
-                                   max_nfev=budget)
+            mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), levmar.lmfit_parameters(params),
+                                   scale_covar=scale_covar, max_nfev=budget)
             r = mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
         if best is None or (r.success, -r.chisqr) > (best.success, -best.chisqr):
             best = r
@@ -595,10 +595,14 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     slots = _law_slots(law, targets, dict(fixed or {}), set(local), dict(initial or {}))
     slots += _scene_slots(targets, dict(free or {}))
     model = _Model(law, targets, solvers, slots, rtol, None if timeout is None else time.monotonic() + timeout)
-    params = lmfit.Parameters()
-    for s in slots:
-        params.add(s.pname, value=s.value / s.scale, vary=s.vary, min=_lmfit_bound(s.lower, s) / s.scale,
-                   max=_lmfit_bound(s.upper, s) / s.scale)
+    bounds = [(_lmfit_bound(s.lower, s) / s.scale, _lmfit_bound(s.upper, s) / s.scale) for s in slots]
+    if not checks and all(lo < hi and (math.isinf(lo) or math.isinf(hi) or hi - lo > 1e-13 + 1e-13 * abs(hi))
+                          for lo, hi in bounds):  # an interval lmfit accepts
+        params = {s.pname: levmar.Param(s.pname, s.value / s.scale, lo, hi, s.vary) for s, (lo, hi) in zip(slots, bounds)}
+    else:  # lmfit's own (and its error where the bounds are no interval)
+        params = lmfit.Parameters()
+        for s, (lo, hi) in zip(slots, bounds):
+            params.add(s.pname, value=s.value / s.scale, vary=s.vary, min=lo, max=hi)
     varying = [s for s in slots if s.vary]
     solver_label = solver if solver != "auto" else "+".join(dict.fromkeys(solvers))
     n_points = sum(t.y.size for t in targets)

@@ -29,8 +29,9 @@ class Param:
         self.value = hi if value > hi else (lo if value < lo else value)  # lmfit clips a value into its bounds
         self.stderr = self.correl = None
 
-    def set(self, v) -> None:
-        self.value = self.max if v > self.max else (self.min if v < self.min else v)
+    def set(self, value) -> None:
+        """lmfit's ``Parameter.set(value=...)``: the value clipped into the bounds."""
+        self.value = self.max if value > self.max else (self.min if value < self.min else value)
 
     def internal(self) -> float:
         """lmfit's ``Parameter.setup_bounds``: the optimizer's value for this value."""
@@ -68,6 +69,18 @@ class Param:
         return cos(val) * (hi - lo) / 2.0
 
 
+def lmfit_parameters(params):
+    """lmfit Parameters for a mapping name -> Param (lmfit Parameters are returned as they are)."""
+    import lmfit
+
+    if isinstance(params, lmfit.Parameters):
+        return params
+    out = lmfit.Parameters()
+    for k, p in params.items():
+        out.add(k, value=p.value, vary=p.vary, min=p.min, max=p.max)
+    return out
+
+
 class Result:
     """What a fit reads of lmfit's MinimizerResult: params (name -> Param), success, message, chisqr."""
 
@@ -86,7 +99,7 @@ MESSAGES = {0: "Invalid Input Parameters. I.e. more variables than data points g
 
 def leastsq(fun, params, scale_covar: bool, max_nfev: int, **options) -> Result | None:
     """Minimize sum(fun(values)**2) over the varying parameters of ``params`` (lmfit Parameters, or a
-    mapping name -> Param) as lmfit's ``leastsq`` method does; fun takes a dict name -> value. options:
+    mapping name -> Param: fit() builds those for a refit) as lmfit's ``leastsq`` method does; fun takes a dict name -> value. options:
     scipy leastsq keywords (ftol, xtol, epsfcn). None where lmfit would go another way."""
     pars = {k: Param(k, float(p.value), -inf if p.min is None else p.min, inf if p.max is None else p.max, p.vary)
             for k, p in params.items()}
