@@ -36,7 +36,7 @@ from scipy.optimize import brentq
 
 from .errors import SceneError, SolverError
 from .law import QUANTITIES, AreaSlipForm, Contact, FrictionLaw, NormalAreaRateForm
-from .scene import G, ConstantNormal, GrowthArea, HertzNormal, Scene
+from .scene import G, ConstantNormal, GrowthArea, HertzNormal, Scene, WeightNormal
 
 #: A quasi-static spring-slider stops with an error once the slip rate exceeds this multiple of the fastest
 #: load-point velocity (stick-slip events, where inertia would matter).
@@ -124,8 +124,9 @@ class Plan:
         x = y[self.index("x")] if "x" in self.states else None
         return self.scene.area(t, x, u)
 
-    def contact(self, t, y, u) -> Contact:
-        """The contact quantities the law requires, and only those, at times t for states y."""
+    def contact(self, t, y, u, normal=None) -> Contact:
+        """The contact quantities the law requires, and only those, at times t for states y (normal: the
+        normal force, when the caller has it)."""
         s = self.scene
         A = dAdt = N = None
         req = self.law.requires
@@ -135,7 +136,7 @@ class Plan:
             else:  # the area alone, where the model offers it (half the cost of a half-sine's area and rate)
                 A = s.area.value(t)
         if self.needs_normal:
-            N = s.normal(t, A)
+            N = s.normal(t, A) if normal is None else normal
         state = ({n: y[self.index(k)] for n, k in zip(self.law.state_names, self.law_states)} or None
                  if self.law.states else None)
         return Contact(t=np.asarray(t, dtype=float), u=np.asarray(u, dtype=float),
@@ -243,8 +244,18 @@ class Plan:
         (a scalar integrator's right-hand side): the dispatch to ``_one_state`` decided once, not per call."""
         direction = float(direction)
         if not self.law.states and "xi" not in self.states and self.scene.spring is None:
-            return lambda t, y: self._one_state(p, t, y, direction)
+            normal = self._fixed_normal()
+            return lambda t, y: self._one_state(p, t, y, direction, normal)
         return lambda t, y: self.derivatives(p, t, y, direction)
+
+    def _fixed_normal(self):
+        """The normal force [N] of one state vector, built once, when the scene's does not change in time (an
+        incline's weight, a constant load): what the model gives at a scalar time, read-only; None otherwise."""
+        if not self.needs_normal or type(self.scene.normal) not in (ConstantNormal, WeightNormal):
+            return None
+        N = self.scene.normal(0.0)
+        N.flags.writeable = False
+        return N
 
     def _quasi_static_acceleration(self, p, t, y, dy) -> float:
         """dv/dt of a quasi-static spring-slider: d F(v, s)/dt = k N (V_lp - v), partials by central differences."""
@@ -280,7 +291,7 @@ class Plan:
                              "block has no slip rate for the spring's load")
         return dF
 
-    def _one_state(self, p, t, y, direction: float) -> np.ndarray:
+    def _one_state(self, p, t, y, direction: float, normal=None) -> np.ndarray:
         """``derivatives`` for one state vector of a memoryless law without compliance (every scalar ODE
         solve): the same arithmetic on Python floats, bitwise equal to the general path (tests check it),
         without its array bookkeeping. The law's force is checked by ``FrictionLaw.evaluate`` (the
@@ -292,7 +303,7 @@ class Plan:
             from .solvers.stick import vanishing_slip
 
             u = direction * float(vanishing_slip(self))
-        c = self.contact(t, y, u)
+        c = self.contact(t, y, u, normal)
         try:
             f = self.law.force(p, c)
             F = float(f) if np.ndim(f) == 0 else math.nan

@@ -325,3 +325,18 @@ def test_levenberg_marquardt_directly_declines_where_lmfit_goes_another_way():
     ref = lmfit.Minimizer(lambda p: np.array([1.0, 2.0]), ps, max_nfev=50).minimize(method="leastsq")
     assert (flat.success, flat.message, flat.params["a"].stderr) == (ref.success, ref.message, ref.params["a"].stderr)
     assert "Could not estimate error-bars" in flat.message
+
+
+def test_the_scalar_right_hand_side_takes_a_constant_normal_force_built_once():
+    """An incline's weight (a normal force that does not change in time) is built once per bound right-hand side,
+    read-only, equal to the scene's at any time; a normal force that changes (an impact's) is not."""
+    import numpy as np
+
+    from frictionlab import get_law, load_dataset
+    from frictionlab.plan import make_plan
+
+    incline = make_plan(load_dataset("incline-dry-d10").scene, get_law("area-rate"))
+    N = incline._fixed_normal()
+    assert N is not None and not N.flags.writeable and np.array_equal(N, incline.scene.normal(0.37))
+    assert make_plan(load_dataset("impact-golf-v28").scene, get_law("area-rate"))._fixed_normal() is None
+    assert make_plan(load_dataset("incline-dry-d10").scene, get_law("wear"))._fixed_normal() is None  # not needed
