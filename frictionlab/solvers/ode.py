@@ -8,6 +8,7 @@ the same numbers (a test checks them against solve_ivp), without its per-step ge
 """
 from __future__ import annotations
 
+import bisect
 import numbers
 
 import numpy as np
@@ -39,6 +40,7 @@ def solve(f, s0: float, s1: float, z0, method: str, s_eval, rtol: float, atol: f
     eps = np.finfo(float).eps
     solver = getattr(scipy.integrate, method)(f, s0, np.asarray(z0, dtype=float), s1, rtol=rtol, atol=atol)
     s_eval = np.asarray(s_eval, dtype=float)
+    eval_list = s_eval.tolist()  # bisect on floats: np.searchsorted's index, without its per-step dispatch
     outs, i = [], 0
     g = event(s0, solver.y) if event is not None else None
     s_event = z_event = None
@@ -55,7 +57,7 @@ def solve(f, s0: float, s1: float, z0, method: str, s_eval, rtol: float, atol: f
                 s = s_event = brentq(lambda x: event(x, sol(x)), solver.t_old, s, xtol=4 * eps, rtol=4 * eps)
                 z = z_event = sol(s)
             g = g_new
-        j = int(np.searchsorted(s_eval, s, side="right"))
+        j = bisect.bisect_right(eval_list, s)
         if j > i:
             outs.append((sol or solver.dense_output())(s_eval[i:j]))
             i = j
