@@ -486,6 +486,34 @@ def test_the_pool_freezes_what_its_workers_inherit_and_unfreezes_it_after():
     assert gc.get_freeze_count() == 0
 
 
+def _gc_threshold(_):
+    import gc
+
+    return gc.get_threshold()[0]
+
+
+def test_a_long_run_tunes_the_collector_and_restores_it_after_also_around_a_pool():
+    """long_run_gc (compare's whole run): objects built before are frozen and the youngest generation is
+    collected less often, in the workers too; a pool inside leaves the run's freeze alone; after the run
+    (also after an error) thresholds and freeze are as before."""
+    import gc
+
+    from frictionlab.workers import GC_YOUNG, long_run_gc, process_pool
+
+    before = gc.get_threshold()
+    assert gc.get_freeze_count() == 0
+    with long_run_gc():
+        assert gc.get_freeze_count() > 0 and gc.get_threshold() == (GC_YOUNG, *before[1:])
+        with process_pool(2) as pool:
+            assert pool.submit(_gc_threshold, None).result() == GC_YOUNG
+        assert gc.get_freeze_count() > 0  # still the run's
+    assert gc.get_freeze_count() == 0 and gc.get_threshold() == before
+    with pytest.raises(ZeroDivisionError):
+        with long_run_gc():
+            1 / 0
+    assert gc.get_freeze_count() == 0 and gc.get_threshold() == before
+
+
 def test_datasets_rebuild_into_a_locked_folder_fails_at_once_and_writes_nothing(tmp_path, capsys):
     from frictionlab import cli
 
