@@ -46,7 +46,7 @@ from collections.abc import Mapping, Sequence
 import attrs
 import numpy as np
 
-from . import vecrk
+from . import compiled, vecrk
 from .errors import ParameterError, SceneError, SolverError
 from .plan import Plan, make_plan
 from .registry import get_law
@@ -543,6 +543,7 @@ def _run_rk(law, batch, p, T, method, rtol, atol, into=None):
     slide_ids = np.nonzero(direction != 0)[0]
     stuck_ids = np.nonzero(direction == 0)[0]
     last_dir = np.zeros(nsc)
+    fast = compiled.prepare(law, full, p, nsc)  # the compiled sliding phases, where they serve this batch
     while slide_ids.size or stuck_ids.size:
         if stuck_ids.size:
             segments[stuck_ids] += 1
@@ -575,7 +576,7 @@ def _run_rk(law, batch, p, T, method, rtol, atol, into=None):
                               f"in scene {i} (chatter); the law is not suited to this scene")
         first_all = Y is None and slide_ids.size == nsc and into is not None  # integrated straight into the result
         res = _slide_rk(law, batch, p, slide_ids, t0, y0, direction, T, t_end, scale, method, rtol, atol,
-                        into["states"] if first_all else None)
+                        into["states"] if first_all else None, fast)
         iterations += res.iterations
         nfev[slide_ids] += res.nfev
         new = res.reached & ~done[slide_ids]
@@ -608,12 +609,16 @@ def _run_rk(law, batch, p, T, method, rtol, atol, into=None):
     out = _finish(law, batch, p, T, Y, ~stuck_mask, need, into)
     out["stick_time"] = stick_time
     return out, {"nfev": int(nfev.sum()), "nfev_per_scene": nfev, "iterations": iterations,
-                 "segments": int(segments.max(initial=0)), "method": method}
+                 "segments": int(segments.max(initial=0)), "method": method,
+                 "engine": "numpy" if fast is None else "compiled"}
 
 
-def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rtol, atol, out=None):
-    """One sliding phase for scenes ``ids`` on the scaled problem (time / span, states / scale)."""
+def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rtol, atol, out=None, fast=None):
+    """One sliding phase for scenes ``ids`` on the scaled problem (time / span, states / scale); with
+    ``fast`` (``compiled.prepare``) by the compiled kernel, else by ``vecrk.integrate``: the same steps."""
     span = t_end[ids]
+    if fast is not None:
+        return fast.integrate(ids, t0, y0, direction, t_end, scale, _scaled_grid(T, ids, span), method, rtol, atol, out)
     sc = scale[:, ids]
 
     def make_rhs(k):

@@ -178,7 +178,7 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
         err = _error_norm(cls, _rows_dot(E, Kf[: ns + 1], tmp=tmp).reshape(len(E), d, k), ha, scale)
         ok = err < 1.0
         with np.errstate(divide="ignore"):
-            factor = np.where(err == 0.0, MAX_FACTOR, SAFETY * err**exponent)
+            factor = np.where(err == 0.0, MAX_FACTOR, SAFETY * np.float_power(err, exponent))  # libm pow, as scipy
         factor = np.where(ok, np.minimum(MAX_FACTOR, factor), np.maximum(MIN_FACTOR, factor))
         factor = np.where(ok & rejected[active], np.minimum(1.0, factor), factor)
         H[active] = ha * factor
