@@ -264,10 +264,7 @@ def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol:
     nsc = batch.n
     p = batch_params(law, params, nsc)
     tgrid = _time_grid(batch, t, n)
-    if nsc > CHUNK:
-        return _chunked(law, batch, p, tgrid, solver, rtol, atol)
-    out, solver, info = _simulate_chunk(law, batch, p, tgrid, solver, rtol, atol)
-    return BatchResult(t=tgrid, solver=solver, law=law.name, info=info, **out)
+    return _chunked(law, batch, p, tgrid, solver, rtol, atol)
 
 
 def _simulate_chunk(law, batch, p, tgrid, solver, rtol, atol, into=None):
@@ -302,8 +299,9 @@ def _simulate_chunk(law, batch, p, tgrid, solver, rtol, atol, into=None):
 
 
 def _chunked(law, batch, p, tgrid, solver, rtol, atol) -> BatchResult:
-    """``simulate_batch`` chunk by chunk (CHUNK scenes each), written in place into the result arrays, so
-    only one chunk's working arrays exist beside the results (memory below 2x the results at any n)."""
+    """``simulate_batch`` chunk by chunk (CHUNK scenes each, or one chunk of them all), written in place into
+    the result arrays allocated first, so only one chunk's working arrays exist beside the results (memory
+    below 2x the results at any n) and a batch of any size does the same work per scene."""
     plan = make_plan(batch.view(), law, "batch scene")
     n, m = batch.n, tgrid.shape[-1]
     states = np.empty((len(plan.states), n, m))  # the states on the grid: v, omega, theta are rows of it
@@ -314,13 +312,16 @@ def _chunked(law, batch, p, tgrid, solver, rtol, atol) -> BatchResult:
     for start in range(0, n, CHUNK):
         sl = slice(start, min(start + CHUNK, n))
         into = {k: None if a is None else a[sl] for k, a in res.items()} | {"states": states[:, sl]}
-        out, s, info = _simulate_chunk(law, batch.subset(sl), _take_params(p, sl), tgrid if tgrid.ndim == 1 else tgrid[sl],
-                                       solver, rtol, atol, into)
+        whole = n <= CHUNK
+        out, s, info = _simulate_chunk(law, batch if whole else batch.subset(sl), p if whole else _take_params(p, sl),
+                                       tgrid if tgrid.ndim == 1 else tgrid[sl], solver, rtol, atol, into)
         res["stick_time"][sl] = out["stick_time"]
         parts.append((s, info))
     solvers = {s for s, _ in parts}
     info = {"chunks": len(parts), "nfev": int(sum(i.get("nfev", 0) for _, i in parts)),
             **({"rtol": rtol, "atol": rtol if atol is None else atol} if "exact" not in solvers else {})}
+    if len(parts) == 1:  # one chunk: its own account too (per-scene counts, segments, engine, ...)
+        info = parts[0][1] | info
     spin = plan.has_spin
     return BatchResult(t=tgrid, solver="+".join(sorted(solvers)), law=law.name, info=info, v=states[0],
                        omega=states[plan.index("omega")] if spin else np.zeros((n, m)),
@@ -658,7 +659,7 @@ def _scaled_grid(T, ids, span):
     m = T.shape[1]
     if T.strides[0] == 0 and np.all(span == span[0]):  # one grid and one span for all
         return T[0] / span[0]
-    Tid = T[ids]
+    Tid = T if ids.size == T.shape[0] else T[ids]  # ids are sorted: all of them is every row in order
     rel = np.linspace(0.0, 1.0, m)
     on = np.all(Tid == span[:, None] * rel, axis=1)
     if on.all():
