@@ -264,7 +264,10 @@ def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol:
     nsc = batch.n
     p = batch_params(law, params, nsc)
     tgrid = _time_grid(batch, t, n)
-    return _chunked(law, batch, p, tgrid, solver, rtol, atol)
+    if nsc > CHUNK:
+        return _chunked(law, batch, p, tgrid, solver, rtol, atol)
+    out, solver, info = _simulate_chunk(law, batch, p, tgrid, solver, rtol, atol)
+    return BatchResult(t=tgrid, solver=solver, law=law.name, info=info, **out)
 
 
 def _simulate_chunk(law, batch, p, tgrid, solver, rtol, atol, into=None):
@@ -299,9 +302,8 @@ def _simulate_chunk(law, batch, p, tgrid, solver, rtol, atol, into=None):
 
 
 def _chunked(law, batch, p, tgrid, solver, rtol, atol) -> BatchResult:
-    """``simulate_batch`` chunk by chunk (CHUNK scenes each, or one chunk of them all), written in place into
-    the result arrays allocated first, so only one chunk's working arrays exist beside the results (memory
-    below 2x the results at any n) and a batch of any size does the same work per scene."""
+    """``simulate_batch`` chunk by chunk (CHUNK scenes each), written in place into the result arrays, so
+    only one chunk's working arrays exist beside the results (memory below 2x the results at any n)."""
     plan = make_plan(batch.view(), law, "batch scene")
     n, m = batch.n, tgrid.shape[-1]
     states = np.empty((len(plan.states), n, m))  # the states on the grid: v, omega, theta are rows of it
@@ -312,16 +314,13 @@ def _chunked(law, batch, p, tgrid, solver, rtol, atol) -> BatchResult:
     for start in range(0, n, CHUNK):
         sl = slice(start, min(start + CHUNK, n))
         into = {k: None if a is None else a[sl] for k, a in res.items()} | {"states": states[:, sl]}
-        whole = n <= CHUNK
-        out, s, info = _simulate_chunk(law, batch if whole else batch.subset(sl), p if whole else _take_params(p, sl),
-                                       tgrid if tgrid.ndim == 1 else tgrid[sl], solver, rtol, atol, into)
+        out, s, info = _simulate_chunk(law, batch.subset(sl), _take_params(p, sl), tgrid if tgrid.ndim == 1 else tgrid[sl],
+                                       solver, rtol, atol, into)
         res["stick_time"][sl] = out["stick_time"]
         parts.append((s, info))
     solvers = {s for s, _ in parts}
     info = {"chunks": len(parts), "nfev": int(sum(i.get("nfev", 0) for _, i in parts)),
             **({"rtol": rtol, "atol": rtol if atol is None else atol} if "exact" not in solvers else {})}
-    if len(parts) == 1:  # one chunk: its own account too (per-scene counts, segments, engine, ...)
-        info = parts[0][1] | info
     spin = plan.has_spin
     return BatchResult(t=tgrid, solver="+".join(sorted(solvers)), law=law.name, info=info, v=states[0],
                        omega=states[plan.index("omega")] if spin else np.zeros((n, m)),
