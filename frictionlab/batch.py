@@ -321,6 +321,9 @@ def _chunked(law, batch, p, tgrid, solver, rtol, atol) -> BatchResult:
     solvers = {s for s, _ in parts}
     info = {"chunks": len(parts), "nfev": int(sum(i.get("nfev", 0) for _, i in parts)),
             **({"rtol": rtol, "atol": rtol if atol is None else atol} if "exact" not in solvers else {})}
+    engines = {i["engine"] for _, i in parts if "engine" in i}
+    if engines:
+        info["engine"] = "+".join(sorted(engines))
     spin = plan.has_spin
     return BatchResult(t=tgrid, solver="+".join(sorted(solvers)), law=law.name, info=info, v=states[0],
                        omega=states[plan.index("omega")] if spin else np.zeros((n, m)),
@@ -582,14 +585,15 @@ def _run_rk(law, batch, p, T, method, rtol, atol, into=None):
         new = res.reached & ~done[slide_ids]
         if Y is None:  # the first phase and every scene slides: its outputs (NaN where not reached) are Y
             Y = res.Y
-            Y *= scale[:, :, None]
+            if res.scaled:
+                Y *= scale[:, :, None]
             done |= new
         elif slide_ids.size == nsc:  # every scene slides: no gathering
-            np.copyto(Y, res.Y * scale[:, :, None], where=new[None])
+            np.copyto(Y, res.Y * scale[:, :, None] if res.scaled else res.Y, where=new[None])
             done |= new
         else:
             r, c = np.nonzero(new)
-            Y[:, slide_ids[r], c] = res.Y[:, r, c] * scale[:, slide_ids[r]]
+            Y[:, slide_ids[r], c] = res.Y[:, r, c] * scale[:, slide_ids[r]] if res.scaled else res.Y[:, r, c]
             done[slide_ids[r], c] = True
         ev = np.nonzero(~np.isnan(res.t_event))[0]
         ids = slide_ids[ev]
@@ -618,7 +622,7 @@ def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rt
     ``fast`` (``compiled.prepare``) by the compiled kernel, else by ``vecrk.integrate``: the same steps."""
     span = t_end[ids]
     if fast is not None:
-        return fast.integrate(ids, t0, y0, direction, t_end, scale, _scaled_grid(T, ids, span), method, rtol, atol, out)
+        return fast.integrate(ids, t0, y0, direction, t_end, scale, T, method, rtol, atol, out)
     sc = scale[:, ids]
 
     def make_rhs(k):

@@ -152,19 +152,19 @@ class Prepared:
     def __init__(self, codes, cols):
         self.codes, self.cols = codes, cols
 
-    def integrate(self, ids, t0, y0, direction, span, scale, t_out, method, rtol, atol=None, out=None) -> vecrk.Result:
+    def integrate(self, ids, t0, y0, direction, span, scale, T, method, rtol, atol=None, out=None) -> vecrk.Result:
         """One sliding phase of scenes ``ids`` (positions in the chunk) on the scaled problem, as
         ``batch._slide_rk`` with ``vecrk.integrate``: t0 (n,) [s], y0 (d, n), direction (n,), span (n,) [s] and
-        scale (d, n) over the whole chunk; t_out the scaled output grid, (m,) shared or (k, m)."""
+        scale (d, n) over the whole chunk; T (n, m) the chunk's output times [s]. The Result's Y is in the
+        states' units (``scaled=False``), written into ``out`` (d, k, m) when given."""
         kern = _compiled().kernel
         atol = rtol if atol is None else atol
-        d, k = y0.shape[0], ids.size
-        t_out = np.asarray(t_out, dtype=float)
-        shared = t_out.ndim == 1
-        grid = t_out[None, :] if shared else np.ascontiguousarray(t_out)
-        m = grid.shape[1]
+        d, k, m = y0.shape[0], ids.size, T.shape[1]
+        rel = np.linspace(0.0, 1.0, m)
+        per_row = not (T.strides[0] == 0 and np.all(span[ids] == span[ids[0]]))
+        grid = np.ascontiguousarray(T) if per_row else (T[0] / span[ids[0]])[None, :]  # as batch._scaled_grid
         Y = np.empty((d, k, m)) if out is None else out
-        reached = np.zeros((k, m), dtype=bool)
+        reached = np.empty((k, m), dtype=bool)  # every entry written
         t_event = np.full(k, np.nan)
         y_event = np.full((d, k), np.nan)
         nfev = np.zeros(k, dtype=np.int64)
@@ -172,7 +172,7 @@ class Prepared:
         Ys = [Y[min(j, d - 1)] for j in range(3)]  # each (k, m) C-contiguous: one signature for any caller
         assert all(y.flags.c_contiguous for y in Ys)
         iters = kern(*_tableau(method), self.codes, self.cols, np.ascontiguousarray(ids, dtype=np.int64), t0, y0,
-                     direction, span, np.require(scale, requirements="CW"), grid, shared, float(rtol), float(atol),
+                     direction, span, np.require(scale, requirements="CW"), grid, per_row, rel, float(rtol), float(atol),
                      vecrk.MAX_ITERATIONS, *Ys, reached, t_event, y_event, nfev, stat)
         if stat[0] != OK:
             i = int(ids[stat[1]])
@@ -180,7 +180,7 @@ class Prepared:
                    TOO_MANY: f"more than {vecrk.MAX_ITERATIONS} steps; the problem is stiff or singular",
                    NOT_FINITE: f"the states became NaN or infinite in scene {i}"}[int(stat[0])]
             raise SolverError(f"batch {method}: {msg}")
-        return vecrk.Result(Y, reached, t_event, y_event, nfev, int(iters))
+        return vecrk.Result(Y, reached, t_event, y_event, nfev, int(iters), scaled=False)
 
 
 def _compiled():

@@ -115,12 +115,14 @@ def _slip(z0, z1, ssc0, ssc1, r, coupled, dsc):
 
 @numba.njit(cache=True, fastmath=False, error_model="numpy")
 def kernel(A, B, Cn, E, AX, CX, D, order, exponent, dop, codes, cols, ids, t0a, y0a, dira, spana, scalea, grid,
-           shared, rtol, atol, max_iter, Y0, Y1, Y2, reached, t_event, y_event, nfev, stat):
+           per_row, rel, rtol, atol, max_iter, Y0, Y1, Y2, reached, t_event, y_event, nfev, stat):
     """Each scene ids[i] from t0a[g] in state y0a[:, g] to the end of its span or its zero of slip, as
     ``vecrk.integrate`` steps it; outputs into row i of Y0, Y1, Y2 (the states' (k, m) output arrays; NaN
-    where not reached), reached[i], the event
+    where not reached; in the states' units, not scaled), reached[i], the event
     into t_event[i], y_event[:, i], evaluations into nfev[i]; a failure into stat. Returns the most
-    step attempts of a scene."""
+    step attempts of a scene. Output times: grid[0] (scaled) for every scene, or with per_row each scene's
+    row of grid (times [s], the chunk's rows), taken as exactly ``rel`` where it is span * rel (as
+    ``batch._scaled_grid`` takes them), else divided by the span."""
     d = y0a.shape[0]
     k = ids.size
     m = grid.shape[1]
@@ -130,6 +132,7 @@ def kernel(A, B, Cn, E, AX, CX, D, order, exponent, dop, codes, cols, ids, t0a, 
     nd = D.shape[0]
     nc = nd + 3 if dop else nd
     K = np.zeros((nk, 3))
+    gr = np.empty(m)
     Fc = np.zeros((nc, 3))
     eps = 2.220446049250313e-16
     eps4 = 1 + 4 * eps
@@ -144,13 +147,24 @@ def kernel(A, B, Cn, E, AX, CX, D, order, exponent, dop, codes, cols, ids, t0a, 
         ssc1 = scalea[1, g] if d > 1 else 1.0
         fac0 = tsc / ssc0
         fac1 = tsc / ssc1 if d > 1 else 0.0
-        fac2 = tsc / scalea[2, g] if d > 2 else 0.0
+        ssc2 = scalea[2, g] if d > 2 else 1.0
+        fac2 = tsc / ssc2 if d > 2 else 0.0
         direction = dira[g]
         dsc = direction / ssc0
         r = sp[1]
         b0 = cols[g, BREAK_AREA] / tsc if not math.isnan(cols[g, BREAK_AREA]) else np.inf
         b1 = cols[g, BREAK_NORMAL] / tsc if not math.isnan(cols[g, BREAK_NORMAL]) else np.inf
-        row = 0 if shared else i
+        if per_row:
+            on = True
+            for col in range(m):
+                if grid[g, col] != tsc * rel[col]:
+                    on = False
+                    break
+            for col in range(m):
+                gr[col] = rel[col] if on else grid[g, col] / tsc
+        else:
+            for col in range(m):
+                gr[col] = grid[0, col]
         t = t0a[g] / tsc
         y0 = y0a[0, g] / ssc0
         y1 = y0a[1, g] / ssc1 if d > 1 else 0.0
@@ -158,14 +172,14 @@ def kernel(A, B, Cn, E, AX, CX, D, order, exponent, dop, codes, cols, ids, t0a, 
         t_end = 1.0
         # the first output at or after t; one exactly at t is the initial state
         ptr = 0
-        while ptr < m and grid[row, ptr] < t:
+        while ptr < m and gr[ptr] < t:
             ptr += 1
         ptr0 = ptr
-        if ptr < m and grid[row, ptr] == t:
-            Y0[i, ptr] = y0
+        if ptr < m and gr[ptr] == t:
+            Y0[i, ptr] = y0 * ssc0
             if d > 1:
-                Y1[i, ptr] = y1
-                Y2[i, ptr] = y2
+                Y1[i, ptr] = y1 * ssc1
+                Y2[i, ptr] = y2 * ssc2
             ptr += 1
         it = 0
         if t < t_end:
@@ -274,7 +288,7 @@ def kernel(A, B, Cn, E, AX, CX, D, order, exponent, dop, codes, cols, ids, t0a, 
                 g_new = _slip(n0, n1, ssc0, ssc1, r, coupled, dsc)
                 stop = g_new <= 0.0 and g_old > 0.0
                 g_old = g_new
-                if stop or (ptr < m and grid[row, ptr] <= t_new):
+                if stop or (ptr < m and gr[ptr] <= t_new):
                     if dop:  # DOP853's extra stages and interpolant (vecrk._dense)
                         for j in range(nx):
                             sx = ns + 1 + j
@@ -340,14 +354,14 @@ def kernel(A, B, Cn, E, AX, CX, D, order, exponent, dop, codes, cols, ids, t0a, 
                             y_event[1, i] = z1
                             y_event[2, i] = z2
                     stop_at = ptr
-                    while stop_at < m and grid[row, stop_at] <= t_stop:
+                    while stop_at < m and gr[stop_at] <= t_stop:
                         stop_at += 1
                     for col in range(ptr, stop_at):
-                        z0, z1, z2 = _dense(Fc, nc, dop, (grid[row, col] - t) / ha, ha, y0, y1, y2)
-                        Y0[i, col] = z0
+                        z0, z1, z2 = _dense(Fc, nc, dop, (gr[col] - t) / ha, ha, y0, y1, y2)
+                        Y0[i, col] = z0 * ssc0
                         if d > 1:
-                            Y1[i, col] = z1
-                            Y2[i, col] = z2
+                            Y1[i, col] = z1 * ssc1
+                            Y2[i, col] = z2 * ssc2
                     ptr = stop_at
                 t = t_new
                 y0, y1, y2 = n0, n1, n2

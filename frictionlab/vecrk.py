@@ -28,7 +28,9 @@ BISECTIONS = 60  # event location: interval shrinks by 2^-60, below double resol
 @attrs.frozen
 class Result:
     """Outputs of ``integrate``: Y (n_states, n, m) where reached (else NaN), reached (n, m) bool,
-    t_event (n,) (NaN where no event), y_event (n_states, n), and counters."""
+    t_event (n,) (NaN where no event), y_event (n_states, n), and counters. ``scaled``: Y is in the
+    problem's (scaled) units, as y_event always is; False where a caller's engine wrote it unscaled
+    (``frictionlab.compiled``)."""
 
     Y: np.ndarray
     reached: np.ndarray
@@ -36,6 +38,7 @@ class Result:
     y_event: np.ndarray
     nfev: np.ndarray  # per problem
     iterations: int
+    scaled: bool = True
 
 
 def _rows_dot(M, K, out=None, tmp=None):

@@ -211,3 +211,19 @@ def test_refused_where_not_served(monkeypatch):
     # numba absent
     monkeypatch.setattr(compiled, "available", lambda: False)
     assert simulate_batch("coulomb", sc, {"mu": 0.3}, solver="DOP853").info["engine"] == "numpy"
+
+
+def test_per_scene_time_grids_are_the_same(monkeypatch):
+    """Output times given per scene (not a multiple of one grid) and one shared grid: the kernel takes them as
+    batch._scaled_grid does."""
+    rng = np.random.default_rng(9)
+    sc = oblique(rng, 12)
+    p = {"mu": rng.uniform(0.1, 0.5, 12)}
+    t = np.sort(rng.uniform(0, 1, (12, 40)), axis=1) * np.array([s.duration for s in sc])[:, None]
+    t[:, -1] = [s.duration for s in sc]
+    t[::3, 0] = 0.0
+    for grid in (t, np.linspace(0.0, 400e-6, 50)):
+        fast = simulate_batch("coulomb", sc, p, t=grid, solver="DOP853")
+        slow = numpy_engine(monkeypatch, "coulomb", sc, p, t=grid, solver="DOP853")
+        assert fast.info["engine"] == "compiled"
+        assert_same(fast, slow)
