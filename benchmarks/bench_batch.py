@@ -254,6 +254,9 @@ def rk_vs_plain(name, law, batch, params, args, rng):
     eng = engines(args)
     batch_times, loop_time, errs = {e: [] for e, _ in eng}, 0.0, []
     last = {}
+    for label, ctx in eng:  # one untimed run each: the process's allocator warmed as for the scaling section
+        with ctx():
+            simulate_batch(law, batch, params, solver="DOP853", rtol=args.rtol, n=NT)
     for chunk in chunks:
         for label, ctx in eng:
             last[label] = None  # the previous run's results are freed first, as a loop over batches would (else each
