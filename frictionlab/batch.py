@@ -16,8 +16,9 @@ Solvers:
             (the area-rate law with eta' > 0 on an unloading contact) go on phase by phase, sliding from
             rest in closed form and perhaps sticking again, with the scenes still going in each round
             (``_exact_phases``); only a scene that starts at zero slip is re-run alone with the scalar solver.
-  'RK45', 'DOP853'  ``frictionlab.vecrk``: scipy's tableaus, per-scene adaptive steps, dense output,
-            zero slip located per scene; stuck phases and breakaway handled per scene.
+  'RK45', 'DOP853'  scipy's tableaus, per-scene adaptive steps, dense output, zero slip located per
+            scene (``frictionlab.vecrk``, or ``frictionlab.compiled`` where it serves: see Engines); stuck
+            phases and breakaway handled per scene.
   'auto'    'exact' where the law and scene admit a closed form, else 'DOP853'.
 Tolerances act on the same scaled problem as ``solvers.ode`` (time by the span, states by
 ``ode.state_scales``), so rtol means what it means for ``simulate(..., solver='ode:...')``;
@@ -29,14 +30,18 @@ integrator evaluates each step's outputs as one block; beyond CHUNK scenes the b
 integrated and finished straight into the result arrays (v, omega, theta are rows of one states
 block), so memory stays below 2x the results and no chunk is copied.
 
-Why numpy (measured by benchmarks/bench_batch.py, CPU time on a shared 2-core machine, load 1.2-1.6):
-at 10,000 scenes and rtol 1e-8 a DOP853 solve costs 14-20 us per scene, 30x to 65x less than a loop
-of solve_ivp on a plain Python right-hand side at the same method, rtol, event and accuracy (not the
-100x targeted); a quarter to a third of it fills the outputs from the dense interpolant, a sixth is
-the sine of the half-sine contact models, and a fixed 5-7 ms per batch is interpreter overhead per
-step (so 1,000 scenes cost 1.3x to 1.5x per scene what 10,000 do). A compiled engine would be
-faster, but would need every law plugin, a plain Python class, written in numba's subset; numpy
-keeps the plugin contract (a force that broadcasts) and needs no compiler.
+Engines (measured by benchmarks/bench_batch.py, CPU time on a shared 2-core machine): the sliding
+phases of the built-in laws' closed-form families (Coulomb, area-rate, wear, Couette) on rigid impacts
+and inclines run in ``frictionlab.compiled`` when numba is installed (``pip install
+'frictionlab[fast]'``), else, like every other law, in ``frictionlab.vecrk`` (numpy); both take the same
+steps and give the same numbers (tests/test_compiled.py: bitwise for every law whose force is its
+form's expression). At 10,000 scenes and rtol 1e-8 a DOP853 solve costs 7 to 8 us per scene with the
+compiled phases (90x to 145x less than a loop of solve_ivp on a plain Python right-hand side at the
+same method, rtol, event and accuracy) and 14 to 17 us with numpy (48x to 65x). With the compiled
+phases, what is left is numpy over the output grid: stuck phases, slip, contact and force on the grid
+(the half-sine's sine at every output), about 4 us of a rolling Coulomb scene's 7. Law plugins stay
+plain Python classes: a plugin, a law with memory or a scene model the kernel does not know takes the
+numpy engine.
 """
 from __future__ import annotations
 
