@@ -484,3 +484,23 @@ def test_the_pool_freezes_what_its_workers_inherit_and_unfreezes_it_after():
         with process_pool(2):
             1 / 0
     assert gc.get_freeze_count() == 0
+
+
+def test_datasets_rebuild_into_a_locked_folder_fails_at_once_and_writes_nothing(tmp_path, capsys):
+    from frictionlab import cli
+
+    out = tmp_path / "data"
+    out.mkdir()
+    holder = _hold_lock(out)  # another process is rebuilding into it
+    try:
+        rc = cli.main(["datasets", "rebuild", "--out", str(out)])
+    finally:
+        holder.stdin.close()
+        holder.wait(10)
+    err = capsys.readouterr().err
+    assert rc == 2, err
+    assert err.strip() == (f"frictionlab: error: {out}: another frictionlab run is writing this output "
+                           f"(lock {tmp_path / '.data.lock'}); wait for it to finish or choose another --out")
+    assert list(out.iterdir()) == []
+    assert cli.main(["datasets", "rebuild", "--out", str(out)]) == 0  # released: the rebuild goes through
+    assert len(list(out.iterdir())) > 10 and not (tmp_path / ".data.lock").exists()

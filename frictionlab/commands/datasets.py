@@ -172,7 +172,9 @@ def _rebuild(args) -> int:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"{out}: cannot create the output folder: {exc.strerror or exc}") from None
-    with tempfile.TemporaryDirectory(dir=out) as tmp:
+    from ..io import output_lock
+
+    with output_lock(out), tempfile.TemporaryDirectory(dir=out) as tmp:  # one rebuild of a folder at a time
         written = rebuild(Path(tmp), generators)
         for p in written:  # all generated first, then moved: no half-rebuilt folder
             shutil.move(str(p), out / p.name)
