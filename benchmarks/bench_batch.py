@@ -237,7 +237,8 @@ def warm_jit(args):
     simulate_batch("coulomb", b, p, solver="DOP853", n=NT)
     st = compiled_kernel.kernel.stats
     print(f"compiled engine: numba {__import__('numba').__version__}; one-off import, compile or cache load and first "
-          f"call {time.perf_counter() - t0:.2f} s wall, {clock() - c0:.2f} s CPU (kernel cache hits {sum(st.cache_hits.values())}, "
+          f"call {time.perf_counter() - t0:.2f} s wall, {clock() - c0:.2f} s CPU (kernel cache hits "
+          f"{sum(st.cache_hits.values())}, "
           f"misses {sum(st.cache_misses.values())}), not in any timing below")
 
 
@@ -283,12 +284,14 @@ def rk_vs_plain(name, law, batch, params, args, rng):
         err_batch = np.max(np.abs(br.u - ex.u), axis=1) / scale
         matched = err_batch[sub].max() <= e.max() * (1 + 1e-6)  # not larger, beyond round-off in the error itself
         print(f"  batch DOP853, {label} engine ({br.info.get('engine', '?')} ran), rtol={args.rtol:g}: {t_batch:.3f} s "
-              f"({t_batch / n * 1e6:.1f} us/scene, median of {len(times)} runs {', '.join(f'{x:.3f}' for x in times)}); "
+              f"({t_batch / n * 1e6:.1f} us/scene, median of {len(times)} runs "
+              f"{', '.join(f'{x:.3f}' for x in times)}); "
               f"slip error max {err_batch.max():.2e}, median {np.median(err_batch):.2e} (on the loop's scenes: max "
               f"{err_batch[sub].max():.2e}, median {np.median(err_batch[sub]):.2e}); {br.info['nfev'] / n:.0f} "
               "evaluations per scene")
         if not matched:
-            print(f"  NO RATIO ({label}): the batch is less accurate than the loop on these scenes (accuracy not matched)")
+            print(f"  NO RATIO ({label}): the batch is less accurate than the loop on these scenes "
+                  "(accuracy not matched)")
             continue
         ratios[label] = ratio = est / t_batch
         print(f"  RATIO plain loop / batch ({label} engine) at matched accuracy: {ratio:.0f}x  (target >= 100x: "

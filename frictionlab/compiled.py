@@ -33,15 +33,9 @@ import numpy as np
 from . import vecrk
 from .errors import SolverError
 
-#: Columns of the per-scene constants (``Prepared.cols``).
-(MASS, RADIUS, INERTIA, DRIVE, VANISH, A_OR_K, C, AREA_PEAK, AREA_PHI, AREA_TC, AREA_CONST, NORMAL_PEAK, NORMAL_PHI,
- NORMAL_TC, NORMAL_CONST, BREAK_AREA, BREAK_NORMAL) = range(17)
-NCOL = 17
-#: Model codes.
-NONE, HALF_SINE, CONSTANT = 0, 1, 2
-FORM_NAR, FORM_AS = 0, 1  # NormalAreaRateForm, AreaSlipForm
-#: Kernel status codes per scene.
-OK, UNDERFLOW, TOO_MANY, NOT_FINITE = 0, 1, 2, 3
+from .compiled_codes import (A_OR_K, AREA_CONST, AREA_PEAK, AREA_PHI, AREA_TC, BREAK_AREA, BREAK_NORMAL, CONSTANT,
+                             DRIVE, FORM_AS, FORM_NAR, HALF_SINE, INERTIA, MASS, NCOL, NONE, NORMAL_CONST, NORMAL_PEAK,
+                             NORMAL_PHI, NORMAL_TC, NOT_FINITE, OK, RADIUS, TOO_MANY, UNDERFLOW, VANISH, C)
 
 def available() -> bool:
     """numba importable (not imported here: the first compiled call imports it)."""
@@ -172,7 +166,8 @@ class Prepared:
         Ys = [Y[min(j, d - 1)] for j in range(3)]  # each (k, m) C-contiguous: one signature for any caller
         assert all(y.flags.c_contiguous for y in Ys)
         iters = kern(*_tableau(method), self.codes, self.cols, np.ascontiguousarray(ids, dtype=np.int64), t0, y0,
-                     direction, span, np.require(scale, requirements="CW"), grid, per_row, rel, float(rtol), float(atol),
+                     direction, span, np.require(scale, requirements="CW"), grid, per_row, rel, float(rtol),
+                     float(atol),
                      vecrk.MAX_ITERATIONS, *Ys, reached, t_event, y_event, nfev, stat)
         if stat[0] != OK:
             i = int(ids[stat[1]])

@@ -8,13 +8,12 @@ import math
 import numba
 import numpy as np
 
-from .compiled import (A_OR_K, AREA_CONST, AREA_PEAK, AREA_PHI, AREA_TC, BREAK_AREA, BREAK_NORMAL, CONSTANT, DRIVE,
-                       FORM_NAR, HALF_SINE, INERTIA, MASS, NORMAL_CONST, NORMAL_PEAK, NORMAL_PHI, NORMAL_TC,
-                       NOT_FINITE, RADIUS, TOO_MANY, UNDERFLOW, VANISH, C)
+from .compiled_codes import (A_OR_K, AREA_CONST, AREA_PEAK, AREA_PHI, AREA_TC, BREAK_AREA, BREAK_NORMAL, CONSTANT,
+                             DRIVE, FORM_NAR, HALF_SINE, INERTIA, MASS, NORMAL_CONST, NORMAL_PEAK, NORMAL_PHI,
+                             NORMAL_TC, NOT_FINITE, RADIUS, TOO_MANY, UNDERFLOW, VANISH, C)
 from .vecrk import BISECTIONS
 
 jit = numba.njit(cache=True, fastmath=False, error_model="numpy", inline="always")
-
 
 
 @jit
