@@ -506,9 +506,10 @@ def _breakaway(law, batch, p, ids, ts, ys, t_end, last_dir):
     return tb, hold, need
 
 
-def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask, block=2048):
+def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask, block=256):
     """Stuck-phase states (``solvers.stick.stuck_states``) at outputs in [t_from, t_to] not yet filled; per
-    scene on its whole grid row, ``block`` scenes at a time (working memory bounded, not per output point)."""
+    scene on its whole grid row, ``block`` scenes at a time (working memory bounded, not per output point;
+    256 scenes of 101 outputs cost a third less per scene than 2,048, their arrays staying in cache)."""
     assert all(y.flags.c_contiguous for y in Y) and done.flags.c_contiguous  # written through flat views
     m = T.shape[1]
     for b in range(0, ids.size, block):
