@@ -506,16 +506,22 @@ def _breakaway(law, batch, p, ids, ts, ys, t_end, last_dir):
     return tb, hold, need
 
 
-def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask, block=256):
+def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask, block=256, fast=None):
     """Stuck-phase states (``solvers.stick.stuck_states``) at outputs in [t_from, t_to] not yet filled; per
     scene on its whole grid row, ``block`` scenes at a time (working memory bounded, not per output point;
-    256 scenes of 101 outputs cost a third less per scene than 2,048, their arrays staying in cache)."""
+    256 scenes of 101 outputs cost a third less per scene than 2,048, their arrays staying in cache). With
+    ``fast`` (numba there) the selection and writing are one compiled pass (``compiled.scatter_stuck``)."""
     assert all(y.flags.c_contiguous for y in Y) and done.flags.c_contiguous  # written through flat views
     m = T.shape[1]
     for b in range(0, ids.size, block):
         bi = slice(b, b + block)
         rows = ids[bi]
         Ts = T[rows]
+        if fast is not None:
+            plan = _plan(law, batch.view(rows, column=True))
+            Ys, _ = stick.stuck_states(plan, Ts, ts[bi, None], ys[:, bi, None])
+            compiled.scatter_stuck(Ys, rows, Ts, t_from[bi], t_to[bi], done, stuck_mask, Y)
+            continue
         sel = (Ts >= t_from[bi, None]) & (Ts <= t_to[bi, None]) & ~done[rows]
         r, c = np.nonzero(sel)
         if r.size == 0:
@@ -565,7 +571,8 @@ def _run_rk(law, batch, p, T, method, rtol, atol, into=None):
                 Y.fill(np.nan)
             if held.any():
                 h_ids = stuck_ids[held]
-                _fill_stuck(law, batch, h_ids, t0[h_ids], y0[:, h_ids], t0[h_ids], end[held], T, Y, done, stuck_mask)
+                _fill_stuck(law, batch, h_ids, t0[h_ids], y0[:, h_ids], t0[h_ids], end[held], T, Y, done, stuck_mask,
+                            fast=fast)
             go = ~np.isnan(tb) & (tb < t_end[stuck_ids])
             ids = stuck_ids[go]
             if ids.size:

@@ -178,6 +178,15 @@ class Prepared:
         return vecrk.Result(Y, reached, t_event, y_event, nfev, int(iters), scaled=False)
 
 
+def scatter_stuck(Ys, rows, Ts, t_from, t_to, done, stuck_mask, Y):
+    """``compiled_kernel.scatter_stuck`` (the bookkeeping of ``batch._fill_stuck``) for states Y (d, n, m)."""
+    d = Y.shape[0]
+    _compiled().scatter_stuck(np.ascontiguousarray(Ys), np.ascontiguousarray(rows, dtype=np.int64),
+                              np.ascontiguousarray(Ts), np.ascontiguousarray(t_from, dtype=float),
+                              np.ascontiguousarray(t_to, dtype=float), done, stuck_mask,
+                              *[Y[min(j, d - 1)] for j in range(3)])
+
+
 def _compiled():
     """The kernel module (imports numba, compiles or loads the kernel on first call)."""
     from . import compiled_kernel

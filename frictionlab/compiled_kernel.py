@@ -379,3 +379,24 @@ def kernel(A, B, Cn, E, AX, CX, D, order, exponent, dop, codes, cols, ids, t0a, 
                     Y2[i, col] = np.nan
     return iters_max
 
+
+
+@numba.njit(cache=True)
+def scatter_stuck(Ys, rows, Ts, t_from, t_to, done, stuck_mask, Y0, Y1, Y2):
+    """Bookkeeping of ``batch._fill_stuck`` in one pass: the stuck states Ys (d, k, m) of scenes rows at
+    their output times Ts (k, m) into the outputs of those scenes in [t_from, t_to] not yet done (rows
+    of Y0, Y1, Y2), marking them done and stuck. No physics: Ys comes from ``stick.stuck_states``."""
+    d = Ys.shape[0]
+    m = Ts.shape[1]
+    for r in range(rows.size):
+        g = rows[r]
+        lo, hi = t_from[r], t_to[r]
+        for c in range(m):
+            tt = Ts[r, c]
+            if tt >= lo and tt <= hi and not done[g, c]:
+                Y0[g, c] = Ys[0, r, c]
+                if d > 1:
+                    Y1[g, c] = Ys[1, r, c]
+                    Y2[g, c] = Ys[2, r, c]
+                done[g, c] = True
+                stuck_mask[g, c] = True
