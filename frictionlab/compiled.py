@@ -19,6 +19,10 @@ checks every output against the numpy engine. The kernel's right-hand side ``_rh
 forms' derivatives as ``Plan.derivatives`` computes them (branch slip included); it is the one place
 physics is written here, and the tests check it against ``Plan.derivatives``.
 
+``scatter_stuck`` does the bookkeeping of ``batch._fill_stuck`` (which outputs a stuck phase owns, and
+writing them) in one compiled pass for the same batches; the stuck states themselves come from
+``solvers.stick.stuck_states``.
+
 Counting: ``nfev`` counts the evaluations each scene made (the numpy engine also counts the dense-output
 stages it evaluates for every active scene of a step in which any needed them). Serial (CPU time is the
 measure); compiled on first use and cached on disk (``cache=True``).
