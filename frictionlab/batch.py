@@ -35,13 +35,13 @@ phases of the built-in laws' closed-form families (Coulomb, area-rate, wear, Cou
 and inclines run in ``frictionlab.compiled`` when numba is installed (``pip install
 'frictionlab[fast]'``), else, like every other law, in ``frictionlab.vecrk`` (numpy); both take the same
 steps and give the same numbers (tests/test_compiled.py: bitwise for every law whose force is its
-form's expression). At 10,000 scenes and rtol 1e-8 a DOP853 solve costs 7 to 8 us per scene with the
-compiled phases (90x to 145x less than a loop of solve_ivp on a plain Python right-hand side at the
-same method, rtol, event and accuracy) and 14 to 17 us with numpy (48x to 65x). With the compiled
-phases, what is left is numpy over the output grid: stuck phases, slip, contact and force on the grid
-(the half-sine's sine at every output), about 4 us of a rolling Coulomb scene's 7. Law plugins stay
-plain Python classes: a plugin, a law with memory or a scene model the kernel does not know takes the
-numpy engine.
+form's expression). At 10,000 scenes and rtol 1e-8 a DOP853 solve costs 5.5 to 8 us per scene with the
+compiled phases (125x to 150x less than a loop of solve_ivp on a plain Python right-hand side at the
+same method, rtol, event and accuracy) and 14 to 18 us with numpy (48x to 65x). With the compiled
+phases, what is left is numpy over the output grid: slip, contact and force on the grid (the
+half-sine's sine at every output) and the stuck phases' states, 3 us of a rolling Coulomb scene's 5.5.
+Law plugins stay plain Python classes: a plugin, a law with memory or a scene model the kernel does not
+know takes the numpy engine.
 """
 from __future__ import annotations
 
