@@ -30,15 +30,15 @@ integrator evaluates each step's outputs as one block; beyond CHUNK scenes the b
 integrated and finished straight into the result arrays (v, omega, theta are rows of one states
 block), so memory stays below 2x the results and no chunk is copied.
 
-Engines (measured by benchmarks/bench_batch.py, CPU time on a shared 2-core machine): the sliding
-phases of the built-in laws' closed-form families (Coulomb, area-rate, wear, Couette) on rigid impacts
-and inclines run in ``frictionlab.compiled`` when numba is installed (``pip install
-'frictionlab[fast]'``), else, like every other law, in ``frictionlab.vecrk`` (numpy); both take the same
-steps and give the same numbers (tests/test_compiled.py: bitwise for every law whose force is its
-form's expression). At 10,000 scenes and rtol 1e-8 a DOP853 solve costs 5.5 to 8 us per scene with the
-compiled phases (125x to 150x less than a loop of solve_ivp on a plain Python right-hand side at the
-same method, rtol, event and accuracy) and 14 to 18 us with numpy (48x to 65x). With the compiled
-phases, what is left is numpy over the output grid: slip, contact and force on the grid (the
+Engines (measured by benchmarks/bench_batch.py, CPU time on a shared 2-core machine): the sliding phases
+of the built-in laws' closed-form families (Coulomb, area-rate, wear, Couette) on rigid impacts and
+inclines run in ``frictionlab.compiled`` when numba is installed (``pip install 'frictionlab[fast]'``),
+else, like every other law, in ``frictionlab.vecrk`` (numpy); both take the same steps and give the same
+numbers (tests/test_compiled.py checks them to 1e-12; bitwise on the benchmark machine for a law whose
+force is its form's expression). At 10,000 scenes and rtol 1e-8 a DOP853 solve costs 5.5 to 9 us per
+scene with the compiled phases (126x to 152x less than a loop of solve_ivp on a plain Python right-hand
+side at the same method, rtol, event and accuracy) and 14 to 18 us with numpy (48x to 65x). With the
+compiled phases, what is left is numpy over the output grid: slip, contact and force on the grid (the
 half-sine's sine at every output) and the stuck phases' states, 3 us of a rolling Coulomb scene's 5.5.
 Law plugins stay plain Python classes: a plugin, a law with memory or a scene model the kernel does not
 know takes the numpy engine.
