@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import importlib.util
 import math
+import warnings
 
 import numpy as np
 
@@ -41,9 +42,26 @@ from .compiled_codes import (A_OR_K, AREA_CONST, AREA_PEAK, AREA_PHI, AREA_TC, B
                              DRIVE, FORM_AS, FORM_NAR, HALF_SINE, INERTIA, MASS, NCOL, NONE, NORMAL_CONST, NORMAL_PEAK,
                              NORMAL_PHI, NORMAL_TC, NOT_FINITE, OK, RADIUS, TOO_MANY, UNDERFLOW, VANISH, C)
 
+_status = None  # None: not checked yet; True: usable; else why not
+
+
 def available() -> bool:
-    """numba importable (not imported here: the first compiled call imports it)."""
-    return importlib.util.find_spec("numba") is not None
+    """numba importable and the kernel module loads, checked once per process (the first batch that could
+    use it imports numba). A numba that fails to import (one built for another numpy, say) warns once and
+    leaves every batch to the numpy engine."""
+    global _status
+    if _status is None:
+        if importlib.util.find_spec("numba") is None:
+            _status = "numba is not installed"
+        else:
+            try:
+                from . import compiled_kernel  # noqa: F401  (imports numba; compiles on first call only)
+                _status = True
+            except Exception as exc:  # numba's import fails in many ways; none may stop a batch
+                _status = f"{type(exc).__name__}: {exc}"
+                warnings.warn(f"frictionlab: numba is installed but does not import ({_status}); batches use the "
+                              "numpy engine", RuntimeWarning, stacklevel=2)
+    return _status is True
 
 
 def _area_code(model):
@@ -64,7 +82,7 @@ def prepare(law, plan, p, n: int):
     with memory, unknown scene model or state)."""
     from .law import AreaSlipForm, NormalAreaRateForm
 
-    if not available() or not type(law).__module__.startswith("frictionlab.laws."):
+    if not type(law).__module__.startswith("frictionlab.laws."):
         return None
     s = plan.scene
     if plan.law_states or s.spring is not None:
@@ -72,7 +90,7 @@ def prepare(law, plan, p, n: int):
     if plan.states not in (("v",), ("v", "omega", "theta")):
         return None
     form = law.form(p)
-    if not isinstance(form, (AreaSlipForm, NormalAreaRateForm)):
+    if not isinstance(form, (AreaSlipForm, NormalAreaRateForm)) or not available():
         return None
     req = law.requires
     area = _area_code(s.area) if plan.needs_area else NONE

@@ -227,3 +227,19 @@ def test_per_scene_time_grids_are_the_same(monkeypatch):
         slow = numpy_engine(monkeypatch, "coulomb", sc, p, t=grid, solver="DOP853")
         assert fast.info["engine"] == "compiled"
         assert_same(fast, slow)
+
+
+def test_a_numba_that_does_not_import_leaves_batches_to_numpy(monkeypatch):
+    """An installed numba whose import fails (built for another numpy, say) warns once; batches still run."""
+    import sys
+
+    monkeypatch.setattr(compiled, "_status", None)
+    import frictionlab
+
+    monkeypatch.setitem(sys.modules, "frictionlab.compiled_kernel", None)  # its import now raises ImportError
+    monkeypatch.delattr(frictionlab, "compiled_kernel", raising=False)
+    rng = np.random.default_rng(4)
+    sc = oblique(rng, 3)
+    with pytest.warns(RuntimeWarning, match="numba is installed but does not import"):
+        br = simulate_batch("coulomb", sc, {"mu": 0.3}, solver="DOP853")
+    assert br.info["engine"] == "numpy" and not compiled.available()
