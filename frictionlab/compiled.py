@@ -11,11 +11,12 @@ sliding phases, scene by scene in one compiled loop, for the cases whose right-h
 
 Everything else (plugin laws, laws with memory, other models) stays on the numpy engine: numba is an
 optional dependency (``pip install 'frictionlab[fast]'``), never needed by a law plugin. ``prepare``
-says whether a batch is served; ``Prepared.integrate`` returns a ``vecrk.Result`` exactly as
+says whether a batch is served; ``Prepared.integrate`` returns a ``vecrk.Result`` as
 ``vecrk.integrate`` does (the same scaled problem, scipy's tableaus passed in as arrays, the same step
-control, initial step, breaks, zero-slip event on the dense output, dense outputs on the same grid),
-so the same steps and the same numbers up to the rounding of a sine; ``tests/test_compiled.py``
-checks every output against the numpy engine. The kernel's right-hand side ``_rhs`` is the built-in
+control, initial step, breaks, zero-slip event on the dense output, dense outputs on the same grid;
+its Y in the states' units), so the same steps and the same numbers, bitwise where numpy's sine is
+libm's and the law's force is its form's expression; ``tests/test_compiled.py`` checks every output
+against the numpy engine to 1e-12. The kernel's right-hand side ``_rhs`` is the built-in
 forms' derivatives as ``Plan.derivatives`` computes them (branch slip included); it is the one place
 physics is written here, and the tests check it against ``Plan.derivatives``.
 
