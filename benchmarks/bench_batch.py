@@ -1,6 +1,7 @@
 """Batch engine against what a user writes (a loop of solve_ivp), and batch closed forms against bare numpy.
 
 Run:  python benchmarks/bench_batch.py [--n 10000] [--sample 300] [--rtol 1e-8] [--repeats 3] [--scaling 1000 10000 100000]
+      [--no-numba]  (the numpy engine only: no compiled path, no numba comparison)
 
 Everything is measured in this one run on this machine; ratios, not absolute times, are the result.
 Times are CPU seconds of this process (time.process_time): on a shared machine other jobs disturb
@@ -16,13 +17,17 @@ them far less than wall time. Scene families (random, seeded):
    event, timed on a random subset and extrapolated (the output says so). Accuracy: the largest slip
    error over the grid against the closed form, relative to u0, on that subset. The ratio is printed
    only when the batch is as accurate (its error not larger, beyond round-off: a relative 1e-6 of the
-   error itself); otherwise the benchmark says so and prints no ratio. Target >= 100x.
+   error itself); otherwise the benchmark says so and prints no ratio. Target >= 100x. Both engines
+   are timed against the same loop when numba is installed: the compiled sliding phases
+   (frictionlab.compiled, the default for the built-in laws) and the numpy engine (frictionlab.vecrk,
+   every law); the kernel's one-off compile or cache load is timed apart, before anything else.
 2. Batch closed forms against bare numpy of the same expressions (the same sine recurrence and
    Bessel weights on both sides). Target: within 1.5x.
 3. Per-scene CPU (median of the repeats at every size) and peak memory (tracemalloc: numpy's
-   allocations) by batch size, against the size of the results. Targets: per-scene cost flat within
-   1.2x from 1k to 100k scenes; peak <= 2x the results.
-4. The share of batch time spent filling outputs from the dense interpolant.
+   allocations) by batch size, against the size of the results, after one untimed batch of the
+   largest size per family (see ``scaling``). Targets: per-scene cost flat within 1.2x from 1k to
+   100k scenes; peak <= 2x the results.
+4. The share of the numpy engine's batch time spent filling outputs from the dense interpolant.
 """
 from __future__ import annotations
 
@@ -37,6 +42,9 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.special import ive
 
+import contextlib
+
+from frictionlab import compiled
 from frictionlab.batch import SceneBatch, simulate_batch
 from frictionlab.solvers.ode import SLIP_MARGIN
 from frictionlab.scene import HalfSineArea, HalfSineNormal, Scene
@@ -195,9 +203,48 @@ PLAIN = {"coulomb": (plain_coulomb, ("u0", "normal.impulse", "normal.contact_tim
 
 
 # --- measurements ---------------------------------------------------------------------------------
+@contextlib.contextmanager
+def numpy_engine():
+    """The numpy engine (frictionlab.vecrk) for every law, as without numba."""
+    saved = compiled.available
+    compiled.available = lambda: False
+    try:
+        yield
+    finally:
+        compiled.available = saved
+
+
+def engines(args):
+    """(label, context) of the batch engines to time: the compiled one when numba is there, and numpy."""
+    out = []
+    if args.numba and compiled.available():
+        out.append(("compiled", contextlib.nullcontext))
+    out.append(("numpy", numpy_engine))
+    return out
+
+
+def warm_jit(args):
+    """Compile or load the compiled kernel once, timed apart (a one-off per machine and numba version)."""
+    if not (args.numba and compiled.available()):
+        print("compiled engine: " + ("numba not installed" if args.numba else "skipped (--no-numba)")
+              + "; the numpy engine serves every batch")
+        return
+    t0 = time.perf_counter()
+    c0 = clock()
+    from frictionlab import compiled_kernel
+
+    b, p = coulomb_family(2, np.random.default_rng(0))
+    simulate_batch("coulomb", b, p, solver="DOP853", n=NT)
+    st = compiled_kernel.kernel.stats
+    print(f"compiled engine: numba {__import__('numba').__version__}; one-off import, compile or cache load and first "
+          f"call {time.perf_counter() - t0:.2f} s wall, {clock() - c0:.2f} s CPU (kernel cache hits "
+          f"{sum(st.cache_hits.values())}, "
+          f"misses {sum(st.cache_misses.values())}), not in any timing below")
+
+
 def rk_vs_plain(name, law, batch, params, args, rng):
-    """Batch DOP853 against a loop of plain solve_ivp on a random subset. Batch runs and loop chunks
-    alternate, so slow and fast spells of a shared machine hit both alike."""
+    """Batch DOP853 (each engine) against a loop of plain solve_ivp on a random subset. Batch runs and loop
+    chunks alternate, so slow and fast spells of a shared machine hit both alike."""
     n = batch.n
     ex = simulate_batch(law, batch, params, solver="exact", n=NT)
     scale = np.abs(batch.values["u0"])
@@ -205,38 +252,51 @@ def rk_vs_plain(name, law, batch, params, args, rng):
     chunks = np.array_split(sub, args.repeats)
     plain, keys = PLAIN[law]
     (pname,) = params
-    batch_times, loop_time, errs = [], 0.0, []
-    br = None
+    eng = engines(args)
+    batch_times, loop_time, errs = {e: [] for e, _ in eng}, 0.0, []
+    last = {}
+    for label, ctx in eng:  # one untimed run each: the process's allocator warmed as for the scaling section
+        with ctx():
+            simulate_batch(law, batch, params, solver="DOP853", rtol=args.rtol, n=NT)
     for chunk in chunks:
-        br = None  # the previous run's results are freed first, as a loop over batches would (else each run pays
-        # page faults for 2x the results' memory)
-        t, br = median_time(lambda: simulate_batch(law, batch, params, solver="DOP853", rtol=args.rtol, n=NT), 1)
-        batch_times.append(t)
+        for label, ctx in eng:
+            last[label] = None  # the previous run's results are freed first, as a loop over batches would (else each
+            # run pays page faults for 2x the results' memory)
+            with ctx():
+                t, last[label] = median_time(
+                    lambda: simulate_batch(law, batch, params, solver="DOP853", rtol=args.rtol, n=NT), 1)
+            batch_times[label].append(t)
         t0 = clock()
         for i in chunk:
             u = plain(*(float(batch.values[k][i]) for k in keys), float(params[pname][i]), args.rtol, "DOP853")
             errs.append(np.max(np.abs(u - ex.u[i])) / scale[i])
         loop_time += clock() - t0
-    t_batch = float(np.median(batch_times))
-    err_batch = np.max(np.abs(br.u - ex.u), axis=1) / scale
     est = loop_time / sub.size * n
     e = np.array(errs)
-    matched = err_batch[sub].max() <= e.max() * (1 + 1e-6)  # not larger, beyond round-off in the error itself
     print(f"\n[{name}] {n} scenes x {NT} samples; {int(np.sum(~np.isnan(ex.stick_time)))} scenes stick (roll)")
-    print(f"  batch DOP853 rtol={args.rtol:g}: {t_batch:.3f} s ({t_batch / n * 1e6:.1f} us/scene, median of "
-          f"{len(batch_times)} runs {', '.join(f'{x:.3f}' for x in batch_times)}); slip error max "
-          f"{err_batch.max():.2e}, median {np.median(err_batch):.2e}; {br.info['nfev'] / n:.0f} evaluations per scene")
     print(f"  plain solve_ivp DOP853 loop, rtol={args.rtol:g}: {loop_time:.2f} s for a random {sub.size} of {n} scenes "
           f"({loop_time / sub.size * 1e6:.0f} us/scene) -> extrapolated {est:.1f} s for all; slip error max "
-          f"{e.max():.2e}, median {np.median(e):.2e} (batch on the same scenes: max {err_batch[sub].max():.2e}, "
-          f"median {np.median(err_batch[sub]):.2e})")
-    if not matched:
-        print("  NO RATIO: the batch is less accurate than the loop on these scenes (accuracy not matched)")
-        return None
-    ratio = est / t_batch
-    print(f"  RATIO plain loop / batch at matched accuracy: {ratio:.0f}x  (target >= 100x: "
-          f"{'met' if ratio >= 100 else 'NOT met'})")
-    return ratio
+          f"{e.max():.2e}, median {np.median(e):.2e}")
+    ratios = {}
+    for label, _ in eng:
+        br, times = last[label], batch_times[label]
+        t_batch = float(np.median(times))
+        err_batch = np.max(np.abs(br.u - ex.u), axis=1) / scale
+        matched = err_batch[sub].max() <= e.max() * (1 + 1e-6)  # not larger, beyond round-off in the error itself
+        print(f"  batch DOP853, {label} engine ({br.info.get('engine', '?')} ran), rtol={args.rtol:g}: {t_batch:.3f} s "
+              f"({t_batch / n * 1e6:.1f} us/scene, median of {len(times)} runs "
+              f"{', '.join(f'{x:.3f}' for x in times)}); "
+              f"slip error max {err_batch.max():.2e}, median {np.median(err_batch):.2e} (on the loop's scenes: max "
+              f"{err_batch[sub].max():.2e}, median {np.median(err_batch[sub]):.2e}); {br.info['nfev'] / n:.0f} "
+              "evaluations per scene")
+        if not matched:
+            print(f"  NO RATIO ({label}): the batch is less accurate than the loop on these scenes "
+                  "(accuracy not matched)")
+            continue
+        ratios[label] = ratio = est / t_batch
+        print(f"  RATIO plain loop / batch ({label} engine) at matched accuracy: {ratio:.0f}x  (target >= 100x: "
+              f"{'met' if ratio >= 100 else 'NOT met'})")
+    return ratios
 
 
 def exact_vs_bare(name, law, batch, params, bare, args, rng):
@@ -310,10 +370,17 @@ def scaling(args, rng):
     from frictionlab import batch as batch_module
 
     chunk = getattr(batch_module, "CHUNK", None)
-    print(f"\n[scaling] batch DOP853 rtol={args.rtol:g}, per-scene CPU and peak memory by batch size "
+    engine = "compiled" if compiled.available() else "numpy"
+    print(f"\n[scaling] batch DOP853 ({engine} engine) rtol={args.rtol:g}, per-scene CPU and peak memory by batch size "
           + (f"(chunks of {chunk} scenes)" if chunk else "(no automatic chunking)"))
+    print("  one untimed batch of the largest size per family first: glibc returns a process's first batches' 1-2 MiB "
+          "temporaries to the system after each batch (4 KiB page faults on every use) until a larger batch has raised "
+          "its dynamic mmap threshold; a process that simulates batches is in that state after its first large one")
     for fam, law in ((coulomb_family, "coulomb"), (wear_family, "wear")):
         per = {}
+        b, p = fam(max(args.scaling), rng)
+        simulate_batch(law, b, p, solver="DOP853", rtol=args.rtol, n=NT)
+        del b, p
         for n in args.scaling:
             b, p = fam(n, rng)
             sys0 = resource.getrusage(resource.RUSAGE_SELF).ru_stime
@@ -342,7 +409,8 @@ def dense_share(args, rng):
     """How much of the batch's time goes to filling outputs from the dense interpolant."""
     from frictionlab import vecrk
 
-    print(f"\n[dense output] share of batch DOP853 time in vecrk._dense and vecrk._fill_dense, {args.n} scenes x {NT}")
+    print(f"\n[dense output] numpy engine: share of batch DOP853 time in vecrk._dense and vecrk._fill_dense, "
+          f"{args.n} scenes x {NT}")
     for fam, law in ((coulomb_family, "coulomb"), (wear_family, "wear")):
         b, p = fam(args.n, rng)
         spent = {"_dense": 0.0, "_fill_dense": 0.0}
@@ -360,7 +428,8 @@ def dense_share(args, rng):
         try:
             for k in spent:
                 setattr(vecrk, k, timed(k))
-            t, _ = median_time(lambda: simulate_batch(law, b, p, solver="DOP853", rtol=args.rtol, n=NT), 1)
+            with numpy_engine():
+                t, _ = median_time(lambda: simulate_batch(law, b, p, solver="DOP853", rtol=args.rtol, n=NT), 1)
         finally:
             for k, f in orig.items():
                 setattr(vecrk, k, f)
@@ -384,7 +453,7 @@ def main(argv=None):
           f"{', '.join(f'{x:.1f}' for x in os.getloadavg())} on {os.cpu_count()} cores")
     print(f"n = {args.n} scenes per family, loop timed on {args.sample}, rtol = {args.rtol:g}, "
           f"median of {args.repeats} repeats, seed {args.seed}")
-    print("batch path timed: frictionlab.vecrk in plain numpy (the only engine; no compiled path), laws in plain Python")
+    warm_jit(args)
     cb, cp = coulomb_family(args.n, rng)
     wb, wp = wear_family(args.n, rng)
     rk_vs_plain("coulomb-roll", "coulomb", cb, cp, args, rng)
@@ -392,7 +461,8 @@ def main(argv=None):
     exact_vs_bare("coulomb-roll", "coulomb", cb, cp, bare_coulomb, args, rng)
     exact_vs_bare("wear-paper", "wear", wb, wp, bare_wear, args, rng)
     dense_share(args, rng)
-    scaling(args, rng)
+    with contextlib.nullcontext() if args.numba else numpy_engine():
+        scaling(args, rng)
     print(f"\nload average at end {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
 
 

@@ -16,8 +16,9 @@ Solvers:
             (the area-rate law with eta' > 0 on an unloading contact) go on phase by phase, sliding from
             rest in closed form and perhaps sticking again, with the scenes still going in each round
             (``_exact_phases``); only a scene that starts at zero slip is re-run alone with the scalar solver.
-  'RK45', 'DOP853'  ``frictionlab.vecrk``: scipy's tableaus, per-scene adaptive steps, dense output,
-            zero slip located per scene; stuck phases and breakaway handled per scene.
+  'RK45', 'DOP853'  scipy's tableaus, per-scene adaptive steps, dense output, zero slip located per
+            scene (``frictionlab.vecrk``, or ``frictionlab.compiled`` where it serves: see Engines); stuck
+            phases and breakaway handled per scene.
   'auto'    'exact' where the law and scene admit a closed form, else 'DOP853'.
 Tolerances act on the same scaled problem as ``solvers.ode`` (time by the span, states by
 ``ode.state_scales``), so rtol means what it means for ``simulate(..., solver='ode:...')``;
@@ -29,14 +30,18 @@ integrator evaluates each step's outputs as one block; beyond CHUNK scenes the b
 integrated and finished straight into the result arrays (v, omega, theta are rows of one states
 block), so memory stays below 2x the results and no chunk is copied.
 
-Why numpy (measured by benchmarks/bench_batch.py, CPU time on a shared 2-core machine, load 1.2-1.6):
-at 10,000 scenes and rtol 1e-8 a DOP853 solve costs 14-20 us per scene, 30x to 65x less than a loop
-of solve_ivp on a plain Python right-hand side at the same method, rtol, event and accuracy (not the
-100x targeted); a quarter to a third of it fills the outputs from the dense interpolant, a sixth is
-the sine of the half-sine contact models, and a fixed 5-7 ms per batch is interpreter overhead per
-step (so 1,000 scenes cost 1.3x to 1.5x per scene what 10,000 do). A compiled engine would be
-faster, but would need every law plugin, a plain Python class, written in numba's subset; numpy
-keeps the plugin contract (a force that broadcasts) and needs no compiler.
+Engines (measured by benchmarks/bench_batch.py, CPU time on a shared 2-core machine): the sliding phases
+of the built-in laws' closed-form families (Coulomb, area-rate, wear, Couette) on rigid impacts and
+inclines run in ``frictionlab.compiled`` when numba is installed (``pip install 'frictionlab[fast]'``),
+else, like every other law, in ``frictionlab.vecrk`` (numpy); both take the same steps and give the same
+numbers (tests/test_compiled.py checks them to 1e-12; bitwise on the benchmark machine for a law whose
+force is its form's expression). At 10,000 scenes and rtol 1e-8 a DOP853 solve costs 5.5 to 9 us per
+scene with the compiled phases (126x to 152x less than a loop of solve_ivp on a plain Python right-hand
+side at the same method, rtol, event and accuracy) and 14 to 18 us with numpy (48x to 65x). With the
+compiled phases, what is left is numpy over the output grid: slip, contact and force on the grid (the
+half-sine's sine at every output) and the stuck phases' states, 3 us of a rolling Coulomb scene's 5.5.
+Law plugins stay plain Python classes: a plugin, a law with memory or a scene model the kernel does not
+know takes the numpy engine.
 """
 from __future__ import annotations
 
@@ -46,7 +51,7 @@ from collections.abc import Mapping, Sequence
 import attrs
 import numpy as np
 
-from . import vecrk
+from . import compiled, vecrk
 from .errors import ParameterError, SceneError, SolverError
 from .plan import Plan, make_plan
 from .registry import get_law
@@ -321,6 +326,9 @@ def _chunked(law, batch, p, tgrid, solver, rtol, atol) -> BatchResult:
     solvers = {s for s, _ in parts}
     info = {"chunks": len(parts), "nfev": int(sum(i.get("nfev", 0) for _, i in parts)),
             **({"rtol": rtol, "atol": rtol if atol is None else atol} if "exact" not in solvers else {})}
+    engines = {i["engine"] for _, i in parts if "engine" in i}
+    if engines:
+        info["engine"] = "+".join(sorted(engines))
     spin = plan.has_spin
     return BatchResult(t=tgrid, solver="+".join(sorted(solvers)), law=law.name, info=info, v=states[0],
                        omega=states[plan.index("omega")] if spin else np.zeros((n, m)),
@@ -498,15 +506,22 @@ def _breakaway(law, batch, p, ids, ts, ys, t_end, last_dir):
     return tb, hold, need
 
 
-def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask, block=2048):
+def _fill_stuck(law, batch, ids, ts, ys, t_from, t_to, T, Y, done, stuck_mask, block=256, fast=None):
     """Stuck-phase states (``solvers.stick.stuck_states``) at outputs in [t_from, t_to] not yet filled; per
-    scene on its whole grid row, ``block`` scenes at a time (working memory bounded, not per output point)."""
+    scene on its whole grid row, ``block`` scenes at a time (working memory bounded, not per output point;
+    256 scenes of 101 outputs cost a third less per scene than 2,048, their arrays staying in cache). With
+    ``fast`` (numba there) the selection and writing are one compiled pass (``compiled.scatter_stuck``)."""
     assert all(y.flags.c_contiguous for y in Y) and done.flags.c_contiguous  # written through flat views
     m = T.shape[1]
     for b in range(0, ids.size, block):
         bi = slice(b, b + block)
         rows = ids[bi]
         Ts = T[rows]
+        if fast is not None:
+            plan = _plan(law, batch.view(rows, column=True))
+            Ys, _ = stick.stuck_states(plan, Ts, ts[bi, None], ys[:, bi, None])
+            compiled.scatter_stuck(Ys, rows, Ts, t_from[bi], t_to[bi], done, stuck_mask, Y)
+            continue
         sel = (Ts >= t_from[bi, None]) & (Ts <= t_to[bi, None]) & ~done[rows]
         r, c = np.nonzero(sel)
         if r.size == 0:
@@ -543,6 +558,7 @@ def _run_rk(law, batch, p, T, method, rtol, atol, into=None):
     slide_ids = np.nonzero(direction != 0)[0]
     stuck_ids = np.nonzero(direction == 0)[0]
     last_dir = np.zeros(nsc)
+    fast = compiled.prepare(law, full, p, nsc)  # the compiled sliding phases, where they serve this batch
     while slide_ids.size or stuck_ids.size:
         if stuck_ids.size:
             segments[stuck_ids] += 1
@@ -555,7 +571,8 @@ def _run_rk(law, batch, p, T, method, rtol, atol, into=None):
                 Y.fill(np.nan)
             if held.any():
                 h_ids = stuck_ids[held]
-                _fill_stuck(law, batch, h_ids, t0[h_ids], y0[:, h_ids], t0[h_ids], end[held], T, Y, done, stuck_mask)
+                _fill_stuck(law, batch, h_ids, t0[h_ids], y0[:, h_ids], t0[h_ids], end[held], T, Y, done, stuck_mask,
+                            fast=fast)
             go = ~np.isnan(tb) & (tb < t_end[stuck_ids])
             ids = stuck_ids[go]
             if ids.size:
@@ -575,20 +592,21 @@ def _run_rk(law, batch, p, T, method, rtol, atol, into=None):
                               f"in scene {i} (chatter); the law is not suited to this scene")
         first_all = Y is None and slide_ids.size == nsc and into is not None  # integrated straight into the result
         res = _slide_rk(law, batch, p, slide_ids, t0, y0, direction, T, t_end, scale, method, rtol, atol,
-                        into["states"] if first_all else None)
+                        into["states"] if first_all else None, fast)
         iterations += res.iterations
         nfev[slide_ids] += res.nfev
         new = res.reached & ~done[slide_ids]
         if Y is None:  # the first phase and every scene slides: its outputs (NaN where not reached) are Y
             Y = res.Y
-            Y *= scale[:, :, None]
+            if res.scaled:
+                Y *= scale[:, :, None]
             done |= new
         elif slide_ids.size == nsc:  # every scene slides: no gathering
-            np.copyto(Y, res.Y * scale[:, :, None], where=new[None])
+            np.copyto(Y, res.Y * scale[:, :, None] if res.scaled else res.Y, where=new[None])
             done |= new
         else:
             r, c = np.nonzero(new)
-            Y[:, slide_ids[r], c] = res.Y[:, r, c] * scale[:, slide_ids[r]]
+            Y[:, slide_ids[r], c] = res.Y[:, r, c] * scale[:, slide_ids[r]] if res.scaled else res.Y[:, r, c]
             done[slide_ids[r], c] = True
         ev = np.nonzero(~np.isnan(res.t_event))[0]
         ids = slide_ids[ev]
@@ -608,12 +626,16 @@ def _run_rk(law, batch, p, T, method, rtol, atol, into=None):
     out = _finish(law, batch, p, T, Y, ~stuck_mask, need, into)
     out["stick_time"] = stick_time
     return out, {"nfev": int(nfev.sum()), "nfev_per_scene": nfev, "iterations": iterations,
-                 "segments": int(segments.max(initial=0)), "method": method}
+                 "segments": int(segments.max(initial=0)), "method": method,
+                 "engine": "numpy" if fast is None else "compiled"}
 
 
-def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rtol, atol, out=None):
-    """One sliding phase for scenes ``ids`` on the scaled problem (time / span, states / scale)."""
+def _slide_rk(law, batch, p, ids, t0, y0, direction, T, t_end, scale, method, rtol, atol, out=None, fast=None):
+    """One sliding phase for scenes ``ids`` on the scaled problem (time / span, states / scale); with
+    ``fast`` (``compiled.prepare``) by the compiled kernel, else by ``vecrk.integrate``: the same steps."""
     span = t_end[ids]
+    if fast is not None:
+        return fast.integrate(ids, t0, y0, direction, t_end, scale, T, method, rtol, atol, out)
     sc = scale[:, ids]
 
     def make_rhs(k):
@@ -653,7 +675,7 @@ def _scaled_grid(T, ids, span):
     m = T.shape[1]
     if T.strides[0] == 0 and np.all(span == span[0]):  # one grid and one span for all
         return T[0] / span[0]
-    Tid = T[ids]
+    Tid = T if ids.size == T.shape[0] else T[ids]  # ids are sorted: all of them is every row in order
     rel = np.linspace(0.0, 1.0, m)
     on = np.all(Tid == span[:, None] * rel, axis=1)
     if on.all():

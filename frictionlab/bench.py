@@ -270,8 +270,12 @@ def measure_case(name, law, params, scene, rtols, repeats, batch_size, n_t=201, 
                nfev=lambda out: 0)
     except FrictionLabError:
         pass
+    try:  # which engine ran the batch's sliding phases (frictionlab.compiled with numba, else numpy)
+        engine = simulate_batch(law, [scene], params, solver=BATCH_METHODS[0], t=t).info.get("engine")
+    except FrictionLabError:
+        engine = None  # no batch for this law
     meta = {"reference": ref_name, "reference_check": ref_check, "n_t": n_t, "batch_size": batch_size,
-            "stick_time_s": ref.stick_time}
+            "stick_time_s": ref.stick_time, "batch_engine": engine}
     return rows, meta
 
 
@@ -356,7 +360,8 @@ def plot_case(path, name, case, rows, env) -> None:
     note = (f"numbers at points: log10 rtol ({min(rt):.0e}..{max(rt):.0e}, atol = rtol on the scaled problem); "
             f"reference: {meta['reference']}" + (f" (Radau {CHECK_RTOL:g} differs by {meta['reference_check']:.1e})"
                                                  if meta["reference_check"] else "")
-            + f"\nexact and batch: per scene in a batch of {meta['batch_size']} (throughput); scipy (plain): solve_ivp "
+            + "\nexact and batch" + (f" ({meta['batch_engine']} engine)" if meta.get("batch_engine") else "")
+            + f": per scene in a batch of {meta['batch_size']} (throughput); scipy (plain): solve_ivp "
               "on a plain Python right-hand side, what a user writes without frictionlab"
             + f"\n{env['cpu']}, {env['cores']} cores; numpy {env['versions'].get('numpy')}, scipy "
               f"{env['versions'].get('scipy')}; errors below {ROUND_OFF:g} drawn at the dashed line")

@@ -28,7 +28,9 @@ BISECTIONS = 60  # event location: interval shrinks by 2^-60, below double resol
 @attrs.frozen
 class Result:
     """Outputs of ``integrate``: Y (n_states, n, m) where reached (else NaN), reached (n, m) bool,
-    t_event (n,) (NaN where no event), y_event (n_states, n), and counters."""
+    t_event (n,) (NaN where no event), y_event (n_states, n), and counters. ``scaled``: Y is in the
+    problem's (scaled) units, as y_event always is; False where a caller's engine wrote it unscaled
+    (``frictionlab.compiled``)."""
 
     Y: np.ndarray
     reached: np.ndarray
@@ -36,6 +38,7 @@ class Result:
     y_event: np.ndarray
     nfev: np.ndarray  # per problem
     iterations: int
+    scaled: bool = True
 
 
 def _rows_dot(M, K, out=None, tmp=None):
@@ -178,7 +181,7 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
         err = _error_norm(cls, _rows_dot(E, Kf[: ns + 1], tmp=tmp).reshape(len(E), d, k), ha, scale)
         ok = err < 1.0
         with np.errstate(divide="ignore"):
-            factor = np.where(err == 0.0, MAX_FACTOR, SAFETY * err**exponent)
+            factor = np.where(err == 0.0, MAX_FACTOR, SAFETY * np.float_power(err, exponent))  # libm pow, as scipy
         factor = np.where(ok, np.minimum(MAX_FACTOR, factor), np.maximum(MIN_FACTOR, factor))
         factor = np.where(ok & rejected[active], np.minimum(1.0, factor), factor)
         H[active] = ha * factor
