@@ -299,6 +299,11 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     order = {d.name: i for i, d in enumerate(dss)}
     if jobs > 1:
         import lmfit  # noqa: F401  (imported once here, before the workers fork, instead of once in each)
+
+        if any(t[1].kind == "impact-outcome" for t in plan):  # likewise numba, where the batch engine will use it
+            from .compiled import available
+
+            available()
     with process_pool(jobs) as pool:
         t0 = time.perf_counter()
         results, done = _run(plan, functools.partial(_fit_task, timeout=fit_timeout), pool, progress, 0, total,
