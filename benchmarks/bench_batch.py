@@ -384,8 +384,10 @@ def scaling(args, rng):
         for n in args.scaling:
             b, p = fam(n, rng)
             sys0 = resource.getrusage(resource.RUSAGE_SELF).ru_stime
+            # every size alike, at least 5 runs: a run whose fresh results land on memory the virtual machine's host
+            # has not yet backed pays several us a scene of system time (first touch), a spell the median passes over
             times = [median_time(lambda: simulate_batch(law, b, p, solver="DOP853", rtol=args.rtol, n=NT), 1)[0]
-                     for _ in range(args.repeats)]  # every size alike: the first run pays the results' page faults
+                     for _ in range(max(args.repeats, 5))]
             sys_time = (resource.getrusage(resource.RUSAGE_SELF).ru_stime - sys0) / len(times)
             t = float(np.median(times))
             tracemalloc.start()
