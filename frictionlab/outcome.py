@@ -83,12 +83,8 @@ class SpeedLaw:
 
 # --- Hertz impact ----------------------------------------------------------------------------
 @functools.cache
-def hertz_shape():
-    """Dimensionless elastic Hertz impact: y'' = -(5/4) y^(3/2), y(0) = 0, y'(0) = 1.
-
-    Returns (s_end, y, dy): the end of contact s_end = (4/5) B(2/5, 1/2) = 2.9432 and the dense
-    solution y(s), y'(s). Integrated once (DOP853, rtol 1e-13).
-    """
+def _hertz_solution():
+    """(s_end, dense) of the dimensionless Hertz impact (see ``hertz_shape``): dense(s) -> (y, y') rows."""
     from scipy.integrate import solve_ivp
 
     def rhs(s, z):
@@ -100,8 +96,16 @@ def hertz_shape():
     end.terminal, end.direction = True, -1
     sol = solve_ivp(rhs, (0.0, 4.0), [0.0, 1.0], method="DOP853", rtol=1e-13, atol=1e-15, dense_output=True,
                     events=end)
-    s_end = float(sol.t_events[0][0])
-    dense = sol.sol
+    return float(sol.t_events[0][0]), sol.sol
+
+
+def hertz_shape():
+    """Dimensionless elastic Hertz impact: y'' = -(5/4) y^(3/2), y(0) = 0, y'(0) = 1.
+
+    Returns (s_end, y, dy): the end of contact s_end = (4/5) B(2/5, 1/2) = 2.9432 and the dense
+    solution y(s), y'(s). Integrated once (DOP853, rtol 1e-13).
+    """
+    s_end, dense = _hertz_solution()
     return s_end, (lambda s: np.maximum(dense(s)[0], 0.0)), (lambda s: dense(s)[1])
 
 
@@ -123,11 +127,13 @@ class HertzPulse:
 
     def shape(self, t):
         """(y, dy/ds) at times t [s]; zero outside the contact."""
-        s_end, y, dy = hertz_shape()
+        s_end, dense = _hertz_solution()
         s = np.asarray(t, dtype=float) / self.time_scale
         inside = (s >= 0) & (s <= s_end)
         sc = np.clip(s, 0.0, s_end)
-        return np.where(inside, y(sc.ravel()).reshape(sc.shape), 0.0), np.where(inside, dy(sc.ravel()).reshape(sc.shape), 0.0)
+        y, dy = dense(sc.ravel())  # both rows of one evaluation of the interpolant
+        return (np.where(inside, np.maximum(y, 0.0).reshape(sc.shape), 0.0),
+                np.where(inside, dy.reshape(sc.shape), 0.0))
 
 
 @attrs.frozen
