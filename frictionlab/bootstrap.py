@@ -382,7 +382,7 @@ def ranking_table(rb: RankingBootstrap, level: float = 0.95) -> list[dict]:
 
 # --- the comparison's bootstrap ------------------------------------------------------------------------
 def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, slow: bool = False, free: Mapping | None = None,
-                   progress=None) -> tuple[list[RankingBootstrap], dict]:
+                   progress=None, timeout: float | None = None) -> tuple[list[RankingBootstrap], dict]:
     """Bootstrap the single-dataset fits of a comparison, parametrically: per dataset, ``n`` replicates
     simulated from the best unflagged fit with the declared noise, and every candidate that fitted
     (law [solver]; structurally identical laws once, ``ranking.merge_identical``) refitted to them,
@@ -414,7 +414,7 @@ def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, slow: bool = Fals
         elif why and not slow:
             skipped[name] = why
         else:
-            opts = {"free": dict(free)} if free else {}
+            opts = ({"free": dict(free)} if free else {}) | ({"timeout": timeout} if timeout is not None else {})
             merged = merge_identical(ok)
             fns = [attrs.evolve(law_fit(f.law, f.solver, **opts), name=" = ".join(members) if len(members) > 1 else "")
                    for f, members, _ in merged]

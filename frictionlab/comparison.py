@@ -177,13 +177,13 @@ def _fit_task(args, timeout=None) -> FitResult:
 
 
 def _equivalence_task(args) -> EquivalenceResult:
-    fa, fb, replicates, seed = args
-    return analyze_equivalence(fa, fb, replicates=replicates, seed=seed)
+    fa, fb, replicates, seed, timeout = args
+    return analyze_equivalence(fa, fb, replicates=replicates, seed=seed, timeout=timeout)
 
 
 def _transfer_task(args):
-    fits, free = args
-    return transfer_candidate(fits, free)
+    fits, free, timeout = args
+    return transfer_candidate(fits, free, timeout)
 
 
 def _run(tasks, fn, pool, progress, done, total, label):
@@ -242,7 +242,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     bootstrap: case resamples per dataset (0: none), drawn from ``seed``; datasets where a law
     needs the ODE, or without a time series, are bootstrapped only with bootstrap_all. tolerance: looser ODE tolerances at
     which the ODE laws of one dataset are refitted (empty: no tolerance check). fit_timeout: time
-    budget of each fit in seconds (None: none); a fit past it is a failed row saying so. replicates: R per
+    budget of each fit in seconds (None: none), the refits of the equivalence test, bootstrap, transfer
+    and tolerance check included; a fit past it is a failed row saying so (a refit, a failed replicate). replicates: R per
     law of the equivalence test's parametric bootstrap (seeded by ``seed``); pairs: (law A, law B)
     to test (default equivalence.PAIRS); pairs where a law needs the ODE solver, or without a time
     series, are tested only with bootstrap_all. transfer: run the transfer stage.
@@ -327,7 +328,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                     slow.append(EquivalenceResult(dataset=d, law_a=la, law_b=lb, solver_a=sa, solver_b=sb,
                                                   status="skipped", reason=why, replicates=replicates, seed=seed))
                 else:
-                    tasks.append((fa, fb, replicates, seed))
+                    tasks.append((fa, fb, replicates, seed, fit_timeout))
             eq_results, done = _run(tasks, _equivalence_task, pool, progress, done, total,
                                     lambda t: f"equivalence on {t[0].datasets[0]}: {t[0].law} [{t[0].solver}] "
                                               f"vs {t[1].law} [{t[1].solver}]")
@@ -339,7 +340,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             t0 = time.perf_counter()
             by_group = candidates_by_group(fits, dss)
             tasks = [(g, c, fs) for g, cands in by_group.items() for c, fs in cands.items()]
-            parts, _ = _run([(fs, dict(free or {})) for _, _, fs in tasks], _transfer_task, pool, None, 0, 0, str)
+            parts, _ = _run([(fs, dict(free or {}), fit_timeout) for _, _, fs in tasks], _transfer_task, pool, None, 0,
+                            0, str)
             for g, cands in by_group.items():
                 transfer_results.append(assemble(g, cands, {c: p for (gg, c, _), p in zip(tasks, parts) if gg == g}))
             if by_group:
@@ -349,7 +351,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
 
         def tolerance_stage():
             t0 = time.perf_counter()
-            rows = tolerance_check(fits, tuple(tolerance), pool, fit_options={"free": dict(free)} if free else None)
+            options = ({"free": dict(free)} if free else {}) | ({"timeout": fit_timeout} if fit_timeout else {})
+            rows = tolerance_check(fits, tuple(tolerance), pool, fit_options=options or None)
             step("tolerance check")
             timings["tolerance"] = time.perf_counter() - t0
             return rows
@@ -362,7 +365,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             if bootstrap:
                 t0 = time.perf_counter()
                 boots, boot_skipped = bootstrap_fits(
-                    fits, bootstrap, seed, pool, bootstrap_all, free,
+                    fits, bootstrap, seed, pool, bootstrap_all, free, timeout=fit_timeout,
                     progress=lambda name, k, n: step(f"bootstrap on {name}: {k}/{n} resamples", advance=k == n))
                 timings["bootstrap"] = time.perf_counter() - t0
             if tol_future is not None:

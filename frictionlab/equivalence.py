@@ -209,19 +209,20 @@ def _refit_options(f: FitResult) -> dict:
 
 def _refit(law: str, opts: dict, target: Target, scan: int = 0, n_starts: int = 1) -> FitResult:
     return fit(law, target, solver=opts["solver"], initial=opts["initial"], fixed=opts["fixed"] or None,
-               free=opts["free"] or None, scan=scan, n_starts=n_starts, checks=False, errors=False)
+               free=opts["free"] or None, scan=scan, n_starts=n_starts, checks=False, errors=False,
+               timeout=opts.get("timeout"))
 
 
 def _with_y(target: Target, y: np.ndarray, what: str) -> Target:
     return Target(target.dataset, target.observable, y, target.sigma, what)
 
 
-def cross_chi2(own: FitResult, other: FitResult) -> float:
+def cross_chi2(own: FitResult, other: FitResult, timeout: float | None = None) -> float:
     """``own``'s law refitted to ``other``'s noise-free best curve: the chi-square it is left with
-    at the declared noise (nan if the refit fails)."""
+    at the declared noise (nan if the refit fails, or takes longer than ``timeout`` seconds)."""
     d = other.per_dataset[0]
     tg = _with_y(d.target, d.model.copy(), f"best fit of {other.law}")
-    r = _refit(own.law, _refit_options(own), tg, scan=25, n_starts=2)
+    r = _refit(own.law, _refit_options(own) | {"timeout": timeout}, tg, scan=25, n_starts=2)
     return float(r.stats.chisqr) if r.ok else math.nan
 
 
@@ -260,12 +261,13 @@ def _seeds(seed: int, key: str, n: int):
 
 # --- the test -------------------------------------------------------------------------------------
 def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = REPLICATES, seed: int = 0,
-                        executor=None, chunk: int | None = None) -> EquivalenceResult:
+                        executor=None, chunk: int | None = None, timeout: float | None = None) -> EquivalenceResult:
     """Discrimination test of ``fit_a``'s law against ``fit_b``'s on their (common) dataset.
 
     replicates: R per null (Monte-Carlo error of a p-value about sqrt(p(1-p)/R)); seed: the draws
     depend on it and on the dataset and the pair only. executor: None (here) or anything with
-    ``submit`` (see bootstrap.py); chunk: replicates per task (default R / 4)."""
+    ``submit`` (see bootstrap.py); chunk: replicates per task (default R / 4); timeout: time budget of
+    each refit in seconds (None: none), past which it counts as a failed refit."""
     base = dict(dataset=fit_a.datasets[0], law_a=fit_a.law, law_b=fit_b.law, solver_a=fit_a.solver,
                 solver_b=fit_b.solver, replicates=int(replicates), seed=int(seed))
     if fit_a.datasets != fit_b.datasets or len(fit_a.datasets) != 1:
@@ -287,9 +289,9 @@ def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = RE
                   sigma_varies=bool(np.ptp(sig) > 1e-12 * np.max(sig)), fitted=fitted, decomposition=dec,
                   chi2={fit_a.law: fit_a.stats.chisqr, fit_b.law: fit_b.stats.chisqr},
                   k={fit_a.law: fit_a.stats.n_params, fit_b.law: fit_b.stats.n_params})
-    d_ab, d_ba = cross_chi2(fit_a, fit_b), cross_chi2(fit_b, fit_a)
+    d_ab, d_ba = cross_chi2(fit_a, fit_b, timeout), cross_chi2(fit_b, fit_a, timeout)
     threshold = _threshold(d_ab, d_ba, n, common["sigma"])
-    opts_a, opts_b = _refit_options(fit_a), _refit_options(fit_b)
+    opts_a, opts_b = (_refit_options(f) | {"timeout": timeout} for f in (fit_a, fit_b))
     seeds = _seeds(seed, f"{base['dataset']}|{fit_a.law}[{fit_a.solver}]|{fit_b.law}[{fit_b.solver}]", replicates)
     chunk = max(1, int(chunk or math.ceil(replicates / 4)))
     groups = [seeds[i:i + chunk] for i in range(0, replicates, chunk)]

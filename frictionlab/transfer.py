@@ -220,7 +220,7 @@ def predict_from(source: FitResult, target: FitResult) -> Prediction:
     return Prediction(**base, status="ok", n=int(z.size), chi2=chi2, rms_sigma=math.sqrt(chi2 / z.size), loglik=loglik)
 
 
-def shared_fit(fits: Sequence[FitResult], free: dict | None = None) -> SharedFit:
+def shared_fit(fits: Sequence[FitResult], free: dict | None = None, timeout: float | None = None) -> SharedFit:
     """One parameter set for every member of ``fits`` (one candidate's separate fits) against them."""
     from scipy.stats import chi2 as chi2_dist
 
@@ -236,7 +236,7 @@ def shared_fit(fits: Sequence[FitResult], free: dict | None = None) -> SharedFit
     for f in sorted(fits, key=lambda f: f.stats.chisqr):
         start = {p.key: p.value for p in f.params.values() if p.kind == "law" and p.vary}
         r = fit(law, targets, solver=f.per_dataset[0].solver, initial=start, scan=0, n_starts=1, free=free or None,
-                checks=False)
+                checks=False, timeout=timeout)
         if r.ok and (best is None or r.stats.chisqr < best.stats.chisqr):
             best = r
     if best is None:
@@ -251,10 +251,12 @@ def shared_fit(fits: Sequence[FitResult], free: dict | None = None) -> SharedFit
                      shared=_determined(best))
 
 
-def transfer_candidate(fits: Sequence[FitResult], free: dict | None = None) -> tuple[list[Prediction], SharedFit]:
-    """Every ordered transfer prediction among one candidate's fits of a group, and its shared fit."""
+def transfer_candidate(fits: Sequence[FitResult], free: dict | None = None,
+                       timeout: float | None = None) -> tuple[list[Prediction], SharedFit]:
+    """Every ordered transfer prediction among one candidate's fits of a group, and its shared fit
+    (each of its fits within ``timeout`` seconds, None: no limit)."""
     preds = [predict_from(s, t) for s in fits for t in fits if s is not t]
-    return preds, shared_fit(fits, free)
+    return preds, shared_fit(fits, free, timeout)
 
 
 def _members(datasets, group_of=None) -> dict[str, list]:

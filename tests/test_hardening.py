@@ -189,6 +189,49 @@ def test_compare_turns_a_runaway_fit_into_a_failed_row(monkeypatch):
     assert [r.law for r in c.ranking if r.status != "failed"][:1] == ["wear"]
 
 
+class _StallsLater(FrictionLaw):
+    """F = k u, whose evaluations never return once ``stall`` is set (after its first fits)."""
+    name = "stalls-later"
+    formula = "F = k u"
+    citation = "a test of --fit-timeout on refits"
+    params = (ParamSpec("k", "N s/m", 1.0, 0.0, 100.0, 1.0, "coefficient"),)
+    requires = frozenset({"u"})
+    stall = False
+
+    def force(self, p, c):
+        while type(self).stall:
+            pass
+        return p["k"] * c.u
+
+
+def test_refits_of_the_equivalence_test_bootstrap_and_transfer_keep_the_time_budget():
+    from frictionlab.bootstrap import bootstrap_fits
+    from frictionlab.equivalence import MIN_REPLICATES, analyze_equivalence
+    from frictionlab.transfer import shared_fit
+
+    fl.register_law(_StallsLater)
+    try:
+        fits = [fl.fit(law, name) for name in ("incline-oil-a100", "incline-oil-a200") for law in ("stalls-later", "wear")]
+        assert all(f.ok for f in fits)
+        _StallsLater.stall = True  # every refit of it now runs away unless its budget stops it
+        t0 = time.monotonic()
+        e = analyze_equivalence(fits[0], fits[1], replicates=MIN_REPLICATES, timeout=0.05)
+        boots, skipped = bootstrap_fits(fits[:2], 4, slow=True, timeout=0.05)  # slow: its fit needs the ODE
+        shared = shared_fit([fits[0], fits[2]], timeout=0.05)
+        assert time.monotonic() - t0 < 60  # without the budget the first refit never returns
+    finally:
+        _StallsLater.stall = False
+        registry.unregister_law("stalls-later")
+    assert e.status == "failed" and f"{2 * MIN_REPLICATES} of {2 * MIN_REPLICATES} replicate refits failed" in e.reason
+    assert math.isnan(e.d_ab) and math.isfinite(e.d_ba)  # its refit to wear's curve stalled; wear's to its curve did not
+    (b,) = boots
+    stalled = b.results["stalls-later [ode]"]
+    assert b.n_ranked == 0 and len(stalled.failures) == 4
+    assert all("exceeded its time budget of 0.05 s" in why for why in stalled.failures)
+    assert shared.status == "failed" and "did not succeed" in shared.reason
+    assert signal.getitimer(signal.ITIMER_REAL)[0] == 0  # no alarm left armed
+
+
 # --- degenerate data ------------------------------------------------------------------------------
 def _tiny(tmp_path, rows: str, name="tiny") -> Path:
     base = fl.load_dataset("incline-oil-a100").path

@@ -64,8 +64,8 @@ def add_parser(sub):
                    help="skip refitting the ODE laws of one dataset at other tolerances "
                         f"({' and '.join(f'{r:.0e}'.replace('e-0', 'e-') for r in TOLERANCE_RTOLS)})")
     p.add_argument("--fit-timeout", type=fit_timeout, default=FIT_TIMEOUT, metavar="SECONDS",
-                   help=f"time budget of each fit; a fit past it is a failed row with that reason "
-                        f"(default {FIT_TIMEOUT:g})")
+                   help="time budget of each fit and refit; a fit past it is a failed row with that reason, a "
+                        f"refit a failed replicate (default {FIT_TIMEOUT:g})")
     p.set_defaults(func=run)
 
 
