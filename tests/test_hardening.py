@@ -189,13 +189,10 @@ def test_compare_turns_a_runaway_fit_into_a_failed_row(monkeypatch):
     assert [r.law for r in c.ranking if r.status != "failed"][:1] == ["wear"]
 
 
-class _StallsLater(FrictionLaw):
-    """F = k u, whose evaluations never return once ``stall`` is set (after its first fits)."""
+class _StallsLater(_Sluggish):
+    """F = k u, whose evaluations never return once ``stall`` is set (after its first fits), and never sleep."""
     name = "stalls-later"
-    formula = "F = k u"
     citation = "a test of --fit-timeout on refits"
-    params = (ParamSpec("k", "N s/m", 1.0, 0.0, 100.0, 1.0, "coefficient"),)
-    requires = frozenset({"u"})
     stall = False
 
     def force(self, p, c):
