@@ -341,21 +341,26 @@ def _hold_lock(path: Path):
     return proc
 
 
-def test_a_second_run_to_a_locked_output_fails_at_once_and_writes_nothing(tmp_path, capsys):
+def _refused_while_locked(out: Path, argv: list[str], capsys) -> None:
+    """``frictionlab ARGV`` while another process holds the lock on ``out``: exit 2, the one-line error."""
     from frictionlab import cli
 
-    out = tmp_path / "rep"
-    holder = _hold_lock(out)  # another process
+    holder = _hold_lock(out)
     try:
-        rc = cli.main(["compare", "--laws", "wear", "--data", "incline-oil-a100", "--bootstrap", "0",
-                       "--no-tolerance", "--out", str(out)])
+        rc = cli.main(argv)
     finally:
         holder.stdin.close()
         holder.wait(10)
     err = capsys.readouterr().err
     assert rc == 2, err
     assert err.strip() == (f"frictionlab: error: {out}: another frictionlab run is writing this output "
-                           f"(lock {tmp_path / '.rep.lock'}); wait for it to finish or choose another --out")
+                           f"(lock {out.parent / f'.{out.name}.lock'}); wait for it to finish or choose another --out")
+
+
+def test_a_second_run_to_a_locked_output_fails_at_once_and_writes_nothing(tmp_path, capsys):
+    out = tmp_path / "rep"
+    _refused_while_locked(out, ["compare", "--laws", "wear", "--data", "incline-oil-a100", "--bootstrap", "0",
+                                "--no-tolerance", "--out", str(out)], capsys)
     assert sorted(p.name for p in tmp_path.iterdir()) == []  # the holder removed its lock; nothing else
 
 
@@ -559,16 +564,7 @@ def test_datasets_rebuild_into_a_locked_folder_fails_at_once_and_writes_nothing(
 
     out = tmp_path / "data"
     out.mkdir()
-    holder = _hold_lock(out)  # another process is rebuilding into it
-    try:
-        rc = cli.main(["datasets", "rebuild", "--out", str(out)])
-    finally:
-        holder.stdin.close()
-        holder.wait(10)
-    err = capsys.readouterr().err
-    assert rc == 2, err
-    assert err.strip() == (f"frictionlab: error: {out}: another frictionlab run is writing this output "
-                           f"(lock {tmp_path / '.data.lock'}); wait for it to finish or choose another --out")
+    _refused_while_locked(out, ["datasets", "rebuild", "--out", str(out)], capsys)  # another process rebuilds into it
     assert list(out.iterdir()) == []
     assert cli.main(["datasets", "rebuild", "--out", str(out)]) == 0  # released: the rebuild goes through
     assert len(list(out.iterdir())) > 10 and not (tmp_path / ".data.lock").exists()
