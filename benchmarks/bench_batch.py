@@ -19,7 +19,7 @@ them far less than wall time. Scene families (random, seeded):
    only when the batch is as accurate (its error not larger, beyond round-off: a relative 1e-6 of the
    error itself); otherwise the benchmark says so and prints no ratio. Target >= 100x. Both engines
    are timed against the same loop when numba is installed: the compiled sliding phases
-   (frictionlab.compiled, the default for the built-in laws) and the numpy engine (frictionlab.vecrk,
+   (frictionlab.solve.compiled, the default for the built-in laws) and the numpy engine (frictionlab.solve.vecrk,
    every law); the kernel's one-off compile or cache load is timed apart, before anything else.
 2. Batch closed forms against bare numpy of the same expressions (the same sine recurrence and
    Bessel weights on both sides). Target: within 1.5x.
@@ -32,6 +32,7 @@ them far less than wall time. Scene families (random, seeded):
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import platform
@@ -42,19 +43,17 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.special import ive
 
-import contextlib
-
-from frictionlab import compiled
-from frictionlab.batch import SceneBatch, simulate_batch
-from frictionlab.solvers.ode import SLIP_MARGIN
-from frictionlab.scene import HalfSineArea, HalfSineNormal, Scene
+from frictionlab.physics.scene import HalfSineArea, HalfSineNormal, Scene
+from frictionlab.solve import compiled
+from frictionlab.solve.batch import SceneBatch, simulate_batch
+from frictionlab.solve.solvers.ode import SLIP_MARGIN
 
 M, R = 0.046, 0.0213
 NT = 101
 
 
 def hardware() -> str:
-    from frictionlab.bench import environment
+    from frictionlab.pipeline.bench import environment
 
     env = environment()
     return f"{env['cpu']}, {env['cores']} cores; " + ", ".join(f"{k} {v}" for k, v in env["versions"].items())
@@ -205,7 +204,7 @@ PLAIN = {"coulomb": (plain_coulomb, ("u0", "normal.impulse", "normal.contact_tim
 # --- measurements ---------------------------------------------------------------------------------
 @contextlib.contextmanager
 def numpy_engine():
-    """The numpy engine (frictionlab.vecrk) for every law, as without numba."""
+    """The numpy engine (frictionlab.solve.vecrk) for every law, as without numba."""
     saved = compiled.available
     compiled.available = lambda: False
     try:
@@ -231,7 +230,7 @@ def warm_jit(args):
         return
     t0 = time.perf_counter()
     c0 = clock()
-    from frictionlab import compiled_kernel
+    from frictionlab.solve import compiled_kernel
 
     b, p = coulomb_family(2, np.random.default_rng(0))
     simulate_batch("coulomb", b, p, solver="DOP853", n=NT)
@@ -364,10 +363,10 @@ def numba_closed_form(batch, params, t_bare, bare):
 
 def scaling(args, rng):
     """Per-scene CPU and peak memory of batch DOP853 by batch size (automatic chunking beyond
-    frictionlab.batch.CHUNK scenes)."""
+    frictionlab.solve.batch.CHUNK scenes)."""
     import tracemalloc
 
-    from frictionlab import batch as batch_module
+    from frictionlab.solve import batch as batch_module
 
     chunk = getattr(batch_module, "CHUNK", None)
     engine = "compiled" if compiled.available() else "numpy"
@@ -422,7 +421,7 @@ def scaling(args, rng):
 
 def dense_share(args, rng):
     """How much of the batch's time goes to filling outputs from the dense interpolant."""
-    from frictionlab import vecrk
+    from frictionlab.solve import vecrk
 
     print(f"\n[dense output] numpy engine: share of batch DOP853 time in vecrk._dense and vecrk._fill_dense, "
           f"{args.n} scenes x {NT}")

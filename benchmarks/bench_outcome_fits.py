@@ -11,8 +11,8 @@ batch engine's closed forms finish those phases vectorized (``batch._exact_phase
 import sys
 import time
 
-from frictionlab.dataset import load_dataset
-from frictionlab.fitting import fit
+from frictionlab.inference.fitting import fit
+from frictionlab.io.dataset import load_dataset
 
 DEFAULT = ["impact-outcome-synthetic", "kharaz2001-spin", "kharaz2001-tangential-cor", "kharaz2001-contact-angle"]
 

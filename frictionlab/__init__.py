@@ -12,26 +12,28 @@ import importlib
 import sys
 import types
 
-__version__ = "0.1.0"
+from .core import __version__  # noqa: F401
 
 #: public name -> the submodule that defines it
 _EXPORTS = {
-    "Comparison": "comparison", "compare": "comparison",
-    "Dataset": "dataset", "load_dataset": "dataset",
-    "derive_omega": "derive",
-    "EquivalenceResult": "equivalence", "analyze_equivalence": "equivalence",
-    "FrictionLabError": "errors",
-    "FitResult": "fitting", "ParamResult": "fitting", "Target": "fitting", "fit": "fitting",
-    "make_target": "fitting", "predict": "fitting", "register_predictor": "fitting",
-    "AreaSlipForm": "law", "Contact": "law", "FrictionLaw": "law", "NormalAreaRateForm": "law", "ParamSpec": "law",
-    "StateSpec": "law",
-    "make_plan": "plan",
-    "RankRow": "ranking",
-    "available_laws": "registry", "get_law": "registry", "register_law": "registry", "unregister_law": "registry",
+    "Comparison": "pipeline.comparison", "compare": "pipeline.comparison",
+    "Dataset": "io.dataset", "load_dataset": "io.dataset",
+    "derive_omega": "physics.derive",
+    "EquivalenceResult": "inference.equivalence", "analyze_equivalence": "inference.equivalence",
+    "FrictionLabError": "core.errors",
+    "FitResult": "inference.fitting", "ParamResult": "inference.fitting", "Target": "inference.fitting",
+    "fit": "inference.fitting", "make_target": "inference.fitting", "predict": "inference.fitting",
+    "register_predictor": "inference.fitting",
+    "AreaSlipForm": "physics.law", "Contact": "physics.law", "FrictionLaw": "physics.law",
+    "NormalAreaRateForm": "physics.law", "ParamSpec": "physics.law", "StateSpec": "physics.law",
+    "make_plan": "solve.plan",
+    "RankRow": "inference.ranking",
+    "available_laws": "physics.registry", "get_law": "physics.registry", "register_law": "physics.registry",
+    "unregister_law": "physics.registry",
     "write_report": "report",
-    "Scene": "scene",
-    "simulate": "solvers",
-    "Trajectory": "trajectory",
+    "Scene": "physics.scene",
+    "simulate": "solve.solvers",
+    "Trajectory": "physics.trajectory",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -14,7 +14,7 @@ import importlib
 import sys
 import warnings
 
-from .errors import FrictionLabError, Terminated
+from .core.errors import FrictionLabError, Terminated
 
 COMMANDS = ("laws", "datasets", "simulate", "fit", "compare", "bench")
 
@@ -95,7 +95,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def load_file(path: str) -> None:
     """Import a user's Python file by path (for laws registered at run time)."""
-    from .registry import load_law_file
+    from .physics.registry import load_law_file
 
     load_law_file(path)
 

@@ -3,7 +3,7 @@
 While the contact unloads (dA/dt < 0) the second term is negative; if it outweighs
 mu N, F has the sign opposite to the slip and the law pushes the body along it.
 """
-from frictionlab.law import FrictionLaw, NormalAreaRateForm, ParamSpec, sign
+from frictionlab.physics.law import FrictionLaw, NormalAreaRateForm, ParamSpec, sign
 
 
 class AreaRate(FrictionLaw):

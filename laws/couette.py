@@ -3,7 +3,7 @@
 Only eta/h enters the force: from motion alone eta and h are not separately
 identifiable. Fix one (a dataset's ``[fixed]`` table usually fixes eta) to fit the other.
 """
-from frictionlab.law import AreaSlipForm, FrictionLaw, ParamSpec
+from frictionlab.physics.law import AreaSlipForm, FrictionLaw, ParamSpec
 
 
 class Couette(FrictionLaw):

@@ -1,5 +1,5 @@
 """Coulomb friction: F = mu N, opposing slip."""
-from frictionlab.law import FrictionLaw, NormalAreaRateForm, ParamSpec, sign
+from frictionlab.physics.law import FrictionLaw, NormalAreaRateForm, ParamSpec, sign
 
 
 class Coulomb(FrictionLaw):

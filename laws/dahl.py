@@ -6,7 +6,7 @@ under periodic slip the force traces a closed hysteresis loop.
 """
 import numpy as np
 
-from frictionlab.law import FrictionLaw, ParamSpec, StateSpec
+from frictionlab.physics.law import FrictionLaw, ParamSpec, StateSpec
 
 
 class Dahl(FrictionLaw):

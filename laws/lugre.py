@@ -6,9 +6,9 @@ At steady sliding z = g(u) sign(u) / sigma0, so F = N (g(u) sign(u) + sigma2 u):
 The bristles relax in g / (sigma0 |u|) ~ 1e-7 s at 10 m/s: a stiff problem (LSODA switches to BDF).
 """
 import numpy as np
-
-from frictionlab.law import FrictionLaw, ParamSpec, StateSpec
 from frictionlab.laws.stribeck import Stribeck, stribeck_curve
+
+from frictionlab.physics.law import FrictionLaw, ParamSpec, StateSpec
 
 
 class LuGre(FrictionLaw):

@@ -10,7 +10,7 @@ friction there. Software anchor: rsfmodel (Leeman et al., SciPy 2016).
 """
 import numpy as np
 
-from frictionlab.law import FrictionLaw, ParamSpec, StateSpec
+from frictionlab.physics.law import FrictionLaw, ParamSpec, StateSpec
 
 #: Reference slip speed V0 [m/s]: mu0 is the steady-state friction coefficient at this speed.
 V0 = 1e-6

@@ -2,7 +2,6 @@
 
 The state changes only with slip (no healing in truly stationary contact)."""
 import numpy as np
-
 from frictionlab.laws.rate_state import RateState
 
 

@@ -2,7 +2,7 @@
 slip speed, plus a viscous term. F = N [g(u) sign(u) + sigma2 u], g(u) = mu_c + (mu_s - mu_c) exp(-(u/vs)^2)."""
 import numpy as np
 
-from frictionlab.law import FrictionLaw, ParamSpec, sign
+from frictionlab.physics.law import FrictionLaw, ParamSpec, sign
 
 
 def stribeck_curve(p, u):

@@ -1,5 +1,5 @@
 """Wear law of the seed paper, eq (3): F = lambda A u."""
-from frictionlab.law import AreaSlipForm, FrictionLaw, ParamSpec
+from frictionlab.physics.law import AreaSlipForm, FrictionLaw, ParamSpec
 
 
 class Wear(FrictionLaw):

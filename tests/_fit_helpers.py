@@ -6,8 +6,8 @@ import math
 import numpy as np
 
 from frictionlab import Dataset, Scene, get_law, simulate
-from frictionlab.dataset import Provenance
-from frictionlab.scene import ConstantArea, HalfSineArea, HalfSineNormal
+from frictionlab.io.dataset import Provenance
+from frictionlab.physics.scene import ConstantArea, HalfSineArea, HalfSineNormal
 
 TC = 500e-6
 MASS = 0.046
@@ -21,7 +21,7 @@ def impact_scene(u0: float = 12.0, normal_tc: float = TC) -> Scene:
 
 def incline_scene() -> Scene:
     """A 20 g block from rest on a 20 deg incline with a constant 200 mm^2 contact (weight normal force)."""
-    from frictionlab.scene import G, WeightNormal
+    from frictionlab.physics.scene import G, WeightNormal
 
     alpha = math.radians(20)
     return Scene(kind="incline", mass=0.02, u0=0.0, duration=1.0, incline=alpha, area=ConstantArea(200e-6),

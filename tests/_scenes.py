@@ -4,7 +4,13 @@ from __future__ import annotations
 import math
 
 from frictionlab import Scene
-from frictionlab.scene import G, ConstantArea, HalfSineArea, HalfSineNormal, WeightNormal
+from frictionlab.physics.scene import (
+    ConstantArea,
+    G,
+    HalfSineArea,
+    HalfSineNormal,
+    WeightNormal,
+)
 
 # The paper's golf ball (Arakawa 2017): m = 46 g, r = 21.3 mm, I = 2 m r^2 / 5.
 MASS, RADIUS = 0.046, 0.0213

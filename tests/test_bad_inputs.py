@@ -23,9 +23,10 @@ from pathlib import Path
 import pytest
 
 import frictionlab as fl
-from frictionlab import cli, registry
-from frictionlab.dataset import builtin_dir
-from frictionlab.errors import FrictionLabError
+from frictionlab import cli
+from frictionlab.core.errors import FrictionLabError
+from frictionlab.io.dataset import builtin_dir
+from frictionlab.physics import registry
 
 CASES_FILE = Path(__file__).parent / "bad_inputs" / "cases.toml"
 CASES = tomllib.loads(CASES_FILE.read_text(encoding="utf-8"))["case"]
@@ -130,7 +131,7 @@ def snapshot(folder: Path) -> dict[str, str]:
     return out
 
 
-#: Progress lines on stderr (frictionlab.progress, when stderr is not a terminal) are not error lines.
+#: Progress lines on stderr (frictionlab.core.progress, when stderr is not a terminal) are not error lines.
 PROGRESS_LINE = re.compile(r"^\d{4}-\d\d-\d\d \d\d:\d\d:\d\d [\w-]+: ")
 
 

@@ -5,12 +5,26 @@ import numpy as np
 import pytest
 
 import frictionlab as fl
-from frictionlab.plan import make_plan
-from frictionlab.registry import get_law
-from frictionlab.solvers import stick
-from frictionlab.batch import SceneBatch, simulate_batch
-from frictionlab.errors import FrictionLabError, ParameterError, SceneError, SolverError
-from frictionlab.scene import G, ConstantArea, GrowthArea, HalfSineArea, HalfSineNormal, HertzNormal, Scene, WeightNormal
+from frictionlab.core.errors import (
+    FrictionLabError,
+    ParameterError,
+    SceneError,
+    SolverError,
+)
+from frictionlab.physics.registry import get_law
+from frictionlab.physics.scene import (
+    ConstantArea,
+    G,
+    GrowthArea,
+    HalfSineArea,
+    HalfSineNormal,
+    HertzNormal,
+    Scene,
+    WeightNormal,
+)
+from frictionlab.solve.batch import SceneBatch, simulate_batch
+from frictionlab.solve.plan import make_plan
+from frictionlab.solve.solvers import stick
 
 M, R = 0.046, 0.0213
 
@@ -208,7 +222,7 @@ def test_errors_are_one_line():
 def test_sweep_in_chunks_on_an_executor_equals_one_call():
     from concurrent.futures import ThreadPoolExecutor
 
-    from frictionlab.batch import simulate_sweep
+    from frictionlab.solve.batch import simulate_sweep
 
     rng = np.random.default_rng(3)
     batch = SceneBatch.sweep(oblique(40.0, 0.5), {"u0": rng.uniform(2, 30, 11)})
@@ -238,7 +252,7 @@ def test_benchmark_script_runs(capsys):
 
 
 def test_shared_table_model_is_allowed_different_tables_are_not():
-    from frictionlab.scene import TableNormal
+    from frictionlab.physics.scene import TableNormal
 
     tc = 450e-6
     tt = np.linspace(0, tc, 50)
@@ -271,7 +285,7 @@ def test_half_sine_area_alone_is_bitwise_the_area_of_the_full_model():
 
 
 def test_normal_integrals_in_place_equal_the_plain_expressions():
-    from frictionlab.solvers import exact
+    from frictionlab.solve.solvers import exact
 
     rng = np.random.default_rng(11)
     tc = rng.uniform(4e-4, 5e-4, (6, 1))
@@ -294,9 +308,9 @@ def test_normal_integrals_in_place_equal_the_plain_expressions():
 
 
 def test_stuck_states_in_place_equal_a_new_array():
-    from frictionlab.plan import make_plan
-    from frictionlab.registry import get_law
-    from frictionlab.solvers import stick
+    from frictionlab.physics.registry import get_law
+    from frictionlab.solve.plan import make_plan
+    from frictionlab.solve.solvers import stick
 
     for scene in (oblique(30.0, 0.5), incline(0.1)):
         plan = make_plan(scene, get_law("coulomb"))
@@ -330,7 +344,7 @@ def test_outputs_on_one_scaled_grid_equal_the_per_scene_path():
 def test_root_at_a_bracket_end_closes_in_a_few_evaluations(monkeypatch):
     """Zero-slip events of rolling impacts whose bracket end is within round-off of the root close in a few
     evaluations, not in bisections (before the safeguard: up to 43 for these scenes), at the same stick times."""
-    from frictionlab import compiled, vecrk
+    from frictionlab.solve import compiled, vecrk
 
     rng = np.random.default_rng(1)
     n = 1000
@@ -368,7 +382,7 @@ def test_root_at_a_bracket_end_closes_in_a_few_evaluations(monkeypatch):
 def test_chunks_written_in_place_equal_one_call(monkeypatch, rng):
     """Chunks integrated straight into the result arrays: scenes that start stuck and break away, stick again,
     and closed forms that hand a scene to the scalar solver give the one-call result bitwise."""
-    from frictionlab import batch as B
+    from frictionlab.solve import batch as B
 
     cases = [("coulomb", [incline(u0) for u0 in (0.0, 0.05, 0.0, 0.2, 0.1, 0.0, 0.3)],
               [{"mu": m} for m in (0.1, 0.5, 0.4, 0.2, 0.6, 0.2, 0.3)], ("exact", "RK45")),

@@ -86,7 +86,7 @@ def test_datasets_show_in_units_a_person_reads(capsys):
 
 
 def test_series_output_does_not_contradict_itself(capsys):
-    from frictionlab.solvers.series import SeriesAccuracyWarning
+    from frictionlab.solve.solvers.series import SeriesAccuracyWarning
 
     with pytest.warns(SeriesAccuracyWarning, match="b = 0.814"):  # the series says it is used beyond its range
         assert main(["simulate", "impact-golf-v28", "--law", "wear", "--param", "lam=1.81e6 Pa s/m",
@@ -120,8 +120,8 @@ def test_quiet_silences_progress(tmp_path, capsys):
 
 
 def test_compare_summary_renders_the_answers_only():
-    from frictionlab.answers import Answer
     from frictionlab.commands.compare import answer_lines
+    from frictionlab.inference.answers import Answer
 
     class C:
         answers = ()

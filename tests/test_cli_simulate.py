@@ -10,9 +10,9 @@ import pytest
 
 import frictionlab as fl
 from frictionlab import cli
-from frictionlab.dataset import builtin_dir
-from frictionlab.figures import is_png
-from frictionlab.outcome import predict_outcomes
+from frictionlab.io.dataset import builtin_dir
+from frictionlab.report.figures import is_png
+from frictionlab.solve.outcome import predict_outcomes
 
 RPM = 60 / (2 * math.pi)
 

@@ -1,4 +1,4 @@
-"""The compiled sliding phases (frictionlab.compiled, numba) against the numpy engine they stand in for:
+"""The compiled sliding phases (frictionlab.solve.compiled, numba) against the numpy engine they stand in for:
 the same outputs, stick times and steps on random batches of every case they serve, the same
 right-hand side as Plan.derivatives, and the numpy engine wherever they do not serve."""
 import math
@@ -8,14 +8,22 @@ import pytest
 
 pytest.importorskip("numba")
 
-from frictionlab import compiled  # noqa: E402
-from frictionlab.batch import SceneBatch, simulate_batch  # noqa: E402
-from frictionlab.law import FrictionLaw, NormalAreaRateForm, ParamSpec, sign  # noqa: E402
-from frictionlab.plan import make_plan  # noqa: E402
-from frictionlab.registry import get_law  # noqa: E402
-from frictionlab.scene import (G, ConstantArea, GrowthArea, HalfSineArea, HalfSineNormal, HertzNormal,  # noqa: E402
-                               Scene, WeightNormal)
-from frictionlab.solvers.ode import state_scales  # noqa: E402
+from frictionlab.physics.law import FrictionLaw, NormalAreaRateForm, ParamSpec, sign  # noqa: E402
+from frictionlab.physics.registry import get_law  # noqa: E402
+from frictionlab.physics.scene import (  # noqa: E402
+    ConstantArea,
+    G,
+    GrowthArea,
+    HalfSineArea,
+    HalfSineNormal,
+    HertzNormal,
+    Scene,
+    WeightNormal,
+)
+from frictionlab.solve import compiled
+from frictionlab.solve.batch import SceneBatch, simulate_batch  # noqa: E402
+from frictionlab.solve.plan import make_plan  # noqa: E402
+from frictionlab.solve.solvers.ode import state_scales  # noqa: E402
 
 M, R = 0.046, 0.0213
 
@@ -124,7 +132,7 @@ def test_breakaway_and_rolling_cases_are_covered(monkeypatch):
 
 def test_chunked_batch_is_the_same(monkeypatch):
     """Beyond CHUNK scenes the first phase is integrated straight into the result rows."""
-    from frictionlab import batch as batch_module
+    from frictionlab.solve import batch as batch_module
 
     rng = np.random.default_rng(5)
     sc = oblique(rng, 30)
@@ -139,7 +147,7 @@ def test_chunked_batch_is_the_same(monkeypatch):
 def test_kernel_rhs_is_plan_derivatives():
     """The kernel's right-hand side (scaled) equals Plan.derivatives on the same scaled problem, through
     contact end, with slip on and against the phase's direction (branch slip)."""
-    from frictionlab import compiled_kernel
+    from frictionlab.solve import compiled_kernel
 
     rhs = compiled_kernel._rhs
     rng = np.random.default_rng(11)
@@ -234,10 +242,10 @@ def test_a_numba_that_does_not_import_leaves_batches_to_numpy(monkeypatch):
     import sys
 
     monkeypatch.setattr(compiled, "_status", None)
-    import frictionlab
+    import frictionlab.solve
 
-    monkeypatch.setitem(sys.modules, "frictionlab.compiled_kernel", None)  # its import now raises ImportError
-    monkeypatch.delattr(frictionlab, "compiled_kernel", raising=False)
+    monkeypatch.setitem(sys.modules, "frictionlab.solve.compiled_kernel", None)  # its import now raises ImportError
+    monkeypatch.delattr(frictionlab.solve, "compiled_kernel", raising=False)
     rng = np.random.default_rng(4)
     sc = oblique(rng, 3)
     with pytest.warns(RuntimeWarning, match="numba is installed but does not import"):

@@ -13,8 +13,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from frictionlab import Scene, get_law, make_plan, simulate
-from frictionlab.errors import SceneError, SolverError
-from frictionlab.scene import Compliance, HalfSineArea, HalfSineNormal
+from frictionlab.core.errors import SceneError, SolverError
+from frictionlab.physics.scene import Compliance, HalfSineArea, HalfSineNormal
 
 # A golf ball striking a rigid plate at 30 m/s, 30 deg from the normal.
 M, R, TC = 0.0459, 0.02135, 450e-6

@@ -13,13 +13,22 @@ import attrs
 import numpy as np
 import pytest
 
-from frictionlab import mdr
-from frictionlab.contact import (Material, MindlinCompliance, MindlinDeresiewiczCompliance, Pair, chi, contact_radius,
-                                 hertz_force, mindlin_stiffness, rigid_psi2)
-from frictionlab.dataset import load_dataset
-from frictionlab.errors import DatasetError, SceneError
-from frictionlab.outcome import OutcomeScene, SpeedLaw, predict_outcomes
-from frictionlab import rebound
+from frictionlab.core.errors import DatasetError, SceneError
+from frictionlab.io.dataset import load_dataset
+from frictionlab.physics import mdr
+from frictionlab.physics.contact import (
+    Material,
+    MindlinCompliance,
+    MindlinDeresiewiczCompliance,
+    Pair,
+    chi,
+    contact_radius,
+    hertz_force,
+    mindlin_stiffness,
+    rigid_psi2,
+)
+from frictionlab.solve import rebound
+from frictionlab.solve.outcome import OutcomeScene, SpeedLaw, predict_outcomes
 
 ALUMINA, GLASS = Material(380e9, 0.23), Material(70e9, 0.25)
 PAIR = Pair(ALUMINA, GLASS)
@@ -115,7 +124,7 @@ def test_stiff_compliance_tends_to_the_rigid_sphere():
     assert errs[1] < 0.02 < errs[0]  # ... and a 1000x stiffer contact is nearly rigid
 
 
-# --- Mindlin-Deresiewicz with microslip by the Method of Dimensionality Reduction (frictionlab.mdr) -----
+# --- Mindlin-Deresiewicz with microslip by the Method of Dimensionality Reduction (frictionlab.physics.mdr) -----
 A_FIXED, N_FIXED = 1e-4, 50.0  # contact radius [m] and normal force [N] of the quasi-static checks
 USTAR = 3 * MU * N_FIXED / (2 * 8 * PAIR.shear * A_FIXED)  # displacement of gross slip: 3 mu N / (2 k_t)
 
@@ -234,15 +243,15 @@ def test_mdr_needs_a_coulomb_law_and_is_not_a_trajectory_model(tmp_path):
     assert ds.scene.compliance == MindlinDeresiewiczCompliance(PAIR.shear, 300)
     out = predict_outcomes("coulomb", ds, {"mu": MU})
     assert np.all(np.isfinite(out["rebound_spin"]))
-    from frictionlab.plan import make_plan
-    from frictionlab.registry import get_law
+    from frictionlab.physics.registry import get_law
+    from frictionlab.solve.plan import make_plan
 
     with pytest.raises(SceneError, match="impact outcomes only"):
         make_plan(ds.scene.impact(V, 0.3).scene, get_law("coulomb"))
-    from frictionlab.predict import applicable_solvers
+    from frictionlab.inference.predict import applicable_solvers
 
     ok = applicable_solvers("coulomb", ds.scene)
-    assert ok["ode"] is None and "frictionlab.mdr" in ok["exact"]  # fits run it under the name 'ode'
+    assert ok["ode"] is None and "frictionlab.physics.mdr" in ok["exact"]  # fits run it under the name 'ode'
     assert all("not of the Coulomb form" in why for why in applicable_solvers("wear", ds.scene).values())
 
 
@@ -278,7 +287,7 @@ def test_compliant_model_predicts_measured_spin_below_30_deg(kharaz_spin):
 def test_compliant_model_predicts_measured_spin_at_6_deg(kharaz_spin):
     """At 6.1 deg (Psi1 = 1.0, where initial gross slip gives way to initial stick with microslip) the model
     gives 117.5 rad/s against 136 measured (-13.7 %). The same paper's tangential restitution at that angle
-    implies 119.1 rad/s (frictionlab.datagen.kharaz.implied_spin), 1.3 % from the model: the spin marker is
+    implies 119.1 rad/s (frictionlab.io.datagen.kharaz.implied_spin), 1.3 % from the model: the spin marker is
     14 % above what the restitution figure implies. With nu = 0.22 for the glass the model gives -16 %."""
     ds, pred = kharaz_spin
     i = int(np.argmin(ds.columns["incidence"]))
@@ -288,7 +297,7 @@ def test_compliant_model_predicts_measured_spin_at_6_deg(kharaz_spin):
 def test_the_two_kharaz_figures_are_compared_by_momentum_balance(kharaz_spin):
     """omega_2 = (1 - e_t) v_t1 / (0.4 r) from the restitution figure: the spin figure's 6.1 deg marker is 12.6 %
     above it (the data's own inconsistency), and the model is within 2 % of the restitution figure there."""
-    from frictionlab.datagen.kharaz import implied_spin
+    from frictionlab.io.datagen.kharaz import implied_spin
 
     ds, pred = kharaz_spin
     inc, w = implied_spin()

@@ -2,8 +2,8 @@
 import filecmp
 from pathlib import Path
 
-from frictionlab.datagen import rebuild
-from frictionlab.dataset import builtin_dir
+from frictionlab.io.datagen import rebuild
+from frictionlab.io.dataset import builtin_dir
 
 
 def test_rebuild_equals_committed_files(tmp_path):

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import frictionlab as fl
-from frictionlab.dataset import builtin_dir, builtin_names
-from frictionlab.errors import DatasetError
+from frictionlab.core.errors import DatasetError
+from frictionlab.io.dataset import builtin_dir, builtin_names
 
 RPM = 2 * math.pi / 60
 
@@ -45,7 +45,7 @@ def test_golf_units_become_si():
 def test_golf_reconstruction_agrees_with_every_stated_number(speed):
     d = fl.load_dataset(f"impact-golf-v{speed}")
     rep = d.reported
-    q = lambda s: fl.units.to_si(s, {"rpm": "rad/s", "us": "s", "deg": "rad"}[s.split()[1]], "test")  # noqa: E731
+    q = lambda s: fl.core.units.to_si(s, {"rpm": "rad/s", "us": "s", "deg": "rad"}[s.split()[1]], "test")  # noqa: E731
     w = d.columns["omega"]
     i = int(np.argmax(w))
     assert w[0] == 0.0
@@ -142,7 +142,7 @@ def test_cli_error_is_one_line_exit_2(run_cli, golf_copy):
 
 
 def test_group_key_declares_the_group_and_defaults_to_the_name_stem(golf_copy):
-    from frictionlab.answers import group_of
+    from frictionlab.inference.answers import group_of
 
     d = fl.load_dataset(golf_copy)
     assert d.group == "" and group_of(d) == d.name.rsplit("-", 1)[0]

@@ -7,10 +7,10 @@ from concurrent.futures import ThreadPoolExecutor
 import attrs
 import numpy as np
 import pytest
-
 from _fit_helpers import TC, TRUTH, impact_scene, incline_scene, synthetic
+
 from frictionlab import analyze_equivalence, fit
-from frictionlab.equivalence import CRITICAL, decomposition
+from frictionlab.inference.equivalence import CRITICAL, decomposition
 
 R = 25  # replicates per law (the smallest p-value is 1/26): each test takes a few seconds
 
@@ -36,7 +36,7 @@ def test_wear_and_couette_are_equivalent():
 def test_one_closed_form_family_needs_no_refits_and_gives_the_refits_answer(monkeypatch):
     """Wear and Couette span one family (F = k A u): the shortcut's T* = 0 is what refitting both laws to every
     replicate gives (to the optimizer's resolution), with the same p-values, powers and verdict."""
-    from frictionlab import equivalence
+    from frictionlab.inference import equivalence
 
     ds = synthetic("wear", TRUTH["wear"], seed=4)
     fw, fc = fit("wear", ds), fit("couette", ds)
@@ -129,8 +129,8 @@ def test_failed_or_skipped_fit_skips_the_test():
 
 
 def test_group_answer_states_exact_and_series_separately():
-    from frictionlab.answers import EQUIVALENCE
-    from frictionlab.equivalence import group_answer
+    from frictionlab.inference.answers import EQUIVALENCE
+    from frictionlab.inference.equivalence import group_answer
 
     ds = synthetic("area-rate", TRUTH["area-rate"], seed=3, name="synth-v1")
     fa = fit("area-rate", ds)
@@ -141,8 +141,8 @@ def test_group_answer_states_exact_and_series_separately():
     assert "rpm on synth-v1" in a["noise_threshold"] and "the paper's series of wear" in a["noise_threshold"]
     assert group_answer(results, ["other"])["equivalence"] == "not tested"
     assert results[0].decomposition is None and results[1].decomposition is not None  # series only
-    from frictionlab.answers import Answer
-    from frictionlab.equivalence import fill_answers
+    from frictionlab.inference.answers import Answer
+    from frictionlab.inference.equivalence import fill_answers
 
     row = Answer(group="synth", datasets=("synth-v1",), provenance="synthetic", best=None, fits=False, headline="",
                  goodness="", equivalence="not tested", noise_threshold="", series_vs_exact="")
@@ -152,8 +152,8 @@ def test_group_answer_states_exact_and_series_separately():
 
 
 def test_slow_pairs_are_left_out_with_the_reason():
-    from frictionlab.comparison import _slow_pair
-    from frictionlab.fitting import FitResult
+    from frictionlab.inference.fitting import FitResult
+    from frictionlab.pipeline.comparison import _slow_pair
 
     ode = FitResult(law="wear", solver="ode", datasets=("x",), status="ok", cpu_time=2.5)
     exact = FitResult(law="coulomb", solver="exact", datasets=("x",), status="ok")
@@ -164,14 +164,14 @@ def test_slow_pairs_are_left_out_with_the_reason():
 
 def test_command_line_defaults_agree_with_the_library():
     from frictionlab.commands import compare as cmd
-    from frictionlab.equivalence import MIN_REPLICATES, REPLICATES
+    from frictionlab.inference.equivalence import MIN_REPLICATES, REPLICATES
 
     assert cmd.REPLICATES == REPLICATES and MIN_REPLICATES == 20
 
 
 def test_replicate_refits_without_error_analysis_give_the_same_statistic(coulomb_data, monkeypatch):
     """The replicates' refits skip the Jacobian (fit(errors=False)): T on every replicate is what full fits give."""
-    from frictionlab import equivalence, fitting
+    from frictionlab.inference import equivalence, fitting
 
     _, fc, fw, e = coulomb_data
     monkeypatch.setattr(equivalence, "fit", lambda *a, errors=True, **k: fitting.fit(*a, **k))

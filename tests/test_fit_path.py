@@ -2,8 +2,8 @@
 import math
 
 import pytest
-
 from _fit_helpers import TRUTH, incline_scene, synthetic
+
 from frictionlab import fit
 
 
@@ -34,7 +34,7 @@ def test_impact_outcomes_on_the_batch_engine_equal_the_row_by_row_solve(law, par
     import numpy as np
 
     from frictionlab import get_law, load_dataset
-    from frictionlab.outcome import _rebounds, rows_of
+    from frictionlab.solve.outcome import _rebounds, rows_of
 
     ds = load_dataset("impact-outcome-synthetic")
     rows = rows_of(ds)
@@ -52,7 +52,7 @@ def test_impact_outcomes_on_the_batch_engine_equal_the_row_by_row_solve(law, par
 def test_a_batch_in_chunks_equals_the_batch_in_one_call(monkeypatch):
     import numpy as np
 
-    from frictionlab import batch as B
+    from frictionlab.solve import batch as B
 
     sb, mu, tc = _coulomb_sweep(3, 37)
     n = len(mu)
@@ -75,7 +75,7 @@ def test_the_one_state_right_hand_side_equals_the_general_one(dataset, law):
     import numpy as np
 
     from frictionlab import get_law, load_dataset
-    from frictionlab.plan import make_plan
+    from frictionlab.solve.plan import make_plan
 
     ds, lw = load_dataset(dataset), get_law(law)
     plan = make_plan(ds.scene, lw)
@@ -96,8 +96,8 @@ def test_the_one_state_right_hand_side_reports_a_bad_force_as_the_law_does():
     import numpy as np
 
     from frictionlab import FrictionLaw, ParamSpec, load_dataset
-    from frictionlab.errors import LawError
-    from frictionlab.plan import make_plan
+    from frictionlab.core.errors import LawError
+    from frictionlab.solve.plan import make_plan
 
     class Bad(FrictionLaw):
         name, formula, citation = "bad-rhs", "F = nan", "test"
@@ -119,7 +119,7 @@ def test_the_ode_loop_equals_solve_ivp(method, stops):
     import numpy as np
     from scipy.integrate import solve_ivp
 
-    from frictionlab.solvers.ode import solve
+    from frictionlab.solve.solvers.ode import solve
 
     def f(s, z):  # a damped oscillator: z[0] crosses zero falling near s = 0.35
         return np.array([z[1], -20.0 * z[0] - 0.5 * z[1]])
@@ -143,9 +143,9 @@ def test_the_closed_form_stop_of_coulomb_impacts_equals_the_root_finder(monkeypa
     closed forms against the general bracketed root search (the fast path switched off)."""
     import numpy as np
 
-    from frictionlab import batch as B
     from frictionlab import simulate
-    from frictionlab.solvers import exact
+    from frictionlab.solve import batch as B
+    from frictionlab.solve.solvers import exact
 
     sb, mu, tc = _coulomb_sweep(11, 40)
     n = len(mu)
@@ -172,8 +172,8 @@ def _coulomb_sweep(seed: int, n: int):
     """n random golf-ball impacts with Coulomb friction and rolling: (SceneBatch, mu, contact times [s])."""
     import numpy as np
 
-    from frictionlab import batch as B
-    from frictionlab.scene import HalfSineNormal, Scene
+    from frictionlab.physics.scene import HalfSineNormal, Scene
+    from frictionlab.solve import batch as B
 
     rng = np.random.default_rng(seed)
     tc = rng.uniform(400e-6, 500e-6, n)
@@ -201,7 +201,8 @@ def test_impact_outcome_rows_are_built_once_per_scene_and_rows_with_the_same_ans
     import attrs
     import numpy as np
 
-    from frictionlab import load_dataset, outcome
+    from frictionlab import load_dataset
+    from frictionlab.solve import outcome
 
     ds = load_dataset("impact-outcome-synthetic")
     rows = outcome.rows_of(ds)
@@ -240,7 +241,7 @@ def test_the_best_fit_model_taken_from_the_last_evaluation_equals_a_fresh_predic
     prediction made afresh at the fitted parameters; and a fit with several starts gives the same answer."""
     import numpy as np
 
-    from frictionlab.predict import predict
+    from frictionlab.inference.predict import predict
 
     data = synthetic(law, TRUTH[law], n=21, name=f"reuse-{law}")
     r = fit(law, data, solver=solver)
@@ -258,7 +259,7 @@ def test_a_repeated_evaluation_reused_gives_the_fit_of_the_general_path(law, sol
     best-fit model are reused: the same fit, number for number, as when every call evaluates afresh."""
     import numpy as np
 
-    from frictionlab import fitting
+    from frictionlab.inference import fitting
 
     data = synthetic(law, TRUTH[law], n=21, name=f"reuse2-{law}")
     fast = fit(law, data, solver=solver, **options)
@@ -293,7 +294,7 @@ def _numbers(r):
 def test_refits_run_levenberg_marquardt_directly_with_lmfits_numbers(law, options, monkeypatch):
     """fit(checks=False) runs lmfit's Levenberg-Marquardt through levmar.leastsq: values, error bars,
     correlations, chi-square, messages and evaluation counts are those of lmfit itself, bit for bit."""
-    from frictionlab import levmar
+    from frictionlab.inference import levmar
 
     data = synthetic(law, TRUTH[law], n=21, name=f"direct-{law}", rel_noise=0.03)
     calls = []
@@ -311,7 +312,7 @@ def test_levenberg_marquardt_directly_declines_where_lmfit_goes_another_way():
     what it says there); an error bar that cannot be estimated is said as lmfit says it."""
     import numpy as np
 
-    from frictionlab import levmar
+    from frictionlab.inference import levmar
 
     params = {"a": levmar.Param("a", 1.0, 0.0, 10.0, True)}
     assert levmar.leastsq(lambda v: np.array([np.nan, 1.0]), params, True, 50) is None
@@ -333,7 +334,7 @@ def test_the_scalar_right_hand_side_takes_a_constant_normal_force_built_once():
     import numpy as np
 
     from frictionlab import get_law, load_dataset
-    from frictionlab.plan import make_plan
+    from frictionlab.solve.plan import make_plan
 
     incline = make_plan(load_dataset("incline-dry-d10").scene, get_law("area-rate"))
     N = incline._fixed_normal()

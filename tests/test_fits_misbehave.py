@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 import frictionlab as fl
-from frictionlab import comparison, fitting
+from frictionlab.inference import fitting
+from frictionlab.pipeline import comparison
 from frictionlab.report import write_report
 
 #: Laws that pass the registry's probe (slips of at most 3 m/s) and break at the golf ball's 12 m/s.
@@ -139,7 +140,7 @@ def test_failing_fit_on_the_command_line(bad_laws, tmp_path, run_cli):
 @pytest.mark.parametrize("kw", [{"fixed": {"lam": -1.0}}, {"initial": {"lam": -1.0}}, {"fixed": {"lam": float("nan")}}])
 def test_fit_refuses_held_or_start_values_outside_the_bounds(kw):
     """A held lam of -1 used to be clipped to 0 and 'fitted' with status ok."""
-    from frictionlab.errors import ParameterError
+    from frictionlab.core.errors import ParameterError
 
     with pytest.raises(ParameterError, match=r"law 'wear': lam = .* is outside its bounds"):
         fitting.fit("wear", "impact-golf-v28", **kw)
@@ -147,7 +148,7 @@ def test_fit_refuses_held_or_start_values_outside_the_bounds(kw):
 
 # -- never lose a result ------------------------------------------------------------------------
 def test_a_failed_forced_rewrite_keeps_the_previous_report(tmp_path):
-    from frictionlab.io import MARKER, atomic_dir
+    from frictionlab.core.files import MARKER, atomic_dir
 
     out = tmp_path / "report"
     out.mkdir()

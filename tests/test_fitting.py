@@ -3,13 +3,13 @@ import math
 
 import numpy as np
 import pytest
-
 from _fit_helpers import TRUTH, impact_scene, incline_scene, synthetic
+
 from frictionlab import FrictionLabError, FrictionLaw, ParamSpec, fit, make_target
-from frictionlab.derive import derive_omega
-from frictionlab.errors import DatasetError, ParameterError
-from frictionlab.fitting import applicable_solvers, auto_solver
-from frictionlab.law import AreaSlipForm
+from frictionlab.core.errors import DatasetError, ParameterError
+from frictionlab.inference.fitting import applicable_solvers, auto_solver
+from frictionlab.physics.derive import derive_omega
+from frictionlab.physics.law import AreaSlipForm
 
 
 def within(p, truth, n_sigma=3.0):

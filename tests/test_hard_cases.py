@@ -12,13 +12,12 @@ import warnings
 
 import numpy as np
 import pytest
+from _scenes import MASS, RADIUS, incline, normal_impact, paper_impact
 
 from frictionlab import FrictionLaw, ParamSpec, simulate
-from frictionlab.errors import LawError, ParameterError, SceneError, SolverError
-from frictionlab.scene import HalfSineArea, TableArea
-from frictionlab.solvers.series import SeriesAccuracyWarning
-
-from _scenes import MASS, RADIUS, incline, normal_impact, paper_impact
+from frictionlab.core.errors import LawError, ParameterError, SceneError, SolverError
+from frictionlab.physics.scene import HalfSineArea, TableArea
+from frictionlab.solve.solvers.series import SeriesAccuracyWarning
 
 TC, A0 = 500e-6, 130e-6
 KAPPA_COUPLED = 7 / (2 * MASS)  # 1/m + r^2/I for a solid sphere
@@ -142,7 +141,7 @@ def test_contact_area_range(area):
 
 def test_tiny_area_on_incline():
     """couette with A = 1e-12 m^2 on an incline: practically free sliding, u = u0 + g (sin alpha) t."""
-    from frictionlab.scene import G
+    from frictionlab.physics.scene import G
 
     for solver in ("exact", "ode"):
         tr = simulate("couette", incline(u0=0.0, area=1e-12), {"eta": 1e-6, "h": 1.0}, solver=solver, n=51)
@@ -164,7 +163,7 @@ def test_impact_starting_without_slip_stays_rolling(solver):
 @pytest.mark.parametrize("mu, moves", [(0.2, True), (0.6, False), (math.tan(math.radians(20)), False)])
 def test_incline_from_rest(solver, mu, moves):
     """From rest a block slides iff mu < tan(alpha); at mu = tan(alpha) exactly it stays (no chatter)."""
-    from frictionlab.scene import G
+    from frictionlab.physics.scene import G
 
     a = math.radians(20)
     tr = simulate("coulomb", incline(u0=0.0), {"mu": mu}, solver=solver, n=101)

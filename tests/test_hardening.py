@@ -20,9 +20,10 @@ from pathlib import Path
 import pytest
 
 import frictionlab as fl
-from frictionlab import io, registry
-from frictionlab.errors import LawError, OutputError, UnitError
-from frictionlab.law import FrictionLaw, ParamSpec
+from frictionlab.core import files as io
+from frictionlab.core.errors import LawError, OutputError, UnitError
+from frictionlab.physics import registry
+from frictionlab.physics.law import FrictionLaw, ParamSpec
 
 SLOW_LAW = '''
 import time
@@ -51,7 +52,7 @@ class Slow(FrictionLaw):
     ("1e200*1e200*1e200 kg", "not finite|accepted magnitudes"),
 ])
 def test_hostile_quantities_are_refused_before_pint_evaluates_them(text, match):
-    from frictionlab.units import to_si
+    from frictionlab.core.units import to_si
 
     with pytest.raises(UnitError, match=match) as info:
         to_si(text, "kg", "scene.mass")
@@ -59,7 +60,7 @@ def test_hostile_quantities_are_refused_before_pint_evaluates_them(text, match):
 
 
 def test_ordinary_quantities_still_convert():
-    from frictionlab.units import to_si, unit_factor
+    from frictionlab.core.units import to_si, unit_factor
 
     assert to_si("46 g", "kg", "m") == pytest.approx(0.046)
     assert to_si("130 mm^2", "m^2", "a") == pytest.approx(1.3e-4)
@@ -202,9 +203,9 @@ class _StallsLater(_Sluggish):
 
 
 def test_refits_of_the_equivalence_test_bootstrap_and_transfer_keep_the_time_budget():
-    from frictionlab.bootstrap import bootstrap_fits
-    from frictionlab.equivalence import MIN_REPLICATES, analyze_equivalence
-    from frictionlab.transfer import shared_fit
+    from frictionlab.inference.bootstrap import bootstrap_fits
+    from frictionlab.inference.equivalence import MIN_REPLICATES, analyze_equivalence
+    from frictionlab.inference.transfer import shared_fit
 
     fl.register_law(_StallsLater)
     try:
@@ -334,7 +335,7 @@ def test_force_replaces_a_report_or_an_empty_folder_and_nothing_else(tmp_path):
 
 def _hold_lock(path: Path):
     """A subprocess holding frictionlab's lock on ``path`` until its stdin closes."""
-    code = ("import sys; from frictionlab.io import output_lock\n"
+    code = ("import sys; from frictionlab.core.files import output_lock\n"
             f"with output_lock({str(path)!r}):\n    print('held', flush=True); sys.stdin.read()\n")
     proc = subprocess.Popen([sys.executable, "-c", code], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
     assert proc.stdout.readline().strip() == "held"
@@ -471,8 +472,8 @@ def test_quantities_at_the_limits_give_errors_naming_the_field_never_a_class(bas
     accepted magnitude: it loads, or the one-line error names the file, not an internal class."""
     import re
 
-    from frictionlab.dataset import builtin_dir
-    from frictionlab.errors import FrictionLabError
+    from frictionlab.core.errors import FrictionLabError
+    from frictionlab.io.dataset import builtin_dir
 
     text = (builtin_dir() / f"{base}.toml").read_text()
     (tmp_path / "d.csv").write_bytes((builtin_dir() / f"{base}.csv").read_bytes())
@@ -518,7 +519,7 @@ def test_the_pool_freezes_what_its_workers_inherit_and_unfreezes_it_after():
     alone) and unfreezes them when the pool closes, also after an error: nothing stays immortal."""
     import gc
 
-    from frictionlab.workers import process_pool
+    from frictionlab.core.workers import process_pool
 
     assert gc.get_freeze_count() == 0
     with process_pool(2) as pool:
@@ -543,7 +544,7 @@ def test_a_long_run_tunes_the_collector_and_restores_it_after_also_around_a_pool
     (also after an error) thresholds and freeze are as before."""
     import gc
 
-    from frictionlab.workers import GC_YOUNG, long_run_gc, process_pool
+    from frictionlab.core.workers import GC_YOUNG, long_run_gc, process_pool
 
     before = gc.get_threshold()
     assert gc.get_freeze_count() == 0

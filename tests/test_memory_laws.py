@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 import frictionlab as fl
-from frictionlab.datagen.springslider import TRUTH
-from frictionlab.errors import SolverError
-from frictionlab.scene import ConstantNormal, Scene, SpringLoad
-from frictionlab.solvers.prescribed import respond
+from frictionlab.core.errors import SolverError
+from frictionlab.io.datagen.springslider import TRUTH
+from frictionlab.physics.scene import ConstantNormal, Scene, SpringLoad
+from frictionlab.solve.solvers.prescribed import respond
 
 N = 1e4
 RS = dict(TRUTH)  # mu0 0.6, a 0.008, b 0.012, Dc 10 um (V0 = 1 um/s): k_c = (b - a)/Dc = 400 /m
@@ -148,7 +148,7 @@ def test_aging_and_slip_told_apart_by_large_steps_not_by_small_ones(rs_fits):
 def test_memoryless_laws_on_a_spring_slider():
     """A viscous law drives the quasi-static slider (mu = c A v / N relaxes to the new speed at rate k N/(c A));
     Coulomb has no slip-rate dependence and is refused with the reason."""
-    from frictionlab.scene import ConstantArea
+    from frictionlab.physics.scene import ConstantArea
 
     scene = slider(2000.0, (0.0, 1.0), (1e-6, 2e-6), 3.0).with_(area=ConstantArea(1e-3))
     c = 0.6 * N / (1e-3 * 1e-6)  # wear law lam: mu = 0.6 at 1 um/s
@@ -163,9 +163,9 @@ def test_memoryless_laws_on_a_spring_slider():
 def test_a_law_whose_force_ignores_the_slip_rate_is_refused_by_the_plan_and_skipped_by_a_fit():
     """Dahl's force depends on its state only (dF/du = 0 at fixed state, whatever its parameters): the plan
     refuses it on a spring-slider up front, so a fit is 'skipped' with that reason, not a failed search."""
-    from frictionlab.dataset import load_dataset
-    from frictionlab.plan import make_plan
-    from frictionlab.registry import get_law
+    from frictionlab.io.dataset import load_dataset
+    from frictionlab.physics.registry import get_law
+    from frictionlab.solve.plan import make_plan
 
     ds = load_dataset("spring-slider-aging")
     with pytest.raises(fl.FrictionLabError, match="'dahl' on a spring-slider: its force does not grow"):
@@ -177,8 +177,8 @@ def test_a_law_whose_force_ignores_the_slip_rate_is_refused_by_the_plan_and_skip
 
 def test_report_figures_survive_a_curve_the_solver_cannot_draw(monkeypatch):
     """A stiff law's dense best-fit curve may exceed the ODE budget: the figure keeps the fitted points."""
-    from frictionlab import figures
-    from frictionlab.fitting import DatasetFit
+    from frictionlab.inference.fitting import DatasetFit
+    from frictionlab.report import figures
 
     ds = fl.load_dataset("incline-oil-a100")
     f = fl.fit("couette", ds, solver="exact")
@@ -194,7 +194,7 @@ def test_report_figures_survive_a_curve_the_solver_cannot_draw(monkeypatch):
 def test_ode_only_laws_skip_impact_outcome_sets_by_default_but_fit_when_the_solver_is_named():
     """`compare --laws all` stays minutes, not hours: an ODE-only law on an impact-outcome set (every
     evaluation simulates every impact) is a skipped candidate with the reason, unless the solver is named."""
-    from frictionlab.comparison import candidates
+    from frictionlab.pipeline.comparison import candidates
 
     outcome = fl.load_dataset("impact-outcome-synthetic")
     (solver, why), = candidates("lugre", outcome, None)

@@ -17,10 +17,16 @@ from scipy.integrate import quad
 from scipy.special import beta
 
 import frictionlab as fl
-from frictionlab.datagen import outcome as gen
-from frictionlab.errors import DatasetError, SceneError
-from frictionlab.outcome import HertzPulse, OutcomeScene, SpeedLaw, hertz_shape, predict_outcomes
-from frictionlab.scene import Compliance
+from frictionlab.core.errors import DatasetError, SceneError
+from frictionlab.io.datagen import outcome as gen
+from frictionlab.physics.scene import Compliance
+from frictionlab.solve.outcome import (
+    HertzPulse,
+    OutcomeScene,
+    SpeedLaw,
+    hertz_shape,
+    predict_outcomes,
+)
 
 M, R = 0.0459, 0.02135
 SPEEDS = np.repeat([20.0, 40.0], 7)
@@ -173,7 +179,7 @@ def test_generator_is_reproducible(tmp_path):
     assert [p.name for p in first] == ["impact-outcome-synthetic.csv", "impact-outcome-synthetic.toml"]
     for p, q in zip(first, second):
         assert filecmp.cmp(p, q, shallow=False)
-        assert filecmp.cmp(p, fl.dataset.builtin_dir() / p.name, shallow=False)
+        assert filecmp.cmp(p, fl.io.dataset.builtin_dir() / p.name, shallow=False)
 
 
 # --- errors ----------------------------------------------------------------------------------------
@@ -200,7 +206,7 @@ def test_errors_are_clear():
     ('[scene.normal]', '[scene.nromal]', "unknown key.*nromal"),
 ])
 def test_bad_outcome_datasets(tmp_path, old, new, match):
-    src = fl.dataset.builtin_dir()
+    src = fl.io.dataset.builtin_dir()
     for ext in ("csv", "toml"):
         text = (src / f"impact-outcome-synthetic.{ext}").read_text()
         if old in text:
@@ -213,9 +219,8 @@ def test_bad_outcome_datasets(tmp_path, old, new, match):
 
 def test_registered_predictor_fits_the_synthetic_truth(monkeypatch):
     """With the predictor registered, fitting Coulomb to the synthetic outcomes recovers mu = 0.25."""
-    from frictionlab import fitting
-    from frictionlab.predict import outcome_predictor
-    from frictionlab.predict import PREDICTORS
+    from frictionlab.inference import fitting
+    from frictionlab.inference.predict import PREDICTORS, outcome_predictor
 
     monkeypatch.setitem(PREDICTORS, "impact-outcome", outcome_predictor)
     r = fitting.fit("coulomb", "impact-outcome-synthetic", solver="exact")

@@ -5,12 +5,18 @@ import math
 
 import numpy as np
 import pytest
+from _scenes import MASS, RADIUS, incline, normal_impact, paper_impact
 
 from frictionlab import Scene, get_law, make_plan, simulate
-from frictionlab.errors import SceneError
-from frictionlab.scene import G, GrowthArea, HalfSineArea, HalfSineNormal, HertzNormal, WeightNormal
-
-from _scenes import MASS, RADIUS, incline, normal_impact, paper_impact
+from frictionlab.core.errors import SceneError
+from frictionlab.physics.scene import (
+    G,
+    GrowthArea,
+    HalfSineArea,
+    HalfSineNormal,
+    HertzNormal,
+    WeightNormal,
+)
 
 SOLVERS = ("exact", "ode", "ode:RK45")
 

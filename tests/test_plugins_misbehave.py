@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import frictionlab as fl
-from frictionlab import registry
-from frictionlab.errors import FrictionLabError, LawError, RegistryError
+from frictionlab.core.errors import FrictionLabError, LawError, RegistryError
+from frictionlab.physics import registry
 
 BAD_LAWS = '''
     import numpy as np

@@ -21,8 +21,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import frictionlab as fl
-from frictionlab.dataset import builtin_dir, from_meta
-from frictionlab.errors import FrictionLabError
+from frictionlab.core.errors import FrictionLabError
+from frictionlab.io.dataset import builtin_dir, from_meta
 
 RPM = 2 * math.pi / 60
 #: unit -> SI factor, by hand
@@ -146,7 +146,7 @@ def test_same_data_in_other_units_fits_to_the_same_parameters(tmp_path, base, la
     a, b = fl.load_dataset(base), fl.load_dataset(toml)
     for col in a.columns:
         np.testing.assert_allclose(b.columns[col], a.columns[col], rtol=1e-12)
-    from frictionlab.fitting import fit
+    from frictionlab.inference.fitting import fit
 
     fa, fb = fit(law, a), fit(law, b)
     assert fa.ok and fb.ok
@@ -293,7 +293,7 @@ WRONG = [0, -1, 3.5, float("nan"), True, [], [1, "x"], {}, {"model": "x"}, "", "
 def test_every_field_with_every_wrong_type_is_a_clear_error(base, monkeypatch):
     """A systematic sweep beside the random fuzz: each known field, set to each kind of wrong value
     (or removed), loads or fails with a one-line FrictionLabError."""
-    from frictionlab import dataset
+    from frictionlab.io import dataset
 
     csv = dataset.read_csv(builtin_dir() / f"{base}.csv")  # the TOML is under test here, not the CSV
     monkeypatch.setattr(dataset, "read_csv", lambda path: {k: v.copy() for k, v in csv.items()})

@@ -16,10 +16,16 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 import frictionlab as fl
-from frictionlab.errors import SolverError
-from frictionlab.law import Contact
-from frictionlab.scene import G, ConstantArea, GrowthArea, HalfSineArea, HalfSineNormal
-from frictionlab.solvers.series import SeriesAccuracyWarning
+from frictionlab.core.errors import SolverError
+from frictionlab.physics.law import Contact
+from frictionlab.physics.scene import (
+    ConstantArea,
+    G,
+    GrowthArea,
+    HalfSineArea,
+    HalfSineNormal,
+)
+from frictionlab.solve.solvers.series import SeriesAccuracyWarning
 
 LAWS = ("coulomb", "area-rate", "wear", "couette")
 ALWAYS_OPPOSE = ("coulomb", "wear", "couette")

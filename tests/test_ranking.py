@@ -2,12 +2,11 @@
 import math
 
 import attrs
-
 import pytest
-
 from _fit_helpers import TRUTH, incline_scene, synthetic
+
 from frictionlab import compare
-from frictionlab.ranking import COLUMNS, RankRow, _rank, rank_groups, to_csv
+from frictionlab.inference.ranking import COLUMNS, RankRow, _rank, rank_groups, to_csv
 
 
 def row(ds, law, aic, solver="exact", n=20, k=1, status="ok"):

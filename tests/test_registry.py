@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 import frictionlab as fl
-from frictionlab import registry
-from frictionlab.errors import LawError, RegistryError
-from frictionlab.law import Contact
+from frictionlab.core.errors import LawError, RegistryError
+from frictionlab.physics import registry
+from frictionlab.physics.law import Contact
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 
@@ -183,7 +183,7 @@ def test_readme_law_example_runs_as_written(tmp_path, run_cli):
     exec(compile(code, "my_laws.py", "exec"), namespace)
     try:
         law = fl.get_law("exp-stribeck")
-        scene = fl.Scene(kind="incline", mass=0.1, u0=1.0, duration=0.05, normal=fl.scene.WeightNormal(1.0))
+        scene = fl.Scene(kind="incline", mass=0.1, u0=1.0, duration=0.05, normal=fl.physics.scene.WeightNormal(1.0))
         traj = fl.simulate("exp-stribeck", scene, solver="ode", t=np.linspace(0, 0.05, 6))
         # mu between mu_k and mu_s, so the block decelerates at between 0.2 and 0.4 N / 0.1 kg
         assert 1.0 - 4.0 * 0.05 <= traj.v[-1] <= 1.0 - 2.0 * 0.05

@@ -7,16 +7,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from frictionlab.errors import FrictionLabError
-
 from _fit_helpers import TRUTH, synthetic
+
 from frictionlab import compare, write_report
-from frictionlab.io import MARKER
 from frictionlab.cli import main
-from frictionlab.progress import Progress
-from frictionlab.errors import OutputError
-from frictionlab.ranking import COLUMNS
+from frictionlab.core.errors import FrictionLabError, OutputError
+from frictionlab.core.files import MARKER
+from frictionlab.core.progress import Progress
+from frictionlab.inference.ranking import COLUMNS
 
 
 @pytest.fixture(scope="module")
@@ -186,7 +184,7 @@ def test_existing_folder_is_refused_then_replaced_with_force(comparison, tmp_pat
 
 
 def test_a_failure_while_writing_leaves_nothing_behind(comparison, tmp_path, monkeypatch):
-    from frictionlab import figures
+    from frictionlab.report import figures
 
     def boom(*a, **k):
         raise RuntimeError("figure failed")
@@ -210,7 +208,7 @@ def test_figures_drawn_by_worker_processes_are_the_ones_drawn_here(comparison, r
 
     assert "Generated <time> by" in html(par)
     assert html(par) == html(report_dir)
-    from frictionlab import figures
+    from frictionlab.report import figures
 
     monkeypatch.setattr(figures, "force_figure", lambda *a, **k: 1 / 0)
     with pytest.raises(ZeroDivisionError):
@@ -221,7 +219,7 @@ def test_figures_drawn_by_worker_processes_are_the_ones_drawn_here(comparison, r
 def test_figures_laid_out_before_saving_are_those_of_a_plain_savefig(comparison, report_dir, tmp_path, monkeypatch):
     """figures._png runs the constrained layout itself and saves without the layout engine (one draw fewer):
     every figure of the report is the same bytes as matplotlib's own savefig with constrained layout."""
-    from frictionlab import figures
+    from frictionlab.report import figures
 
     def plain(fig):
         buf = io.BytesIO()
@@ -323,8 +321,9 @@ def test_a_new_dataset_kind_plugs_in_through_one_predictor(tmp_path, monkeypatch
     the report need; without it the dataset is skipped with the reason."""
     import attrs
 
-    from frictionlab import fitting, simulate
-    from frictionlab.dataset import Dataset
+    from frictionlab import simulate
+    from frictionlab.inference import fitting
+    from frictionlab.io.dataset import Dataset
 
     base = synthetic("wear", {"lam": 1.2e6})
     speeds = np.array([8.0, 10.0, 12.0, 14.0, 16.0])

@@ -4,10 +4,10 @@ import math
 import attrs
 import numpy as np
 import pytest
-
 from _fit_helpers import TRUTH, synthetic
+
 from frictionlab import compare
-from frictionlab.answers import Answer
+from frictionlab.inference.answers import Answer
 from frictionlab.report import build, first_screen
 from frictionlab.report.render import html_page, markdown
 
@@ -112,8 +112,7 @@ def test_names_and_descriptions_never_leak_raw_html(comp, tmp_path):
 
 
 def test_one_functional_form_is_one_entry():
-    from frictionlab import figures
-    from frictionlab.report import ranking
+    from frictionlab.report import figures, ranking
 
     ds = synthetic("wear", {"lam": 1.2e6}, seed=8, n=21, name="impact-forms")
     c = compare(laws=["wear", "couette", "coulomb"], datasets=[ds], solvers=["exact"], equivalence=False)
@@ -127,7 +126,7 @@ def test_one_functional_form_is_one_entry():
 
 
 def test_table_numbers_keep_their_significant_figures():
-    from frictionlab.display import fmt
+    from frictionlab.core.display import fmt
 
     assert [fmt(x) for x in (1.0, 0.5, 12.5, 1100.0, 10090.4, 3.41391)] == ["1.000", "0.5000", "12.50", "1100",
                                                                             "10090", "3.414"]
@@ -159,7 +158,7 @@ def test_plausibility_flags_reach_the_parameter_they_name():
 
 
 def test_a_group_row_shows_its_first_flag_and_counts_the_others():
-    from frictionlab.ranking import RankRow
+    from frictionlab.inference.ranking import RankRow
     from frictionlab.report.ranking import group_table
 
     row = RankRow("ALL", "area-rate", "exact", 650, 16, aic=1.0, rank=3,

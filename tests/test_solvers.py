@@ -11,13 +11,12 @@ import warnings
 
 import numpy as np
 import pytest
+from _scenes import MASS, PAPER, RADIUS, incline, normal_impact, paper_impact
 
 from frictionlab import simulate
-from frictionlab.errors import SolverError
-from frictionlab.scene import G, GrowthArea
-from frictionlab.solvers.series import SeriesAccuracyWarning
-
-from _scenes import MASS, PAPER, RADIUS, incline, normal_impact, paper_impact
+from frictionlab.core.errors import SolverError
+from frictionlab.physics.scene import G, GrowthArea
+from frictionlab.solve.solvers.series import SeriesAccuracyWarning
 
 RPM = 30.0 / math.pi  # rad/s -> rpm
 

@@ -5,17 +5,15 @@ import math
 
 import numpy as np
 import pytest
+from _scenes import incline, normal_impact
 
 import frictionlab as fl
 from frictionlab import Contact, FrictionLaw, ParamSpec, StateSpec, make_plan, simulate
-from frictionlab.batch import simulate_batch
-from frictionlab.errors import LawError, SolverError
-from frictionlab.predict import applicable_solvers
-from frictionlab.scene import G
-
-from frictionlab.solvers.prescribed import respond
-
-from _scenes import incline, normal_impact
+from frictionlab.core.errors import LawError, SolverError
+from frictionlab.inference.predict import applicable_solvers
+from frictionlab.physics.scene import G
+from frictionlab.solve.batch import simulate_batch
+from frictionlab.solve.solvers.prescribed import respond
 
 
 class SlipMeter(FrictionLaw):
@@ -173,11 +171,11 @@ def stateful_plugin(tmp_path, monkeypatch):
 
 def test_third_party_stateful_law_works_as_a_builtin(stateful_plugin, run_cli):
     """Registered by an entry point; integrated by the plan; listed with its state; joins 'all' only."""
-    from frictionlab.comparison import DEFAULT_LAWS, select_laws
+    from frictionlab.pipeline.comparison import DEFAULT_LAWS, select_laws
 
     law = fl.get_law("relaxing-third-party")
     # a block sliding at constant speed (no drive, huge mass): m(x) = mu (1 - exp(-x / L)), x = u0 t
-    scene = fl.Scene(kind="incline", mass=1e12, u0=1.0, duration=2.0, normal=fl.scene.WeightNormal(10.0))
+    scene = fl.Scene(kind="incline", mass=1e12, u0=1.0, duration=2.0, normal=fl.physics.scene.WeightNormal(10.0))
     t = np.linspace(0.0, 2.0, 9)
     tr = simulate(law, scene, {"mu": 0.3, "L": 0.5}, t=t)
     assert tr.solver == "ode:LSODA"
@@ -217,7 +215,7 @@ def test_readme_stateful_law_example_runs_as_written():
     exec(compile(code, "my_stateful_law.py", "exec"), {})
     try:
         # sliding at a constant 1 m/s (no drive, huge mass), started in steady state
-        scene = fl.Scene(kind="incline", mass=1e12, u0=1.0, duration=1e-2, normal=fl.scene.WeightNormal(10.0))
+        scene = fl.Scene(kind="incline", mass=1e12, u0=1.0, duration=1e-2, normal=fl.physics.scene.WeightNormal(10.0))
         tr = simulate("lagged-coulomb", scene, {"mu": 0.3, "L": 1e-3}, t=np.linspace(0, 1e-2, 5))
         assert np.allclose(tr.force, 3.0, rtol=1e-9)  # started steady, stays steady
         F, s = respond("lagged-coulomb", {"mu": 0.3, "L": 1e-3}, np.linspace(0, 4e-3, 5),
@@ -241,8 +239,9 @@ def test_rate_state_sticks_at_zero_slip_with_its_state_held():
 
 
 def test_plugin_with_a_degenerate_state_spec_is_skipped_naming_it(tmp_path, monkeypatch):
-    from frictionlab import registry
     from test_registry import _write_dist
+
+    from frictionlab.physics import registry
 
     bad = STATEFUL_PLUGIN.replace('StateSpec("m", "", 0.0, 0.3,', 'StateSpec("m", "", 0.0, 0.0,')
     _write_dist(tmp_path, "degenerate-law", bad, "degenerate = degenerate_law:Relaxing\n")

@@ -6,15 +6,15 @@ import math
 import attrs
 import numpy as np
 import pytest
+from _fit_helpers import TRUTH, incline_scene, synthetic
 
 import frictionlab as fl
-from _fit_helpers import TRUTH, incline_scene, synthetic
 from frictionlab import FrictionLaw, ParamSpec, compare, fit, load_dataset
-from frictionlab.goodness import FITS_LEVEL, runs_test
-from frictionlab.ranking import NEAR_TIE, RankRow, _rank, rank_groups
 from frictionlab.commands.compare import answer_lines
-from frictionlab.datagen.knowntruth import QuadraticDrag  # registered nowhere
-from frictionlab.verdicts import POOR
+from frictionlab.inference.goodness import FITS_LEVEL, runs_test
+from frictionlab.inference.ranking import NEAR_TIE, RankRow, _rank, rank_groups
+from frictionlab.inference.verdicts import POOR
+from frictionlab.io.datagen.knowntruth import QuadraticDrag  # registered nowhere
 
 REGISTERED = ["coulomb", "area-rate", "wear", "couette"]
 
@@ -27,7 +27,7 @@ def _incline(law, params, sigma=0.002, seed=11, name=None):
     y = v + np.random.default_rng(seed).normal(0.0, sigma, t.size)
     return fl.Dataset(name=name or "incline-test", kind="incline", observable="v", path=None,
                       columns={"t": t, "v": y}, units={"t": "s", "v": "m/s"}, noise={"v": sigma}, scene=scene,
-                      fixed={}, provenance=fl.dataset.Provenance("synthetic", "tests", command="tests"),
+                      fixed={}, provenance=fl.io.dataset.Provenance("synthetic", "tests", command="tests"),
                       noise_kind="known")
 
 
@@ -146,7 +146,7 @@ def test_a_derived_omega_fit_carries_no_chi_square_statistics():
 
 # --- 4. bootstrap ------------------------------------------------------------------------------
 def test_bootstrap_is_parametric_and_skips_noise_free_series():
-    from frictionlab.bootstrap import bootstrap_fits
+    from frictionlab.inference.bootstrap import bootstrap_fits
 
     golf = [fit(law, "impact-golf-v28") for law in ("wear", "coulomb")]
     oil = [fit(law, "incline-oil-a100") for law in ("wear", "couette", "coulomb")]
@@ -195,8 +195,8 @@ def test_a_parameter_without_effect_is_found_by_sensitivity():
 
 
 def test_a_trajectory_that_leaves_the_plausible_range_is_flagged():
-    from frictionlab.fitting import DatasetFit, make_target
-    from frictionlab.plausibility import RANGE, check_plausibility
+    from frictionlab.inference.fitting import DatasetFit, make_target
+    from frictionlab.inference.plausibility import RANGE, check_plausibility
 
     class NoModel:  # no free parameters: only the trajectory checks run
         def residual(self, values):
@@ -231,8 +231,8 @@ class PushingDrag(FrictionLaw):
 
 
 def test_friction_that_supplies_energy_is_flagged():
-    from frictionlab.fitting import DatasetFit, make_target
-    from frictionlab.plausibility import check_plausibility
+    from frictionlab.inference.fitting import DatasetFit, make_target
+    from frictionlab.inference.plausibility import check_plausibility
 
     class NoModel:
         def residual(self, values):
@@ -246,8 +246,8 @@ def test_friction_that_supplies_energy_is_flagged():
 
 
 def test_too_few_points_with_assumed_sigma_is_untestable_not_a_poor_set():
-    from frictionlab.goodness import goodness
-    from frictionlab.verdicts import _verdict
+    from frictionlab.inference.goodness import goodness
+    from frictionlab.inference.verdicts import _verdict
 
     g = goodness(np.array([0.3, -0.2, 0.1, 0.4, -0.5]), 1, "assumed")  # 5 points: no runs test, no chi2
     row = RankRow("d", "coulomb", "exact", 5, 1, 1.0, 1.0, 1.0, 3.0, 3.0, 3.0, rank=1, fits=g.fits, goodness=g,
@@ -261,7 +261,7 @@ def test_a_group_where_no_law_could_be_fitted_is_not_answered_from_another_group
     """A group whose candidates all failed says so; it never borrows the ranking of all datasets."""
     from types import SimpleNamespace
 
-    from frictionlab.verdicts import make_answers
+    from frictionlab.inference.verdicts import make_answers
 
     prov = SimpleNamespace(kind="synthetic")
     dss = [SimpleNamespace(name=n, provenance=prov, group="") for n in ("oil-a", "oil-b", "slider-a", "slider-b")]
@@ -276,8 +276,8 @@ def test_a_group_where_no_law_could_be_fitted_is_not_answered_from_another_group
 
 def test_a_spring_slider_step_is_measured_against_its_fastest_load_point_velocity():
     """A velocity step 1 -> 10 um/s makes the slip overshoot 10x the first velocity: physics, not a pumping law."""
-    from frictionlab.plausibility import _trajectories
-    from frictionlab.registry import get_law
+    from frictionlab.inference.plausibility import _trajectories
+    from frictionlab.physics.registry import get_law
 
     d = load_dataset("spring-slider-aging")
     r = fit("rate-state-aging", d, initial={"a": 0.008, "b": 0.012, "Dc": 1e-5, "mu0": 0.6})
@@ -300,7 +300,7 @@ def test_a_dataset_no_compared_law_applies_to_is_left_out_before_fitting_with_on
     assert any(line.startswith("  spring-slider-slip: not fitted") for line in answer_lines(c))
     with pytest.raises(fl.FrictionLabError, match="none of the datasets can be fitted: spring-slider-slip: none of"):
         compare(datasets=["spring-slider-slip"], equivalence=False, transfer=False)
-    from frictionlab.comparison import candidates
+    from frictionlab.pipeline.comparison import candidates
 
     assert candidates("rate-state-slip", load_dataset("spring-slider-slip"), None) == [("ode", None)]  # still fitted
 
@@ -310,7 +310,7 @@ def test_goodness_p_values_are_scipy_stats_own():
     numbers on residuals of many shapes (runs test, lag-1 correlation) and on a chi-square grid."""
     from scipy.stats import chi2, norm
 
-    from frictionlab.goodness import RUNS_MIN, chi2_pvalue, lag1
+    from frictionlab.inference.goodness import RUNS_MIN, chi2_pvalue, lag1
 
     rng = np.random.default_rng(3)
     for _ in range(300):

@@ -24,7 +24,7 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from ..bench import run_bench, write_bench
+    from ..pipeline.bench import run_bench, write_bench
 
     _check_out(args)
     import datetime as _dt
@@ -46,7 +46,7 @@ def _check_out(args):
     """Fail before the (long) measurement if the output folder cannot be written."""
     from pathlib import Path
 
-    from ..errors import OutputError
+    from ..core.errors import OutputError
 
     path = Path(args.out)
     if path.exists() and not args.force:

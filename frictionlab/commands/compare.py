@@ -4,8 +4,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..errors import OutputError, ParameterError
-from ..progress import Progress
+from ..core.errors import OutputError, ParameterError
+from ..core.progress import Progress
 from .fit import FIT_TIMEOUT, fit_timeout
 
 #: Default number of bootstrap resamples: about +15 s (idle) to +35 s (busy machine) on 2 cores for the
@@ -70,10 +70,10 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from ..comparison import compare
-    from ..io import check_target, output_lock
+    from ..core.files import check_target, output_lock
+    from ..core.workers import long_run_gc
+    from ..pipeline.comparison import compare
     from ..report import write_report
-    from ..workers import long_run_gc
     from .fit import parse_free
 
     parent = args.out.parent if str(args.out.parent) else Path(".")
@@ -86,7 +86,7 @@ def run(args) -> int:
                              f"got {args.bootstrap}")
     if args.seed < 0:
         raise ParameterError(f"--seed must be a non-negative integer, got {args.seed}")
-    from ..equivalence import MIN_REPLICATES
+    from ..inference.equivalence import MIN_REPLICATES
 
     if args.replicates < MIN_REPLICATES:
         raise ParameterError(f"--replicates must be at least {MIN_REPLICATES}, got {args.replicates}")

@@ -9,7 +9,7 @@ from pathlib import Path
 
 def add_parser(sub):
     from ..cli import subcommand
-    from ..dataset_template import KINDS
+    from ..io.template import KINDS
 
     p = subcommand(sub, "datasets", help="list, show, start (template) or rebuild datasets",
                    description="Datasets are a CSV of columns plus a TOML of the same name that gives units, noise, "
@@ -59,8 +59,8 @@ def add_parser(sub):
 
 
 def _list(args) -> int:
-    from ..dataset import builtin_dir, builtin_names, load_dataset
-    from ..table import render
+    from ..core.table import render
+    from ..io.dataset import builtin_dir, builtin_names, load_dataset
 
     rows = []
     for name in builtin_names():
@@ -89,8 +89,8 @@ def _values(table: dict) -> str:
 
 
 def _show(args) -> int:
-    from ..dataset import load_dataset
-    from ..display import describe, quantity_text
+    from ..core.display import describe, quantity_text
+    from ..io.dataset import load_dataset
 
     d = load_dataset(args.name)
     pv = d.provenance
@@ -124,16 +124,16 @@ def _show(args) -> int:
 
 def _to_file_unit(d, column: str) -> float:
     """Factor from SI to the unit the dataset's file uses for ``column``."""
-    from ..dataset import COLUMN_SI
-    from ..units import unit_factor
+    from ..core.units import unit_factor
+    from ..io.dataset import COLUMN_SI
 
     return 1.0 / unit_factor(d.units[column], COLUMN_SI.get(column, ""), column)
 
 
 def _template(args) -> int:
-    from ..dataset_template import template
-    from ..errors import OutputError
-    from ..io import atomic_write_text
+    from ..core.errors import OutputError
+    from ..core.files import atomic_write_text
+    from ..io.template import template
 
     if not args.out.is_dir():
         raise OutputError(f"{args.out}: folder does not exist")
@@ -150,8 +150,8 @@ def _template(args) -> int:
 
 
 def _rebuild(args) -> int:
-    from ..dataset import builtin_dir
-    from ..datagen import GENERATORS, KNOWN_TRUTH, KNOWN_TRUTH_DIR, rebuild
+    from ..io.datagen import GENERATORS, KNOWN_TRUTH, KNOWN_TRUTH_DIR, rebuild
+    from ..io.dataset import builtin_dir
 
     generators = KNOWN_TRUTH if args.known_truth else GENERATORS
     home = (args.out or KNOWN_TRUTH_DIR) if args.known_truth else builtin_dir()
@@ -165,14 +165,14 @@ def _rebuild(args) -> int:
             return 1
         print(f"{len(written)} generated files equal the committed ones in {home}")
         return 0
-    from ..errors import OutputError
+    from ..core.errors import OutputError
 
     out = args.out or home
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"{out}: cannot create the output folder: {exc.strerror or exc}") from None
-    from ..io import output_lock
+    from ..core.files import output_lock
 
     with output_lock(out), tempfile.TemporaryDirectory(dir=out) as tmp:  # one rebuild of a folder at a time
         written = rebuild(Path(tmp), generators)

@@ -4,8 +4,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from ..errors import OutputError, ParameterError, SolverError
-from ..freeable import SCENE_QUANTITIES
+from ..core.errors import OutputError, ParameterError, SolverError
+from ..physics.freeable import SCENE_QUANTITIES
 
 
 def add_parser(sub):
@@ -48,7 +48,7 @@ def _split(text: str, what: str) -> tuple[str, str]:
 
 def parse_free(items) -> dict:
     """'u0=8 m/s:14 m/s[:12 m/s]' -> {'u0': (8.0, 14.0[, 12.0])} in SI."""
-    from ..units import to_si
+    from ..core.units import to_si
 
     out = {}
     for item in items:
@@ -87,7 +87,7 @@ FIT_TIMEOUT = 900.0
 
 
 def parse_fix(law, items) -> dict:
-    from ..units import to_si
+    from ..core.units import to_si
 
     out = {}
     for item in items:
@@ -98,8 +98,8 @@ def parse_fix(law, items) -> dict:
 
 
 def run(args) -> int:
-    from ..fitting import fit
-    from ..registry import get_law
+    from ..inference.fitting import fit
+    from ..physics.registry import get_law
     from ..report import fit_json as _fit_json
 
     law = get_law(args.law)
@@ -111,7 +111,7 @@ def run(args) -> int:
         raise SolverError(result.reason)
     print(result.summary())
     if args.json:
-        from ..io import atomic_write_text
+        from ..core.files import atomic_write_text
         from ..report import clean as _clean
 
         atomic_write_text(args.json, json.dumps(_clean(_fit_json(result)), indent=1, allow_nan=False) + "\n")

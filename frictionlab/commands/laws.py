@@ -15,9 +15,9 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from ..law import QUANTITIES
-    from ..registry import available_laws, law_source
-    from ..table import render
+    from ..core.table import render
+    from ..physics.law import QUANTITIES
+    from ..physics.registry import available_laws, law_source
 
     laws = available_laws()
     if args.brief:

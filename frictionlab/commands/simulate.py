@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from ..errors import ParameterError, SolverError
+from ..core.errors import ParameterError, SolverError
 
 RPM = 60.0 / (2.0 * math.pi)
 PLOT_POINTS = 501
@@ -45,7 +45,7 @@ def add_parser(sub):
 
 def parse_params(law, items) -> dict[str, float]:
     """['lam=1.81e6 Pa s/m', 'mu=0.2'] -> SI floats, each converted against the law's parameter unit."""
-    from ..units import to_si
+    from ..core.units import to_si
     from .fit import _split
 
     out = {}
@@ -57,9 +57,9 @@ def parse_params(law, items) -> dict[str, float]:
 
 
 def run(args) -> int:
-    from ..dataset import load_dataset
-    from ..io import atomic_write_bytes, atomic_write_text, check_writable
-    from ..registry import get_law
+    from ..core.files import atomic_write_bytes, atomic_write_text, check_writable
+    from ..io.dataset import load_dataset
+    from ..physics.registry import get_law
 
     law = get_law(args.law)
     params = parse_params(law, args.param)
@@ -101,7 +101,8 @@ def _params_text(law, p) -> str:
 # --- time series ---------------------------------------------------------------------------------
 def _series(law, ds, params, args):
     import numpy as np
-    from ..solvers import simulate
+
+    from ..solve.solvers import simulate
 
     scene = ds.scene
     if scene is None:
@@ -127,7 +128,8 @@ def _series(law, ds, params, args):
 
 def _summary(law, ds, tr, p) -> str:
     import numpy as np
-    from ..display import fmt_time
+
+    from ..core.display import fmt_time
 
     T = float(tr.t[-1])
     lines = [f"{law.name} on {ds.name} ({tr.solver}): {_params_text(law, p)}"]
@@ -141,7 +143,7 @@ def _summary(law, ds, tr, p) -> str:
                  f"spin {tr.omega[-1] * RPM:.6g} rpm, theta {math.degrees(tr.theta[-1]):.6g} deg, "
                  f"force {tr.force[-1]:.6g} N")
     if tr.solver == "series":
-        from ..solvers.series import slip_zero
+        from ..solve.solvers.series import slip_zero
 
         t = np.linspace(0.0, T, 20001)
         tz = slip_zero(t, simulate_series_slip(law, ds, p, t))
@@ -162,7 +164,7 @@ def simulate_series_slip(law, ds, p, t) -> np.ndarray:
     """The series solution's slip at times t (for where it crosses zero)."""
     import warnings
 
-    from ..solvers import simulate
+    from ..solve.solvers import simulate
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # the accuracy warning was given for the run itself
@@ -170,8 +172,8 @@ def simulate_series_slip(law, ds, p, t) -> np.ndarray:
 
 
 def _series_figure(ds, tr, title) -> bytes:
-    from ..display import NAMES, time_unit, unit
-    from ..figures import _plt, _png
+    from ..core.display import NAMES, time_unit, unit
+    from ..report.figures import _plt, _png
 
     plt = _plt()
     obs = ds.observable
@@ -197,8 +199,8 @@ OUTCOME_COLUMNS = ("speed", "incidence", "rebound_spin", "tangential_cor", "rebo
 
 
 def _outcomes(law, ds, params, args):
-    from ..outcome import predict_outcomes
-    from ..table import render
+    from ..core.table import render
+    from ..solve.outcome import predict_outcomes
 
     out = predict_outcomes(law, ds, params, args.solver, rtol=args.rtol)
     p = law.resolve({**{k: v for k, v in ds.fixed.items() if k in law.param_names}, **params})
@@ -217,8 +219,9 @@ def _outcomes(law, ds, params, args):
 
 def _outcome_figure(law, ds, p, args) -> bytes:
     import numpy as np
-    from ..figures import _plt, _png
-    from ..outcome import predict_outcomes
+
+    from ..report.figures import _plt, _png
+    from ..solve.outcome import predict_outcomes
 
     plt = _plt()
     obs = ds.observable

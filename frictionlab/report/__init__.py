@@ -36,10 +36,23 @@ from pathlib import Path
 
 import attrs
 
-from ..errors import OutputError
-from ..io import atomic_dir
-from . import (bootstrap, datasets, derivation, equivalence, first_screen, fits, identifiability, method, ranking,
-               rebound, summary, tolerance, transfer)
+from ..core.errors import OutputError
+from ..core.files import atomic_dir
+from . import (
+    bootstrap,
+    datasets,
+    derivation,
+    equivalence,
+    first_screen,
+    fits,
+    identifiability,
+    method,
+    ranking,
+    rebound,
+    summary,
+    tolerance,
+    transfer,
+)
 from .doc import Section
 from .render import html_page, markdown
 from .results import SCHEMA, clean, fit_json, ranking_csv, results_json
@@ -88,13 +101,13 @@ _DRAWING = threading.Lock()  # one report at a time hands its figures to forked 
 
 def _drawn(figs, jobs: int):
     """(index, PNG bytes) of every figure, in the order they finish: on ``jobs`` forked workers when jobs > 1."""
-    from ..workers import process_pool
+    from ..core.workers import process_pool
 
     if jobs <= 1 or len(figs) <= 1:
         for i, f in enumerate(figs):
             yield i, f.draw()
         return
-    from ..figures import _plt
+    from .figures import _plt
 
     _plt()  # pyplot imported once here, before the workers fork, instead of once in each
     with _DRAWING:

@@ -3,9 +3,9 @@ from __future__ import annotations
 
 import math
 
-from ..bootstrap import parameter_table, ranking_table
-from ..display import fmt, interval_text, param_text
-from ..ranking import TIE_AIC
+from ..core.display import fmt, interval_text, param_text
+from ..inference.bootstrap import parameter_table, ranking_table
+from ..inference.ranking import TIE_AIC
 from .doc import Section
 from .summary import first_share
 from .text import pct

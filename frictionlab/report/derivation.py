@@ -5,9 +5,9 @@ import math
 
 import numpy as np
 
-from .. import figures
-from ..derive import METHODS, derive_omega
-from ..display import fmt, unit
+from ..core.display import fmt, unit
+from ..physics.derive import METHODS, derive_omega
+from . import figures
 from .doc import Section
 
 TITLE = "Spin from rotation angle"

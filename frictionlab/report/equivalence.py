@@ -1,9 +1,9 @@
 """'Equivalence test': can the data tell two laws apart (the discrimination test of ``equivalence.py``)?"""
 from __future__ import annotations
 
-from .. import figures
-from ..display import fmt
-from ..equivalence import ALPHA, AREA_RATE, CRITICAL, POWER, WEAR
+from ..core.display import fmt
+from ..inference.equivalence import ALPHA, AREA_RATE, CRITICAL, POWER, WEAR
+from . import figures
 from .doc import Section
 
 TITLE = "Equivalence test: can the data tell two laws apart?"

@@ -1,6 +1,6 @@
 """The first screen: the verdict table (``Comparison.answers``) and the figure of the central finding.
 
-The verdict table only renders the answers the verdict layer filled (``frictionlab/answers.py``);
+The verdict table only renders the answers the verdict layer filled (``frictionlab/inference/answers.py``);
 a column without data says so. Without answers it shows what the comparison does hold, labelled
 as such (the AIC ranking's first place and the equivalence analysis' verdict), never a verdict
 of its own. The finding: the paper's truncated series of a F = k A u law against the exact
@@ -14,10 +14,10 @@ import math
 import attrs
 import numpy as np
 
-from .. import figures
-from ..answers import group_of
-from ..display import fmt_time
-from ..solvers.series import slip_zero
+from ..core.display import fmt_time
+from ..inference.answers import group_of
+from ..solve.solvers.series import slip_zero
+from . import figures
 from .doc import Section
 from .text import PROVENANCE_WORDS, sig
 

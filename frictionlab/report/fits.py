@@ -3,11 +3,11 @@ from __future__ import annotations
 
 import re
 
-from .. import figures
-from ..display import param_cells, param_text
-from ..errors import FrictionLabError
-from ..registry import get_law
-from ..units import to_si
+from ..core.display import param_cells, param_text
+from ..core.errors import FrictionLabError
+from ..core.units import to_si
+from ..physics.registry import get_law
+from . import figures
 from .doc import Section
 
 TITLE = "Fits"

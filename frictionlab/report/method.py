@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import json
 
-from ..predict import FIT_RTOL
-from ..ranking import COLUMNS, TIE_AIC
+from ..inference.predict import FIT_RTOL
+from ..inference.ranking import COLUMNS, TIE_AIC
 from .doc import Section
 from .results import SCHEMA
 from .text import rtol_text

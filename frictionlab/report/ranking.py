@@ -3,9 +3,9 @@ from __future__ import annotations
 
 import math
 
-from .. import figures
-from ..display import fmt, unit
-from ..ranking import TIE_AIC
+from ..core.display import fmt, unit
+from ..inference.ranking import TIE_AIC
+from . import figures
 from .doc import Section
 from .text import fixed
 

@@ -1,13 +1,13 @@
 """'Rebound predicted from material data': impact-outcome datasets that state their materials and
 friction coefficient, predicted (not fitted) by a rigid sphere and by Mindlin-Deresiewicz compliance
-with microslip (frictionlab.mdr), with residuals, and the Psi2-Psi1 diagram of Maw, Barber and Fawcett (frictionlab.rebound)."""
+with microslip (frictionlab.physics.mdr), with residuals, and the Psi2-Psi1 diagram of Maw, Barber and Fawcett (frictionlab.solve.rebound)."""
 from __future__ import annotations
 
 import math
 
 import numpy as np
 
-from .. import rebound
+from ..solve import rebound
 from .doc import Section
 
 TITLE = "Rebound predicted from material data"

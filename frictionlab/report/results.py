@@ -53,10 +53,10 @@ import math
 
 import numpy as np
 
-from ..bootstrap import parameter_table, ranking_table
-from ..dataset import COLUMN_SI
-from ..predict import FIT_RTOL
-from ..ranking import COLUMNS, to_csv
+from ..inference.bootstrap import parameter_table, ranking_table
+from ..inference.predict import FIT_RTOL
+from ..inference.ranking import COLUMNS, to_csv
+from ..io.dataset import COLUMN_SI
 
 #: Columns ranking.csv adds after ``ranking.COLUMNS``: what rss and rmse are measured in.
 UNIT_COLUMNS = ("observable", "rss_unit", "rmse_unit")

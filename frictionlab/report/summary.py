@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import datetime as _dt
 
-from ..bootstrap import wilson
-from ..equivalence import AREA_RATE, WEAR
+from ..inference.bootstrap import wilson
+from ..inference.equivalence import AREA_RATE, WEAR
 from .doc import Section
 from .text import PROVENANCE_WORDS, pct
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import math
 
-from ..display import fmt
+from ..core.display import fmt
 
 PROVENANCE_WORDS = {
     "measured": "measured",

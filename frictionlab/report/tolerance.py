@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import math
 
-from ..display import fmt, param_text
-from ..predict import FIT_RTOL
+from ..core.display import fmt, param_text
+from ..inference.predict import FIT_RTOL
 from .doc import Section
 from .text import rtol_text
 

@@ -1,8 +1,8 @@
 """'Prediction across conditions': does one parameter set serve every dataset of a group (``transfer.py``)?"""
 from __future__ import annotations
 
-from ..display import fmt
-from ..transfer import ALPHA
+from ..core.display import fmt
+from ..inference.transfer import ALPHA
 from .doc import Section
 
 TITLE = "Prediction across conditions"

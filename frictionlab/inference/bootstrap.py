@@ -1,0 +1,449 @@
+"""Bootstrap confidence intervals for fitted parameters, and how often each law ranks first.
+
+``bootstrap(fit_fn, dataset, n, seed, executor)`` refits ``n`` resampled copies of a dataset (or
+of a group of datasets, fitted together) and returns a ``BootstrapResult``:
+  method='parametric' y* = best-fit model + Gaussian noise of the dataset's declared sigma (a
+                     simulation from the fit, then a refit): the comparison's choice, valid for
+                     time series (no resampling of correlated points) where sigma is known.
+  method='residual'  y* = best-fit model + residuals of the original fit drawn with replacement
+                     (centred); times, scene and noise estimate unchanged.
+  method='case'      rows drawn with replacement (kept in time order): no model assumed; breaks
+                     the time structure of a series, so only for independent rows.
+Replicate r draws from its own generator, ``SeedSequence(seed).spawn(n)[r]``, inside the task that
+fits it, so the numbers depend on the seed only, never on the executor, its workers or the order
+in which tasks finish.
+
+``executor`` is anything with ``submit(fn, *args) -> future`` whose futures have ``result()``:
+None runs here, one replicate after another; a ``concurrent.futures`` executor; or a
+``dask.distributed.Client`` (pip install 'frictionlab[dask]'; e.g. ``Client(LocalCluster())`` or
+``Client('tcp://scheduler:8786')`` for a real cluster). Functions and datasets travel by pickle.
+
+``bootstrap_ranking(laws, dataset, n, seed, executor)`` fits every law to the same resampled
+copies and counts how often each ranks first by AIC. A law given with a solver
+(``law_fit('wear', 'series')``) is its own candidate, labelled 'wear [series]', so the paper's
+series and the exact solution of one law compete as they do in the comparison's ranking. Fits
+already made on the original data can be passed (``base=``, ``bases=``) instead of being
+repeated. ``parameter_table`` and ``ranking_table`` turn the results into rows for the report.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+
+import attrs
+import numpy as np
+
+from ..core.errors import FrictionLabError, ParameterError
+
+METHODS = ("parametric", "residual", "case")
+
+
+# --- fitting functions that travel ---------------------------------------------------------------
+@attrs.frozen
+class LawFit:
+    """A picklable fit function: ``fitting.fit(law, data, solver, **options)``.
+
+    ``warm(values)`` returns a copy that starts from ``values`` with no grid scan and one
+    Levenberg-Marquardt run, without the plausibility flags (``fit(checks=False)``): replicates
+    start at the original best fit, which is where the bootstrap asks how far the optimum moves.
+    """
+
+    law: str
+    solver: str = "auto"
+    options: tuple = ()  # sorted (key, value) pairs of fitting.fit keyword arguments
+    start: tuple = ()  # sorted (name, value) law-parameter start values, SI
+    name: str = ""  # the candidate's name when it differs from the law's (e.g. 'wear = couette')
+
+    def __call__(self, data):
+        from .fitting import fit
+
+        kw = dict(self.options)
+        if self.start:  # a replicate: only its values and AIC are read, so no plausibility flags
+            kw.update(initial={**dict(kw.get("initial") or {}), **dict(self.start)}, scan=0, n_starts=1, checks=False)
+        return fit(self.law, data, solver=self.solver, **kw)
+
+    def warm(self, values: Mapping[str, float]) -> "LawFit":
+        return attrs.evolve(self, start=tuple(sorted(values.items())))
+
+    @property
+    def label(self) -> str:
+        """The candidate's name: the law, with ' [solver]' when a solver was named."""
+        name = self.name or self.law
+        return name if self.solver == "auto" else f"{name} [{self.solver}]"
+
+
+def law_fit(law, solver: str = "auto", **options) -> LawFit:
+    """``LawFit`` for a law name and ``fitting.fit`` keyword options (free, fixed, local, ...)."""
+    name = law if isinstance(law, str) else law.name
+    return LawFit(name, solver, tuple(sorted(options.items())))
+
+
+# --- results ---------------------------------------------------------------------------------------
+@attrs.frozen(eq=False)
+class BootstrapResult:
+    """Bootstrap of one fit. samples (n, k) holds the fitted values of ``names`` (the parameters the
+    data determine, ``FitResult.determined``) per replicate (NaN rows where the refit failed); aic (n,)
+    the replicate's AIC."""
+
+    law: str
+    datasets: tuple[str, ...]
+    method: str
+    seed: int
+    names: tuple[str, ...]
+    units: tuple[str, ...]
+    base: object  # the FitResult on the original data
+    samples: np.ndarray
+    aic: np.ndarray
+    failures: tuple[str, ...]  # reasons, one per failed replicate
+
+    @property
+    def n(self) -> int:
+        return self.samples.shape[0]
+
+    @property
+    def n_ok(self) -> int:
+        return int(np.sum(np.all(np.isfinite(self.samples), axis=1))) if self.samples.size else self.n - len(self.failures)
+
+    def interval(self, name: str, level: float = 0.95) -> tuple[float, float]:
+        """Percentile interval [SI] of parameter ``name`` over the successful replicates."""
+        col = self._column(name)
+        if col.size == 0:
+            return math.nan, math.nan
+        a = (1.0 - level) / 2.0
+        lo, hi = np.quantile(col, [a, 1.0 - a])
+        return float(lo), float(hi)
+
+    def std(self, name: str) -> float:
+        col = self._column(name)
+        return float(np.std(col, ddof=1)) if col.size > 1 else math.nan
+
+    def _column(self, name):
+        if name not in self.names:
+            raise ParameterError(f"bootstrap of '{self.law}': no fitted parameter '{name}' (has: {', '.join(self.names)})")
+        col = self.samples[:, self.names.index(name)]
+        return col[np.isfinite(col)]
+
+
+# --- resampling (runs inside the tasks) --------------------------------------------------------------
+def _as_list(dataset):
+    return list(dataset) if isinstance(dataset, (list, tuple)) else [dataset]
+
+
+def _resample(datasets, models, method, rng):
+    """Resampled copies of datasets; models[i] is dataset i's best-fit model of its observable."""
+    out = []
+    for ds, model in zip(datasets, models):
+        cols = dict(ds.columns)
+        if method == "case":
+            idx = np.sort(rng.integers(0, len(ds), len(ds)))
+            cols = {k: v[idx] for k, v in cols.items()}
+        elif method == "parametric":
+            cols[ds.observable] = model + rng.normal(0.0, ds.noise[ds.observable], model.shape)
+        else:
+            y = cols[ds.observable]
+            res = y - model
+            res = res - res.mean()
+            cols[ds.observable] = model + res[rng.integers(0, res.size, res.size)]
+        out.append(attrs.evolve(ds, columns=cols))
+    return out
+
+
+def _values(result, names):
+    if not getattr(result, "ok", False):
+        return None
+    return [result.params[k].value if k in result.params else math.nan for k in names]
+
+
+def _aic(result):
+    stats = getattr(result, "stats", None)
+    return float(stats.aic) if stats is not None and getattr(result, "ok", False) else math.nan
+
+
+def _run_chunk(fit_fns, datasets, models, method, seeds):
+    """Fit every function in fit_fns to the replicates of seeds; returns, per seed, per function,
+    (values or None, aic, failure reason)."""
+    single = len(datasets) == 1
+    out = []
+    for seed in seeds:
+        rng = np.random.default_rng(seed)
+        data = _resample(datasets, models, method, rng)
+        row = []
+        for fn, names in fit_fns:
+            try:
+                r = fn(data[0] if single else data)
+                vals = _values(r, names)
+                row.append((vals, _aic(r), "" if vals is not None else (getattr(r, "reason", "") or "fit failed")))
+            except FrictionLabError as exc:
+                row.append((None, math.nan, str(exc)))
+        out.append(row)
+    return out
+
+
+def _dispatch(executor, fit_fns, datasets, models, method, seed, n, chunk, progress=None):
+    """Rows of _run_chunk over n resamples in batches of ``chunk``; progress(done, n) after each batch."""
+    seeds = np.random.SeedSequence(seed).spawn(n)
+    chunk = max(1, int(chunk or math.ceil(n / 16)))
+    groups = [seeds[i:i + chunk] for i in range(0, n, chunk)]
+    parts, done = [], 0
+    futures = None if executor is None else [executor.submit(_run_chunk, fit_fns, datasets, models, method, g)
+                                             for g in groups]
+    for i, g in enumerate(groups):
+        parts.append(_run_chunk(fit_fns, datasets, models, method, g) if futures is None else futures[i].result())
+        done += len(g)
+        if progress:
+            progress(done, n)
+    return [row for part in parts for row in part]
+
+
+def _prepare(fit_fn, dataset, method, base=None):
+    from ..io.dataset import load_dataset
+
+    if method not in METHODS:
+        raise ParameterError(f"bootstrap: method must be one of {', '.join(METHODS)}, got {method!r}")
+    datasets = [load_dataset(d) for d in _as_list(dataset)]
+    if base is None:
+        base = fit_fn(datasets[0] if len(datasets) == 1 else datasets)
+    elif tuple(getattr(base, "datasets", ())) != tuple(d.name for d in datasets):
+        raise ParameterError(f"bootstrap: the given fit is of {', '.join(getattr(base, 'datasets', ()))}, "
+                             f"not of {', '.join(d.name for d in datasets)}")
+    if not getattr(base, "ok", False):
+        raise FrictionLabError(f"bootstrap: the fit on the original data did not succeed "
+                               f"({getattr(base, 'reason', '') or getattr(base, 'status', 'failed')})")
+    models = [None] * len(datasets)
+    if method in ("residual", "parametric"):
+        for i, ds in enumerate(datasets):
+            part = next((p for p in base.per_dataset if p.target.name == ds.name), None)
+            if part is None or part.target.derivation or part.target.observable != ds.observable \
+                    or part.model.shape != ds.y.shape:
+                raise FrictionLabError(f"bootstrap: dataset '{ds.name}' was not fitted on its own observable column; "
+                                       "use method='case'")
+            models[i] = part.model
+    names = base.determined
+    units = tuple(base.params[k].unit for k in names)
+    law_values = {p.key: p.value for p in base.params.values() if p.vary and p.kind == "law"}
+    replicate_fn = fit_fn.warm(law_values) if hasattr(fit_fn, "warm") else fit_fn
+    return datasets, base, models, names, units, replicate_fn
+
+
+def _collect(law, datasets, method, seed, names, units, base, rows, k):
+    samples = np.full((len(rows), len(names)), np.nan)
+    aic = np.full(len(rows), np.nan)
+    failures = []
+    for r, row in enumerate(rows):
+        vals, a, why = row[k]
+        if vals is None:
+            failures.append(why)
+        else:
+            samples[r] = vals
+            aic[r] = a
+    return BootstrapResult(law=law, datasets=tuple(d.name for d in datasets), method=method, seed=seed, names=names,
+                           units=units, base=base, samples=samples, aic=aic, failures=tuple(failures))
+
+
+def _check_n(n, seed):
+    if not (isinstance(n, (int, np.integer)) and n >= 1):
+        raise ParameterError(f"bootstrap: n must be a positive integer, got {n!r}")
+    if not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ParameterError(f"bootstrap: seed must be a non-negative integer, got {seed!r}")
+
+
+# --- public API -----------------------------------------------------------------------------------------
+def bootstrap(fit_fn, dataset, n: int = 200, seed: int = 0, executor=None, method: str = "residual",
+              chunk: int | None = None, base=None) -> BootstrapResult:
+    """Refit ``n`` resampled copies of ``dataset`` (a Dataset, name or path, or a list fitted together).
+
+    fit_fn(data) -> FitResult, e.g. ``law_fit('wear', solver='exact')`` (warm-started replicates) or
+    any picklable callable. chunk: replicates per submitted task (default: n / 16, at least 1).
+    base: fit_fn's FitResult on the original data, if already made (else it is fitted here).
+    """
+    _check_n(n, seed)
+    datasets, base, models, names, units, rfn = _prepare(fit_fn, dataset, method, base)
+    rows = _dispatch(executor, [(rfn, names)], datasets, models, method, seed, n, chunk)
+    return _collect(base.law, datasets, method, seed, names, units, base, rows, 0)
+
+
+@attrs.frozen(eq=False)
+class RankingBootstrap:
+    """How often each candidate ranks first (lowest AIC) over paired resamples; per candidate a
+    BootstrapResult. Candidates are labelled as ``LawFit.label``: the law, or 'law [solver]'."""
+
+    laws: tuple[str, ...]  # candidate labels
+    datasets: tuple[str, ...]
+    first: dict  # label -> number of replicates it ranked first (ties within tie AIC split evenly)
+    n_ranked: int  # replicates where every candidate's refit succeeded
+    results: dict  # label -> BootstrapResult
+
+    def fraction(self, law: str) -> float:
+        return self.first[law] / self.n_ranked if self.n_ranked else math.nan
+
+
+def bootstrap_ranking(laws: Sequence, dataset, n: int = 200, seed: int = 0, executor=None, solver: str = "auto",
+                      method: str = "case", chunk: int | None = None, tie: float | None = None,
+                      bases: Sequence | None = None, progress=None, **fit_options) -> RankingBootstrap:
+    """Fit every law to the same ``n`` resampled copies of ``dataset`` and count first places by AIC.
+
+    method 'case' (default) assumes no law's model; 'residual' resamples around the best law's fit;
+    'parametric' simulates from the best (unflagged) law's fit with the declared noise.
+    laws: names or LawFit objects (distinct labels). tie: AIC difference counted as a tie (default
+    ranking.TIE_AIC). bases: the laws' FitResults on the original data, if already made.
+    progress(done, n): called after each batch of resamples.
+    """
+    from .ranking import TIE_AIC
+
+    _check_n(n, seed)
+    tie = TIE_AIC if tie is None else tie
+    fns = [f if isinstance(f, LawFit) else law_fit(f, solver, **fit_options) for f in laws]
+    names = [f.label for f in fns]
+    if len(set(names)) != len(names):
+        raise ParameterError(f"bootstrap: candidates must differ; got {', '.join(names)}")
+    if bases is not None and len(bases) != len(fns):
+        raise ParameterError(f"bootstrap: {len(bases)} base fits given for {len(fns)} candidates")
+    prepared = [_prepare(f, dataset, "case", b) for f, b in zip(fns, bases or [None] * len(fns))]
+    datasets = prepared[0][0]
+    models = [None] * len(datasets)
+    if method in ("residual", "parametric"):  # resample around the best unflagged fit to the original data
+        best = min(range(len(fns)), key=lambda i: (bool(getattr(prepared[i][1], "flags", ())), _aic(prepared[i][1])))
+        models = _prepare(fns[best], dataset, method, prepared[best][1])[2]
+    elif method not in METHODS:
+        raise ParameterError(f"bootstrap: method must be one of {', '.join(METHODS)}, got {method!r}")
+    rows = _dispatch(executor, [(p[5], p[3]) for p in prepared], datasets, models, method, seed, n, chunk,
+                     progress)
+    results = {name: _collect(p[1].law, datasets, method, seed, p[3], p[4], p[1], rows, k)
+               for k, (name, p) in enumerate(zip(names, prepared))}
+    first = dict.fromkeys(names, 0.0)
+    ranked = 0
+    for row in rows:
+        aics = np.array([cell[1] for cell in row])
+        if not np.all(np.isfinite(aics)):
+            continue
+        ranked += 1
+        winners = [names[k] for k in np.nonzero(aics <= aics.min() + tie)[0]]
+        for w in winners:
+            first[w] += 1.0 / len(winners)
+    return RankingBootstrap(laws=tuple(names), datasets=tuple(d.name for d in datasets), first=first,
+                            n_ranked=ranked, results=results)
+
+
+# --- tables for the comparison report ----------------------------------------------------------------
+def wilson(k: float, m: int, level: float = 0.95) -> tuple[float, float]:
+    """Wilson score interval of a proportion k / m at ``level`` (nan, nan for m = 0)."""
+    from statistics import NormalDist
+
+    if not m:
+        return math.nan, math.nan
+    z = NormalDist().inv_cdf(0.5 + level / 2.0)
+    p = k / m
+    centre = (p + z * z / (2 * m)) / (1 + z * z / m)
+    half = z * math.sqrt(p * (1 - p) / m + z * z / (4 * m * m)) / (1 + z * z / m)
+    return (0.0 if k <= 0 else max(0.0, centre - half)), (1.0 if k >= m else min(1.0, centre + half))
+
+
+def parameter_table(results, level: float = 0.95) -> list[dict]:
+    """Rows: law, solver, datasets, parameter, unit, value (original fit), stderr (lmfit),
+    boot_median, boot_std, ci_low, ci_high (percentile, ``level``), n_ok, n_failed, method, seed.
+    SI units."""
+    if isinstance(results, BootstrapResult):
+        results = [results]
+    elif isinstance(results, RankingBootstrap):
+        results = list(results.results.values())
+    elif isinstance(results, Mapping):
+        results = list(results.values())
+    rows = []
+    for b in results:
+        for name, unit in zip(b.names, b.units):
+            col = b._column(name)
+            lo, hi = b.interval(name, level)
+            p = b.base.params[name]
+            rows.append({"law": b.law, "solver": b.base.solver, "datasets": "+".join(b.datasets), "parameter": name,
+                         "unit": unit,
+                         "value": p.value, "stderr": p.stderr, "boot_median": float(np.median(col)) if col.size else math.nan,
+                         "boot_std": b.std(name), "ci_low": lo, "ci_high": hi, "level": level, "n_ok": int(col.size),
+                         "n_failed": len(b.failures), "method": b.method, "seed": b.seed})
+    return rows
+
+
+def ranking_table(rb: RankingBootstrap, level: float = 0.95) -> list[dict]:
+    """Rows: datasets, candidate (label), law, solver, first_fraction with a Wilson interval at
+    ``level``, first_count, n_ranked (replicates where every candidate's refit succeeded), method,
+    seed; most often first on top."""
+    m = rb.n_ranked
+    rows = []
+    for law in rb.laws:
+        k = rb.first[law]
+        p = k / m if m else math.nan
+        lo, hi = wilson(k, m, level)
+        any_result = rb.results[law]
+        rows.append({"datasets": "+".join(rb.datasets), "candidate": law, "law": any_result.law,
+                     "solver": any_result.base.solver, "first_fraction": p, "ci_low": lo, "ci_high": hi,
+                     "level": level, "first_count": k, "n_ranked": m, "method": any_result.method,
+                     "seed": any_result.seed})
+    return sorted(rows, key=lambda r: -(r["first_fraction"] if math.isfinite(r["first_fraction"]) else -1))
+
+
+# --- the comparison's bootstrap ------------------------------------------------------------------------
+def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, slow: bool = False, free: Mapping | None = None,
+                   progress=None, timeout: float | None = None) -> tuple[list[RankingBootstrap], dict]:
+    """Bootstrap the single-dataset fits of a comparison, parametrically: per dataset, ``n`` replicates
+    simulated from the best unflagged fit with the declared noise, and every candidate that fitted
+    (law [solver]; structurally identical laws once, ``ranking.merge_identical``) refitted to them,
+    warm-started from its fit, which is reused as the base. Datasets whose noise is not known
+    (assumed: e.g. a noise-free reconstructed series) are skipped with that reason: resampling them
+    would measure the method's determinism, not the data's firmness. Without ``slow``, only datasets
+    whose every fit is one closed-form or series solution per evaluation are bootstrapped: not those
+    where a law needs the ODE solver, nor those without a time series (an impact-outcome set
+    simulates every impact at each evaluation).
+    progress(dataset, done, n): after each batch of resamples, and (n, n) for a dataset left out.
+    Returns (one RankingBootstrap per dataset, {dataset: why it was not bootstrapped})."""
+    from .ranking import merge_identical
+
+    by_ds: dict = {}
+    for f in fits:
+        if len(f.datasets) == 1:
+            by_ds.setdefault(f.datasets[0], []).append(f)
+    out, skipped = [], {}
+    for name, group in by_ds.items():
+        ok = [f for f in group if f.ok]
+        why = _slow(ok, n) if ok else ""
+        target = ok[0].per_dataset[0].target if ok else None
+        if not ok:
+            skipped[name] = "no law could be fitted"
+        elif target.derivation or target.dataset.noise_kind != "known":
+            skipped[name] = (f"no firmness figure: its noise is {target.dataset.noise_kind}, not measured "
+                             f"({target.dataset.provenance.kind} series), so replicates simulated with a guessed sigma "
+                             "would measure the guess, not the data")
+        elif why and not slow:
+            skipped[name] = why
+        else:
+            opts = ({"free": dict(free)} if free else {}) | ({"timeout": timeout} if timeout is not None else {})
+            merged = merge_identical(ok)
+            fns = [attrs.evolve(law_fit(f.law, f.solver, **opts), name=" = ".join(members) if len(members) > 1 else "")
+                   for f, members, _ in merged]
+            try:
+                out.append(bootstrap_ranking(fns, target.dataset, n=n, seed=seed, method="parametric",
+                                             executor=executor, bases=[f for f, _, _ in merged],
+                                             progress=progress and (
+                                                 lambda done, total, name=name: progress(name, done, total))))
+            except FrictionLabError as exc:
+                skipped[name] = str(exc)
+        if progress and name in skipped:
+            progress(name, n, n)
+    return out, skipped
+
+
+def _slow(fits, n: int) -> str:
+    """Why refitting ``fits`` (one dataset's) n times is slow, or '' if it is not."""
+    ode = [f for f in fits if f.solver.startswith("ode")]
+    target = fits[0].per_dataset[0].target
+    if ode:
+        what = f"{', '.join(f'{f.law} [{f.solver}]' for f in ode)} need{'s' * (len(ode) == 1)} the ODE solver here"
+    elif target.t is None:
+        kind = target.dataset.kind
+        what = (f"{'an' if kind[0] in 'aeiou' else 'a'} {kind} set: each evaluation of a fit simulates every one "
+                f"of its {target.y.size} rows")
+        ode = fits
+    else:
+        return ""
+    one = len(ode) == 1
+    return (f"{what}; {'its fit' if one else 'their fits'} took {sum(f.cpu_time for f in ode):.1f} CPU s on the "
+            f"original data, and each of the {n} resamples would refit {'it' if one else 'them'}; add "
+            "--bootstrap-all to include it")

@@ -1,0 +1,128 @@
+"""Results in the ecosystem's idiom: tidy pandas frames, lmfit Parameters and reports, notebook HTML.
+
+Every number is SI, with its unit in a column of its own (``unit``, ``rss_unit``, ``rmse_unit``).
+pandas and lmfit are imported only when one of these is called.
+"""
+from __future__ import annotations
+
+import html
+import math
+import re
+
+from ..io.dataset import COLUMN_SI
+
+RANKING_COLUMNS = ("dataset", "law", "solver", "candidate", "rank", "status", "observable", "n_points", "n_params",
+                   "rss", "rss_unit", "rmse", "rmse_unit", "redchi", "aic", "aicc", "bic", "delta_aic",
+                   "akaike_weight", "reason")
+PARAMETER_COLUMNS = ("dataset", "law", "solver", "parameter", "value", "stderr", "unit", "kind", "vary", "fixed_by",
+                     "lower", "upper")
+
+
+def _units(observable: str) -> tuple[str, str]:
+    """(rss unit, rmse unit) of an observable, SI; '1' for a plain number."""
+    u = COLUMN_SI.get(observable, "") or "1"
+    return (f"({u})^2" if "/" in u else (u if u == "1" else f"{u}^2")), u
+
+
+def ranking_frame(c):
+    """Comparison.to_dataframe(): one row per dataset and candidate, then the group rows."""
+    import pandas as pd
+
+    obs = {d.name: d.observable for d in c.datasets}
+    rows = []
+    for r in list(c.ranking) + list(c.groups):
+        o = obs.get(r.dataset, "")
+        rss_u, rmse_u = _units(o) if o else ("", "")
+        rows.append({"dataset": r.dataset, "law": r.law, "solver": r.solver, "candidate": r.candidate,
+                     "rank": r.rank, "status": r.status, "observable": o, "n_points": r.n_points,
+                     "n_params": r.n_params, "rss": r.rss, "rss_unit": rss_u, "rmse": r.rmse, "rmse_unit": rmse_u,
+                     "redchi": r.redchi, "aic": r.aic, "aicc": r.aicc, "bic": r.bic, "delta_aic": r.delta_aic,
+                     "akaike_weight": r.akaike_weight, "reason": r.reason})
+    df = pd.DataFrame(rows, columns=list(RANKING_COLUMNS))
+    df["rank"] = df["rank"].astype("Int64")
+    return df
+
+
+def parameters_frame(fits):
+    """One row per parameter of every successful fit (dataset joined with '+' for a global fit)."""
+    import pandas as pd
+
+    rows = []
+    for f in fits:
+        if not f.ok:
+            continue
+        for p in f.params.values():
+            rows.append({"dataset": "+".join(f.datasets), "law": f.law, "solver": f.solver, "parameter": p.name,
+                         "value": p.value, "stderr": p.stderr if p.stderr is not None else math.nan,
+                         "unit": p.unit, "kind": p.kind, "vary": p.vary, "fixed_by": p.fixed_by,
+                         "lower": p.lower, "upper": p.upper})
+    return pd.DataFrame(rows, columns=list(PARAMETER_COLUMNS))
+
+
+def _lmfit_name(name: str) -> str:
+    s = re.sub(r"\W", "_", name)
+    return s if re.match(r"[A-Za-z_]", s) else f"p_{s}"
+
+
+def lmfit_parameters(f):
+    """FitResult.lmfit_params: lmfit.Parameters in SI with standard errors and correlations set."""
+    import lmfit
+
+    ps = lmfit.Parameters()
+    names = {}
+    for p in f.params.values():
+        n = _lmfit_name(p.name)
+        names[p.name] = n
+        lo = p.lower if p.lower is not None and math.isfinite(p.lower) else -math.inf
+        hi = p.upper if p.upper is not None and math.isfinite(p.upper) else math.inf
+        if p.kind == "derived":
+            lo, hi = -math.inf, math.inf
+        ps.add(n, value=p.value, vary=p.vary and p.kind != "derived", min=min(lo, p.value), max=max(hi, p.value))
+        ps[n].stderr = p.stderr
+        ps[n].init_value = getattr(p, "initial", None)
+    for (a, b), r in f.correlations.items():
+        if a in names and b in names:
+            ps[names[a]].correl = {**(ps[names[a]].correl or {}), names[b]: r}
+            ps[names[b]].correl = {**(ps[names[b]].correl or {}), names[a]: r}
+    return ps
+
+
+def fit_report(f, **kwargs) -> str:
+    """Our statistics, then lmfit's [[Variables]] and [[Correlations]] of the SI parameters."""
+    import lmfit
+
+    if not f.ok:
+        return f"[[Fit]] {f.law} [{f.solver}] on {', '.join(f.datasets)}: {f.status}: {f.reason}"
+    s = f.stats
+    head = [f"[[Fit]] {f.law} [{f.solver}] on {', '.join(f.datasets)} (SI units)",
+            f"    # data points      = {s.n_points}", f"    # variables        = {s.n_params} identifiable "
+            f"({s.n_free} free)", f"    chi-square         = {s.chisqr:.6g}", f"    reduced chi-square = {s.redchi:.6g}",
+            f"    Akaike info crit   = {s.aic:.6g}", f"    Bayesian info crit = {s.bic:.6g}",
+            f"    function evals     = {f.nfev}"]
+    head += [f"    warning: {w}" for w in f.identifiability.warnings]
+    units = "\n".join(f"    {_lmfit_name(p.name)}: {p.unit or '(no unit)'}" for p in f.params.values())
+    return "\n".join(head) + "\n" + lmfit.fit_report(f.lmfit_params, **kwargs) + "\n[[Units]]\n" + units
+
+
+def _table(df, caption: str) -> str:
+    return (f"<div><b>{html.escape(caption)}</b>" + df.to_html(index=False, na_rep="", float_format=lambda x: f"{x:.4g}")
+            + "</div>")
+
+
+def fit_html(f) -> str:
+    """FitResult._repr_html_: a heading line and the parameter table."""
+    head = html.escape(repr(f).strip("<>"))
+    if not f.ok:
+        return f"<p>{head}</p>"
+    s = f.stats
+    return (f"<p><b>{html.escape(f.law)} [{html.escape(f.solver)}]</b> on {html.escape(', '.join(f.datasets))}: "
+            f"χ² = {s.chisqr:.4g}, reduced χ² = {s.redchi:.3g}, AIC = {s.aic:.4g}, n = {s.n_points}, "
+            f"k = {s.n_params}</p>" + _table(f.to_dataframe().drop(columns=["dataset", "law", "solver"]), "parameters"))
+
+
+def comparison_html(c) -> str:
+    """Comparison._repr_html_: the first places per dataset and the ranking table."""
+    df = ranking_frame(c)
+    cols = ["dataset", "candidate", "rank", "status", "rmse", "rmse_unit", "redchi", "delta_aic", "akaike_weight"]
+    return (f"<p>{html.escape(repr(c).strip('<>'))}</p>"
+            + _table(df[df["rank"].notna()][cols], "ranking (SI units; group rows at the end)"))

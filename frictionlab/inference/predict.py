@@ -1,0 +1,218 @@
+"""What is fitted and how a law predicts it: targets, one predictor per dataset kind, solver choice.
+
+``predict(law, target, params, solver, scene, rtol)`` is the single place that turns law parameters
+into the model of a dataset's observable. Time-series kinds ('impact', 'incline') simulate and
+read a trajectory series; another kind (e.g. 'impact-outcome', whose rows are impacts) plugs in
+with ``register_predictor(kind, fn)``. A kind without a predictor is skipped with that reason.
+``rtol`` is the ODE tolerance of the prediction (None: ``FIT_RTOL``); it is an argument, never
+module state, so fits at different tolerances can run side by side.
+"""
+from __future__ import annotations
+
+import functools
+import inspect
+import warnings
+from collections.abc import Callable, Mapping
+
+import attrs
+import numpy as np
+
+from ..core.errors import DatasetError, FrictionLabError, ParameterError
+from ..io.dataset import Dataset, load_dataset
+from ..physics.freeable import SCENE_QUANTITIES
+from ..physics.registry import get_law
+from ..physics.scene import Scene
+from ..solve.outcome import OUTCOMES, predict_outcomes, rows_of
+
+#: Trajectory series that a time-series observable reads.
+SERIES = {"omega": "omega", "theta": "theta", "v": "v", "u": "u", "mu": "load"}
+
+#: Default ODE tolerance of fits (``fit(..., rtol=None)``). The tolerance check of the built-in
+#: comparison (``fitcost.tolerance_check``, measured in benchmarks/README) finds that refitting at
+#: 1e-10 moves no parameter of an ODE fit by more than a few thousandths of its standard error,
+#: for about half the CPU time; 1e-3 moves them by standard errors.
+FIT_RTOL = 1e-6
+
+
+class SkipDataset(FrictionLabError):
+    """A dataset this law or solver cannot predict (reported as 'skipped', not 'failed')."""
+
+
+# --- targets: what is fitted -------------------------------------------------------------
+@attrs.frozen(eq=False)
+class Target:
+    """One fitted series: the dataset, the observable, its values y and 1-sigma per point (SI)."""
+
+    dataset: Dataset
+    observable: str
+    y: np.ndarray
+    sigma: np.ndarray
+    derivation: str = ""  # "" or how y was derived (e.g. omega from theta by poly9)
+
+    @property
+    def name(self) -> str:
+        return self.dataset.name
+
+    @property
+    def t(self) -> np.ndarray | None:
+        return self.dataset.columns.get("t")
+
+    @property
+    def label(self) -> str:
+        return f"{self.name} ({self.observable}{', ' + self.derivation if self.derivation else ''})"
+
+
+def make_target(dataset, observable: str | None = None, derive: str | None = None) -> Target:
+    """The series to fit from ``dataset``: its observable, another column, or omega derived from theta.
+
+    derive: None, 'poly9' or 'spline' (then observable is omega, computed from the theta column).
+    """
+    ds = load_dataset(dataset)
+    if ds.kind == "contact-area":
+        raise SkipDataset(f"dataset '{ds.name}' is a contact-area series: supporting data, not fitted")
+    obs = observable or ds.observable
+    if derive:
+        from ..physics.derive import derive_omega
+
+        if "theta" not in ds.columns:
+            raise DatasetError(f"dataset '{ds.name}': deriving omega needs a 'theta' column")
+        d = derive_omega(ds.t, ds.columns["theta"], derive, ds.noise.get("theta"))
+        return Target(ds, "omega", d.omega, d.sigma, f"omega from theta by {derive}")
+    if obs not in ds.columns:
+        raise DatasetError(f"dataset '{ds.name}': no column '{obs}' to fit (has: {', '.join(ds.columns)})")
+    if obs in ds.noise:
+        sigma = np.full(len(ds), ds.noise[obs])
+    else:
+        raise DatasetError(f"dataset '{ds.name}': [noise] gives no estimate for '{obs}'; add e.g. {obs} = '...'")
+    return Target(ds, obs, ds.columns[obs], sigma)
+
+
+# --- predictions: one function per dataset kind -------------------------------------------
+Predictor = Callable[..., np.ndarray]
+PREDICTORS: dict[str, Predictor] = {}
+
+
+def register_predictor(kind: str, fn: Predictor) -> None:
+    """Make dataset ``kind`` fittable: fn(law, target, scene, params, solver[, rtol=...]) -> model of
+    target.y (SI). A predictor that solves ODEs takes the keyword ``rtol`` (always given a number)."""
+    PREDICTORS[kind] = fn
+
+
+@functools.lru_cache(maxsize=None)
+def takes_rtol(fn) -> bool:
+    """Whether predictor ``fn`` accepts the ``rtol`` keyword."""
+    try:
+        ps = inspect.signature(fn).parameters.values()
+    except (TypeError, ValueError):
+        return False
+    return any(p.name == "rtol" or p.kind is p.VAR_KEYWORD for p in ps)
+
+
+def _predict_series(law, target, scene, params, solver, rtol=FIT_RTOL):
+    from ..solve.solvers import simulate
+
+    if target.observable not in SERIES:
+        raise SkipDataset(f"dataset '{target.name}': observable '{target.observable}' is not a simulated series "
+                          f"({', '.join(SERIES)})")
+    tr = simulate(law, scene, params, solver=solver, t=target.t, rtol=rtol)
+    return tr[SERIES[target.observable]]
+
+
+def outcome_predictor(law, target, scene, params, solver, rtol=FIT_RTOL):
+    """Model of an impact-outcome target: the observable outcome per row, SI, row by row through
+    ``outcome.predict_outcomes``, ODEs solved to ``rtol``."""
+    if target.observable not in OUTCOMES:
+        raise SkipDataset(f"dataset '{target.name}': '{target.observable}' is not an impact outcome "
+                          f"({', '.join(OUTCOMES)})")
+    if target.observable in ("psi1", "psi2") and (scene.materials is None or scene.friction is None):
+        raise SkipDataset(f"dataset '{target.name}': {target.observable} needs [scene.materials] with the "
+                          "moduli and the stated friction coefficient")
+    rows = rows_of(target.dataset)
+    return predict_outcomes(law, scene, params, solver, speed=rows["speed"], incidence=rows["incidence"],
+                            spin=rows["spin"], rtol=FIT_RTOL if rtol is None else rtol)[target.observable]
+
+
+register_predictor("impact", _predict_series)
+register_predictor("incline", _predict_series)
+register_predictor("spring-slider", _predict_series)
+register_predictor("impact-outcome", outcome_predictor)
+
+
+def predict(law, target: Target, params: Mapping[str, float], solver: str = "exact",
+            scene: Scene | None = None, rtol: float | None = None) -> np.ndarray:
+    """The law's prediction of ``target.y`` (SI) for law parameters ``params`` (SI), on ``scene``
+    (default: the dataset's), solving any ODE to ``rtol`` (None: FIT_RTOL). Raises SkipDataset
+    for a kind nobody can predict yet."""
+    law = get_law(law)
+    kind = target.dataset.kind
+    if kind not in PREDICTORS:
+        raise SkipDataset(f"no predictor for dataset kind '{kind}' (dataset '{target.name}'); "
+                          f"known: {', '.join(PREDICTORS)}")
+    fn = PREDICTORS[kind]
+    kw = {"rtol": FIT_RTOL if rtol is None else rtol} if takes_rtol(fn) else {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # series accuracy warnings are recorded in the result instead
+        return np.asarray(fn(law, target, scene or target.dataset.scene, params, solver, **kw), dtype=float)
+
+
+def applicable_solvers(law, scene: Scene) -> dict[str, str | None]:
+    """For 'exact', 'series' and 'ode': None if it applies to ``law`` on ``scene``, else why not."""
+    from ..solve.plan import make_plan
+    from ..solve.solvers import exact, series
+
+    law = get_law(law)
+    if hasattr(scene, "example"):  # an impact-outcome template: check on one of its impacts
+        if getattr(scene.compliance, "model", None) == "mindlin-deresiewicz":
+            from ..solve.outcome import mdr_solvers
+
+            return mdr_solvers(law)
+        scene = scene.example()
+    try:
+        plan = make_plan(scene, law)
+    except FrictionLabError as exc:
+        return {name: str(exc) for name in ("exact", "series", "ode")}
+    out = {"ode": None}
+    for name, module in (("exact", exact), ("series", series)):
+        try:
+            for p in (law.defaults(), _generic_params(law)):  # forms may degenerate at defaults (eta' = 0)
+                module.check(plan, p)
+            out[name] = None
+        except FrictionLabError as exc:
+            out[name] = str(exc)
+    return out
+
+
+def _generic_params(law) -> dict[str, float]:
+    p = {}
+    for s in law.params:
+        v = s.default + s.scale
+        p[s.name] = v if v <= s.upper else s.default - s.scale
+    return p
+
+
+def auto_solver(law, scene: Scene) -> str:
+    """'exact' where a closed form exists for this law and scene, else 'ode'."""
+    return "exact" if applicable_solvers(law, scene)["exact"] is None else "ode"
+
+
+def set_scene_quantity(scene: Scene, name: str, value: float) -> Scene:
+    """A copy of ``scene`` with the (dotted) quantity ``name`` set to ``value`` (SI)."""
+    head, _, tail = name.partition(".")
+    if not tail:
+        return attrs.evolve(scene, **{head: float(value)})
+    sub = getattr(scene, head)
+    return attrs.evolve(scene, **{head: attrs.evolve(sub, **{tail: float(value)})})
+
+
+def get_scene_quantity(scene: Scene, name: str) -> float:
+    if name not in SCENE_QUANTITIES:
+        raise ParameterError(f"scene quantity '{name}' cannot be freed; choose from {', '.join(SCENE_QUANTITIES)}")
+    obj = scene
+    for part in name.split("."):
+        if obj is None or not hasattr(obj, part):
+            raise ParameterError(f"scene quantity '{name}': this scene has no {part!r}"
+                                 + (f" ({type(obj).__name__})" if obj is not None else ""))
+        obj = getattr(obj, part)
+    if not isinstance(obj, (int, float)):
+        raise ParameterError(f"scene quantity '{name}' is not a number on this scene")
+    return float(obj)

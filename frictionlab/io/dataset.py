@@ -1,0 +1,430 @@
+"""Datasets: a CSV series plus a TOML sidecar of the same stem, loaded into SI arrays.
+
+The TOML holds ``name``, optionally ``group`` (datasets of one material and setup compared
+together; default: the name without its last ``-suffix``), ``kind``, ``observable``, ``[columns]`` (column -> unit),
+``[noise]`` (observable -> quantity, and ``kind = "known" | "assumed"``: whether sigma was
+measured or is a guess; default assumed), ``[scene]``, ``[fixed]`` law parameters,
+``[provenance]`` and optionally ``[reported]``. Loading validates everything and fails
+with a one-line ``DatasetError`` naming the file and the field.
+"""
+from __future__ import annotations
+
+import io
+import math
+from importlib import resources
+from pathlib import Path
+
+import attrs
+import numpy as np
+
+from ..core.errors import DatasetError, FrictionLabError
+from ..core.files import MAX_CSV_BYTES, check_name, read_bytes, read_text, read_toml
+from ..core.units import MAX_SI, check_text, check_time_scale, unit_factor
+from ..physics.scene import KINDS, Scene
+from ..solve.outcome import OUTCOMES, OutcomeScene
+
+PROVENANCE_KINDS = ("measured", "reported", "reconstructed", "synthetic")
+#: What a dataset says about its noise: 'known' (sigma measured: the likelihood uses it) or
+#: 'assumed' (a guess: the fit profiles sigma out). Absent means assumed.
+NOISE_KINDS = ("known", "assumed")
+DATA_KINDS = KINDS + ("contact-area",)
+
+#: SI unit of each well-known column; other columns must declare a unit of their own.
+COLUMN_SI = {
+    "t": "s", "omega": "rad/s", "theta": "rad", "u": "m/s", "v": "m/s", "A": "m^2", "N": "N", "x": "m",
+    "speed": "m/s", "incidence": "rad", "spin": "rad/s", "rebound_spin": "rad/s", "tangential_cor": "",
+    "rebound_angle": "rad", "cm_tangential_cor": "", "normal_cor": "", "contact_rebound_angle": "rad", "psi1": "",
+    "psi2": "", "mu": "",
+}
+
+
+@attrs.frozen
+class Provenance:
+    kind: str  # measured | reported | reconstructed | synthetic
+    source: str
+    method: str = ""
+    command: str = ""
+    seed: int | None = None
+    truth: dict = attrs.field(factory=dict)  # generating law and parameters, for synthetic data
+
+
+@attrs.frozen(eq=False)
+class Dataset:
+    """A loaded dataset: SI arrays by column, the scene, fixed law parameters, provenance."""
+
+    name: str
+    kind: str
+    observable: str
+    path: Path | None
+    columns: dict  # name -> SI ndarray
+    units: dict  # name -> unit string as written in the TOML
+    noise: dict  # column -> SI float (standard deviation)
+    scene: Scene | None
+    fixed: dict  # law parameter name -> SI float
+    provenance: Provenance
+    description: str = ""
+    reported: dict = attrs.field(factory=dict)
+    fixed_units: dict = attrs.field(factory=dict)
+    noise_kind: str = "assumed"  # NOISE_KINDS: is the [noise] sigma measured ('known') or a guess ('assumed')?
+    group: str = ""  # declared group (TOML 'group'); "" -> answers.group_of derives it from the name
+
+    @property
+    def t(self) -> np.ndarray:
+        if "t" not in self.columns:
+            raise DatasetError(f"dataset '{self.name}' ({self.kind}) has no time column: one impact per row")
+        return self.columns["t"]
+
+    @property
+    def y(self) -> np.ndarray:
+        return self.columns[self.observable]
+
+    @property
+    def sigma(self) -> float:
+        return self.noise[self.observable]
+
+    def __len__(self) -> int:
+        return len(next(iter(self.columns.values())))
+
+    def __repr__(self) -> str:
+        return f"<Dataset {self.name}: {self.kind}, {len(self)} points of {self.observable}, {self.provenance.kind}>"
+
+
+def builtin_dir() -> Path:
+    """Folder of the built-in datasets (the repository's datasets/, installed as frictionlab.data)."""
+    return Path(str(resources.files("frictionlab.data")))
+
+
+def builtin_names() -> list[str]:
+    return sorted(p.stem for p in builtin_dir().glob("*.toml"))
+
+
+def resolve(name_or_path: str | Path) -> Path:
+    """Path of a dataset TOML from a built-in name, a .toml path or a .csv path."""
+    p = Path(name_or_path)
+    if p.suffix in (".toml", ".csv"):
+        p = p.with_suffix(".toml")
+        if not p.exists():
+            raise DatasetError(f"{p}: no such dataset file")
+        return p
+    candidate = builtin_dir() / f"{name_or_path}.toml"
+    if candidate.exists():
+        return candidate
+    raise DatasetError(f"unknown dataset '{name_or_path}'; built-in: {', '.join(builtin_names())} (or give a .toml path)")
+
+
+def load_dataset(name_or_path: str | Path) -> Dataset:
+    """Load and validate a dataset by built-in name or path to its TOML (or CSV)."""
+    if isinstance(name_or_path, Dataset):
+        return name_or_path
+    path = resolve(name_or_path)
+    return from_meta(read_toml(path), path)
+
+
+def _req(meta, key, path, typ=str):
+    if key not in meta:
+        raise DatasetError(f"{path}: missing required key '{key}'")
+    if not isinstance(meta[key], typ):
+        what = {str: "string", dict: "table"}.get(typ, typ.__name__)
+        raise DatasetError(f"{path}: '{key}' must be a {what}, got {type(meta[key]).__name__}")
+    return meta[key]
+
+
+def _table(meta, key, path, where=None):
+    """An optional TOML table: {} when absent, an error when present but not a table."""
+    value = meta.get(key, {})
+    if not isinstance(value, dict):
+        raise DatasetError(f"{path}: {where or key} must be a table, got {type(value).__name__} {value!r}")
+    return value
+
+
+def from_meta(meta: dict, path: Path) -> Dataset:
+    """Build a Dataset from a parsed TOML dict whose CSV sits beside ``path``."""
+    name = check_name(_req(meta, "name", path), f"{path}: name")
+    group = meta.get("group", "")
+    if "group" in meta:
+        if not isinstance(group, str):
+            raise DatasetError(f"{path}: group = {group!r}, expected a quoted name (letters, digits, . _ + -)")
+        group = check_name(group, f"{path}: group")
+    kind = _req(meta, "kind", path)
+    if kind not in DATA_KINDS:
+        raise DatasetError(f"{path}: kind = {kind!r}, expected one of {', '.join(DATA_KINDS)}")
+    observable = _req(meta, "observable", path)
+    if observable == "t":
+        raise DatasetError(f"{path}: observable = 't': the time column cannot be the observable")
+    if kind == "impact-outcome":
+        if observable not in OUTCOMES:
+            raise DatasetError(f"{path}: observable {observable!r} is not an impact outcome ({', '.join(OUTCOMES)})")
+    units = _req(meta, "columns", path, dict)
+    for col, u in units.items():
+        if not isinstance(u, str):
+            raise DatasetError(f"{path}: columns.{col} must be a unit string like 'us' or 'rpm'")
+    if "t" not in units and kind != "impact-outcome":
+        raise DatasetError(f"{path}: [columns] must declare the time column 't'")
+    if observable not in units:
+        raise DatasetError(f"{path}: observable {observable!r} is not declared in [columns] ({', '.join(units)})")
+
+    csv = path.with_suffix(".csv")
+    raw = read_csv(csv)
+    columns = {}
+    for col, unit in units.items():
+        if col not in raw:
+            raise DatasetError(f"{csv}: missing column '{col}' declared in {path.name} (has: {_names(raw)})")
+        si = COLUMN_SI.get(col)
+        if si is None:
+            raise DatasetError(f"{path}: column '{col}' is not a known quantity ({', '.join(COLUMN_SI)})")
+        try:
+            columns[col] = raw[col] * unit_factor(unit, si, f"{path}: columns.{col}")
+        except FrictionLabError as exc:
+            raise DatasetError(str(exc)) from None
+        bad = np.nonzero(~(np.abs(columns[col]) <= MAX_SI))[0]
+        if bad.size:
+            i = int(bad[0])
+            raise DatasetError(f"{csv}: column {col!r} line {_line_of_row(csv, i)}: {raw[col][i]:g} {unit} is beyond "
+                               f"the accepted magnitude {MAX_SI:g} in SI units")
+    if "t" in columns:
+        t = columns["t"]
+        bad = np.nonzero(np.diff(t) <= 0)[0]
+        if bad.size:
+            i = int(bad[0])
+            raise DatasetError(f"{csv}: column 't' must increase strictly; line {_line_of_row(csv, i + 1)} "
+                               f"({raw['t'][i + 1]:g}) does not exceed the line before ({raw['t'][i]:g})")
+        if kind != "contact-area" and t[0] < 0:
+            raise DatasetError(f"{csv}: column 't' line {_line_of_row(csv, 0)}: time {raw['t'][0]:g} is negative; "
+                               "times count from first contact (or release) at t = 0")
+    for col in ("A", "N"):
+        if col in columns and np.any(columns[col] < 0):
+            raise DatasetError(f"{csv}: column '{col}' has negative values")
+
+    noise_spec = _table(meta, "noise", path, "[noise]")
+    if observable not in noise_spec:
+        raise DatasetError(f"{path}: [noise] must give the noise of the observable, e.g. {observable} = '100 rpm'")
+    noise_spec = dict(noise_spec)
+    noise_kind = noise_spec.pop("kind", "assumed")
+    if noise_kind not in NOISE_KINDS:
+        raise DatasetError(f"{path}: noise.kind = {noise_kind!r}, expected one of {', '.join(NOISE_KINDS)} "
+                           "(known: sigma measured; assumed: a guess, profiled out by the fit)")
+    noise = {}
+    for col, value in noise_spec.items():
+        if col not in columns:
+            raise DatasetError(f"{path}: noise.{col} names no declared column")
+        noise[col] = _quantity(value, COLUMN_SI[col], f"{path}: noise.{col}")
+        if not noise[col] > 0:
+            raise DatasetError(f"{path}: noise.{col} must be positive, got {value!r}")
+
+    provenance = _provenance(meta.get("provenance"), path)
+    scene = None
+    if kind != "contact-area":
+        spec = meta.get("scene")
+        if not isinstance(spec, dict):
+            raise DatasetError(f"{path}: missing required table [scene]")
+        try:
+            if kind == "impact-outcome":
+                scene = OutcomeScene.from_spec(spec, str(path))
+            else:
+                scene = Scene.from_spec(spec, kind, str(path), columns, columns.get("t"))
+        except FrictionLabError as exc:  # a model's own check (no file in it) still names the file
+            raise DatasetError(str(exc) if str(exc).startswith(str(path)) else f"{path}: [scene]: {exc}") from None
+        if kind == "impact-outcome":
+            _check_outcome_rows(columns, observable, path, csv, scene)
+        else:
+            _check_observable(scene, observable, path)
+            _check_time_unit(columns, units, spec, kind, scene, path)
+
+    fixed, fixed_units = {}, {}
+    for key, value in _table(meta, "fixed", path, "[fixed]").items():
+        from ..physics.registry import available_laws
+
+        specs = [(law.name, s) for law in available_laws().values() for s in law.params if s.name == key]
+        if not specs:
+            raise DatasetError(f"{path}: fixed.{key} is not a parameter of any registered law")
+        unit = specs[0][1].unit
+        fixed[key] = _quantity(value, unit, f"{path}: fixed.{key}")
+        fixed_units[key] = unit
+        for law_name, spec in specs:
+            if spec.unit == unit and not spec.lower <= fixed[key] <= spec.upper:
+                raise DatasetError(f"{path}: fixed.{key} = {value!r} is outside the bounds of law '{law_name}' "
+                                   f"[{spec.lower:g}, {spec.upper:g}] {spec.unit}".rstrip())
+
+    extra = set(meta) - {"name", "group", "kind", "observable", "columns", "noise", "scene", "fixed", "provenance",
+                         "reported", "description"}
+    if extra:
+        raise DatasetError(f"{path}: unknown top-level key(s) {sorted(extra)}")
+    reported = _table(meta, "reported", path, "[reported]")
+    for table, values in (("reported", reported), ("provenance.truth", provenance.truth)):
+        for key, value in values.items():  # read by the report later: refuse what pint would choke on now
+            if isinstance(value, str):
+                try:
+                    check_text(value, f"{path}: {table}.{key}")
+                except FrictionLabError as exc:
+                    raise DatasetError(str(exc)) from None
+    if not isinstance(meta.get("description", ""), str):
+        raise DatasetError(f"{path}: 'description' must be a string")
+    return Dataset(name=name, kind=kind, observable=observable, path=path, columns=columns, units=dict(units),
+                   noise=noise, scene=scene, fixed=fixed, provenance=provenance,
+                   description=meta.get("description", ""), reported=reported,
+                   fixed_units=fixed_units, noise_kind=noise_kind, group=group)
+
+
+def _check_time_unit(columns, units, spec, kind, scene, path) -> None:
+    """The time column must span about the scene's duration (given, or the impact's contact time)."""
+    if "duration" in spec:
+        field = "scene.duration"
+    elif kind == "impact" and scene.duration > 0:
+        field = "the scene's contact time"
+    else:
+        return  # the duration was taken from the time column itself
+    try:
+        check_time_scale(float(columns["t"][-1]), scene.duration, units["t"], f"{path}: columns.t", field)
+    except FrictionLabError as exc:
+        raise DatasetError(str(exc)) from None
+
+
+#: Trajectory series each observable needs, and what in a scene provides it.
+def _check_observable(scene: Scene, observable: str, path) -> None:
+    """A dataset whose observable its own scene cannot produce would be fitted against zeros."""
+    if scene.kind not in ("impact", "incline"):
+        return
+    if observable in ("omega", "theta") and not ({"spin", "slip-coupling"} & scene.effects):
+        raise DatasetError(f"{path}: observable {observable!r} needs the scene to integrate spin; "
+                           "add \"spin\" to scene.effects (and a scene.radius)")
+    if observable == "A" and scene.area is None:
+        raise DatasetError(f"{path}: observable 'A' needs a [scene.area] model")
+    if observable == "N" and scene.normal is None:
+        raise DatasetError(f"{path}: observable 'N' needs a [scene.normal] model")
+
+
+def _check_outcome_rows(columns, observable, path, csv, scene) -> None:
+    """An impact-outcome dataset: one impact per row (speed, incidence), an outcome as observable."""
+    for col in ("speed", "incidence"):
+        if col not in columns:
+            raise DatasetError(f"{path}: an impact-outcome dataset needs a '{col}' column in [columns] "
+                               "(one impact per row)")
+    bad = np.nonzero(~(columns["speed"] > 0))[0]
+    if bad.size:
+        raise DatasetError(f"{csv}: column 'speed' line {_line_of_row(csv, int(bad[0]))}: impact speed must be positive")
+    inc = columns["incidence"]
+    bad = np.nonzero(~((inc > 0) & (inc < math.pi / 2)))[0]
+    if bad.size:
+        raise DatasetError(f"{csv}: column 'incidence' line {_line_of_row(csv, int(bad[0]))}: incidence must be "
+                           f"strictly between 0 and 90 deg (measured from the "
+                           f"{'surface normal' if scene.angle_reference == 'normal' else 'surface'})")
+
+
+def _names(columns) -> str:
+    """Column names for a one-line message (repr when a name holds odd characters)."""
+    return ", ".join(c if c.isprintable() and "," not in c else repr(c) for c in columns)
+
+
+def _quantity(value, si, where):
+    from ..core.units import to_si
+
+    try:
+        return to_si(value, si, where)
+    except FrictionLabError as exc:
+        raise DatasetError(str(exc)) from None
+
+
+def _provenance(p, path) -> Provenance:
+    if not isinstance(p, dict):
+        raise DatasetError(f"{path}: missing required table [provenance] (kind = {' | '.join(PROVENANCE_KINDS)})")
+    extra = set(p) - {"kind", "source", "method", "command", "seed", "truth"}
+    if extra:
+        raise DatasetError(f"{path}: [provenance] has unknown key(s) {sorted(extra)}; "
+                           "known: kind, source, method, command, seed, truth")
+    kind = p.get("kind")
+    if kind not in PROVENANCE_KINDS:
+        raise DatasetError(f"{path}: provenance.kind = {kind!r}, expected one of {', '.join(PROVENANCE_KINDS)}")
+    if not isinstance(p.get("source"), str) or not p["source"]:
+        raise DatasetError(f"{path}: provenance.source must name where the data come from")
+    if kind in ("reconstructed", "synthetic") and not p.get("command"):
+        raise DatasetError(f"{path}: provenance.command must give the command that regenerates {kind} data")
+    for key in ("method", "command"):
+        if not isinstance(p.get(key, ""), str):
+            raise DatasetError(f"{path}: provenance.{key} must be a string")
+    seed = p.get("seed")
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int)):
+        raise DatasetError(f"{path}: provenance.seed must be an integer, got {seed!r}")
+    if not isinstance(p.get("truth", {}), dict):
+        raise DatasetError(f"{path}: provenance.truth must be a table")
+    return Provenance(kind=kind, source=p["source"], method=p.get("method", ""), command=p.get("command", ""),
+                      seed=p.get("seed"), truth=p.get("truth", {}))
+
+
+def read_csv(csv: Path) -> dict[str, np.ndarray]:
+    """Read a numeric CSV with a header row into float arrays; one-line errors on bad content.
+    The CSV must lie in its folder once links are resolved (see io.read_bytes)."""
+    import warnings
+
+    import pandas as pd
+
+    try:
+        text = read_bytes(csv, MAX_CSV_BYTES, within=Path(csv).parent).decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise DatasetError(f"{csv}: CSV does not parse: not UTF-8 text (byte {exc.start + 1})") from None
+    try:
+        with warnings.catch_warnings():
+            # more fields in every row than in the header: pandas would shift the columns silently
+            warnings.simplefilter("error", pd.errors.ParserWarning)
+            df = pd.read_csv(io.StringIO(text), comment="#", skipinitialspace=True, index_col=False, dtype=str,
+                             keep_default_na=False)
+    except pd.errors.EmptyDataError:
+        raise DatasetError(f"{csv}: file is empty") from None
+    except pd.errors.ParserWarning:
+        raise DatasetError(f"{csv}: CSV does not parse: data rows have more fields than the header") from None
+    except (pd.errors.ParserError, UnicodeError, ValueError, OSError) as exc:
+        first = (str(exc).splitlines() or [type(exc).__name__])[0]
+        raise DatasetError(f"{csv}: CSV does not parse: {first}") from None
+    names = [str(c).strip() for c in df.columns]
+    header = _header_names(text)
+    for i, name in enumerate(header if header is not None else names):
+        if not name:
+            raise DatasetError(f"{csv}: header column {i + 1} has no name (a stray comma?)")
+        if any(sep in name for sep in (";", "\t")):
+            raise DatasetError(f"{csv}: header {name!r} looks ;- or tab-separated; write comma-separated values")
+    if header is not None:
+        dup = sorted({n for n in header if header.count(n) > 1})
+        if dup:
+            raise DatasetError(f"{csv}: column {dup[0]!r} appears more than once in the header")
+    if len(df) == 0:
+        raise DatasetError(f"{csv}: no data rows")
+    out = {}
+    for col, name in zip(df.columns, names):
+        text = df[col]
+        values = np.array([_number(x) for x in text], dtype=float)
+        bad = np.nonzero(~np.isfinite(values))[0]
+        if bad.size:
+            i = int(bad[0])
+            raise DatasetError(f"{csv}: column {name!r} line {_line_of_row(csv, i)}: {text.iloc[i]!r} "
+                               "is not a finite number")
+        out[name] = values
+    return out
+
+
+def _number(text) -> float:
+    """A CSV cell as a float (correctly rounded, like Python's float), NaN if it is not a number."""
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def _header_names(text: str) -> list[str] | None:
+    """Column names as written in the header line (pandas renames duplicates), or None if unreadable."""
+    import csv as csvmod
+
+    try:
+        lines = text.splitlines(keepends=True)
+        rows = (r for r in csvmod.reader(line for line in lines if line.strip() and not line.lstrip().startswith("#")))
+        return [c.strip() for c in next(rows)]
+    except (csvmod.Error, StopIteration):
+        return None
+
+
+def _line_of_row(csv: Path, row: int) -> int:
+    """1-based line number in the file of data row ``row`` (0-based, after header and comments)."""
+    try:
+        lines = read_text(csv, MAX_CSV_BYTES).splitlines()
+    except DatasetError:
+        return 0
+    data = [i for i, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")]
+    return data[row + 1] + 1 if row + 1 < len(data) else len(lines)

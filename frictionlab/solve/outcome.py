@@ -1,0 +1,548 @@
+"""Impact outcomes: one oblique impact per row, and what the ball does after it.
+
+An ``impact-outcome`` dataset has one impact per CSV row (columns ``speed`` [m/s] and
+``incidence`` [angle], optionally the inbound ``spin`` [rad/s]) and the ball in its TOML
+``[scene]``. ``predict_outcomes`` simulates every row with ``simulate`` and returns, SI:
+
+  rebound_spin    omega at the end of contact [rad/s], positive in the sense friction drives it
+                  for positive tangential velocity (topspin for a ball sliding forward)
+  tangential_cor  -(v_t2 - r omega_2) / (v_t1 - r omega_1): tangential restitution of the contact
+                  point [-]; < 0 still sliding forward at rebound, 0 rolling, > 0 the contact point
+                  reversed (possible only with tangential compliance, Maw, Barber and Fawcett 1976)
+  rebound_angle   angle of the outbound velocity of the centre of mass [rad], from the same
+                  reference as the incidence
+  cm_tangential_cor      v_t2 / v_t1: tangential restitution of the centre of mass [-] (what Kharaz,
+                  Gorham and Salman (2001) and the DEM benchmarks call the tangential restitution)
+  normal_cor      v_n2 / v_n1 = e [-] (from the normal-contact model of the row)
+  contact_rebound_angle  atan(v_c2 / v_n2) [rad], v_c2 = v_t2 - r omega_2: rebound angle of the contact
+                  point, from the normal; negative when the contact point reversed
+  psi1, psi2      Maw, Barber and Fawcett's normalized incidence and rebound angles of the contact point,
+                  (kappa / mu) v_c1 / v_n1 and (kappa / mu) v_c2 / v_n2, kappa = 4 G*/E* from
+                  [scene.materials] and mu the friction coefficient stated there (frictionlab.physics.contact)
+
+Angles: ``incidence`` is measured from the surface normal (0 = head-on), so v_t = V sin(theta)
+and v_n = V cos(theta); with ``angle_reference = "surface"`` in [scene] it is measured from the
+surface (v_t = V cos, v_n = V sin) and so is the rebound angle. The outbound normal speed is e v_n.
+
+Normal contact per row, ``[scene.normal]``:
+  model = "half-sine"  N = Np sin(pi t / t_c), impulse m v_n (1 + e). Given ``contact_time`` and
+      ``restitution``; with ``reference_speed`` v_ref both depend on the normal speed:
+      t_c = contact_time (v_n / v_ref)^contact_time_exponent (default -1/5, Hertz's exponent) and
+      e = restitution - restitution_slope (v_n - v_ref) [slope in s/m], kept within [0, 1].
+  model = "hertz"  elastic Hertz impact of a sphere (radius r) on a flat: N = K delta^(3/2),
+      K = (4/3) E* sqrt(r), E* the effective ``modulus`` (or from [scene.materials]); delta(t) = delta_m y(v_n t / delta_m) with
+      y'' = -(5/4) y^(3/2), y(0) = 0, y'(0) = 1, delta_m = (5 m v_n^2 / (4 K))^(2/5), contact time
+      2.943 delta_m / v_n. The elastic pulse has impulse 2 m v_n; it is scaled by (1 + e)/2 so the
+      impulse is m v_n (1 + e) (restitution as for half-sine). Contact area A = pi r delta.
+Contact area, ``[scene.area]`` (for laws that read A or dA/dt):
+  model = "half-sine"  A = A0 sin(pi t / t_c) over the row's contact time; with a reference speed,
+      A0 = peak (v_n / v_ref)^peak_exponent (default 4/5: Hertz, A_max = pi r delta_m ~ v_n^(4/5)); v_ref is
+      the area's reference_speed, else the normal model's.
+  model = "hertz"  A = pi r delta(t) of the Hertz pulse (the default with a Hertz normal force).
+Tangential: the law, with the scene's effects (default spin and slip coupling, so slip stops and
+the ball rolls as the law allows), optional [scene.compliance] (model = "linear" with stiffness and
+damping, or "mindlin": k_t = 8 G* a(t) with G* from [scene.materials] or ``shear_modulus``).
+Materials, ``[scene.materials]``: ball_young, ball_poisson, surface_young, surface_poisson and the
+friction coefficient the source states (``friction``, used only to normalize psi1 and psi2).
+"""
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Mapping
+
+import attrs
+import numpy as np
+
+from ..core.errors import DatasetError, SceneError
+from ..physics.contact import (
+    Compliance,
+    MindlinCompliance,
+    Pair,
+    compliance_from_spec,
+    materials_from_spec,
+    normalized_angle,
+)
+from ..physics.scene import (
+    HalfSineArea,
+    HalfSineNormal,
+    Scene,
+    read_effects,
+    spec_reader,
+)
+
+#: Outcome observables and their SI units.
+OUTCOMES = {"rebound_spin": "rad/s", "tangential_cor": "", "rebound_angle": "rad", "cm_tangential_cor": "",
+            "normal_cor": "", "contact_rebound_angle": "rad", "psi1": "", "psi2": ""}
+ANGLE_REFERENCES = ("normal", "surface")
+
+
+# --- speed dependence ---------------------------------------------------------------------
+@attrs.frozen
+class SpeedLaw:
+    """value(v_n) = value * (v_n / reference_speed)^exponent + slope (v_n - reference_speed); constant
+    without a reference speed. Units: those of value; slope per m/s."""
+
+    value: float
+    reference_speed: float | None = None
+    exponent: float = 0.0
+    slope: float = 0.0
+
+    def __call__(self, vn: float) -> float:
+        if self.reference_speed is None:
+            return self.value
+        return self.value * (vn / self.reference_speed) ** self.exponent + self.slope * (vn - self.reference_speed)
+
+
+# --- Hertz impact ----------------------------------------------------------------------------
+@functools.cache
+def _hertz_solution():
+    """(s_end, dense) of the dimensionless Hertz impact (see ``hertz_shape``): dense(s) -> (y, y') rows."""
+    from scipy.integrate import solve_ivp
+
+    def rhs(s, z):
+        return [z[1], -1.25 * max(z[0], 0.0) ** 1.5]
+
+    def end(s, z):
+        return z[0]
+
+    end.terminal, end.direction = True, -1
+    sol = solve_ivp(rhs, (0.0, 4.0), [0.0, 1.0], method="DOP853", rtol=1e-13, atol=1e-15, dense_output=True,
+                    events=end)
+    return float(sol.t_events[0][0]), sol.sol
+
+
+def hertz_shape():
+    """Dimensionless elastic Hertz impact: y'' = -(5/4) y^(3/2), y(0) = 0, y'(0) = 1.
+
+    Returns (s_end, y, dy): the end of contact s_end = (4/5) B(2/5, 1/2) = 2.9432 and the dense
+    solution y(s), y'(s). Integrated once (DOP853, rtol 1e-13).
+    """
+    s_end, dense = _hertz_solution()
+    return s_end, (lambda s: np.maximum(dense(s)[0], 0.0)), (lambda s: dense(s)[1])
+
+
+@attrs.frozen
+class HertzPulse:
+    """One elastic Hertz impact: indentation delta(t) = delta_max y(v_n t / delta_max) for 0 <= t <= t_c."""
+
+    stiffness: float  # K [N/m^1.5]
+    delta_max: float  # [m]
+    normal_speed: float  # [m/s]
+
+    @property
+    def time_scale(self) -> float:
+        return self.delta_max / self.normal_speed
+
+    @property
+    def contact_time(self) -> float:
+        return hertz_shape()[0] * self.time_scale
+
+    def shape(self, t):
+        """(y, dy/ds) at times t [s]; zero outside the contact."""
+        s_end, dense = _hertz_solution()
+        s = np.asarray(t, dtype=float) / self.time_scale
+        inside = (s >= 0) & (s <= s_end)
+        sc = np.clip(s, 0.0, s_end)
+        y, dy = dense(sc.ravel())  # both rows of one evaluation of the interpolant
+        return (np.where(inside, np.maximum(y, 0.0).reshape(sc.shape), 0.0),
+                np.where(inside, dy.reshape(sc.shape), 0.0))
+
+
+@attrs.frozen
+class HertzPulseNormal:
+    """N(t) = factor K delta(t)^(3/2) [N]; factor = (1 + e)/2 scales the elastic impulse 2 m v_n to m v_n (1 + e)."""
+
+    pulse: HertzPulse
+    factor: float
+
+    @property
+    def contact_time(self) -> float:
+        return self.pulse.contact_time
+
+    def __call__(self, t, A=None):
+        y, _ = self.pulse.shape(t)
+        return self.factor * self.pulse.stiffness * (self.pulse.delta_max * y) ** 1.5
+
+
+@attrs.frozen
+class HertzPulseArea:
+    """A(t) = pi r delta(t) [m^2], dA/dt = pi r v_n y'(s)."""
+
+    pulse: HertzPulse
+    radius: float
+
+    @property
+    def contact_time(self) -> float:
+        return self.pulse.contact_time
+
+    def __call__(self, t, x=None, speed=None):
+        y, dy = self.pulse.shape(t)
+        c = math.pi * self.radius
+        return c * self.pulse.delta_max * y, c * self.pulse.normal_speed * dy
+
+
+# --- the scene template ------------------------------------------------------------------------
+@attrs.frozen
+class Inbound:
+    """One row's impact: the simulated scene and what the outcomes need (SI)."""
+
+    scene: Scene
+    tangential_speed: float  # v_t1, ball centre [m/s]
+    normal_speed: float  # v_n1 [m/s]
+    spin: float  # omega_1 [rad/s]
+    restitution: float  # e [-]
+    contact_time: float  # [s]
+
+
+@attrs.frozen
+class OutcomeScene:
+    """The ball and contact models of an impact-outcome dataset; ``impact`` builds one row's Scene."""
+
+    mass: float  # [kg]
+    radius: float  # [m]
+    normal: dict  # {"model": "half-sine" | "hertz", "contact_time": SpeedLaw | None, "modulus": float | None, "restitution": SpeedLaw}
+    area: dict | None = None  # {"model": "half-sine" | "hertz", "peak": SpeedLaw | None}
+    inertia_factor: float = 0.4
+    effects: frozenset = frozenset({"spin", "slip-coupling"})
+    compliance: Compliance | MindlinCompliance | None = None
+    angle_reference: str = "normal"
+    kind: str = "impact-outcome"
+    materials: Pair | None = None
+    friction: float | None = None  # the friction coefficient the source states (normalizes psi1, psi2)
+
+    def impact(self, speed: float, incidence: float, spin: float = 0.0) -> Inbound:
+        """The scene of one impact at ``speed`` [m/s] and ``incidence`` [rad], inbound ``spin`` [rad/s]."""
+        if not (math.isfinite(speed) and speed > 0):
+            raise SceneError(f"impact speed must be a positive number of m/s, got {speed!r}")
+        if not (math.isfinite(incidence) and 0 < incidence < math.pi / 2):
+            raise SceneError(f"incidence must be strictly between 0 and 90 deg, got {math.degrees(incidence):g} deg")
+        if not math.isfinite(spin):
+            raise SceneError(f"inbound spin must be finite, got {spin!r}")
+        along, across = (math.sin, math.cos) if self.angle_reference == "normal" else (math.cos, math.sin)
+        vt, vn = speed * along(incidence), speed * across(incidence)
+        e = self.normal["restitution"](vn)
+        e = min(max(e, 0.0), 1.0)
+        if self.normal["model"] == "hertz":
+            K = 4.0 / 3.0 * self.normal["modulus"] * math.sqrt(self.radius)
+            pulse = HertzPulse(K, (5.0 * self.mass * vn * vn / (4.0 * K)) ** 0.4, vn)
+            normal = HertzPulseNormal(pulse, (1.0 + e) / 2.0)
+            tc = pulse.contact_time
+        else:
+            tc = self.normal["contact_time"](vn)
+            if not (math.isfinite(tc) and tc > 0):
+                raise SceneError(f"contact time at normal speed {vn:g} m/s is {tc!r} s; check scene.normal")
+            normal, pulse = HalfSineNormal(self.mass * vn * (1.0 + e), tc), None
+        area = None
+        if self.area is not None:
+            if self.area["model"] == "hertz":
+                area = HertzPulseArea(pulse, self.radius)
+            else:
+                area = HalfSineArea(self.area["peak"](vn), tc)
+        coupled = "slip-coupling" in self.effects
+        scene = Scene(kind="impact", mass=self.mass, u0=vt - (self.radius * spin if coupled else 0.0), duration=tc,
+                      radius=self.radius, inertia_factor=self.inertia_factor, omega0=spin, area=area, normal=normal,
+                      compliance=self.compliance, effects=self.effects)
+        return Inbound(scene, vt, vn, spin, e, tc)
+
+    def example(self) -> Scene:
+        """One representative impact (reference speed or 30 m/s, 45 deg): what a solver check needs."""
+        vref = self.normal["restitution"].reference_speed or 30.0
+        return self.impact(vref, math.pi / 4).scene
+
+    # -- from a TOML [scene] table --------------------------------------------------------------
+    @classmethod
+    def from_spec(cls, spec: Mapping, where: str) -> "OutcomeScene":
+        known = {"mass", "radius", "inertia_factor", "effects", "angle_reference", "normal", "area", "compliance",
+                 "materials"}
+        extra = set(spec) - known
+        if extra:
+            raise SceneError(f"{where}: [scene] of an impact-outcome dataset has unknown key(s) {sorted(extra)}; "
+                             f"known: {', '.join(sorted(known))}")
+        q = spec_reader(spec, where)
+        effects = read_effects(spec, where, default=("spin", "slip-coupling"))
+        if not {"spin", "slip-coupling"} & effects:
+            raise SceneError(f"{where}: scene.effects must include 'spin' (and usually 'slip-coupling'): "
+                             "the outcomes are the rebound spin and the contact point's restitution")
+        ref = spec.get("angle_reference", "normal")
+        if ref not in ANGLE_REFERENCES:
+            raise SceneError(f"{where}: scene.angle_reference must be 'normal' or 'surface', got {ref!r}")
+        mass, radius = q("mass", "kg"), q("radius", "m")
+        inertia_factor = q("inertia_factor", "", required=False, default=0.4)
+        for key in ("normal", "area", "compliance", "materials"):
+            if key in spec and not isinstance(spec[key], Mapping):
+                raise SceneError(f"{where}: scene.{key} must be a table, got {type(spec[key]).__name__}")
+        if "normal" not in spec:
+            raise SceneError(f"{where}: an impact-outcome [scene] needs a [scene.normal] table "
+                             "(model = 'half-sine' with contact_time and restitution, or 'hertz' with modulus)")
+        pair, friction = materials_from_spec(spec["materials"], where, q) if "materials" in spec else (None, None)
+        normal = _normal_spec(spec["normal"], where, q, pair)
+        area = _area_spec(spec.get("area"), where, q, normal)
+        compliance = None
+        if "compliance" in spec:
+            compliance = compliance_from_spec(spec["compliance"], where, q, pair, radius)
+            effects |= {"compliance"}
+            if compliance.model != "linear" and area is None:
+                raise SceneError(f"{where}: compliance model '{compliance.model}' needs the contact area: use "
+                                 "scene.normal.model = 'hertz' or a [scene.area] table")
+        elif "compliance" in effects:
+            raise SceneError(f"{where}: effect 'compliance' needs a [scene.compliance] table "
+                             "(model = 'linear' with stiffness and damping, or 'mindlin')")
+        try:
+            return cls(mass=mass, radius=radius, normal=normal, area=area, inertia_factor=inertia_factor,
+                       effects=effects, compliance=compliance, angle_reference=ref, materials=pair,
+                       friction=friction)
+        except SceneError as exc:
+            raise SceneError(f"{where}: {exc}") from None
+
+
+def _normal_spec(n, where, q, pair=None) -> dict:
+    p = "scene.normal"
+    model = n.get("model")
+    known = {"model", "contact_time", "restitution", "reference_speed", "contact_time_exponent",
+             "restitution_slope", "modulus"}
+    extra = set(n) - known
+    if extra:
+        raise SceneError(f"{where}: [{p}] has unknown key(s) {sorted(extra)}; known: {', '.join(sorted(known))}")
+    vref = q("reference_speed", "m/s", n, p, required=False)
+    e = q("restitution", "", n, p, positive=False)
+    if not 0 <= e <= 1:
+        raise SceneError(f"{where}: {p}.restitution must be in [0, 1], got {n['restitution']!r}")
+    slope = q("restitution_slope", "s/m", n, p, required=False, positive=False, default=0.0)
+    if (slope or "contact_time_exponent" in n) and vref is None:
+        raise SceneError(f"{where}: {p}: restitution_slope and contact_time_exponent need a reference_speed")
+    out = {"model": model, "restitution": SpeedLaw(e, vref, 0.0, -slope), "contact_time": None, "modulus": None}
+    if model == "half-sine":
+        tc = q("contact_time", "s", n, p)
+        exponent = q("contact_time_exponent", "", n, p, required=False, positive=False, default=-0.2)
+        out["contact_time"] = SpeedLaw(tc, vref, exponent)
+    elif model == "hertz":
+        out["modulus"] = q("modulus", "Pa", n, p, required=pair is None)
+        if out["modulus"] is None:
+            out["modulus"] = pair.modulus
+        if "contact_time" in n:
+            raise SceneError(f"{where}: {p}.contact_time: a Hertz contact's duration follows from modulus and speed")
+    else:
+        raise SceneError(f"{where}: {p}.model must be 'half-sine' or 'hertz' for an impact-outcome scene, got {model!r}")
+    return out
+
+
+def _area_spec(a, where, q, normal) -> dict | None:
+    p = "scene.area"
+    if a is None:
+        return {"model": "hertz", "peak": None} if normal["model"] == "hertz" else None
+    model = a.get("model")
+    extra = set(a) - {"model", "peak", "peak_exponent", "reference_speed"}
+    if extra:
+        raise SceneError(f"{where}: [{p}] has unknown key(s) {sorted(extra)}; "
+                         "known: model, peak, peak_exponent, reference_speed")
+    if model == "hertz":
+        if normal["model"] != "hertz":
+            raise SceneError(f"{where}: {p}.model = 'hertz' needs a Hertz normal force (scene.normal.model = 'hertz')")
+        return {"model": "hertz", "peak": None}
+    if model == "half-sine":
+        vref = q("reference_speed", "m/s", a, p, required=False, default=normal["restitution"].reference_speed)
+        peak = q("peak", "m^2", a, p)
+        exponent = q("peak_exponent", "", a, p, required=False, positive=False, default=0.8)
+        if normal["model"] == "hertz":
+            raise SceneError(f"{where}: {p}.model = 'half-sine' with a Hertz normal force: use model = 'hertz'")
+        return {"model": "half-sine", "peak": SpeedLaw(peak, vref, exponent)}
+    raise SceneError(f"{where}: {p}.model must be 'half-sine' or 'hertz' for an impact-outcome scene, got {model!r}")
+
+
+# --- prediction ------------------------------------------------------------------------------------
+def rows_of(dataset) -> dict[str, np.ndarray]:
+    """speed, incidence (and spin) columns of an impact-outcome dataset, checked."""
+    c = dataset.columns
+    for col in ("speed", "incidence"):
+        if col not in c:
+            raise DatasetError(f"dataset '{dataset.name}': an impact-outcome dataset needs a '{col}' column")
+    return {"speed": c["speed"], "incidence": c["incidence"], "spin": c.get("spin", np.zeros(len(c["speed"])))}
+
+
+def predict_outcomes(law, dataset_or_scene, params: Mapping[str, float] | None = None, solver: str = "ode", *,
+                     speed=None, incidence=None, spin=None, rtol: float = 1e-10) -> dict[str, np.ndarray]:
+    """Simulate every impact and return its outcomes (SI arrays, one entry per row).
+
+    dataset_or_scene: an impact-outcome Dataset (its rows and ``[fixed]`` parameters) or an
+    OutcomeScene with ``speed`` [m/s], ``incidence`` [rad] (and ``spin`` [rad/s]) arrays.
+    Returns every observable of OUTCOMES (psi1 and psi2 only when the scene has [scene.materials]
+    with a stated friction coefficient), and per row the
+    speed, incidence, normal_speed, tangential_speed, restitution, contact_time [s],
+    rebound_speed_t (v_t2) [m/s] and rolled (slip stopped during contact, bool).
+    """
+    from ..physics.registry import get_law
+
+    law = get_law(law)
+    fixed = {}
+    if not isinstance(dataset_or_scene, OutcomeScene) and hasattr(dataset_or_scene, "columns"):  # a Dataset
+        ds = dataset_or_scene
+        if ds.kind != "impact-outcome":
+            raise DatasetError(f"dataset '{ds.name}' is a {ds.kind} dataset; predict_outcomes needs an impact-outcome one")
+        rows = rows_of(ds)
+        fixed = {k: v for k, v in ds.fixed.items() if k in law.param_names}
+        template = ds.scene
+    elif isinstance(dataset_or_scene, OutcomeScene):
+        template = dataset_or_scene
+        if speed is None or incidence is None:
+            raise SceneError("predict_outcomes with an OutcomeScene needs speed [m/s] and incidence [rad] arrays")
+        speed, incidence = np.broadcast_arrays(np.atleast_1d(np.asarray(speed, dtype=float)),
+                                               np.atleast_1d(np.asarray(incidence, dtype=float)))
+        spin = np.zeros(speed.shape) if spin is None else np.broadcast_to(np.asarray(spin, dtype=float), speed.shape)
+        rows = {"speed": speed, "incidence": incidence, "spin": spin}
+    else:
+        raise SceneError(f"predict_outcomes: expected an impact-outcome Dataset or an OutcomeScene, "
+                         f"got {type(dataset_or_scene).__name__}")
+    p = law.resolve({**fixed, **(params or {})})
+    n = len(rows["speed"])
+    out = {k: np.empty(n) for k in ("speed", "incidence", "normal_speed", "tangential_speed", "restitution",
+                                     "contact_time", "rebound_spin", "tangential_cor", "rebound_angle",
+                                     "rebound_speed_t", "cm_tangential_cor", "contact_rebound_angle")}
+    out["rolled"] = np.zeros(n, dtype=bool)
+    r = template.radius
+    imps = _inbound(template, rows)
+    if getattr(template.compliance, "model", None) == "mindlin-deresiewicz":
+        v2, w2, rolled = _mdr_rebounds(law, imps, p, template)
+    else:
+        v2, w2, rolled = _rebounds(law, imps, p, solver, rtol)
+    for i, imp in enumerate(imps):
+        slip_in = imp.tangential_speed - r * imp.spin
+        vn2 = imp.restitution * imp.normal_speed
+        angle = math.atan2(v2[i], vn2) if template.angle_reference == "normal" else math.atan2(vn2, v2[i])
+        cm_cor = v2[i] / imp.tangential_speed if imp.tangential_speed != 0.0 else math.nan
+        for k, v in (("speed", rows["speed"][i]), ("incidence", rows["incidence"][i]),
+                     ("normal_speed", imp.normal_speed), ("tangential_speed", imp.tangential_speed),
+                     ("restitution", imp.restitution), ("contact_time", imp.contact_time), ("rebound_spin", w2[i]),
+                     ("tangential_cor", 0.0 - (v2[i] - r * w2[i]) / slip_in), ("rebound_angle", angle),
+                     ("rebound_speed_t", v2[i]), ("cm_tangential_cor", cm_cor),
+                     ("contact_rebound_angle", math.atan2(v2[i] - r * w2[i], vn2))):
+            out[k][i] = v
+    out["rolled"][:] = rolled
+    out["normal_cor"] = out["restitution"].copy()
+    if template.materials is not None and template.friction is not None:
+        kappa, mu = template.materials.stiffness_ratio, template.friction
+        vc1 = out["tangential_speed"] - r * np.asarray(rows["spin"], dtype=float)
+        out["psi1"] = normalized_angle(vc1, out["normal_speed"], mu, kappa)
+        out["psi2"] = normalized_angle(np.tan(out["contact_rebound_angle"]), 1.0, mu, kappa)
+    return out
+
+
+MDR_NEEDS_COULOMB = ("compliance model 'mindlin-deresiewicz' gives every point of the contact its own Coulomb limit "
+                     "(mu times the local pressure); law '{law}' is not of the Coulomb form F = mu N")
+
+
+def mdr_solvers(law) -> dict[str, str | None]:
+    """``predict.applicable_solvers`` for a template with Mindlin-Deresiewicz compliance: its own fixed-step
+    integrator (frictionlab.physics.mdr) runs under the name 'ode' for laws of the Coulomb form; nothing else applies."""
+    from ..physics.law import NormalAreaRateForm
+
+    form = law.form(law.defaults())
+    if not (isinstance(form, NormalAreaRateForm) and form.c == 0.0):
+        why = MDR_NEEDS_COULOMB.format(law=law.name)
+        return {"exact": why, "series": why, "ode": why}
+    why = "compliance model 'mindlin-deresiewicz' is integrated by frictionlab.physics.mdr (solver 'ode')"
+    return {"exact": why, "series": why, "ode": None}
+
+
+def _mdr_rebounds(law, imps, p, template):
+    """End-of-contact tangential velocity [m/s] and spin [rad/s] of every row with Mindlin-Deresiewicz
+    compliance (frictionlab.physics.mdr, all rows in one vectorized integration), and whether the contact point
+    ended rolling (|v - r omega| below 1e-6 of its inbound value; with compliance it rarely does)."""
+    from ..physics import mdr
+    from ..physics.law import NormalAreaRateForm
+
+    form = law.form(p)
+    if not (isinstance(form, NormalAreaRateForm) and form.c == 0.0 and form.a >= 0.0):
+        raise SceneError(MDR_NEEDS_COULOMB.format(law=law.name))
+    r, m = template.radius, template.mass
+    inertia = template.inertia_factor * m * r * r
+    tc = np.array([imp.contact_time for imp in imps])
+    probe = np.linspace(0.0, 1.0, 201)[None, :] * tc[:, None]
+    amax = np.sqrt(np.array([np.max(imp.scene.area(probe[i])[0]) for i, imp in enumerate(imps)]) / math.pi)
+    meff = inertia / (r * r + inertia / m)  # effective mass of the contact point, m f / (1 + f)
+    try:
+        steps = mdr.steps_for(template.compliance.shear, amax, meff, tc)
+    except ValueError as exc:
+        raise SceneError(f"compliance model 'mindlin-deresiewicz': {exc}") from None
+    t = np.linspace(0.0, 1.0, steps + 1)[None, :] * tc[:, None]
+    N = np.array([imp.scene.normal(t[i]) for i, imp in enumerate(imps)])
+    A = np.array([imp.scene.area(t[i])[0] for i, imp in enumerate(imps)])
+    v0 = np.array([imp.tangential_speed for imp in imps])
+    w0 = np.array([imp.spin for imp in imps])
+    try:
+        v2, w2 = mdr.impacts(t, N, A, form.a, template.compliance.shear, m, r, inertia, v0, w0,
+                             springs=template.compliance.springs)
+    except ValueError as exc:
+        raise SceneError(f"compliance model 'mindlin-deresiewicz': {exc}") from None
+    if not (np.all(np.isfinite(v2)) and np.all(np.isfinite(w2))):
+        raise SceneError("compliance model 'mindlin-deresiewicz': the integration gave a non-finite rebound")
+    rolled = np.abs(v2 - r * w2) <= 1e-6 * np.abs(v0 - r * w0)
+    return v2, w2, rolled
+
+
+#: The last few (template, rows) -> per-row impacts: a fit evaluates the same rows of one scene at every step.
+_INBOUND: dict = {}
+
+
+def _inbound(template: OutcomeScene, rows) -> tuple[Inbound, ...]:
+    """Each row's Inbound (its scene), checked; the same tuple again for the same template object and rows."""
+    key = (id(template),) + tuple(np.asarray(rows[k], dtype=float).tobytes() for k in ("speed", "incidence", "spin"))
+    hit = _INBOUND.get(key)
+    if hit is not None and hit[0] is template:  # the entry holds the template, so its id is not reused meanwhile
+        return hit[1]
+    imps = []
+    for i in range(len(rows["speed"])):
+        try:
+            imps.append(template.impact(float(rows["speed"][i]), float(rows["incidence"][i]), float(rows["spin"][i])))
+        except SceneError as exc:
+            raise SceneError(f"row {i + 1}: {exc}") from None
+        if imps[-1].tangential_speed - template.radius * imps[-1].spin == 0.0:
+            raise SceneError(f"row {i + 1}: the contact point does not slip on arrival (v_t = r omega), "
+                             "so its tangential restitution is undefined")
+    if len(_INBOUND) >= 8:
+        _INBOUND.pop(next(iter(_INBOUND)))
+    _INBOUND[key] = (template, tuple(imps))
+    return _INBOUND[key][1]
+
+
+_BATCHES: dict = {}  # id(impacts) -> (impacts, SceneBatch), beside _INBOUND
+
+
+def _scene_batch(imps: tuple):
+    """The batch engine's SceneBatch of the rows' scenes: built once for the tuple ``_inbound`` returns."""
+    from .batch import SceneBatch
+
+    hit = _BATCHES.get(id(imps))
+    if hit is not None and hit[0] is imps:
+        return hit[1]
+    batch = SceneBatch.from_scenes([imp.scene for imp in imps])  # may refuse: the caller falls back, nothing kept
+    if len(_BATCHES) >= 8:
+        _BATCHES.pop(next(iter(_BATCHES)))
+    _BATCHES[id(imps)] = (imps, batch)
+    return batch
+
+
+def _rebounds(law, imps, p, solver, rtol):
+    """Tangential velocity [m/s] and spin [rad/s] at the end of each impact, and whether its slip stopped.
+
+    The closed forms run on the batch engine (``batch.simulate_batch``, one vectorized call for all
+    rows; tests check it equals the row-by-row solve) when the rows' scenes share one structure;
+    otherwise, for the ODE solver, or when the batch refuses, each row is simulated alone (which
+    also names the row in any error)."""
+    from ..core.errors import FrictionLabError
+    from .solvers import simulate
+
+    if solver == "exact" and len(imps) > 1:
+        from .batch import SceneBatch, simulate_batch
+
+        try:
+            t = np.array([[0.0, imp.contact_time] for imp in imps])
+            br = simulate_batch(law, _scene_batch(imps), p, t=t, solver="exact")
+            return br.v[:, -1], br.omega[:, -1], ~np.isnan(br.stick_time)
+        except FrictionLabError:
+            pass  # the row-by-row path below gives the answer or the error naming the row
+    v2, w2, rolled = (np.empty(len(imps)) for _ in range(3))
+    for i, imp in enumerate(imps):
+        tr = simulate(law, imp.scene, p, solver=solver, t=np.array([0.0, imp.contact_time]), rtol=rtol)
+        v2[i], w2[i], rolled[i] = float(tr.v[-1]), float(tr.omega[-1]), tr.stick_time is not None
+    return v2, w2, rolled.astype(bool)

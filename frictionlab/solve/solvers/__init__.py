@@ -1,0 +1,72 @@
+"""Solvers: ``exact`` (closed forms), ``series`` (the paper's expansion), ``ode`` (solve_ivp).
+
+Every solver returns a ``Trajectory``; ``simulate`` is the one entry point.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ...core.errors import SceneError, SolverError
+from ...physics.registry import get_law
+from ...physics.scene import Scene
+from ..plan import make_plan
+from . import exact, ode, segments, series
+
+SOLVERS = ("exact", "series", "ode")
+
+
+def parse_solver(text: str) -> tuple[str, str | None]:
+    """'exact', 'series', 'ode' or 'ode:METHOD' -> (name, method)."""
+    name, _, method = str(text).partition(":")
+    if name not in SOLVERS:
+        raise SolverError(f"unknown solver {text!r}; choose exact, series, ode or ode:METHOD "
+                          f"(METHOD one of {', '.join(ode.METHODS)})")
+    if name != "ode" and method:
+        raise SolverError(f"solver {name!r} takes no method; only ode:METHOD does")
+    if name == "ode":
+        method = method or "LSODA"
+        if method not in ode.METHODS:
+            raise SolverError(f"unknown ODE method {method!r}; choose one of {', '.join(ode.METHODS)}")
+    return name, method or None
+
+
+def simulate(law, scene, params=None, solver: str = "ode", t=None, rtol: float = 1e-10, atol: float | None = None,
+             n: int = 201):
+    """Simulate ``law`` on a scene (or a dataset's scene) and return a Trajectory.
+
+    law: a registered name or a FrictionLaw; scene: a Scene or a Dataset (its ``[fixed]``
+    parameters apply and its time column is the default ``t``); params: SI values overriding
+    the law's defaults; solver: 'exact', 'series', 'ode' (LSODA) or 'ode:METHOD'; t: sample times [s],
+    default n points over the scene's duration.
+    """
+    law = get_law(law)
+    name = "scene"
+    fixed = {}
+    if not isinstance(scene, Scene) and hasattr(scene, "scene") and hasattr(scene, "fixed"):  # a Dataset
+        name = f"dataset '{scene.name}'"
+        fixed = {k: v for k, v in scene.fixed.items() if k in law.param_names}
+        if scene.kind == "impact-outcome":
+            raise SceneError(f"dataset '{scene.name}' (impact-outcome) holds one impact per row; simulate its rows "
+                             "with frictionlab.solve.outcome.predict_outcomes")
+        if scene.scene is None:
+            raise SceneError(f"dataset '{scene.name}' ({scene.kind}) has no [scene] to simulate; "
+                             "it is a supporting series, not a motion to fit")
+        if t is None:
+            t = scene.t
+        scene = scene.scene
+    if not isinstance(scene, Scene):
+        raise SolverError(f"simulate: expected a Scene or Dataset, got {type(scene).__name__}")
+    p = law.resolve({**fixed, **(params or {})})
+    if t is None:
+        t = np.linspace(0.0, scene.duration, n)
+    t = np.asarray(t, dtype=float)
+    if t.ndim != 1 or t.size == 0 or (np.diff(t) < 0).any() or t[0] < 0 or not np.isfinite(t).all():
+        raise SolverError("simulate: t must be a non-empty, non-decreasing 1-D array of times >= 0")
+    plan = make_plan(scene, law, name)
+    kind, method = parse_solver(solver)
+    if kind == "series":
+        return series.solve(plan, p, t)
+    if kind == "exact":
+        exact.check(plan, p)
+        return segments.run(plan, p, t, exact.make_slide(), "exact")
+    return segments.run(plan, p, t, ode.make_slide(method, rtol, atol), f"ode:{method}")

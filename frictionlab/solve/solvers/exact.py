@@ -1,0 +1,326 @@
+"""Closed-form solutions, for laws whose ``form`` is known and scenes that admit one.
+
+AreaSlipForm, F = k A u:
+  half-sine area, no drive (the paper's impact, eq (6)):  u = u0 exp(-b (1 - cos phi t)),
+      b = kappa k A0 / phi (kappa = 1/m, or 1/m + r^2/I with slip coupling); the integral of u
+      is a Bessel series, int_0^t exp(b cos phi s - b) ds = ive(0,b) t + 2 sum_k ive(k,b) sin(k phi t)/(k phi).
+  constant area, constant drive a (incline):  u = u_inf + (u0 - u_inf) exp(-t/tau),
+      tau = 1/(kappa k A), u_inf = a tau.
+NormalAreaRateForm, F = s (a N + c dA/dt) while slip keeps its sign s:
+  u = u_s + drive (t - t_s) - kappa s [a (IN(t) - IN(t_s)) + c (A(t) - A(t_s))], IN = int N dt,
+  for half-sine or constant (weight) N and half-sine or constant A; slip reaching zero is
+  located by root finding and handed to the stick logic.
+In every case the friction impulse J(t) = int F dt and its integral K(t) give the states:
+  v = v_s + drive dt - J/m,  omega = omega_s + r J / I,  theta = theta_s + omega_s dt + r K / I.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.optimize import brentq
+from scipy.special import ive
+
+from ...core.errors import SolverError
+from ...physics.law import AreaSlipForm, NormalAreaRateForm
+from ...physics.scene import ConstantArea, HalfSineArea, HalfSineNormal, WeightNormal
+
+SCAN = 4096  # grid points scanned for the first zero of slip
+SLIP_MARGIN = 1e-12  # slip, relative to its scale, by which a stop must pass zero (as in ode.zero_slip)
+
+
+def check(plan, p) -> None:
+    """Raise SolverError unless a closed form exists for this law and scene."""
+    _form_and_reason(plan, p)
+
+
+def _form_and_reason(plan, p):
+    law, s = plan.law, plan.scene
+    name = f"law '{law.name}'"
+    if law.states:
+        raise SolverError(f"exact: {name} has internal state ({', '.join(law.state_names)}): closed forms do not "
+                          "apply; use --solver ode")
+    form = law.form(p)
+    if form is None:
+        raise SolverError(f"exact: {name} declares no closed form; use the ode solver")
+    if "xi" in plan.states:
+        raise SolverError("exact: no closed form with tangential compliance; use the ode solver")
+    if isinstance(form, AreaSlipForm):
+        if isinstance(s.area, HalfSineArea) and plan.drive == 0.0:
+            return form
+        if isinstance(s.area, ConstantArea):
+            return form
+        raise SolverError(f"exact: {name} has a closed form only with a half-sine area and no drive, "
+                          f"or a constant area; this scene has {type(s.area).__name__} and drive {plan.drive:g} m/s^2")
+    if isinstance(form, NormalAreaRateForm):
+        if not isinstance(s.normal, (HalfSineNormal, WeightNormal)):
+            raise SolverError(f"exact: {name} needs a half-sine or weight normal force; this scene has "
+                              f"{type(s.normal).__name__}")
+        if form.c != 0.0 and not isinstance(s.area, (HalfSineArea, ConstantArea)):
+            raise SolverError(f"exact: {name} needs a half-sine or constant area; this scene has {type(s.area).__name__}")
+        return form
+    raise SolverError(f"exact: {name} returned an unknown form {form!r}")
+
+
+def make_slide():
+    def slide(plan, p, t0, y0, direction, t_out):
+        form = _form_and_reason(plan, p)
+        t_out = np.asarray(t_out, dtype=float)
+        if isinstance(form, AreaSlipForm):
+            (J, K), t_stop = _area_slip(plan, form.k, t0, y0, t_out), None
+        else:
+            J, K, t_stop = _normal_area_rate(plan, form, t0, y0, direction, t_out)
+        keep = t_out <= t_stop if t_stop is not None else np.ones(t_out.shape, dtype=bool)
+        Y = _states(plan, t0, y0, t_out[keep], J[keep], K[keep])
+        y_stop = None
+        if t_stop is not None:
+            Js, Ks = _normal_area_rate(plan, form, t0, y0, direction, np.array([t_stop]), find_stop=False)[:2]
+            y_stop = _states(plan, t0, y0, np.array([t_stop]), Js, Ks)[:, 0]
+        return Y, t_stop, y_stop, {"nfev": 0}
+
+    return slide
+
+
+def _states(plan, t0, y0, t, J, K, out=None):
+    """States at times t from the friction impulse J and its integral K (terms that vanish skipped: a batch
+    evaluates this on large grids)."""
+    s = plan.scene
+    dt = t - t0
+    if out is None:
+        out = np.empty((len(plan.states),) + np.broadcast_shapes(np.shape(J), np.shape(dt)))
+    for i, name in enumerate(plan.states):
+        if name == "v":
+            np.divide(J, -s.mass, out=out[i])
+            out[i] += y0[i]
+            if np.asarray(plan.drive).any():
+                out[i] += plan.drive * dt
+        elif name == "omega":
+            np.multiply(J, s.radius / s.inertia, out=out[i])
+            out[i] += y0[i]
+        elif name == "theta":
+            np.multiply(K, s.radius / s.inertia, out=out[i])
+            out[i] += y0[i]
+            w0 = y0[plan.index("omega")]
+            if np.asarray(w0).any():
+                out[i] += w0 * dt
+        else:  # pragma: no cover - guarded by check()
+            raise SolverError(f"exact: state '{name}' has no closed form")
+    return out
+
+
+# --- F = k A u ------------------------------------------------------------------------
+B_LAPLACE = 500.0  # above this b the integral of exp(-2 b sin^2) is summed as a Laplace-type series
+
+
+def bessel_integral(b, phi, t) -> np.ndarray:
+    """int_0^t exp(b cos(phi s) - b) ds for 0 <= t <= pi/phi, to machine precision.
+
+    b [-], phi [1/s] and t [s] broadcast against each other (a batch passes (n, 1) columns
+    and an (n, m) grid).
+    b <= 500: the Bessel (Jacobi-Anger) series ive(0,b) t + 2 sum_k ive(k,b) sin(k phi t) / (k phi);
+    the sines come from the recurrence sin((k+1)x) = 2 cos(x) sin(kx) - sin((k-1)x); terms stop
+    once 2 I_k(b) e^-b / k falls below 1e-17 I_0(b) e^-b for every b.
+    b > 500: the series would need ~sqrt(90 b) terms (6e6 at b = 4.5e11) and loses accuracy;
+    instead see ``_laplace_integral``.
+    """
+    b, phi, t = (np.asarray(v, dtype=float) for v in (b, phi, t))
+    big = b > B_LAPLACE
+    if not big.any():
+        return _bessel_series(b, phi, t)
+    if big.all():
+        return _laplace_integral(b, phi, t)
+    return np.where(big, _laplace_integral(np.where(big, b, 2 * B_LAPLACE), phi, t),
+                    _bessel_series(np.where(big, 0.0, b), phi, t))
+
+
+def _bessel_series(b, phi, t):
+    kmax = int(math.ceil(math.sqrt(2.0 * max(float(np.max(b, initial=0.0)), 1.0) * 45.0))) + 20
+    # every weight in one call; the series stops at the first k whose term is negligible for every b
+    k = np.arange(kmax + 1, dtype=float).reshape((-1,) + (1,) * np.ndim(b))
+    w = ive(k, b)
+    small = (2.0 * w[1:] <= 1e-17 * k[1:] * w[0]).reshape(kmax, -1).all(axis=1)
+    last = int(np.argmax(small)) + 1 if small.any() else kmax
+    coef = 2.0 * w[1:] / (k[1:] * phi)
+    x = phi * t
+    out = w[0] * t
+    two_cos = 2.0 * np.cos(x)
+    s_prev, s_k = np.zeros_like(x), np.sin(x)
+    for j in range(last):
+        out = out + coef[j] * s_k
+        if j + 1 < last:
+            s_prev, s_k = s_k, two_cos * s_k - s_prev
+    return out
+
+
+def _laplace_integral(b, phi, t):
+    """The same integral for large b: with x = sin(phi s / 2) it is (2/phi) int_0^X exp(-2 b x^2) / sqrt(1 - x^2) dx.
+
+    The integrand is below exp(-b/2) for x > 1/2, so X is capped there and 1/sqrt(1 - x^2) is
+    expanded, sum_n C(2n,n)/4^n x^(2n); each term is an incomplete gamma function and the terms
+    fall like (1/(4b))^n.
+    """
+    from scipy.special import gamma, gammainc
+
+    X = np.minimum(np.sin(phi * t / 2.0), 0.5)
+    z = 2.0 * b * X * X
+    out = np.zeros(np.broadcast(b, z).shape)
+    c = 1.0
+    for n in range(12):
+        a = n + 0.5
+        out = out + c * 0.5 * (2.0 * b) ** (-a) * gamma(a) * gammainc(a, z)
+        c *= (2 * n + 1) / (2 * n + 2)
+    return (2.0 / phi) * out
+    return out
+
+
+def _area_slip(plan, k, t0, y0, t):
+    s = plan.scene
+    u0 = plan.rigid_slip(y0)
+    kappa = plan.kappa
+    if isinstance(s.area, ConstantArea):
+        rate = kappa * k * s.area.area
+        dt = t - t0
+        x = rate * dt
+        # e1 = (1 - exp(-x)) / rate and e2 = int_0^dt e1, written to stay exact for tiny x
+        with np.errstate(divide="ignore", invalid="ignore"):
+            g1 = np.where(x > 1e-8, -np.expm1(-x) / np.where(x > 0, x, 1.0), 1.0 - x / 2.0 + x * x / 6.0)
+            g2 = np.where(x > 1e-5, (x + np.expm1(-x)) / np.where(x > 0, x * x, 1.0), 0.5 - x / 6.0 + x * x / 24.0)
+        a = plan.drive
+        u = u0 * np.exp(-x) + a * dt * g1
+        int_u = u0 * dt * g1 + a * dt * dt * g2
+        J = (a * dt - (u - u0)) / kappa
+        K = (a * dt * dt / 2.0 - (int_u - u0 * dt)) / kappa
+        return J, K
+    if t0 != 0.0:
+        raise SolverError("exact: the half-sine closed form starts at first contact only")
+    tc = s.area.contact_time
+    phi = math.pi / tc
+    b = kappa * k * s.area.peak / phi
+    tau = np.minimum(t, tc)
+    u = u0 * np.exp(-2.0 * b * np.sin(phi * tau / 2.0) ** 2)
+    int_u = u0 * bessel_integral(b, phi, tau)
+    u_end = u0 * np.exp(-2.0 * b)
+    int_u = int_u + u_end * np.maximum(t - tc, 0.0)
+    J = (u0 - u) / kappa
+    K = (u0 * t - int_u) / kappa
+    return J, K
+
+
+# --- F = s (a N + c dA/dt) --------------------------------------------------------------
+def _normal_integrals(normal, t, a=1.0):
+    """a IN and a IIN: IN = int_0^t N, IIN = int_0^t IN, for half-sine or constant N (a: a factor per
+    scene, folded into the coefficients; the term of times after contact skipped when there are none)."""
+    t = np.asarray(t, dtype=float)
+    if isinstance(normal, WeightNormal):
+        return a * normal.value * t, a * normal.value * t * t / 2.0
+    tc = normal.contact_time
+    phi = math.pi / tc
+    c = a * normal.peak / phi
+    after = bool(((t.max(axis=-1, keepdims=True) if t.ndim else t) > tc).any())  # each row's latest time
+    tau = np.minimum(t, tc) if after else t
+    x = phi * tau
+    if x.ndim == 0 or np.broadcast_shapes(x.shape, np.shape(c)) != x.shape:  # small inputs: plainly
+        IN, IIN = c * (1.0 - np.cos(x)), c * (tau - np.sin(x) / phi)
+    else:  # large grids: in place, no temporaries
+        IN = np.cos(x)
+        np.subtract(1.0, IN, out=IN)
+        IN *= c
+        IIN = np.sin(x, out=x)
+        IIN /= -phi
+        IIN += tau
+        IIN *= c
+    if after:
+        IIN = IIN + (2.0 * c) * np.maximum(t - tc, 0.0)
+    return IN, IIN
+
+
+def _area_integrals(area, t):
+    """A(t) and int_0^t A, for half-sine or constant A (zeros without an area model)."""
+    if area is None:
+        return np.zeros_like(t), np.zeros_like(t)
+    if isinstance(area, ConstantArea):
+        return np.full_like(t, area.area), area.area * t
+    tc = area.contact_time
+    phi = math.pi / tc
+    tau = np.minimum(t, tc)
+    A = np.where(t <= tc, area.peak * np.sin(phi * tau), 0.0)
+    return A, area.peak / phi * (1.0 - np.cos(phi * tau))
+
+
+def closed_stop_applies(plan, form, t0) -> bool:
+    """Whether ``half_sine_stop`` gives the stop: F = s a N (a >= 0, no area term), N a half-sine
+    pulse, no drive, from first contact (Coulomb on an impact)."""
+    return bool((np.asarray(t0) == 0.0).all() and (np.asarray(form.c) == 0.0).all() and (np.asarray(form.a) >= 0.0).all()
+                and isinstance(plan.scene.normal, HalfSineNormal) and (np.asarray(plan.drive) == 0.0).all())
+
+
+def half_sine_stop(plan, form, u_s):
+    """Time [s] at which slip u_s reaches zero under F = s a N, N = Np sin(phi t) (see
+    ``closed_stop_applies``): kappa a IN(t) = |u_s| with IN = (2 Np / phi) sin^2(phi t / 2), so
+    t = (2 / phi) arcsin(sqrt(q / 2)), q = |u_s| phi / (kappa a Np) (the half-angle form keeps early
+    stops accurate); inf where q > 2 (the pulse ends first). Arrays broadcast (a batch)."""
+    n = plan.scene.normal
+    phi = np.pi / np.asarray(n.contact_time, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        q = np.abs(u_s) * phi / (plan.kappa * form.a * n.peak)
+        return np.where(q <= 2.0, 2.0 / phi * np.arcsin(np.sqrt(np.minimum(q, 2.0) / 2.0)), np.inf)
+
+
+def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
+    """Friction impulse J and its integral K from t0 at times t (and, with find_stop, the stop).
+
+    t0 and direction are floats, or (with find_stop=False) per-scene columns (k, 1) of a batch
+    broadcasting against t (k, q): a batch restarts its scenes' sliding phases at their own times."""
+    s = plan.scene
+    sgn = np.where(np.asarray(direction) != 0, direction, 1.0)
+    area = s.area if (np.asarray(form.c) != 0.0).any() else None
+    t0_ = np.atleast_1d(np.asarray(t0, dtype=float))  # (1,) for a float: broadcasts against t as before
+
+    def JK(tt):
+        # terms that vanish (no area term; start at first contact) are skipped: a batch of many
+        # scenes evaluates this on large grids
+        J, K = _normal_integrals(s.normal, tt, form.a)
+        if (t0_ != 0.0).any():
+            IN0, IIN0 = _normal_integrals(s.normal, t0_, form.a)
+            J, K = J - IN0, K - (IIN0 + IN0 * (tt - t0))
+        if area is not None:
+            A, IA = _area_integrals(area, tt)
+            A0, IA0 = _area_integrals(area, t0_)
+            J, K = J + form.c * (A - A0), K + form.c * (IA - IA0 - A0 * (tt - t0))
+        return (J, K) if (sgn == 1.0).all() else (sgn * J, sgn * K)
+
+    J, K = JK(t)
+    if not find_stop or t.size == 0:
+        return J, K, None
+    u_s = float(plan.rigid_slip(y0))
+
+    def slip(tt):
+        return u_s + plan.drive * (tt - t0) - plan.kappa * JK(np.atleast_1d(tt))[0]
+
+    T = float(t[-1])
+    # slip must pass zero by a hair (as in the ode solver's event): at a restart from rest,
+    # round-off in the slip an ulp after t0 is not a new stop
+    s = plan.scene
+    margin = SLIP_MARGIN * max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * (s.radius or 0.0), 1e-300)
+    if closed_stop_applies(plan, form, t0):  # slip falls monotonically: a stop iff it has passed zero at T
+        if sgn * slip(T)[0] + margin > 0.0:
+            return J, K, None
+        return J, K, float(min(half_sine_stop(plan, form, u_s), T))
+    grid = np.unique(np.concatenate([np.linspace(t0, T, SCAN), t]))
+    g = sgn * slip(grid) + margin
+    bad = np.nonzero(g[1:] <= 0.0)[0]
+    if bad.size == 0:
+        return J, K, None
+    i = int(bad[0]) + 1
+    xtol, rtol = 1e-15 * max(T, 1e-300), 4 * np.finfo(float).eps
+    t_margin = float(grid[i]) if g[i] == 0.0 else brentq(lambda x: sgn * slip(x)[0] + margin, grid[i - 1], grid[i],
+                                                         xtol=xtol, rtol=rtol)
+    # the margin only detects the stop; the stop itself is where slip is zero, found from the
+    # last time slip was strictly of the phase's sign (the closed form is exact, keep it so)
+    ahead = np.nonzero(sgn * slip(grid[:i]) > 0.0)[0]
+    if ahead.size == 0:
+        return J, K, t_margin
+    lo = float(grid[int(ahead[-1])])
+    if sgn * slip(t_margin)[0] >= 0.0:
+        return J, K, t_margin
+    return J, K, float(brentq(lambda x: sgn * slip(x)[0], lo, t_margin, xtol=xtol, rtol=rtol))

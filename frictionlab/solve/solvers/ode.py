@@ -1,0 +1,192 @@
+"""Numerical integration with scipy's ODE solvers, on a scaled problem, with zero slip as an event.
+
+Time is scaled by the simulated span and each state by its typical size, so that one pair of
+tolerances means the same thing for a 1 ns and a 1 s contact, for 1e-12 and 1 m^2 areas.
+``solve`` is scipy's ``solve_ivp`` loop for the one case used here (sorted output times, at most
+one terminal event on a scalar function): the same solver steps, dense output and event root, so
+the same numbers (a test checks them against solve_ivp), without its per-step generality.
+"""
+from __future__ import annotations
+
+import bisect
+import numbers
+
+import numpy as np
+import scipy.integrate
+from scipy.optimize import brentq
+
+from ...core.errors import FrictionLabError, SolverError
+
+METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+
+#: Right-hand-side evaluations one sliding phase may take before it is stopped with an error (a
+#: problem too stiff for the method; Radau at rtol 1e-12 on the bench's LuGre impact takes 26,000).
+MAX_NFEV = 50_000
+
+#: Slip, relative to its scale, by which the zero-slip event waits past zero (see zero_slip).
+SLIP_MARGIN = 1e-12
+
+
+def solve(f, s0: float, s1: float, z0, method: str, s_eval, rtol: float, atol: float, event=None,
+          event_direction: float = 0.0, label: str = "integration failed"):
+    """Integrate z' = f(s, z) from s0 to s1 with scipy's ``method`` and return
+    (Z at the times s_eval reached (n_states, k), s_event or None, z_event or None, the solver).
+
+    s_eval: increasing times within [s0, s1]. event(s, z) -> float: a terminal event where it crosses
+    zero in ``event_direction`` (as in solve_ivp: < 0 falling, > 0 rising, 0 either way), located by
+    brentq on the step's dense output to 4 eps, exactly as solve_ivp does. A failed step raises
+    SolverError('{label}: {scipy's message}').
+    """
+    eps = np.finfo(float).eps
+    solver = getattr(scipy.integrate, method)(f, s0, np.asarray(z0, dtype=float), s1, rtol=rtol, atol=atol)
+    s_eval = np.asarray(s_eval, dtype=float)
+    eval_list = s_eval.tolist()  # bisect on floats: np.searchsorted's index, without its per-step dispatch
+    outs, i = [], 0
+    g = event(s0, solver.y) if event is not None else None
+    s_event = z_event = None
+    while True:
+        message = solver.step()
+        if solver.status == "failed":
+            raise SolverError(f"{label}: {message}")
+        s, z, sol = solver.t, solver.y, None
+        if event is not None:
+            g_new = event(s, z)
+            up, down = g <= 0 <= g_new, g >= 0 >= g_new
+            if (up and event_direction > 0) or (down and event_direction < 0) or ((up or down) and event_direction == 0):
+                sol = solver.dense_output()
+                s = s_event = brentq(lambda x: event(x, sol(x)), solver.t_old, s, xtol=4 * eps, rtol=4 * eps)
+                z = z_event = sol(s)
+            g = g_new
+        j = bisect.bisect_right(eval_list, s)
+        if j > i:
+            outs.append((sol or solver.dense_output())(s_eval[i:j]))
+            i = j
+        if s_event is not None or solver.status == "finished":
+            break
+    Z = np.hstack(outs) if outs else np.empty((len(z0), 0))
+    return Z, s_event, z_event, solver
+
+
+def state_scales(plan, T: float) -> np.ndarray:
+    """Typical size of each state; shape (n_states,), or (n_states, n) for a batch view with array fields."""
+    s = plan.scene
+    r = 1.0 if s.radius is None else s.radius
+    V = np.maximum(np.maximum(np.abs(s.u0), np.abs(plan.drive) * T), np.abs(s.omega0) * (0.0 if s.radius is None else r))
+    V = np.where(V > 1e-300, V, 1.0)
+    size = {"v": V, "omega": V / r, "theta": V * T / r, "x": V * T, "xi": V * T, **law_state_scales(plan)}
+    return np.array(np.broadcast_arrays(*[size[k] for k in plan.states]), dtype=float)
+
+
+def law_state_scales(plan) -> dict[str, float]:
+    """The declared scale of each internal state of the plan's law, by plan name ("law:z")."""
+    return {k: spec.scale for k, spec in zip(plan.law_states, plan.law.states)}
+
+
+def phase_scales(plan, p, t0: float, T: float, y0, direction: float) -> np.ndarray:
+    """Typical size of each state over a sliding phase [t0, T], so that tolerances act relative to it.
+
+    Velocities scale with the largest of the initial slip and body speed, and the speed the
+    drive can reach: |drive| (T - t0), or less where the law's force at that speed exceeds
+    the drive (a lubricated block levels off at u_inf << g T). Spin and angle scale with the
+    friction impulse the law can deliver, J ~ min(F (T - t0), (V + |drive| T) / kappa), F the
+    law's largest force at slip V over the span: with a weak law (b = 1e-6) spin is tiny, and
+    scaling it by V / r would leave it to the absolute tolerance alone.
+    """
+    s = plan.scene
+    r = s.radius or 1.0
+    span = max(T - t0, T * 1e-12, 1e-300)
+    tt = np.linspace(t0, T, 33)
+    yy = np.repeat(np.asarray(y0, dtype=float)[:, None], tt.size, axis=1)
+
+    def largest_force(u):
+        F, _ = plan.force(p, tt, yy, np.full(tt.size, u))
+        return float(np.max(np.abs(F)))
+
+    V = max(abs(s.u0), abs(float(y0[0])), abs(float(plan.rigid_slip(y0))), abs(s.omega0) * r)
+    if plan.drive != 0.0:
+        reach = abs(plan.drive) * span
+        F = largest_force(np.sign(plan.drive) * reach)
+        V = max(V, reach * min(1.0, s.mass * abs(plan.drive) / F) if F > 0 else reach)
+    V = V if V > 0 and np.isfinite(V) else 1.0
+    if s.spring is not None:  # the load point sets the speeds
+        V = max(V, max(s.spring.velocities))
+    size = {"v": V, "x": V * span, "xi": V * span, **law_state_scales(plan)}
+    if plan.has_spin:
+        J = min(largest_force((direction or 1.0) * V) * span, (V + abs(plan.drive) * span) / plan.kappa)
+        w = max(r * J / s.inertia, abs(s.omega0), 1e-12 * V / r)
+        size["omega"] = w
+        size["theta"] = max(w * span, abs(float(y0[plan.index("theta")])), 1e-300)
+    return np.array([size[k] for k in plan.states])
+
+
+def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = None):
+    """A sliding-phase function for ``segments.run`` using solve_ivp ``method``."""
+    if method not in METHODS:
+        raise SolverError(f"unknown ODE method {method!r}; choose one of {', '.join(METHODS)}")
+    if isinstance(rtol, bool) or not isinstance(rtol, numbers.Real) or not (0 < rtol < 1):
+        raise SolverError(f"rtol must be a number in (0, 1), got {rtol!r}")
+    atol = rtol if atol is None else atol
+    if isinstance(atol, bool) or not isinstance(atol, numbers.Real) or not (0 < atol < float("inf")):
+        raise SolverError(f"atol must be a positive number, got {atol!r}")
+
+    def slide(plan, p, t0, y0, direction, t_out):
+        if len(t_out) == 0 or t_out[-1] <= t0:
+            return np.repeat(np.asarray(y0, dtype=float)[:, None], len(t_out), axis=1), None, None, {"nfev": 0}
+        T = float(t_out[-1])
+        scale = phase_scales(plan, p, t0, T, y0, direction)
+        tscale = T
+        compliant = "xi" in plan.states
+
+        calls = [0]
+        rates = plan.bound(p, direction)
+
+        def f(s, z):
+            calls[0] += 1
+            if calls[0] > MAX_NFEV:
+                raise SolverError(f"ode:{method}: law '{plan.law.name}' needed more than {MAX_NFEV} right-hand-side "
+                                  f"evaluations (stopped at t = {s * tscale:.6g} s): too stiff for {method} here")
+            return rates(s * tscale, z * scale) * tscale / scale
+
+        event = None
+        if not compliant and direction != 0:
+            r, iw = (plan.scene.radius, plan.index("omega")) if plan.coupled else (0.0, 0)
+            sv, sw = float(scale[0]), float(scale[iw])
+
+            def zero_slip(s, z):
+                # slip / its scale (plan.rigid_slip on the scaled state), fired once slip has passed zero by a
+                # hair (SLIP_MARGIN of its scale), so that round-off at a restart from rest is not a new stop
+                return (z[0] * sv - r * (z[iw] * sw)) / sv + direction * SLIP_MARGIN
+
+            event = zero_slip
+        s_eval = np.clip(np.asarray(t_out, dtype=float) / tscale, t0 / tscale, T / tscale)
+        s_eval, back = np.unique(s_eval, return_inverse=True)  # repeated times (e.g. a resample) solved once
+        failed = f"ode:{method}: integration failed for law '{plan.law.name}'"
+        # where the right-hand side jumps (a load-point velocity step) the integration restarts
+        cuts = [b / tscale for b in plan.breaks if t0 < b < T] if event is None else []
+        edges = [t0 / tscale] + cuts + [T / tscale]
+        z0, parts, stats = np.asarray(y0, dtype=float) / scale, [], {"nfev": 0, "njev": 0, "nlu": 0}
+        try:
+            for k, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
+                last = k == len(edges) - 2
+                inside = s_eval[(s_eval >= a) & ((s_eval <= b) if last else (s_eval < b))]
+                Z, s_stop, z_stop, solver = solve(f, a, b, z0, method, inside, rtol, atol, event, -direction, failed)
+                parts.append(Z)
+                for key in stats:
+                    stats[key] += int(getattr(solver, key))
+                z0 = solver.y
+        except FrictionLabError:
+            raise
+        except Exception as exc:  # a law raising inside the integrator
+            raise SolverError(f"{failed}: {exc}") from exc
+        Z = np.hstack(parts)
+        Y = Z[:, back[back < Z.shape[1]]] * scale[:, None]  # a stop ends the samples reached
+        t_stop = y_stop = None
+        if s_stop is not None:
+            t_stop = float(s_stop) * tscale
+            y_stop = z_stop * scale
+        info = {**stats, "method": method, "rtol": rtol, "atol": atol}
+        return Y, t_stop, y_stop, info
+
+    return slide
+
+
