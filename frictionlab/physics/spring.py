@@ -1,0 +1,71 @@
+"""The spring-slider's drive: a spring pulled at a load-point velocity that steps, from ``[scene.spring]``."""
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import attrs
+import numpy as np
+
+from ..core.errors import SceneError
+from ..core.units import to_si
+from .sceneread import known_keys, positive
+
+@attrs.frozen(eq=False)
+class SpringLoad:
+    """A spring of stiffness k per unit normal force [1/m] pulled at a load-point velocity that steps.
+
+    The load point moves at velocities[i] [m/s] from times[i] [s] on (times[0] = 0); a velocity of 0
+    is a hold. The spring force per unit normal force, mu = K (x_lp - x) / N, obeys
+    d mu/dt = k (V_lp - v): k = K / N is the stiffness per unit normal stress of the
+    rate-and-state literature (k_c = (b - a) / Dc). The block is quasi-static (see plan.py).
+    """
+
+    stiffness: float = attrs.field(validator=positive)
+    times: tuple = attrs.field(converter=lambda x: tuple(float(v) for v in x))
+    velocities: tuple = attrs.field(converter=lambda x: tuple(float(v) for v in x))
+
+    def __attrs_post_init__(self):
+        t, v = np.asarray(self.times), np.asarray(self.velocities)
+        if t.size == 0 or t.size != v.size:
+            raise SceneError(f"SpringLoad: times and velocities must be non-empty lists of one length, got {t.size} "
+                             f"and {v.size}")
+        if t[0] != 0.0 or np.any(np.diff(t) <= 0) or not np.all(np.isfinite(t)):
+            raise SceneError(f"SpringLoad: times must start at 0 s and increase strictly, got {list(self.times)}")
+        if not np.all(np.isfinite(v)) or np.any(v < 0):
+            raise SceneError(f"SpringLoad: velocities must be finite and >= 0, got {list(self.velocities)}")
+
+    def velocity(self, t):
+        """Load-point velocity V_lp(t) [m/s]."""
+        i = np.searchsorted(np.asarray(self.times), np.asarray(t, dtype=float), side="right") - 1
+        return np.asarray(self.velocities)[np.clip(i, 0, len(self.times) - 1)]
+
+    @property
+    def breaks(self) -> tuple[float, ...]:
+        """Times [s] at which the load-point velocity steps (where an integrator should restart)."""
+        return self.times[1:]
+
+
+
+def spring_from_spec(spec, where, q, kind):
+    """[scene.spring]: stiffness [1/m per unit normal force], times and velocities of the load point."""
+    if "spring" not in spec:
+        if kind == "spring-slider":
+            raise SceneError(f"{where}: a spring-slider needs a [scene.spring] table with 'stiffness', 'times' "
+                             "and 'velocities'")
+        return None
+    if kind != "spring-slider":
+        raise SceneError(f"{where}: [scene.spring] belongs to kind 'spring-slider', not {kind!r}")
+    sp = spec["spring"]
+    if not isinstance(sp, Mapping):
+        raise SceneError(f"{where}: scene.spring must be a table, got {type(sp).__name__}")
+    known_keys(sp, {"stiffness", "times", "velocities"}, where, "[scene.spring]")
+    lists = {}
+    for key, unit in (("times", "s"), ("velocities", "m/s")):
+        v = sp.get(key)
+        if not isinstance(v, list) or not v:
+            raise SceneError(f"{where}: scene.spring.{key} must be a non-empty list of quantities in {unit}")
+        lists[key] = [to_si(x, unit, f"{where}: scene.spring.{key}[{i}]") for i, x in enumerate(v)]
+    try:
+        return SpringLoad(q("stiffness", "1/m", sp, "scene.spring"), lists["times"], lists["velocities"])
+    except SceneError as exc:
+        raise SceneError(f"{where}: scene.spring: {exc}") from None
