@@ -9,7 +9,6 @@ with a one-line ``DatasetError`` naming the file and the field.
 """
 from __future__ import annotations
 
-import io
 import math
 from importlib import resources
 from pathlib import Path
@@ -18,9 +17,10 @@ import attrs
 import numpy as np
 
 from ..core.errors import DatasetError, FrictionLabError
-from ..core.files import MAX_CSV_BYTES, check_name, read_bytes, read_text, read_toml
+from ..core.files import check_name, read_toml
 from ..core.units import MAX_SI, check_text, check_time_scale, unit_factor
 from ..physics.scene import KINDS, Scene
+from .csvread import _line_of_row, read_csv
 from ..solve.outcome import OUTCOMES, OutcomeScene
 
 PROVENANCE_KINDS = ("measured", "reported", "reconstructed", "synthetic")
@@ -139,6 +139,24 @@ def _table(meta, key, path, where=None):
 
 def from_meta(meta: dict, path: Path) -> Dataset:
     """Build a Dataset from a parsed TOML dict whose CSV sits beside ``path``."""
+    name, group, kind, observable, units = _header(meta, path)
+    csv = path.with_suffix(".csv")
+    raw = read_csv(csv)
+    columns = _columns(raw, units, path, csv)
+    _check_series(columns, raw, kind, csv)
+    noise, noise_kind = _noise(meta, path, observable, columns)
+    provenance = _provenance(meta.get("provenance"), path)
+    scene = _scene(meta, path, kind, observable, columns, units, csv)
+    fixed, fixed_units = _fixed(_table(meta, "fixed", path, "[fixed]"), path)
+    reported = _rest(meta, path, provenance)
+    return Dataset(name=name, kind=kind, observable=observable, path=path, columns=columns, units=dict(units),
+                   noise=noise, scene=scene, fixed=fixed, provenance=provenance,
+                   description=meta.get("description", ""), reported=reported,
+                   fixed_units=fixed_units, noise_kind=noise_kind, group=group)
+
+
+def _header(meta, path):
+    """name, group, kind, observable and the [columns] units, checked against one another."""
     name = check_name(_req(meta, "name", path), f"{path}: name")
     group = meta.get("group", "")
     if "group" in meta:
@@ -162,9 +180,11 @@ def from_meta(meta: dict, path: Path) -> Dataset:
         raise DatasetError(f"{path}: [columns] must declare the time column 't'")
     if observable not in units:
         raise DatasetError(f"{path}: observable {observable!r} is not declared in [columns] ({', '.join(units)})")
+    return name, group, kind, observable, units
 
-    csv = path.with_suffix(".csv")
-    raw = read_csv(csv)
+
+def _columns(raw, units, path, csv) -> dict:
+    """The declared columns of the CSV in SI units, each a known quantity of sane magnitude."""
     columns = {}
     for col, unit in units.items():
         if col not in raw:
@@ -181,6 +201,11 @@ def from_meta(meta: dict, path: Path) -> Dataset:
             i = int(bad[0])
             raise DatasetError(f"{csv}: column {col!r} line {_line_of_row(csv, i)}: {raw[col][i]:g} {unit} is beyond "
                                f"the accepted magnitude {MAX_SI:g} in SI units")
+    return columns
+
+
+def _check_series(columns, raw, kind, csv) -> None:
+    """Time increases strictly and starts at t >= 0; areas and normal forces are not negative."""
     if "t" in columns:
         t = columns["t"]
         bad = np.nonzero(np.diff(t) <= 0)[0]
@@ -195,6 +220,9 @@ def from_meta(meta: dict, path: Path) -> Dataset:
         if col in columns and np.any(columns[col] < 0):
             raise DatasetError(f"{csv}: column '{col}' has negative values")
 
+
+def _noise(meta, path, observable, columns):
+    """The [noise] table: sigma [SI] by column and the noise kind."""
     noise_spec = _table(meta, "noise", path, "[noise]")
     if observable not in noise_spec:
         raise DatasetError(f"{path}: [noise] must give the noise of the observable, e.g. {observable} = '100 rpm'")
@@ -210,30 +238,37 @@ def from_meta(meta: dict, path: Path) -> Dataset:
         noise[col] = _quantity(value, COLUMN_SI[col], f"{path}: noise.{col}")
         if not noise[col] > 0:
             raise DatasetError(f"{path}: noise.{col} must be positive, got {value!r}")
+    return noise, noise_kind
 
-    provenance = _provenance(meta.get("provenance"), path)
-    scene = None
-    if kind != "contact-area":
-        spec = meta.get("scene")
-        if not isinstance(spec, dict):
-            raise DatasetError(f"{path}: missing required table [scene]")
-        try:
-            if kind == "impact-outcome":
-                scene = OutcomeScene.from_spec(spec, str(path))
-            else:
-                scene = Scene.from_spec(spec, kind, str(path), columns, columns.get("t"))
-        except FrictionLabError as exc:  # a model's own check (no file in it) still names the file
-            raise DatasetError(str(exc) if str(exc).startswith(str(path)) else f"{path}: [scene]: {exc}") from None
+
+def _scene(meta, path, kind, observable, columns, units, csv):
+    """The [scene] table as a Scene (or OutcomeScene); None for a contact-area series."""
+    if kind == "contact-area":
+        return None
+    spec = meta.get("scene")
+    if not isinstance(spec, dict):
+        raise DatasetError(f"{path}: missing required table [scene]")
+    try:
         if kind == "impact-outcome":
-            _check_outcome_rows(columns, observable, path, csv, scene)
+            scene = OutcomeScene.from_spec(spec, str(path))
         else:
-            _check_observable(scene, observable, path)
-            _check_time_unit(columns, units, spec, kind, scene, path)
+            scene = Scene.from_spec(spec, kind, str(path), columns, columns.get("t"))
+    except FrictionLabError as exc:  # a model's own check (no file in it) still names the file
+        raise DatasetError(str(exc) if str(exc).startswith(str(path)) else f"{path}: [scene]: {exc}") from None
+    if kind == "impact-outcome":
+        _check_outcome_rows(columns, observable, path, csv, scene)
+    else:
+        _check_observable(scene, observable, path)
+        _check_time_unit(columns, units, spec, kind, scene, path)
+    return scene
+
+
+def _fixed(table, path):
+    """[fixed] law parameters in SI, each a parameter of some registered law and within its bounds."""
+    from ..physics.registry import available_laws
 
     fixed, fixed_units = {}, {}
-    for key, value in _table(meta, "fixed", path, "[fixed]").items():
-        from ..physics.registry import available_laws
-
+    for key, value in table.items():
         specs = [(law.name, s) for law in available_laws().values() for s in law.params if s.name == key]
         if not specs:
             raise DatasetError(f"{path}: fixed.{key} is not a parameter of any registered law")
@@ -244,7 +279,11 @@ def from_meta(meta: dict, path: Path) -> Dataset:
             if spec.unit == unit and not spec.lower <= fixed[key] <= spec.upper:
                 raise DatasetError(f"{path}: fixed.{key} = {value!r} is outside the bounds of law '{law_name}' "
                                    f"[{spec.lower:g}, {spec.upper:g}] {spec.unit}".rstrip())
+    return fixed, fixed_units
 
+
+def _rest(meta, path, provenance) -> dict:
+    """No unknown top-level key; [reported] and provenance.truth readable later; returns [reported]."""
     extra = set(meta) - {"name", "group", "kind", "observable", "columns", "noise", "scene", "fixed", "provenance",
                          "reported", "description"}
     if extra:
@@ -259,10 +298,7 @@ def from_meta(meta: dict, path: Path) -> Dataset:
                     raise DatasetError(str(exc)) from None
     if not isinstance(meta.get("description", ""), str):
         raise DatasetError(f"{path}: 'description' must be a string")
-    return Dataset(name=name, kind=kind, observable=observable, path=path, columns=columns, units=dict(units),
-                   noise=noise, scene=scene, fixed=fixed, provenance=provenance,
-                   description=meta.get("description", ""), reported=reported,
-                   fixed_units=fixed_units, noise_kind=noise_kind, group=group)
+    return reported
 
 
 def _check_time_unit(columns, units, spec, kind, scene, path) -> None:
@@ -348,83 +384,3 @@ def _provenance(p, path) -> Provenance:
         raise DatasetError(f"{path}: provenance.truth must be a table")
     return Provenance(kind=kind, source=p["source"], method=p.get("method", ""), command=p.get("command", ""),
                       seed=p.get("seed"), truth=p.get("truth", {}))
-
-
-def read_csv(csv: Path) -> dict[str, np.ndarray]:
-    """Read a numeric CSV with a header row into float arrays; one-line errors on bad content.
-    The CSV must lie in its folder once links are resolved (see io.read_bytes)."""
-    import warnings
-
-    import pandas as pd
-
-    try:
-        text = read_bytes(csv, MAX_CSV_BYTES, within=Path(csv).parent).decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise DatasetError(f"{csv}: CSV does not parse: not UTF-8 text (byte {exc.start + 1})") from None
-    try:
-        with warnings.catch_warnings():
-            # more fields in every row than in the header: pandas would shift the columns silently
-            warnings.simplefilter("error", pd.errors.ParserWarning)
-            df = pd.read_csv(io.StringIO(text), comment="#", skipinitialspace=True, index_col=False, dtype=str,
-                             keep_default_na=False)
-    except pd.errors.EmptyDataError:
-        raise DatasetError(f"{csv}: file is empty") from None
-    except pd.errors.ParserWarning:
-        raise DatasetError(f"{csv}: CSV does not parse: data rows have more fields than the header") from None
-    except (pd.errors.ParserError, UnicodeError, ValueError, OSError) as exc:
-        first = (str(exc).splitlines() or [type(exc).__name__])[0]
-        raise DatasetError(f"{csv}: CSV does not parse: {first}") from None
-    names = [str(c).strip() for c in df.columns]
-    header = _header_names(text)
-    for i, name in enumerate(header if header is not None else names):
-        if not name:
-            raise DatasetError(f"{csv}: header column {i + 1} has no name (a stray comma?)")
-        if any(sep in name for sep in (";", "\t")):
-            raise DatasetError(f"{csv}: header {name!r} looks ;- or tab-separated; write comma-separated values")
-    if header is not None:
-        dup = sorted({n for n in header if header.count(n) > 1})
-        if dup:
-            raise DatasetError(f"{csv}: column {dup[0]!r} appears more than once in the header")
-    if len(df) == 0:
-        raise DatasetError(f"{csv}: no data rows")
-    out = {}
-    for col, name in zip(df.columns, names):
-        text = df[col]
-        values = np.array([_number(x) for x in text], dtype=float)
-        bad = np.nonzero(~np.isfinite(values))[0]
-        if bad.size:
-            i = int(bad[0])
-            raise DatasetError(f"{csv}: column {name!r} line {_line_of_row(csv, i)}: {text.iloc[i]!r} "
-                               "is not a finite number")
-        out[name] = values
-    return out
-
-
-def _number(text) -> float:
-    """A CSV cell as a float (correctly rounded, like Python's float), NaN if it is not a number."""
-    try:
-        return float(text)
-    except (TypeError, ValueError):
-        return math.nan
-
-
-def _header_names(text: str) -> list[str] | None:
-    """Column names as written in the header line (pandas renames duplicates), or None if unreadable."""
-    import csv as csvmod
-
-    try:
-        lines = text.splitlines(keepends=True)
-        rows = (r for r in csvmod.reader(line for line in lines if line.strip() and not line.lstrip().startswith("#")))
-        return [c.strip() for c in next(rows)]
-    except (csvmod.Error, StopIteration):
-        return None
-
-
-def _line_of_row(csv: Path, row: int) -> int:
-    """1-based line number in the file of data row ``row`` (0-based, after header and comments)."""
-    try:
-        lines = read_text(csv, MAX_CSV_BYTES).splitlines()
-    except DatasetError:
-        return 0
-    data = [i for i, line in enumerate(lines) if line.strip() and not line.lstrip().startswith("#")]
-    return data[row + 1] + 1 if row + 1 < len(data) else len(lines)
