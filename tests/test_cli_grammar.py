@@ -65,7 +65,7 @@ def test_every_command_has_its_own_help_with_examples(argv, capsys):
     assert "Lists: repeat an option or separate values with commas" in out
 
 
-@pytest.mark.parametrize("kind", ["impact", "incline", "impact-outcome"])
+@pytest.mark.parametrize("kind", ["impact", "incline", "impact-outcome", "spring-slider"])
 def test_datasets_template_writes_a_pair_that_loads(kind, tmp_path, capsys):
     assert main(["datasets", "template", kind, "--name", "mine", "--out", str(tmp_path)]) == 0
     d = load_dataset(tmp_path / "mine.toml")

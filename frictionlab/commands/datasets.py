@@ -33,10 +33,13 @@ def add_parser(sub):
     show.add_argument("name", metavar="NAME_OR_TOML", help="built-in dataset name or TOML path")
     show.set_defaults(func=_show)
     tpl = subcommand(acts, "template", help="write a commented TOML + CSV pair to start a dataset from",
-                     description="Write NAME.toml and NAME.csv for a dataset of KIND: every field commented, "
-                                 "example rows computed from a law (labelled synthetic) to be replaced with your "
-                                 "data. The pair loads as it is: 'frictionlab datasets show NAME.toml'.",
+                     description="Write NAME.toml and NAME.csv for a dataset of KIND: every field and every "
+                                 "observable commented, the [noise] kinds (known, estimated, none), materials and "
+                                 "compliance examples where they apply, and example rows computed from a law "
+                                 "(labelled synthetic) to be replaced with your data. The pair loads as it is: "
+                                 "'frictionlab datasets show NAME.toml'.",
                      examples="""  frictionlab datasets template impact
+  frictionlab datasets template spring-slider --name velstep --out data/
   frictionlab datasets template incline --name slide --out data/""")
     tpl.add_argument("kind", choices=KINDS, metavar="KIND", help=f"one of {', '.join(KINDS)}")
     tpl.add_argument("--name", default="my-data", help="dataset and file name (default: my-data)")
@@ -100,8 +103,12 @@ def _show(args) -> int:
     if d.description:
         print(f"  description: {d.description}")
     print("  columns:     " + ", ".join(f"{c} [{u or '-'}]" for c, u in d.units.items()))
-    print("  noise:       " + ", ".join(f"{c} ± {quantity_text(v * _to_file_unit(d, c), d.units.get(c, ''))}"
-                                        if d.units.get(c) else f"{c} ± {v:.4g}" for c, v in d.noise.items()))
+    sigmas = ", ".join(f"{c} ± {quantity_text(v * _to_file_unit(d, c), d.units.get(c, ''))}"
+                       if d.units.get(c) else f"{c} ± {v:.4g}" for c, v in d.noise.items())
+    print(f"  noise:       {d.noise_kind} ({NOISE_MEANING.get(d.noise_kind, 'see the README')})"
+          + (f": {sigmas}" if sigmas else ""))
+    if d.time_zero:
+        print(f"  time zero:   t = 0 at {d.time_zero:.10g} s of the file's clock (subtracted from column t)")
     print(f"  provenance:  {pv.kind}; {pv.source}")
     if pv.method:
         print(f"  method:      {pv.method}")
@@ -122,6 +129,11 @@ def _show(args) -> int:
     return 0
 
 
+#: What each [noise] kind means, in the words ``datasets show`` prints.
+NOISE_MEANING = {"known": "sigma measured, used as it is", "assumed": "a guess: the fit profiles sigma out",
+                 "estimated": "sigma estimated from the data alone", "none": "noise-free numbers"}
+
+
 def _to_file_unit(d, column: str) -> float:
     """Factor from SI to the unit the dataset's file uses for ``column``."""
     from ..core.units import unit_factor
@@ -132,11 +144,12 @@ def _to_file_unit(d, column: str) -> float:
 
 def _template(args) -> int:
     from ..core.errors import OutputError
-    from ..core.files import atomic_write_text
+    from ..core.files import atomic_write_text, check_name
     from ..io.template import template
 
     if not args.out.is_dir():
         raise OutputError(f"{args.out}: folder does not exist")
+    check_name(args.name, "datasets template: --name")
     toml_path, csv_path = args.out / f"{args.name}.toml", args.out / f"{args.name}.csv"
     for p in (toml_path, csv_path):
         if p.exists() and not args.force:

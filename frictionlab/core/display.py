@@ -110,6 +110,8 @@ SCENE_FIELD_UNITS = {
 }
 #: Owner class -> SI unit of its 'value' field.
 VALUE_UNITS = {"WeightNormal": "N", "ConstantNormal": "N"}
+#: Owner class -> SI units of fields whose name means another unit elsewhere (a spring-slider's stiffness).
+OWNER_FIELD_UNITS = {"SpringLoad": {"stiffness": "1/m", "times": "s", "velocities": "m/s", "mass": "kg"}}
 
 
 def quantity_text(value: float, unit_: str) -> str:
@@ -123,6 +125,10 @@ def quantity_text(value: float, unit_: str) -> str:
         value, unit_ = value * 60 / (2 * math.pi), "rpm"
     elif unit_ == "m" and 1e-3 <= abs(value) < 1:
         value, unit_ = value * 1e3, "mm"
+    elif unit_ == "m/s" and 0 < abs(value) < 1e-3:  # a load point's velocity
+        value, unit_ = value * 1e6, "um/s"
+    elif unit_ == "1/m":  # a rate-and-state stiffness per unit normal stress reads per micrometre
+        value, unit_ = value * 1e-6, "1/um"
     else:
         name, f = _scale(value, unit_)
         value, unit_ = value * f, name
@@ -137,6 +143,8 @@ def describe(obj, unit_: str = "") -> list[str]:
 
     if isinstance(obj, (int, float, np.floating, np.integer)) and not isinstance(obj, bool):
         return [quantity_text(obj, unit_)]
+    if isinstance(obj, (tuple, list)) and obj and unit_ and all(isinstance(v, (int, float)) for v in obj):
+        return [", ".join(quantity_text(v, unit_) for v in obj)]
     if isinstance(obj, (frozenset, set, tuple, list)):
         return [", ".join(sorted(map(str, obj))) or "none"]
     if isinstance(obj, np.ndarray):
@@ -162,6 +170,7 @@ def describe(obj, unit_: str = "") -> list[str]:
         if value is None or name == "kind":
             continue
         u = VALUE_UNITS.get(head, "") if name == "value" else SCENE_FIELD_UNITS.get(name, "")
+        u = OWNER_FIELD_UNITS.get(head, {}).get(name, u)
         sub = describe(value, u)
         lines.append(f"  {name}: {sub[0]}")
         lines += ["  " + x for x in sub[1:]]

@@ -4,7 +4,8 @@ The TOML holds ``name``, optionally ``group`` (datasets of one material and setu
 together; default: the name without its last ``-suffix``), ``kind``, ``observable``, ``[columns]`` (column -> unit),
 ``[noise]`` (observable -> quantity, and ``kind = "known" | "assumed"``: whether sigma was
 measured or is a guess; default assumed), ``[scene]``, ``[fixed]`` law parameters,
-``[provenance]`` and optionally ``[reported]``. Loading validates everything and fails
+``[provenance]`` and optionally ``[reported]`` and ``time_zero`` (the file's time of t = 0, subtracted
+from column t; a time column that starts elsewhere without it is an error). Loading validates everything and fails
 with a one-line ``DatasetError`` naming the file and the field.
 """
 from __future__ import annotations
@@ -21,9 +22,9 @@ from ..core.files import check_name, read_toml
 from ..core.units import MAX_SI, check_text, check_time_scale, unit_factor
 from ..physics.scene import KINDS, Scene
 from .csvread import _line_of_row, read_csv
+from .provenance import PROVENANCE_KINDS, Provenance, _provenance  # noqa: F401  (re-exported)
 from ..solve.outcome import OUTCOMES, OutcomeScene
 
-PROVENANCE_KINDS = ("measured", "reported", "reconstructed", "synthetic")
 #: What a dataset says about its noise: 'known' (sigma measured: the likelihood uses it) or
 #: 'assumed' (a guess: the fit profiles sigma out). Absent means assumed.
 NOISE_KINDS = ("known", "assumed")
@@ -36,16 +37,6 @@ COLUMN_SI = {
     "rebound_angle": "rad", "cm_tangential_cor": "", "normal_cor": "", "contact_rebound_angle": "rad", "psi1": "",
     "psi2": "", "mu": "",
 }
-
-
-@attrs.frozen
-class Provenance:
-    kind: str  # measured | reported | reconstructed | synthetic
-    source: str
-    method: str = ""
-    command: str = ""
-    seed: int | None = None
-    truth: dict = attrs.field(factory=dict)  # generating law and parameters, for synthetic data
 
 
 @attrs.frozen(eq=False)
@@ -67,6 +58,7 @@ class Dataset:
     fixed_units: dict = attrs.field(factory=dict)
     noise_kind: str = "assumed"  # NOISE_KINDS: is the [noise] sigma measured ('known') or a guess ('assumed')?
     group: str = ""  # declared group (TOML 'group'); "" -> answers.group_of derives it from the name
+    time_zero: float = 0.0  # the file's time of t = 0 [s] (TOML 'time_zero'), already subtracted from columns['t']
 
     @property
     def t(self) -> np.ndarray:
@@ -143,6 +135,7 @@ def from_meta(meta: dict, path: Path) -> Dataset:
     csv = path.with_suffix(".csv")
     raw = read_csv(csv)
     columns = _columns(raw, units, path, csv)
+    time_zero = _time_origin(meta, columns, raw, kind, path, csv)
     _check_series(columns, raw, kind, csv)
     noise, noise_kind = _noise(meta, path, observable, columns)
     provenance = _provenance(meta.get("provenance"), path)
@@ -152,7 +145,7 @@ def from_meta(meta: dict, path: Path) -> Dataset:
     return Dataset(name=name, kind=kind, observable=observable, path=path, columns=columns, units=dict(units),
                    noise=noise, scene=scene, fixed=fixed, provenance=provenance,
                    description=meta.get("description", ""), reported=reported,
-                   fixed_units=fixed_units, noise_kind=noise_kind, group=group)
+                   fixed_units=fixed_units, noise_kind=noise_kind, group=group, time_zero=time_zero)
 
 
 def _header(meta, path):
@@ -202,6 +195,30 @@ def _columns(raw, units, path, csv) -> dict:
             raise DatasetError(f"{csv}: column {col!r} line {_line_of_row(csv, i)}: {raw[col][i]:g} {unit} is beyond "
                                f"the accepted magnitude {MAX_SI:g} in SI units")
     return columns
+
+
+def _time_origin(meta, columns, raw, kind, path, csv) -> float:
+    """The file's time of t = 0 [s] (TOML ``time_zero``, default 0), subtracted from column t in place.
+
+    Times count from first contact, release or the start of the load-point schedule; a column that
+    starts elsewhere (a later first frame, a lab clock, epoch seconds) is an error unless ``time_zero``
+    says where t = 0 lies: an offset is never guessed, so no series is fitted against the wrong origin."""
+    if "time_zero" not in meta:
+        if "t" in columns and kind != "contact-area" and columns["t"][0] != 0:
+            first = raw["t"][0]
+            raise DatasetError(f"{csv}: column 't' starts at {first:.10g}, not 0: times count from first contact (or "
+                               f"release, or the start of loading); say where t = 0 lies in the file's clock with "
+                               f"time_zero = \"{first:.10g} <unit>\" at the top of {path.name} (subtracted from t), "
+                               "or time_zero = \"0 s\" if the first sample is later than t = 0")
+        return 0.0
+    if "t" not in columns:
+        raise DatasetError(f"{path}: time_zero needs a time column 't'")
+    zero = _quantity(meta["time_zero"], "s", f"{path}: time_zero")
+    if columns["t"][0] < zero:
+        raise DatasetError(f"{path}: time_zero = {meta['time_zero']!r} is after the first time in {csv.name} "
+                           f"({raw['t'][0]:.10g}): t = 0 must not lie after the first sample")
+    columns["t"] = columns["t"] - zero
+    return zero
 
 
 def _check_series(columns, raw, kind, csv) -> None:
@@ -285,7 +302,7 @@ def _fixed(table, path):
 def _rest(meta, path, provenance) -> dict:
     """No unknown top-level key; [reported] and provenance.truth readable later; returns [reported]."""
     extra = set(meta) - {"name", "group", "kind", "observable", "columns", "noise", "scene", "fixed", "provenance",
-                         "reported", "description"}
+                         "reported", "description", "time_zero"}
     if extra:
         raise DatasetError(f"{path}: unknown top-level key(s) {sorted(extra)}")
     reported = _table(meta, "reported", path, "[reported]")
@@ -358,29 +375,3 @@ def _quantity(value, si, where):
         return to_si(value, si, where)
     except FrictionLabError as exc:
         raise DatasetError(str(exc)) from None
-
-
-def _provenance(p, path) -> Provenance:
-    if not isinstance(p, dict):
-        raise DatasetError(f"{path}: missing required table [provenance] (kind = {' | '.join(PROVENANCE_KINDS)})")
-    extra = set(p) - {"kind", "source", "method", "command", "seed", "truth"}
-    if extra:
-        raise DatasetError(f"{path}: [provenance] has unknown key(s) {sorted(extra)}; "
-                           "known: kind, source, method, command, seed, truth")
-    kind = p.get("kind")
-    if kind not in PROVENANCE_KINDS:
-        raise DatasetError(f"{path}: provenance.kind = {kind!r}, expected one of {', '.join(PROVENANCE_KINDS)}")
-    if not isinstance(p.get("source"), str) or not p["source"]:
-        raise DatasetError(f"{path}: provenance.source must name where the data come from")
-    if kind in ("reconstructed", "synthetic") and not p.get("command"):
-        raise DatasetError(f"{path}: provenance.command must give the command that regenerates {kind} data")
-    for key in ("method", "command"):
-        if not isinstance(p.get(key, ""), str):
-            raise DatasetError(f"{path}: provenance.{key} must be a string")
-    seed = p.get("seed")
-    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int)):
-        raise DatasetError(f"{path}: provenance.seed must be an integer, got {seed!r}")
-    if not isinstance(p.get("truth", {}), dict):
-        raise DatasetError(f"{path}: provenance.truth must be a table")
-    return Provenance(kind=kind, source=p["source"], method=p.get("method", ""), command=p.get("command", ""),
-                      seed=p.get("seed"), truth=p.get("truth", {}))

@@ -7,4 +7,5 @@ SCENE_QUANTITIES = {
     "area.peak": "m^2", "area.contact_time": "s", "area.area": "m^2", "area.initial": "m^2", "area.rate": "m^2/m",
     "normal.impulse": "N*s", "normal.contact_time": "s", "normal.value": "N", "normal.coefficient": "N/m^3",
     "compliance.stiffness": "N/m", "compliance.damping": "N*s/m",
+    "spring.stiffness": "1/m",  # a spring-slider's machine stiffness per unit normal force (k of rate-and-state)
 }

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..core.errors import SceneError
 from ..core.units import to_si
-from .sceneread import known_keys, positive
+from .sceneread import known_keys, nonnegative, positive
 
 @attrs.frozen(eq=False)
 class SpringLoad:
@@ -17,12 +17,17 @@ class SpringLoad:
     The load point moves at velocities[i] [m/s] from times[i] [s] on (times[0] = 0); a velocity of 0
     is a hold. The spring force per unit normal force, mu = K (x_lp - x) / N, obeys
     d mu/dt = k (V_lp - v): k = K / N is the stiffness per unit normal stress of the
-    rate-and-state literature (k_c = (b - a) / Dc). The block is quasi-static (see plan.py).
+    rate-and-state literature (k_c = (b - a) / Dc).
+
+    ``mass`` [kg] is the slider's inertia: m dv/dt = K (x_lp - x) - F. With mass 0 (the default) the
+    block is quasi-static, as in rsfmodel and most of the literature: the spring's load always equals
+    the friction (see plan.py). A slider with mass can be followed through stick-slip.
     """
 
     stiffness: float = attrs.field(validator=positive)
     times: tuple = attrs.field(converter=lambda x: tuple(float(v) for v in x))
     velocities: tuple = attrs.field(converter=lambda x: tuple(float(v) for v in x))
+    mass: float = attrs.field(default=0.0, validator=nonnegative)  # [kg]; 0: quasi-static
 
     def __attrs_post_init__(self):
         t, v = np.asarray(self.times), np.asarray(self.velocities)
@@ -44,10 +49,15 @@ class SpringLoad:
         """Times [s] at which the load-point velocity steps (where an integrator should restart)."""
         return self.times[1:]
 
+    @property
+    def inertial(self) -> bool:
+        """True when the slider has a mass (m dv/dt = K (x_lp - x) - F), False when it is quasi-static."""
+        return self.mass > 0
 
 
 def spring_from_spec(spec, where, q, kind):
-    """[scene.spring]: stiffness [1/m per unit normal force], times and velocities of the load point."""
+    """[scene.spring]: stiffness [1/m per unit normal force], times and velocities of the load point, and the
+    slider's optional mass [kg] (absent or 0: quasi-static)."""
     if "spring" not in spec:
         if kind == "spring-slider":
             raise SceneError(f"{where}: a spring-slider needs a [scene.spring] table with 'stiffness', 'times' "
@@ -58,7 +68,7 @@ def spring_from_spec(spec, where, q, kind):
     sp = spec["spring"]
     if not isinstance(sp, Mapping):
         raise SceneError(f"{where}: scene.spring must be a table, got {type(sp).__name__}")
-    known_keys(sp, {"stiffness", "times", "velocities"}, where, "[scene.spring]")
+    known_keys(sp, {"stiffness", "times", "velocities", "mass"}, where, "[scene.spring]")
     lists = {}
     for key, unit in (("times", "s"), ("velocities", "m/s")):
         v = sp.get(key)
@@ -66,6 +76,7 @@ def spring_from_spec(spec, where, q, kind):
             raise SceneError(f"{where}: scene.spring.{key} must be a non-empty list of quantities in {unit}")
         lists[key] = [to_si(x, unit, f"{where}: scene.spring.{key}[{i}]") for i, x in enumerate(v)]
     try:
-        return SpringLoad(q("stiffness", "1/m", sp, "scene.spring"), lists["times"], lists["velocities"])
+        return SpringLoad(q("stiffness", "1/m", sp, "scene.spring"), lists["times"], lists["velocities"],
+                          mass=q("mass", "kg", sp, "scene.spring", required=False, positive=False, default=0.0))
     except SceneError as exc:
         raise SceneError(f"{where}: scene.spring: {exc}") from None

@@ -15,7 +15,10 @@ static friction up to the law's capacity. For the laws' closed-form families the
 solved by hand, otherwise by root finding. k and c are constants for model 'linear' and follow
 the contact radius for 'mindlin' (``Plan.spring``).
 
-A spring-slider (kind 'spring-slider') is quasi-static, as in the rate-and-state literature and
+A spring-slider (kind 'spring-slider') with a mass ([scene.spring] mass > 0) integrates
+  load   the spring's force per unit normal force [-], d load/dt = k (V_lp(t) - v)
+and m dv/dt = N load - F(v, s), so stick-slip can be followed. Without a mass (the default) it is
+quasi-static, as in the rate-and-state literature and
 rsfmodel: the block's inertia is neglected, so the spring's load per unit normal force always
 equals the friction coefficient, mu = F(v, s)/N, and d mu/dt = k (V_lp(t) - v) fixes the slip rate:
     dv/dt = (k N (V_lp - v) - sum_i dF/ds_i ds_i/dt) / (dF/dv),
@@ -52,7 +55,7 @@ from ..physics.scene import (
 )
 
 #: A quasi-static spring-slider stops with an error once the slip rate exceeds this multiple of the fastest
-#: load-point velocity (stick-slip events, where inertia would matter).
+#: load-point velocity (a runaway, where inertia would matter: give the slider a mass to follow it).
 QUASI_STATIC_LIMIT = 1e3
 
 #: Prefix of a law's internal states in the plan's state vector ("law:theta" cannot clash with the spin angle).
@@ -112,7 +115,7 @@ class Plan:
         s = self.scene
         values = {"v": s.u0 + (s.radius * s.omega0 if self.coupled else 0.0), "omega": s.omega0, "theta": 0.0,
                   "x": 0.0, "xi": 0.0}
-        values.update({k: 0.0 for k in self.law_states})
+        values.update({k: 0.0 for k in self.law_states}, load=0.0)
         y0 = np.array(np.broadcast_arrays(*[values[k] for k in self.states]), dtype=float)
         if self.law_states:
             if p is None:
@@ -124,6 +127,8 @@ class Plan:
             for name in self.law.state_names:
                 y[self.index(LAW_PREFIX + name)] = init[name]
             y0 = y.reshape(y0.shape)
+        if "load" in self.states:  # the spring starts at the friction of the initial state: no jolt at t = 0
+            y0[self.index("load")] = float(self.force(p, np.zeros(1), y0[:, None], y0[:1])[0][0] / s.normal(0.0))
         return y0
 
     # -- contact quantities ----------------------------------------------------------
@@ -248,7 +253,7 @@ class Plan:
                 u = branch_slip(self, u, direction)
             F, c = self.force(p, np.asarray(t), y, np.asarray(u))
         dy = self._rates(p, t, y, F, u, c)
-        if self.scene.spring is not None:
+        if self.scene.spring is not None and not self.scene.spring.inertial:
             dy[0] = self._quasi_static_acceleration(p, t, y, dy)
         return dy
 
@@ -278,8 +283,8 @@ class Plan:
         if abs(v) > fastest:
             raise SolverError(f"law '{self.law.name}' on a spring-slider: the slip rate reached {v:.3g} m/s at "
                               f"t = {float(t):.6g} s, beyond {QUASI_STATIC_LIMIT:g} times the fastest load point: an "
-                              "unstable slider (k below the law's critical stiffness), where the quasi-static model "
-                              "no longer holds")
+                              f"unstable slider ({runaway_cause(p, s.spring.stiffness)}); the quasi-static model "
+                              "cannot follow it: give the slider a mass ([scene.spring] mass) to simulate the slip")
         dF = self.slip_rate_partials(p, t, y)
         N = float(s.normal(t))
         return (s.spring.stiffness * N * (float(s.spring.velocity(t)) - v) - float(dF[1:] @ dy[1:])) / dF[0]
@@ -288,14 +293,15 @@ class Plan:
         """Partials of the friction force [N] of a spring-slider's one state vector y by its slip rate
         (first, N s/m) and by each law state, by central differences; error if dF/du is not positive
         (the quasi-static block then has no slip rate for the spring's load)."""
-        n = len(self.states)
+        rows = [0] + [self.index(k) for k in self.law_states]  # the slip rate and the law's states
+        n = len(rows)
         v = float(y[0])
         steps = [1e-5 * abs(v) + 1e-30] + [1e-5 * (abs(float(y[i])) + 1e-3 * spec.scale)
-                                           for i, spec in zip(range(1, n), self.law.states)]
+                                           for i, spec in zip(rows[1:], self.law.states)]
         Y = np.repeat(np.asarray(y, dtype=float)[:, None], 2 * n, axis=1)
-        for i, h in enumerate(steps):
-            Y[i, 2 * i] += h
-            Y[i, 2 * i + 1] -= h
+        for j, (i, h) in enumerate(zip(rows, steps)):
+            Y[i, 2 * j] += h
+            Y[i, 2 * j + 1] -= h
         F, _ = self.force(p, np.full(2 * n, t), Y, Y[0])
         dF = (F[0::2] - F[1::2]) / (2.0 * np.array(steps))
         if not dF[0] > 0:
@@ -340,8 +346,12 @@ class Plan:
             shape = np.broadcast_shapes(shape, np.shape(y)[1:])
         out = np.empty((len(self.states),) + shape)
         for i, name in enumerate(self.states):
-            if name == "v":
+            if name == "v" and "load" in self.states:  # a slider with mass: m dv/dt = N load - F
+                out[i] = (s.normal(t) * y[self.index("load")] - F) / s.spring.mass
+            elif name == "v":
                 np.subtract(self.drive, F / s.mass, out=out[i, ...])
+            elif name == "load":
+                out[i] = s.spring.stiffness * (s.spring.velocity(t) - y[0])
             elif name == "omega":
                 np.multiply(F, s.radius, out=out[i, ...])
                 out[i] /= s.inertia
@@ -401,9 +411,23 @@ def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan
                                  "contact area: add a [scene.area] model (hertz or half-sine)")
         states.append("xi")
     states += [LAW_PREFIX + n for n in law.state_names]
+    if scene.spring is not None and scene.spring.inertial:
+        states.append("load")
     plan = Plan(scene=scene, law=law, states=tuple(states), coupled=coupled, needs_area=needs_area,
                 needs_normal=needs_normal)
     if scene.spring is not None:  # a law that cannot drive a quasi-static slider at all (Dahl: F depends on its state
         defaults = law.defaults()  # only) is refused here, not found out at every evaluation of a fit
         plan.slip_rate_partials(defaults, 0.0, plan.initial_state(defaults))
     return plan
+
+
+def runaway_cause(p, k: float) -> str:
+    """Why a spring-slider of stiffness k [1/m] ran away, from the rate-and-state parameters in p (SI) if any."""
+    if not {"a", "b", "Dc"} <= set(p):
+        return "the law's friction falls with slip rate faster than the spring can follow"
+    k_c = (p["b"] - p["a"]) / p["Dc"]
+    if k < k_c:
+        return f"k = {k:.4g} /m is below the critical stiffness k_c = (b - a)/Dc = {k_c:.4g} /m: stick-slip"
+    return (f"k = {k:.4g} /m is above the critical stiffness k_c = (b - a)/Dc = {k_c:.4g} /m, which is stable to small "
+            "perturbations only: the slip law runs away after large velocity jumps above k_c (Gu, Rice, Ruina and "
+            "Tse 1984)")

@@ -110,7 +110,7 @@ def phase_scales(plan, p, t0: float, T: float, y0, direction: float) -> np.ndarr
     V = V if V > 0 and np.isfinite(V) else 1.0
     if s.spring is not None:  # the load point sets the speeds
         V = max(V, max(s.spring.velocities))
-    size = {"v": V, "x": V * span, "xi": V * span, **law_state_scales(plan)}
+    size = {"v": V, "x": V * span, "xi": V * span, "load": 1.0, **law_state_scales(plan)}
     if plan.has_spin:
         J = min(largest_force((direction or 1.0) * V) * span, (V + abs(plan.drive) * span) / plan.kappa)
         w = max(r * J / s.inertia, abs(s.omega0), 1e-12 * V / r)

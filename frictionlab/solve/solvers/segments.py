@@ -102,7 +102,9 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
     for name, arr in (("u", u), ("v", Y[0]), ("omega", omega), ("theta", theta), ("force", F)):
         if not np.isfinite(arr).all():
             raise SolverError(f"{solver_name}: {name} became NaN or infinite for law '{plan.law.name}' with {dict(p)}")
-    load = F / plan.scene.normal(t_eval) if plan.scene.spring is not None else None  # quasi-static: spring = friction
+    load = None
+    if plan.scene.spring is not None:  # with a mass the spring's own state; quasi-static: spring = friction
+        load = Y[plan.index("load")].copy() if "load" in plan.states else F / plan.scene.normal(t_eval)
     return Trajectory(t=t_eval, u=u, v=Y[0].copy(), omega=omega, theta=theta, force=F, A=A, N=c.N, load=load,
                       solver=solver_name, law=plan.law.name, stick_time=stick_time, info=info,
                       law_states={n: Y[plan.index(k)].copy() for n, k in zip(plan.law.state_names, plan.law_states)})

@@ -1,0 +1,44 @@
+"""Where a dataset's numbers come from: the ``[provenance]`` table (measured, reported, reconstructed, synthetic)."""
+from __future__ import annotations
+
+import attrs
+
+from ..core.errors import DatasetError
+
+PROVENANCE_KINDS = ("measured", "reported", "reconstructed", "synthetic")
+
+
+@attrs.frozen
+class Provenance:
+    kind: str  # measured | reported | reconstructed | synthetic
+    source: str
+    method: str = ""
+    command: str = ""
+    seed: int | None = None
+    truth: dict = attrs.field(factory=dict)  # generating law and parameters, for synthetic data
+
+
+def _provenance(p, path) -> Provenance:
+    if not isinstance(p, dict):
+        raise DatasetError(f"{path}: missing required table [provenance] (kind = {' | '.join(PROVENANCE_KINDS)})")
+    extra = set(p) - {"kind", "source", "method", "command", "seed", "truth"}
+    if extra:
+        raise DatasetError(f"{path}: [provenance] has unknown key(s) {sorted(extra)}; "
+                           "known: kind, source, method, command, seed, truth")
+    kind = p.get("kind")
+    if kind not in PROVENANCE_KINDS:
+        raise DatasetError(f"{path}: provenance.kind = {kind!r}, expected one of {', '.join(PROVENANCE_KINDS)}")
+    if not isinstance(p.get("source"), str) or not p["source"]:
+        raise DatasetError(f"{path}: provenance.source must name where the data come from")
+    if kind in ("reconstructed", "synthetic") and not p.get("command"):
+        raise DatasetError(f"{path}: provenance.command must give the command that regenerates {kind} data")
+    for key in ("method", "command"):
+        if not isinstance(p.get(key, ""), str):
+            raise DatasetError(f"{path}: provenance.{key} must be a string")
+    seed = p.get("seed")
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int)):
+        raise DatasetError(f"{path}: provenance.seed must be an integer, got {seed!r}")
+    if not isinstance(p.get("truth", {}), dict):
+        raise DatasetError(f"{path}: provenance.truth must be a table")
+    return Provenance(kind=kind, source=p["source"], method=p.get("method", ""), command=p.get("command", ""),
+                      seed=p.get("seed"), truth=p.get("truth", {}))
