@@ -46,6 +46,7 @@ def add_parser(sub):
     tpl.add_argument("--out", type=Path, default=Path("."), help="folder to write into (default: here)")
     tpl.add_argument("--force", action="store_true", help="replace existing files")
     tpl.set_defaults(func=_template)
+    _add_import(acts)
     rb = subcommand(acts, "rebuild", help="regenerate the generated built-in (or known-truth) datasets",
                     description="Regenerate every generated built-in dataset from its command and seed; with "
                                 "--known-truth, the known-truth datasets of examples/known-truth instead.",
@@ -59,6 +60,79 @@ def add_parser(sub):
                     help="rebuild the known-truth datasets (default folder: ./examples/known-truth) instead of the "
                          "built-in ones")
     rb.set_defaults(func=_rebuild)
+
+
+def _add_import(acts):
+    from ..cli import subcommand
+
+    imp = subcommand(acts, "import", help="turn a raw laboratory record into a dataset (velocity steps)",
+                     description="Read a raw record and write NAME.toml and NAME.csv, a measured dataset. FORMAT "
+                                 "velstep: whitespace-separated Time(s) Displ(microns) Friction "
+                                 "EffectiveNormalstress(MPa), one velocity step per file (the sliced records of the "
+                                 "steadystate routine, Giacomel et al. 2024). The load-point velocities and step time "
+                                 "come from the displacement record; the machine stiffness is estimated from the "
+                                 "loading after the step unless given (fit it with --free spring.stiffness).",
+                     examples="""  frictionlab datasets import velstep velstep1.txt --name velstep1 --out data/ \\
+      --source 'pgiacomel/steadystate, velstep1_TR2_exp013_sepiolite.txt' --license MIT \\
+      --citation 'Giacomel et al., Geosphere (2024), doi:10.1130/GES02739.1'
+  frictionlab fit rate-state-aging data/velstep1.toml --free spring.stiffness='0.0005 1/um:1 1/um'""")
+    imp.add_argument("format", choices=("velstep",), metavar="FORMAT", help="raw format: velstep")
+    imp.add_argument("raw", type=Path, metavar="RAWFILE", help="the raw record")
+    imp.add_argument("--name", required=True, help="dataset and file name")
+    imp.add_argument("--out", type=Path, default=Path("."), help="folder to write into (default: here)")
+    imp.add_argument("--points", type=int, default=600, help="samples to keep (default 600)")
+    imp.add_argument("--steps", type=int, default=1, help="velocity steps in the record (default 1)")
+    imp.add_argument("--detrend", action="store_true", help="remove friction's slip trend, a straight line in "
+                     "displacement fitted before the step (default: keep the record as measured)")
+    imp.add_argument("--stiffness", help="machine stiffness per unit normal stress, e.g. '0.01 1/um' (default: "
+                                         "estimated from the loading after the step)")
+    imp.add_argument("--source", default="", help="where the record comes from (default: its path)")
+    imp.add_argument("--license", default="", help="the record's license, e.g. MIT")
+    imp.add_argument("--citation", default="", help="what to cite")
+    imp.add_argument("--force", action="store_true", help="replace existing files")
+    imp.set_defaults(func=_import)
+
+
+def _import(args) -> int:
+    import shlex
+
+    from ..core.errors import OutputError, ParameterError
+    from ..core.files import atomic_write_text, check_name
+    from ..core.units import to_si
+    from ..io.dataset import load_dataset
+    from ..io.velstep import velstep_dataset
+
+    check_name(args.name, "datasets import: --name")
+    if not 10 <= args.points <= 100_000 or not 1 <= args.steps <= 50:
+        raise ParameterError("datasets import: --points must be 10 to 100000 and --steps 1 to 50")
+    if not args.out.is_dir():
+        raise OutputError(f"{args.out}: folder does not exist")
+    paths = args.out / f"{args.name}.toml", args.out / f"{args.name}.csv"
+    if any(p.resolve() == args.raw.resolve() for p in paths):
+        raise OutputError(f"{args.raw}: the output would overwrite the raw record; choose another --name or --out")
+    for p in paths:
+        if p.exists() and not args.force:
+            raise OutputError(f"{p}: exists; choose another --name or --out, or pass --force")
+    k = to_si(args.stiffness, "1/m", "--stiffness") if args.stiffness else None
+    command = "frictionlab datasets import velstep " + " ".join(shlex.quote(a) for a in (
+        args.raw.name, "--name", args.name, "--points", str(args.points), "--steps", str(args.steps))) + (
+        " --detrend" if args.detrend else "") + (f" --stiffness {shlex.quote(args.stiffness)}" if k else "")
+    toml, csv, imp = velstep_dataset(args.raw, args.name, steps=args.steps, points=args.points,
+                                     detrend=args.detrend, stiffness=k, source=args.source,
+                                     license=args.license, citation=args.citation, command=command)
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:  # the pair must load before it is written
+        (Path(tmp) / paths[0].name).write_text(toml)
+        (Path(tmp) / paths[1].name).write_text(csv)
+        load_dataset(Path(tmp) / paths[0].name)
+    atomic_write_text(paths[1], csv)
+    atomic_write_text(paths[0], toml)
+    v = " -> ".join(f"{x * 1e6:g} um/s" for x in imp.velocities)
+    print(f"wrote {paths[0]} and {paths[1]}: {len(imp.index)} samples, load point {v} (step at "
+          f"{', '.join(f'{t:.6g} s' for t in imp.step_times)}), k = {imp.stiffness * 1e-6:.3g} 1/um "
+          f"({'stated' if imp.stiffness_stated else 'estimated; fit it with --free spring.stiffness'})")
+    return 0
 
 
 def _list(args) -> int:
@@ -110,6 +184,10 @@ def _show(args) -> int:
     if d.time_zero:
         print(f"  time zero:   t = 0 at {d.time_zero:.10g} s of the file's clock (subtracted from column t)")
     print(f"  provenance:  {pv.kind}; {pv.source}")
+    if pv.license:
+        print(f"  license:     {pv.license}")
+    if pv.citation:
+        print(f"  cite:        {pv.citation}")
     if pv.method:
         print(f"  method:      {pv.method}")
     if pv.command:

@@ -16,15 +16,17 @@ class Provenance:
     command: str = ""
     seed: int | None = None
     truth: dict = attrs.field(factory=dict)  # generating law and parameters, for synthetic data
+    license: str = ""  # the data's license as the source states it (e.g. "MIT")
+    citation: str = ""  # what to cite when using the data
 
 
 def _provenance(p, path) -> Provenance:
     if not isinstance(p, dict):
         raise DatasetError(f"{path}: missing required table [provenance] (kind = {' | '.join(PROVENANCE_KINDS)})")
-    extra = set(p) - {"kind", "source", "method", "command", "seed", "truth"}
+    extra = set(p) - {"kind", "source", "method", "command", "seed", "truth", "license", "citation"}
     if extra:
         raise DatasetError(f"{path}: [provenance] has unknown key(s) {sorted(extra)}; "
-                           "known: kind, source, method, command, seed, truth")
+                           "known: kind, source, method, command, seed, truth, license, citation")
     kind = p.get("kind")
     if kind not in PROVENANCE_KINDS:
         raise DatasetError(f"{path}: provenance.kind = {kind!r}, expected one of {', '.join(PROVENANCE_KINDS)}")
@@ -32,7 +34,7 @@ def _provenance(p, path) -> Provenance:
         raise DatasetError(f"{path}: provenance.source must name where the data come from")
     if kind in ("reconstructed", "synthetic") and not p.get("command"):
         raise DatasetError(f"{path}: provenance.command must give the command that regenerates {kind} data")
-    for key in ("method", "command"):
+    for key in ("method", "command", "license", "citation"):
         if not isinstance(p.get(key, ""), str):
             raise DatasetError(f"{path}: provenance.{key} must be a string")
     seed = p.get("seed")
@@ -41,4 +43,5 @@ def _provenance(p, path) -> Provenance:
     if not isinstance(p.get("truth", {}), dict):
         raise DatasetError(f"{path}: provenance.truth must be a table")
     return Provenance(kind=kind, source=p["source"], method=p.get("method", ""), command=p.get("command", ""),
-                      seed=p.get("seed"), truth=p.get("truth", {}))
+                      seed=p.get("seed"), truth=p.get("truth", {}), license=p.get("license", ""),
+                      citation=p.get("citation", ""))
