@@ -147,6 +147,15 @@ def _list(args) -> int:
     print(render(rows))
     print(f"\n{len(rows)} datasets in {builtin_dir()}; 'frictionlab datasets show NAME' for details, "
           "'frictionlab datasets template KIND' to start your own.")
+    from ..io import external
+
+    here = external.present()
+    missing = sorted(set(external.RECORDS) - set(here))
+    if here:
+        print(f"measured records present in {', '.join(map(str, external.raw_dirs()))}: {', '.join(here)}")
+    if missing:
+        print(f"measured records not in the repository (license of their source; see 'datasets show NAME' for where "
+              f"to place them): {', '.join(missing)}")
     return 0
 
 

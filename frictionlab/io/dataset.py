@@ -101,6 +101,10 @@ def resolve(name_or_path: str | Path) -> Path:
     candidate = builtin_dir() / f"{name_or_path}.toml"
     if candidate.exists():
         return candidate
+    from . import external
+
+    if str(name_or_path) in external.RECORDS:  # a measured record placed beside the repository, not in it
+        return external.dataset_toml(str(name_or_path))
     raise DatasetError(f"unknown dataset '{name_or_path}'; built-in: {', '.join(builtin_names())} (or give a .toml path)")
 
 
