@@ -414,7 +414,10 @@ def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, slow: bool = Fals
         elif why and not slow:
             skipped[name] = why
         else:
-            opts = ({"free": dict(free)} if free else {}) | ({"timeout": timeout} if timeout is not None else {})
+            from .predict import has_scene_quantity
+
+            mine = {k: v for k, v in (free or {}).items() if has_scene_quantity(target.dataset.scene, k)}
+            opts = ({"free": mine} if mine else {}) | ({"timeout": timeout} if timeout is not None else {})
             merged = merge_identical(ok)
             fns = [attrs.evolve(law_fit(f.law, f.solver, **opts), name=" = ".join(members) if len(members) > 1 else "")
                    for f, members, _ in merged]

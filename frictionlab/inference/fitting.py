@@ -64,6 +64,7 @@ from .predict import (
     applicable_solvers,
     auto_solver,
     get_scene_quantity,
+    has_scene_quantity,
     make_target,
     predict,
     register_predictor,
@@ -331,7 +332,11 @@ def _scene_slots(targets, free) -> list[_Slot]:
         if len(bounds) == 3 and not lo <= float(bounds[2]) <= hi:
             raise ParameterError(f"free scene quantity '{name}': start {float(bounds[2]):g} is outside its bounds "
                                  f"[{lo:g}, {hi:g}]")
-        for i, tg in enumerate(targets):
+        having = [i for i, tg in enumerate(targets) if has_scene_quantity(tg.dataset.scene, name)]
+        if not having:  # a quantity freed for a comparison applies to the datasets whose scene has it
+            get_scene_quantity(targets[0].dataset.scene, name)  # the one-line error naming what is missing
+        for i in having:
+            tg = targets[i]
             current = get_scene_quantity(tg.dataset.scene, name)
             start = float(bounds[2]) if len(bounds) == 3 else min(max(current, lo), hi)
             disp = name if len(targets) == 1 else f"{name}[{tg.name}]"

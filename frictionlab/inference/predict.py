@@ -204,14 +204,24 @@ def set_scene_quantity(scene: Scene, name: str, value: float) -> Scene:
     return attrs.evolve(scene, **{head: attrs.evolve(sub, **{tail: float(value)})})
 
 
+def has_scene_quantity(scene: Scene, name: str) -> bool:
+    """True if ``scene`` has the (dotted) numeric quantity ``name`` (a spring-slider's spring.stiffness, ...)."""
+    try:
+        get_scene_quantity(scene, name)
+    except ParameterError:
+        return False
+    return True
+
+
 def get_scene_quantity(scene: Scene, name: str) -> float:
     if name not in SCENE_QUANTITIES:
         raise ParameterError(f"scene quantity '{name}' cannot be freed; choose from {', '.join(SCENE_QUANTITIES)}")
     obj = scene
     for part in name.split("."):
         if obj is None or not hasattr(obj, part):
-            raise ParameterError(f"scene quantity '{name}': this scene has no {part!r}"
-                                 + (f" ({type(obj).__name__})" if obj is not None else ""))
+            raise ParameterError(f"scene quantity '{name}': this scene has no {name.split('.')[0]!r}"
+                                 if obj is None else f"scene quantity '{name}': this scene has no {part!r} "
+                                 f"({type(obj).__name__})")
         obj = getattr(obj, part)
     if not isinstance(obj, (int, float)):
         raise ParameterError(f"scene quantity '{name}' is not a number on this scene")

@@ -43,9 +43,10 @@ def raw_dirs() -> list[Path]:
     env = os.environ.get("FRICTIONLAB_RAW_DATA")
     if env is not None:
         return [Path(p) for p in env.split(os.pathsep) if p]
-    from .dataset import builtin_dir
+    from importlib import resources
 
-    return [builtin_dir().resolve().parent.parent / "shared" / "data"]
+    builtin = Path(str(resources.files("frictionlab.data")))  # the repository's datasets/ folder
+    return [builtin.resolve().parent.parent / "shared" / "data"]
 
 
 def _sha256(path: Path) -> str:

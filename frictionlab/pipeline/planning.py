@@ -9,6 +9,7 @@ import attrs
 
 from ..core.errors import FrictionLabError
 from ..inference.fitting import PREDICTORS, FitResult, applicable_solvers, auto_solver
+from ..inference.predict import has_scene_quantity
 from ..inference.ranking import family
 from ..io.dataset import Dataset
 from ..physics.registry import available_laws, get_law
@@ -82,6 +83,9 @@ class FitPlan:
 def plan_fits(law_names: Sequence[str], dss: Sequence[Dataset], solvers, free) -> FitPlan:
     """Every (law, solver) candidate on every dataset, or the reason a dataset or candidate is left out."""
     skipped_ds, tasks, fits, no_law = {}, [], [], set()
+    for name in free or {}:
+        if not any(ds.scene is not None and has_scene_quantity(ds.scene, name) for ds in dss):
+            raise FrictionLabError(f"compare --free {name}: none of the datasets' scenes has this quantity")
     for ds in dss:
         if ds.kind == "contact-area":
             skipped_ds[ds.name] = "contact-area series: supporting data (the area model of a scene), not fitted"
@@ -98,7 +102,8 @@ def plan_fits(law_names: Sequence[str], dss: Sequence[Dataset], solvers, free) -
             if why:
                 fits.append(FitResult(law=law, solver=solver, datasets=(ds.name,), status="skipped", reason=why))
             else:
-                tasks.append((law, ds, solver, dict(free or {})))
+                tasks.append((law, ds, solver, {k: v for k, v in (free or {}).items()
+                                                 if has_scene_quantity(ds.scene, k)}))  # what this scene has
     if len(skipped_ds) == len(dss):
         raise FrictionLabError("compare: none of the datasets can be fitted: "
                                + "; ".join(f"{k}: {v}" for k, v in skipped_ds.items()))
