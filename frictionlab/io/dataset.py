@@ -208,7 +208,7 @@ def _time_origin(meta, columns, raw, kind, path, csv) -> float:
     starts elsewhere (a later first frame, a lab clock, epoch seconds) is an error unless ``time_zero``
     says where t = 0 lies: an offset is never guessed, so no series is fitted against the wrong origin."""
     if "time_zero" not in meta:
-        if "t" in columns and kind != "contact-area" and columns["t"][0] != 0:
+        if "t" in columns and kind != "contact-area" and columns["t"][0] > 0:  # negative: _check_series
             first = raw["t"][0]
             raise DatasetError(f"{csv}: column 't' starts at {first:.10g}, not 0: times count from first contact (or "
                                f"release, or the start of loading); say where t = 0 lies in the file's clock with "
