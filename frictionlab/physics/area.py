@@ -7,7 +7,7 @@ import attrs
 import numpy as np
 
 from ..core.errors import SceneError
-from .sceneread import column_of, known_keys, nonnegative, positive
+from .sceneread import column_of, model_of, nonnegative, positive
 
 @attrs.frozen
 class HalfSineArea:
@@ -101,9 +101,7 @@ def area_from_spec(a, where, q, columns, t):
     if a is None:
         return None
     p = "scene.area"
-    model = a.get("model")
-    if isinstance(model, str) and model in AREA_KEYS:
-        known_keys(a, AREA_KEYS[model] | {"model"}, where, f"[{p}] with model {model!r}")
+    model = model_of(a, AREA_KEYS, where, p)
     if model == "half-sine":
         return HalfSineArea(q("peak", "m^2", a, p), q("contact_time", "s", a, p))
     if model == "constant":

@@ -7,7 +7,7 @@ import attrs
 import numpy as np
 
 from ..core.errors import SceneError
-from .sceneread import column_of, known_keys, nonnegative, positive
+from .sceneread import column_of, model_of, nonnegative, positive
 
 G = 9.80665  # standard gravity [m/s^2]
 
@@ -79,9 +79,7 @@ def normal_from_spec(n, where, q, columns, t, mass, contact_time, spec, incline)
     if n is None:
         return None
     p = "scene.normal"
-    model = n.get("model")
-    if isinstance(model, str) and model in NORMAL_KEYS:
-        known_keys(n, NORMAL_KEYS[model] | {"model"}, where, f"[{p}] with model {model!r}")
+    model = model_of(n, NORMAL_KEYS, where, p)
     if model == "half-sine":
         tc = q("contact_time", "s", n, p, required=contact_time is None, default=contact_time)
         if "impulse" in n:

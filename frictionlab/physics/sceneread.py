@@ -97,3 +97,10 @@ def known_keys(table, keys, where, label):
         raise SceneError(f"{where}: {label} has unknown key(s) {sorted(extra)}; "
                          f"known: {', '.join(sorted(keys)) or 'none'}")
 
+
+def model_of(table, keys: dict, where: str, prefix: str):
+    """The ``model`` named in a sub-table, its keys checked against ``keys[model]`` when the model is known."""
+    model = table.get("model")
+    if isinstance(model, str) and model in keys:
+        known_keys(table, keys[model] | {"model"}, where, f"[{prefix}] with model {model!r}")
+    return model

@@ -80,3 +80,15 @@ def spring_from_spec(spec, where, q, kind):
                           mass=q("mass", "kg", sp, "scene.spring", required=False, positive=False, default=0.0))
     except SceneError as exc:
         raise SceneError(f"{where}: scene.spring: {exc}") from None
+
+
+def runaway_cause(p, k: float) -> str:
+    """Why a spring-slider of stiffness k [1/m] ran away, from the rate-and-state parameters in p (SI) if any."""
+    if not {"a", "b", "Dc"} <= set(p):
+        return "the law's friction falls with slip rate faster than the spring can follow"
+    k_c = (p["b"] - p["a"]) / p["Dc"]
+    if k < k_c:
+        return f"k = {k:.4g} /m is below the critical stiffness k_c = (b - a)/Dc = {k_c:.4g} /m: stick-slip"
+    return (f"k = {k:.4g} /m is above the critical stiffness k_c = (b - a)/Dc = {k_c:.4g} /m, which is stable to small "
+            "perturbations only: the slip law runs away after large velocity jumps above k_c (Gu, Rice, Ruina and "
+            "Tse 1984)")

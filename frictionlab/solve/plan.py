@@ -53,6 +53,7 @@ from ..physics.scene import (
     Scene,
     WeightNormal,
 )
+from ..physics.spring import runaway_cause
 
 #: A quasi-static spring-slider stops with an error once the slip rate exceeds this multiple of the fastest
 #: load-point velocity (a runaway, where inertia would matter: give the slider a mass to follow it).
@@ -420,14 +421,3 @@ def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan
         plan.slip_rate_partials(defaults, 0.0, plan.initial_state(defaults))
     return plan
 
-
-def runaway_cause(p, k: float) -> str:
-    """Why a spring-slider of stiffness k [1/m] ran away, from the rate-and-state parameters in p (SI) if any."""
-    if not {"a", "b", "Dc"} <= set(p):
-        return "the law's friction falls with slip rate faster than the spring can follow"
-    k_c = (p["b"] - p["a"]) / p["Dc"]
-    if k < k_c:
-        return f"k = {k:.4g} /m is below the critical stiffness k_c = (b - a)/Dc = {k_c:.4g} /m: stick-slip"
-    return (f"k = {k:.4g} /m is above the critical stiffness k_c = (b - a)/Dc = {k_c:.4g} /m, which is stable to small "
-            "perturbations only: the slip law runs away after large velocity jumps above k_c (Gu, Rice, Ruina and "
-            "Tse 1984)")
