@@ -233,7 +233,7 @@ def test_refits_of_the_equivalence_test_bootstrap_and_transfer_keep_the_time_bud
 # --- degenerate data ------------------------------------------------------------------------------
 def _tiny(tmp_path, rows: str, name="tiny") -> Path:
     base = fl.load_dataset("incline-oil-a100").path
-    text = base.read_text().replace('name = "incline-oil-a100"', f'name = "{name}"')
+    text = base.read_text().replace('name = "incline-oil-a100"', f'name = "{name}"\ntime_zero = "0 s"')  # t from 0.25
     (tmp_path / "d.toml").write_text(text.replace('incline = "20 deg"', 'incline = "20 deg"\nduration = "0.5 s"'))
     (tmp_path / "d.csv").write_text("t,v\n" + rows)
     return tmp_path / "d.toml"
