@@ -54,7 +54,7 @@ def test_lists_are_repeated_options_or_commas_everywhere():
     assert d.local == ["mu", "eta_prime"]
 
 
-@pytest.mark.parametrize("argv", [[c] for c in COMMANDS] + [["datasets", a] for a in ("list", "show", "template",
+@pytest.mark.parametrize("argv", [[c] for c in COMMANDS] + [["datasets", a] for a in ("list", "show", "template", "import",
                                                                                       "rebuild")])
 def test_every_command_has_its_own_help_with_examples(argv, capsys):
     with pytest.raises(SystemExit) as exc:
