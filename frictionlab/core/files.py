@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import errno
 import os
-import re
 import shutil
 import stat
 import tempfile
@@ -37,10 +36,6 @@ MAX_CSV_BYTES = 256 << 20  # 256 MiB
 MAX_TOML_DEPTH = 16
 #: File that marks a folder written by frictionlab (a report, a bench report, rebuilt datasets).
 MARKER = ".frictionlab-output"
-#: A name that becomes a file name (a dataset's name): a letter or digit, then letters, digits
-#: and . _ + -, at most MAX_NAME characters.
-MAX_NAME = 100
-_SLUG = re.compile(r"[A-Za-z0-9][A-Za-z0-9._+-]*")
 
 
 # --- reading --------------------------------------------------------------------------------
@@ -146,17 +141,6 @@ def read_toml(path, error=DatasetError) -> dict:
         raise error(f"{path}: TOML does not parse: {exc}") from None
     except RecursionError:
         raise error(f"{path}: TOML nests too deeply to parse") from None
-
-
-def check_name(name: str, where: str) -> str:
-    """``name`` if it can become part of a file name (see _SLUG), else a one-line DatasetError."""
-    shown = name if len(name) <= 40 else name[:37] + "..."
-    if len(name) > MAX_NAME:
-        raise DatasetError(f"{where}: {shown!r} is {len(name)} characters long; at most {MAX_NAME}")
-    if not _SLUG.fullmatch(name):
-        raise DatasetError(f"{where}: {shown!r} must start with a letter or digit and hold only letters, digits "
-                           "and . _ + - (it becomes part of file names)")
-    return name
 
 
 # --- writing --------------------------------------------------------------------------------

@@ -20,6 +20,7 @@ import attrs
 import numpy as np
 
 from ..core.errors import FrictionLabError, LawError, RegistryError
+from ..core.names import check_name
 from .law import (
     QUANTITIES,
     AreaSlipForm,
@@ -62,8 +63,7 @@ def validate_law(law: FrictionLaw, source: str) -> None:
     for attr in ("name", "formula", "citation", "params", "requires"):
         if not hasattr(law, attr):
             raise LawError(f"law plugin {source}: missing class attribute '{attr}'")
-    if not isinstance(law.name, str) or not law.name or any(ch.isspace() for ch in law.name):
-        raise LawError(f"law plugin {source}: name must be a non-empty word, got {law.name!r}")
+    check_name(law.name, f"law plugin {source}: name", LawError)
     if not isinstance(law.requires, (set, frozenset)) or not all(isinstance(q, str) for q in law.requires):
         raise LawError(f"law '{law.name}' ({source}): requires must be a frozenset of quantity names, "
                        f"got {law.requires!r}")
