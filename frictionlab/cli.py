@@ -101,15 +101,28 @@ def load_file(path: str) -> None:
 
 
 def main(argv=None) -> int:
+    """Run the command line ``argv``; the exit status: 0 done, 2 bad input or a refused output, 1 a bug,
+    130/143/129 interrupted, terminated or hung up, 141 the reader of the output went away."""
+    from .core.terminal import guarded_streams
+
     argv = sys.argv[1:] if argv is None else list(argv)
+    with guarded_streams() as (out, err):  # all output inert and encodable; a failing stream named
+        rc = _main(argv)
+        out.flush()
+        if out.failure is not None and rc != 141:
+            print(f"frictionlab: error: cannot write to {out.name}: {out.failure.strerror or out.failure} "
+                  "(files the run wrote are complete)", file=sys.stderr)
+            rc = rc or 2
+        return rc
+
+
+def _main(argv: list[str]) -> int:
     try:
         parser = build_parser()
     except Exception as exc:  # a command module that fails to import
         if "--debug" in argv:
             raise
-        print(f"frictionlab: internal error: {type(exc).__name__}: {one_line(exc)} "
-              "(rerun with --debug for the traceback)", file=sys.stderr)
-        return 1
+        return _say(f"internal error: {type(exc).__name__}: {one_line(exc)} (rerun with --debug for the traceback)", 1)
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # argparse already printed its one-line usage error
@@ -120,8 +133,18 @@ def main(argv=None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    return _run(args)
+
+
+def _say(message: str, status: int) -> int:
+    print(f"frictionlab: {message}", file=sys.stderr)
+    return status
+
+
+def _run(args) -> int:
+    """Run the parsed command; every way it can end becomes one line on stderr and an exit status."""
     formatwarning = warnings.formatwarning
-    sigterm = _terminate_cleanly()
+    restore = _signals_end_cleanly()
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("default")
@@ -132,53 +155,53 @@ def main(argv=None) -> int:
     except FrictionLabError as exc:
         if args.debug:
             raise
-        print(f"frictionlab: error: {one_line(exc)}", file=sys.stderr)
-        return 2
+        return _say(f"error: {one_line(exc)}", 2)
     except BrokenPipeError:  # the reader of our output went away (| head): stop quietly, as cat does
-        try:
-            import os
-
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        except (OSError, ValueError):
-            pass
+        _silence_stdout()
         return 141
     except OSError as exc:  # the file system refused (permissions, a full disk): the user's to fix
         if args.debug:
             raise
         where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
-        print(f"frictionlab: error: {where}{one_line(exc.strerror or exc)}", file=sys.stderr)
-        return 2
+        return _say(f"error: {where}{one_line(exc.strerror or exc)}", 2)
     except KeyboardInterrupt:
-        print("frictionlab: interrupted", file=sys.stderr)
-        return 130
-    except Terminated:
-        print("frictionlab: terminated", file=sys.stderr)
-        return 143
+        return _say("interrupted", 130)
+    except Terminated as exc:
+        return _say(exc.word(), 128 + exc.signum)
     except Exception as exc:  # a bug, not bad input: say so in one line, exit 1
         if args.debug:
             raise
-        print(f"frictionlab: internal error: {type(exc).__name__}: {one_line(exc)} "
-              "(a bug in frictionlab or a plugin; rerun with --debug for the traceback)", file=sys.stderr)
-        return 1
+        return _say(f"internal error: {type(exc).__name__}: {one_line(exc)} "
+                    "(a bug in frictionlab or a plugin; rerun with --debug for the traceback)", 1)
     finally:
         warnings.formatwarning = formatwarning
-        sigterm()
+        restore()
 
 
-def _terminate_cleanly():
-    """Make SIGTERM an exception (errors.Terminated) while a command runs, so that clean-up runs:
-    workers stopped, temporary output removed, locks released. Returns the function that undoes it."""
+def _silence_stdout() -> None:
+    try:
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
+def _signals_end_cleanly():
+    """Make SIGTERM and SIGHUP an exception (errors.Terminated) while a command runs, so that clean-up
+    runs: workers stopped, temporary output removed, locks released. Returns the function that undoes it."""
     import signal
     import threading
 
     if threading.current_thread() is not threading.main_thread():
         return lambda: None
 
-    def on_sigterm(signum, frame):
+    def on_signal(signum, frame):
         raise Terminated(signum)
 
-    old = signal.signal(signal.SIGTERM, on_sigterm)
-    return lambda: signal.signal(signal.SIGTERM, old)
+    sigs = [s for s in (getattr(signal, "SIGTERM", None), getattr(signal, "SIGHUP", None)) if s is not None]
+    old = {s: signal.signal(s, on_signal) for s in sigs}
+    return lambda: [signal.signal(s, h) for s, h in old.items()]
 
 
 if __name__ == "__main__":  # pragma: no cover
