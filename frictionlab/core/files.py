@@ -203,8 +203,6 @@ _held: dict[str, int] = {}  # lock file -> times held by this process
 def output_lock(path):
     """Hold an exclusive lock on the output ``path`` (a file ``.NAME.lock`` beside it, removed on
     release). A second holder, in this process or another, fails at once with an OutputError."""
-    import fcntl
-
     path = Path(path)
     parent = path.parent if str(path.parent) else Path(".")
     lock = parent / f".{path.name}.lock"
@@ -218,27 +216,7 @@ def output_lock(path):
         return
     busy = OutputError(f"{path}: another frictionlab run is writing this output (lock {lock}); "
                        "wait for it to finish or choose another --out")
-    while True:
-        try:
-            fd = os.open(lock, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o666 & ~_umask())
-        except FileNotFoundError:
-            raise OutputError(f"{path}: parent folder {parent} does not exist") from None
-        except OSError as exc:
-            raise _oserror(path, exc, "cannot lock") from None
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError as exc:
-            os.close(fd)
-            if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
-                raise busy from None
-            raise _oserror(path, exc, "cannot lock") from None
-        try:  # the holder before us may have removed the file after we opened it: lock the new one
-            same = os.fstat(fd).st_ino == os.stat(lock).st_ino
-        except FileNotFoundError:
-            same = False
-        if same:
-            break
-        os.close(fd)
+    fd = _take_lock(lock, path, parent, busy)
     _held[key] = 1
     try:
         yield
@@ -249,6 +227,50 @@ def output_lock(path):
         except OSError:
             pass
         os.close(fd)
+
+
+_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+
+
+def _take_lock(lock: Path, path: Path, parent: Path, busy: OutputError) -> int:
+    """A descriptor of the lock file ``lock``, created with O_EXCL|O_NOFOLLOW (a planted link is never
+    followed) and flock-ed. A lock file left by a run that died is taken over (nobody holds its flock);
+    one held is ``busy``; a symbolic link or anything but a regular file there is refused."""
+    import fcntl
+
+    planted = OutputError(f"{path}: the lock file {lock} is a symbolic link or not a regular file (not made by "
+                          "frictionlab); remove it and run again")
+    for _ in range(100):
+        try:
+            try:
+                fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_EXCL | _NOFOLLOW, 0o666 & ~_umask())
+            except FileExistsError:  # another run's, or one left behind: held if its flock is
+                fd = os.open(lock, os.O_RDWR | _NOFOLLOW | getattr(os, "O_NONBLOCK", 0))
+        except FileNotFoundError:
+            if not parent.is_dir():
+                raise OutputError(f"{path}: parent folder {parent} does not exist") from None
+            continue  # released between the two opens: create it again
+        except OSError as exc:
+            if exc.errno == errno.ELOOP or os.path.islink(lock):
+                raise planted from None
+            raise _oserror(path, exc, "cannot lock") from None
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            os.close(fd)
+            raise planted
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError as exc:
+            os.close(fd)
+            if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                raise busy from None
+            raise _oserror(path, exc, "cannot lock") from None
+        try:  # the holder before us may have removed the file after we opened it: lock the new one
+            if os.fstat(fd).st_ino == os.lstat(lock).st_ino:
+                return fd
+        except FileNotFoundError:
+            pass
+        os.close(fd)
+    raise busy
 
 
 def _replaceable(path: Path) -> bool:
