@@ -143,10 +143,12 @@ def _say(message: str, status: int) -> int:
 
 def _run(args) -> int:
     """Run the parsed command; every way it can end becomes one line on stderr and an exit status."""
+    from .core.files import inputs_of_run
+
     formatwarning = warnings.formatwarning
     restore = _signals_end_cleanly()
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), inputs_of_run():  # outputs keep clear of every file the run reads
             warnings.simplefilter("default")
             warnings.formatwarning = lambda m, c, *a, **k: f"warning: {one_line(m)}\n"
             for path in args.load:

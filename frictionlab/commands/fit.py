@@ -98,14 +98,19 @@ def parse_fix(law, items) -> dict:
 
 
 def run(args) -> int:
+    from ..core.files import check_apart
     from ..inference.fitting import fit
+    from ..io.dataset import load_dataset
     from ..physics.registry import get_law
     from ..report import fit_json as _fit_json
 
     law = get_law(args.law)
     if args.json and not args.json.parent.is_dir():  # before the work, not after
         raise OutputError(f"{args.json}: cannot write: folder {args.json.parent} does not exist")
-    result = fit(law, args.datasets, solver=args.solver, free=parse_free(args.free), fixed=parse_fix(law, args.fix),
+    datasets = [load_dataset(d) for d in args.datasets]
+    if args.json:
+        check_apart(args.json)  # never over a file the fit reads
+    result = fit(law, datasets, solver=args.solver, free=parse_free(args.free), fixed=parse_fix(law, args.fix),
                  local=args.local, observable=args.observable, derive=args.derive, timeout=args.fit_timeout)
     if result.status == "skipped":  # asked for explicitly, an inapplicable solver is an error, not a skip
         raise SolverError(result.reason)

@@ -38,6 +38,40 @@ MAX_TOML_DEPTH = 16
 MARKER = ".frictionlab-output"
 
 
+# --- what a run reads -----------------------------------------------------------------------
+_runs: list[set[str]] = []  # while a command runs (inputs_of_run), the real paths of the files it read
+
+
+@contextmanager
+def inputs_of_run():
+    """Collect, for the block (one command), the real path of every file read through this module or
+    named by ``note_input``; outputs checked in the block (``check_apart``) must keep clear of them."""
+    _runs.append(set())
+    try:
+        yield _runs[-1]
+    finally:
+        _runs.pop()
+
+
+def note_input(path) -> None:
+    """Record ``path`` as read by the running command (a plugin file, a dataset)."""
+    if _runs:
+        _runs[-1].add(os.path.realpath(path))
+
+
+def check_apart(path, inputs=()) -> None:
+    """Raise OutputError if the output ``path`` (real path) is, contains or lies inside a file the running
+    command reads (see inputs_of_run) or one of ``inputs``: a run never writes over, into or instead of
+    what it reads, and ``--force`` never removes it."""
+    real = os.path.realpath(path)
+    read = set(_runs[-1] if _runs else ()) | {os.path.realpath(p) for p in inputs}
+    for inp in sorted(read):
+        how = ("is" if inp == real else "contains" if inp.startswith(real.rstrip(os.sep) + os.sep)
+               else "lies inside" if real.startswith(inp + os.sep) else "")
+        if how:
+            raise OutputError(f"{path}: this output {how} {inp}, which the run reads; choose another output path")
+
+
 # --- reading --------------------------------------------------------------------------------
 def _kind(mode: int) -> str:
     for test, name in ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
@@ -51,6 +85,7 @@ def read_bytes(path, limit: int, within=None, error=DatasetError) -> bytes:
     """The bytes of the regular file ``path``, at most ``limit`` of them; ``within``: a folder the
     file's real path must lie in. Raises ``error`` with a one-line message naming the path."""
     path = Path(path)
+    note_input(path)
     if within is not None:
         real, base = os.path.realpath(path), os.path.realpath(within)
         if os.path.commonpath([real, base]) != base:
@@ -164,6 +199,7 @@ def check_writable(path) -> Path:
     """Raise OutputError unless a file can be written at ``path`` (its folder exists and is a folder)."""
     path = Path(path)
     parent = path.parent if str(path.parent) else Path(".")
+    check_apart(path)
     if not parent.exists():
         raise OutputError(f"{path}: folder {parent} does not exist")
     if not parent.is_dir():
@@ -281,6 +317,7 @@ def _replaceable(path: Path) -> bool:
 def check_target(path, force: bool = False) -> Path:
     """Raise OutputError unless an output folder may be created (or, with ``force``, replaced) at ``path``."""
     path = Path(path)
+    check_apart(path)
     if os.path.lexists(path):
         if not force:
             raise OutputError(f"{path}: output folder exists; choose another --out or pass --force")

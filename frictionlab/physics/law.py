@@ -173,6 +173,9 @@ class FrictionLaw:
         p = self.defaults()
         for name, value in (values or {}).items():
             s = self.spec(name)
+            if isinstance(value, (bool, np.bool_)):  # True is not 1 m
+                raise ParameterError(f"law '{self.name}': {name} = {value!r} is a boolean, not a number "
+                                     f"(SI value in {s.unit or 'plain units'})")
             try:
                 v = float(value)
             except (TypeError, ValueError):

@@ -20,6 +20,7 @@ import attrs
 import numpy as np
 
 from ..core.errors import FrictionLabError, LawError, RegistryError
+from ..core.files import note_input
 from ..core.names import check_name
 from .law import (
     QUANTITIES,
@@ -285,6 +286,7 @@ def load_law_file(path) -> None:
     from pathlib import Path
 
     p = Path(path)
+    note_input(p)
     if p.suffix != ".py":
         raise RegistryError(f"--load {path}: expected a Python file ending in .py")
     try:

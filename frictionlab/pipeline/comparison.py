@@ -31,6 +31,7 @@ import attrs
 import numpy as np
 
 from ..core.errors import FrictionLabError, ParameterError
+from ..core.arguments import as_items
 from ..core.workers import process_pool
 from ..inference import equivalence as _equivalence
 from ..inference import transfer as _transfer
@@ -282,7 +283,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
         if isinstance(r, bool) or not isinstance(r, (int, float)) or not 0 < r < 1:
             raise ParameterError(f"compare: every tolerance must be a number in (0, 1), got {r!r}")
     law_names = select_laws(laws)
-    dss = _unique_datasets(load_dataset(d) for d in (datasets if datasets is not None else builtin_names()))
+    dss = _unique_datasets(load_dataset(d) for d in (as_items(datasets, "compare: datasets") if datasets is not None
+                                                     else builtin_names()))
     if not dss:
         raise FrictionLabError("compare: no datasets to compare")
     skipped_ds, plan, fits, no_law = {}, [], [], set()

@@ -30,12 +30,14 @@ and add ``mysection`` to ``SECTIONS`` at the place it belongs. Return None to le
 from __future__ import annotations
 
 import json
+import os
 import threading
 from concurrent.futures import as_completed
 from pathlib import Path
 
 import attrs
 
+from ..core.arguments import check_type
 from ..core.errors import OutputError
 from ..core.files import atomic_dir
 from . import (
@@ -131,6 +133,10 @@ def write_report(c, out, force: bool = False, progress=None, jobs: int = 1) -> P
     progress(done, total, label), if given, is called after each figure and file. jobs: worker
     processes drawing the figures (the same PNG bytes as one process draws).
     """
+    from ..pipeline.comparison import Comparison
+
+    check_type(c, Comparison, "write_report: c", "a Comparison (what frictionlab.compare returns)")
+    check_type(out, (str, os.PathLike), "write_report: out", "a folder path")
     out = Path(out)
     if out.exists() and not force:  # said in Python's terms; the command line checks before its work
         raise OutputError(f"{out}: the folder exists; pass force=True to replace it, or choose another folder")
