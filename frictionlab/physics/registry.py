@@ -39,6 +39,8 @@ class PluginWarning(UserWarning):
     """A law plugin was skipped."""
 
 
+#: numpy's error state before any plugin ran: entry points are loaded and probed in it.
+_NUMPY_STATE = np.geterr()
 _laws: dict[str, FrictionLaw] = {}
 _sources: dict[str, str] = {}
 _runtime: list[tuple[FrictionLaw, str]] = []
@@ -179,11 +181,12 @@ def _load() -> None:
             seen.add(key)
             source = f"entry point '{ep.name} = {ep.value}' of {dist_name}"
             try:
-                try:
-                    obj = ep.load()
-                except FrictionLabError as exc:  # e.g. a degenerate ParamSpec or StateSpec at import
-                    raise LawError(f"law plugin {source}: {exc}") from None
-                law = _as_law(obj, source)
+                with np.errstate(**_NUMPY_STATE):  # as before any plugin, whatever one set; restored after
+                    try:
+                        obj = ep.load()
+                    except FrictionLabError as exc:  # e.g. a degenerate ParamSpec or StateSpec at import
+                        raise LawError(f"law plugin {source}: {exc}") from None
+                    law = _as_law(obj, source)
             except FrictionLabError as exc:
                 warnings.warn(f"frictionlab: skipped law plugin: {exc}", PluginWarning, stacklevel=3)
                 continue
@@ -301,7 +304,8 @@ def load_law_file(path) -> None:
     module = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = module
     try:
-        spec.loader.exec_module(module)
+        with np.errstate():  # a plugin's np.seterr at import stays in the plugin (restored after)
+            spec.loader.exec_module(module)
     except FrictionLabError as exc:
         del sys.modules[spec.name]
         msg = str(exc)
