@@ -13,10 +13,11 @@ import signal
 import sys
 import threading
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from multiprocessing import get_context
 
-from .errors import Terminated
+from .errors import FrictionLabError, Terminated
 
 #: Allocations between two collections of the youngest generation during a long run (Python's default is
 #: 700): a fit's short-lived objects are mostly freed by reference counting before a collection finds them.
@@ -61,13 +62,15 @@ def _on_sigterm(signum, frame):
 
 
 @contextmanager
-def process_pool(jobs: int):
-    """A process pool of ``jobs`` forked workers, or None (run here) for one job or without fork.
+def process_pool(jobs: int, stage: str = "frictionlab"):
+    """A process pool of ``jobs`` forked workers, or None (run here) for one job, without fork, or
+    where the pool cannot start (a read-only /dev/shm: a warning says so and the run goes on as --jobs 1).
 
     On any exception, ^C (KeyboardInterrupt) and SIGTERM included, the workers are terminated and
     reaped before the exception goes on: no worker outlives the call. SIGTERM becomes the exception
     ``errors.Terminated`` while the pool lives (when called from the main thread and nothing else
-    handles SIGTERM).
+    handles SIGTERM). A worker lost (killed, out of memory, a plugin ending its process) is a
+    FrictionLabError naming ``stage``.
     """
     try:
         ctx = get_context("fork") if jobs > 1 else None
@@ -84,20 +87,39 @@ def process_pool(jobs: int):
     # passes (the workers' and the parent's) skip it instead of touching, and so copying, every page of it
     frozen = gc.get_freeze_count()  # a caller's freeze (long_run_gc) is the caller's to undo
     gc.freeze()
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init,
-                               initargs=(os.getpid(),))
+    pool = _start(jobs, ctx)
     try:
         yield pool
-    except BaseException:
+    except BrokenProcessPool:
         _stop(pool)
+        raise FrictionLabError(f"{stage}: a worker process was lost (killed, out of memory, or a law plugin "
+                               "that ends its process)") from None
+    except BaseException:
+        if pool is not None:
+            _stop(pool)
         raise
     else:
-        pool.shutdown(wait=True)
+        if pool is not None:
+            pool.shutdown(wait=True)
     finally:
         if not frozen:
             gc.unfreeze()
         if handle:
             signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def _start(jobs: int, ctx) -> ProcessPoolExecutor | None:
+    """The pool, or None with a warning where it cannot start (no semaphores: /dev/shm read-only or missing)."""
+    try:
+        return ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init,
+                                   initargs=(os.getpid(),))
+    except (OSError, ImportError, NotImplementedError) as exc:
+        import warnings
+
+        why = getattr(exc, "strerror", None) or exc
+        warnings.warn(f"cannot start worker processes ({why}; they need shared memory in /dev/shm); "
+                      "running with --jobs 1", RuntimeWarning, stacklevel=4)
+        return None
 
 
 def _stop(pool: ProcessPoolExecutor) -> None:

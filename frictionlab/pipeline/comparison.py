@@ -325,7 +325,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             from ..solve.compiled import available
 
             available()
-    with process_pool(jobs) as pool:
+    with process_pool(jobs, "compare") as pool:
         t0 = time.perf_counter()
         results, done = _run(plan, functools.partial(_fit_task, timeout=fit_timeout), pool, progress, 0, total,
                              label)

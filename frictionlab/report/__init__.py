@@ -115,7 +115,7 @@ def _drawn(figs, jobs: int):
     with _DRAWING:
         _FIGURES[:] = figs
         try:
-            with process_pool(jobs) as pool:
+            with process_pool(jobs, "report: drawing the figures") as pool:
                 if pool is None:  # no fork on this platform
                     for i, f in enumerate(figs):
                         yield i, f.draw()
