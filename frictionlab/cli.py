@@ -199,11 +199,45 @@ def _signals_end_cleanly():
         return lambda: None
 
     def on_signal(signum, frame):
+        if not caught:  # a plugin's bare except: may swallow the exception: then end anyway, cleanly
+            timer = threading.Timer(HARD_EXIT_AFTER, _hard_exit, (signum,))
+            timer.daemon = True
+            timer.start()
+            caught.append(timer)
+        else:
+            _hard_exit(signum)
         raise Terminated(signum)
 
+    caught = []
     sigs = [s for s in (getattr(signal, "SIGTERM", None), getattr(signal, "SIGHUP", None)) if s is not None]
     old = {s: signal.signal(s, on_signal) for s in sigs}
-    return lambda: [signal.signal(s, h) for s, h in old.items()]
+
+    def restore():
+        for t in caught:
+            t.cancel()
+        for s, h in old.items():
+            signal.signal(s, h)
+    return restore
+
+
+#: Seconds after SIGTERM or SIGHUP before the process ends even if the exception raised was swallowed.
+HARD_EXIT_AFTER = 3.0
+
+
+def _hard_exit(signum: int) -> None:
+    """End now: temporary output and locks removed, one line said; workers end with us (PDEATHSIG)."""
+    import os
+
+    from .core.errors import Terminated
+    from .core.files import remove_leftovers
+
+    remove_leftovers()
+    try:
+        sys.stderr.write(f"frictionlab: {Terminated(signum).word()}\n")
+        sys.stderr.flush()
+    except Exception:  # noqa: BLE001 (nothing more can be said)
+        pass
+    os._exit(128 + int(signum))
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -99,7 +99,7 @@ def parse_fix(law, items) -> dict:
 
 def run(args) -> int:
     from ..core.files import check_apart
-    from ..inference.fitting import fit
+    from ..pipeline.budget import fit_within_budget
     from ..io.dataset import load_dataset
     from ..physics.registry import get_law
     from ..report import fit_json as _fit_json
@@ -110,7 +110,7 @@ def run(args) -> int:
     datasets = [load_dataset(d) for d in args.datasets]
     if args.json:
         check_apart(args.json)  # never over a file the fit reads
-    result = fit(law, datasets, solver=args.solver, free=parse_free(args.free), fixed=parse_fix(law, args.fix),
+    result = fit_within_budget(law, datasets, solver=args.solver, free=parse_free(args.free), fixed=parse_fix(law, args.fix),
                  local=args.local, observable=args.observable, derive=args.derive, timeout=args.fit_timeout)
     if result.status == "skipped":  # asked for explicitly, an inapplicable solver is an error, not a skip
         raise SolverError(result.reason)

@@ -211,20 +211,44 @@ def check_writable(path) -> Path:
     return path
 
 
+_leftovers: set[str] = set()  # temporary files and folders, and locks, of this process not yet removed
+
+
+def _remove(path: str) -> None:
+    if os.path.isdir(path) and not os.path.islink(path):
+        shutil.rmtree(path, ignore_errors=True)
+    else:
+        try:
+            os.unlink(path)
+        except OSError:
+            pass
+    _leftovers.discard(path)
+
+
+def remove_leftovers() -> None:
+    """Remove every temporary file, folder and lock this process made and has not removed yet (for an
+    exit that cannot run the normal clean-up: a plugin that swallowed SIGTERM)."""
+    for path in list(_leftovers):
+        _remove(path)
+
+
 def atomic_write_bytes(path, data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file in the same folder, then rename."""
     path = check_writable(path)
     tmp = None
     try:
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        _leftovers.add(tmp)
         os.fchmod(fd, 0o666 & ~_umask())
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
         os.replace(tmp, path)
+        _leftovers.discard(tmp)
     except OSError as exc:
-        if tmp is not None and os.path.exists(tmp):
-            os.unlink(tmp)
         raise _oserror(path, exc) from None
+    finally:  # on any exit, ^C and SIGTERM included
+        if tmp is not None and tmp in _leftovers:
+            _remove(tmp)
 
 
 def atomic_write_text(path, text: str) -> None:
@@ -254,14 +278,12 @@ def output_lock(path):
                        "wait for it to finish or choose another --out")
     fd = _take_lock(lock, path, parent, busy)
     _held[key] = 1
+    _leftovers.add(str(lock))
     try:
         yield
     finally:
         del _held[key]
-        try:
-            os.unlink(lock)
-        except OSError:
-            pass
+        _remove(str(lock))
         os.close(fd)
 
 
@@ -350,6 +372,7 @@ def atomic_dir(path, force: bool = False, marker: str = "frictionlab output\n"):
             tmp = Path(tempfile.mkdtemp(dir=parent, prefix=f".{path.name}.", suffix=".tmp"))
         except OSError as exc:
             raise _oserror(path, exc) from None
+        _leftovers.add(str(tmp))
         try:
             try:
                 os.chmod(tmp, 0o777 & ~_umask())
@@ -363,6 +386,7 @@ def atomic_dir(path, force: bool = False, marker: str = "frictionlab output\n"):
             try:
                 if os.path.lexists(path):
                     old = Path(tempfile.mkdtemp(dir=parent, prefix=f".{path.name}.", suffix=".old"))
+                    _leftovers.add(str(old))
                     os.replace(path, old / "x")
                 os.replace(tmp, path)
             except OSError as exc:
@@ -371,9 +395,9 @@ def atomic_dir(path, force: bool = False, marker: str = "frictionlab output\n"):
                 raise _oserror(path, exc) from None
             finally:
                 if old is not None:
-                    shutil.rmtree(old, ignore_errors=True)
+                    _remove(str(old))
         finally:
-            shutil.rmtree(tmp, ignore_errors=True)
+            _remove(str(tmp))
 
 
 def _fix_modes(folder: Path) -> None:

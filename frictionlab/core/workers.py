@@ -139,3 +139,88 @@ def _stop(pool: ProcessPoolExecutor) -> None:
     manager = getattr(pool, "_executor_manager_thread", None)
     if manager is not None:
         manager.join(5)
+
+
+class OverBudget(Exception):
+    """A call run by ``bounded`` ran past its limit; its process was ended."""
+
+
+def bounded(fn, limit: float, *args):
+    """``fn(*args)`` run in a forked child process that is ended (SIGKILL) once it has run ``limit``
+    seconds: a time budget enforced from outside the code it bounds (a plugin's ``except:`` cannot keep
+    it). The result or the exception comes back pickled; OverBudget past the limit. Runs here where
+    there is no fork."""
+    import pickle
+    import select
+    import time
+
+    if not hasattr(os, "fork"):
+        return fn(*args)
+    read, write = os.pipe()
+    with _quiet_fork():
+        pid = os.fork()
+    if pid == 0:  # the child: never returns into the caller's code
+        status = 0
+        try:
+            os.close(read)
+            _worker_init(os.getppid())
+            try:
+                payload = pickle.dumps((True, fn(*args)))
+            except BaseException as exc:  # noqa: BLE001 (sent back as it is)
+                payload = _pickled_error(exc)
+            with os.fdopen(write, "wb") as fh:
+                fh.write(payload)
+        except BaseException:  # noqa: BLE001
+            status = 1
+        finally:
+            os._exit(status)
+    os.close(write)
+    chunks, deadline = [], time.monotonic() + limit
+    try:
+        while True:
+            left = deadline - time.monotonic()
+            if left <= 0 or not select.select([read], [], [], left)[0]:
+                raise OverBudget(f"ran past {limit:g} s")
+            chunk = os.read(read, 1 << 16)
+            if not chunk:
+                break
+            chunks.append(chunk)
+    finally:
+        os.close(read)
+        _end(pid)
+    if not chunks:
+        raise OverBudget("its process ended without a result")
+    ok, value = pickle.loads(b"".join(chunks))
+    if ok:
+        return value
+    raise value
+
+
+def _pickled_error(exc: BaseException) -> bytes:
+    import pickle
+
+    try:
+        return pickle.dumps((False, exc))
+    except Exception:  # an exception that does not pickle: its type and text
+        return pickle.dumps((False, RuntimeError(f"{type(exc).__name__}: {exc}")))
+
+
+def _end(pid: int) -> None:
+    """Kill the child ``pid`` if it still runs, and reap it."""
+    try:
+        done, _ = os.waitpid(pid, os.WNOHANG)
+        if not done:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+    except ChildProcessError:
+        pass
+
+
+@contextmanager
+def _quiet_fork():
+    """Python warns when a process with threads forks; the child here only computes and exits."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", category=DeprecationWarning, message=".*fork.*")
+        yield

@@ -30,8 +30,8 @@ from concurrent.futures.process import BrokenProcessPool
 import attrs
 import numpy as np
 
-from ..core.errors import FrictionLabError, ParameterError
 from ..core.arguments import as_items
+from ..core.errors import FrictionLabError, ParameterError
 from ..core.workers import process_pool
 from ..inference import equivalence as _equivalence
 from ..inference import transfer as _transfer
@@ -62,6 +62,7 @@ from ..inference.transfer import (
 from ..inference.verdicts import make_answers, not_fitted_answers
 from ..io.dataset import Dataset, builtin_names, load_dataset
 from ..physics.registry import available_laws, get_law
+from .budget import fit_within_budget
 
 Progress = Callable[[int, int, str], None]
 
@@ -190,7 +191,7 @@ def no_law_applies(dataset: Dataset, skipped, solvers=None) -> str:
 def _fit_task(args, timeout=None) -> FitResult:
     law, dataset, solver, free = args
     try:
-        return fit(law, dataset, solver=solver, free=free, timeout=timeout)
+        return fit_within_budget(law, dataset, solver=solver, free=free, timeout=timeout)
     except FrictionLabError as exc:  # e.g. a freed scene quantity this scene does not have
         return FitResult(law=law, solver=solver, datasets=(dataset.name,), status="skipped", reason=str(exc))
 
