@@ -41,6 +41,9 @@ def long_run_gc(young: int = GC_YOUNG):
             gc.unfreeze()
 
 
+LOST = "a worker process was lost (killed, out of memory, or a law plugin that ends its process)"
+
+
 def _worker_init(parent: int) -> None:
     """In a worker: ^C goes to the parent, which stops the pool; SIGTERM ends the worker at once;
     and (on Linux) the worker gets SIGTERM when the parent dies, even by SIGKILL, so no worker
@@ -77,7 +80,10 @@ def process_pool(jobs: int, stage: str = "frictionlab"):
     except ValueError:  # no fork on this platform: run serially
         ctx = None
     if ctx is None:
-        yield None
+        try:
+            yield None
+        except BrokenProcessPool:  # a process of bounded() lost
+            raise FrictionLabError(f"{stage}: {LOST}") from None
         return
     handle = (threading.current_thread() is threading.main_thread()
               and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL)
@@ -92,8 +98,7 @@ def process_pool(jobs: int, stage: str = "frictionlab"):
         yield pool
     except BrokenProcessPool:
         _stop(pool)
-        raise FrictionLabError(f"{stage}: a worker process was lost (killed, out of memory, or a law plugin "
-                               "that ends its process)") from None
+        raise FrictionLabError(f"{stage}: {LOST}") from None
     except BaseException:
         if pool is not None:
             _stop(pool)
@@ -148,8 +153,8 @@ class OverBudget(Exception):
 def bounded(fn, limit: float, *args):
     """``fn(*args)`` run in a forked child process that is ended (SIGKILL) once it has run ``limit``
     seconds: a time budget enforced from outside the code it bounds (a plugin's ``except:`` cannot keep
-    it). The result or the exception comes back pickled; OverBudget past the limit. Runs here where
-    there is no fork."""
+    it). The result or the exception comes back pickled; OverBudget past the limit; BrokenProcessPool
+    if the child died without a result. Runs here where there is no fork."""
     import pickle
     import select
     import time
@@ -188,8 +193,8 @@ def bounded(fn, limit: float, *args):
     finally:
         os.close(read)
         _end(pid)
-    if not chunks:
-        raise OverBudget("its process ended without a result")
+    if not chunks:  # the child died (killed, or a plugin's os._exit): as a pool's lost worker
+        raise BrokenProcessPool("the process running it ended without a result")
     ok, value = pickle.loads(b"".join(chunks))
     if ok:
         return value
