@@ -309,7 +309,7 @@ def _take_lock(lock: Path, path: Path, parent: Path, busy: OutputError) -> int:
                 raise OutputError(f"{path}: parent folder {parent} does not exist") from None
             continue  # released between the two opens: create it again
         except OSError as exc:
-            if exc.errno in (errno.ELOOP, errno.EISDIR) or os.path.islink(lock):
+            if exc.errno == errno.ELOOP or os.path.islink(lock):
                 raise planted from None
             raise _oserror(path, exc, "cannot lock") from None
         if not stat.S_ISREG(os.fstat(fd).st_mode):
