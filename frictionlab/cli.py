@@ -143,7 +143,7 @@ def _say(message: str, status: int) -> int:
 
 def _run(args) -> int:
     """Run the parsed command; every way it can end becomes one line on stderr and an exit status."""
-    from .core.files import inputs_of_run
+    from .core.inputs import inputs_of_run
 
     formatwarning = warnings.formatwarning
     restore = _signals_end_cleanly()

@@ -98,7 +98,7 @@ def parse_fix(law, items) -> dict:
 
 
 def run(args) -> int:
-    from ..core.files import check_apart
+    from ..core.inputs import check_apart
     from ..core.workers import process_pool
     from ..io.dataset import load_dataset
     from ..pipeline.budget import fit_within_budget

@@ -20,7 +20,7 @@ import attrs
 import numpy as np
 
 from ..core.errors import FrictionLabError, LawError, RegistryError
-from ..core.files import note_input
+from ..core.inputs import note_input
 from ..core.names import check_name
 from .law import (
     QUANTITIES,

@@ -40,6 +40,7 @@ import attrs
 from ..core.arguments import check_type
 from ..core.errors import OutputError
 from ..core.files import atomic_dir
+from ..core.inputs import check_apart
 from . import (
     bootstrap,
     datasets,
@@ -137,6 +138,7 @@ def write_report(c, out, force: bool = False, progress=None, jobs: int = 1) -> P
 
     check_type(c, Comparison, "write_report: c", "a Comparison (what frictionlab.compare returns)")
     check_type(out, (str, os.PathLike), "write_report: out", "a folder path")
+    check_apart(out, [p for d in c.datasets if d.path is not None for p in (d.path, d.path.with_suffix(".csv"))])
     out = Path(out)
     if out.exists() and not force:  # said in Python's terms; the command line checks before its work
         raise OutputError(f"{out}: the folder exists; pass force=True to replace it, or choose another folder")
