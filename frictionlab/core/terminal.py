@@ -134,17 +134,20 @@ class TerminalStream:
         return getattr(self.unfiltered, attr)
 
 
-def reopen_closed_standard_fds() -> None:
+def reopen_closed_standard_fds() -> set[int]:
     """Open /dev/null on any of the file descriptors 0, 1, 2 that is closed (``2>&-``), so that no
-    file this run opens gets that number (and receives what is meant for the terminal)."""
+    file this run opens gets that number (and receives what is meant for the terminal); returns them."""
+    closed = set()
     for fd in (0, 1, 2):
         try:
             os.fstat(fd)
         except OSError:
+            closed.add(fd)
             new = os.open(os.devnull, os.O_RDWR)
             if new != fd:  # a lower one was closed too and took this open: the loop reaches it
                 os.dup2(new, fd)
                 os.close(new)
+    return closed
 
 
 class _Null:
@@ -163,10 +166,12 @@ class _Null:
 @contextmanager
 def guarded_streams():
     """Replace sys.stdout and sys.stderr by TerminalStream objects for the block; yields them."""
-    reopen_closed_standard_fds()
+    closed = reopen_closed_standard_fds()
     saved = sys.stdout, sys.stderr
     out = TerminalStream(sys.stdout if sys.stdout is not None else _Null(), "standard output")
     err = TerminalStream(sys.stderr if sys.stderr is not None else _Null(), "standard error")
+    if 1 in closed:  # nothing shown can reach anyone: said once at the end (core of the command line)
+        out.failure = OSError(errno.EBADF, "it is closed")
     sys.stdout, sys.stderr = out, err
     try:
         yield out, err
