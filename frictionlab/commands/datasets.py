@@ -97,12 +97,13 @@ def _import(args) -> int:
     import shlex
 
     from ..core.errors import OutputError, ParameterError
-    from ..core.files import atomic_write_text, check_name
+    from ..core.files import atomic_write_text
+    from ..core.names import check_name
     from ..core.units import to_si
     from ..io.dataset import load_dataset
     from ..io.velstep import velstep_dataset
 
-    check_name(args.name, "datasets import: --name")
+    check_name(args.name, "datasets import --name", OutputError)  # before any path is made of it
     if not 10 <= args.points <= 100_000 or not 1 <= args.steps <= 50:
         raise ParameterError("datasets import: --points must be 10 to 100000 and --steps 1 to 50")
     if not args.out.is_dir():
@@ -231,12 +232,13 @@ def _to_file_unit(d, column: str) -> float:
 
 def _template(args) -> int:
     from ..core.errors import OutputError
-    from ..core.files import atomic_write_text, check_name
+    from ..core.files import atomic_write_text
+    from ..core.names import check_name
     from ..io.template import template
 
+    check_name(args.name, "datasets template --name", OutputError)  # before any path is made of it
     if not args.out.is_dir():
         raise OutputError(f"{args.out}: folder does not exist")
-    check_name(args.name, "datasets template: --name")
     toml_path, csv_path = args.out / f"{args.name}.toml", args.out / f"{args.name}.csv"
     for p in (toml_path, csv_path):
         if p.exists() and not args.force:

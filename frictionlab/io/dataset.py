@@ -18,7 +18,8 @@ import attrs
 import numpy as np
 
 from ..core.errors import DatasetError, FrictionLabError
-from ..core.files import check_name, read_toml
+from ..core.files import read_toml
+from ..core.names import check_name
 from ..core.units import MAX_SI, check_text, check_time_scale, unit_factor
 from ..physics.scene import KINDS, Scene
 from .csvread import _line_of_row, read_csv
@@ -154,12 +155,12 @@ def from_meta(meta: dict, path: Path) -> Dataset:
 
 def _header(meta, path):
     """name, group, kind, observable and the [columns] units, checked against one another."""
-    name = check_name(_req(meta, "name", path), f"{path}: name")
+    name = check_name(_req(meta, "name", path), f"{path}: name", DatasetError)
     group = meta.get("group", "")
     if "group" in meta:
         if not isinstance(group, str):
             raise DatasetError(f"{path}: group = {group!r}, expected a quoted name (letters, digits, . _ + -)")
-        group = check_name(group, f"{path}: group")
+        group = check_name(group, f"{path}: group", DatasetError)
     kind = _req(meta, "kind", path)
     if kind not in DATA_KINDS:
         raise DatasetError(f"{path}: kind = {kind!r}, expected one of {', '.join(DATA_KINDS)}")

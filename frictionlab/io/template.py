@@ -10,7 +10,7 @@ from __future__ import annotations
 import tomllib
 
 from ..core.errors import DatasetError
-from ..core.files import check_name
+from ..core.names import check_name
 
 KINDS = ("impact", "incline", "impact-outcome", "spring-slider")
 
@@ -194,7 +194,7 @@ def template(kind: str, name: str = "my-data") -> tuple[str, str]:
 
     if kind not in KINDS:
         raise DatasetError(f"datasets template: kind {kind!r}; expected one of {', '.join(KINDS)}")
-    check_name(name, "datasets template: --name")
+    check_name(name, "datasets template: --name", DatasetError)
     toml = template_toml(kind, name)
     law, params = _LAW[kind][:2]
     method = tomllib.loads(toml)["provenance"]["method"]

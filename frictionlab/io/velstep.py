@@ -20,7 +20,8 @@ import attrs
 import numpy as np
 
 from ..core.errors import DatasetError
-from ..core.files import MAX_CSV_BYTES, check_name, read_text
+from ..core.files import MAX_CSV_BYTES, read_text
+from ..core.names import check_name
 
 #: Header names accepted for the four raw columns (case-insensitive; '_' or nothing between words).
 RAW_HEADER = (r"time\(s\)", r"displ(acement)?\(microns\)", r"friction", r"effective_?normal_?stress\(mpa\)")
@@ -194,7 +195,7 @@ def velstep_dataset(raw_path, name: str, *, steps: int = 1, points: int = 600, d
                     stiffness: float | None = None, source: str = "", license: str = "", citation: str = "",
                     command: str = "") -> tuple[str, str, Imported]:
     """(TOML text, CSV text, what was found) of a measured spring-slider dataset from one raw record."""
-    check_name(name, "datasets import: --name")
+    check_name(name, "datasets import: --name", DatasetError)
     raw = read_raw(raw_path)
     imp = analyse(raw, steps, points, detrend, stiffness)
     toml = velstep_toml(name, raw, imp, source=source, license=license, citation=citation, command=command)
