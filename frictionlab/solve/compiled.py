@@ -20,7 +20,7 @@ against the numpy engine to 1e-12. The kernel's right-hand side ``_rhs`` is the 
 forms' derivatives as ``Plan.derivatives`` computes them (branch slip included); it is the one place
 physics is written here, and the tests check it against ``Plan.derivatives``.
 
-``scatter_stuck`` does the bookkeeping of ``batch._fill_stuck`` (which outputs a stuck phase owns, and
+``scatter_stuck`` does the bookkeeping of ``batchstick.fill_stuck`` (which outputs a stuck phase owns, and
 writing them) in one compiled pass for the same batches; the stuck states themselves come from
 ``solvers.stick.stuck_states``.
 
@@ -160,7 +160,7 @@ def prepare(law, plan, p, n: int):
         put(NORMAL_TC, s.normal.contact_time)
     elif normal == CONSTANT:
         put(NORMAL_CONST, s.normal.value)
-    # breaks as ``batch._breaks`` takes them: every half-sine model's end of contact, read or not
+    # breaks as ``batchrk.breaks`` takes them: every half-sine model's end of contact, read or not
     put(BREAK_AREA, getattr(s.area, "contact_time", np.nan))
     put(BREAK_NORMAL, getattr(s.normal, "contact_time", np.nan))
     need_dadt = code == FORM_NAR and bool(np.any(np.asarray(c) != 0.0))
@@ -196,7 +196,7 @@ class Prepared:
 
     def integrate(self, ids, t0, y0, direction, span, scale, T, method, rtol, atol=None, out=None) -> vecrk.Result:
         """One sliding phase of scenes ``ids`` (positions in the chunk) on the scaled problem, as
-        ``batch._slide_rk`` with ``vecrk.integrate``: t0 (n,) [s], y0 (d, n), direction (n,), span (n,) [s] and
+        ``batchrk.slide_rk`` with ``vecrk.integrate``: t0 (n,) [s], y0 (d, n), direction (n,), span (n,) [s] and
         scale (d, n) over the whole chunk; T (n, m) the chunk's output times [s]. The Result's Y is in the
         states' units (``scaled=False``), written into ``out`` (d, k, m) when given."""
         kern = _compiled().kernel
@@ -204,7 +204,7 @@ class Prepared:
         d, k, m = y0.shape[0], ids.size, T.shape[1]
         rel = np.linspace(0.0, 1.0, m)
         per_row = not (T.strides[0] == 0 and np.all(span[ids] == span[ids[0]]))
-        grid = np.ascontiguousarray(T) if per_row else (T[0] / span[ids[0]])[None, :]  # as batch._scaled_grid
+        grid = np.ascontiguousarray(T) if per_row else (T[0] / span[ids[0]])[None, :]  # as batchrk.scaled_grid
         Y = np.empty((d, k, m)) if out is None else out
         reached = np.empty((k, m), dtype=bool)  # every entry written
         t_event = np.full(k, np.nan)
@@ -227,7 +227,7 @@ class Prepared:
 
 
 def scatter_stuck(Ys, rows, Ts, t_from, t_to, done, stuck_mask, Y):
-    """``compiled_kernel.scatter_stuck`` (the bookkeeping of ``batch._fill_stuck``) for states Y (d, n, m)."""
+    """``compiled_kernel.scatter_stuck`` (the bookkeeping of ``batchstick.fill_stuck``) for states Y (d, n, m)."""
     d = Y.shape[0]
     _compiled().scatter_stuck(np.ascontiguousarray(Ys), np.ascontiguousarray(rows, dtype=np.int64),
                               np.ascontiguousarray(Ts), np.ascontiguousarray(t_from, dtype=float),

@@ -143,7 +143,7 @@ def kernel(A, B, Cn, E, AX, CX, D, order, exponent, dop, codes, cols, ids, t0a, 
     into t_event[i], y_event[:, i], evaluations into nfev[i]; a failure into stat. Returns the most
     step attempts of a scene. Output times: grid[0] (scaled) for every scene, or with per_row each scene's
     row of grid (times [s], the chunk's rows), taken as exactly ``rel`` where it is span * rel (as
-    ``batch._scaled_grid`` takes them), else divided by the span."""
+    ``batchrk.scaled_grid`` takes them), else divided by the span."""
     d = y0a.shape[0]
     k = ids.size
     m = grid.shape[1]
@@ -405,7 +405,7 @@ def kernel(A, B, Cn, E, AX, CX, D, order, exponent, dop, codes, cols, ids, t0a, 
 
 @numba.njit(cache=True)
 def scatter_stuck(Ys, rows, Ts, t_from, t_to, done, stuck_mask, Y0, Y1, Y2):
-    """Bookkeeping of ``batch._fill_stuck`` in one pass: the stuck states Ys (d, k, m) of scenes rows at
+    """Bookkeeping of ``batchstick.fill_stuck`` in one pass: the stuck states Ys (d, k, m) of scenes rows at
     their output times Ts (k, m) into the outputs of those scenes in [t_from, t_to] not yet done (rows
     of Y0, Y1, Y2), marking them done and stuck. No physics: Ys comes from ``stick.stuck_states``."""
     d = Ys.shape[0]
