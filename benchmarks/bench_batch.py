@@ -423,11 +423,11 @@ def dense_share(args, rng):
     """How much of the batch's time goes to filling outputs from the dense interpolant."""
     from frictionlab.solve import vecrk
 
-    print(f"\n[dense output] numpy engine: share of batch DOP853 time in vecrk._dense and vecrk._fill_dense, "
+    print(f"\n[dense output] numpy engine: share of batch DOP853 time in vecrk.dense_output and vecrk.fill_dense, "
           f"{args.n} scenes x {NT}")
     for fam, law in ((coulomb_family, "coulomb"), (wear_family, "wear")):
         b, p = fam(args.n, rng)
-        spent = {"_dense": 0.0, "_fill_dense": 0.0}
+        spent = {"dense_output": 0.0, "fill_dense": 0.0}
         orig = {k: getattr(vecrk, k) for k in spent}
 
         def timed(k):
@@ -447,8 +447,8 @@ def dense_share(args, rng):
         finally:
             for k, f in orig.items():
                 setattr(vecrk, k, f)
-        print(f"  {law:8s}: {t:.3f} s, interpolant {spent['_dense'] / t:.0%}, filling outputs "
-              f"{spent['_fill_dense'] / t:.0%}")
+        print(f"  {law:8s}: {t:.3f} s, interpolant {spent['dense_output'] / t:.0%}, filling outputs "
+              f"{spent['fill_dense'] / t:.0%}")
 
 
 def main(argv=None):

@@ -88,7 +88,7 @@ def _constants(cols, g):
 
 @jit
 def _comb(coef, K, nterm):
-    """sum_j coef[j] K[j] over the nonzero coefficients, added in order (as ``vecrk._vec_dot``)."""
+    """sum_j coef[j] K[j] over the nonzero coefficients, added in order (as ``vecdense.vec_dot``)."""
     a0 = a1 = a2 = 0.0
     first = True
     for j in range(nterm):
@@ -106,7 +106,7 @@ def _comb(coef, K, nterm):
 
 @jit
 def _dense(Fc, nc, dop, x, h, y0, y1, y2):
-    """The step's dense output at fraction x (``vecrk._Dense``: DOP853's nested x, 1 - x products, or
+    """The step's dense output at fraction x (``vecdense.Dense``: DOP853's nested x, 1 - x products, or
     RK45's polynomial times h)."""
     a0, a1, a2 = Fc[nc - 1, 0] * x, Fc[nc - 1, 1] * x, Fc[nc - 1, 2] * x
     if dop:
@@ -310,7 +310,7 @@ def kernel(A, B, Cn, E, AX, CX, D, order, exponent, dop, codes, cols, ids, t0a, 
                 stop = g_new <= 0.0 and g_old > 0.0
                 g_old = g_new
                 if stop or (ptr < m and gr[ptr] <= t_new):
-                    if dop:  # DOP853's extra stages and interpolant (vecrk._dense)
+                    if dop:  # DOP853's extra stages and interpolant (vecdense.dense_output)
                         for j in range(nx):
                             sx = ns + 1 + j
                             c0, c1, c2 = _comb(AX[j], K, sx)
