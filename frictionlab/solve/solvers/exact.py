@@ -143,12 +143,17 @@ def _bessel_series(b, phi, t):
     coef = 2.0 * w[1:] / (k[1:] * phi)
     x = phi * t
     out = w[0] * t
-    two_cos = 2.0 * np.cos(x)
-    s_prev, s_k = np.zeros_like(x), np.sin(x)
-    for j in range(last):
-        out = out + coef[j] * s_k
-        if j + 1 < last:
-            s_prev, s_k = s_k, two_cos * s_k - s_prev
+    out = out if out.shape == x.shape else np.broadcast_to(out, x.shape).copy()
+    two_cos = np.cos(x)
+    two_cos *= 2.0
+    s_prev, s_k, tmp = np.zeros_like(x), np.sin(x), np.empty_like(x)
+    for j in range(last):  # in place: the grid's arrays are the memory traffic, the same numbers as plainly
+        np.multiply(coef[j], s_k, out=tmp)
+        out += tmp
+        if j + 1 < last:  # s_prev becomes sin((k+1)x)
+            np.multiply(two_cos, s_k, out=tmp)
+            np.subtract(tmp, s_prev, out=s_prev)
+            s_prev, s_k = s_k, s_prev
     return out
 
 
