@@ -1,4 +1,4 @@
-"""The process pool every parallel stage runs on (``compare``'s fits, tests and bootstrap; the report's figures).
+"""The process pool (or Dask cluster) every parallel stage runs on (``compare``'s fits, tests and bootstrap; the report's figures).
 
 ``process_pool(jobs)`` is a context manager yielding a ``ProcessPoolExecutor`` of ``jobs`` forked
 workers, or None (run in this process) for one job or where fork is unavailable. Workers are
@@ -117,3 +117,37 @@ def _stop(pool: ProcessPoolExecutor) -> None:
     manager = getattr(pool, "_executor_manager_thread", None)
     if manager is not None:
         manager.join(5)
+
+
+@contextmanager
+def executor(jobs: int, client=None):
+    """Where a run's tasks go: a dask.distributed ``client``'s workers (``client.get_executor``: futures of
+    ``concurrent.futures``; tasks and their arguments are pickled, never hashed) or, without one,
+    ``process_pool(jobs)`` (None: run here). The client is the caller's: it stays open afterwards; on any
+    exception the run's queued tasks are cancelled."""
+    if client is None:
+        with process_pool(jobs) as pool:
+            yield pool
+        return
+    ex = client.get_executor(pure=False)
+    try:
+        yield ex
+    except BaseException:
+        ex.shutdown(wait=False)
+        raise
+    else:
+        ex.shutdown(wait=True)
+
+
+def connect(address: str):
+    """A dask.distributed Client of the scheduler at ``address`` (e.g. tcp://host:8786), or a one-line error."""
+    from .errors import ParameterError
+
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ParameterError("--scheduler needs dask.distributed: pip install 'frictionlab[dask]'") from None
+    try:
+        return Client(address, timeout="10s")
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise ParameterError(f"--scheduler {address}: cannot connect to a Dask scheduler there ({exc})") from None

@@ -99,10 +99,17 @@ def _draw(i: int) -> bytes:
 _DRAWING = threading.Lock()  # one report at a time hands its figures to forked workers through _FIGURES
 
 
-def _drawn(figs, jobs: int):
-    """(index, PNG bytes) of every figure, in the order they finish: on ``jobs`` forked workers when jobs > 1."""
-    from ..core.workers import process_pool
+def _drawn(figs, jobs: int, client=None):
+    """(index, PNG bytes) of every figure, in the order they finish: on ``jobs`` forked workers when jobs > 1,
+    or on a dask.distributed ``client``'s workers (the draw closures travel by cloudpickle)."""
+    from ..core.workers import executor, process_pool
 
+    if client is not None and len(figs) > 1:
+        with executor(1, client) as ex:
+            futures = {ex.submit(f.draw): i for i, f in enumerate(figs)}
+            for fut in as_completed(futures):
+                yield futures[fut], fut.result()
+        return
     if jobs <= 1 or len(figs) <= 1:
         for i, f in enumerate(figs):
             yield i, f.draw()
@@ -125,11 +132,12 @@ def _drawn(figs, jobs: int):
             _FIGURES.clear()
 
 
-def write_report(c, out, force: bool = False, progress=None, jobs: int = 1) -> Path:
+def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, client=None) -> Path:
     """Write the report folder ``out`` whole or not at all; an existing folder is replaced only with force=True.
 
     progress(done, total, label), if given, is called after each figure and file. jobs: worker
-    processes drawing the figures (the same PNG bytes as one process draws).
+    processes drawing the figures (the same PNG bytes as one process draws); client: a dask.distributed
+    Client whose workers draw them instead.
     """
     out = Path(out)
     if out.exists() and not force:  # said in Python's terms; the command line checks before its work
@@ -139,7 +147,7 @@ def write_report(c, out, force: bool = False, progress=None, jobs: int = 1) -> P
         figs = [f for s in sections for f in s.figures]
         total, images = len(figs) + 1, {}
         (tmp / "figures").mkdir()
-        for done, (i, png) in enumerate(_drawn(figs, jobs), 1):
+        for done, (i, png) in enumerate(_drawn(figs, jobs, client), 1):
             images[figs[i].name] = png
             (tmp / "figures" / figs[i].name).write_bytes(png)
             if progress:
