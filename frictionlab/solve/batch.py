@@ -23,7 +23,8 @@ Solvers:
 Tolerances act on the same scaled problem as ``solvers.ode`` (time by the span, states by
 ``ode.state_scales``), so rtol means what it means for ``simulate(..., solver='ode:...')``;
 with the same method the batch takes the same steps as solve_ivp (tests check the errors match).
-``simulate_sweep`` runs a batch in chunks on an executor (local, concurrent.futures or Dask).
+``sweep.simulate_sweep`` runs a batch in chunks on an executor (local, concurrent.futures or Dask), streamed
+to disk as Parquet and reduced per chunk where it outgrows memory.
 
 Outputs: the default grid (n points over each scene's span) is one grid in scaled time, so the
 integrator evaluates each step's outputs as one block; beyond CHUNK scenes the batch runs in chunks
@@ -60,7 +61,7 @@ from .plan import make_plan
 from .scenebatch import SceneBatch, batch_params, take_params
 from .solvers import exact
 
-__all__ = ["SOLVERS", "CHUNK", "SceneBatch", "BatchResult", "batch_params", "simulate_batch", "simulate_sweep"]
+__all__ = ["SOLVERS", "CHUNK", "SceneBatch", "BatchResult", "batch_params", "simulate_batch"]
 
 SOLVERS = ("auto", "exact") + vecrk.METHODS
 #: Scenes per chunk of ``simulate_batch``: beyond this the batch runs in chunks written into the result,
@@ -179,42 +180,6 @@ def _chunked(law, batch, p, tgrid, solver, rtol, atol) -> BatchResult:
     return BatchResult(t=tgrid, solver="+".join(sorted(solvers)), law=law.name, info=info, v=states[0],
                        omega=states[plan.index("omega")] if spin else np.zeros((n, m)),
                        theta=states[plan.index("theta")] if spin else np.zeros((n, m)), **res)
-
-
-def simulate_sweep(law, scenes, params=None, t=None, solver: str = "auto", rtol: float = 1e-8,
-                   atol: float | None = None, n: int = 201, executor=None, chunk: int = 5000) -> BatchResult:
-    """``simulate_batch`` in chunks of ``chunk`` scenes, dispatched on ``executor`` (as in
-    ``frictionlab.inference.bootstrap``: None runs here; a concurrent.futures executor or a dask.distributed
-    Client spreads the chunks). Results are concatenated in scene order and equal the one-call result.
-    """
-    law = get_law(law)
-    batch = scenes if isinstance(scenes, SceneBatch) else SceneBatch.from_scenes(scenes)
-    p = batch_params(law, params, batch.n)
-    tgrid = _time_grid(batch, t, n)
-    chunk = max(1, int(chunk))
-    jobs = []
-    for start in range(0, batch.n, chunk):
-        sl = slice(start, min(start + chunk, batch.n))
-        args = (law.name, batch.subset(sl), take_params(p, sl), tgrid if tgrid.ndim == 1 else tgrid[sl], solver, rtol,
-                atol, n)
-        jobs.append(args)
-    if executor is None:
-        parts = [simulate_batch(*a) for a in jobs]
-    else:
-        parts = [f.result() for f in [executor.submit(simulate_batch, *a) for a in jobs]]
-    return _concat(parts, tgrid)
-
-
-def _concat(parts, tgrid) -> BatchResult:
-    def cat(name):
-        arrs = [getattr(r, name) for r in parts]
-        return None if any(a is None for a in arrs) else np.concatenate(arrs, axis=0)
-
-    info = {"chunks": len(parts), "solver_per_chunk": [r.solver for r in parts],
-            "nfev": int(sum(r.info.get("nfev", 0) for r in parts))}
-    return BatchResult(t=tgrid, u=cat("u"), v=cat("v"), omega=cat("omega"), theta=cat("theta"), force=cat("force"),
-                       stick_time=cat("stick_time"), A=cat("A"), N=cat("N"), solver=parts[0].solver, law=parts[0].law,
-                       info=info)
 
 
 def _time_grid(batch, t, n):
