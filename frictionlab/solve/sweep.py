@@ -83,7 +83,7 @@ def simulate_sweep(law, scenes, params=None, t=None, solver: str = "auto", rtol:
     try:
         import pyarrow.parquet
     except ImportError:
-        raise OutputError(f"{out}: writing a sweep to Parquet needs pyarrow: pip install pyarrow") from None
+        raise OutputError(f"{out}: writing a sweep to Parquet needs pyarrow: pip install 'frictionlab[parquet]'") from None
     del pyarrow  # imported to fail early, before any work; the chunks import it where they run
     with atomic_dir(out, force=force) as tmp:
         (tmp / "samples").mkdir()
