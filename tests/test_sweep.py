@@ -77,3 +77,14 @@ def test_bad_reduction_and_existing_folder(sweep_case, tmp_path):
     with pytest.raises(FrictionLabError, match="did not write"):
         simulate_sweep("coulomb", batch, p, n=21, out=tmp_path / "mine", force=True)
     assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"
+
+
+def test_reductions_keep_no_chunk_alive(sweep_case):
+    """A reduction that is a view (omega[:, -1]) is copied where the chunk runs: the per-scene arrays a chunk
+    sends back hold none of its samples (a sweep of many chunks would otherwise keep them all)."""
+    from frictionlab.solve.sweep import FIELDS, _chunk_task
+
+    batch, p = sweep_case
+    job = ("coulomb", batch, p, np.linspace(0.0, batch.template.duration, 41), "auto", 1e-8, None, 41)
+    _, per = _chunk_task(0, 0, job, None, lambda r: {"w": r.omega[:, -1]}, FIELDS)
+    assert all(a.base is None and a.shape == (11,) for a in per.values())

@@ -126,10 +126,10 @@ def _chunk_task(i, start, job, folder, reduce, fields):
 
     r = simulate_batch(*job)
     k = len(r)
-    per_scene = {"scene": np.arange(start, start + k, dtype=np.int64), "stick_time": np.asarray(r.stick_time)}
+    per_scene = {"scene": np.arange(start, start + k, dtype=np.int64), "stick_time": np.array(r.stick_time)}
     if reduce is not None:
         for name, v in dict(reduce(r)).items():
-            v = np.asarray(v)
+            v = np.array(v)  # a copy: a view (omega[:, -1]) would keep the chunk's whole states alive
             if v.shape != (k,):
                 raise SolverError(f"simulate_sweep: reduction '{name}' has shape {v.shape}, expected ({k},): one "
                                   "value per scene of the chunk")
