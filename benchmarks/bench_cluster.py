@@ -81,6 +81,19 @@ def one_run(dss, bootstrap, workers):
             return time.perf_counter() - t0, c
 
 
+def first_difference(a, b, path="") -> str:
+    """Where two results first differ (a JSON path and both values)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        for k in a.keys() | b.keys():
+            d = first_difference(a.get(k), b.get(k), f"{path}/{k}")
+            if d:
+                return d
+        return ""
+    if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+        return next((d for i, (x, y) in enumerate(zip(a, b)) if (d := first_difference(x, y, f"{path}[{i}]"))), "")
+    return "" if a == b else f"{path}: {str(a)[:200]!r} != {str(b)[:200]!r}"
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--datasets", type=int, default=20)
@@ -109,7 +122,8 @@ def main(argv=None):
             same = got == ref
             print(f"  {'local, 1 process' if w == 'local' else f'Dask, {w} worker process' + 'es' * (w > 1):28s} "
                   f"{t:6.1f} s wall; numbers {'equal to the first run' if same else 'DIFFER'}", flush=True)
-            assert same, "the numbers differ between runs"
+            if not same:
+                raise SystemExit("the numbers differ between runs: " + first_difference(ref, got))
     med = {k: statistics.median(v) for k, v in times.items()}
     r21, r1l = med[1] / med[2], med[1] / med["local"]
     print(f"median wall: local {med['local']:.1f} s, 1 worker {med[1]:.1f} s, 2 workers {med[2]:.1f} s")

@@ -14,10 +14,13 @@ OPTIONS = dict(laws=LAWS, datasets=DATA, bootstrap=12, tolerance=(1e-3,), replic
 def numbers(c):
     """Everything results.json records but the clocks (times, dates) and where it ran."""
     import json
+    import re
 
     from frictionlab.report import results_json
 
     def strip(x):
+        if isinstance(x, str):  # a sentence quoting a measured time ("its fit took 1.4 CPU s")
+            return re.sub(r"\d+(\.\d+)? (CPU )?s\b", "# s", x)
         if isinstance(x, dict):
             return {k: strip(v) for k, v in x.items()
                     if not any(w in k for w in ("time", "timings", "cpu", "wall", "created", "settings", "versions"))}
