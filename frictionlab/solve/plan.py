@@ -189,6 +189,11 @@ class Plan(CompliantPatch):
         (a scalar integrator's right-hand side): the dispatch to ``_one_state`` decided once, not per call."""
         direction = float(direction)
         if not self.law.states and "xi" not in self.states and self.scene.spring is None:
+            from .fastrhs import scalar_rhs
+
+            fast = scalar_rhs(self, p, direction)  # a built-in closed-form family on known models: floats only
+            if fast is not None:
+                return fast
             normal = self._fixed_normal()
             return lambda t, y: self._one_state(p, t, y, direction, normal)
         return lambda t, y: self.derivatives(p, t, y, direction)
