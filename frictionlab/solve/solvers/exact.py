@@ -312,7 +312,8 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
             return J, K, None
         return J, K, float(min(half_sine_stop(plan, form, u_s), T))
     grid = np.unique(np.concatenate([np.linspace(t0, T, SCAN), t]))
-    g = sgn * slip(grid) + margin
+    signed = sgn * slip(grid)
+    g = signed + margin
     bad = np.nonzero(g[1:] <= 0.0)[0]
     if bad.size == 0:
         return J, K, None
@@ -322,7 +323,7 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
                                                          xtol=xtol, rtol=rtol)
     # the margin only detects the stop; the stop itself is where slip is zero, found from the
     # last time slip was strictly of the phase's sign (the closed form is exact, keep it so)
-    ahead = np.nonzero(sgn * slip(grid[:i]) > 0.0)[0]
+    ahead = np.nonzero(signed[:i] > 0.0)[0]  # the scan's values, not evaluated again
     if ahead.size == 0:
         return J, K, t_margin
     lo = float(grid[int(ahead[-1])])
