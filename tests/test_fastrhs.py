@@ -44,7 +44,9 @@ def test_float_rhs_equals_the_general_one(law):
         plan = make_plan(scene, lw)
         p = lw.resolve(PARAMS[law])
         for direction in (0.0, 1.0, -1.0):
-            fast = fastrhs.scalar_rhs(plan, p, direction)
+            from frictionlab.solve.solvers.stick import vanishing_slip
+
+            fast = fastrhs.scalar_rhs(plan, p, direction, float(vanishing_slip(plan)))
             assert fast is not None, (law, scene.kind)
             for _ in range(20):
                 t = rng.uniform(-0.1, 1.2) * scene.duration

@@ -75,8 +75,10 @@ def _force(form, plan):
     return lambda t, x, u: (a * normal(t) + c * area(t, x, u)[1]) * ((u > 0.0) - (u < 0.0))
 
 
-def scalar_rhs(plan, p, direction: float):
-    """f(t, y) -> dy/dt for one state vector y of ``plan`` (see the module), or None where it does not apply."""
+def scalar_rhs(plan, p, direction: float, vanishing: float = 0.0):
+    """f(t, y) -> dy/dt for one state vector y of ``plan`` (see the module), or None where it does not apply.
+    vanishing: the slip [m/s] (``solvers.stick.vanishing_slip``) held while the phase's slip has not yet
+    got its direction's sign."""
     law, s = plan.law, plan.scene
     if (not type(law).__module__.startswith("frictionlab.laws.") or law.states or s.spring is not None
             or not set(plan.states) <= {"v", "omega", "theta", "x"}):
@@ -91,10 +93,7 @@ def scalar_rhs(plan, p, direction: float):
     coupled, spin = plan.coupled, plan.has_spin
     m, drive = float(s.mass), float(plan.drive)
     inertia = float(s.inertia) if spin else 1.0
-    if direction != 0.0:
-        from .solvers.stick import vanishing_slip
-
-        tiny = direction * float(vanishing_slip(plan))
+    tiny = direction * vanishing
     general = plan._one_state
 
     def rhs(t, y):

@@ -190,8 +190,10 @@ class Plan(CompliantPatch):
         direction = float(direction)
         if not self.law.states and "xi" not in self.states and self.scene.spring is None:
             from .fastrhs import scalar_rhs
+            from .solvers.stick import vanishing_slip
 
-            fast = scalar_rhs(self, p, direction)  # a built-in closed-form family on known models: floats only
+            tiny = float(vanishing_slip(self)) if direction != 0.0 else 0.0
+            fast = scalar_rhs(self, p, direction, tiny)  # a built-in closed-form family on known models: floats
             if fast is not None:
                 return fast
             normal = self._fixed_normal()
