@@ -49,7 +49,7 @@ BATCH_SIZE, QUICK_BATCH_SIZE = 10_000, 1_000  # scenes per batch: closed form an
 #: Methods timed per call (a solve's cost) and methods timed per scene in a batch (throughput): the diagrams
 #: draw them on separate axes.
 BATCH_COSTS = ("batch:", "exact")
-SINGLE_EXACT = "exact (one call)"
+SINGLE_EXACT = "exact, one call"
 ROUND_OFF = 1e-15  # errors below this are drawn as 'exact to round-off'
 MIN_LOOP = 0.02  # s of CPU per timed repeat
 REFERENCE_RTOL = 1e-13

@@ -25,6 +25,10 @@ def is_batch_cost(method: str) -> bool:
 
 def _draw(ax, rows, floor) -> None:
     """One line per method: error against median CPU time, bars from fastest to slowest repeat."""
+    if not any(r["status"] == "ok" for r in rows):
+        ax.text(0.5, 0.5, "no method of this kind applies to this law", ha="center", va="center",
+                transform=ax.transAxes, fontsize=9, color="#555555")
+        return
     for method in dict.fromkeys(r["method"] for r in rows):
         pts = [r for r in rows if r["method"] == method and r["status"] == "ok"]
         if not pts:
