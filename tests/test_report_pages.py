@@ -25,6 +25,7 @@ def test_many_groups_make_an_index_and_a_page_per_group(comparison, tmp_path, mo
         page = (out / "groups" / f"{g}.html").read_text()
         others = [n for h, names in groups.items() if h != g for n in names]
         assert all(n in page for n in groups[g]) and not any(n in page for n in others)
+        assert 'href="../report.html"' in page
         assert (out / "groups" / f"{g}.md").read_text().count(f"../figures/{g}/") >= 1
         assert list((out / "figures" / g).glob("*.png"))
     assert "groups/impact-golf.md" in (out / "report.md").read_text()

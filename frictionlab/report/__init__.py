@@ -188,6 +188,8 @@ def _built_pages(c):
         sections, more = build(cc, modules)
         if groups:
             sections.insert(len(sections) - 1, pages.index_section(groups))
+        elif sections:  # a group's page: the way back to the index first
+            sections[0].blocks.insert(0, ("links", [("all dataset groups (the index)", "../report.html")]))
         built.append((path, sections, figdir))
         for k, v in more.items():  # one level deep: numbers per dataset from every page
             extra[k] = {**extra.get(k, {}), **v} if isinstance(v, dict) else v
