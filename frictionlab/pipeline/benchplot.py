@@ -57,11 +57,9 @@ def _draw(ax, rows, floor) -> None:
 
 def plot_case(path, name, case, rows, env) -> None:
     """Two panels sharing the error axis: the cost of one solve (left) and of a scene in a batch (right)."""
-    import matplotlib
+    from ..core.display import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     fig, (left, right) = plt.subplots(1, 2, figsize=(12.0, 6.2), dpi=100, layout="constrained", sharex=True)
     floor = ROUND_OFF / 3
     meta = case["meta"]

@@ -14,7 +14,7 @@ from concurrent.futures.process import BrokenProcessPool
 import attrs
 
 from ..core.errors import FrictionLabError, ParameterError
-from ..core.workers import executor
+from ..core.cluster import executor
 from .planning import FitPlan
 from .settings import Settings
 
@@ -91,7 +91,7 @@ def run_stages(comparison, run: Run, stages: Sequence[Stage], forced: bool = Fal
     every one given, when ``forced``), timed; returns the comparison with every stage's fields filled."""
     chosen = [s for s in stages if forced or s.wanted(run)]
     timings = dict(comparison.timings)
-    with executor(run.settings.jobs, run.client) as pool:
+    with executor(run.settings.jobs, run.client, "compare") as pool:
         run.pool = pool
         side, pending = ThreadPoolExecutor(1), []
         try:

@@ -30,14 +30,17 @@ and add ``mysection`` to ``SECTIONS`` at the place it belongs. Return None to le
 from __future__ import annotations
 
 import json
+import os
 import threading
 from concurrent.futures import as_completed
 from pathlib import Path
 
 import attrs
 
+from ..core.arguments import check_type
 from ..core.errors import OutputError
 from ..core.files import atomic_dir
+from ..core.inputs import check_apart
 from . import (
     bootstrap,
     datasets,
@@ -105,7 +108,8 @@ _DRAWING = threading.Lock()  # one report at a time hands its figures to forked 
 def _drawn(figs, jobs: int, client=None):
     """(index, PNG bytes) of every figure, in the order they finish: on ``jobs`` forked workers when jobs > 1,
     or on a dask.distributed ``client``'s workers (the draw closures travel by cloudpickle)."""
-    from ..core.workers import executor, process_pool
+    from ..core.cluster import executor
+    from ..core.workers import process_pool
 
     if client is not None and len(figs) > 1:
         with executor(1, client) as ex:
@@ -123,7 +127,7 @@ def _drawn(figs, jobs: int, client=None):
     with _DRAWING:
         _FIGURES[:] = figs
         try:
-            with process_pool(jobs) as pool:
+            with process_pool(jobs, "report: drawing the figures") as pool:
                 if pool is None:  # no fork on this platform
                     for i, f in enumerate(figs):
                         yield i, f.draw()
@@ -144,6 +148,11 @@ def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, clie
     is written as an index (report.html/.md: every group's verdict, the summary, a link per group) and one
     page per group (groups/GROUP.html/.md, its figures in figures/GROUP/).
     """
+    from ..pipeline.comparison import Comparison
+
+    check_type(c, Comparison, "write_report: c", "a Comparison (what frictionlab.compare returns)")
+    check_type(out, (str, os.PathLike), "write_report: out", "a folder path")
+    check_apart(out, [p for d in c.datasets if d.path is not None for p in (d.path, d.path.with_suffix(".csv"))])
     out = Path(out)
     if out.exists() and not force:  # said in Python's terms; the command line checks before its work
         raise OutputError(f"{out}: the folder exists; pass force=True to replace it, or choose another folder")
