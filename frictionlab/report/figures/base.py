@@ -1,0 +1,79 @@
+"""What every report figure shares: the Agg backend, PNG bytes at one DPI, law colours and line styles,
+legend labels, and which fits are one curve. Display units: rpm, deg, us/ms/s, N."""
+from __future__ import annotations
+
+import io
+
+import numpy as np
+
+LAW_COLORS = {"coulomb": "#7f7f7f", "area-rate": "#d95f02", "wear": "#1b9e77", "couette": "#7570b3"}
+EXTRA_COLORS = ["#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#1f78b4"]
+DPI = 110
+#: Two fits are one curve when they differ by at most this fraction of the noise at every data point.
+SAME_CURVE = 1e-3
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _png(fig) -> bytes:
+    """The figure as PNG bytes at DPI. A layout engine (constrained layout) is run here, at the
+    saving DPI, and then switched off: savefig would otherwise draw the whole figure once more
+    (without rendering) just to run it. The same bytes as a plain savefig (tests/test_report.py)."""
+    buf = io.BytesIO()
+    engine = fig.get_layout_engine()
+    if engine is not None:
+        fig.set_dpi(DPI)
+        engine.execute(fig)
+        fig.set_layout_engine(None)
+    fig.savefig(buf, format="png", dpi=DPI)
+    _plt().close(fig)
+    return buf.getvalue()
+
+
+def _style(law: str, solver: str, i: int) -> dict:
+    color = LAW_COLORS.get(law, EXTRA_COLORS[i % len(EXTRA_COLORS)])
+    ls = "--" if solver == "series" else "-"
+    return {"color": color, "ls": ls, "lw": 1.8}
+
+
+def _label(f, rows, laws=None) -> str:
+    r = next((r for r in rows if r.law == f.law and r.solver == f.solver), None)
+    extra = f", ΔAIC {r.delta_aic:.1f}" if r is not None and r.rank is not None else ""
+    return f"{' = '.join(laws or [f.law])} [{f.solver}]{extra}"
+
+
+def same_curve(a, b) -> bool:
+    """Whether two fits of one dataset with one solver predict the same curve at every data point (within
+    SAME_CURVE sigma): laws of one functional form, or a law whose extra term has no effect there."""
+    if a.solver != b.solver or len(a.per_dataset) != len(b.per_dataset):
+        return False
+    for da, db in zip(a.per_dataset, b.per_dataset):
+        if da.model.shape != db.model.shape or not np.all(np.abs(da.model - db.model) <= SAME_CURVE * da.target.sigma):
+            return False
+    return True
+
+
+def distinct_curves(fits) -> list[tuple[object, list[str]]]:
+    """(representative fit, the laws whose fits are that same curve, sorted) for successful fits, in order."""
+    out: list[tuple[object, list[str]]] = []
+    for f in fits:
+        if not f.ok:
+            continue
+        for rep, laws in out:
+            if same_curve(rep, f):
+                laws.append(f.law)
+                break
+        else:
+            out.append((f, [f.law]))
+    return [(f, sorted(laws)) for f, laws in out]
+
+
+def is_png(data: bytes) -> bool:
+    return data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 100
