@@ -40,27 +40,43 @@ def equivalence_figure(dataset, fw_list, fa, decomps) -> bytes:
     return base._png(fig)
 
 
+def one_curve(e) -> bool:
+    """Whether the pair's T is zero (to 1e-4 per data point) on the data and on every replicate: one curve."""
+    both = np.concatenate([e.t_a, e.t_b, [e.t_obs]])
+    return float(np.ptp(both)) <= 1e-4 * max(e.n_points, 1)
+
+
 def discrimination_figure(dataset: str, results) -> bytes:
-    """One panel per tested pair on ``dataset``: the distribution of T = chi2_A - chi2_B over the
-    replicates of each law's fit, and the observed T."""
+    """One panel per tested pair on ``dataset`` whose laws differ: the distribution of T = chi2_A - chi2_B
+    over the replicates of each law's fit, and the observed T. Pairs that are one curve (T = 0 throughout)
+    get no panel, only a line under the title."""
+    from matplotlib.ticker import MaxNLocator
+
     plt = base._plt()
-    fig, axes = plt.subplots(1, len(results), figsize=(4.6 * len(results), 3.4), squeeze=False, layout="constrained")
-    for ax, e in zip(axes[0], results):
+    drawn = [e for e in results if not one_curve(e)]
+    same = [e for e in results if one_curve(e)]
+    fig, axes = plt.subplots(1, max(1, len(drawn)), figsize=(4.6 * max(1, len(drawn)), 3.4), squeeze=False,
+                             layout="constrained")
+    for ax, e in zip(axes[0], drawn):
         both = np.concatenate([e.t_a, e.t_b, [e.t_obs]])
         span = float(np.ptp(both))
-        if span <= 1e-4 * max(e.n_points, 1):
-            ax.text(0.5, 0.5, f"one curve: T = 0 on the data\nand on all {e.t_a.size + e.t_b.size} replicates",
-                    ha="center", va="center", transform=ax.transAxes)
-        else:
-            bins = np.linspace(both.min() - 0.02 * span, both.max() + 0.02 * span, 40)
-            for t, law, solver in ((e.t_a, e.law_a, e.solver_a), (e.t_b, e.law_b, e.solver_b)):
-                ax.hist(t, bins=bins, alpha=0.6, color=base.LAW_COLORS.get(law, "0.5"), histtype="stepfilled",
-                        label=f"data from {law} [{solver}]")
-            ax.axvline(e.t_obs, color="k", lw=1.5, label="observed T")
-            ax.legend(fontsize=7)
+        bins = np.linspace(both.min() - 0.02 * span, both.max() + 0.02 * span, 40)
+        for t, law, solver in ((e.t_a, e.law_a, e.solver_a), (e.t_b, e.law_b, e.solver_b)):
+            ax.hist(t, bins=bins, alpha=0.6, color=base.LAW_COLORS.get(law, "0.5"), histtype="stepfilled",
+                    label=f"data from {law} [{solver}]")
+        ax.axvline(e.t_obs, color="k", lw=1.5, label="observed T")
+        ax.legend(fontsize=7, loc="best")
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
+        ax.ticklabel_format(axis="x", style="sci", scilimits=(-3, 4), useMathText=True)
         ax.set_xlabel(f"T = χ²({e.law_a}) − χ²({e.law_b})")
         ax.set_ylabel("replicates")
         ax.set_title(f"{e.law_a} [{e.solver_a}] vs {e.law_b} [{e.solver_b}]: {e.verdict}", fontsize=9)
         ax.grid(alpha=0.3)
-    fig.suptitle(f"{dataset}: the discrimination test (parametric bootstrap)", fontsize=11)
+    if not drawn:
+        axes[0, 0].set_axis_off()
+    title = f"{dataset}: the discrimination test (parametric bootstrap)"
+    if same:
+        title += "\n" + "; ".join(f"{e.law_a} [{e.solver_a}] = {e.law_b} [{e.solver_b}]" for e in same) + \
+            ": one curve (T = 0 on the data and on every replicate), not drawn"
+    fig.suptitle(title, fontsize=11 if len(drawn) > 1 else 9.5)
     return base._png(fig)
