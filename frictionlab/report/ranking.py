@@ -13,7 +13,7 @@ TITLE = "Ranking"
 
 
 def curve_labels(c, dataset: str) -> dict[tuple[str, str], str]:
-    """(law, solver) -> 'couette = wear' for the fits on ``dataset`` that are one curve (figures.same_curve)."""
+    """(law, solver) -> 'wear = couette' for the fits on ``dataset`` that are one curve (figures.same_curve)."""
     out = {}
     for f, laws in figures.distinct_curves(c.fits_on(dataset)):
         for law in laws:
@@ -35,7 +35,7 @@ def law_aliases(c) -> dict[str, str]:
     alias: dict[str, str] = {}
     for key, same in together.items():
         if same:
-            merged = sorted(set(alias.get(min(key), min(key)).split(" = ")) | set(key))
+            merged = figures.simplest_first(set(alias.get(min(key), min(key)).split(" = ")) | set(key))
             for law in merged:
                 alias[law] = " = ".join(merged)
     return alias

@@ -61,7 +61,7 @@ def same_curve(a, b) -> bool:
 
 
 def distinct_curves(fits) -> list[tuple[object, list[str]]]:
-    """(representative fit, the laws whose fits are that same curve, sorted) for successful fits, in order."""
+    """(representative fit, the laws whose fits are that same curve, simplest first) for successful fits, in order."""
     out: list[tuple[object, list[str]]] = []
     for f in fits:
         if not f.ok:
@@ -72,7 +72,20 @@ def distinct_curves(fits) -> list[tuple[object, list[str]]]:
                 break
         else:
             out.append((f, [f.law]))
-    return [(f, sorted(laws)) for f, laws in out]
+    return [(f, simplest_first(laws)) for f, laws in out]
+
+
+def simplest_first(laws) -> list[str]:
+    """Laws of one curve in the order the ranking names them ('wear = couette'): fewest parameters first,
+    then by name (inference.ranking.merge_identical), so each merged candidate has one spelling."""
+    from ...physics.registry import get_law
+
+    def key(law):
+        try:
+            return (len(get_law(law).params), law)
+        except Exception:  # a law no longer registered: by name after the others
+            return (1 << 30, law)
+    return sorted(set(laws), key=key)
 
 
 def is_png(data: bytes) -> bool:

@@ -8,7 +8,7 @@ from . import base
 
 def ranking_figure(rows, alias: dict | None = None) -> bytes:
     """Heat map of delta-AIC, candidates x datasets, with ranks; grey where no fit. ``alias`` maps a law
-    to the label it shares with laws of the same curve everywhere ("couette = wear"): one row for them."""
+    to the label it shares with laws of the same curve everywhere ("wear = couette"): one row for them."""
     plt = base._plt()
     from matplotlib.colors import LogNorm
 
