@@ -79,7 +79,7 @@ def test_datasets_show_in_units_a_person_reads(capsys):
     assert main(["datasets", "show", "impact-golf-v28"]) == 0
     out = capsys.readouterr().out
     assert "np.float64" not in out and "Scene(" not in out
-    for text in ("mass: 46 g", "radius: 21.3 mm", "peak: 130 mm^2", "contact_time: 500 us", "omega ± 200 rpm"):
+    for text in ("mass: 46 g", "radius: 21.3 mm", "peak: 130 mm^2", "contact_time: 500 µs", "omega ± 200 rpm"):
         assert text in out
     assert main(["datasets", "show", "impact-outcome-synthetic"]) == 0
     assert "SpeedLaw(" not in capsys.readouterr().out
@@ -93,7 +93,7 @@ def test_series_output_does_not_contradict_itself(capsys):
                      "--solver", "series"]) == 0
     out = capsys.readouterr().out
     assert "never reached zero" not in out
-    assert "truncated series' slip crosses zero at t = 286.7 us" in out
+    assert "truncated series' slip crosses zero at t = 286.7 µs" in out
 
 
 def test_outputs_get_the_umask_permissions(tmp_path, capsys):

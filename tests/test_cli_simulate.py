@@ -64,7 +64,7 @@ def test_coulomb_csv_has_normal_force_and_stick_time(capsys, tmp_path):
     m, u0, tc = 0.046, 12.0, 500e-6
     impulse = m * 28 * math.cos(math.radians(30)) * 1.8
     t_s = math.acos(1 - m * u0 / (0.3 * impulse / 2)) * tc / math.pi
-    assert f"slip reached zero at t = {t_s * 1e6:.4g} us" in out
+    assert f"slip reached zero at t = {t_s * 1e6:.4g} µs" in out
 
 
 def test_defaults_and_fixed_values_are_used(capsys):

@@ -43,7 +43,7 @@ def test_finding_computed_from_the_fitted_series(comp):
     sections, extra = _first(comp)
     assert extra["series_slip_zero_s"][f.dataset.name] == f.t_cross
     md = markdown("t", sections)
-    assert f"cross zero at {f.t_cross * 1e6:.4g} us" in md and "figures/finding.png" in md
+    assert f"cross zero at {f.t_cross * 1e6:.4g} µs" in md and "figures/finding.png" in md
 
 
 def test_without_answers_nothing_is_declared_to_fit(comp):
