@@ -43,10 +43,33 @@ def _style(law: str, solver: str, i: int) -> dict:
     return {"color": color, "ls": ls, "lw": 1.8}
 
 
-def _label(f, rows, laws=None) -> str:
-    r = next((r for r in rows if r.law == f.law and r.solver == f.solver), None)
+def _label(f, rows, laws=None, under=()) -> str:
+    """'wear = couette [exact], ΔAIC 1.2' (the ranking row that holds the law, merged or not), and the
+    candidates drawn under this curve (``under``: 'lies over coulomb [exact]')."""
+    r = next((r for r in rows if f.law in (r.members or (r.law,)) and r.solver == f.solver), None)
     extra = f", ΔAIC {r.delta_aic:.1f}" if r is not None and r.rank is not None else ""
-    return f"{' = '.join(laws or [f.law])} [{f.solver}]{extra}"
+    hidden = f" (hides {', '.join(under)})" if under else ""
+    return f"{' = '.join(laws or [f.law])} [{f.solver}]{extra}{hidden}"
+
+
+#: A curve is hidden under another when they differ by less than this fraction of the plotted span everywhere.
+HIDDEN = 4e-3
+
+
+def visible_curves(curves, span: float) -> list[tuple[object, list[str], list[str]]]:
+    """(fit, laws, hidden) for the curves of ``distinct_curves`` that can be seen: a curve within HIDDEN x
+    ``span`` of an earlier one at every data point is not drawn, and is named in that one's legend entry."""
+    out: list[tuple[object, list[str], list[str]]] = []
+    for f, laws in curves:
+        m = f.per_dataset[0].model
+        for g, _, hidden in out:
+            mg = g.per_dataset[0].model
+            if mg.shape == m.shape and np.all(np.abs(mg - m) <= HIDDEN * span):
+                hidden.append(f"{' = '.join(laws)} [{f.solver}]")
+                break
+        else:
+            out.append((f, laws, []))
+    return out
 
 
 def same_curve(a, b) -> bool:

@@ -29,14 +29,15 @@ def fit_figure(dataset, fits, rows) -> bytes:
     ax.errorbar(t * tf, y * uf, yerr=sigma * uf, fmt="o", ms=3.2, color="black", ecolor="0.7", elinewidth=0.8,
                 label=f"data ({kind})" + (f", {target.derivation}" if curves and target.derivation else ""), zorder=1)
     tt = np.linspace(float(t[0]), float(t[-1]), 300)
-    for i, (f, laws) in enumerate(curves):
+    for i, (f, laws, hidden) in enumerate(base.visible_curves(curves, float(np.ptp(y)))):
         d = f.per_dataset[0]
         style = base._style(f.law, f.solver, i)
+        label = base._label(f, rows, laws, hidden)
         try:
             tr = d.trajectory(f.law, tt)
-            ax.plot(tr.t * tf, tr[obs] * uf, label=base._label(f, rows, laws), zorder=3, **style)
+            ax.plot(tr.t * tf, tr[obs] * uf, label=label, zorder=3, **style)
         except FrictionLabError:  # a stiff law whose dense curve exceeds the solver's budget: the fitted points
-            ax.plot(t * tf, d.model * uf, label=base._label(f, rows, laws), zorder=3, **style)
+            ax.plot(t * tf, d.model * uf, label=label, zorder=3, **style)
         axr.plot(t * tf, d.residual * uf, marker=".", ms=3, **style)
     axr.fill_between(t * tf, -sigma * uf, sigma * uf, color="0.85", label="±1σ noise", zorder=0)
     axr.axhline(0, color="0.3", lw=0.8)
@@ -70,22 +71,22 @@ def outcome_figure(dataset, fits, rows) -> bytes:
     observation against impact angle (right; one line per group of the other inputs, e.g. speed,
     never joining different groups), in the dataset's own units."""
     plt = base._plt()
-    curves = base.distinct_curves(fits)
     obs = dataset.observable
     uname, uf = column_unit(dataset, obs)
     ylab = f"{obs.replace('_', ' ')}" + (f" [{uname}]" if uname else "")
     y = dataset.columns[obs] * uf
+    curves = base.visible_curves(base.distinct_curves(fits), float(np.ptp(dataset.columns[obs])))
     sigma = dataset.noise.get(obs, 0.0) * uf
     angle = next((c for c in dataset.columns if c != obs and c in ("incidence", "angle")), None)
     others = [c for c in dataset.columns if c not in (obs, angle) and c in ("speed", "spin")
               and len(np.unique(dataset.columns[c])) > 1]
-    fig, (axp, axa) = plt.subplots(1, 2, figsize=(11.0, 4.6), layout="constrained",
+    fig, (axp, axa) = plt.subplots(1, 2, figsize=(11.0, 5.2), layout="constrained",
                                    gridspec_kw={"width_ratios": [1, 1.35]})
     lo, hi = float(np.min(y)), float(np.max(y))
-    for i, (f, laws) in enumerate(curves):
+    for i, (f, laws, hidden) in enumerate(curves):
         st = base._style(f.law, f.solver, i)
         axp.plot(y, f.per_dataset[0].model * uf, "o", ms=4, color=st["color"], alpha=0.85,
-                 label=base._label(f, rows, laws))
+                 label=base._label(f, rows, laws, hidden))
         lo, hi = min(lo, float(np.min(f.per_dataset[0].model * uf))), max(hi, float(np.max(f.per_dataset[0].model * uf)))
     pad = 0.05 * (hi - lo or 1.0)
     axp.plot([lo - pad, hi + pad], [lo - pad, hi + pad], color="0.3", lw=0.9, label="predicted = observed")
@@ -103,17 +104,18 @@ def outcome_figure(dataset, fits, rows) -> bytes:
             idx = np.array([k for k in range(len(dataset)) if keys[k] == key])
             idx = idx[np.argsort(x[idx], kind="stable")]
             glabel = ", ".join(f"{c} {key[j] * column_unit(dataset, c)[1]:.3g} {column_unit(dataset, c)[0]}"
-                               for j, c in enumerate(others)) or "data"
+                               for j, c in enumerate(others))
             axa.errorbar(x[idx], y[idx], yerr=sigma, fmt=markers[gi % len(markers)], ms=4, color="black",
-                         ecolor="0.7", elinewidth=0.7, label=f"data: {glabel}", zorder=1)
-            for i, (f, laws) in enumerate(curves):
+                         ecolor="0.7", elinewidth=0.7, zorder=1,
+                         label=f"data: {glabel}" if glabel else f"data ({dataset.provenance.kind})")
+            for i, (f, laws, hidden) in enumerate(curves):
                 st = base._style(f.law, f.solver, i)
                 axa.plot(x[idx], f.per_dataset[0].model[idx] * uf, color=st["color"], ls=st["ls"], lw=1.4,
-                         label=base._label(f, rows, laws) if gi == 0 else None, zorder=2)
+                         label=base._label(f, rows, laws, hidden) if gi == 0 else None, zorder=2)
         axa.set_xlabel(f"{angle} [{au}]")
         axa.set_ylabel(ylab)
         axa.set_title(f"against {angle}" + (f", one line per {' and '.join(others)}" if others else ""), fontsize=10)
-        axa.legend(fontsize=7, ncol=2)
+        axa.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.16))  # below: never over data
     else:
         axa.set_visible(False)
     for a in (axp, axa):
