@@ -72,6 +72,19 @@ def visible_curves(curves, span: float) -> list[tuple[object, list[str], list[st
     return out
 
 
+def draw_fit(ax, f, obs: str, t, tf: float, uf: float, label: str, **style):
+    """The fit ``f``'s ``obs`` as a dense curve over the span of the data times ``t`` (s), scaled by tf and uf;
+    a stiff law whose dense curve exceeds the solver's budget draws its fitted points instead."""
+    from ...core.errors import FrictionLabError
+
+    d = f.per_dataset[0]
+    try:
+        tr = d.trajectory(f.law, np.linspace(float(t[0]), float(t[-1]), 300))
+        ax.plot(tr.t * tf, tr[obs] * uf, label=label, zorder=3, **style)
+    except FrictionLabError:
+        ax.plot(t * tf, d.model * uf, label=label, zorder=3, **style)
+
+
 def same_curve(a, b) -> bool:
     """Whether two fits of one dataset with one solver predict the same curve at every data point (within
     SAME_CURVE sigma): laws of one functional form, or a law whose extra term has no effect there."""

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...core.display import time_unit, unit
+from ...core.display import NAMES, time_unit, unit
 from . import base
 
 
@@ -26,6 +26,10 @@ def finding_figure(findings) -> bytes:
             target = f.series.per_dataset[0].target
             ax.errorbar(d.t * tf, target.y * sf, yerr=target.sigma * sf, fmt="o", ms=2.6, color="black",
                         ecolor="0.75", elinewidth=0.7, label=f"data ({d.provenance.kind})", zorder=1)
+        elif "omega" in d.columns:  # fitted to another column: the dataset's spin column, as given
+            ax.errorbar(d.t * tf, d.columns["omega"] * sf, yerr=d.noise.get("omega", 0.0) * sf, fmt="o", ms=2.6,
+                        color="black", ecolor="0.75", elinewidth=0.7, zorder=1,
+                        label=f"data ({d.provenance.kind}), spin column")
         for fit, color, ls in ((f.full, "#1b9e77", "-"), (f.series, "#d95f02", "--")):
             tr = fit.per_dataset[0].trajectory(fit.law, t)
             label = f"{fit.law} [{fit.solver}]" + (" (paper's truncated series)" if fit.solver == "series" else "")
@@ -49,6 +53,80 @@ def finding_figure(findings) -> bytes:
         ax.legend(fontsize=7, loc="lower right")
         for a in (ax, axu):
             a.grid(alpha=0.3)
-    fig.suptitle("Why the paper's spin falls:" + (" " if n > 1 else "\n") + "its truncated series' slip turns negative; "
-                 "the exact solution's never does", fontsize=10.5)
+    fig.suptitle(wrapped("Why the paper's spin falls: its truncated series' slip turns negative; the exact solution's "
+                         "never does", 4.6 * n + 0.4, 10.5), fontsize=10.5)
     return base._png(fig)
+
+
+def wrapped(text: str, width_in: float, fontsize: float) -> str:
+    """``text`` broken into lines that fit a figure ``width_in`` inches wide at ``fontsize`` points."""
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, max(20, int(width_in * 72 / (0.55 * fontsize)))))
+
+
+def data_figure(views, title: str) -> bytes:
+    """Per view (report.first_screen.DataView), one column: the data with the top-ranked candidates (top)
+    and, only where the paper's series was fitted, the slip u(t) of the series and the exact fit (bottom).
+    A dataset without time (one impact per row) shows its observable against impact angle."""
+    from .fits import against_angle, angle_column
+
+    plt = base._plt()
+    n = len(views)
+    slips = any(v.series is not None for v in views)
+    width = 5.2 * n + 0.6
+    fig, axes = plt.subplots(2 if slips else 1, n, figsize=(width, 5.6 if slips else 4.4), squeeze=False,
+                             layout="constrained", gridspec_kw={"height_ratios": [1.5, 1]} if slips else None)
+    for j, v in enumerate(views):
+        d, ax = v.dataset, axes[0, j]
+        curves = [(f, label, base._style(f.law, f.solver, i)) for i, (f, label) in enumerate(zip(v.fits, v.labels))]
+        target = v.fits[0].per_dataset[0].target
+        if target.t is not None:
+            xlabel = _against_time(ax, d, target, curves)
+        elif angle_column(d) is not None:
+            against_angle(ax, d, curves)
+            xlabel = ax.get_xlabel()
+        else:
+            ax.set_axis_off()
+            continue
+        ax.set_title(d.name + ("" if d.provenance.kind == "measured" else f" ({d.provenance.kind} data)"),
+                     fontsize=10)
+        ax.grid(alpha=0.3)
+        if slips:
+            _slip_panel(axes[1, j], v.series, xlabel) if v.series is not None else axes[1, j].set_axis_off()
+        if not slips or v.series is None:
+            ax.set_xlabel(xlabel)
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2 if ax.get_xlabel() else -0.08),
+                  ncol=2)  # below the panel: never over the data
+    fig.suptitle(wrapped(title, width, 10.5), fontsize=10.5)
+    return base._png(fig)
+
+
+def _against_time(ax, d, target, curves) -> str:
+    """The fitted column against time with each fit's dense curve; returns the time axis' label."""
+    tname, tf = time_unit(float(d.t[-1]))
+    obs = target.observable
+    uname, uf = unit(obs)
+    ax.errorbar(target.t * tf, target.y * uf, yerr=target.sigma * uf, fmt="o", ms=3, color="black", ecolor="0.75",
+                elinewidth=0.7, label=f"data ({d.provenance.kind})", zorder=1)
+    for f, label, style in curves:
+        base.draw_fit(ax, f, obs, d.t, tf, uf, label, **style)
+    name = NAMES.get(obs, obs.replace("_", " "))
+    ax.set_ylabel(f"{name} [{uname}]")
+    return f"time [{tname}]"
+
+
+def _slip_panel(ax, s, xlabel: str):
+    """The slip u(t) of the paper's series and of the exact (or ODE) fit of the same law (a SeriesFinding)."""
+    tname, tf = time_unit(float(s.dataset.t[-1]))
+    t = np.linspace(0.0, float(s.dataset.t[-1]), 300)
+    for i, fit in enumerate((s.full, s.series)):  # styled as in the panel above: the series dashed
+        tr = fit.per_dataset[0].trajectory(fit.law, t)
+        ax.plot(t * tf, tr["u"], label=f"{fit.law} [{fit.solver}]", **base._style(fit.law, fit.solver, i))
+    ax.axhline(0, color="0.3", lw=0.8)
+    if s.t_cross is not None:
+        ax.axvline(s.t_cross * tf, color="#d95f02", ls=":", lw=1.3)
+    ax.set_ylabel("slip u [m/s]")
+    ax.set_xlabel(xlabel)
+    ax.legend(fontsize=7, loc="best")
+    ax.grid(alpha=0.3)

@@ -28,16 +28,10 @@ def fit_figure(dataset, fits, rows) -> bytes:
     kind = dataset.provenance.kind
     ax.errorbar(t * tf, y * uf, yerr=sigma * uf, fmt="o", ms=3.2, color="black", ecolor="0.7", elinewidth=0.8,
                 label=f"data ({kind})" + (f", {target.derivation}" if curves and target.derivation else ""), zorder=1)
-    tt = np.linspace(float(t[0]), float(t[-1]), 300)
     for i, (f, laws, hidden) in enumerate(base.visible_curves(curves, float(np.ptp(y)))):
         d = f.per_dataset[0]
         style = base._style(f.law, f.solver, i)
-        label = base._label(f, rows, laws, hidden)
-        try:
-            tr = d.trajectory(f.law, tt)
-            ax.plot(tr.t * tf, tr[obs] * uf, label=label, zorder=3, **style)
-        except FrictionLabError:  # a stiff law whose dense curve exceeds the solver's budget: the fitted points
-            ax.plot(t * tf, d.model * uf, label=label, zorder=3, **style)
+        base.draw_fit(ax, f, obs, t, tf, uf, base._label(f, rows, laws, hidden), **style)
         axr.plot(t * tf, d.residual * uf, marker=".", ms=3, **style)
     axr.fill_between(t * tf, -sigma * uf, sigma * uf, color="0.85", label="±1σ noise", zorder=0)
     axr.axhline(0, color="0.3", lw=0.8)
@@ -77,9 +71,7 @@ def outcome_figure(dataset, fits, rows) -> bytes:
     y = dataset.columns[obs] * uf
     curves = base.visible_curves(base.distinct_curves(fits), float(np.ptp(dataset.columns[obs])))
     sigma = dataset.noise.get(obs, 0.0) * uf
-    angle = next((c for c in dataset.columns if c != obs and c in ("incidence", "angle")), None)
-    others = [c for c in dataset.columns if c not in (obs, angle) and c in ("speed", "spin")
-              and len(np.unique(dataset.columns[c])) > 1]
+    angle = angle_column(dataset)
     fig, (axp, axa) = plt.subplots(1, 2, figsize=(11.0, 5.2), layout="constrained",
                                    gridspec_kw={"width_ratios": [1, 1.35]})
     lo, hi = float(np.min(y)), float(np.max(y))
@@ -95,26 +87,8 @@ def outcome_figure(dataset, fits, rows) -> bytes:
     axp.set_title("predicted against observed", fontsize=10)
     axp.legend(fontsize=7.5)
     if angle is not None:
-        au, af = column_unit(dataset, angle)
-        x = dataset.columns[angle] * af
-        keys = [tuple(dataset.columns[c][k] for c in others) for k in range(len(dataset))]
-        groups = list(dict.fromkeys(keys))
-        markers = "osD^v<>"
-        for gi, key in enumerate(groups):
-            idx = np.array([k for k in range(len(dataset)) if keys[k] == key])
-            idx = idx[np.argsort(x[idx], kind="stable")]
-            glabel = ", ".join(f"{c} {key[j] * column_unit(dataset, c)[1]:.3g} {column_unit(dataset, c)[0]}"
-                               for j, c in enumerate(others))
-            axa.errorbar(x[idx], y[idx], yerr=sigma, fmt=markers[gi % len(markers)], ms=4, color="black",
-                         ecolor="0.7", elinewidth=0.7, zorder=1,
-                         label=f"data: {glabel}" if glabel else f"data ({dataset.provenance.kind})")
-            for i, (f, laws, hidden) in enumerate(curves):
-                st = base._style(f.law, f.solver, i)
-                axa.plot(x[idx], f.per_dataset[0].model[idx] * uf, color=st["color"], ls=st["ls"], lw=1.4,
-                         label=base._label(f, rows, laws, hidden) if gi == 0 else None, zorder=2)
-        axa.set_xlabel(f"{angle} [{au}]")
-        axa.set_ylabel(ylab)
-        axa.set_title(f"against {angle}" + (f", one line per {' and '.join(others)}" if others else ""), fontsize=10)
+        against_angle(axa, dataset, [(f, base._label(f, rows, laws, hidden), base._style(f.law, f.solver, i))
+                                     for i, (f, laws, hidden) in enumerate(curves)])
         axa.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.16))  # below: never over data
     else:
         axa.set_visible(False)
@@ -124,6 +98,40 @@ def outcome_figure(dataset, fits, rows) -> bytes:
     fig.suptitle(f"{dataset.name}: fits of every law" + ("" if kind == "measured" else f"  ({kind} data)"),
                  fontsize=11)
     return base._png(fig)
+
+
+def angle_column(dataset) -> str | None:
+    """The impact-angle input column of an impact-outcome dataset (None without one)."""
+    return next((c for c in dataset.columns if c != dataset.observable and c in ("incidence", "angle")), None)
+
+
+def against_angle(ax, dataset, curves):
+    """The observable against impact angle, one line per group of the other inputs (e.g. speed; never
+    joining different groups); ``curves``: (fit, legend label, style) drawn through each group's rows."""
+    obs, angle = dataset.observable, angle_column(dataset)
+    uname, uf = column_unit(dataset, obs)
+    y, sigma = dataset.columns[obs] * uf, dataset.noise.get(obs, 0.0) * uf
+    others = [c for c in dataset.columns if c not in (obs, angle) and c in ("speed", "spin")
+              and len(np.unique(dataset.columns[c])) > 1]
+    au, af = column_unit(dataset, angle)
+    x = dataset.columns[angle] * af
+    keys = [tuple(dataset.columns[c][k] for c in others) for k in range(len(dataset))]
+    markers = "osD^v<>"
+    for gi, key in enumerate(dict.fromkeys(keys)):
+        idx = np.array([k for k in range(len(dataset)) if keys[k] == key])
+        idx = idx[np.argsort(x[idx], kind="stable")]
+        glabel = ", ".join(f"{c} {key[j] * column_unit(dataset, c)[1]:.3g} {column_unit(dataset, c)[0]}"
+                           for j, c in enumerate(others))
+        ax.errorbar(x[idx], y[idx], yerr=sigma, fmt=markers[gi % len(markers)], ms=4, color="black",
+                    ecolor="0.7", elinewidth=0.7, zorder=1,
+                    label=f"data: {glabel}" if glabel else f"data ({dataset.provenance.kind})")
+        for f, label, st in curves:
+            ax.plot(x[idx], f.per_dataset[0].model[idx] * uf, color=st["color"], ls=st["ls"], lw=1.4,
+                    label=label if gi == 0 else None, zorder=2)
+    ylab = f"{obs.replace('_', ' ')}" + (f" [{uname}]" if uname else "")
+    ax.set_xlabel(f"{angle} [{au}]")
+    ax.set_ylabel(ylab)
+    ax.set_title(f"against {angle}" + (f", one line per {' and '.join(others)}" if others else ""), fontsize=10)
 
 
 def _residual_limits(ax, residuals, sigma):
