@@ -15,7 +15,7 @@ def equivalence_figure(dataset, fw_list, fa, decomps) -> bytes:
     t_end = float(dataset.t[-1])
     tname, tf = time_unit(t_end)
     t = np.linspace(0.0, t_end, 400)
-    fig, axes = plt.subplots(1, max(1, len(fw_list)), figsize=(5.4 * max(1, len(fw_list)), 3.9), squeeze=False, layout="constrained")
+    fig, axes = plt.subplots(1, max(1, len(fw_list)), figsize=(5.4 * max(1, len(fw_list)), 4.7), squeeze=False, layout="constrained")
     Fa = fa.per_dataset[0].trajectory(fa.law, t).force
     for ax, fw, dec in zip(axes[0], fw_list, decomps):
         Fw = fw.per_dataset[0].trajectory(fw.law, t).force
@@ -29,13 +29,13 @@ def equivalence_figure(dataset, fw_list, fa, decomps) -> bytes:
             ax.plot(t * tf, dec.c_area * A, color="0.45", lw=1, ls="-.", label="λu0(1−b)A")
             ax.plot(t * tf, dec.c_area_rate * A * dA, color="0.45", lw=1, ls=":", label="(λu0b/(φA0)) A dA/dt")
             ax.plot(t * tf, dec.mu * (N + dec.eta_prime * dA), color="#e7298a", lw=1.2,
-                    label=f"implied μN+μη'dA/dt (μ={dec.mu:.3g}, η'={dec.eta_prime:.3g})")
+                    label=f"implied μN+μη'dA/dt (μ = {dec.mu:.3g}, η' = {dec.eta_prime:.3g} N s/m²)")
         ax.axhline(0, color="0.3", lw=0.8)
         ax.set_xlabel(f"time [{tname}]")
         ax.set_ylabel("friction force [N]")
         ax.set_title(f"wear [{fw.solver}] vs area-rate", fontsize=10)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.2))  # below: never over a curve
     fig.suptitle(f"{dataset.name}: is λAu equivalent to μN + μη' dA/dt?", fontsize=11)
     return base._png(fig)
 
