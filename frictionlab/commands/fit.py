@@ -105,8 +105,12 @@ def run(args) -> int:
     law = get_law(args.law)
     if args.json and not args.json.parent.is_dir():  # before the work, not after
         raise OutputError(f"{args.json}: cannot write: folder {args.json.parent} does not exist")
-    result = fit(law, args.datasets, solver=args.solver, free=parse_free(args.free), fixed=parse_fix(law, args.fix),
-                 local=args.local, observable=args.observable, derive=args.derive, timeout=args.fit_timeout)
+    from ..core.progress import Progress
+
+    with Progress("fit", quiet=args.quiet, delay=2.0) as bar:  # a quick fit stays silent
+        result = fit(law, args.datasets, solver=args.solver, free=parse_free(args.free),
+                     fixed=parse_fix(law, args.fix), local=args.local, observable=args.observable,
+                     derive=args.derive, timeout=args.fit_timeout, progress=bar)
     if result.status == "skipped":  # asked for explicitly, an inapplicable solver is an error, not a skip
         raise SolverError(result.reason)
     print(result.summary())

@@ -72,10 +72,15 @@ def run(args) -> int:
     for path in (args.out, args.plot):
         if path is not None:
             check_writable(path)
-    if ds.kind == "impact-outcome":
-        text, summary, figure = _outcomes(law, ds, params, args)
-    else:
-        text, summary, figure = _series(law, ds, params, args)
+    from ..core.progress import Progress
+
+    with Progress("simulate", quiet=args.quiet, delay=2.0) as bar:  # a quick run stays silent
+        if ds.kind == "impact-outcome":
+            bar(0, 1, f"solving {len(ds)} impacts of {ds.name}")
+            text, summary, figure = _outcomes(law, ds, params, args)
+        else:
+            text, summary, figure = _series(law, ds, params, args, bar)
+        bar(1, 1, "done")
     written = []
     try:  # both outputs or neither
         if args.plot is not None:
@@ -99,7 +104,27 @@ def _params_text(law, p) -> str:
 
 
 # --- time series ---------------------------------------------------------------------------------
-def _series(law, ds, params, args):
+def _solving(bar, what: str, t_end: float):
+    """A context in which every ODE step tells ``bar`` the simulated time reached (per mille of t_end)."""
+    import time
+
+    from ..core.display import fmt_time
+    from ..solve.solvers.ode import watching
+
+    state = {"t": 0.0, "at": -1e9}
+
+    def tick(t):
+        now = time.monotonic()
+        state["t"] = max(state["t"], float(t))
+        if now - state["at"] >= 0.25:
+            state["at"] = now
+            bar(int(1000 * min(state["t"] / t_end, 1.0)), 1000,
+                f"{what}: t = {fmt_time(state['t'], t_end)} of {fmt_time(t_end)} simulated")
+    bar(0, 1000, what)
+    return watching(tick)
+
+
+def _series(law, ds, params, args, bar=lambda *a: None):
     import numpy as np
 
     from ..solve.solvers import simulate
@@ -109,7 +134,8 @@ def _series(law, ds, params, args):
         simulate(law, ds, params, solver=args.solver, rtol=args.rtol)  # raises the loader's one-line error
     t_end = max(float(scene.duration), float(ds.t[-1]))
     t = np.linspace(0.0, t_end, args.points) if args.points else ds.t
-    tr = simulate(law, ds, params, solver=args.solver, rtol=args.rtol, t=t)
+    with _solving(bar, f"solving {law.name} on {ds.name}", t_end):
+        tr = simulate(law, ds, params, solver=args.solver, rtol=args.rtol, t=t)
     p = law.resolve({**{k: v for k, v in ds.fixed.items() if k in law.param_names}, **params})
     summary = _summary(law, ds, tr, p)
     figure = None
@@ -118,7 +144,7 @@ def _series(law, ds, params, args):
         if len(t) < PLOT_POINTS:  # a smooth curve; any solver warning was already given for the run above
             import warnings
 
-            with warnings.catch_warnings():
+            with warnings.catch_warnings(), _solving(bar, f"solving at {PLOT_POINTS} times for the plot", t_end):
                 warnings.simplefilter("ignore")
                 fine = simulate(law, ds, params, solver=args.solver, rtol=args.rtol,
                                 t=np.linspace(0.0, t_end, PLOT_POINTS))

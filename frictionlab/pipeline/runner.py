@@ -100,6 +100,7 @@ def run_stages(comparison, run: Run, stages: Sequence[Stage], forced: bool = Fal
                     continue
                 if stage.name == "answer":  # the verdicts read every other stage's fields
                     comparison = _collect(comparison, pending, timings)
+                run.step(f"stage {stage.name} started", advance=False)  # each stage named as it begins
                 part, timings[stage.name] = _timed(stage, comparison, run)
                 comparison = attrs.evolve(comparison, **part)
             comparison = _collect(comparison, pending, timings)
