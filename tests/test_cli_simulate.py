@@ -125,3 +125,30 @@ def test_errors_are_one_line(capsys, tmp_path, argv, match):
     assert rc == 2 and len(lines) == 1 and lines[0].startswith("frictionlab")
     assert pytest.importorskip("re").search(match, lines[0]), lines[0]
     assert not out_csv.exists() and out == ""
+
+
+def test_trajectory_and_dataset_as_dataframes_with_concise_reprs():
+    """Both tables in SI with their units; the law's state is its own column (state_theta), never the
+    rotation angle theta; the reprs are one line, not arrays."""
+    import frictionlab as fl
+
+    d = fl.load_dataset("spring-slider-aging")
+    df = d.to_dataframe()
+    assert list(df.columns) == list(d.columns) and df.attrs["units"]["t"] == "s" and len(df) == len(d)
+    tr = fl.simulate("rate-state-aging", d, {})
+    tdf = tr.to_dataframe()
+    assert "state_theta" in tdf.columns and float(tdf["state_theta"].iloc[0]) > 0 and not tdf["theta"].any()
+    assert "\n" not in repr(tr) and "state_theta" in repr(tr) and "array" not in repr(tr)
+    assert "state_theta" in tr.csv_text().splitlines()[0].split(",")
+
+
+def test_the_api_takes_quantity_strings_where_the_command_line_does():
+    import frictionlab as fl
+    from frictionlab.core.errors import UnitError
+
+    ds = fl.load_dataset("impact-golf-v28")
+    a = fl.simulate("wear", ds, {"lam": "1.81e6 Pa s/m"}, solver="exact")
+    b = fl.simulate("wear", ds, {"lam": 1.81e6}, solver="exact")
+    assert np.array_equal(a.omega, b.omega)
+    with pytest.raises(UnitError, match="lam: '1.81e6' has no unit"):
+        fl.simulate("wear", ds, {"lam": "1.81e6"})
