@@ -48,7 +48,7 @@ def test_lists_are_repeated_options_or_commas_everywhere():
                "--solver", "exact", "--solver", "series"])
     assert (a.laws, a.data, a.solver) == (b.laws, b.data, b.solver) == (["wear", "coulomb"], ["x.toml", "y"],
                                                                        ["exact", "series"])
-    c = parse(["simulate", "d", "--law", "couette", "--param", "eta=0.1 Pa s,h=80 um", "--param", "x=1"])
+    c = parse(["simulate", "couette", "d", "--param", "eta=0.1 Pa s,h=80 um", "--param", "x=1"])
     assert c.param == ["eta=0.1 Pa s", "h=80 um", "x=1"]
     d = parse(["fit", "area-rate", "a", "b", "--local", "mu,eta_prime"])
     assert d.local == ["mu", "eta_prime"]
@@ -89,7 +89,7 @@ def test_series_output_does_not_contradict_itself(capsys):
     from frictionlab.solve.solvers.series import SeriesAccuracyWarning
 
     with pytest.warns(SeriesAccuracyWarning, match="b = 0.814"):  # the series says it is used beyond its range
-        assert main(["simulate", "impact-golf-v28", "--law", "wear", "--param", "lam=1.81e6 Pa s/m",
+        assert main(["simulate", "wear", "impact-golf-v28", "--param", "lam=1.81e6 Pa s/m",
                      "--solver", "series"]) == 0
     out = capsys.readouterr().out
     assert "never reached zero" not in out
@@ -100,7 +100,7 @@ def test_outputs_get_the_umask_permissions(tmp_path, capsys):
     old = os.umask(0o022)
     try:
         csv = tmp_path / "s.csv"
-        assert main(["simulate", "impact-golf-v28", "--law", "wear", "--solver", "exact", "--out", str(csv)]) == 0
+        assert main(["simulate", "wear", "impact-golf-v28", "--solver", "exact", "--out", str(csv)]) == 0
         assert stat.S_IMODE(csv.stat().st_mode) == 0o644
         assert main(["datasets", "template", "incline", "--out", str(tmp_path)]) == 0
         assert stat.S_IMODE((tmp_path / "my-data.toml").stat().st_mode) == 0o644
