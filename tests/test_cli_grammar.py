@@ -134,3 +134,17 @@ def test_compare_summary_renders_the_answers_only():
     C.answers = (a,)
     assert answer_lines(C())[1] == ("  impact-golf: no registered law describes these data; chi2 p < 1e-6; lambda A u "
                                     "vs mu N + mu eta' dA/dt: not equivalent; the series' slip crosses zero at 309 us")
+
+
+def test_defaults_that_differ_between_the_command_line_and_the_api_are_said_in_both(capsys):
+    import inspect
+
+    from frictionlab import compare
+    from frictionlab.commands.compare import BOOTSTRAP_N
+
+    assert main(["compare", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    api = inspect.signature(compare).parameters
+    assert api["bootstrap"].default == 0 != BOOTSTRAP_N and api["fit_timeout"].default is None
+    assert f"--bootstrap {BOOTSTRAP_N} (API bootstrap=0)" in text and "(API fit_timeout=None)" in text
+    assert f"bootstrap {BOOTSTRAP_N}" in " ".join(compare.__doc__.split()) and "case resamples" not in text

@@ -143,6 +143,9 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     stages: the names of the stages to run (``stages.STAGES``: fit, rank, equivalence, transfer,
     tolerance, bootstrap, answer), None for every stage the options above switch on; ``run_stages``
     runs more of them on the result later.
+    The command line's ``frictionlab compare`` differs in three defaults (said in its --help): bootstrap
+    150, the tolerance check on (commands.compare.TOLERANCE_RTOLS), fit_timeout 900 s; here each runs only when
+    asked for.
     """
     started = time.perf_counter()
     settings = Settings(laws=(), solvers=tuple(solvers) if solvers else None,
