@@ -242,3 +242,18 @@ def test_fit_report_names_both_aic_conventions_and_the_laws_bounds():
     assert f"Akaike info crit   = {r.stats.aic:.6g}  (-2 ln L + 2k" in text
     assert f"minimizer_result.aic = {r.minimizer_result.aic:.6g} is n ln(chi2/n) + 2k" in text
     assert "lam: Pa s/m, bounds [0, 1e+13]" in text and r.to_dataframe()["upper"].iloc[0] == 1e13
+
+
+def test_a_flag_and_what_it_did_to_the_rank_are_in_the_ranking_frame():
+    import pandas as pd
+
+    from frictionlab.inference.frames import ranking_frame
+    from frictionlab.inference.ranking import RankRow
+
+    class C:
+        datasets, groups = (), ()
+        ranking = (RankRow("d", "area-rate", "exact", 10, 2, aic=1.0, rank=2, flags=("rests on eta_prime",)),
+                   RankRow("d", "coulomb", "exact", 10, 1, aic=5.0, rank=1))
+    df = ranking_frame(C())
+    assert isinstance(df, pd.DataFrame) and list(df["plausibility_flags"]) == ["rests on eta_prime", ""]
+    assert df["rank_effect"].iloc[0].startswith("ranked after every unflagged") and df["rank_effect"].iloc[1] == ""

@@ -13,7 +13,7 @@ from ..io.dataset import COLUMN_SI
 
 RANKING_COLUMNS = ("dataset", "law", "solver", "candidate", "rank", "status", "observable", "n_points", "n_params",
                    "rss", "rss_unit", "rmse", "rmse_unit", "redchi", "aic", "aicc", "bic", "delta_aic",
-                   "akaike_weight", "reason")
+                   "akaike_weight", "reason", "plausibility_flags", "fits", "rank_effect")
 PARAMETER_COLUMNS = ("dataset", "law", "solver", "parameter", "value", "stderr", "unit", "kind", "vary", "fixed_by",
                      "lower", "upper")
 
@@ -37,10 +37,19 @@ def ranking_frame(c):
                      "rank": r.rank, "status": r.status, "observable": o, "n_points": r.n_points,
                      "n_params": r.n_params, "rss": r.rss, "rss_unit": rss_u, "rmse": r.rmse, "rmse_unit": rmse_u,
                      "redchi": r.redchi, "aic": r.aic, "aicc": r.aicc, "bic": r.bic, "delta_aic": r.delta_aic,
-                     "akaike_weight": r.akaike_weight, "reason": r.reason})
+                     "akaike_weight": r.akaike_weight, "reason": r.reason, "plausibility_flags": "; ".join(r.flags),
+                     "fits": r.fits, "rank_effect": _rank_effect(r)})
     df = pd.DataFrame(rows, columns=list(RANKING_COLUMNS))
     df["rank"] = df["rank"].astype("Int64")
     return df
+
+
+def _rank_effect(r) -> str:
+    """What a plausibility flag did to the candidate's place ('' without flags)."""
+    if not r.flags:
+        return ""
+    return ("ranked after every unflagged candidate, whatever its AIC" if r.rank is not None else
+            "flagged; not ranked")
 
 
 def parameters_frame(fits):
