@@ -106,7 +106,7 @@ def build(ctx) -> Section:
                     lambda d=d, fits=fits, rows=rows: figures.fit_figure(d, fits, rows))
             if "t" in d.columns:
                 sec.fig(f"force-{d.name}.png", f"{d.name}: friction force of each best fit.",
-                        lambda d=d, fits=fits: figures.force_figure(d, fits))
+                        lambda d=d, fits=fits, rows=rows: figures.force_figure(d, fits, rows))
         prow = []
         for f in fits:
             if f.ok:

@@ -48,8 +48,19 @@ def _label(f, rows, laws=None, under=()) -> str:
     candidates drawn under this curve (``under``: 'lies over coulomb [exact]')."""
     r = next((r for r in rows if f.law in (r.members or (r.law,)) and r.solver == f.solver), None)
     extra = f", ΔAIC {r.delta_aic:.1f}" if r is not None and r.rank is not None else ""
+    name = " = ".join(laws or [f.law])
+    if r is not None and len(r.members) > 1:  # the ranking's merged candidate: its name, its members not repeated
+        name = r.law
+        under = [u for u in under if u not in {f"{m} [{f.solver}]" for m in r.members}]
     hidden = f" (hides {', '.join(under)})" if under else ""
-    return f"{' = '.join(laws or [f.law])} [{f.solver}]{extra}{hidden}"
+    return f"{name} [{f.solver}]{extra}{hidden}"
+
+
+def wrapped(text: str, width_in: float, fontsize: float) -> str:
+    """``text`` broken into lines that fit a figure ``width_in`` inches wide at ``fontsize`` points."""
+    import textwrap
+
+    return "\n".join(textwrap.wrap(text, max(20, int(width_in * 72 / (0.55 * fontsize)))))
 
 
 #: A curve is hidden under another when they differ by less than this fraction of the plotted span everywhere.

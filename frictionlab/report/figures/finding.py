@@ -53,16 +53,9 @@ def finding_figure(findings) -> bytes:
         ax.legend(fontsize=7, loc="lower right")
         for a in (ax, axu):
             a.grid(alpha=0.3)
-    fig.suptitle(wrapped("Why the paper's spin falls: its truncated series' slip turns negative; the exact solution's "
+    fig.suptitle(base.wrapped("Why the paper's spin falls: its truncated series' slip turns negative; the exact solution's "
                          "never does", 4.6 * n + 0.4, 10.5), fontsize=10.5)
     return base._png(fig)
-
-
-def wrapped(text: str, width_in: float, fontsize: float) -> str:
-    """``text`` broken into lines that fit a figure ``width_in`` inches wide at ``fontsize`` points."""
-    import textwrap
-
-    return "\n".join(textwrap.wrap(text, max(20, int(width_in * 72 / (0.55 * fontsize)))))
 
 
 def data_figure(views, title: str) -> bytes:
@@ -98,7 +91,7 @@ def data_figure(views, title: str) -> bytes:
             ax.set_xlabel(xlabel)
         ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2 if ax.get_xlabel() else -0.08),
                   ncol=2)  # below the panel: never over the data
-    fig.suptitle(wrapped(title, width, 10.5), fontsize=10.5)
+    fig.suptitle(base.wrapped(title, width, 10.5), fontsize=10.5)
     return base._png(fig)
 
 

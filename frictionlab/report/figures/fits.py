@@ -143,20 +143,22 @@ def _residual_limits(ax, residuals, sigma):
     ax.set_ylim(-1.08 * top, 1.08 * top)
 
 
-def force_figure(dataset, fits) -> bytes:
+def force_figure(dataset, fits, rows=()) -> bytes:
     """The friction force history of every law's best fit."""
     plt = base._plt()
     curves = [(f, laws) for f, laws in base.distinct_curves(fits) if f.per_dataset[0].target.t is not None]
+    span = float(np.ptp(curves[0][0].per_dataset[0].target.y)) if curves else 1.0
+    curves = base.visible_curves(curves, span)  # a force history under another's: named in its entry
     t_end = float(dataset.t[-1])
     tname, tf = time_unit(t_end)
     fig, ax = plt.subplots(figsize=(7.6, 3.8), layout="constrained")
     drawn = 0
-    for i, (f, laws) in enumerate(curves):
+    for i, (f, laws, hidden) in enumerate(curves):
         try:
             tr = f.per_dataset[0].trajectory(f.law, np.linspace(0.0, t_end, 300))
         except FrictionLabError:  # a stiff law whose dense curve exceeds the solver's budget: left out
             continue
-        ax.plot(tr.t * tf, tr.force, label=f"{' = '.join(laws)} [{f.solver}]", **base._style(f.law, f.solver, i))
+        ax.plot(tr.t * tf, tr.force, label=base._label(f, rows, laws, hidden), **base._style(f.law, f.solver, i))
         drawn += 1
     ax.axhline(0, color="0.3", lw=0.8)
     ax.set_xlabel(f"time [{tname}]")

@@ -37,5 +37,6 @@ def ranking_figure(rows, alias: dict | None = None) -> bytes:
     ax.set_yticks(range(len(cands)), cands, fontsize=8)
     cb = fig.colorbar(im, ax=ax, shrink=0.85)
     cb.set_label("ΔAIC + 1 (log scale; 1 = best)")
-    ax.set_title("Ranking per dataset: #rank and ΔAIC (solver exact unless named)")
+    ax.set_title(base.wrapped("Ranking per dataset: #rank and ΔAIC (solver exact unless named)",
+                              fig.get_figwidth() - 1.2, 12), fontsize=12)
     return base._png(fig)
