@@ -68,7 +68,7 @@ def data_figure(views, title: str) -> bytes:
     n = len(views)
     slips = any(v.series is not None for v in views)
     width = 5.2 * n + 0.6
-    fig, axes = plt.subplots(2 if slips else 1, n, figsize=(width, 5.6 if slips else 4.4), squeeze=False,
+    fig, axes = plt.subplots(2 if slips else 1, n, figsize=(width, 4.15 if slips else 3.7), squeeze=False,
                              layout="constrained", gridspec_kw={"height_ratios": [1.5, 1]} if slips else None)
     for j, v in enumerate(views):
         d, ax = v.dataset, axes[0, j]
