@@ -148,3 +148,13 @@ def test_defaults_that_differ_between_the_command_line_and_the_api_are_said_in_b
     assert api["bootstrap"].default == 0 != BOOTSTRAP_N and api["fit_timeout"].default is None
     assert f"--bootstrap {BOOTSTRAP_N} (API bootstrap=0)" in text and "(API fit_timeout=None)" in text
     assert f"bootstrap {BOOTSTRAP_N}" in " ".join(compare.__doc__.split()) and "case resamples" not in text
+
+
+def test_the_fit_tolerance_default_is_the_librarys_and_said_beside_simulates(capsys):
+    from frictionlab.commands.fit import FIT_RTOL
+    from frictionlab.inference.predict import FIT_RTOL as LIBRARY
+
+    assert FIT_RTOL == LIBRARY
+    assert main(["fit", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert f"(default {LIBRARY:g}, the library's FIT_RTOL" in text and "'simulate' defaults to 1e-10" in text

@@ -37,7 +37,8 @@ def add_parser(sub):
     p.add_argument("--param", action=ListAction, default=[], metavar="NAME=VALUE",
                    help="law parameter with its unit, e.g. lam='1.81e6 Pa s/m' or mu=0.2")
     p.add_argument("--solver", default="ode", help="exact, series, ode or ode:METHOD (default: ode, i.e. LSODA)")
-    p.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance of the ode solver (default 1e-10)")
+    p.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance of the ode solver (default 1e-10, as fl.simulate; "
+                        "a fit's solves default to 1e-6, 'fit --rtol')")
     p.add_argument("--points", type=int, metavar="N",
                    help="write N evenly spaced times over the scene's duration instead of the dataset's times")
     p.add_argument("--out", type=Path, metavar="FILE.csv", help="write the simulated series (SI) as CSV")

@@ -567,7 +567,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     n_starts: Levenberg-Marquardt runs from the best distinct grid points (the lowest chi2 wins);
     at most ODE_STARTS when a dataset is solved by 'ode' (deterministic, never timing-dependent).
     rtol: relative (and scaled absolute) tolerance of every ODE solve in the fit, in (0, 1);
-    None uses FIT_RTOL (1e-10). Closed forms and the series ignore it.
+    None uses predict.FIT_RTOL (1e-6; simulate's default is 1e-10). Closed forms and the series ignore it.
     timeout: time budget of the fit in seconds (None: none); past it the fit is 'failed'.
     checks: False skips the plausibility flags and the SI copy of lmfit's result (``minimizer_result``
     None): for replicate refits (equivalence, bootstrap, transfer) that read only the values, their
