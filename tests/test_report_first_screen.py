@@ -197,3 +197,14 @@ def test_a_group_row_shows_its_first_flag_and_counts_the_others():
     (cells,) = group_table([row])[1]
     assert cells[-1].endswith("; FLAG (ranked after every unflagged candidate): a: rests on eta_prime; 2 more flags: "
                               "see each dataset's table")
+
+
+def test_the_command_lines_closing_answers_fold_groups_without_a_fitted_law(comp):
+    from frictionlab.commands.compare import answer_lines
+
+    kw = dict(provenance="synthetic", fits=False, goodness="", equivalence="not tested", noise_threshold="",
+              series_vs_exact="", headline="not fitted: no law compared applies")
+    none = [Answer(group=g, datasets=(), best=None, **kw) for g in ("slider-a", "slider-b")]
+    fitted = Answer(group="impact", datasets=("impact-x",), best="wear [exact]", **{**kw, "headline": "best: wear"})
+    lines = answer_lines(attrs.evolve(comp, answers=(none[0], fitted, none[1])))
+    assert lines[1].startswith("  impact: ") and lines[2:] == ["  not fitted: no law compared applies: slider-a, slider-b"]

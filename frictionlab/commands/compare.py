@@ -122,10 +122,15 @@ def answer_lines(c) -> list[str]:
     if not c.answers:
         return ["answers: none (the verdict layer filled no Comparison.answers); see the report's tables"]
     out = ["answers (full sentences in report.html and results.json):"]
+    folded: dict[str, list[str]] = {}
     for a in c.answers:
+        if a.best is None:  # groups without a fitted law: one line per reason, as on the report's first screen
+            folded.setdefault(a.cell("best") or "no law could be fitted", []).append(a.group)
+            continue
         eq = a.cell("equivalence")
         parts = [a.cell("best"), a.cell("goodness"),
                  f"lambda A u vs mu N + mu eta' dA/dt: {eq}" if eq and eq != "not tested" else "", a.cell("threshold"), a.cell("series"),
                  a.cell("transfer")]
         out.append(f"  {a.group}: " + "; ".join(p for p in parts if p))
+    out += [f"  {reason}: {', '.join(groups)}" for reason, groups in folded.items()]
     return out
