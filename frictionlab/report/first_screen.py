@@ -9,8 +9,6 @@ series' slip crosses zero (computed here from the fitted series).
 """
 from __future__ import annotations
 
-import math
-
 import attrs
 import numpy as np
 
