@@ -1,11 +1,13 @@
 """The first screen: the verdict table (``Comparison.answers``) and the figure of the central finding.
 
 The verdict table only renders the answers the verdict layer filled (``frictionlab/inference/answers.py``);
-a column without data says so. Without answers it shows what the comparison does hold, labelled
-as such (the AIC ranking's first place and the equivalence analysis' verdict), never a verdict
-of its own. The finding: the paper's truncated series of a F = k A u law against the exact
-solution of the same law, spin above and the slip u(t) of each below, with the time at which the
-series' slip crosses zero (computed here from the fitted series).
+columns without data are named in one line under it, and groups without a fitted law fold into one
+line. Without answers it shows what the comparison does hold, labelled as such (the AIC ranking's
+first place and the equivalence analysis' verdict), never a verdict of its own. The finding, where
+a dataset's spin falls and the paper's truncated series of a F = k A u law has its slip cross zero:
+that series against the exact solution of the same law, spin above and the slip u(t) of each below,
+with the crossing time (computed here from the fitted series). Elsewhere the figure and sentences
+of ``data_view`` describe the compared data.
 """
 from __future__ import annotations
 
