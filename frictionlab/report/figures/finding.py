@@ -89,7 +89,9 @@ def data_figure(views, title: str) -> bytes:
             _slip_panel(axes[1, j], v.series, xlabel) if v.series is not None else axes[1, j].set_axis_off()
         if not slips or v.series is None:
             ax.set_xlabel(xlabel)
-        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2 if ax.get_xlabel() else -0.08),
+        else:  # the slip panel below carries the time axis
+            ax.tick_params(labelbottom=False)
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2 if ax.get_xlabel() else -0.03),
                   ncol=2)  # below the panel: never over the data
     fig.suptitle(base.wrapped(title, width, 10.5), fontsize=10.5)
     return base._png(fig)
