@@ -207,4 +207,4 @@ def test_the_command_lines_closing_answers_fold_groups_without_a_fitted_law(comp
     none = [Answer(group=g, datasets=(), best=None, **kw) for g in ("slider-a", "slider-b")]
     fitted = Answer(group="impact", datasets=("impact-x",), best="wear [exact]", **{**kw, "headline": "best: wear"})
     lines = answer_lines(attrs.evolve(comp, answers=(none[0], fitted, none[1])))
-    assert lines[1].startswith("  impact: ") and lines[2:] == ["  not fitted: no law compared applies: slider-a, slider-b"]
+    assert lines[1].startswith("  impact: ") and lines[2:] == ["  slider-a, slider-b: not fitted: no law compared applies"]

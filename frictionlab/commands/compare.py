@@ -132,5 +132,5 @@ def answer_lines(c) -> list[str]:
                  f"lambda A u vs mu N + mu eta' dA/dt: {eq}" if eq and eq != "not tested" else "", a.cell("threshold"), a.cell("series"),
                  a.cell("transfer")]
         out.append(f"  {a.group}: " + "; ".join(p for p in parts if p))
-    out += [f"  {reason}: {', '.join(groups)}" for reason, groups in folded.items()]
+    out += [f"  {', '.join(groups)}: {reason}" for reason, groups in folded.items()]
     return out
