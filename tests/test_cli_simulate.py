@@ -178,3 +178,11 @@ def test_the_law_comes_first_as_in_fit_and_the_earlier_form_still_works_with_a_n
     assert "earlier form; write 'frictionlab simulate wear impact-golf-v28'" in err
     rc, _, err = run(capsys, "simulate", "wear", "impact-golf-v28", "--law", "coulomb")
     assert rc == 2 and "the law is given twice" in err
+
+
+def test_a_spring_slider_csv_holds_the_laws_state_and_no_rotation_angle(capsys, tmp_path):
+    csv = tmp_path / "s.csv"
+    rc, out, _ = run(capsys, "simulate", "rate-state-aging", "spring-slider-aging", "--out", str(csv))
+    df = pd.read_csv(csv)
+    assert rc == 0 and "state_theta" in df.columns and "theta" not in df.columns and "omega" not in df.columns
+    assert df["state_theta"].iloc[0] > 0 and "state_theta" in out and "spin" not in out

@@ -2,7 +2,8 @@
 
 Law parameters come from the law's defaults, then the dataset's [fixed] values, then --param
 (values with units, e.g. lam='1.81e6 Pa s/m'; a dimensional value must say its unit). The CSV
-holds SI columns t,u,v,omega,theta,force (and A, N where the plan built them); for an
+holds SI columns t,u,v,omega,theta,force (omega and theta only where the scene spins; A, N and a law's
+states as state_NAME where the plan built them); for an
 impact-outcome dataset it holds one row per impact. Outputs are written only after the whole
 simulation and figure succeeded, so a failed run writes nothing.
 """
@@ -174,7 +175,17 @@ def _series(law, ds, params, args, bar=lambda *a: None):
                 fine = simulate(law, ds, params, solver=args.solver, rtol=args.rtol,
                                 t=np.linspace(0.0, t_end, PLOT_POINTS))
         figure = _series_figure(ds, fine, f"{law.name} [{tr.solver}]: {_params_text(law, p)}", args.y)
-    return tr.csv_text(), summary, figure
+    return _csv(tr, "spin" in scene.effects), summary, figure
+
+
+def _csv(tr, spins: bool) -> str:
+    """The trajectory's CSV (SI); without a spin state, no rotation columns (all zeros, and 'theta' would read
+    as a rate-and-state theta, which is the column state_theta)."""
+    if spins:
+        return tr.csv_text()
+    cols = {k: v for k, v in tr.columns().items() if k not in ("omega", "theta")}
+    lines = [",".join(cols)] + [",".join(f"{x:.17g}" for x in row) for row in zip(*cols.values())]
+    return "\n".join(lines) + "\n"
 
 
 def _summary(law, ds, tr, p) -> str:
@@ -190,9 +201,11 @@ def _summary(law, ds, tr, p) -> str:
     else:
         i = int(np.argmax(np.abs(tr.v)))
         lines.append(f"  peak velocity  {tr.v[i]:.6g} m/s at t = {fmt_time(tr.t[i], T)}")
-    lines.append(f"  at t = {fmt_time(T, T)}: slip u = {tr.u[-1]:.6g} m/s, v = {tr.v[-1]:.6g} m/s, "
-                 f"spin {tr.omega[-1] * RPM:.6g} rpm, theta {math.degrees(tr.theta[-1]):.6g} deg, "
-                 f"force {tr.force[-1]:.6g} N")
+    spin = (f"spin {tr.omega[-1] * RPM:.6g} rpm, theta {math.degrees(tr.theta[-1]):.6g} deg, "
+            if "spin" in ds.scene.effects else "")
+    lines.append(f"  at t = {fmt_time(T, T)}: slip u = {tr.u[-1]:.6g} m/s, v = {tr.v[-1]:.6g} m/s, {spin}"
+                 f"force {tr.force[-1]:.6g} N" + "".join(f", {k} {v[-1]:.6g} (SI)" for k, v in tr.columns().items()
+                                                       if k.startswith("state_")))
     if tr.solver == "series":
         from ..solve.solvers.series import slip_zero
 
