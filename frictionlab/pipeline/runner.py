@@ -19,6 +19,8 @@ from .planning import FitPlan
 from .settings import Settings
 
 Progress = Callable[[int, int, str], None]
+#: the last tasks of a stage are named in the progress label while they run (a slow fit is not anonymous)
+RUNNING_SHOWN = 3
 
 
 @attrs.define
@@ -48,7 +50,9 @@ class Run:
                     raise FrictionLabError(f"compare: a worker process died while running {what} "
                                            "(killed, out of memory, or a law plugin that ends its process)") from None
                 if label:
-                    self.step(label(tasks[i]))
+                    running = [label(tasks[j]) for f, j in futures.items() if not f.done()]
+                    self.step(label(tasks[i]) + (f"; still running: {', '.join(running)}"
+                                                 if 0 < len(running) <= RUNNING_SHOWN else ""))
             return results
         for i, t in enumerate(tasks):
             results[i] = fn(t)
