@@ -55,6 +55,8 @@ class Run:
                                                  if 0 < len(running) <= RUNNING_SHOWN else ""))
             return results
         for i, t in enumerate(tasks):
+            if label:  # what runs now, for the 'still working' line of a slow task
+                self.step(f"running {label(t)}", advance=False)
             results[i] = fn(t)
             if label:
                 self.step(label(t))
