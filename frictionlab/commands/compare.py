@@ -75,6 +75,7 @@ def add_parser(sub):
 def run(args) -> int:
     from ..core.files import check_target, output_lock
     from ..core.workers import long_run_gc
+    from ..io.dataset import builtin_names, load_dataset
     from ..pipeline.comparison import compare
     from ..report import write_report
     from .fit import parse_free
@@ -94,10 +95,11 @@ def run(args) -> int:
     if args.replicates < MIN_REPLICATES:
         raise ParameterError(f"--replicates must be at least {MIN_REPLICATES}, got {args.replicates}")
     free = parse_free(args.free)
+    datasets = [load_dataset(d) for d in args.data or builtin_names()]  # read first: --out keeps clear of them
     with output_lock(args.out), long_run_gc():  # a second run to the same --out fails now, not after the work
         check_target(args.out, args.force)
         with Progress("compare", quiet=args.quiet) as bar:
-            result = compare(laws=args.laws or None, datasets=args.data or None, solvers=args.solver or None,
+            result = compare(laws=args.laws or None, datasets=datasets, solvers=args.solver or None,
                              free=free, equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar,
                              bootstrap=args.bootstrap, seed=args.seed, bootstrap_all=args.bootstrap_all,
                              tolerance=TOLERANCE_RTOLS if args.tolerance else (), fit_timeout=args.fit_timeout,

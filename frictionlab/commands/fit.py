@@ -103,19 +103,28 @@ def parse_fix(law, items) -> dict:
 
 
 def run(args) -> int:
-    from ..inference.fitting import fit
+    from ..core.inputs import check_apart
+    from ..core.workers import process_pool
+    from ..io.dataset import load_dataset
+    from ..pipeline.budget import fit_within_budget
     from ..physics.registry import get_law
     from ..report import fit_json as _fit_json
 
     law = get_law(args.law)
     if args.json and not args.json.parent.is_dir():  # before the work, not after
         raise OutputError(f"{args.json}: cannot write: folder {args.json.parent} does not exist")
+    datasets = [load_dataset(d) for d in args.datasets]
+    if args.json:
+        check_apart(args.json)  # never over a file the fit reads
+    options = dict(solver=args.solver, free=parse_free(args.free), fixed=parse_fix(law, args.fix), local=args.local,
+                   observable=args.observable, derive=args.derive, timeout=args.fit_timeout, rtol=args.rtol)
     from ..core.progress import Progress
+    from ..pipeline.budget import is_third_party
 
-    with Progress("fit", quiet=args.quiet, delay=2.0) as bar:  # a quick fit stays silent
-        result = fit(law, args.datasets, solver=args.solver, free=parse_free(args.free),
-                     fixed=parse_fix(law, args.fix), local=args.local, observable=args.observable,
-                     derive=args.derive, timeout=args.fit_timeout, rtol=args.rtol, progress=bar)
+    with process_pool(1, "fit"), Progress("fit", quiet=args.quiet, delay=2.0) as bar:  # a quick fit stays silent
+        if args.fit_timeout is None or not is_third_party(law):  # fitted here (not in a child): it can report
+            options["progress"] = bar
+        result = fit_within_budget(law, datasets, **options)
     if result.status == "skipped":  # asked for explicitly, an inapplicable solver is an error, not a skip
         raise SolverError(result.reason)
     print(result.summary())

@@ -42,6 +42,7 @@ from contextlib import contextmanager
 import attrs
 import numpy as np
 
+from ..core.arguments import as_items, check_type
 from ..core.errors import DatasetError, FrictionLabError, ParameterError, SolverError
 from ..physics.registry import get_law
 from ..physics.scene import Scene
@@ -580,9 +581,10 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     """
     import lmfit  # slow to import: only when fitting
 
+    check_type(solver, str, "fit: solver", "a solver name such as 'auto', 'exact' or 'ode'")
     law = get_law(law)
     started, cpu_started = time.perf_counter(), time.thread_time()
-    items = datasets if isinstance(datasets, (list, tuple)) else [datasets]
+    items = as_items(datasets, "fit: datasets")
     if not items:
         raise DatasetError("fit: no datasets given")
     names = tuple(d.name if hasattr(d, "name") else str(d) for d in items)  # str() of a Target prints its arrays
@@ -596,6 +598,9 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     except SkipDataset as exc:
         return give_up("skipped", str(exc))
     names = tuple(t.name for t in targets)
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:  # its points would count twice and the error bars shrink by sqrt(2)
+        raise DatasetError(f"fit: dataset '{twice[0]}' is given more than once; give each dataset once")
     for name in list(fixed or {}) + list(local) + list(initial or {}):
         law.spec(name)  # unknown names are input errors
     law.resolve({**(initial or {}), **(fixed or {})})  # so are held or start values outside the bounds

@@ -359,11 +359,9 @@ STYLE = {  # method -> (color, marker, line style)
 
 
 def plot_case(path, name, case, rows, env) -> None:
-    import matplotlib
+    from ..core.display import pyplot
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(9.0, 6.2), dpi=110, layout="constrained")
     floor = ROUND_OFF / 3
     for method in dict.fromkeys(r["method"] for r in rows):

@@ -24,6 +24,7 @@ from collections.abc import Sequence
 import attrs
 import numpy as np
 
+from ..core.arguments import as_items
 from ..core.errors import FrictionLabError
 from ..inference.equivalence import PAIRS, REPLICATES, EquivalenceResult
 from ..inference.fitting import FitResult
@@ -154,7 +155,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                         replicates=replicates, pairs=tuple(pairs), transfer=transfer)
     settings = attrs.evolve(settings, laws=select_laws(laws))
     chosen = select(STAGES, stages)
-    dss = unique_datasets(load_dataset(d) for d in (datasets if datasets is not None else builtin_names()))
+    dss = unique_datasets(load_dataset(d) for d in (as_items(datasets, "compare: datasets") if datasets is not None
+                                                    else builtin_names()))
     if not dss:
         raise FrictionLabError("compare: no datasets to compare")
     run = _make_run(settings, dss, progress)

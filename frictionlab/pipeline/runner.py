@@ -96,7 +96,7 @@ def run_stages(comparison, run: Run, stages: Sequence[Stage], forced: bool = Fal
     every one given, when ``forced``), timed; returns the comparison with every stage's fields filled."""
     chosen = [s for s in stages if forced or s.wanted(run)]
     timings = dict(comparison.timings)
-    with process_pool(run.settings.jobs) as pool:
+    with process_pool(run.settings.jobs, "compare") as pool:
         run.pool = pool
         side, pending = ThreadPoolExecutor(1), []
         try:

@@ -6,6 +6,7 @@ from collections.abc import Sequence
 import attrs
 import numpy as np
 
+from ..core.arguments import as_items
 from ..core.errors import ParameterError
 from ..inference.equivalence import MIN_REPLICATES, PAIRS, REPLICATES
 from ..physics.registry import available_laws, get_law
@@ -17,12 +18,7 @@ DEFAULT_LAWS = ("coulomb", "area-rate", "wear", "couette")
 
 def select_laws(laws: Sequence[str] | None) -> tuple[str, ...]:
     """Law names to compare: None -> DEFAULT_LAWS; "all" (alone or in the list) -> every registered law."""
-    if laws is None:
-        names = DEFAULT_LAWS
-    elif isinstance(laws, str):
-        names = (laws,)
-    else:
-        names = tuple(laws)
+    names = DEFAULT_LAWS if laws is None else tuple(as_items(laws, "compare: laws"))
     if "all" in names:
         names = tuple(available_laws()) + tuple(n for n in names if n != "all")
     return tuple(dict.fromkeys(get_law(n).name for n in names))

@@ -30,14 +30,17 @@ and add ``mysection`` to ``SECTIONS`` at the place it belongs. Return None to le
 from __future__ import annotations
 
 import json
+import os
 import threading
 from concurrent.futures import as_completed
 from pathlib import Path
 
 import attrs
 
+from ..core.arguments import check_type
 from ..core.errors import OutputError
 from ..core.files import atomic_dir
+from ..core.inputs import check_apart
 from . import (
     bootstrap,
     datasets,
@@ -113,7 +116,7 @@ def _drawn(figs, jobs: int):
     with _DRAWING:
         _FIGURES[:] = figs
         try:
-            with process_pool(jobs) as pool:
+            with process_pool(jobs, "report: drawing the figures") as pool:
                 if pool is None:  # no fork on this platform
                     for i, f in enumerate(figs):
                         yield i, f.draw()
@@ -131,6 +134,11 @@ def write_report(c, out, force: bool = False, progress=None, jobs: int = 1) -> P
     progress(done, total, label), if given, is called after each figure and file. jobs: worker
     processes drawing the figures (the same PNG bytes as one process draws).
     """
+    from ..pipeline.comparison import Comparison
+
+    check_type(c, Comparison, "write_report: c", "a Comparison (what frictionlab.compare returns)")
+    check_type(out, (str, os.PathLike), "write_report: out", "a folder path")
+    check_apart(out, [p for d in c.datasets if d.path is not None for p in (d.path, d.path.with_suffix(".csv"))])
     out = Path(out)
     if out.exists() and not force:  # said in Python's terms; the command line checks before its work
         raise OutputError(f"{out}: the folder exists; pass force=True to replace it, or choose another folder")
