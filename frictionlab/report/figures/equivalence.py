@@ -67,7 +67,7 @@ def discrimination_figure(dataset: str, results) -> bytes:
         ax.axvline(e.t_obs, color="k", lw=1.5, label="observed T")
         ax.legend(fontsize=7, loc="best")
         ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
-        ax.ticklabel_format(axis="x", style="sci", scilimits=(-3, 4), useMathText=True)
+        ax.ticklabel_format(axis="x", style="sci", scilimits=(-3, 4))  # text offset: mathtext is off (core.display.pyplot)
         ax.set_xlabel(f"T = χ²({e.law_a}) − χ²({e.law_b})")
         ax.set_ylabel("replicates")
         ax.set_title(f"{e.law_a} [{e.solver_a}] vs {e.law_b} [{e.solver_b}]: {e.verdict}", fontsize=9)
