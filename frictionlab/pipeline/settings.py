@@ -41,6 +41,7 @@ class Settings:
     replicates: int = REPLICATES
     pairs: tuple = PAIRS
     transfer: bool = True
+    cluster: str = ""  # where the tasks ran when not on a local pool: "Dask cluster at ADDRESS (N workers)"
 
     def __attrs_post_init__(self):
         from ..solve.solvers import parse_solver
@@ -75,4 +76,4 @@ class Settings:
                 "bootstrap": int(self.bootstrap), "seed": int(self.seed), "bootstrap_all": bool(self.bootstrap_all),
                 "tolerance": [float(r) for r in self.tolerance], "fit_timeout": self.fit_timeout,
                 "replicates": int(self.replicates), "pairs": [list(p) for p in self.pairs],
-                "transfer": bool(self.transfer)}
+                "transfer": bool(self.transfer)} | ({"cluster": self.cluster} if self.cluster else {})

@@ -71,8 +71,9 @@ def environment():
     return env
 
 
-def markdown(title: str, sections) -> str:
-    return environment().get_template("report.md.j2").render(title=title, sections=sections)
+def markdown(title: str, sections, figdir: str = "figures") -> str:
+    """The page's Markdown; figures are linked from ``figdir`` (relative to the page)."""
+    return environment().get_template("report.md.j2").render(title=title, sections=sections, figdir=figdir)
 
 
 def html_page(title: str, sections, images: dict[str, bytes]) -> str:

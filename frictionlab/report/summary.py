@@ -41,7 +41,8 @@ def _how_it_ran(c) -> str:
             f"{c.versions.get('frictionlab')}; the comparison took {c.wall_time:.1f} s"
             + (" (" + ", ".join(f"{k} {v:.1f} s" for k, v in c.timings.items()) + ", partly in parallel)"
                if len(c.timings) > 1 else "")
-            + f" on {jobs} worker process{'es' * (jobs != 1)}. Laws: {', '.join(c.laws)}. "
+            + (f" on a {c.settings['cluster']}" if c.settings.get("cluster") else
+               f" on {jobs} worker process{'es' * (jobs != 1)}") + f". Laws: {', '.join(c.laws)}. "
             f"Datasets: {len(c.datasets)} ({len(c.fitted_datasets)} fitted).")
 
 
