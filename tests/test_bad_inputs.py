@@ -34,7 +34,7 @@ CASES = tomllib.loads(CASES_FILE.read_text(encoding="utf-8"))["case"]
 #: How a loader case (a broken dataset) is handed to each command that reads data.
 LOADER_ARGV = {
     "datasets": ["datasets", "show", "{data}"],
-    "simulate": ["simulate", "{data}", "--law", "coulomb", "--out", "{out}"],
+    "simulate": ["simulate", "coulomb", "{data}", "--out", "{out}"],
     "fit": ["fit", "coulomb", "{data}"],
     "compare": ["compare", "--laws", "coulomb", "--data", "{data}", "--out", "{out}"],
 }

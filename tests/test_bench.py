@@ -105,7 +105,7 @@ def test_tied_laws_share_a_place_in_the_tolerance_study():
     from frictionlab.inference.fitcost import fit_tolerance_study
 
     rows = fit_tolerance_study(["couette", "wear"], "incline-oil-a100", methods=("LSODA",), rtols=(1e-8,))
-    assert all(r["rank"] == 1 and r["ranking"] == "couette = wear" and r["ranking_as_reference"] for r in rows)
+    assert all(r["rank"] == 1 and r["ranking"] == "wear = couette" and r["ranking_as_reference"] for r in rows)
 
 
 def test_fit_takes_its_tolerance_as_an_argument():

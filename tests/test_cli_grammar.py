@@ -48,7 +48,7 @@ def test_lists_are_repeated_options_or_commas_everywhere():
                "--solver", "exact", "--solver", "series"])
     assert (a.laws, a.data, a.solver) == (b.laws, b.data, b.solver) == (["wear", "coulomb"], ["x.toml", "y"],
                                                                        ["exact", "series"])
-    c = parse(["simulate", "d", "--law", "couette", "--param", "eta=0.1 Pa s,h=80 um", "--param", "x=1"])
+    c = parse(["simulate", "couette", "d", "--param", "eta=0.1 Pa s,h=80 um", "--param", "x=1"])
     assert c.param == ["eta=0.1 Pa s", "h=80 um", "x=1"]
     d = parse(["fit", "area-rate", "a", "b", "--local", "mu,eta_prime"])
     assert d.local == ["mu", "eta_prime"]
@@ -79,7 +79,7 @@ def test_datasets_show_in_units_a_person_reads(capsys):
     assert main(["datasets", "show", "impact-golf-v28"]) == 0
     out = capsys.readouterr().out
     assert "np.float64" not in out and "Scene(" not in out
-    for text in ("mass: 46 g", "radius: 21.3 mm", "peak: 130 mm^2", "contact_time: 500 us", "omega ± 200 rpm"):
+    for text in ("mass: 46 g", "radius: 21.3 mm", "peak: 130 mm^2", "contact_time: 500 µs", "omega ± 200 rpm"):
         assert text in out
     assert main(["datasets", "show", "impact-outcome-synthetic"]) == 0
     assert "SpeedLaw(" not in capsys.readouterr().out
@@ -89,18 +89,18 @@ def test_series_output_does_not_contradict_itself(capsys):
     from frictionlab.solve.solvers.series import SeriesAccuracyWarning
 
     with pytest.warns(SeriesAccuracyWarning, match="b = 0.814"):  # the series says it is used beyond its range
-        assert main(["simulate", "impact-golf-v28", "--law", "wear", "--param", "lam=1.81e6 Pa s/m",
+        assert main(["simulate", "wear", "impact-golf-v28", "--param", "lam=1.81e6 Pa s/m",
                      "--solver", "series"]) == 0
     out = capsys.readouterr().out
     assert "never reached zero" not in out
-    assert "truncated series' slip crosses zero at t = 286.7 us" in out
+    assert "truncated series' slip crosses zero at t = 286.7 µs" in out
 
 
 def test_outputs_get_the_umask_permissions(tmp_path, capsys):
     old = os.umask(0o022)
     try:
         csv = tmp_path / "s.csv"
-        assert main(["simulate", "impact-golf-v28", "--law", "wear", "--solver", "exact", "--out", str(csv)]) == 0
+        assert main(["simulate", "wear", "impact-golf-v28", "--solver", "exact", "--out", str(csv)]) == 0
         assert stat.S_IMODE(csv.stat().st_mode) == 0o644
         assert main(["datasets", "template", "incline", "--out", str(tmp_path)]) == 0
         assert stat.S_IMODE((tmp_path / "my-data.toml").stat().st_mode) == 0o644
@@ -134,3 +134,27 @@ def test_compare_summary_renders_the_answers_only():
     C.answers = (a,)
     assert answer_lines(C())[1] == ("  impact-golf: no registered law describes these data; chi2 p < 1e-6; lambda A u "
                                     "vs mu N + mu eta' dA/dt: not equivalent; the series' slip crosses zero at 309 us")
+
+
+def test_defaults_that_differ_between_the_command_line_and_the_api_are_said_in_both(capsys):
+    import inspect
+
+    from frictionlab import compare
+    from frictionlab.commands.compare import BOOTSTRAP_N
+
+    assert main(["compare", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    api = inspect.signature(compare).parameters
+    assert api["bootstrap"].default == 0 != BOOTSTRAP_N and api["fit_timeout"].default is None
+    assert f"--bootstrap {BOOTSTRAP_N} (API bootstrap=0)" in text and "(API fit_timeout=None)" in text
+    assert f"bootstrap {BOOTSTRAP_N}" in " ".join(compare.__doc__.split()) and "case resamples" not in text
+
+
+def test_the_fit_tolerance_default_is_the_librarys_and_said_beside_simulates(capsys):
+    from frictionlab.commands.fit import FIT_RTOL
+    from frictionlab.inference.predict import FIT_RTOL as LIBRARY
+
+    assert FIT_RTOL == LIBRARY
+    assert main(["fit", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert f"(default {LIBRARY:g}, the library's FIT_RTOL" in text and "'simulate' defaults to 1e-10" in text

@@ -226,3 +226,34 @@ def test_degenerate_fit_takes_errors_and_correlations_from_the_identifiable_part
     # the one strong correlation is the real one (lambda with u0), not eta or h with anything
     assert [(a, b) for a, b, _ in c.identifiability.high_correlations] == [("eta/h", "u0")]
     assert [(a, b) for a, b, _ in w.identifiability.high_correlations] == [("lam", "u0")]
+
+
+def test_fit_report_names_both_aic_conventions_and_the_laws_bounds():
+    """fit_report()'s AIC is ours (-2 ln L + 2k); lmfit's minimizer_result.aic (n ln(chi2/n) + 2k) is named
+    beside it with its value; the law's bounds are shown where lmfit's say inf."""
+    import math
+
+    from frictionlab import fit as _fit
+
+    r = _fit("wear", "impact-golf-v28", solver="series")
+    text = r.fit_report()
+    n, k, chi2 = r.stats.n_points, r.stats.n_free, r.minimizer_result.chisqr
+    assert math.isclose(r.minimizer_result.aic, n * math.log(chi2 / n) + 2 * k, rel_tol=1e-9)
+    assert f"Akaike info crit   = {r.stats.aic:.6g}  (-2 ln L + 2k" in text
+    assert f"minimizer_result.aic = {r.minimizer_result.aic:.6g} is n ln(chi2/n) + 2k" in text
+    assert "lam: Pa s/m, bounds [0, 1e+13]" in text and r.to_dataframe()["upper"].iloc[0] == 1e13
+
+
+def test_a_flag_and_what_it_did_to_the_rank_are_in_the_ranking_frame():
+    import pandas as pd
+
+    from frictionlab.inference.frames import ranking_frame
+    from frictionlab.inference.ranking import RankRow
+
+    class C:
+        datasets, groups = (), ()
+        ranking = (RankRow("d", "area-rate", "exact", 10, 2, aic=1.0, rank=2, flags=("rests on eta_prime",)),
+                   RankRow("d", "coulomb", "exact", 10, 1, aic=5.0, rank=1))
+    df = ranking_frame(C())
+    assert isinstance(df, pd.DataFrame) and list(df["plausibility_flags"]) == ["rests on eta_prime", ""]
+    assert df["rank_effect"].iloc[0].startswith("ranked after every unflagged") and df["rank_effect"].iloc[1] == ""

@@ -190,3 +190,68 @@ def test_readme_law_example_runs_as_written(tmp_path, run_cli):
         assert law.citation.startswith("R. Stribeck")
     finally:
         fl.unregister_law("exp-stribeck")
+
+
+def test_a_notebook_cell_registering_a_law_can_run_again():
+    """The same class again: a no-op with a warning; the class defined anew (same module and name): it
+    replaces the earlier one, with a warning; another class of the same law name is still an error."""
+    import warnings as _w
+
+    from frictionlab import FrictionLaw, ParamSpec, get_law, register_law, unregister_law
+
+    def define(k):
+        class CellLaw(FrictionLaw):
+            name = "cell-law"
+            formula = "F = k N"
+            citation = "a test"
+            params = (ParamSpec("k", "", k, 0.0, 10.0, 0.3, "a coefficient"),)
+            requires = frozenset({"u", "N"})
+
+            def force(self, p, c):
+                return p["k"] * c.N * np.sign(c.u)
+        return CellLaw
+
+    first = define(0.3)
+    try:
+        register_law(first)
+        with _w.catch_warnings(record=True) as seen:
+            _w.simplefilter("always")
+            register_law(first)
+            assert get_law("cell-law").spec("k").default == 0.3 and "nothing changed" in str(seen[-1].message)
+            register_law(define(0.4))
+            assert get_law("cell-law").spec("k").default == 0.4 and "replaces the earlier" in str(seen[-1].message)
+    finally:
+        unregister_law("cell-law")
+
+
+def test_loading_the_same_law_file_twice_is_a_note_not_an_error(tmp_path, capsys):
+    """``--load f --load f`` (a notebook's cell run twice, on the command line): the second registration of
+    the same module.class replaces the first with a warning; the command runs."""
+    import warnings as _w
+
+    from frictionlab import unregister_law
+    from frictionlab.cli import main
+
+    f = tmp_path / "my_twice_laws.py"
+    f.write_text('''from frictionlab import FrictionLaw, ParamSpec, register_law
+
+
+@register_law
+class Twice(FrictionLaw):
+    name = "twice"
+    formula = "F = k u"
+    citation = "loaded twice"
+    params = (ParamSpec("k", "N s/m", 1.0, 0.0, 10.0, 1.0, "coefficient"),)
+    requires = frozenset({"u"})
+
+    def force(self, p, c):
+        return p["k"] * c.u
+''')
+    try:
+        with _w.catch_warnings(record=True) as seen:
+            _w.simplefilter("always")
+            assert main(["--load", str(f), "--load", str(f), "laws"]) == 0
+        assert any("'twice'" in str(w.message) and "again" in str(w.message) for w in seen)
+        assert "twice" in capsys.readouterr().out
+    finally:
+        unregister_law("twice")

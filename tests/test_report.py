@@ -217,7 +217,7 @@ def test_figures_drawn_by_worker_processes_are_the_ones_drawn_here(comparison, r
 
 
 def test_figures_laid_out_before_saving_are_those_of_a_plain_savefig(comparison, report_dir, tmp_path, monkeypatch):
-    """figures._png runs the constrained layout itself and saves without the layout engine (one draw fewer):
+    """figures.base._png runs the constrained layout itself and saves without the layout engine (one draw fewer):
     every figure of the report is the same bytes as matplotlib's own savefig with constrained layout."""
     from frictionlab.report import figures
 
@@ -227,7 +227,7 @@ def test_figures_laid_out_before_saving_are_those_of_a_plain_savefig(comparison,
         figures._plt().close(fig)
         return buf.getvalue()
 
-    monkeypatch.setattr(figures, "_png", plain)
+    monkeypatch.setattr(figures.base, "_png", plain)  # every figure module saves through base
     out = write_report(comparison, tmp_path / "plain")
     names = sorted(p.name for p in (report_dir / "figures").iterdir())
     assert len(names) > 2 and names == sorted(p.name for p in (out / "figures").iterdir())

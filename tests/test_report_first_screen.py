@@ -43,13 +43,13 @@ def test_finding_computed_from_the_fitted_series(comp):
     sections, extra = _first(comp)
     assert extra["series_slip_zero_s"][f.dataset.name] == f.t_cross
     md = markdown("t", sections)
-    assert f"cross zero at {f.t_cross * 1e6:.4g} us" in md and "figures/finding.png" in md
+    assert f"cross zero at {f.t_cross * 1e6:.4g} µs" in md and "figures/finding.png" in md
 
 
 def test_without_answers_nothing_is_declared_to_fit(comp):
     md = markdown("t", _first(attrs.evolve(comp, answers=()))[0])
     assert "`Comparison.answers` is empty)" in md and "lowest AIC (not a fit test)" in md
-    assert "No data in this comparison for: goodness-of-fit test." in md
+    assert "Not in this comparison: a goodness-of-fit test." in md
     assert "differ by more than the noise when sigma" in md  # the discrimination test's threshold is shown
 
 
@@ -61,9 +61,40 @@ def test_answers_are_rendered_and_empty_columns_said(comp):
     md = markdown("t", _first(attrs.evolve(comp, answers=(a,)))[0])
     head = next(line for line in md.splitlines() if line.startswith("| dataset group"))
     assert "best law" in head and "goodness of fit" in head and "noise threshold" not in head
-    assert "No data in this comparison for: noise threshold, one parameter set for all conditions?." in md
+    assert ("Not in this comparison: a noise threshold; one parameter set across conditions (no group of two or "
+            "more datasets).") in md
     assert "chi2 p = 0.41" in md and "implausible: eta' = -7.9e11" in md
     assert "`Comparison.answers` is empty" not in md
+
+
+def test_groups_without_a_fitted_law_fold_into_one_line_under_the_table(comp):
+    kw = dict(provenance="synthetic", fits=False, goodness="", equivalence="not tested", noise_threshold="",
+              series_vs_exact="", headline="not fitted: no law compared applies")
+    fitted = Answer(group="impact", datasets=("impact-x",), best="wear [exact]", **{**kw, "fits": True,
+                                                                                    "headline": "best: wear [exact]"})
+    none = [Answer(group=g, datasets=(), best=None, **kw) for g in ("slider-a", "slider-b")]
+    md = markdown("t", _first(attrs.evolve(comp, answers=(fitted, *none)))[0])
+    assert "Not fitted (no law compared applies): slider-a, slider-b." in md
+    assert not [line for line in md.splitlines() if line.startswith("| **slider")]
+
+
+def test_the_golf_story_only_where_the_data_spin_falls(comp):
+    """The synthetic wear impact's spin rises throughout contact: the first screen shows the data with the top
+    candidates and says so with numbers from the data; the paper's golf data (spin falls) get the story."""
+    from frictionlab.core.display import unit
+    from frictionlab.report.text import sig
+
+    md = markdown("t", _first(comp)[0])
+    assert "Why the paper's spin falls" not in md and "**What the data show.**" in md
+    d = comp.fitted_datasets[0]
+    target = comp.fits_on(d.name)[0].per_dataset[0].target
+    assert target.observable == "omega"
+    name, f = unit("omega")
+    assert f"to {sig(float(target.y[-1]) * f)} {name} over 500 µs and never falls" in md
+    assert "Ranked first: " in md
+    golf = compare(laws=["wear"], datasets=["impact-golf-v28"], equivalence=False, transfer=False)
+    md = markdown("t", _first(golf)[0])
+    assert "**Why the paper's spin falls.**" in md and "What the data show" not in md
 
 
 def test_cells_are_the_short_forms_and_the_full_sentences_follow_the_table(comp):
@@ -122,7 +153,7 @@ def test_one_functional_form_is_one_entry():
     rows = [line for line in md.splitlines() if line.startswith("| 1 |") or line.startswith("| 2 |")]
     # the ranking merges one closed-form family into one candidate (ranking.merge_identical)
     assert len(rows) == 2 and "wear = couette [exact]" in rows[0] and "| 1.000 |" in rows[0]
-    assert ranking.law_aliases(c) == {"couette": "couette = wear", "wear": "couette = wear"}
+    assert ranking.law_aliases(c) == {"couette": "wear = couette", "wear": "wear = couette"}  # as the ranking spells it
 
 
 def test_table_numbers_keep_their_significant_figures():
@@ -164,4 +195,16 @@ def test_a_group_row_shows_its_first_flag_and_counts_the_others():
     row = RankRow("ALL", "area-rate", "exact", 650, 16, aic=1.0, rank=3,
                   flags=("a: rests on eta_prime", "b: slip reaches 10.9 u0", "c: rests on eta_prime"))
     (cells,) = group_table([row])[1]
-    assert cells[-1].endswith("; FLAG: a: rests on eta_prime; 2 more flags: see each dataset's table")
+    assert cells[-1].endswith("; FLAG (ranked after every unflagged candidate): a: rests on eta_prime; 2 more flags: "
+                              "see each dataset's table")
+
+
+def test_the_command_lines_closing_answers_fold_groups_without_a_fitted_law(comp):
+    from frictionlab.commands.compare import answer_lines
+
+    kw = dict(provenance="synthetic", fits=False, goodness="", equivalence="not tested", noise_threshold="",
+              series_vs_exact="", headline="not fitted: no law compared applies")
+    none = [Answer(group=g, datasets=(), best=None, **kw) for g in ("slider-a", "slider-b")]
+    fitted = Answer(group="impact", datasets=("impact-x",), best="wear [exact]", **{**kw, "headline": "best: wear"})
+    lines = answer_lines(attrs.evolve(comp, answers=(none[0], fitted, none[1])))
+    assert lines[1].startswith("  impact: ") and lines[2:] == ["  slider-a, slider-b: not fitted: no law compared applies"]

@@ -1,8 +1,6 @@
 """``frictionlab bench``: work-precision diagrams and tables for every scene kind."""
 from __future__ import annotations
 
-import sys
-
 
 def add_parser(sub):
     from ..cli import subcommand
@@ -27,14 +25,11 @@ def run(args) -> int:
     from ..pipeline.bench import run_bench
     from ..pipeline.benchplot import write_bench
 
+    from ..core.progress import Progress
+
     _check_out(args)
-    import datetime as _dt
-
-    def progress(msg):
-        if not args.quiet:
-            print(f"{_dt.datetime.now():%Y-%m-%d %H:%M:%S} bench: {msg}", file=sys.stderr, flush=True)
-
-    result = run_bench(quick=args.quick, fits=args.fits, progress=progress)
+    with Progress("bench", quiet=args.quiet) as bar:
+        result = run_bench(quick=args.quick, fits=args.fits, progress=bar)
     files = write_bench(args.out, result, force=args.force)
     env = result["env"]
     print(f"wrote {args.out}/: {', '.join(files)}")

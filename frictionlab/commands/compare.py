@@ -27,7 +27,10 @@ def add_parser(sub):
     p = subcommand(sub, "compare", help="compare laws on datasets and write a report folder",
                    description="Fit every law to every dataset (default: the four mission laws, all "
                                "built-in datasets), rank them, test the paper's equivalence claim, and write report.md, "
-                               "report.html, figures/, ranking.csv and results.json.",
+                               "report.html, figures/, ranking.csv and results.json. Three defaults differ from "
+                               "the library's fl.compare(), which runs only what it is asked for: --bootstrap "
+                               f"{BOOTSTRAP_N} (API bootstrap=0), the tolerance check on (API tolerance=()), and "
+                               f"--fit-timeout {FIT_TIMEOUT:g} s (API fit_timeout=None).",
                    examples="""  frictionlab compare                          # the four mission laws on every built-in dataset into ./report
   frictionlab compare --laws wear,area-rate --data impact-golf-v28 --out golf
   frictionlab compare --data my.toml --data impact-golf-v61 --solver exact --solver series
@@ -58,7 +61,7 @@ def add_parser(sub):
                    help="skip predicting across the datasets of a group and the shared-parameter fits")
     p.add_argument("--bootstrap", type=int, default=BOOTSTRAP_N, metavar="N",
                    help=f"parametric replicates per dataset for confidence intervals and first-place shares "
-                        f"(default: {BOOTSTRAP_N}; 0: none)")
+                        f"(default: {BOOTSTRAP_N}; 0: none; fl.compare() defaults to 0)")
     p.add_argument("--seed", type=int, default=0,
                    help="seed of the bootstrap resamples and of the equivalence test's replicates (default: 0)")
     p.add_argument("--bootstrap-all", action="store_true",
@@ -136,10 +139,15 @@ def answer_lines(c) -> list[str]:
     if not c.answers:
         return ["answers: none (the verdict layer filled no Comparison.answers); see the report's tables"]
     out = ["answers (full sentences in report.html and results.json):"]
+    folded: dict[str, list[str]] = {}
     for a in c.answers:
+        if a.best is None:  # groups without a fitted law: one line per reason, as on the report's first screen
+            folded.setdefault(a.cell("best") or "no law could be fitted", []).append(a.group)
+            continue
         eq = a.cell("equivalence")
         parts = [a.cell("best"), a.cell("goodness"),
                  f"lambda A u vs mu N + mu eta' dA/dt: {eq}" if eq and eq != "not tested" else "", a.cell("threshold"), a.cell("series"),
                  a.cell("transfer")]
         out.append(f"  {a.group}: " + "; ".join(p for p in parts if p))
+    out += [f"  {', '.join(groups)}: {reason}" for reason, groups in folded.items()]
     return out

@@ -33,6 +33,10 @@ def add_parser(sub):
                    help="in a global fit, fit this law parameter separately per dataset")
     p.add_argument("--observable", help="fit this column instead of the dataset's observable (e.g. theta)")
     p.add_argument("--derive", choices=("poly9", "spline"), help="fit omega derived from the theta column")
+    p.add_argument("--rtol", type=float, metavar="R",
+                   help=f"relative tolerance of every ODE solve in the fit (default {FIT_RTOL:g}, the library's "
+                        "FIT_RTOL: a fit solves the model hundreds of times; 'simulate' defaults to 1e-10 for one "
+                        "solve; closed forms and the series ignore it)")
     p.add_argument("--json", type=Path, metavar="FILE", help="also write the result as JSON")
     p.add_argument("--fit-timeout", type=fit_timeout, default=FIT_TIMEOUT, metavar="SECONDS",
                    help=f"time budget of the fit; past it the fit fails with that reason (default {FIT_TIMEOUT:g})")
@@ -84,6 +88,7 @@ def fit_timeout(value: str) -> float:
 
 #: Default time budget of one fit [s]: far above the slowest built-in fit (an ODE fit, seconds).
 FIT_TIMEOUT = 900.0
+FIT_RTOL = 1e-6  # inference.predict.FIT_RTOL, here without importing the numerical stack for --help
 
 
 def parse_fix(law, items) -> dict:
@@ -112,8 +117,13 @@ def run(args) -> int:
     if args.json:
         check_apart(args.json)  # never over a file the fit reads
     options = dict(solver=args.solver, free=parse_free(args.free), fixed=parse_fix(law, args.fix), local=args.local,
-                   observable=args.observable, derive=args.derive, timeout=args.fit_timeout)
-    with process_pool(1, "fit"):  # no pool: a lost fitting process becomes one line naming the stage
+                   observable=args.observable, derive=args.derive, timeout=args.fit_timeout, rtol=args.rtol)
+    from ..core.progress import Progress
+    from ..pipeline.budget import is_third_party
+
+    with process_pool(1, "fit"), Progress("fit", quiet=args.quiet, delay=2.0) as bar:  # a quick fit stays silent
+        if args.fit_timeout is None or not is_third_party(law):  # fitted here (not in a child): it can report
+            options["progress"] = bar
         result = fit_within_budget(law, datasets, **options)
     if result.status == "skipped":  # asked for explicitly, an inapplicable solver is an error, not a skip
         raise SolverError(result.reason)

@@ -1,8 +1,9 @@
-"""``frictionlab simulate DATASET --law NAME``: one law on one dataset's scene, as a table, CSV or figure.
+"""``frictionlab simulate LAW DATASET``: one law on one dataset's scene, as a table, CSV or figure.
 
 Law parameters come from the law's defaults, then the dataset's [fixed] values, then --param
 (values with units, e.g. lam='1.81e6 Pa s/m'; a dimensional value must say its unit). The CSV
-holds SI columns t,u,v,omega,theta,force (and A, N where the plan built them); for an
+holds SI columns t,u,v,omega,theta,force (omega and theta only where the scene spins; A, N and a law's
+states as state_NAME where the plan built them); for an
 impact-outcome dataset it holds one row per impact. Outputs are written only after the whole
 simulation and figure succeeded, so a failed run writes nothing.
 """
@@ -28,20 +29,45 @@ def add_parser(sub):
     p = subcommand(sub, "simulate", help="simulate a law on a dataset's scene",
                    description="Simulate LAW on the scene of DATASET (built-in name or TOML path): a summary on "
                                "screen, the series as CSV (--out) and a figure with the data (--plot).",
-                   examples="""  frictionlab simulate impact-golf-v28 --law wear --param lam='1.81e6 Pa s/m' --solver exact
-  frictionlab simulate impact-golf-v28 --law wear --param lam='1.81e6 Pa s/m' --solver series --plot s.png
-  frictionlab simulate incline-oil-a100 --law couette --param eta='0.1 Pa s',h='80 um' --out v.csv""")
-    p.add_argument("dataset", metavar="DATASET_OR_TOML", help="built-in dataset name or path to its TOML")
-    p.add_argument("--law", required=True, help="registered law name (see 'frictionlab laws')")
+                   examples="""  frictionlab simulate wear impact-golf-v28 --param lam='1.81e6 Pa s/m' --solver exact
+  frictionlab simulate wear impact-golf-v28 --param lam='1.81e6 Pa s/m' --solver series --plot s.png --y omega
+  frictionlab simulate couette incline-oil-a100 --param eta='0.1 Pa s',h='80 um' --out v.csv""")
+    p.add_argument("law", metavar="LAW", help="registered law name (see 'frictionlab laws'), as in 'fit'")
+    p.add_argument("dataset", metavar="DATASET", nargs="?", help="built-in dataset name or path to its TOML")
+    p.add_argument("--law", dest="old_law", metavar="NAME",
+                   help="the earlier form 'simulate DATASET --law NAME', still accepted (with a note)")
     p.add_argument("--param", action=ListAction, default=[], metavar="NAME=VALUE",
                    help="law parameter with its unit, e.g. lam='1.81e6 Pa s/m' or mu=0.2")
     p.add_argument("--solver", default="ode", help="exact, series, ode or ode:METHOD (default: ode, i.e. LSODA)")
-    p.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance of the ode solver (default 1e-10)")
+    p.add_argument("--rtol", type=float, default=1e-10, help="relative tolerance of the ode solver (default 1e-10, as fl.simulate; "
+                        "a fit's solves default to 1e-6, 'fit --rtol')")
     p.add_argument("--points", type=int, metavar="N",
                    help="write N evenly spaced times over the scene's duration instead of the dataset's times")
     p.add_argument("--out", type=Path, metavar="FILE.csv", help="write the simulated series (SI) as CSV")
     p.add_argument("--plot", type=Path, metavar="FILE.png", help="write a figure of the observable with the data")
+    p.add_argument("--y", metavar="COLUMN", help="plot this simulated column instead of the dataset's observable "
+                   "(e.g. omega for the spin of a dataset that fits theta; the CSV's column names)")
     p.set_defaults(func=run)
+
+
+def _law_and_dataset(args) -> str:
+    """'simulate LAW DATASET' (as 'fit LAW DATASET'), or the earlier 'simulate DATASET --law LAW' with a note;
+    sets args.dataset and returns the law's name."""
+    import sys
+
+    if args.old_law is not None:
+        if args.dataset is not None:
+            raise ParameterError(f"simulate: the law is given twice ({args.law!r} and --law {args.old_law!r}); "
+                                 "write 'frictionlab simulate LAW DATASET'")
+        if not args.quiet:
+            print(f"note: 'simulate {args.law} --law {args.old_law}' is the earlier form; write 'frictionlab simulate "
+                  f"{args.old_law} {args.law}' (the law first, as in 'fit')", file=sys.stderr)
+        args.dataset = args.law
+        return args.old_law
+    if args.dataset is None:
+        raise ParameterError(f"simulate: expected a law and a dataset ('frictionlab simulate LAW DATASET'), got only "
+                             f"{args.law!r}")
+    return args.law
 
 
 def parse_params(law, items) -> dict[str, float]:
@@ -62,7 +88,7 @@ def run(args) -> int:
     from ..io.dataset import load_dataset
     from ..physics.registry import get_law
 
-    law = get_law(args.law)
+    law = get_law(_law_and_dataset(args))
     params = parse_params(law, args.param)
     if not MIN_RTOL <= args.rtol < 1:
         raise SolverError(f"--rtol: rtol must be a number in (0, 1), at least {MIN_RTOL:g} (a float resolves "
@@ -75,10 +101,15 @@ def run(args) -> int:
             check_writable(path)
     if args.out is not None and args.plot is not None and os.path.realpath(args.out) == os.path.realpath(args.plot):
         raise OutputError(f"{args.out}: --out and --plot name the same file; give two paths")
-    if ds.kind == "impact-outcome":
-        text, summary, figure = _outcomes(law, ds, params, args)
-    else:
-        text, summary, figure = _series(law, ds, params, args)
+    from ..core.progress import Progress
+
+    with Progress("simulate", quiet=args.quiet, delay=2.0) as bar:  # a quick run stays silent
+        if ds.kind == "impact-outcome":
+            bar(0, 1, f"solving {len(ds)} impacts of {ds.name}")
+            text, summary, figure = _outcomes(law, ds, params, args)
+        else:
+            text, summary, figure = _series(law, ds, params, args, bar)
+        bar(1, 1, "done")
     written = []
     try:  # both outputs or neither
         if args.plot is not None:
@@ -102,7 +133,27 @@ def _params_text(law, p) -> str:
 
 
 # --- time series ---------------------------------------------------------------------------------
-def _series(law, ds, params, args):
+def _solving(bar, what: str, t_end: float):
+    """A context in which every ODE step tells ``bar`` the simulated time reached (per mille of t_end)."""
+    import time
+
+    from ..core.display import fmt_time
+    from ..solve.solvers.ode import watching
+
+    state = {"t": 0.0, "at": -1e9}
+
+    def tick(t):
+        now = time.monotonic()
+        state["t"] = max(state["t"], float(t))
+        if now - state["at"] >= 0.25:
+            state["at"] = now
+            bar(int(1000 * min(state["t"] / t_end, 1.0)), 1000,
+                f"{what}: t = {fmt_time(state['t'], t_end)} of {fmt_time(t_end)} simulated")
+    bar(0, 1000, what)
+    return watching(tick)
+
+
+def _series(law, ds, params, args, bar=lambda *a: None):
     import numpy as np
 
     from ..solve.solvers import simulate
@@ -112,7 +163,8 @@ def _series(law, ds, params, args):
         simulate(law, ds, params, solver=args.solver, rtol=args.rtol)  # raises the loader's one-line error
     t_end = max(float(scene.duration), float(ds.t[-1]))
     t = np.linspace(0.0, t_end, args.points) if args.points else ds.t
-    tr = simulate(law, ds, params, solver=args.solver, rtol=args.rtol, t=t)
+    with _solving(bar, f"solving {law.name} on {ds.name}", t_end):
+        tr = simulate(law, ds, params, solver=args.solver, rtol=args.rtol, t=t)
     p = law.resolve({**{k: v for k, v in ds.fixed.items() if k in law.param_names}, **params})
     summary = _summary(law, ds, tr, p)
     figure = None
@@ -121,12 +173,22 @@ def _series(law, ds, params, args):
         if len(t) < PLOT_POINTS:  # a smooth curve; any solver warning was already given for the run above
             import warnings
 
-            with warnings.catch_warnings():
+            with warnings.catch_warnings(), _solving(bar, f"solving at {PLOT_POINTS} times for the plot", t_end):
                 warnings.simplefilter("ignore")
                 fine = simulate(law, ds, params, solver=args.solver, rtol=args.rtol,
                                 t=np.linspace(0.0, t_end, PLOT_POINTS))
-        figure = _series_figure(ds, fine, f"{law.name} [{tr.solver}]: {_params_text(law, p)}")
-    return tr.csv_text(), summary, figure
+        figure = _series_figure(ds, fine, f"{law.name} [{tr.solver}]: {_params_text(law, p)}", args.y)
+    return _csv(tr, "spin" in scene.effects), summary, figure
+
+
+def _csv(tr, spins: bool) -> str:
+    """The trajectory's CSV (SI); without a spin state, no rotation columns (all zeros, and 'theta' would read
+    as a rate-and-state theta, which is the column state_theta)."""
+    if spins:
+        return tr.csv_text()
+    cols = {k: v for k, v in tr.columns().items() if k not in ("omega", "theta")}
+    lines = [",".join(cols)] + [",".join(f"{x:.17g}" for x in row) for row in zip(*cols.values())]
+    return "\n".join(lines) + "\n"
 
 
 def _summary(law, ds, tr, p) -> str:
@@ -142,9 +204,11 @@ def _summary(law, ds, tr, p) -> str:
     else:
         i = int(np.argmax(np.abs(tr.v)))
         lines.append(f"  peak velocity  {tr.v[i]:.6g} m/s at t = {fmt_time(tr.t[i], T)}")
-    lines.append(f"  at t = {fmt_time(T, T)}: slip u = {tr.u[-1]:.6g} m/s, v = {tr.v[-1]:.6g} m/s, "
-                 f"spin {tr.omega[-1] * RPM:.6g} rpm, theta {math.degrees(tr.theta[-1]):.6g} deg, "
-                 f"force {tr.force[-1]:.6g} N")
+    spin = (f"spin {tr.omega[-1] * RPM:.6g} rpm, theta {math.degrees(tr.theta[-1]):.6g} deg, "
+            if "spin" in ds.scene.effects else "")
+    lines.append(f"  at t = {fmt_time(T, T)}: slip u = {tr.u[-1]:.6g} m/s, v = {tr.v[-1]:.6g} m/s, {spin}"
+                 f"force {tr.force[-1]:.6g} N" + "".join(f", {k} {v[-1]:.6g} (SI)" for k, v in tr.columns().items()
+                                                       if k.startswith("state_")))
     if tr.solver == "series":
         from ..solve.solvers.series import slip_zero
 
@@ -174,20 +238,25 @@ def simulate_series_slip(law, ds, p, t) -> np.ndarray:
         return simulate(law, ds, p, solver="series", t=t).u
 
 
-def _series_figure(ds, tr, title) -> bytes:
+def _series_figure(ds, tr, title, y: str | None = None) -> bytes:
+    """The simulated column ``y`` (default the dataset's observable) against time, with the dataset's
+    column of that name where it has one."""
     from ..core.display import NAMES, time_unit, unit
     from ..report.figures import _plt, _png
 
     plt = _plt()
-    obs = ds.observable
+    obs = y or ds.observable
+    cols = tr.columns()
+    if obs not in cols and obs != "mu":
+        raise ParameterError(f"--y {obs}: the simulation has no such column; choose from {', '.join(cols)}")
     uname, uf = unit(obs)
     tname, tf = time_unit(float(tr.t[-1]))
     fig, ax = plt.subplots(figsize=(7, 4.2))
-    model = tr[obs] if obs in ("u", "v", "omega", "theta", "mu") else tr.columns().get(obs)
-    if model is not None:
-        ax.plot(tr.t * tf, model * uf, color="#1b9e77", lw=1.8, label="simulated")
-    ax.errorbar(ds.t * tf, ds.y * uf, yerr=ds.sigma * uf, fmt="o", ms=3.5, color="k", ecolor="0.6", lw=0.8,
-                label=f"{ds.name} ({ds.provenance.kind})")
+    ax.plot(tr.t * tf, tr[obs] * uf, color="#1b9e77", lw=1.8, label="simulated")
+    if obs in ds.columns:
+        sigma = ds.noise.get(obs, 0.0)
+        ax.errorbar(ds.t * tf, ds.columns[obs] * uf, yerr=sigma * uf, fmt="o", ms=3.5, color="k", ecolor="0.6",
+                    lw=0.8, label=f"{ds.name} ({ds.provenance.kind})")
     ax.set_xlabel(f"time [{tname}]")
     ax.set_ylabel(f"{NAMES.get(obs, obs)} [{uname}]")
     ax.set_title(title, fontsize=9)
@@ -202,20 +271,28 @@ OUTCOME_COLUMNS = ("speed", "incidence", "rebound_spin", "tangential_cor", "rebo
 
 
 def _outcomes(law, ds, params, args):
+    """One row per impact: the summary shows the dataset's own observable (in its file's unit) beside the
+    rebound spin and the contact point's e_T; the CSV holds every outcome the scene gives (SI)."""
     from ..core.table import render
-    from ..solve.outcome import predict_outcomes
+    from ..report.figures import column_unit
+    from ..solve.outcome import OUTCOMES, predict_outcomes
 
     out = predict_outcomes(law, ds, params, args.solver, rtol=args.rtol)
     p = law.resolve({**{k: v for k, v in ds.fixed.items() if k in law.param_names}, **params})
+    obs = ds.observable
+    ou, of = column_unit(ds, obs)
+    shown = f"{obs} (the dataset's observable)" + (f" [{ou}]" if ou else "")
     rows = [{"speed [m/s]": out["speed"][i], "incidence [deg]": math.degrees(out["incidence"][i]),
-             "rebound spin [rpm]": out["rebound_spin"][i] * RPM, "e_T": out["tangential_cor"][i],
-             "rebound angle [deg]": math.degrees(out["rebound_angle"][i]), "rolled": bool(out["rolled"][i])}
+             shown: out[obs][i] * of, "rebound spin [rpm]": out["rebound_spin"][i] * RPM,
+             "e_T at the contact point": out["tangential_cor"][i], "rolled": bool(out["rolled"][i])}
             for i in range(len(out["speed"]))]
+    if obs == "rebound_spin":
+        rows = [{k: v for k, v in r.items() if k != "rebound spin [rpm]"} for r in rows]
     summary = f"{law.name} on {ds.name} ({args.solver}): {_params_text(law, p)}\n" + render(rows)
-    lines = [",".join(OUTCOME_COLUMNS)]
+    cols = list(OUTCOME_COLUMNS) + [c for c in OUTCOMES if c in out and c not in OUTCOME_COLUMNS]
+    lines = [",".join(cols)]
     for i in range(len(out["speed"])):
-        lines.append(",".join(f"{float(out[c][i]):.17g}" if c != "rolled" else str(int(out[c][i]))
-                              for c in OUTCOME_COLUMNS))
+        lines.append(",".join(f"{float(out[c][i]):.17g}" if c != "rolled" else str(int(out[c][i])) for c in cols))
     figure = _outcome_figure(law, ds, p, args) if args.plot is not None else None
     return "\n".join(lines) + "\n", summary, figure
 
@@ -223,12 +300,14 @@ def _outcomes(law, ds, params, args):
 def _outcome_figure(law, ds, p, args) -> bytes:
     import numpy as np
 
+    from ..report.figures import column_unit
+
     from ..report.figures import _plt, _png
     from ..solve.outcome import predict_outcomes
 
     plt = _plt()
     obs = ds.observable
-    uname, uf = {"rebound_spin": ("rpm", RPM), "rebound_angle": ("deg", 180 / math.pi)}.get(obs, ("-", 1.0))
+    uname, uf = column_unit(ds, obs)
     fig, ax = plt.subplots(figsize=(7, 4.2))
     speeds = np.unique(ds.columns["speed"])
     inc = ds.columns["incidence"]

@@ -40,7 +40,7 @@ def unit(name: str) -> tuple[str, float]:
 def time_unit(t_max: float) -> tuple[str, float]:
     """A time unit that keeps numbers readable for a record lasting t_max seconds."""
     if t_max < 2e-3:
-        return "us", 1e6
+        return "µs", 1e6
     if t_max < 2.0:
         return "ms", 1e3
     return "s", 1.0
@@ -82,7 +82,7 @@ def fmt_value(value: float, err: float | None, unit_: str) -> str:
 
 
 #: SI unit -> (display unit, factor, threshold): shown in the display unit when |value| < threshold.
-_SMALL = {"m": ("um", 1e6, 1e-3), "m^2": ("mm^2", 1e6, 1e-2), "s": ("us", 1e6, 2e-3)}
+_SMALL = {"m": ("µm", 1e6, 1e-3), "m^2": ("mm^2", 1e6, 1e-2), "s": ("µs", 1e6, 2e-3)}
 
 
 def _scale(value: float | None, unit_: str) -> tuple[str, float]:
@@ -127,7 +127,7 @@ OWNER_FIELD_UNITS = {"SpringLoad": {"stiffness": "1/m", "times": "s", "velocitie
 
 
 def quantity_text(value: float, unit_: str) -> str:
-    """A scene value for people: g, mm, deg, rpm, and um/mm^2/us where small; 4 significant figures."""
+    """A scene value for people: g, mm, deg, rpm, and µm/mm^2/µs where small; 4 significant figures."""
     value = float(value)
     if unit_ == "kg" and abs(value) < 1:
         value, unit_ = value * 1e3, "g"

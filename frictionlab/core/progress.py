@@ -6,7 +6,7 @@ rate and the ETA. On anything else (a log file, a pipe) it writes lines such as
 ``2026-11-23 01:02:03 compare: 12/40 (30%) wear [exact] on impact-golf-v28; ETA 0:01:10`` to
 stderr, at most one per ``every`` seconds plus the first and the last, and a "still working" line
 when a single step takes longer than ``heartbeat`` seconds, so a redirected run is never silent
-and a log stays short. ``quiet=True`` silences it.
+and a log stays short (``delay``: nothing at all from a run shorter than that); the "still working" line names the last label (the stage and item). ``quiet=True`` silences it.
 """
 from __future__ import annotations
 
@@ -25,20 +25,24 @@ class Progress:
     """progress(done, total, label); use as a context manager or call close() at the end."""
 
     def __init__(self, desc: str, stream=None, quiet: bool = False, every: float = 5.0, tty: bool | None = None,
-                 heartbeat: float = 30.0):
+                 heartbeat: float = 10.0, delay: float = 0.0):
         self.desc, self.stream, self.quiet, self.every = desc, stream or sys.stderr, quiet, every
         self.tty = (hasattr(self.stream, "isatty") and self.stream.isatty()) if tty is None else tty
         self.start = time.monotonic()
         self.last_line = -1e9
         self.bar = None
-        self.done, self.total = 0, 0
+        self.done, self.total, self.label = 0, 0, ""
         self.heartbeat = heartbeat
+        self.delay = delay  # seconds during which nothing is shown: a run shorter than that stays silent
         self._stop = threading.Event()
         self._lock = threading.Lock()
         self._beat = None
 
     def __call__(self, done: int, total: int, label: str = "") -> None:
         if self.quiet:
+            return
+        if self.delay and time.monotonic() - self.start < self.delay:
+            self.done, self.total, self.label = done, total, label
             return
         if self.tty:
             self._draw(done, total, label)
@@ -49,7 +53,7 @@ class Progress:
             if self._beat is None and self.heartbeat:
                 self._beat = threading.Thread(target=self._beats, daemon=True)
                 self._beat.start()
-        self.done, self.total = done, total
+        self.done, self.total, self.label = done, total, label
 
     def _write(self, text: str, now: float) -> None:
         with self._lock:
@@ -64,13 +68,15 @@ class Progress:
             if now - self.last_line >= self.heartbeat and self.done < self.total:
                 stamp = _dt.datetime.now().strftime("%Y-%m-%d %H:%M:%S")
                 self._write(f"{stamp} {self.desc}: {self.done}/{self.total} done, still working "
-                            f"({_clock(now - self.start)} so far)", now)
+                            f"({_clock(now - self.start)} so far)" + (f"; last: {self.label}" if self.label else ""),
+                            now)
 
     def line(self, done: int, total: int, label: str, now: float | None = None) -> str:
         """The plain progress line: time stamp, count, share, label and ETA."""
         elapsed = (now if now is not None else time.monotonic()) - self.start
         share = done / total if total else 1.0
-        eta = f"ETA {_clock(elapsed * (1 - share) / share)}" if 0 < share < 1 else f"took {_clock(elapsed)}"
+        eta = (f"ETA {_clock(elapsed * (1 - share) / share)}" if 0 < share < 1 else
+               "ETA after the first step" if share == 0 else f"took {_clock(elapsed)}")
         stamp = _dt.datetime.now().strftime("%Y-%m-%d %H:%M:%S")
         return f"{stamp} {self.desc}: {done}/{total} ({100 * share:.0f}%) {label}; {eta}"
 

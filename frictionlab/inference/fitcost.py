@@ -48,7 +48,10 @@ def _ranking(fits: dict) -> tuple[tuple[str, ...], dict]:
         else:
             groups.append([law])
         rank[law] = 1 + sum(1 for o in order if ok[o] < ok[law] - TIE_AIC)
-    return tuple(tuple(sorted(g)) for g in groups), rank
+    from ..physics.registry import get_law
+
+    simplest = lambda law: (len(get_law(law).params), law)  # noqa: E731  'wear = couette', as the ranking spells it
+    return tuple(tuple(sorted(g, key=simplest)) for g in groups), rank
 
 
 def _run_fits(todo, ds, executor, progress, options) -> dict:

@@ -386,6 +386,7 @@ class _Model:
         self.last_error = ""
         self.nfev = 0
         self._last = None  # (values, models, residual) of the last evaluation that solved every target
+        self.progress = None  # fitprogress.FitProgress, told of every evaluation
 
     def split(self, values: Mapping[str, float]):
         """Per-target law parameters and scenes for SI slot values (by lmfit name)."""
@@ -416,6 +417,8 @@ class _Model:
             return self._last[2].copy()
         self.nfev += 1
         self._last = None
+        if self.progress is not None:
+            self.progress.tick()
         out, ms = [], []
         for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values)):
             try:
@@ -510,6 +513,12 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
         return params, True, "nothing to fit: every parameter is held", None, []
     slow = any(x.startswith("ode") for x in solvers)
     starts = [{s.pname: params[s.pname].value for s in varying}]
+    budget = max_nfev or 200 * (len(varying) + 1)
+    if model.progress is not None:
+        from .fitprogress import LM_EVALS
+
+        lm = LM_EVALS * (len(varying) + 1)
+        model.progress.stage("scanning start points", scan, total=scan + n_starts * lm + 2 * len(varying) + 2)
     if scan:
         fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
         scored = []
@@ -523,7 +532,9 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
     for i, start in enumerate(starts):
         for k, v in start.items():  # every varying parameter; lmfit works on its own copy
             params[k].set(value=v)
-        budget = max_nfev or 200 * (len(varying) + 1)
+        if model.progress is not None:
+            model.progress.stage(f"Levenberg-Marquardt start {i + 1} of {len(starts)}", lm,
+                                 total=model.progress.done + (len(starts) - i) * lm + 2 * len(varying) + 2)
         r = None
         if direct:
             before = model.nfev, model.failures, model.last_error, model._last
@@ -549,7 +560,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         fixed: Mapping[str, float] | None = None, local: Sequence[str] = (),
         initial: Mapping[str, float] | None = None, observable: str | None = None, derive: str | None = None,
         scan: int = 125, n_starts: int = 3, max_nfev: int | None = None, rtol: float | None = None,
-        timeout: float | None = None, checks: bool = True, errors: bool = True) -> FitResult:
+        timeout: float | None = None, checks: bool = True, errors: bool = True, progress=None) -> FitResult:
     """Fit ``law`` to one dataset or a group of them (a global fit) and return a FitResult.
 
     law: name or FrictionLaw. datasets: a Dataset, name, path or Target, or a list of them.
@@ -562,7 +573,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     n_starts: Levenberg-Marquardt runs from the best distinct grid points (the lowest chi2 wins);
     at most ODE_STARTS when a dataset is solved by 'ode' (deterministic, never timing-dependent).
     rtol: relative (and scaled absolute) tolerance of every ODE solve in the fit, in (0, 1);
-    None uses FIT_RTOL (1e-10). Closed forms and the series ignore it.
+    None uses predict.FIT_RTOL (1e-6; simulate's default is 1e-10). Closed forms and the series ignore it.
     timeout: time budget of the fit in seconds (None: none); past it the fit is 'failed'.
     checks: False skips the plausibility flags and the SI copy of lmfit's result (``minimizer_result``
     None): for replicate refits (equivalence, bootstrap, transfer) that read only the values, their
@@ -570,6 +581,8 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     errors: False skips the error analysis beyond lmfit's (the Jacobian, and what it shows: parameters
     without effect, ratio-only pairs, identifiable directions; every free parameter counts in k): for
     refits that read only the values and the chi-square (the equivalence test's replicates).
+    progress(done, total, label): told the stage (start scan, each Levenberg-Marquardt start, error
+    analysis) and its count of model evaluations (core.progress.Progress takes it).
     """
     import lmfit  # slow to import: only when fitting
 
@@ -623,6 +636,10 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     slots = _law_slots(law, targets, dict(fixed or {}), set(local), dict(initial or {}))
     slots += _scene_slots(targets, dict(free or {}))
     model = _Model(law, targets, solvers, slots, rtol, None if timeout is None else time.monotonic() + timeout)
+    if progress is not None:
+        from .fitprogress import FitProgress
+
+        model.progress = FitProgress(progress, f"{law.name} on {', '.join(names)}", scan + n_starts)
     bounds = [(_lmfit_bound(s.lower, s) / s.scale, _lmfit_bound(s.upper, s) / s.scale) for s in slots]
     if not checks and all(lo < hi and (math.isinf(lo) or math.isinf(hi) or hi - lo > 1e-13 + 1e-13 * abs(hi))
                           for lo, hi in bounds):  # an interval lmfit accepts
@@ -659,6 +676,8 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     except Exception as exc:  # an optimizer or law crash is a failed fit, not a crashed comparison
         return give_up("failed", f"{type(exc).__name__}: {exc}", nfev=model.nfev)
 
+    if model.progress is not None:
+        model.progress.stage("error analysis", 2 * len(varying) + 2)
     if errors:
         J = jacobian(model, slots, values)
         structure = find_structure(law, slots, values, J)
@@ -705,7 +724,11 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     ident = make_verdict(structure, presults, correl)
     flags, numbers, nfev = (), {}, model.nfev
     if status == "ok" and checks:
+        if model.progress is not None:
+            model.progress.stage("plausibility checks", 1)
         flags, numbers = check_plausibility(law, per, model, slots, values, likelihood)
+    if model.progress is not None:
+        model.progress.finish(f"{status} after {model.nfev} evaluations")
     return FitResult(law=law.name, solver=solver_label, datasets=names, status=status, reason=reason,
                      params=presults, correlations=correl, stats=stats, identifiability=ident,
                      per_dataset=tuple(per), nfev=nfev, wall_time=time.perf_counter() - started,

@@ -13,7 +13,7 @@ from ..io.dataset import COLUMN_SI
 
 RANKING_COLUMNS = ("dataset", "law", "solver", "candidate", "rank", "status", "observable", "n_points", "n_params",
                    "rss", "rss_unit", "rmse", "rmse_unit", "redchi", "aic", "aicc", "bic", "delta_aic",
-                   "akaike_weight", "reason")
+                   "akaike_weight", "reason", "plausibility_flags", "fits", "rank_effect")
 PARAMETER_COLUMNS = ("dataset", "law", "solver", "parameter", "value", "stderr", "unit", "kind", "vary", "fixed_by",
                      "lower", "upper")
 
@@ -37,10 +37,19 @@ def ranking_frame(c):
                      "rank": r.rank, "status": r.status, "observable": o, "n_points": r.n_points,
                      "n_params": r.n_params, "rss": r.rss, "rss_unit": rss_u, "rmse": r.rmse, "rmse_unit": rmse_u,
                      "redchi": r.redchi, "aic": r.aic, "aicc": r.aicc, "bic": r.bic, "delta_aic": r.delta_aic,
-                     "akaike_weight": r.akaike_weight, "reason": r.reason})
+                     "akaike_weight": r.akaike_weight, "reason": r.reason, "plausibility_flags": "; ".join(r.flags),
+                     "fits": r.fits, "rank_effect": _rank_effect(r)})
     df = pd.DataFrame(rows, columns=list(RANKING_COLUMNS))
     df["rank"] = df["rank"].astype("Int64")
     return df
+
+
+def _rank_effect(r) -> str:
+    """What a plausibility flag did to the candidate's place ('' without flags)."""
+    if not r.flags:
+        return ""
+    return ("ranked after every unflagged candidate, whatever its AIC" if r.rank is not None else
+            "flagged; not ranked")
 
 
 def parameters_frame(fits):
@@ -97,11 +106,29 @@ def fit_report(f, **kwargs) -> str:
     head = [f"[[Fit]] {f.law} [{f.solver}] on {', '.join(f.datasets)} (SI units)",
             f"    # data points      = {s.n_points}", f"    # variables        = {s.n_params} identifiable "
             f"({s.n_free} free)", f"    chi-square         = {s.chisqr:.6g}", f"    reduced chi-square = {s.redchi:.6g}",
-            f"    Akaike info crit   = {s.aic:.6g}", f"    Bayesian info crit = {s.bic:.6g}",
+            f"    Akaike info crit   = {s.aic:.6g}  ({aic_convention(f)})", f"    Bayesian info crit = {s.bic:.6g}",
             f"    function evals     = {f.nfev}"]
     head += [f"    warning: {w}" for w in f.identifiability.warnings]
-    units = "\n".join(f"    {_lmfit_name(p.name)}: {p.unit or '(no unit)'}" for p in f.params.values())
-    return "\n".join(head) + "\n" + lmfit.fit_report(f.lmfit_params, **kwargs) + "\n[[Units]]\n" + units
+    units = "\n".join(f"    {_lmfit_name(p.name)}: {p.unit or '(no unit)'}" + _bounds_text(p) for p in f.params.values())
+    return (("\n".join(head) + "\n" + lmfit.fit_report(f.lmfit_params, **kwargs) + "\n[[Units and the law's bounds]]\n"
+             + units + "\n    (lmfit's [lo:hi] shows inf where a bound lies beyond 1e4 typical scales of the "
+             "parameter; the law's bound above still holds, and to_dataframe() shows it)"))
+
+
+def _bounds_text(p) -> str:
+    lo, hi = getattr(p, "lower", None), getattr(p, "upper", None)
+    return "" if lo is None or hi is None else f", bounds [{lo:g}, {hi:g}]"
+
+
+def aic_convention(f) -> str:
+    """Which AIC this is, and lmfit's own (``minimizer_result.aic``: n ln(chi2/n) + 2 k, no constant) beside it."""
+    s = f.stats
+    ours = {"known": "-2 ln L + 2k with the stated sigma", "assumed": "-2 ln L + 2k, sigma profiled (k + 1)"}.get(
+        s.likelihood, f"-2 ln L + 2k ({s.likelihood} likelihood)")
+    mr = getattr(f, "minimizer_result", None)
+    theirs = getattr(mr, "aic", None)
+    return ours + ("" if theirs is None else f"; lmfit's minimizer_result.aic = {theirs:.6g} is n ln(chi2/n) + 2k, "
+                   "without the constant: compare AICs of one convention only")
 
 
 def _table(df, caption: str) -> str:

@@ -78,6 +78,16 @@ class Dataset:
     def __len__(self) -> int:
         return len(next(iter(self.columns.values())))
 
+    def to_dataframe(self):
+        """The columns as a pandas DataFrame (SI; units by column in ``df.attrs['units']``, the file's own
+        units in ``df.attrs['file_units']``, the noise in ``df.attrs['noise']``)."""
+        import pandas as pd
+
+        df = pd.DataFrame(self.columns)
+        df.attrs.update(units={k: COLUMN_SI.get(k, "SI") for k in df.columns}, file_units=dict(self.units),
+                        noise=dict(self.noise), noise_kind=self.noise_kind, provenance=self.provenance.kind)
+        return df
+
     def __repr__(self) -> str:
         return f"<Dataset {self.name}: {self.kind}, {len(self)} points of {self.observable}, {self.provenance.kind}>"
 

@@ -198,13 +198,18 @@ class FrictionLaw:
         return {s.name: s.default for s in self.params}
 
     def resolve(self, values: Mapping[str, float] | None = None) -> dict[str, float]:
-        """Defaults overlaid with ``values``, each checked against its bounds."""
+        """Defaults overlaid with ``values``, each checked against its bounds. A value is an SI number or a
+        quantity string with its unit, as on the command line ('1.81e6 Pa s/m', '80 um', '0.3')."""
         p = self.defaults()
         for name, value in (values or {}).items():
             s = self.spec(name)
             if isinstance(value, (bool, np.bool_)):  # True is not 1 m
                 raise ParameterError(f"law '{self.name}': {name} = {value!r} is a boolean, not a number "
                                      f"(SI value in {s.unit or 'plain units'})")
+            if isinstance(value, str):
+                from ..core.units import to_si
+
+                value = to_si(value, s.unit, f"law '{self.name}': {name}")
             try:
                 v = float(value)
             except (TypeError, ValueError):

@@ -212,7 +212,9 @@ def _load() -> None:
 def register_law(obj=None, *, replace: bool = False):
     """Register a law class or instance at run time; usable as a class decorator.
 
-    ``replace=True`` swaps out a law of the same name registered earlier at run time.
+    ``replace=True`` swaps out a law of the same name registered earlier at run time. Registering the
+    same class again (a notebook cell run twice) is a no-op with a warning; a class of the same module and
+    name defined anew (the cell edited) replaces the earlier one, with a warning saying so.
     """
 
     def _register(o):
@@ -229,6 +231,13 @@ def _runtime_add(law: FrictionLaw, source: str, replace: bool) -> None:
         _runtime.append((law, source))
         return
     _load()
+    if law.name in _laws and _sources[law.name] == source:  # a notebook cell run again: the same class by name
+        if type(_laws[law.name]) is type(law):
+            warnings.warn(f"law '{law.name}': {source} again; nothing changed", stacklevel=4)
+            return
+        warnings.warn(f"law '{law.name}': {source} again; the new definition replaces the earlier one",
+                      stacklevel=4)
+        replace = True
     if replace and law.name in _laws and _sources[law.name].startswith("run-time"):
         unregister_law(law.name)
     _add(law, source)

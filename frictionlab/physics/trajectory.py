@@ -41,9 +41,27 @@ class Trajectory:
         return value
 
     def columns(self) -> dict[str, np.ndarray]:
+        """The series by name (SI): t, u, v, omega, theta, force, then A, N, load where built, then each
+        law state as ``state_NAME`` (a rate-and-state 'theta' is ``state_theta``, never the rotation angle)."""
         out = {k: getattr(self, k) for k in ("t", "u", "v", "omega", "theta", "force")}
         out.update({k: getattr(self, k) for k in ("A", "N", "load") if getattr(self, k) is not None})
+        out.update({f"state_{k}": np.asarray(v) for k, v in self.law_states.items()
+                    if np.shape(v) == np.shape(self.t)})
         return out
+
+    def to_dataframe(self):
+        """The columns as a pandas DataFrame (SI; units by column in ``df.attrs['units']``)."""
+        import pandas as pd
+
+        df = pd.DataFrame(self.columns())
+        df.attrs["units"] = {k: CSV_UNITS.get(k, "SI") for k in df.columns}
+        return df
+
+    def __repr__(self) -> str:
+        n, end = len(self.t), float(self.t[-1]) if len(self.t) else 0.0
+        return (f"<Trajectory {self.law or '?'} [{self.solver or '?'}]: {n} times, t = 0 to {end:.4g} s; "
+                f"columns {', '.join(self.columns())}"
+                + (f"; stuck at {self.stick_time:.4g} s" if self.stick_time is not None else "") + ">")
 
     def csv_text(self) -> str:
         """The columns (SI, units in CSV_UNITS) as CSV text, full precision."""

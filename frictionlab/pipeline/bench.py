@@ -241,13 +241,41 @@ FIT_METHODS, QUICK_FIT_METHODS = ("LSODA", "DOP853"), ("LSODA",)
 FIT_RTOLS, QUICK_FIT_RTOLS = (1e-3, 1e-5, 1e-7, 1e-10), (1e-3, 1e-7)
 
 
+def _steps(progress, total: int):
+    """The one-argument callback the measurements call before each item, as ``progress(done, total, label)``
+    (core.progress.Progress): done counts the items finished; ``total`` is an estimate, raised if passed."""
+    if progress is None:
+        return None
+    n = [0]
+
+    def step(msg: str):
+        n[0] += 1
+        progress(n[0] - 1, max(total, n[0]), msg)
+    return step
+
+
+def expected_items(quick: bool, fits: bool) -> int:
+    """About how many measurements run_bench makes (series and exact counted for every case)."""
+    rtols = QUICK_RTOLS if quick else RTOLS
+    per = len(rtols) * (len(ODE_METHODS) + len(BATCH_METHODS)) + 2
+    n = sum(per + (len(PLAIN_METHODS) * len(rtols) if law in ("coulomb", "wear", "couette") else 0)
+            for _, law, _, _ in cases().values())
+    if fits:
+        methods, frt = (QUICK_FIT_METHODS, QUICK_FIT_RTOLS) if quick else (FIT_METHODS, FIT_RTOLS)
+        n += sum(len(laws) * (len(methods) * len(frt) + 1) for _, laws in FIT_CASES)
+    return n
+
+
 def run_bench(quick: bool = False, progress=None, fits: bool = True) -> dict:
     """Measure every scene kind (and, with ``fits``, the fit-tolerance study); returns
-    {'env', 'settings', 'cases': {name: {title, law, params, meta}}, 'rows', 'fit_rows'}."""
+    {'env', 'settings', 'cases': {name: {title, law, params, meta}}, 'rows', 'fit_rows'}.
+    progress(done, total, label): told before each measurement (the total is an estimate)."""
     rtols = QUICK_RTOLS if quick else RTOLS
     repeats = 3 if quick else 7
     batch_size = QUICK_BATCH_SIZE if quick else BATCH_SIZE
     env = environment()
+    total = expected_items(quick, fits)
+    outer, progress = progress, _steps(progress, total)
     all_rows, info = [], {}
     for name, (title, law, params, scene) in cases().items():
         rows, meta = measure_case(name, law, params, scene, rtols, repeats, batch_size, n_t=101 if quick else 201,
@@ -264,4 +292,6 @@ def run_bench(quick: bool = False, progress=None, fits: bool = True) -> dict:
         for dataset, laws in FIT_CASES:
             fit_rows += fit_tolerance_study(laws, dataset, QUICK_FIT_METHODS if quick else FIT_METHODS,
                                             QUICK_FIT_RTOLS if quick else FIT_RTOLS, progress=progress)
+    if outer is not None:
+        outer(total, total, "done")
     return {"env": env, "settings": settings, "cases": info, "rows": all_rows, "fit_rows": fit_rows}

@@ -19,6 +19,8 @@ from .planning import FitPlan
 from .settings import Settings
 
 Progress = Callable[[int, int, str], None]
+#: the last tasks of a stage are named in the progress label while they run (a slow fit is not anonymous)
+RUNNING_SHOWN = 3
 
 
 @attrs.define
@@ -49,9 +51,13 @@ class Run:
                     raise FrictionLabError(f"compare: a worker process died while running {what} "
                                            "(killed, out of memory, or a law plugin that ends its process)") from None
                 if label:
-                    self.step(label(tasks[i]))
+                    running = [label(tasks[j]) for f, j in futures.items() if not f.done()]
+                    self.step(label(tasks[i]) + (f"; still running: {', '.join(running)}"
+                                                 if 0 < len(running) <= RUNNING_SHOWN else ""))
             return results
         for i, t in enumerate(tasks):
+            if label:  # what runs now, for the 'still working' line of a slow task
+                self.step(f"running {label(t)}", advance=False)
             results[i] = fn(t)
             if label:
                 self.step(label(t))
@@ -101,6 +107,7 @@ def run_stages(comparison, run: Run, stages: Sequence[Stage], forced: bool = Fal
                     continue
                 if stage.name == "answer":  # the verdicts read every other stage's fields
                     comparison = _collect(comparison, pending, timings)
+                run.step(f"stage {stage.name} started", advance=False)  # each stage named as it begins
                 part, timings[stage.name] = _timed(stage, comparison, run)
                 comparison = attrs.evolve(comparison, **part)
             comparison = _collect(comparison, pending, timings)

@@ -1,15 +1,15 @@
 """The first screen: the verdict table (``Comparison.answers``) and the figure of the central finding.
 
 The verdict table only renders the answers the verdict layer filled (``frictionlab/inference/answers.py``);
-a column without data says so. Without answers it shows what the comparison does hold, labelled
-as such (the AIC ranking's first place and the equivalence analysis' verdict), never a verdict
-of its own. The finding: the paper's truncated series of a F = k A u law against the exact
-solution of the same law, spin above and the slip u(t) of each below, with the time at which the
-series' slip crosses zero (computed here from the fitted series).
+columns without data are named in one line under it, and groups without a fitted law fold into one
+line. Without answers it shows what the comparison does hold, labelled as such (the AIC ranking's
+first place and the equivalence analysis' verdict), never a verdict of its own. The finding, where
+a dataset's spin falls and the paper's truncated series of a F = k A u law has its slip cross zero:
+that series against the exact solution of the same law, spin above and the slip u(t) of each below,
+with the crossing time (computed here from the fitted series). Elsewhere the figure and sentences
+of ``data_view`` describe the compared data.
 """
 from __future__ import annotations
-
-import math
 
 import attrs
 import numpy as np
@@ -18,6 +18,8 @@ from ..core.display import fmt_time
 from ..inference.answers import group_of
 from ..solve.solvers.series import slip_zero
 from . import figures
+from .data_view import data_views, describe, spin_falls
+from .data_view import title as view_title
 from .doc import Section
 from .text import PROVENANCE_WORDS, sig
 
@@ -91,11 +93,23 @@ def finding_text(shown) -> str:
                    if more else "")
 
 
+#: what each column would have said, for the one line naming the columns this comparison has no data for
+ABSENT = {"best": "a best law", "goodness": "a goodness-of-fit test",
+          "equivalence": "the equivalence test of λAu and μN + μη′dA/dt (no dataset fitted with both)",
+          "threshold": "a noise threshold", "series": "the paper's series against the exact solution (no series fitted)",
+          "transfer": "one parameter set across conditions (no group of two or more datasets)"}
+
+
 def _answer_table(sec: Section, answers):
-    empty = [head for key, head in COLUMNS if not any(a.cell(key) for a in answers)]
-    cols = [(key, head) for key, head in COLUMNS if head not in empty]
-    rows, notes = [], []
+    """The verdict table: groups without a fitted law fold into one line under it, columns without data go."""
+    folded: dict[str, list[str]] = {}
     for a in answers:
+        if a.best is None:
+            folded.setdefault(a.cell("best") or "no law could be fitted", []).append(a.group)
+    shown = [a for a in answers if a.best is not None]
+    cols = [(key, head) for key, head in COLUMNS if any(a.cell(key) for a in shown)]
+    rows, notes = [], []
+    for a in shown:
         cells = [_clip(a.cell(key)) or "—" for key, _ in cols]
         flags = _flags(a)
         if flags and "implausible" not in cells[0]:
@@ -106,10 +120,15 @@ def _answer_table(sec: Section, answers):
         if flags:
             parts.append("implausible: " + "; ".join(flags))
         notes.append(f"**{a.group}** ({', '.join(a.datasets)}; {a.provenance}): " + ". ".join(parts) + ".")
-    sec.table(["dataset group"] + [h for _, h in cols], rows)
-    sec.more("Each verdict in full (datasets, tests, p-values, thresholds per dataset)", notes)
-    if empty:
-        sec.p("No data in this comparison for: " + ", ".join(empty) + ".")
+    if rows:
+        sec.table(["dataset group"] + [h for _, h in cols], rows)
+        sec.more("Each verdict in full (datasets, tests, p-values, thresholds per dataset)", notes)
+    for reason, groups in folded.items():
+        head, _, why = reason.partition(": ")
+        sec.p(f"{head[0].upper()}{head[1:]}" + (f" ({why})" if why else "") + f": {', '.join(groups)}.")
+    absent = [ABSENT[key] for key, _ in COLUMNS if key not in dict(cols)]
+    if shown and absent:
+        sec.p("Not in this comparison: " + "; ".join(absent) + ".")
 
 
 def _clip(text: str, limit: int = CELL_LIMIT) -> str:
@@ -145,7 +164,7 @@ def _fallback_table(sec: Section, c, findings):
                "λAu ≡ μN + μη′dA/dt? (discrimination test)", "noise threshold", "series slip"], rows)
     for tr in c.transfer:
         sec.p(f"Across conditions ({tr.group}): {tr.answer()}.")
-    sec.p("No data in this comparison for: goodness-of-fit test.")
+    sec.p("Not in this comparison: " + ABSENT["goodness"] + ".")
 
 
 def _tied(best) -> str:
@@ -181,14 +200,19 @@ def build(ctx) -> Section:
                  "The table shows what the comparison holds: the lowest AIC (a relative ranking, not a test that "
                  "the law fits), its reduced χ², and the discrimination test's verdict and noise threshold.")
         _fallback_table(sec, c, findings)
-    shown = _pick(findings)
-    if shown:
+    story = [f for f in _pick(findings) if f.t_cross is not None and spin_falls(f.dataset)]
+    if story:
         sec.fig("finding.png", "Spin (top) and slip u(t) (bottom) of the truncated series and the exact solution "
                 "of the same law, fitted to the same data; dotted: where the series' slip crosses zero.",
-                lambda: figures.finding_figure(shown), side="**Why the paper's spin falls.** " + finding_text(shown))
-    else:
-        sec.p("Why the paper's spin falls: no dataset here has both the paper's series and an exact solution fitted, "
-              "so this comparison cannot show it.")
+                lambda: figures.finding_figure(story), side="**Why the paper's spin falls.** " + finding_text(story))
+        return sec
+    views = data_views(c, findings)
+    if views:
+        sec.fig("finding.png", "The data with the top-ranked candidates (#rank, ΔAIC)" + (
+            "; below, where the paper's series was fitted, the slip u(t) of the series and of the exact "
+            "solution of the same law" if any(v.series for v in views) else "") + ".",
+                lambda: figures.data_figure(views, view_title(views)),
+                side="**What the data show.** " + " ".join(describe(v) for v in views))
     return sec
 
 

@@ -9,6 +9,7 @@ from ..core.units import to_si
 from ..physics.registry import get_law
 from . import figures
 from .doc import Section
+from .text import micro
 
 TITLE = "Fits"
 
@@ -96,7 +97,7 @@ def build(ctx) -> Section:
         rows = [r for r in c.ranking if r.dataset == d.name]
         sec.h3(d.name)
         if d.description:
-            sec.p(d.description)
+            sec.p(micro(d.description))
         for check in (truth_check(d, c), reported_check(d, c)):
             if check:
                 sec.p(check)
@@ -105,7 +106,7 @@ def build(ctx) -> Section:
                     lambda d=d, fits=fits, rows=rows: figures.fit_figure(d, fits, rows))
             if "t" in d.columns:
                 sec.fig(f"force-{d.name}.png", f"{d.name}: friction force of each best fit.",
-                        lambda d=d, fits=fits: figures.force_figure(d, fits))
+                        lambda d=d, fits=fits, rows=rows: figures.force_figure(d, fits, rows))
         prow = []
         for f in fits:
             if f.ok:

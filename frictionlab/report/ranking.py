@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import math
 
-from ..core.display import fmt, unit
+from ..core.display import OBSERVABLE_UNITS, fmt, unit
 from ..inference.ranking import TIE_AIC
 from . import figures
 from .doc import Section
@@ -13,7 +13,7 @@ TITLE = "Ranking"
 
 
 def curve_labels(c, dataset: str) -> dict[tuple[str, str], str]:
-    """(law, solver) -> 'couette = wear' for the fits on ``dataset`` that are one curve (figures.same_curve)."""
+    """(law, solver) -> 'wear = couette' for the fits on ``dataset`` that are one curve (figures.same_curve)."""
     out = {}
     for f, laws in figures.distinct_curves(c.fits_on(dataset)):
         for law in laws:
@@ -35,16 +35,17 @@ def law_aliases(c) -> dict[str, str]:
     alias: dict[str, str] = {}
     for key, same in together.items():
         if same:
-            merged = sorted(set(alias.get(min(key), min(key)).split(" = ")) | set(key))
+            merged = figures.simplest_first(set(alias.get(min(key), min(key)).split(" = ")) | set(key))
             for law in merged:
                 alias[law] = " = ".join(merged)
     return alias
 
 
-def candidate_table(rows, observable: str, labels: dict | None = None) -> tuple[list[str], list[list]]:
+def candidate_table(rows, observable: str, labels: dict | None = None,
+                    display: tuple[str, float] | None = None) -> tuple[list[str], list[list]]:
     """One row per candidate; candidates whose fits are one curve (``labels``) share one row, their Akaike
-    weights summed."""
-    uname, uf = unit(observable)
+    weights summed. display: (unit, factor from SI) of the RMSE, default the observable's display unit."""
+    uname, uf = display or unit(observable)
     headers = ["rank", "law [solver]", "n", "k", f"RMSE [{uname}]", "reduced χ²", "AIC", "AICc", "BIC", "ΔAIC",
                "Akaike weight", "fits? (χ² p, runs p)", "status"]
     labels = labels or {}
@@ -79,7 +80,8 @@ def _flags(r, limit: int | None = None) -> str:
     flags are its members', each in full in that dataset's table)."""
     shown = r.flags if limit is None else r.flags[:limit]
     more = len(r.flags) - len(shown)
-    return "".join(f"; FLAG: {f}" for f in shown) + (f"; {more} more flag{'s' * (more > 1)}: see each dataset's table"
+    head = "; FLAG (ranked after every unflagged candidate): " if r.flags and r.rank else "; FLAG: "
+    return "".join((head if i == 0 else "; FLAG: ") + f for i, f in enumerate(shown)) + (f"; {more} more flag{'s' * (more > 1)}: see each dataset's table"
                                                      if more else "")
 
 
@@ -116,8 +118,9 @@ def build(ctx) -> Section:
         lik = next((f.stats for f in c.fits_on(d.name) if f.ok), None)
         if lik is not None:
             sec.p(f"Likelihood: σ {lik.likelihood}. {lik.likelihood_reason[0].upper()}{lik.likelihood_reason[1:]}.")
+        shown = unit(d.observable) if d.observable in OBSERVABLE_UNITS else figures.column_unit(d, d.observable)
         sec.table(*candidate_table([r for r in c.ranking if r.dataset == d.name], d.observable,
-                                   curve_labels(c, d.name)))
+                                   curve_labels(c, d.name), (shown[0] or "-", shown[1])))
         merged = [f"{r.candidate}: {r.parameterizations}" for r in c.ranking
                   if r.dataset == d.name and r.parameterizations]
         if merged:

@@ -21,33 +21,51 @@ def first_share(rb, best) -> str:
 
 
 def build(ctx) -> Section:
-    from .ranking import curve_labels
-    from .tolerance import tolerance_verdicts
-
     c = ctx.c
     sec = Section(TITLE)
-    fitted = c.fitted_datasets
+    sec.p(_how_it_ran(c))
+    warning = _provenance_warning(c)
+    if warning:
+        sec.warn(warning)
+    sec.items(_best_items(c) + _group_items(c) + _series_items(c) + _tolerance_items(c))
+    _equivalence_table(sec, c)
+    for tr in c.transfer:
+        sec.p(f"Across conditions ({tr.group}): {tr.answer()}.")
+    return sec
+
+
+def _how_it_ran(c) -> str:
+    """When, by which version, how long, on how many workers, which laws and datasets."""
+    jobs = c.settings.get("jobs", 1)
+    return (f"Generated {_dt.datetime.now().astimezone().strftime('%Y-%m-%d %H:%M %Z')} by frictionlab "
+            f"{c.versions.get('frictionlab')}; the comparison took {c.wall_time:.1f} s"
+            + (" (" + ", ".join(f"{k} {v:.1f} s" for k, v in c.timings.items()) + ", partly in parallel)"
+               if len(c.timings) > 1 else "")
+            + (f" on a {c.settings['cluster']}" if c.settings.get("cluster") else
+               f" on {jobs} worker process{'es' * (jobs != 1)}") + f". Laws: {', '.join(c.laws)}. "
+            f"Datasets: {len(c.datasets)} ({len(c.fitted_datasets)} fitted).")
+
+
+def _provenance_warning(c) -> str:
+    """A warning when not every dataset is a measurement ('' when all are)."""
     kinds = {}
     for d in c.datasets:
         kinds.setdefault(d.provenance.kind, []).append(d.name)
-    jobs = c.settings.get("jobs", 1)
-    sec.p(f"Generated {_dt.datetime.now().astimezone().strftime('%Y-%m-%d %H:%M %Z')} by frictionlab "
-          f"{c.versions.get('frictionlab')}; the comparison took {c.wall_time:.1f} s"
-          + (" (" + ", ".join(f"{k} {v:.1f} s" for k, v in c.timings.items()) + ", partly in parallel)"
-             if len(c.timings) > 1 else "")
-          + (f" on a {c.settings['cluster']}" if c.settings.get("cluster") else
-             f" on {jobs} worker process{'es' * (jobs != 1)}") + f". Laws: {', '.join(c.laws)}. "
-          f"Datasets: {len(c.datasets)} ({len(fitted)} fitted).")
-    if [n for k, v in kinds.items() if k != "measured" for n in v]:
-        parts = [f"{len(v)} {PROVENANCE_WORDS.get(k, k)} ({', '.join(v)})" for k, v in kinds.items()]
-        sec.warn(("No dataset in this report is a measurement. " if "measured" not in kinds else
-                  "Not every dataset in this report is a measurement. ") + "; ".join(parts) + ". Reconstructed "
-                 "series are curves rebuilt to agree with numbers stated in a paper; synthetic series were generated "
-                 "with a known law plus noise. Rankings on them test the method and the claims' internal "
-                 "consistency, not nature.")
+    if not [n for k, v in kinds.items() if k != "measured" for n in v]:
+        return ""
+    parts = [f"{len(v)} {PROVENANCE_WORDS.get(k, k)} ({', '.join(v)})" for k, v in kinds.items()]
+    return (("No dataset in this report is a measurement. " if "measured" not in kinds else
+             "Not every dataset in this report is a measurement. ") + "; ".join(parts) + ". Reconstructed "
+            "series are curves rebuilt to agree with numbers stated in a paper; synthetic series were generated "
+            "with a known law plus noise. Rankings on them test the method and the claims' internal "
+            "consistency, not nature.")
+
+
+def _best_items(c) -> list[str]:
+    """Per fitted dataset its rank-1 candidates, their Akaike weight and bootstrap share."""
     items = []
     boot = {rb.datasets[0]: rb for rb in c.bootstrap}
-    for d in fitted:
+    for d in c.fitted_datasets:
         best = [r for r in c.ranking if r.dataset == d.name and r.rank == 1]
         if best:
             fits = all(r.fits and not r.flags for r in best)
@@ -59,6 +77,12 @@ def build(ctx) -> Section:
                             "; not bootstrapped" if d.name in c.bootstrap_skipped else "") + ")")
         else:
             items.append(f"**{d.name}**: no law could be fitted")
+    return items
+
+
+def _group_items(c) -> list[str]:
+    """Per dataset group its rank-1 candidates by summed AIC."""
+    items = []
     for g in dict.fromkeys(r.dataset for r in c.groups):
         best = [r.candidate for r in c.groups if r.dataset == g and r.rank == 1]
         fits = all(r.fits and not r.flags for r in c.groups if r.dataset == g and r.rank == 1)
@@ -66,7 +90,15 @@ def build(ctx) -> Section:
             items.append(f"**{g}**: {'best' if fits else 'top-ranked (does not fit)'} " + " = ".join(best)
                          + " (summed AIC over the group"
                          + ("; a tie" if len(best) > 1 else "") + ")")
-    for d in fitted:
+    return items
+
+
+def _series_items(c) -> list[str]:
+    """Where the paper's truncated series and the exact solution of one law differ by more than 2 in AIC."""
+    from .ranking import curve_labels
+
+    items = []
+    for d in c.fitted_datasets:
         labels, said = curve_labels(c, d.name), set()
         for law in c.laws:
             label = labels.get((law, "series"), law)
@@ -82,22 +114,30 @@ def build(ctx) -> Section:
                 items.append(f"**{d.name}**: the paper's truncated series of {label} fits {better} than the {full.solver} "
                              f"solution of the same law (ΔAIC {abs(ser.aic - full.aic):.1f}): the approximation, not "
                              "the law, makes that difference (see the notes under Fits)")
+    return items
+
+
+def _tolerance_items(c) -> list[str]:
+    from .tolerance import tolerance_verdicts
+
     verdicts = tolerance_verdicts(c)
-    if verdicts:
-        items.append(f"**Solver tolerance** ({c.tolerance[0]['dataset']}): refitted at " + verdicts[0]
-                     + " (see 'What solver tolerance does to a fit')")
-    sec.items(items)
+    if not verdicts:
+        return []
+    return [f"**Solver tolerance** ({c.tolerance[0]['dataset']}): refitted at " + verdicts[0]
+            + " (see 'What solver tolerance does to a fit')"]
+
+
+def _equivalence_table(sec: Section, c):
+    """The paper's equivalence verdict per dataset, exact (or ODE) and series."""
     paper = [e for e in c.equivalence if (e.law_a, e.law_b) == (WEAR, AREA_RATE)]
-    if paper:
-        sec.p("Equivalence of λAu and μN + μη′dA/dt per dataset (the discrimination test; details under "
-              "'Equivalence test'):")
-        verdicts: dict[str, dict[str, str]] = {}
-        for e in paper:
-            key = "series" if e.solver_a == "series" else "full"
-            verdicts.setdefault(e.dataset, {})[key] = (e.verdict or e.status) + ("" if key == "series" else
-                                                                                  f" [{e.solver_a}]")
-        sec.table(["dataset", "wear solved exactly or numerically", "wear by the paper's series"],
-                  [[d, v.get("full", ""), v.get("series", "–")] for d, v in verdicts.items()])
-    for tr in c.transfer:
-        sec.p(f"Across conditions ({tr.group}): {tr.answer()}.")
-    return sec
+    if not paper:
+        return
+    sec.p("Equivalence of λAu and μN + μη′dA/dt per dataset (the discrimination test; details under "
+          "'Equivalence test'):")
+    verdicts: dict[str, dict[str, str]] = {}
+    for e in paper:
+        key = "series" if e.solver_a == "series" else "full"
+        verdicts.setdefault(e.dataset, {})[key] = (e.verdict or e.status) + ("" if key == "series" else
+                                                                              f" [{e.solver_a}]")
+    sec.table(["dataset", "wear solved exactly or numerically", "wear by the paper's series"],
+              [[d, v.get("full", ""), v.get("series", "–")] for d, v in verdicts.items()])

@@ -28,3 +28,10 @@ def rtol_text(r: float) -> str:
 def sig(x, digits: int = 3) -> str:
     """A table number with ``digits`` significant figures ('' for None/nan)."""
     return fmt(x, digits)
+
+
+def micro(text: str) -> str:
+    """'40 um', '500 us' as a file may spell them, written '40 µm', '500 µs' as the figures and tables do."""
+    import re
+
+    return re.sub(r"(?<=\d) u([sm])\b", r" µ\1", text)

@@ -9,6 +9,7 @@ the same numbers (a test checks them against solve_ivp), without its per-step ge
 from __future__ import annotations
 
 import bisect
+import contextlib
 import numbers
 
 import numpy as np
@@ -25,6 +26,21 @@ MAX_NFEV = 50_000
 
 #: Slip, relative to its scale, by which the zero-slip event waits past zero (see zero_slip).
 SLIP_MARGIN = 1e-12
+
+
+#: Callbacks told the time reached after each step (``watching``); the innermost is called.
+_WATCHERS: list = []
+
+
+@contextlib.contextmanager
+def watching(fn):
+    """Call ``fn(t)`` with the time reached after every step of every integration inside the block (for
+    progress on a long single solve; the command line's ``simulate``)."""
+    _WATCHERS.append(fn)
+    try:
+        yield
+    finally:
+        _WATCHERS.remove(fn)
 
 
 def solve(f, s0: float, s1: float, z0, method: str, s_eval, rtol: float, atol: float, event=None,
@@ -49,6 +65,8 @@ def solve(f, s0: float, s1: float, z0, method: str, s_eval, rtol: float, atol: f
         if solver.status == "failed":
             raise SolverError(f"{label}: {message}")
         s, z, sol = solver.t, solver.y, None
+        if _WATCHERS:
+            _WATCHERS[-1](s)
         if event is not None:
             g_new = event(s, z)
             up, down = g <= 0 <= g_new, g >= 0 >= g_new

@@ -1,0 +1,82 @@
+"""The paper's equivalence claim: force histories and the discrimination test's distributions."""
+from __future__ import annotations
+
+import numpy as np
+
+from ...core.display import time_unit
+from . import base
+
+
+def equivalence_figure(dataset, fw_list, fa, decomps) -> bytes:
+    """Friction force of the wear fits, the area-rate fit, and the paper's two-term decomposition
+    of each wear fit with its projection onto mu N + mu eta' dA/dt."""
+    plt = base._plt()
+    s = fa.per_dataset[0].scene
+    t_end = float(dataset.t[-1])
+    tname, tf = time_unit(t_end)
+    t = np.linspace(0.0, t_end, 400)
+    fig, axes = plt.subplots(1, max(1, len(fw_list)), figsize=(5.4 * max(1, len(fw_list)), 4.7), squeeze=False, layout="constrained")
+    Fa = fa.per_dataset[0].trajectory(fa.law, t).force
+    for ax, fw, dec in zip(axes[0], fw_list, decomps):
+        Fw = fw.per_dataset[0].trajectory(fw.law, t).force
+        ax.plot(t * tf, Fw, color=base.LAW_COLORS["wear"], lw=2, ls="--" if fw.solver == "series" else "-",
+                label=f"wear [{fw.solver}]")
+        ax.plot(t * tf, Fa, color=base.LAW_COLORS["area-rate"], lw=2, label=f"area-rate [{fa.solver}]")
+        if dec is not None:
+            A, dA = s.area(t)
+            A = np.where(t <= s.area.contact_time, A, 0.0)
+            N = s.normal(t, A)
+            ax.plot(t * tf, dec.c_area * A, color="0.45", lw=1, ls="-.", label="λu0(1−b)A")
+            ax.plot(t * tf, dec.c_area_rate * A * dA, color="0.45", lw=1, ls=":", label="(λu0b/(φA0)) A dA/dt")
+            ax.plot(t * tf, dec.mu * (N + dec.eta_prime * dA), color="#e7298a", lw=1.2,
+                    label=f"implied μN+μη'dA/dt (μ = {dec.mu:.3g}, η' = {dec.eta_prime:.3g} N s/m²)")
+        ax.axhline(0, color="0.3", lw=0.8)
+        ax.set_xlabel(f"time [{tname}]")
+        ax.set_ylabel("friction force [N]")
+        ax.set_title(f"wear [{fw.solver}] vs area-rate", fontsize=10)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.2))  # below: never over a curve
+    fig.suptitle(f"{dataset.name}: is λAu equivalent to μN + μη' dA/dt?", fontsize=11)
+    return base._png(fig)
+
+
+def one_curve(e) -> bool:
+    """Whether the pair's T is zero (to 1e-4 per data point) on the data and on every replicate: one curve."""
+    both = np.concatenate([e.t_a, e.t_b, [e.t_obs]])
+    return float(np.ptp(both)) <= 1e-4 * max(e.n_points, 1)
+
+
+def discrimination_figure(dataset: str, results) -> bytes:
+    """One panel per tested pair on ``dataset`` whose laws differ: the distribution of T = chi2_A - chi2_B
+    over the replicates of each law's fit, and the observed T. Pairs that are one curve (T = 0 throughout)
+    get no panel, only a line under the title."""
+    from matplotlib.ticker import MaxNLocator
+
+    plt = base._plt()
+    drawn = [e for e in results if not one_curve(e)]
+    same = [e for e in results if one_curve(e)]
+    fig, axes = plt.subplots(1, max(1, len(drawn)), figsize=(4.6 * max(1, len(drawn)), 3.4), squeeze=False,
+                             layout="constrained")
+    for ax, e in zip(axes[0], drawn):
+        both = np.concatenate([e.t_a, e.t_b, [e.t_obs]])
+        span = float(np.ptp(both))
+        bins = np.linspace(both.min() - 0.02 * span, both.max() + 0.02 * span, 40)
+        for t, law, solver in ((e.t_a, e.law_a, e.solver_a), (e.t_b, e.law_b, e.solver_b)):
+            ax.hist(t, bins=bins, alpha=0.6, color=base.LAW_COLORS.get(law, "0.5"), histtype="stepfilled",
+                    label=f"data from {law} [{solver}]")
+        ax.axvline(e.t_obs, color="k", lw=1.5, label="observed T")
+        ax.legend(fontsize=7, loc="best")
+        ax.xaxis.set_major_locator(MaxNLocator(nbins=5))
+        ax.ticklabel_format(axis="x", style="sci", scilimits=(-3, 4))  # text offset: mathtext is off (core.display.pyplot)
+        ax.set_xlabel(f"T = χ²({e.law_a}) − χ²({e.law_b})")
+        ax.set_ylabel("replicates")
+        ax.set_title(f"{e.law_a} [{e.solver_a}] vs {e.law_b} [{e.solver_b}]: {e.verdict}", fontsize=9)
+        ax.grid(alpha=0.3)
+    if not drawn:
+        axes[0, 0].set_axis_off()
+    title = f"{dataset}: the discrimination test (parametric bootstrap)"
+    if same:
+        title += "\n" + "; ".join(f"{e.law_a} [{e.solver_a}] = {e.law_b} [{e.solver_b}]" for e in same) + \
+            ": one curve (T = 0 on the data and on every replicate), not drawn"
+    fig.suptitle(title, fontsize=11 if len(drawn) > 1 else 9.5)
+    return base._png(fig)
