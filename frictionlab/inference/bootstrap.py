@@ -384,11 +384,10 @@ def ranking_table(rb: RankingBootstrap, level: float = 0.95) -> list[dict]:
 def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, slow: bool = False, free: Mapping | None = None,
                    progress=None, timeout: float | None = None) -> tuple[list[RankingBootstrap], dict]:
     """Bootstrap the single-dataset fits of a comparison, parametrically: per dataset, ``n`` replicates
-    simulated from the best unflagged fit with the declared noise, and every candidate that fitted
+    simulated from the best unflagged fit with the noise the likelihood uses (measured or estimated), and every candidate that fitted
     (law [solver]; structurally identical laws once, ``ranking.merge_identical``) refitted to them,
-    warm-started from its fit, which is reused as the base. Datasets whose noise is not known
-    (assumed: e.g. a noise-free reconstructed series) are skipped with that reason: resampling them
-    would measure the method's determinism, not the data's firmness. Without ``slow``, only datasets
+    warm-started from its fit, which is reused as the base. Noise-free reconstructions ('none')
+    are skipped with that reason: resampling them would measure the method's determinism. Without ``slow``, only datasets
     whose every fit is one closed-form or series solution per evaluation are bootstrapped: not those
     where a law needs the ODE solver, nor those without a time series (an impact-outcome set
     simulates every impact at each evaluation).
@@ -407,10 +406,9 @@ def bootstrap_fits(fits, n: int, seed: int = 0, executor=None, slow: bool = Fals
         target = ok[0].per_dataset[0].target if ok else None
         if not ok:
             skipped[name] = "no law could be fitted"
-        elif target.derivation or target.dataset.noise_kind != "known":
-            skipped[name] = (f"no firmness figure: its noise is {target.dataset.noise_kind}, not measured "
-                             f"({target.dataset.provenance.kind} series), so replicates simulated with a guessed sigma "
-                             "would measure the guess, not the data")
+        elif target.derivation or target.dataset.noise_kind == "none":
+            skipped[name] = (f"no firmness figure: a noise-free {target.dataset.provenance.kind} series has no noise "
+                             "to simulate replicates with")
         elif why and not slow:
             skipped[name] = why
         else:

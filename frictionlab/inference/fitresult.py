@@ -45,9 +45,9 @@ class Stats:
     aic: float
     aicc: float
     bic: float
-    likelihood: str = "assumed"  # 'known' | 'assumed' | 'mixed' | 'none' (see the module docstring)
+    likelihood: str = "estimated"  # 'known' | 'estimated' | 'mixed' | 'none' (see fitting's docstring)
     neg2loglik: float = math.nan  # -2 ln L at the best fit, constant included
-    k_lik: int = 0  # parameters counted by AIC/AICc/BIC: n_params plus one profiled sigma per assumed dataset
+    k_lik: int = 0  # parameters counted by AIC/AICc/BIC: n_params (sigma is measured or estimated without the law)
     likelihood_reason: str = ""  # why this likelihood (the dataset's [noise] kind)
 
 

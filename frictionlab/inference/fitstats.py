@@ -9,32 +9,48 @@ from .fitresult import ParamResult, Stats
 from .identifiability import in_ratio
 
 
-def _likelihood(targets) -> str:
-    """'none' if a target is a derived (smoothed) series, else the datasets' noise kind ('mixed' if they differ)."""
-    if any(t.derivation for t in targets):
+#: Likelihoods whose sigma is used as given (no parameter of the fit): measured, estimated without a
+#: law, or the stated precision of a reconstruction's stated numbers.
+AS_GIVEN = ("known", "estimated", "stated")
+
+
+def noise_kind(target) -> str:
+    """The likelihood one target calls for: 'none' for a derived (smoothed) series or a noise-free curve,
+    'stated' for a reconstruction's stated numbers, else its dataset's [noise] kind."""
+    if target.derivation:
         return "none"
-    kinds = {t.dataset.noise_kind for t in targets}
+    return "stated" if target.observable == "stated" else target.dataset.noise_kind
+
+
+def _likelihood(targets) -> str:
+    """'none' if any target has no likelihood, else the targets' kind ('mixed' if they differ)."""
+    kinds = {noise_kind(t) for t in targets}
+    if "none" in kinds:
+        return "none"
     return kinds.pop() if len(kinds) == 1 else "mixed"
 
 
 LIKELIHOOD_REASON = {
     "known": "[noise] kind = known: sigma is measured, so the Gaussian likelihood uses it as given "
              "(AIC = chi2 + 2k + sum ln(2 pi sigma^2)); error bars are not rescaled",
-    "assumed": "[noise] kind = assumed (or not given): sigma is a guess, so it is profiled out "
-               "(-2 ln L = n ln(chi2/n) + n + sum ln(2 pi sigma^2), one more parameter); error bars are scaled "
-               "by sqrt(reduced chi2)",
-    "mixed": "the datasets differ: known sigma used where measured, profiled where assumed",
-    "none": "fitted to a derived series (omega smoothed from theta): correlated points, no valid likelihood",
+    "estimated": "sigma estimated from the data without any law (io/noise.py), the same for every law: the "
+                 "likelihood uses it as given, and the goodness of fit is an F test carrying the estimate's "
+                 "degrees of freedom",
+    "mixed": "the datasets differ: measured sigma where known, estimated from the data elsewhere",
+    "stated": "[noise] kind = none, a noise-free reconstruction: laws are compared on the numbers it was drawn "
+              "through ([stated]), the chi-square against their stated precision (one unit of the last digit; the "
+              "framing interval for a time); the dense curve is for figures only",
+    "none": "no valid likelihood: a derived series (omega smoothed from theta, correlated points) or a "
+            "noise-free reconstruction",
 }
 
 
 def neg2loglik(chisqr: float, n: int, sigma: np.ndarray, kind: str) -> float:
-    """-2 ln L of one dataset [constant included]: chi2 + C if sigma is known, n ln(chi2/n) + n + C if
-    it is profiled (the maximum over a common scale of the declared sigmas); C = sum ln(2 pi sigma_i^2)."""
-    const = float(np.sum(np.log(2 * math.pi * np.asarray(sigma, dtype=float) ** 2)))
-    if kind == "known":
-        return chisqr + const
-    return n * math.log(max(chisqr, np.finfo(float).tiny) / n) + n + const
+    """-2 ln L of one dataset [constant included]: chi2 + C, C = sum ln(2 pi sigma_i^2), with sigma measured
+    ('known') or estimated from the data alone ('estimated': one plug-in value for every law); nan for 'none'."""
+    if kind not in AS_GIVEN:
+        return math.nan
+    return chisqr + float(np.sum(np.log(2 * math.pi * np.asarray(sigma, dtype=float) ** 2)))
 
 
 def _si_result(best, slots):
@@ -63,8 +79,8 @@ def _si_result(best, slots):
 
 def _stats(n, k, k_free, chisqr, per) -> Stats:
     """Information criteria from the likelihood the datasets' noise calls for (module docstring):
-    AIC = -2 ln L + 2 k', AICc = AIC + 2k'(k'+1)/(n-k'-1), BIC = -2 ln L + k' ln n, where k' = k plus
-    one profiled sigma per assumed-noise dataset. NaN for a derived (smoothed) series."""
+    AIC = -2 ln L + 2 k, AICc = AIC + 2k(k+1)/(n-k-1), BIC = -2 ln L + k ln n (sigma measured or
+    estimated without a law: no parameter of the fit). NaN without a valid likelihood ('none')."""
     single = len(per) == 1
     kind = _likelihood([d.target for d in per])
     base = dict(n_points=n, n_params=k, n_free=k_free, chisqr=chisqr, redchi=chisqr / (n - k) if n > k else math.inf,
@@ -74,9 +90,7 @@ def _stats(n, k, k_free, chisqr, per) -> Stats:
         return Stats(aic=math.nan, aicc=math.nan, bic=math.nan, **base)
     ll, kk = 0.0, k
     for d in per:
-        own = d.target.dataset.noise_kind
-        ll += neg2loglik(d.chisqr, d.target.y.size, d.target.sigma, own)
-        kk += own != "known"
+        ll += neg2loglik(d.chisqr, d.target.y.size, d.target.sigma, noise_kind(d.target))
     aic = ll + 2 * kk
     aicc = aic + (2 * kk * (kk + 1) / (n - kk - 1) if n - kk - 1 > 0 else math.inf)
     return Stats(aic=aic, aicc=aicc, bic=ll + kk * math.log(n), neg2loglik=ll, k_lik=kk, **base)

@@ -12,13 +12,13 @@ quantity) raises a one-line FrictionLabError.
 * Residuals are (model - data) / sigma, sigma the dataset's noise estimate, so datasets in
   different units fit together.
 * The likelihood follows what the dataset says about its noise (``Dataset.noise_kind``): 'known'
-  sigma is used as given (-2 ln L = chi2 + sum ln(2 pi sigma_i^2), error bars NOT scaled);
-  'assumed' sigma is profiled out, one scale per dataset (-2 ln L = n ln(chi2/n) + n +
-  sum ln(2 pi sigma_i^2), one more parameter in AIC/AICc/BIC, error bars scaled by sqrt(reduced
-  chi2)). The constant is kept, so -2 ln L of different datasets add. A derived series (omega
-  smoothed from theta) has correlated points: it gets no likelihood, no criteria, no error bars.
-* Every fit carries its goodness of fit (``goodness.py``) and plausibility flags (``plausibility.py``). With several datasets, law parameters are shared (a global
-  fit) unless named in ``local``.
+  (measured) and 'estimated' (from the data alone, io/noise.py, one value for every law) sigma are
+  used as given: -2 ln L = chi2 + sum ln(2 pi sigma_i^2), error bars NOT scaled; the estimate's
+  degrees of freedom go into the goodness of fit (an F test). The constant is kept, so -2 ln L of
+  different datasets add. A derived series (omega smoothed from theta) or a noise-free
+  reconstruction ('none') has no likelihood: no criteria, no error bars.
+* Every fit carries its goodness of fit (``goodness.py``) and plausibility flags (``plausibility.py``).
+  With several datasets, law parameters are shared (a global fit) unless named in ``local``.
 * Predictions go through ``predict``; a dataset kind plugs in with ``register_predictor``.
 * ``timeout`` is a time budget per fit in seconds (None: none): a fit that exceeds it is a failed
   result saying so. It is checked before every evaluation of the model and, in the main thread,
@@ -43,6 +43,7 @@ from . import levmar
 from .fitmodel import ODE_STARTS, PENALTY, FitTimeout, _alarm, _law_slots, _lmfit_bound, _Model, _scene_slots, _search, _si
 from .fitresult import DatasetFit, FitResult, ParamResult, Stats
 from .fitstats import (
+    AS_GIVEN,
     LIKELIHOOD_REASON,
     _likelihood,
     _param_results,
@@ -149,7 +150,8 @@ def _run_search(lmfit, model, params, slots, solvers, budget, likelihood, checks
     try:
         with _alarm(timeout):
             best_params, success, message, best, notes = _search(lmfit, model, params, slots, solvers, *budget,
-                                                                 scale_covar=likelihood != "known", direct=not checks)
+                                                                 scale_covar=likelihood not in AS_GIVEN,
+                                                                 direct=not checks)
             values = _si(best_params, slots)
             models = model.models(values)
         model.deadline = None  # the error analysis after it is bounded work
@@ -241,11 +243,13 @@ def _result(law, names, solver_label, model, slots, values, models, best_params,
         notes.append(f"{model.failures} of {model.nfev} evaluations could not be solved and were penalized "
                      f"(last: {model.last_error})")
     notes += _series_notes(law, per)
-    jac = (jacobian_errors(slots, values, J, structure, stats.redchi if likelihood != "known" else 1.0) if errors
+    scaled = likelihood not in AS_GIVEN  # error bars from the scatter when sigma means nothing
+    jac = (jacobian_errors(slots, values, J, structure, stats.redchi if scaled else 1.0) if errors
            else {"errors": {}, "derived": {}, "correl": {}})
     presults = _param_results(slots, best_params, targets, structure, jac)
     if likelihood == "none":  # error bars rest on independent points: a smoothed series has none to give
         presults = {k: attrs.evolve(p, stderr=None) for k, p in presults.items()}
+    if any(t.derivation for t in targets):
         notes.append("fitted to a derived series (omega smoothed from theta): its points are correlated, so no "
                      "chi-square, information criterion or error bar is valid; fit theta itself for those")
     correl = _correlations(slots, varying, best_params, structure, jac)
@@ -268,7 +272,8 @@ def _per_dataset(model, values, models, k_each) -> list[DatasetFit]:
         r = m - tg.y
         per.append(DatasetFit(tg, solver_i, p, scene, m, float(r @ r), float(np.sqrt(np.mean(r**2))),
                               float(np.sum((r / tg.sigma) ** 2)),
-                              goodness(r / tg.sigma, round(k_each), _likelihood([tg]))))
+                              goodness(r / tg.sigma, round(k_each), _likelihood([tg]),
+                                       tg.dataset.noise_df.get(tg.observable, math.inf))))
     return per
 
 

@@ -112,7 +112,7 @@ def _effects(model, slots, values, likelihood) -> dict[str, float]:
     base = model.residual(values)
     chi = float(base @ base)
     n_free = sum(s.vary for s in slots)
-    unit = 1.0 if likelihood == "known" else max(chi / max(base.size - n_free, 1), np.finfo(float).tiny)
+    unit = 1.0 if likelihood in ("known", "estimated", "stated") else max(chi / max(base.size - n_free, 1), np.finfo(float).tiny)
     out = {}
     for s in slots:
         if not (s.vary and s.kind == "law" and s.lower <= 0.0 <= s.upper and values[s.pname] != 0.0):

@@ -64,9 +64,9 @@ class RankRow:
     status: str = "ok"  # ok | tied | indistinguishable | failed | skipped | incomplete
     reason: str = ""
     tied_with: tuple[str, ...] = ()  # candidates within NEAR_TIE (tied: within TIE_AIC)
-    likelihood: str = ""  # 'known' | 'assumed' | 'mixed' | 'none' (fitting.Stats.likelihood)
+    likelihood: str = ""  # 'known' | 'estimated' | 'mixed' | 'none' (fitting.Stats.likelihood)
     neg2loglik: float = math.nan
-    k_lik: int = 0  # parameters counted by the criteria (plus a profiled sigma where noise is assumed)
+    k_lik: int = 0  # parameters counted by the criteria 
     chi2_p: float = math.nan
     runs_p: float = math.nan
     lag1: float = math.nan

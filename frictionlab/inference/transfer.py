@@ -188,7 +188,7 @@ def _neg2ll(f: FitResult) -> float:
 
 
 def _k(f: FitResult) -> int:
-    """Parameters the likelihood counts (``Stats.k_lik``: plus a profiled sigma per assumed-noise dataset)."""
+    """Parameters the likelihood counts (``Stats.k_lik``)."""
     return int(getattr(f.stats, "k_lik", 0) or f.stats.n_params)
 
 

@@ -2,9 +2,11 @@
 
 The TOML holds ``name``, optionally ``group`` (datasets of one material and setup compared
 together; default: the name without its last ``-suffix``), ``kind``, ``observable``, ``[columns]`` (column -> unit),
-``[noise]`` (observable -> quantity, and ``kind = "known" | "assumed"``: whether sigma was
-measured or is a guess; default assumed), ``[scene]``, ``[fixed]`` law parameters,
-``[provenance]`` and optionally ``[reported]``. Loading validates everything and fails
+``[noise]`` (``kind = "known" | "estimated" | "none"`` and column -> quantity: see NOISE_KINDS;
+no table means estimated), ``[scene]``, ``[fixed]`` law parameters,
+``[provenance]`` and optionally ``[reported]`` and ``[stated]`` (the numbers a noise-free
+reconstruction was drawn through, each ``name = ["value", "precision"]``, names from STATED: what
+its laws are compared on). Loading validates everything and fails
 with a one-line ``DatasetError`` naming the file and the field.
 """
 from __future__ import annotations
@@ -24,10 +26,17 @@ from ..physics.scene import KINDS, Scene
 from ..solve.outcome import OUTCOMES, OutcomeScene
 
 PROVENANCE_KINDS = ("measured", "reported", "reconstructed", "synthetic")
-#: What a dataset says about its noise: 'known' (sigma measured: the likelihood uses it) or
-#: 'assumed' (a guess: the fit profiles sigma out). Absent means assumed.
-NOISE_KINDS = ("known", "assumed")
+#: What a dataset says about its noise: 'known' (sigma measured and declared: the likelihood uses it),
+#: 'estimated' (sigma estimated from the data alone, without any law: ``noise.py``; declared values,
+#: if any, are ignored) or 'none' (a noise-free reconstruction: the declared values are the stated
+#: precision of the numbers it was drawn through). No [noise] table means estimated; the old
+#: 'assumed' (a guessed sigma) is read as estimated: a guess is never used.
+NOISE_KINDS = ("known", "estimated", "none")
+NOISE_ALIASES = {"assumed": "estimated"}
 DATA_KINDS = KINDS + ("contact-area",)
+#: Numbers a paper states about an impact's spin, and their SI units: the peak spin, its time, the spin
+#: at the end of contact (t_c, the scene's contact time) and the largest rotation angle.
+STATED = {"omega_peak": "rad/s", "t_peak": "s", "omega_end": "rad/s", "theta_max": "rad"}
 
 #: SI unit of each well-known column; other columns must declare a unit of their own.
 COLUMN_SI = {
@@ -65,7 +74,10 @@ class Dataset:
     description: str = ""
     reported: dict = attrs.field(factory=dict)
     fixed_units: dict = attrs.field(factory=dict)
-    noise_kind: str = "assumed"  # NOISE_KINDS: is the [noise] sigma measured ('known') or a guess ('assumed')?
+    noise_kind: str = "estimated"  # NOISE_KINDS: sigma measured ('known'), from the data ('estimated'), or 'none'
+    noise_df: dict = attrs.field(factory=dict)  # column -> effective degrees of freedom of an estimated sigma
+    noise_note: str = ""  # which noise is used, and why (one sentence, for the report and `datasets show`)
+    stated: dict = attrs.field(factory=dict)  # STATED name -> (value, precision) in SI ([stated])
     group: str = ""  # declared group (TOML 'group'); "" -> answers.group_of derives it from the name
 
     @property
@@ -195,21 +207,7 @@ def from_meta(meta: dict, path: Path) -> Dataset:
         if col in columns and np.any(columns[col] < 0):
             raise DatasetError(f"{csv}: column '{col}' has negative values")
 
-    noise_spec = _table(meta, "noise", path, "[noise]")
-    if observable not in noise_spec:
-        raise DatasetError(f"{path}: [noise] must give the noise of the observable, e.g. {observable} = '100 rpm'")
-    noise_spec = dict(noise_spec)
-    noise_kind = noise_spec.pop("kind", "assumed")
-    if noise_kind not in NOISE_KINDS:
-        raise DatasetError(f"{path}: noise.kind = {noise_kind!r}, expected one of {', '.join(NOISE_KINDS)} "
-                           "(known: sigma measured; assumed: a guess, profiled out by the fit)")
-    noise = {}
-    for col, value in noise_spec.items():
-        if col not in columns:
-            raise DatasetError(f"{path}: noise.{col} names no declared column")
-        noise[col] = _quantity(value, COLUMN_SI[col], f"{path}: noise.{col}")
-        if not noise[col] > 0:
-            raise DatasetError(f"{path}: noise.{col} must be positive, got {value!r}")
+    noise, noise_kind, noise_df, noise_note = _noise(meta, path, observable, columns)
 
     provenance = _provenance(meta.get("provenance"), path)
     scene = None
@@ -246,7 +244,7 @@ def from_meta(meta: dict, path: Path) -> Dataset:
                                    f"[{spec.lower:g}, {spec.upper:g}] {spec.unit}".rstrip())
 
     extra = set(meta) - {"name", "group", "kind", "observable", "columns", "noise", "scene", "fixed", "provenance",
-                         "reported", "description"}
+                         "reported", "description", "stated"}
     if extra:
         raise DatasetError(f"{path}: unknown top-level key(s) {sorted(extra)}")
     reported = _table(meta, "reported", path, "[reported]")
@@ -262,7 +260,72 @@ def from_meta(meta: dict, path: Path) -> Dataset:
     return Dataset(name=name, kind=kind, observable=observable, path=path, columns=columns, units=dict(units),
                    noise=noise, scene=scene, fixed=fixed, provenance=provenance,
                    description=meta.get("description", ""), reported=reported,
-                   fixed_units=fixed_units, noise_kind=noise_kind, group=group)
+                   fixed_units=fixed_units, noise_kind=noise_kind, group=group,
+                   noise_df=noise_df, noise_note=noise_note, stated=_stated(meta, path, kind, noise_kind))
+
+
+def _stated(meta, path, kind, noise_kind) -> dict:
+    """[stated]: name -> (value, precision) in SI; only an impact's noise-free reconstruction has one."""
+    spec = _table(meta, "stated", path, "[stated]")
+    if spec and (kind != "impact" or noise_kind != "none"):
+        raise DatasetError(f"{path}: [stated] belongs to an impact reconstruction with [noise] kind = 'none'")
+    out = {}
+    for name, pair in spec.items():
+        if name not in STATED:
+            raise DatasetError(f"{path}: stated.{name} is not a stated number frictionlab can predict "
+                               f"({', '.join(STATED)})")
+        if not (isinstance(pair, list) and len(pair) == 2):
+            raise DatasetError(f"{path}: stated.{name} must be [\"value\", \"precision\"], e.g. [\"6700 rpm\", \"100 rpm\"]")
+        value, prec = (_quantity(x, STATED[name], f"{path}: stated.{name}") for x in pair)
+        if not prec > 0:
+            raise DatasetError(f"{path}: stated.{name}: the precision must be positive, got {pair[1]!r}")
+        out[name] = (value, prec)
+    return out
+
+
+def _noise(meta, path, observable, columns) -> tuple[dict, str, dict, str]:
+    """(sigma by column, kind, degrees of freedom by estimated column, note) from the [noise] table."""
+    from .noise import estimate
+
+    spec = dict(_table(meta, "noise", path, "[noise]"))
+    kind = spec.pop("kind", "estimated")
+    alias = NOISE_ALIASES.get(kind)
+    kind = alias or kind
+    if kind not in NOISE_KINDS:
+        raise DatasetError(f"{path}: noise.kind = {kind!r}, expected one of {', '.join(NOISE_KINDS)} "
+                           "(known: sigma measured; estimated: from the data; none: a noise-free reconstruction)")
+    declared = {}
+    for col, value in spec.items():
+        if col not in columns:
+            raise DatasetError(f"{path}: noise.{col} names no declared column")
+        declared[col] = _quantity(value, COLUMN_SI[col], f"{path}: noise.{col}")
+        if not declared[col] > 0:
+            raise DatasetError(f"{path}: noise.{col} must be positive, got {value!r}")
+    if kind == "none":
+        return declared, kind, {}, ("none: a noise-free reconstruction; laws are compared on the numbers it was "
+                                    "drawn through, at their stated precision ([stated]); the curve is for figures")
+    if kind == "known":
+        if observable not in declared:
+            raise DatasetError(f"{path}: [noise] kind = 'known' must give the measured sigma of the observable, "
+                               f"e.g. {observable} = '100 rpm'")
+        return declared, kind, {}, "declared sigma, measured (kind = known)"
+    noise, df = {}, {}
+    for col in columns:
+        if col in ("t", "speed", "incidence"):
+            continue
+        est = estimate(columns, col)
+        if est is not None:
+            noise[col], df[col] = est.sigma, est.df
+    if observable not in noise:
+        raise DatasetError(f"{path}: the noise of '{observable}' cannot be estimated from the data (too few "
+                           f"points, or no scatter): declare it, [noise] kind = 'known', {observable} = '...'")
+    method = {"GSJS": "Gasser-Sroka-Jennen-Steinmetz differences", "replicates": "the spread of replicates"}
+    how = method[estimate(columns, observable).method]
+    why = (f"[noise] kind = '{next(k for k, v in NOISE_ALIASES.items() if v == kind)}' is read as estimated: a "
+           "guessed sigma is never used" if alias else "no measured sigma declared")
+    ignored = f"; the declared {observable} sigma is ignored" if observable in declared else ""
+    note = f"estimated from the data by {how} ({df[observable]:.0f} effective degrees of freedom): {why}{ignored}"
+    return noise, kind, df, note
 
 
 def _check_time_unit(columns, units, spec, kind, scene, path) -> None:

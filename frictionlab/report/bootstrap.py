@@ -24,7 +24,7 @@ def build(ctx) -> Section:
         return sec
     sec.p(f"Each candidate (law [solver]) was refitted to the same {n} **parametric replicates** of its dataset: the "
           "best unflagged fit plus Gaussian noise of the dataset's declared (known) sigma, so the time structure of "
-          "a series is never resampled; datasets whose sigma is only assumed get no firmness figure. Each refit "
+          "a series is never resampled; noise-free reconstructions get no firmness figure. Each refit "
           "starts from the "
           "candidate's best fit on the original data (no grid scan, one Levenberg-Marquardt run). Parameter "
           "intervals are 95% **percentile intervals** (2.5th to 97.5th percentile of the refitted values). "

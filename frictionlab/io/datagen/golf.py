@@ -40,10 +40,21 @@ STATED = {
              u0=27.0, A0=270e-6, lam=0.96e6, b=0.83),
 }
 #: Assumed (not stated in the paper): restitution of a golf ball for the half-sine normal-force
-#: model, falling with speed as the paper's ref 4 describes; noise of the reconstructed series.
+#: model, falling with speed as the paper's ref 4 describes.
 RESTITUTION = {28: 0.80, 61: 0.70}
-NOISE_RPM = {28: 200, 61: 450}
-NOISE_THETA_DEG = 0.5
+#: Precision of each stated number: one unit of its last significant digit (6,700 rpm: 100 rpm;
+#: 13 deg: 1 deg), the camera's framing interval for a time. The series has no noise ([noise] kind
+#: = 'none'): laws are compared on these numbers ([stated]), the curve is drawn for figures.
+PRECISION = dict(omega_peak=100 * RPM, t_peak=FRAME, omega_c=100 * RPM, theta_max=math.radians(1))
+
+
+def stated_table(s: dict) -> dict:
+    """The [stated] table of a golf dataset: [value, precision] of each stated number, in rpm, us, deg."""
+    rpm = lambda x: f"{x / RPM:.0f} rpm"  # noqa: E731
+    return {"omega_peak": [rpm(s["omega_peak"]), rpm(PRECISION["omega_peak"])],
+            "t_peak": [f"{s['t_peak'] * 1e6:g} us", f"{PRECISION['t_peak'] * 1e6:g} us"],
+            "omega_end": [rpm(s["omega_c"]), rpm(PRECISION["omega_c"])],
+            "theta_max": [f"{math.degrees(s['theta_max']):g} deg", f"{math.degrees(PRECISION['theta_max']):g} deg"]}
 
 
 def spin_curve(s: dict) -> PchipInterpolator:
@@ -73,7 +84,8 @@ def build(out_dir: Path) -> list[Path]:
                             "interval. A reconstruction that agrees with every number the paper states; "
                             "not the camera measurements themselves."),
             "columns": {"t": "us", "omega": "rpm", "theta": "deg"},
-            "noise": {"kind": "assumed", "omega": f"{NOISE_RPM[speed]} rpm", "theta": f"{NOISE_THETA_DEG} deg"},
+            "noise": {"kind": "none"},
+            "stated": stated_table(s),
             "scene": {
                 "mass": "46 g", "radius": "21.3 mm", "inertia_factor": 0.4,
                 "u0": f"{s['u0']:g} m/s",
@@ -86,8 +98,9 @@ def build(out_dir: Path) -> list[Path]:
                 "source": SOURCE,
                 "method": ("PCHIP through (0,0), (t_p/2, f*omega_p), (t_p, omega_p), (t_c, omega_c); f solved so that "
                            "the integral of omega over the contact equals the stated largest rotation angle; "
-                           "theta is that integral. Noise levels and the restitution of the normal-force model "
-                           "are assumptions, not stated in the paper. See frictionlab/io/datagen/golf.py."),
+                           "theta is that integral. Noise-free: laws are compared on the stated numbers at their "
+                           "stated precision ([stated]). The restitution of the normal-force model is an "
+                           "assumption, not stated in the paper. See frictionlab/io/datagen/golf.py."),
                 "command": "frictionlab datasets rebuild",
             },
             "reported": {
@@ -111,13 +124,12 @@ def build(out_dir: Path) -> list[Path]:
         "description": ("Contact area of a golf ball on a transparent PMMA target at 32 m/s, as eq (1) of the paper "
                         "describes it; a supporting series (scenes may use it as a measured-area column), not fitted."),
         "columns": {"t": "us", "A": "mm^2"},
-        "noise": {"kind": "assumed", "A": "5 mm^2"},
+        "noise": {"kind": "none"},
         "provenance": {
             "kind": "reconstructed",
             "source": SOURCE + "; Fig. 2a: peak 150 mm^2 at 220 us",
             "method": ("eq (1), A = A0 sin(pi t / t_c) with A0 = 150 mm^2 and t_c = 2 x 220 us = 440 us, sampled "
-                       "every 10 us; the measured points of Fig. 2a are not published as numbers. The noise level "
-                       "is an assumption."),
+                       "every 10 us; the measured points of Fig. 2a are not published as numbers. Noise-free."),
             "command": "frictionlab datasets rebuild",
         },
         "reported": {"A_peak": "150 mm^2", "t_peak": "220 us", "impact_speed": "32 m/s"},

@@ -1,0 +1,102 @@
+"""Noise from the data alone, without any friction law: what a dataset with ``[noise] kind = "estimated"``
+(or no ``[noise]`` table) is fitted with.
+
+* Replicates (rows with the same conditions, e.g. one incidence angle measured several times): the
+  pooled within-condition variance, sum over conditions of sum (y - mean)^2 / sum (n_c - 1), with
+  sum (n_c - 1) degrees of freedom.
+* Otherwise Gasser, Sroka and Jennen-Steinmetz (1986, Biometrika 73): for points in order of x (time,
+  or incidence within one speed) the pseudo-residuals e_i = a_i y_{i-1} + b_i y_{i+1} - y_i,
+  a_i = (x_{i+1} - x_i) / (x_{i+1} - x_{i-1}), b_i = 1 - a_i, vanish on any straight line, so
+  sigma^2 = mean of e_i^2 / (a_i^2 + b_i^2 + 1) carries the noise and only the curvature of the
+  signal between neighbours (small when the sampling resolves the curve; it inflates sigma, so
+  the tests that use it err on the side of accepting a law).
+
+The estimate sigma^2 = y' Q y is a quadratic form in the data; with pure noise its effective degrees
+of freedom are nu = tr(Q)^2 / tr(Q^2) (Satterthwaite), about 0.51 n for evenly spaced points. A test
+that uses sigma-hat carries nu: the goodness of fit is an F test with (n - k, nu) degrees of freedom.
+"""
+from __future__ import annotations
+
+import math
+
+import attrs
+import numpy as np
+
+MIN_DF = 2.0  # fewer effective degrees of freedom give no usable estimate
+
+
+@attrs.frozen
+class NoiseEstimate:
+    """sigma [the column's SI unit], its effective degrees of freedom, and how it was obtained."""
+
+    sigma: float
+    df: float
+    method: str  # 'replicates' | 'GSJS'
+
+
+def gsjs(x: np.ndarray, y: np.ndarray, segments: np.ndarray | None = None) -> NoiseEstimate | None:
+    """The Gasser-Sroka-Jennen-Steinmetz estimate of y's noise, points ordered by x (increasing within
+    each segment label; segments: a label per point, None for one series). None without a triple of
+    neighbours spanning a positive interval."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    seg = np.zeros(x.size, dtype=int) if segments is None else np.asarray(segments)
+    i = np.arange(1, x.size - 1)
+    i = i[(seg[i - 1] == seg[i]) & (seg[i + 1] == seg[i]) & (x[i + 1] > x[i - 1])] if i.size else i
+    if not i.size:
+        return None
+    a = (x[i + 1] - x[i]) / (x[i + 1] - x[i - 1])
+    W = np.column_stack([a, -np.ones_like(a), 1.0 - a]) / np.sqrt(a * a + (1 - a) ** 2 + 1)[:, None]
+    I = np.column_stack([i - 1, i, i + 1])  # noqa: E741 (the points each pseudo-residual combines)
+    e = np.sum(W * y[I], axis=1)
+    m = i.size
+    # tr(Q) and tr(Q^2) of Q = C'C / m (C: the m x n pseudo-residual weights; each row has unit norm, so
+    # tr(Q) = 1); tr(Q^2) = |C C'|_F^2 / m^2, and rows r, s of C overlap only when their triples do.
+    tr2 = 0.0
+    for d in range(3):
+        r, s = np.arange(m - d), np.arange(d, m)
+        dot = np.zeros(r.size)
+        for p in range(3):
+            for q in range(3):
+                dot += W[r, p] * W[s, q] * (I[r, p] == I[s, q])
+        tr2 += (1 if d == 0 else 2) * float(dot @ dot)
+    return NoiseEstimate(math.sqrt(float(e @ e) / m), m * m / tr2 if tr2 > 0 else 0.0, "GSJS")
+
+
+def replicate_spread(keys: list, y: np.ndarray) -> NoiseEstimate | None:
+    """Pooled within-condition spread of y over rows with equal ``keys``; None without replicates."""
+    y = np.asarray(y, dtype=float)
+    groups: dict = {}
+    for i, k in enumerate(keys):
+        groups.setdefault(k, []).append(i)
+    ss, df = 0.0, 0
+    for idx in groups.values():
+        if len(idx) > 1:
+            v = y[idx]
+            ss += float(np.sum((v - v.mean()) ** 2))
+            df += len(idx) - 1
+    if df < MIN_DF:
+        return None
+    return NoiseEstimate(math.sqrt(ss / df), float(df), "replicates")
+
+
+def estimate(columns: dict, col: str) -> NoiseEstimate | None:
+    """The noise of column ``col`` of a dataset's SI columns: from replicates if the conditions repeat,
+    else GSJS along t (a time series) or along incidence within each speed (one impact per row).
+    None when the data give no estimate (too few points, or a series without noise: sigma 0)."""
+    y = columns[col]
+    if "t" in columns:
+        est = gsjs(columns["t"], y)
+    else:
+        conds = [c for c in ("speed", "incidence", "spin") if c in columns and c != col]
+        if not conds:
+            return None
+        keys = list(zip(*(np.round(columns[c], 12).tolist() for c in conds)))
+        est = replicate_spread(keys, y)
+        if est is None:
+            order = np.lexsort([columns[c] for c in reversed(conds)])
+            along = columns[conds[-1]][order] if len(conds) > 1 else columns[conds[0]][order]
+            seg = (np.round(columns[conds[0]][order], 9) if len(conds) > 1 else None)
+            est = gsjs(along, y[order], seg)
+    if est is None or est.df < MIN_DF or not est.sigma > 0 or not math.isfinite(est.sigma):
+        return None
+    return est
