@@ -340,14 +340,3 @@ def _verdict(e: EquivalenceResult) -> tuple[str, str]:
     return "cannot tell at this noise", (f"{head}: T tells neither law from the other although {power}: "
                                          f"T falls where the two null distributions overlap{caveat}. {thr}.")
 
-
-def group_answer(results, datasets, pair: tuple[str, str] = PAIRS[0]) -> dict:
-    from .equivalence_groups import group_answer as _g
-
-    return _g(results, datasets, pair)
-
-
-def fill_answers(answers, results) -> tuple:
-    from .equivalence_groups import fill_answers as _f
-
-    return _f(answers, results)

@@ -32,7 +32,7 @@ import numpy as np
 
 from ..core.errors import FrictionLabError, ParameterError
 from ..core.workers import process_pool
-from ..inference import equivalence as _equivalence
+from ..inference import equivalence_groups as _equivalence
 from ..inference import transfer as _transfer
 from ..inference.answers import group_of
 from ..inference.bootstrap import bootstrap_fits
