@@ -52,7 +52,8 @@ from .fitstats import (
     _stats,
     neg2loglik,
 )
-from .goodness import combine, goodness
+from ..io.noise import ratio_pvalue
+from .goodness import combine, f_pvalue, goodness
 from .identifiability import find_structure, jacobian, jacobian_errors, make_verdict
 from .plausibility import check_plausibility
 from .predict import (
@@ -73,6 +74,7 @@ from .predict import (
 __all__ = ["DatasetFit", "FitResult", "ParamResult", "PREDICTORS", "SCENE_QUANTITIES", "SkipDataset", "Stats", "Target",
            "applicable_solvers", "auto_solver", "fit", "get_scene_quantity", "make_target", "predict",
            "register_predictor", "set_scene_quantity"]
+SHARPEN_BELOW = 1e-3  # an F p-value (conservative) below this already rejects: no simulation needed
 _KEEP = (ODE_STARTS, PENALTY, LIKELIHOOD_REASON, neg2loglik)  # re-exported names other modules read from here
 
 
@@ -228,7 +230,7 @@ def _result(law, names, solver_label, model, slots, values, models, best_params,
         structure = find_structure(law, slots, values, J)
     else:
         structure = {"at_bounds": (), "ratios": (), "no_effect": (), "k_eff": len(varying), "n_free": len(varying)}
-    per = _per_dataset(model, values, models, structure["k_eff"] / len(targets))
+    per = _per_dataset(model, values, models, structure["k_eff"] / len(targets), J if errors else None)
     chisqr = sum(d.chisqr for d in per)
     stats = _stats(sum(t.y.size for t in targets), structure["k_eff"], len(varying), chisqr, per)
     status, reason = "ok", ""
@@ -265,15 +267,23 @@ def _result(law, names, solver_label, model, slots, values, models, best_params,
                      flags=tuple(flags), plausibility=numbers, minimizer_result=_si_result(best, slots) if checks else None)
 
 
-def _per_dataset(model, values, models, k_each) -> list[DatasetFit]:
-    """Each target's part of the fit; k_each: a group's parameters shared out for each member's test."""
-    per = []
+def _per_dataset(model, values, models, k_each, J=None) -> list[DatasetFit]:
+    """Each target's part of the fit; k_each: a group's parameters shared out for each member's test;
+    J: the weighted Jacobian of all targets' points (None: not computed)."""
+    per, start = [], 0
     for tg, solver_i, (p, scene), m in zip(model.targets, model.solvers, model.split(values), models):
         r = m - tg.y
+        z = r / tg.sigma
+        kind, k = _likelihood([tg]), round(k_each)
+        est = tg.dataset.noise_est.get(tg.observable) if kind == "estimated" else None
+        chi_p = None
+        if est is not None:
+            chi_p = f_pvalue(float(z @ z), z.size - k, est.df)
+            if J is not None and chi_p >= SHARPEN_BELOW:  # conservative: sharpen where it does not already reject
+                chi_p = ratio_pvalue(est, float(z @ z), J[start:start + z.size])
+        start += z.size
         per.append(DatasetFit(tg, solver_i, p, scene, m, float(r @ r), float(np.sqrt(np.mean(r**2))),
-                              float(np.sum((r / tg.sigma) ** 2)),
-                              goodness(r / tg.sigma, round(k_each), _likelihood([tg]),
-                                       tg.dataset.noise_df.get(tg.observable, math.inf))))
+                              float(z @ z), goodness(z, k, kind, est.df if est else math.inf, chi_p)))
     return per
 
 

@@ -4,8 +4,9 @@ Two tests per fitted dataset, on the normalized residuals z = (model - data) / s
 
 * chi-square: p = P(chi2 with n - k degrees of freedom >= observed chi2) where the dataset's sigma
   is known (measured). Where sigma is estimated from the data (io/noise.py, nu effective degrees of
-  freedom) the same statistic is an F test: p = P(F(n - k, nu) >= chi2 / (n - k)), the estimate's
-  own uncertainty carried in.
+  freedom) the estimate's own uncertainty is carried in: the F test p = P(F(n - k, nu) >= chi2 / (n - k))
+  (conservative: residuals and estimate share the noise), sharpened where it does not already reject
+  by the exact null of both from common noise (``noise.ratio_pvalue``, done by the fit).
 * residual structure: the Wald-Wolfowitz runs test on the signs of z (zeros dropped), one-sided:
   a law that misses the data's shape leaves long runs of one sign (too few runs). Normal
   approximation with continuity correction; needs at least RUNS_MIN nonzero residuals, else NaN.
@@ -64,7 +65,7 @@ class Goodness:
     @property
     def short(self) -> str:
         """'fits: chi2 p = 0.96' / 'fails: runs p = 8e-10': the verdict and the p-value closest to failing."""
-        ps = [(name, p) for name, p in (("χ²" if self.likelihood != "estimated" else "F", self.chi2_p), ("runs", self.runs_p)) if math.isfinite(p)]
+        ps = [(name, p) for name, p in (("χ²" if self.likelihood != "estimated" else "χ²/σ̂²", self.chi2_p), ("runs", self.runs_p)) if math.isfinite(p)]
         if self.fits is None or not ps:
             return "not testable"
         name, p = min(ps, key=lambda x: x[1])
@@ -135,21 +136,23 @@ def f_pvalue(chisqr: float, dof: int, df_sigma: float) -> float:
     return float(fdtrc(dof, df_sigma, chisqr / dof)) if dof > 0 and math.isfinite(chisqr) else math.nan
 
 
-def goodness(z: np.ndarray, k: int, likelihood: str, df_sigma: float = math.inf) -> Goodness:
+def goodness(z: np.ndarray, k: int, likelihood: str, df_sigma: float = math.inf, chi_p: float | None = None) -> Goodness:
     """Goodness of one fitted dataset from its normalized residuals z, k fitted parameters and the
-    degrees of freedom of its sigma (infinite when measured)."""
+    degrees of freedom of its sigma (infinite when measured); chi_p: the fit test's p where the caller
+    has a sharper one (``noise.ratio_pvalue``)."""
     z = np.asarray(z, dtype=float)
     if likelihood == "none":
         return Goodness("none", math.nan, math.nan, 0, math.nan, math.nan, math.nan, None,
                         "no test: no valid likelihood (a smoothed, derived series or a noise-free curve)")
-    chi_p = f_pvalue(float(z @ z), z.size - k, df_sigma if likelihood == "estimated" else math.inf)
+    if chi_p is None:
+        chi_p = f_pvalue(float(z @ z), z.size - k, df_sigma if likelihood == "estimated" else math.inf)
     runs, expected, runs_p = runs_test(z)
     r1, r1_p = lag1(z)
     return _decide(likelihood, chi_p, runs_p, runs, expected, r1, r1_p)
 
 
 def _decide(likelihood, chi_p, runs_p, runs, expected, r1, r1_p) -> Goodness:
-    tests = [(name, p) for name, p in (("chi-square" if likelihood != "estimated" else "F test", chi_p), ("runs test", runs_p)) if math.isfinite(p)]
+    tests = [(name, p) for name, p in (("chi-square" if likelihood != "estimated" else "chi-square at estimated sigma", chi_p), ("runs test", runs_p)) if math.isfinite(p)]
     if not tests:
         return Goodness(likelihood, chi_p, runs_p, runs, expected, r1, r1_p, None, "no test possible (too few points)")
     failed = [f"{name} p = {_p(p)} < {TEST_LEVEL:g}" for name, p in tests if p < TEST_LEVEL]

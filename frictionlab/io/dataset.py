@@ -76,6 +76,7 @@ class Dataset:
     fixed_units: dict = attrs.field(factory=dict)
     noise_kind: str = "estimated"  # NOISE_KINDS: sigma measured ('known'), from the data ('estimated'), or 'none'
     noise_df: dict = attrs.field(factory=dict)  # column -> effective degrees of freedom of an estimated sigma
+    noise_est: dict = attrs.field(factory=dict, repr=False)  # column -> noise.NoiseEstimate (estimated kind)
     noise_note: str = ""  # which noise is used, and why (one sentence, for the report and `datasets show`)
     stated: dict = attrs.field(factory=dict)  # STATED name -> (value, precision) in SI ([stated])
     group: str = ""  # declared group (TOML 'group'); "" -> answers.group_of derives it from the name
@@ -207,7 +208,7 @@ def from_meta(meta: dict, path: Path) -> Dataset:
         if col in columns and np.any(columns[col] < 0):
             raise DatasetError(f"{csv}: column '{col}' has negative values")
 
-    noise, noise_kind, noise_df, noise_note = _noise(meta, path, observable, columns)
+    noise, noise_kind, noise_est, noise_note = _noise(meta, path, observable, columns)
 
     provenance = _provenance(meta.get("provenance"), path)
     scene = None
@@ -261,7 +262,7 @@ def from_meta(meta: dict, path: Path) -> Dataset:
                    noise=noise, scene=scene, fixed=fixed, provenance=provenance,
                    description=meta.get("description", ""), reported=reported,
                    fixed_units=fixed_units, noise_kind=noise_kind, group=group,
-                   noise_df=noise_df, noise_note=noise_note, stated=_stated(meta, path, kind, noise_kind))
+                   noise_df={k: e.df for k, e in noise_est.items()}, noise_est=noise_est, noise_note=noise_note, stated=_stated(meta, path, kind, noise_kind))
 
 
 def _stated(meta, path, kind, noise_kind) -> dict:
@@ -309,23 +310,23 @@ def _noise(meta, path, observable, columns) -> tuple[dict, str, dict, str]:
             raise DatasetError(f"{path}: [noise] kind = 'known' must give the measured sigma of the observable, "
                                f"e.g. {observable} = '100 rpm'")
         return declared, kind, {}, "declared sigma, measured (kind = known)"
-    noise, df = {}, {}
+    noise, ests = {}, {}
     for col in columns:
         if col in ("t", "speed", "incidence"):
             continue
         est = estimate(columns, col)
         if est is not None:
-            noise[col], df[col] = est.sigma, est.df
+            noise[col], ests[col] = est.sigma, est
     if observable not in noise:
         raise DatasetError(f"{path}: the noise of '{observable}' cannot be estimated from the data (too few "
                            f"points, or no scatter): declare it, [noise] kind = 'known', {observable} = '...'")
     method = {"GSJS": "Gasser-Sroka-Jennen-Steinmetz differences", "replicates": "the spread of replicates"}
-    how = method[estimate(columns, observable).method]
+    how = method[ests[observable].method]
     why = (f"[noise] kind = '{next(k for k, v in NOISE_ALIASES.items() if v == kind)}' is read as estimated: a "
            "guessed sigma is never used" if alias else "no measured sigma declared")
     ignored = f"; the declared {observable} sigma is ignored" if observable in declared else ""
-    note = f"estimated from the data by {how} ({df[observable]:.0f} effective degrees of freedom): {why}{ignored}"
-    return noise, kind, df, note
+    note = f"estimated from the data by {how} ({ests[observable].df:.0f} effective degrees of freedom): {why}{ignored}"
+    return noise, kind, ests, note
 
 
 def _check_time_unit(columns, units, spec, kind, scene, path) -> None:

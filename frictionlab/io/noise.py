@@ -14,6 +14,9 @@
 The estimate sigma^2 = y' Q y is a quadratic form in the data; with pure noise its effective degrees
 of freedom are nu = tr(Q)^2 / tr(Q^2) (Satterthwaite), about 0.51 n for evenly spaced points. A test
 that uses sigma-hat carries nu: the goodness of fit is an F test with (n - k, nu) degrees of freedom.
+The fit's residuals and sigma-hat come from the same noise, so that F test is conservative; where it
+does not already reject, ``ratio_pvalue`` gives the exact p of chi2 / (n - k) under the fitted law
+(linearized at the fit) by simulating both quadratic forms from common noise draws.
 """
 from __future__ import annotations
 
@@ -32,6 +35,20 @@ class NoiseEstimate:
     sigma: float
     df: float
     method: str  # 'replicates' | 'GSJS'
+    rows: np.ndarray | None = attrs.field(default=None, eq=False, repr=False)  # GSJS: point indices (m x 3)
+    weights: np.ndarray | None = attrs.field(default=None, eq=False, repr=False)  # GSJS: unit-norm weights (m x 3)
+    labels: np.ndarray | None = attrs.field(default=None, eq=False, repr=False)  # replicates: condition per point
+
+    def variance(self, E: np.ndarray) -> np.ndarray:
+        """sigma-hat^2 of each row of E (draws x points, in the dataset's row order)."""
+        if self.labels is not None:
+            out = np.zeros(E.shape[0])
+            for g in np.unique(self.labels):
+                block = E[:, self.labels == g]
+                out += np.sum((block - block.mean(axis=1, keepdims=True)) ** 2, axis=1)
+            return out / self.df
+        e = np.einsum("zmk,mk->zm", E[:, self.rows], self.weights)
+        return np.mean(e * e, axis=1)
 
 
 def gsjs(x: np.ndarray, y: np.ndarray, segments: np.ndarray | None = None) -> NoiseEstimate | None:
@@ -59,7 +76,7 @@ def gsjs(x: np.ndarray, y: np.ndarray, segments: np.ndarray | None = None) -> No
             for q in range(3):
                 dot += W[r, p] * W[s, q] * (I[r, p] == I[s, q])
         tr2 += (1 if d == 0 else 2) * float(dot @ dot)
-    return NoiseEstimate(math.sqrt(float(e @ e) / m), m * m / tr2 if tr2 > 0 else 0.0, "GSJS")
+    return NoiseEstimate(math.sqrt(float(e @ e) / m), m * m / tr2 if tr2 > 0 else 0.0, "GSJS", rows=I, weights=W)
 
 
 def replicate_spread(keys: list, y: np.ndarray) -> NoiseEstimate | None:
@@ -76,7 +93,10 @@ def replicate_spread(keys: list, y: np.ndarray) -> NoiseEstimate | None:
             df += len(idx) - 1
     if df < MIN_DF:
         return None
-    return NoiseEstimate(math.sqrt(ss / df), float(df), "replicates")
+    labels = np.zeros(len(keys), dtype=int)
+    for j, idx in enumerate(groups.values()):
+        labels[idx] = j
+    return NoiseEstimate(math.sqrt(ss / df), float(df), "replicates", labels=labels)
 
 
 def estimate(columns: dict, col: str) -> NoiseEstimate | None:
@@ -97,6 +117,29 @@ def estimate(columns: dict, col: str) -> NoiseEstimate | None:
             along = columns[conds[-1]][order] if len(conds) > 1 else columns[conds[0]][order]
             seg = (np.round(columns[conds[0]][order], 9) if len(conds) > 1 else None)
             est = gsjs(along, y[order], seg)
+            if est is not None:  # back to the dataset's row order
+                est = attrs.evolve(est, rows=order[est.rows])
     if est is None or est.df < MIN_DF or not est.sigma > 0 or not math.isfinite(est.sigma):
         return None
     return est
+
+
+DRAWS = 4000  # noise draws of ``ratio_pvalue``
+
+
+def ratio_pvalue(est: NoiseEstimate, chisqr: float, J: np.ndarray, seed: int = 0) -> float:
+    """P(chi2* / (n - k) >= chisqr / (n - k)) where chi2* is the fit's chi-square at sigma-hat on data of the
+    fitted law plus noise, linearized at the fit: residuals e - P e (P the projection onto the columns
+    of J, the weighted Jacobian of this dataset's points, n x k) over sigma-hat^2 of the same e.
+    chisqr is at sigma-hat. Monte Carlo with DRAWS draws: its floor is 1 / (DRAWS + 1)."""
+    n = J.shape[0]
+    rng = np.random.default_rng(seed)
+    E = rng.standard_normal((DRAWS, n))
+    if J.size:
+        U, s, _ = np.linalg.svd(J, full_matrices=False)
+        Qj = U[:, s > 1e-9 * s.max()] if s.size and s.max() > 0 else U[:, :0]
+        E_res = E - (E @ Qj) @ Qj.T
+    else:
+        E_res = E
+    ratio = np.sum(E_res * E_res, axis=1) / est.variance(E)
+    return (1.0 + float(np.sum(ratio >= chisqr))) / (DRAWS + 1.0)

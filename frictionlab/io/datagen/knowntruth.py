@@ -99,7 +99,7 @@ def build(out_dir: Path) -> list[Path]:
             "description": (f"Known-truth impact: golf-ball-like scene, u0 = {u0:g} m/s, A0 = {A0 * 1e6:g} mm^2, "
                             f"t_c = {tc * 1e6:g} us; spin generated with {law_name}. SYNTHETIC, not measured."),
             "columns": {"t": "us", "omega": "rpm"},
-            "noise": {"omega": f"{sigma:g} rpm"},
+            "noise": {"kind": "known", "omega": f"{sigma:g} rpm"},
             "scene": spec,
             "provenance": {
                 "kind": "synthetic",
