@@ -23,7 +23,7 @@ def test_every_builtin_loads_with_honest_provenance():
         if d.provenance.kind == "measured":
             assert "MEASURED" in d.description and "@" in d.provenance.source  # repository path @ commit
         assert d.provenance.command == "frictionlab datasets rebuild"
-        assert np.all(np.isfinite(d.y)) and d.sigma > 0
+        assert np.all(np.isfinite(d.y)) and (d.sigma > 0 if d.noise_kind != "none" else d.provenance.kind == "reconstructed")
         if d.provenance.kind == "synthetic":
             assert d.provenance.seed is not None and "law" in d.provenance.truth
             assert "SYNTHETIC" in d.description
@@ -32,8 +32,9 @@ def test_every_builtin_loads_with_honest_provenance():
 def test_golf_units_become_si():
     d = fl.load_dataset("impact-golf-v28")
     assert d.t[1] == pytest.approx(10e-6)
-    assert d.observable == "theta" and d.sigma == pytest.approx(math.radians(0.5))
-    assert d.noise["omega"] == pytest.approx(200 * RPM)
+    assert d.observable == "theta" and d.noise_kind == "none" and d.noise == {}  # noise-free: no sigma at all
+    assert d.stated["omega_peak"] == pytest.approx((6700 * RPM, 100 * RPM))
+    assert d.stated["theta_max"] == pytest.approx((math.radians(13), math.radians(1)))
     s = d.scene
     assert (s.mass, s.radius, s.u0) == pytest.approx((0.046, 0.0213, 12.0))
     assert s.area.peak == pytest.approx(130e-6) and s.area.contact_time == pytest.approx(500e-6)

@@ -100,8 +100,16 @@ def _show(args) -> int:
     if d.description:
         print(f"  description: {d.description}")
     print("  columns:     " + ", ".join(f"{c} [{u or '-'}]" for c, u in d.units.items()))
-    print("  noise:       " + ", ".join(f"{c} ± {quantity_text(v * _to_file_unit(d, c), d.units.get(c, ''))}"
-                                        if d.units.get(c) else f"{c} ± {v:.4g}" for c, v in d.noise.items()))
+    def sd(c, v):
+        return f"{c} ± {quantity_text(v * _to_file_unit(d, c), d.units.get(c, ''))}" if d.units.get(c) else f"{c} ± {v:.4g}"
+
+    values = ", ".join(sd(c, v) for c, v in d.noise.items() if d.noise_kind != "none")
+    print(f"  noise:       {d.noise_kind}{': ' + values if values else ''} ({d.noise_note})")
+    if d.stated:
+        from ..io.dataset import STATED
+
+        print("  stated:      " + ", ".join(f"{k} = {quantity_text(v, STATED[k])} ± {quantity_text(p, STATED[k])}"
+                                            for k, (v, p) in d.stated.items()))
     print(f"  provenance:  {pv.kind}; {pv.source}")
     if pv.method:
         print(f"  method:      {pv.method}")

@@ -93,7 +93,8 @@ class Dataset:
 
     @property
     def sigma(self) -> float:
-        return self.noise[self.observable]
+        """The observable's sigma [SI]: measured or estimated; nan for a noise-free reconstruction."""
+        return self.noise.get(self.observable, math.nan) if self.noise_kind == "none" else self.noise[self.observable]
 
     def __len__(self) -> int:
         return len(next(iter(self.columns.values())))
@@ -290,6 +291,8 @@ def _noise(meta, path, observable, columns) -> tuple[dict, str, dict, str]:
 
     spec = dict(_table(meta, "noise", path, "[noise]"))
     kind = spec.pop("kind", "estimated")
+    if not isinstance(kind, str):
+        raise DatasetError(f"{path}: noise.kind must be a string, one of {', '.join(NOISE_KINDS)}")
     alias = NOISE_ALIASES.get(kind)
     kind = alias or kind
     if kind not in NOISE_KINDS:
@@ -303,7 +306,7 @@ def _noise(meta, path, observable, columns) -> tuple[dict, str, dict, str]:
         if not declared[col] > 0:
             raise DatasetError(f"{path}: noise.{col} must be positive, got {value!r}")
     if kind == "none":
-        return declared, kind, {}, ("none: a noise-free reconstruction; laws are compared on the numbers it was "
+        return declared, kind, {}, ("a noise-free reconstruction; laws are compared on the numbers it was "
                                     "drawn through, at their stated precision ([stated]); the curve is for figures")
     if kind == "known":
         if observable not in declared:
