@@ -197,11 +197,11 @@ def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = RE
     d_ab, d_ba = cross_chi2(fit_a, fit_b, timeout), cross_chi2(fit_b, fit_a, timeout)
     t_obs = float(fit_a.stats.chisqr - fit_b.stats.chisqr)
     tol = TIE_REL * max(common["n_points"], fit_a.stats.chisqr, fit_b.stats.chisqr)
-    t_a, t_b, failed, stopped = _sample(fit_a, fit_b, replicates, seed, t_obs, tol, executor, chunk, timeout)
+    t_a, t_b, failed, stopped, drawn = _sample(fit_a, fit_b, replicates, seed, t_obs, tol, executor, chunk, timeout)
     res = dict(**base, **common, t_obs=t_obs, t_a=t_a, t_b=t_b, failed=failed, d_ab=d_ab, d_ba=d_ba, stopped=stopped)
     if min(t_a.size, t_b.size) < MIN_REPLICATES // 2:
         return EquivalenceResult(**res, status="failed",
-                                 reason=f"{failed} replicate refits failed: too few left to test")
+                                 reason=f"{failed} of {2 * drawn} replicate refits failed: too few left to test")
     p_a, p_b = _p_side(t_a, t_obs, tol), _p_side(-t_b, -t_obs, tol)
     crit_a, crit_b = float(np.quantile(t_a, 1 - ALPHA / 2)), float(np.quantile(t_b, ALPHA / 2))
     res.update(p_a=p_a, p_b=p_b, p=min(1.0, 2 * min(p_a, p_b)), q_a=_p_upper(-t_a, -t_obs, tol),
@@ -232,10 +232,10 @@ def _common(fit_a: FitResult, fit_b: FitResult) -> dict:
 
 def _sample(fit_a, fit_b, most, seed, t_obs, tol, executor, chunk, timeout):
     """Replicates of T under each fit, in batches until the decision is clear (module docstring, 3).
-    Returns (T under A, T under B, failed refits, why sampling stopped)."""
+    Returns (T under A, T under B, failed refits, why sampling stopped, replicates drawn per null)."""
     if one_family(fit_a, fit_b):  # one model: both refits of every replicate are the same fit, T* = 0
         zeros = np.zeros(MIN_REPLICATES)
-        return zeros, zeros.copy(), 0, "one model: T* = 0 on every replicate"
+        return zeros, zeros.copy(), 0, "one model: T* = 0 on every replicate", MIN_REPLICATES
     from .replicates import seed_sequence
 
     da, db = fit_a.per_dataset[0], fit_b.per_dataset[0]
@@ -257,7 +257,7 @@ def _sample(fit_a, fit_b, most, seed, t_obs, tol, executor, chunk, timeout):
         if done:
             why = f"{done} after {len(rows)} replicates per null"
             break
-    return t_a, t_b, int(np.sum(~np.isfinite(arr))), why
+    return t_a, t_b, int(np.sum(~np.isfinite(arr))), why, len(rows)
 
 
 def _clear(t_a: np.ndarray, t_b: np.ndarray, t_obs: float, tol: float) -> str:
