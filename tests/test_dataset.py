@@ -142,11 +142,14 @@ def test_cli_error_is_one_line_exit_2(run_cli, golf_copy):
     assert out.returncode != 0 and "Traceback" in out.stderr
 
 
-def test_group_key_declares_the_group_and_defaults_to_the_name_stem(golf_copy):
+def test_group_key_declares_the_group_and_nothing_is_inferred_from_names(golf_copy):
     from frictionlab.inference.answers import group_of
 
     d = fl.load_dataset(golf_copy)
-    assert d.group == "" and group_of(d) == d.name.rsplit("-", 1)[0]
+    assert d.group == "impact-golf" and group_of(d) == "impact-golf"  # the built-in file declares it
+    _edit(golf_copy, 'group = "impact-golf"\n', '')
+    d = fl.load_dataset(golf_copy)
+    assert d.group == "" and group_of(d) == d.name  # no key: its own group, never "impact-golf" from the name
     _edit(golf_copy, 'kind = "impact"', 'group = "golf-balls"\nkind = "impact"')
     d = fl.load_dataset(golf_copy)
     assert d.group == "golf-balls" and group_of(d) == "golf-balls"

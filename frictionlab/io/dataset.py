@@ -1,7 +1,7 @@
 """Datasets: a CSV series plus a TOML sidecar of the same stem, loaded into SI arrays.
 
 The TOML holds ``name``, optionally ``group`` (datasets of one material and setup compared
-together; default: the name without its last ``-suffix``), ``kind``, ``observable``, ``[columns]`` (column -> unit),
+together; without it a dataset is its own group: nothing is inferred from names), ``kind``, ``observable``, ``[columns]`` (column -> unit),
 ``[noise]`` (``kind = "known" | "estimated" | "none"`` and column -> quantity: see NOISE_KINDS;
 no table means estimated), ``[scene]``, ``[fixed]`` law parameters,
 ``[provenance]`` and optionally ``[reported]`` and ``[stated]`` (the numbers a noise-free
@@ -79,7 +79,7 @@ class Dataset:
     noise_est: dict = attrs.field(factory=dict, repr=False)  # column -> noise.NoiseEstimate (estimated kind)
     noise_note: str = ""  # which noise is used, and why (one sentence, for the report and `datasets show`)
     stated: dict = attrs.field(factory=dict)  # STATED name -> (value, precision) in SI ([stated])
-    group: str = ""  # declared group (TOML 'group'); "" -> answers.group_of derives it from the name
+    group: str = ""  # declared group (TOML 'group'); "": the dataset is its own group (nothing is inferred from names)
 
     @property
     def t(self) -> np.ndarray:

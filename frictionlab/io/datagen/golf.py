@@ -77,6 +77,7 @@ def build(out_dir: Path) -> list[Path]:
         vn = speed * math.cos(math.radians(30))
         meta = {
             "name": f"impact-golf-v{speed}",
+            "group": "impact-golf",  # one ball and target at two speeds
             "kind": "impact",
             "observable": "theta",
             "description": (f"Golf ball (46 g, 42.6 mm) in oblique impact on a rigid steel target inclined 30 deg, "
