@@ -364,7 +364,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                 transfer_results.append(assemble(g, cands, {c: p for (gg, c, _), p in zip(tasks, parts) if gg == g}))
             if by_group:
                 timings["transfer"] = time.perf_counter() - t0
-            transfer_results += _transfer.skipped(dss)
+            transfer_results += _transfer.skipped(dss, fits=fits)
         step = _Step(progress, done, total)
 
         def tolerance_stage():
