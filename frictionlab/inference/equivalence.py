@@ -14,8 +14,8 @@ law B to one dataset (each with its own solver) and asks whether the data can te
 3. Sequential Monte Carlo (after Besag and Clifford 1991): replicates come in batches of BATCH, up to
    ``replicates`` per null; sampling stops once the decision is clear: every p-value's 99% Clopper-
    Pearson interval lies above ALPHA / 2 (clear cases cost a batch or two), or one lies below it, or,
-   from FAR_MIN replicates on, T lies more than FAR null standard deviations beyond all of a law's
-   replicates. Then that law's p is the normal tail of T beyond the replicates' mean and standard
+   from FAR_MIN replicates on, T lies beyond all of a law's replicates and more than FAR of their
+   standard deviations above their mean. Then that law's p is the normal tail of T beyond the replicates' mean and standard
    deviation (below the Monte-Carlo floor 1 / (m + 1), which a group's Holm step needs to pass). The Monte-Carlo
    standard error sqrt(p (1 - p) / m) of each p is reported, and how many replicates were drawn.
 4. One two-sided rule at ALPHA: p = min(1, 2 min(p_A, p_B)); the two laws are told apart when p < ALPHA
@@ -53,8 +53,8 @@ REPLICATES = 400  # the most replicates per null (sequential: clear cases stop a
 BATCH = 20  # replicates per null drawn between stopping checks
 MIN_REPLICATES = 20  # the smallest allowed maximum
 CI_LEVEL = 0.99  # Clopper-Pearson interval of a Monte-Carlo p-value that decides when to stop
-FAR = 3.0  # T this many null standard deviations beyond every replicate of a law rejects it without more draws
-FAR_MIN = 60  # ... once at least this many are drawn
+FAR = 4.0  # T this many null standard deviations above the mean and beyond every replicate of a law rejects it
+FAR_MIN = 40  # ... once at least this many are drawn (its p is then the normal tail, below 1e-4)
 TIE_REL = 1e-4  # |T* - T| below this fraction of max(n, chi2) is a tie (the optimizer's resolution)
 VERDICTS = ("equivalent", "not equivalent", "cannot tell at this noise")
 
@@ -270,14 +270,14 @@ def _clear(t_a: np.ndarray, t_b: np.ndarray, t_obs: float, tol: float) -> str:
     if any(hi < ALPHA / 2 for _, hi in bounds):
         return f"a p-value's {CI_LEVEL:.0%} Monte-Carlo interval below {ALPHA / 2:g}"
     if _far(t_a, t_obs) or _far(-t_b, -t_obs):
-        return f"T lies more than {FAR:g} null standard deviations beyond every replicate of one law"
+        return f"T lies beyond every replicate of one law, more than {FAR:g} of their standard deviations from their mean"
     return ""
 
 
 def _far(sample: np.ndarray, x: float) -> bool:
-    """Whether x lies more than FAR standard deviations above every value of sample (of at least FAR_MIN)."""
+    """Whether x lies above every value of sample (of at least FAR_MIN) and FAR standard deviations above its mean."""
     sd = float(np.std(sample)) if sample.size else 0.0
-    return sample.size >= FAR_MIN and sd > 0 and x - float(sample.max()) > FAR * sd
+    return sample.size >= FAR_MIN and sd > 0 and x > float(sample.max()) and x - float(sample.mean()) > FAR * sd
 
 
 def _p_side(sample: np.ndarray, x: float, tol: float) -> float:
