@@ -14,9 +14,11 @@ law B to one dataset (each with its own solver) and asks whether the data can te
 3. Sequential Monte Carlo (after Besag and Clifford 1991): replicates come in batches of BATCH, up to
    ``replicates`` per null; sampling stops once the decision is clear: every p-value's 99% Clopper-
    Pearson interval lies above ALPHA / 2 (clear cases cost a batch or two), or one lies below it, or,
-   from FAR_MIN replicates on, T lies beyond all of a law's replicates and more than FAR of their
-   standard deviations above their mean. Then that law's p is the normal tail of T beyond the replicates' mean and standard
-   deviation (below the Monte-Carlo floor 1 / (m + 1), which a group's Holm step needs to pass). The Monte-Carlo
+   from FAR_MIN replicates on, T lies beyond all of a law's replicates and an exponential tail fitted to
+   them (peaks over their TAIL_Q quantile u: p = (1 - TAIL_Q) exp(-(T - u) / mean excess)) puts its p
+   below FAR_P. That tail estimate (at least TAIL_FLOOR: beyond it, extrapolation) is then the law's p, below the Monte-Carlo floor 1 / (m + 1) that a
+   group's Holm step would otherwise sit on; an exponential tail is conservative for the normal-like
+   and chi-square-like nulls of this statistic. The Monte-Carlo
    standard error sqrt(p (1 - p) / m) of each p is reported, and how many replicates were drawn.
 4. One two-sided rule at ALPHA: p = min(1, 2 min(p_A, p_B)); the two laws are told apart when p < ALPHA
    (**not equivalent**; the text says which law is rejected, and a law that fails its own fit tests
@@ -41,6 +43,8 @@ from ..core.display import unit
 from ..core.errors import FrictionLabError, ParameterError
 from .decomposition import Decomposition, decomposition
 from .fitting import FitResult
+from .qualitative import qualitative
+from .qualitative import text as qual_text
 from .replicates import cross_chi2, one_family, refit_options, replicate_chunk
 
 WEAR, AREA_RATE, COUETTE, COULOMB = "wear", "area-rate", "couette", "coulomb"
@@ -53,8 +57,10 @@ REPLICATES = 400  # the most replicates per null (sequential: clear cases stop a
 BATCH = 20  # replicates per null drawn between stopping checks
 MIN_REPLICATES = 20  # the smallest allowed maximum
 CI_LEVEL = 0.99  # Clopper-Pearson interval of a Monte-Carlo p-value that decides when to stop
-FAR = 4.0  # T this many null standard deviations above the mean and beyond every replicate of a law rejects it
-FAR_MIN = 40  # ... once at least this many are drawn (its p is then the normal tail, below 1e-4)
+FAR_MIN = 40  # replicates before T beyond all of a law's may stop sampling by its tail estimate
+TAIL_Q = 0.75  # the exponential tail is fitted to the replicates above this quantile
+FAR_P = ALPHA / 20  # ... when that tail puts T's p below this (clear of any Holm level up to 10 members)
+TAIL_FLOOR = 1e-6  # a tail estimate is extrapolation: smaller values are reported as this bound
 TIE_REL = 1e-4  # |T* - T| below this fraction of max(n, chi2) is a tie (the optimizer's resolution)
 VERDICTS = ("equivalent", "not equivalent", "cannot tell at this noise")
 
@@ -98,6 +104,7 @@ class EquivalenceResult:
     observable: str = ""
     rms: float = math.nan  # RMS difference of the two best curves (SI; 'stated': in stated precisions)
     fits: dict = attrs.field(factory=dict)  # law -> passes its own fit tests (True / False / None)
+    qualitative: dict = attrs.field(factory=dict)  # qualitative.qualitative: shared curve features
     fitted: dict = attrs.field(factory=dict)  # law -> {param: SI value}
     decomposition: Decomposition | None = None  # the paper's decomposition (wear [series] only)
 
@@ -208,6 +215,8 @@ def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = RE
                q_b=_p_upper(t_b, t_obs, tol), power_a=float(np.mean(t_b > crit_a + tol)),
                power_b=float(np.mean(t_a < crit_b - tol)))
     verdict, why = _verdict(EquivalenceResult(**res, status="ok"))
+    if common["qualitative"]["verdict"] != "not applicable":
+        why += f" Qualitatively (shared curve features): {qual_text(common['qualitative'], fit_a.law, fit_b.law)}."
     if one_family(fit_a, fit_b):
         why += (" Both laws span one closed-form family here (one model), so each replicate's two refits are the "
                 "same fit and T* = 0 on every replicate, without refitting.")
@@ -226,6 +235,7 @@ def _common(fit_a: FitResult, fit_b: FitResult) -> dict:
                 fitted={f.law: {k: p.value for k, p in f.params.items() if p.kind == "law"} for f in (fit_a, fit_b)},
                 decomposition=decomposition(fit_a) or decomposition(fit_b),
                 fits={f.law: (f.goodness.fits if f.goodness is not None else None) for f in (fit_a, fit_b)},
+                qualitative=qualitative(fit_a, fit_b),
                 chi2={fit_a.law: fit_a.stats.chisqr, fit_b.law: fit_b.stats.chisqr},
                 k={fit_a.law: fit_a.stats.n_params, fit_b.law: fit_b.stats.n_params})
 
@@ -270,24 +280,28 @@ def _clear(t_a: np.ndarray, t_b: np.ndarray, t_obs: float, tol: float) -> str:
     if any(hi < ALPHA / 2 for _, hi in bounds):
         return f"a p-value's {CI_LEVEL:.0%} Monte-Carlo interval below {ALPHA / 2:g}"
     if _far(t_a, t_obs) or _far(-t_b, -t_obs):
-        return f"T lies beyond every replicate of one law, more than {FAR:g} of their standard deviations from their mean"
+        return f"T lies beyond every replicate of one law, with a tail-estimated p below {FAR_P:g}"
     return ""
 
 
+def _tail(sample: np.ndarray, x: float) -> float:
+    """Exponential-tail estimate of P(T* >= x) from the replicates above their TAIL_Q quantile (nan if none)."""
+    u = float(np.quantile(sample, TAIL_Q))
+    excess = sample[sample > u] - u
+    if not excess.size or not excess.mean() > 0:
+        return math.nan
+    return (1 - TAIL_Q) * math.exp(-(x - u) / float(excess.mean()))
+
+
 def _far(sample: np.ndarray, x: float) -> bool:
-    """Whether x lies above every value of sample (of at least FAR_MIN) and FAR standard deviations above its mean."""
-    sd = float(np.std(sample)) if sample.size else 0.0
-    return sample.size >= FAR_MIN and sd > 0 and x > float(sample.max()) and x - float(sample.mean()) > FAR * sd
+    """Whether x lies above every value of sample (of at least FAR_MIN) with a tail-estimated p below FAR_P."""
+    return sample.size >= FAR_MIN and x > float(sample.max()) and _tail(sample, x) < FAR_P
 
 
 def _p_side(sample: np.ndarray, x: float, tol: float) -> float:
-    """The upper-tail p of x: Monte-Carlo, or below its floor the normal tail where x is far beyond (_far)."""
+    """The upper-tail p of x: Monte-Carlo, or below its floor the tail estimate where x is far beyond (_far)."""
     p = _p_upper(sample, x, tol)
-    if _far(sample, x):
-        from scipy.special import ndtr
-
-        p = min(p, float(ndtr(-(x - float(sample.mean())) / float(np.std(sample)))))
-    return p
+    return min(p, max(_tail(sample, x), TAIL_FLOOR)) if _far(sample, x) else p
 
 
 def _count(sample: np.ndarray, x: float, tol: float) -> float:

@@ -100,6 +100,11 @@ def group_answer(results, datasets, pair: tuple[str, str] = PAIRS[0]) -> dict:
                              "; ".join(f"{v} ({how})" for v, how in tested) or "not tested")}
     if _threshold_short(full or series):
         short["threshold"] = _threshold_short(full or series) + ("" if full else " [series]")
+    qual = {f"{e.dataset} [{e.solver_a}]": e.qualitative["verdict"] + (f" ({e.qualitative['differs']})"
+                                                                       if e.qualitative.get("differs") else "")
+            for e in mine if e.ok and e.qualitative.get("verdict") not in (None, "not applicable")}
+    if qual:
+        short["qualitative"] = "; ".join(f"{k}: {v}" for k, v in qual.items())
     notes = [f"{how}: {n}" for n, how in ((n_full, "exact"), (n_series, "series")) if n]
     if notes:
         short["equivalence"] += " — " + "; ".join(notes)
