@@ -93,3 +93,38 @@ def test_holm_steps_down_across_members():
     assert holm([0.01, 0.04, 0.03]) == [True, False, False]  # 0.01 < 0.05/3; 0.03 > 0.05/2 stops
     assert holm([0.01, 0.02, 0.04]) == [True, True, True]  # 0.01 < 0.0167, 0.02 < 0.025, 0.04 < 0.05
     assert holm([0.03, 0.03]) == [False, False]  # each alone below 0.05, neither after Holm
+
+
+def _impact(truth: str, sigma: float, seed: int, estimated: bool):
+    from _fit_helpers import TRUTH, impact_scene
+
+    from frictionlab.io.dataset import Provenance
+
+    scene = impact_scene()
+    t = np.linspace(0.0, scene.duration, 41)
+    y = fl.simulate(truth, scene, TRUTH[truth], solver="exact", t=t).omega + np.random.default_rng(seed).normal(0, sigma, 41)
+    cols = {"t": t, "omega": y}
+    kw = {"noise": {"omega": sigma}, "noise_kind": "known"}
+    if estimated:
+        est = estimate(cols, "omega")
+        kw = {"noise": {"omega": est.sigma}, "noise_kind": "estimated", "noise_df": {"omega": est.df},
+              "noise_est": {"omega": est}}
+    return fl.Dataset(name=f"kt-{truth}", kind="impact", observable="omega", path=None, columns=cols,
+                      units={"t": "s", "omega": "rad/s"}, scene=scene, fixed={},
+                      provenance=Provenance("synthetic", "tests", seed=seed), **kw)
+
+
+@pytest.mark.parametrize("estimated", [False, True])
+def test_the_papers_pair_on_known_truth_rejects_the_false_law_and_keeps_the_true_one(estimated):
+    """Wear truth: at a quarter of the pair's threshold noise the test rejects area-rate (never wear); at four
+    times it, it rejects neither. With sigma measured and with sigma estimated from the data."""
+    from frictionlab import analyze_equivalence
+
+    thr = 41.6  # rad/s: the pair's threshold on wear's noise-free curve (benchmarks/calibration.py prints it)
+    low = _impact("wear", thr / 4, 7, estimated)
+    e = analyze_equivalence(fit("wear", low), fit("area-rate", low))
+    assert e.verdict == "not equivalent" and e.p_b < 0.025 <= e.p_a, e.explanation
+    assert e.threshold == pytest.approx(thr, rel=0.3)  # from the noisy fits: near the noise-free value
+    high = _impact("wear", 4 * thr, 8, estimated)
+    e = analyze_equivalence(fit("wear", high), fit("area-rate", high))
+    assert e.verdict != "not equivalent" and e.p_a >= 0.025, e.explanation
