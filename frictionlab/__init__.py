@@ -9,8 +9,6 @@ matplotlib; ``import frictionlab as fl; fl.fit(...)`` works as if they were impo
 from __future__ import annotations
 
 import importlib
-import sys
-import types
 
 from .core import __version__  # noqa: F401
 
@@ -46,20 +44,6 @@ def __getattr__(name: str):
     value = getattr(importlib.import_module(f".{module}", __name__), name)
     globals()[name] = value  # later look-ups skip this function
     return value
-
-
-class _Package(types.ModuleType):
-    """The package's module type: an exported name that is also a submodule's name (``predict``) stays
-    the exported function when that submodule is imported (importing a submodule would otherwise
-    rebind the package attribute to it); the submodule itself is in ``sys.modules`` as always."""
-
-    def __setattr__(self, name, value):
-        if isinstance(value, types.ModuleType) and name in _EXPORTS and _EXPORTS[name] != name:
-            return
-        super().__setattr__(name, value)
-
-
-sys.modules[__name__].__class__ = _Package
 
 
 def __dir__():

@@ -157,7 +157,7 @@ def test_group_answer_states_exact_and_series_separately():
 
 def test_slow_pairs_are_left_out_with_the_reason():
     from frictionlab.inference.fitting import FitResult
-    from frictionlab.pipeline.comparison import _slow_pair
+    from frictionlab.pipeline.planning import slow_pair as _slow_pair
 
     ode = FitResult(law="wear", solver="ode", datasets=("x",), status="ok", cpu_time=2.5)
     exact = FitResult(law="coulomb", solver="exact", datasets=("x",), status="ok")

@@ -14,7 +14,7 @@ import pytest
 
 import frictionlab as fl
 from frictionlab.inference import fitting
-from frictionlab.pipeline import comparison
+from frictionlab.pipeline import comparison, stages
 from frictionlab.report import write_report
 
 #: Laws that pass the registry's probe (slips of at most 3 m/s) and break at the golf ball's 12 m/s.
@@ -106,7 +106,7 @@ def test_failing_fits_are_ranked_with_their_reason_and_the_comparison_completes(
 
 def test_a_fit_that_does_not_converge_is_recorded_and_the_comparison_completes(monkeypatch):
     # two evaluations are not enough for Levenberg-Marquardt from any start
-    monkeypatch.setattr(comparison, "fit", functools.partial(fitting.fit, max_nfev=2, scan=0))
+    monkeypatch.setattr(stages, "fit_one", functools.partial(fitting.fit, max_nfev=2, scan=0))
     c = comparison.compare(laws=["coulomb", "wear"], datasets=["incline-oil-a100"], solvers=["exact"],
                            equivalence=False, jobs=1)
     assert {f.law for f in c.fits} == {"coulomb", "wear"}

@@ -54,7 +54,7 @@ def add_parser(sub):
     p.add_argument("--no-transfer", dest="transfer", action="store_false",
                    help="skip predicting across the datasets of a group and the shared-parameter fits")
     p.add_argument("--bootstrap", type=int, default=BOOTSTRAP_N, metavar="N",
-                   help=f"case resamples per dataset for confidence intervals and first-place shares "
+                   help=f"parametric replicates per dataset for confidence intervals and first-place shares "
                         f"(default: {BOOTSTRAP_N}; 0: none)")
     p.add_argument("--seed", type=int, default=0,
                    help="seed of the bootstrap resamples and of the equivalence test's replicates (default: 0)")

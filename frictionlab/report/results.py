@@ -32,7 +32,7 @@ results.json:
              shared{}, separate{}, serves, alpha}], ranking[{candidate, chi2, n, rms_sigma, loglik, rank}], answer}],
     derivations{dataset: {method: {rms_vs_omega_column, omega_peak, omega_end, noisy_rms_vs_omega_column,
                                    noisy_omega_peak, noisy_omega_end, noisy_median_sigma}}},
-    timings_s{stage: wall-clock seconds} (fits, equivalence, transfer, tolerance, bootstrap),
+    timings_s{stage: wall-clock seconds} (fit, rank, equivalence, transfer, tolerance, bootstrap, answer: the stages run),
     bootstrap{n (0: not run), seed, method: parametric, level: 0.95, interval: percentile,
               first_place_interval: wilson, all (slow datasets included),
               datasets[{dataset, n_ranked,

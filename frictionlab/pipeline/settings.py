@@ -1,0 +1,82 @@
+"""What a comparison is asked to do: the laws, solvers and stage switches of ``compare``, checked once."""
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import attrs
+import numpy as np
+
+from ..core.errors import ParameterError
+from ..inference.equivalence import MIN_REPLICATES, PAIRS, REPLICATES
+from ..physics.registry import available_laws, get_law
+
+#: The laws ``compare`` fits by default: the four of the mission (the seed paper's question). Other
+#: registered laws (stribeck, lugre, dahl, rate-and-state, installed plugins) join when named or with "all".
+DEFAULT_LAWS = ("coulomb", "area-rate", "wear", "couette")
+
+
+def select_laws(laws: Sequence[str] | None) -> tuple[str, ...]:
+    """Law names to compare: None -> DEFAULT_LAWS; "all" (alone or in the list) -> every registered law."""
+    if laws is None:
+        names = DEFAULT_LAWS
+    elif isinstance(laws, str):
+        names = (laws,)
+    else:
+        names = tuple(laws)
+    if "all" in names:
+        names = tuple(available_laws()) + tuple(n for n in names if n != "all")
+    return tuple(dict.fromkeys(get_law(n).name for n in names))
+
+
+@attrs.frozen
+class Settings:
+    """The options of one comparison (see ``compare``), validated when made: SI, seconds, counts."""
+
+    laws: tuple[str, ...]
+    solvers: tuple[str, ...] | None = None
+    free: dict = attrs.field(factory=dict)  # scene quantity -> (lower, upper) in SI
+    equivalence: bool = True
+    jobs: int = 1
+    bootstrap: int = 0
+    seed: int = 0
+    bootstrap_all: bool = False
+    tolerance: tuple[float, ...] = ()
+    fit_timeout: float | None = None
+    replicates: int = REPLICATES
+    pairs: tuple = PAIRS
+    transfer: bool = True
+
+    def __attrs_post_init__(self):
+        from ..solve.solvers import parse_solver
+
+        for s in self.solvers or ():
+            if s != "auto":
+                parse_solver(s)  # an unknown solver is an input error, before any work
+        for name in ("bootstrap", "seed", "replicates"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
+                raise ParameterError(f"compare: {name} must be a non-negative integer, got {v!r}")
+        t = self.fit_timeout
+        if t is not None and (isinstance(t, bool) or not isinstance(t, (int, float)) or not 0 < t < float("inf")):
+            raise ParameterError(f"compare: fit_timeout must be a positive number of seconds, got {t!r}")
+        for r in self.tolerance:
+            if isinstance(r, bool) or not isinstance(r, (int, float)) or not 0 < r < 1:
+                raise ParameterError(f"compare: every tolerance must be a number in (0, 1), got {r!r}")
+
+    def check_replicates(self) -> None:
+        if self.equivalence and self.replicates < MIN_REPLICATES:
+            raise ParameterError(f"compare: replicates must be at least {MIN_REPLICATES}, got {self.replicates}")
+
+    def fit_options(self) -> dict:
+        """Options every refit of a stage shares: the freed scene quantities and the time budget."""
+        return ({"free": dict(self.free)} if self.free else {}) | (
+            {"timeout": self.fit_timeout} if self.fit_timeout else {})
+
+    def as_dict(self) -> dict:
+        """The settings as results.json records them."""
+        return {"solvers": list(self.solvers) if self.solvers else "default", "jobs": self.jobs,
+                "equivalence": self.equivalence, "free": {k: list(v) for k, v in self.free.items()},
+                "bootstrap": int(self.bootstrap), "seed": int(self.seed), "bootstrap_all": bool(self.bootstrap_all),
+                "tolerance": [float(r) for r in self.tolerance], "fit_timeout": self.fit_timeout,
+                "replicates": int(self.replicates), "pairs": [list(p) for p in self.pairs],
+                "transfer": bool(self.transfer)}

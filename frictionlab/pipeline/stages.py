@@ -1,0 +1,134 @@
+"""The named stages of ``compare``, in order: fit, rank, equivalence, transfer, tolerance, bootstrap,
+answer. Each reads the comparison so far and returns the fields of ``Comparison`` it fills.
+
+- fit: every planned (law, dataset, solver) fitted (``inference.fitting.fit``) -> ``fits``
+- rank: per dataset and per group (``inference.ranking``) -> ``ranking``, ``groups``
+- equivalence: the discrimination test per pair and dataset (``inference.equivalence``) -> ``equivalence``
+- transfer: one parameter set across a group's conditions (``inference.transfer``) -> ``transfer``
+- tolerance: the ODE laws of one dataset refitted at other tolerances (``inference.fitcost``) -> ``tolerance``
+- bootstrap: parametric replicates, intervals and first-place shares (``inference.bootstrap``) ->
+  ``bootstrap``, ``bootstrap_skipped``
+- answer: one verdict row per dataset group, the first screen (``inference.verdicts``) -> ``answers``
+"""
+from __future__ import annotations
+
+import functools
+
+from ..core.errors import FrictionLabError
+from ..inference import equivalence_groups as _equivalence
+from ..inference import transfer as _transfer
+from ..inference.answers import group_of
+from ..inference.bootstrap import bootstrap_fits
+from ..inference.equivalence import EquivalenceResult, analyze_equivalence
+from ..inference.fitcost import tolerance_check
+from ..inference.fitting import FitResult
+from ..inference.fitting import fit as fit_one
+from ..inference.ranking import family, rank_fits, rank_groups
+from ..inference.verdicts import make_answers, not_fitted_answers
+from .planning import pair_index, slow_pair
+from .runner import Run, Stage
+
+
+def fit(c, run: Run) -> dict:
+    timeout = run.settings.fit_timeout
+    results = run.map(functools.partial(_fit_task, timeout=timeout), run.plan.tasks,
+                      lambda t: f"{t[0]} [{t[2]}] on {t[1].name}")
+    order = {d.name: i for i, d in enumerate(c.datasets)}
+    fits = list(c.fits) + results
+    fits.sort(key=lambda f: (order[f.datasets[0]], c.laws.index(f.law), family(f.solver) == "series"))
+    if all(f.status == "skipped" for f in fits):
+        reasons = list(dict.fromkeys(f.reason for f in fits))
+        raise FrictionLabError("compare: no fit could be made: " + "; ".join(reasons[:3])
+                               + (f" (and {len(reasons) - 3} more reasons)" if len(reasons) > 3 else ""))
+    return {"fits": tuple(fits)}
+
+
+def _fit_task(args, timeout=None) -> FitResult:
+    law, dataset, solver, free = args
+    try:
+        return fit_one(law, dataset, solver=solver, free=free, timeout=timeout)
+    except FrictionLabError as exc:  # e.g. a freed scene quantity this scene does not have
+        return FitResult(law=law, solver=solver, datasets=(dataset.name,), status="skipped", reason=str(exc))
+
+
+def rank(c, run: Run) -> dict:
+    ranking = rank_fits(c.fits)
+    kinds = {d.name: d.kind for d in c.datasets}
+    groups = rank_groups(ranking, kinds, named={d.name: group_of(d) for d in c.datasets})
+    return {"ranking": tuple(ranking), "groups": tuple(groups)}
+
+
+def equivalence(c, run: Run) -> dict:
+    s = run.settings
+    lookup = {(f.datasets[0], f.law, f.solver): f for f in c.fits}
+    tasks, slow = [], []
+    for d, (la, sa), (lb, sb) in run.eq_pairs:
+        fa, fb = lookup[(d, la, sa)], lookup[(d, lb, sb)]
+        why = slow_pair(fa, fb, s.replicates) if not s.bootstrap_all else ""
+        if why:
+            slow.append(EquivalenceResult(dataset=d, law_a=la, law_b=lb, solver_a=sa, solver_b=sb,
+                                          status="skipped", reason=why, replicates=s.replicates, seed=s.seed))
+        else:
+            tasks.append((fa, fb, s.replicates, s.seed, s.fit_timeout))
+    results = run.map(_equivalence_task, tasks, lambda t: f"equivalence on {t[0].datasets[0]}: {t[0].law} "
+                                                          f"[{t[0].solver}] vs {t[1].law} [{t[1].solver}]")
+    run.done += len(slow)
+    order = {d.name: i for i, d in enumerate(c.datasets)}
+    key = lambda e: (order[e.dataset], pair_index(s.pairs, e), "series" in (e.solver_a, e.solver_b))  # noqa: E731
+    return {"equivalence": tuple(sorted(results + slow, key=key))}
+
+
+def _equivalence_task(args) -> EquivalenceResult:
+    fa, fb, replicates, seed, timeout = args
+    return analyze_equivalence(fa, fb, replicates=replicates, seed=seed, timeout=timeout)
+
+
+def transfer(c, run: Run) -> dict:
+    by_group = _transfer.candidates_by_group(c.fits, c.datasets)
+    tasks = [(g, cand, fs) for g, cands in by_group.items() for cand, fs in cands.items()]
+    free = dict(run.settings.free)
+    parts = run.map(_transfer_task, [(fs, free, run.settings.fit_timeout) for _, _, fs in tasks])
+    results = [_transfer.assemble(g, cands, {cand: p for (gg, cand, _), p in zip(tasks, parts) if gg == g})
+               for g, cands in by_group.items()]
+    return {"transfer": tuple(results + _transfer.skipped(c.datasets, fits=c.fits))}
+
+
+def _transfer_task(args):
+    fits, free, timeout = args
+    return _transfer.transfer_candidate(fits, free, timeout)
+
+
+def tolerance(c, run: Run) -> dict:
+    rows = tolerance_check(c.fits, tuple(run.settings.tolerance), run.pool,
+                           fit_options=run.settings.fit_options() or None)
+    run.step("tolerance check")
+    return {"tolerance": tuple(rows)}
+
+
+def bootstrap(c, run: Run) -> dict:
+    s = run.settings
+    boots, skipped = bootstrap_fits(
+        c.fits, s.bootstrap, s.seed, run.pool, s.bootstrap_all, s.free or None, timeout=s.fit_timeout,
+        progress=lambda name, k, n: run.step(f"bootstrap on {name}: {k}/{n} resamples", advance=k == n))
+    return {"bootstrap": tuple(boots), "bootstrap_skipped": skipped}
+
+
+def answer(c, run: Run) -> dict:
+    fitted = [d for d in c.datasets if d.name not in c.skipped_datasets]
+    answers = make_answers(fitted, c.fits, c.ranking, c.groups)
+    # the verdict layer's rows; the equivalence and transfer fields are filled by their producers
+    answers = _transfer.fill_answers(_equivalence.fill_answers(answers, c.equivalence), c.transfer)
+    not_applicable = {k: v for k, v in c.skipped_datasets.items() if k in run.plan.no_law}
+    return {"answers": answers + not_fitted_answers(c.datasets, not_applicable, fitted)}
+
+
+#: The pipeline, in order; ``compare(stages=[...])`` runs the ones named, ``run_stages`` continues a comparison.
+STAGES = (
+    Stage("fit", fit, lambda run: True),
+    Stage("rank", rank, lambda run: True),
+    Stage("equivalence", equivalence, lambda run: run.settings.equivalence and bool(run.eq_pairs)),
+    Stage("transfer", transfer, lambda run: run.settings.transfer),
+    Stage("tolerance", tolerance, lambda run: bool(run.settings.tolerance), beside=True),
+    Stage("bootstrap", bootstrap, lambda run: run.settings.bootstrap > 0),
+    Stage("answer", answer, lambda run: True),
+)
