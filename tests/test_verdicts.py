@@ -181,7 +181,7 @@ def test_a_derived_omega_fit_carries_no_chi_square_statistics():
 
 # --- 4. bootstrap ------------------------------------------------------------------------------
 def test_bootstrap_is_parametric_and_skips_noise_free_series():
-    from frictionlab.inference.bootstrap import bootstrap_fits
+    from frictionlab.inference.ranking_bootstrap import bootstrap_fits
 
     golf = [fit(law, "impact-golf-v28") for law in ("wear", "coulomb")]
     oil = [fit(law, "incline-oil-a100") for law in ("wear", "couette", "coulomb")]

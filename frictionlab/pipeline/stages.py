@@ -18,7 +18,7 @@ from ..core.errors import FrictionLabError
 from ..inference import equivalence_groups as _equivalence
 from ..inference import transfer as _transfer
 from ..inference.answers import group_of
-from ..inference.bootstrap import bootstrap_fits
+from ..inference.ranking_bootstrap import bootstrap_fits
 from ..inference.equivalence import EquivalenceResult, analyze_equivalence
 from ..inference.fitcost import tolerance_check
 from ..inference.fitting import FitResult

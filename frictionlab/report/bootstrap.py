@@ -4,7 +4,7 @@ from __future__ import annotations
 import math
 
 from ..core.display import fmt, interval_text, param_text
-from ..inference.bootstrap import parameter_table, ranking_table
+from ..inference.ranking_bootstrap import parameter_table, ranking_table
 from ..inference.ranking import TIE_AIC
 from .doc import Section
 from .summary import first_share

@@ -53,7 +53,7 @@ import math
 
 import numpy as np
 
-from ..inference.bootstrap import parameter_table, ranking_table
+from ..inference.ranking_bootstrap import parameter_table, ranking_table
 from ..inference.predict import FIT_RTOL
 from ..inference.ranking import COLUMNS, to_csv
 from ..io.dataset import COLUMN_SI
