@@ -106,7 +106,7 @@ def _show(args) -> int:
     values = ", ".join(sd(c, v) for c, v in d.noise.items() if d.noise_kind != "none")
     print(f"  noise:       {d.noise_kind}{': ' + values if values else ''} ({d.noise_note})")
     if d.stated:
-        from ..io.dataset import STATED
+        from ..io.noise import STATED
 
         print("  stated:      " + ", ".join(f"{k} = {quantity_text(v, STATED[k])} ± {quantity_text(p, STATED[k])}"
                                             for k, (v, p) in d.stated.items()))

@@ -135,7 +135,7 @@ def stated_numbers(tr, contact_time: float) -> dict[str, float]:
 def _predict_series(law, target, scene, params, solver, rtol=FIT_RTOL):
     from ..solve.solvers import simulate
 
-    if target.observable == "stated":  # a reconstruction's stated numbers (io.dataset.STATED)
+    if target.observable == "stated":  # a reconstruction's stated numbers (io.noise.STATED)
         tc = scene.area.contact_time
         tr = simulate(law, scene, params, solver=solver, t=np.linspace(0.0, tc, STATED_GRID), rtol=rtol)
         got = stated_numbers(tr, tc)

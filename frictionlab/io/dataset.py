@@ -24,19 +24,10 @@ from ..core.files import MAX_CSV_BYTES, check_name, read_bytes, read_text, read_
 from ..core.units import MAX_SI, check_text, check_time_scale, unit_factor
 from ..physics.scene import KINDS, Scene
 from ..solve.outcome import OUTCOMES, OutcomeScene
+from .noise import NOISE_KINDS, STATED, noise_table, stated_table  # noqa: F401 (NOISE_KINDS, STATED: read from here too)
 
 PROVENANCE_KINDS = ("measured", "reported", "reconstructed", "synthetic")
-#: What a dataset says about its noise: 'known' (sigma measured and declared: the likelihood uses it),
-#: 'estimated' (sigma estimated from the data alone, without any law: ``noise.py``; declared values,
-#: if any, are ignored) or 'none' (a noise-free reconstruction: the declared values are the stated
-#: precision of the numbers it was drawn through). No [noise] table means estimated; the old
-#: 'assumed' (a guessed sigma) is read as estimated: a guess is never used.
-NOISE_KINDS = ("known", "estimated", "none")
-NOISE_ALIASES = {"assumed": "estimated"}
 DATA_KINDS = KINDS + ("contact-area",)
-#: Numbers a paper states about an impact's spin, and their SI units: the peak spin, its time, the spin
-#: at the end of contact (t_c, the scene's contact time) and the largest rotation angle.
-STATED = {"omega_peak": "rad/s", "t_peak": "s", "omega_end": "rad/s", "theta_max": "rad"}
 
 #: SI unit of each well-known column; other columns must declare a unit of their own.
 COLUMN_SI = {
@@ -209,7 +200,8 @@ def from_meta(meta: dict, path: Path) -> Dataset:
         if col in columns and np.any(columns[col] < 0):
             raise DatasetError(f"{csv}: column '{col}' has negative values")
 
-    noise, noise_kind, noise_est, noise_note = _noise(meta, path, observable, columns)
+    noise, noise_kind, noise_est, noise_note = noise_table(_table(meta, "noise", path, "[noise]"), path, observable,
+                                                           columns, _si_of)
 
     provenance = _provenance(meta.get("provenance"), path)
     scene = None
@@ -263,73 +255,8 @@ def from_meta(meta: dict, path: Path) -> Dataset:
                    noise=noise, scene=scene, fixed=fixed, provenance=provenance,
                    description=meta.get("description", ""), reported=reported,
                    fixed_units=fixed_units, noise_kind=noise_kind, group=group,
-                   noise_df={k: e.df for k, e in noise_est.items()}, noise_est=noise_est, noise_note=noise_note, stated=_stated(meta, path, kind, noise_kind))
-
-
-def _stated(meta, path, kind, noise_kind) -> dict:
-    """[stated]: name -> (value, precision) in SI; only an impact's noise-free reconstruction has one."""
-    spec = _table(meta, "stated", path, "[stated]")
-    if spec and (kind != "impact" or noise_kind != "none"):
-        raise DatasetError(f"{path}: [stated] belongs to an impact reconstruction with [noise] kind = 'none'")
-    out = {}
-    for name, pair in spec.items():
-        if name not in STATED:
-            raise DatasetError(f"{path}: stated.{name} is not a stated number frictionlab can predict "
-                               f"({', '.join(STATED)})")
-        if not (isinstance(pair, list) and len(pair) == 2):
-            raise DatasetError(f"{path}: stated.{name} must be [\"value\", \"precision\"], e.g. [\"6700 rpm\", \"100 rpm\"]")
-        value, prec = (_quantity(x, STATED[name], f"{path}: stated.{name}") for x in pair)
-        if not prec > 0:
-            raise DatasetError(f"{path}: stated.{name}: the precision must be positive, got {pair[1]!r}")
-        out[name] = (value, prec)
-    return out
-
-
-def _noise(meta, path, observable, columns) -> tuple[dict, str, dict, str]:
-    """(sigma by column, kind, degrees of freedom by estimated column, note) from the [noise] table."""
-    from .noise import estimate
-
-    spec = dict(_table(meta, "noise", path, "[noise]"))
-    kind = spec.pop("kind", "estimated")
-    if not isinstance(kind, str):
-        raise DatasetError(f"{path}: noise.kind must be a string, one of {', '.join(NOISE_KINDS)}")
-    alias = NOISE_ALIASES.get(kind)
-    kind = alias or kind
-    if kind not in NOISE_KINDS:
-        raise DatasetError(f"{path}: noise.kind = {kind!r}, expected one of {', '.join(NOISE_KINDS)} "
-                           "(known: sigma measured; estimated: from the data; none: a noise-free reconstruction)")
-    declared = {}
-    for col, value in spec.items():
-        if col not in columns:
-            raise DatasetError(f"{path}: noise.{col} names no declared column")
-        declared[col] = _quantity(value, COLUMN_SI[col], f"{path}: noise.{col}")
-        if not declared[col] > 0:
-            raise DatasetError(f"{path}: noise.{col} must be positive, got {value!r}")
-    if kind == "none":
-        return declared, kind, {}, ("a noise-free reconstruction; laws are compared on the numbers it was "
-                                    "drawn through, at their stated precision ([stated]); the curve is for figures")
-    if kind == "known":
-        if observable not in declared:
-            raise DatasetError(f"{path}: [noise] kind = 'known' must give the measured sigma of the observable, "
-                               f"e.g. {observable} = '100 rpm'")
-        return declared, kind, {}, "declared sigma, measured (kind = known)"
-    noise, ests = {}, {}
-    for col in columns:
-        if col in ("t", "speed", "incidence"):
-            continue
-        est = estimate(columns, col)
-        if est is not None:
-            noise[col], ests[col] = est.sigma, est
-    if observable not in noise:
-        raise DatasetError(f"{path}: the noise of '{observable}' cannot be estimated from the data (too few "
-                           f"points, or no scatter): declare it, [noise] kind = 'known', {observable} = '...'")
-    method = {"GSJS": "Gasser-Sroka-Jennen-Steinmetz differences", "replicates": "the spread of replicates"}
-    how = method[ests[observable].method]
-    why = (f"[noise] kind = '{next(k for k, v in NOISE_ALIASES.items() if v == kind)}' is read as estimated: a "
-           "guessed sigma is never used" if alias else "no measured sigma declared")
-    ignored = f"; the declared {observable} sigma is ignored" if observable in declared else ""
-    note = f"estimated from the data by {how} ({ests[observable].df:.0f} effective degrees of freedom): {why}{ignored}"
-    return noise, kind, ests, note
+                   noise_df={k: e.df for k, e in noise_est.items()}, noise_est=noise_est, noise_note=noise_note,
+                   stated=stated_table(_table(meta, "stated", path, "[stated]"), path, kind, noise_kind, _quantity))
 
 
 def _check_time_unit(columns, units, spec, kind, scene, path) -> None:
@@ -380,6 +307,11 @@ def _check_outcome_rows(columns, observable, path, csv, scene) -> None:
 def _names(columns) -> str:
     """Column names for a one-line message (repr when a name holds odd characters)."""
     return ", ".join(c if c.isprintable() and "," not in c else repr(c) for c in columns)
+
+
+def _si_of(col, value, where):
+    """A declared noise value of column ``col`` in SI."""
+    return _quantity(value, COLUMN_SI[col], where)
 
 
 def _quantity(value, si, where):

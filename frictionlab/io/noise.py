@@ -25,7 +25,20 @@ import math
 import attrs
 import numpy as np
 
+from ..core.errors import DatasetError
+
 MIN_DF = 2.0  # fewer effective degrees of freedom give no usable estimate
+#: What a dataset says about its noise: 'known' (sigma measured and declared: the likelihood uses it),
+#: 'estimated' (sigma estimated from the data alone, without any law: ``noise.py``; declared values,
+#: if any, are ignored) or 'none' (a noise-free reconstruction: the declared values are the stated
+#: precision of the numbers it was drawn through). No [noise] table means estimated; the old
+#: 'assumed' (a guessed sigma) is read as estimated: a guess is never used.
+NOISE_KINDS = ("known", "estimated", "none")
+NOISE_ALIASES = {"assumed": "estimated"}
+#: Numbers a paper states about an impact's spin, and their SI units: the peak spin, its time, the spin
+#: at the end of contact (t_c, the scene's contact time) and the largest rotation angle.
+STATED = {"omega_peak": "rad/s", "t_peak": "s", "omega_end": "rad/s", "theta_max": "rad"}
+
 
 
 @attrs.frozen
@@ -143,3 +156,69 @@ def ratio_pvalue(est: NoiseEstimate, chisqr: float, J: np.ndarray, seed: int = 0
         E_res = E
     ratio = np.sum(E_res * E_res, axis=1) / est.variance(E)
     return (1.0 + float(np.sum(ratio >= chisqr))) / (DRAWS + 1.0)
+
+
+# --- the [noise] and [stated] tables of a dataset TOML ----------------------------------------------
+def stated_table(spec: dict, path, kind: str, noise_kind: str, quantity) -> dict:
+    """[stated] (``spec``): name -> (value, precision) in SI; only an impact's noise-free reconstruction has
+    one. quantity(text, si_unit, where) parses a quantity."""
+    if spec and (kind != "impact" or noise_kind != "none"):
+        raise DatasetError(f"{path}: [stated] belongs to an impact reconstruction with [noise] kind = 'none'")
+    out = {}
+    for name, pair in spec.items():
+        if name not in STATED:
+            raise DatasetError(f"{path}: stated.{name} is not a stated number frictionlab can predict "
+                               f"({', '.join(STATED)})")
+        if not (isinstance(pair, list) and len(pair) == 2):
+            raise DatasetError(f"{path}: stated.{name} must be [\"value\", \"precision\"], e.g. [\"6700 rpm\", \"100 rpm\"]")
+        value, prec = (quantity(x, STATED[name], f"{path}: stated.{name}") for x in pair)
+        if not prec > 0:
+            raise DatasetError(f"{path}: stated.{name}: the precision must be positive, got {pair[1]!r}")
+        out[name] = (value, prec)
+    return out
+
+
+def noise_table(spec: dict, path, observable: str, columns: dict, si_of) -> tuple[dict, str, dict, str]:
+    """(sigma by column, kind, NoiseEstimate by estimated column, note) from the [noise] table ``spec``;
+    si_of(column, text, where) parses a declared value into SI."""
+    spec = dict(spec)
+    kind = spec.pop("kind", "estimated")
+    if not isinstance(kind, str):
+        raise DatasetError(f"{path}: noise.kind must be a string, one of {', '.join(NOISE_KINDS)}")
+    alias = NOISE_ALIASES.get(kind)
+    kind = alias or kind
+    if kind not in NOISE_KINDS:
+        raise DatasetError(f"{path}: noise.kind = {kind!r}, expected one of {', '.join(NOISE_KINDS)} "
+                           "(known: sigma measured; estimated: from the data; none: a noise-free reconstruction)")
+    declared = {}
+    for col, value in spec.items():
+        if col not in columns:
+            raise DatasetError(f"{path}: noise.{col} names no declared column")
+        declared[col] = si_of(col, value, f"{path}: noise.{col}")
+        if not declared[col] > 0:
+            raise DatasetError(f"{path}: noise.{col} must be positive, got {value!r}")
+    if kind == "none":
+        return declared, kind, {}, ("a noise-free reconstruction; laws are compared on the numbers it was "
+                                    "drawn through, at their stated precision ([stated]); the curve is for figures")
+    if kind == "known":
+        if observable not in declared:
+            raise DatasetError(f"{path}: [noise] kind = 'known' must give the measured sigma of the observable, "
+                               f"e.g. {observable} = '100 rpm'")
+        return declared, kind, {}, "declared sigma, measured (kind = known)"
+    noise, ests = {}, {}
+    for col in columns:
+        if col in ("t", "speed", "incidence"):
+            continue
+        est = estimate(columns, col)
+        if est is not None:
+            noise[col], ests[col] = est.sigma, est
+    if observable not in noise:
+        raise DatasetError(f"{path}: the noise of '{observable}' cannot be estimated from the data (too few "
+                           f"points, or no scatter): declare it, [noise] kind = 'known', {observable} = '...'")
+    method = {"GSJS": "Gasser-Sroka-Jennen-Steinmetz differences", "replicates": "the spread of replicates"}
+    how = method[ests[observable].method]
+    why = (f"[noise] kind = '{next(k for k, v in NOISE_ALIASES.items() if v == kind)}' is read as estimated: a "
+           "guessed sigma is never used" if alias else "no measured sigma declared")
+    ignored = f"; the declared {observable} sigma is ignored" if observable in declared else ""
+    note = f"estimated from the data by {how} ({ests[observable].df:.0f} effective degrees of freedom): {why}{ignored}"
+    return noise, kind, ests, note
