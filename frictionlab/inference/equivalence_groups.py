@@ -75,7 +75,8 @@ def _threshold_short(es) -> str:
 
 def _num2(x: float) -> str:
     """Two significant figures (whole numbers from 100 on): 1.8, 0.27, 150, 1,200."""
-    return f"{float(f'{x:.2g}'):,.0f}" if abs(x) >= 100 else f"{x:.2g}"
+    r = float(f"{x:.2g}")
+    return f"{r:,.0f}" if abs(r) >= 100 else f"{r:g}"
 
 
 def group_answer(results, datasets, pair: tuple[str, str] = PAIRS[0]) -> dict:
