@@ -128,3 +128,14 @@ def test_the_papers_pair_on_known_truth_rejects_the_false_law_and_keeps_the_true
     high = _impact("wear", 4 * thr, 8, estimated)
     e = analyze_equivalence(fit("wear", high), fit("area-rate", high))
     assert e.verdict != "not equivalent" and e.p_a >= 0.025, e.explanation
+
+
+def test_golf_answer_states_the_quantitative_and_the_qualitative_verdict_from_the_stated_numbers():
+    c = fl.compare(laws=["wear", "area-rate"], datasets=["impact-golf-v28"], transfer=False, bootstrap=0)
+    (a,) = c.answers
+    assert a.short["equivalence"].startswith("not equivalent (exact and series); qualitatively different")
+    assert "peak" in a.short["qualitative"] and "Qualitatively" in a.noise_threshold
+    e = next(e for e in c.equivalence if e.solver_a == "exact" and e.law_b == "area-rate")
+    assert e.observable == "stated" and e.n_points == 4  # four stated numbers, not 51 curve points
+    assert e.qualitative["features"]["data"]["t_peak"] == pytest.approx(260e-6)
+    assert e.qualitative["features"]["wear"]["peak"] is False  # the exact wear spin has no peak before t_c

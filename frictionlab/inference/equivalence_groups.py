@@ -106,6 +106,9 @@ def group_answer(results, datasets, pair: tuple[str, str] = PAIRS[0]) -> dict:
             for e in mine if e.ok and e.qualitative.get("verdict") not in (None, "not applicable")}
     if qual:
         short["qualitative"] = "; ".join(f"{k}: {v}" for k, v in qual.items())
+        kinds = {v.split(" (")[0] for v in qual.values()}
+        short["equivalence"] += "; " + (kinds.pop() if len(kinds) == 1 else "qualitatively equivalent on some, not all")
+        text = f"Qualitatively (do the fitted curves share the data's features?): {short['qualitative']}. " + text
     notes = [f"{how}: {n}" for n, how in ((n_full, "exact"), (n_series, "series")) if n]
     if notes:
         short["equivalence"] += " — " + "; ".join(notes)
