@@ -83,16 +83,19 @@ def test_fit_test_with_estimated_sigma_holds_its_level():
     assert f_rej <= exact
 
 
-def test_group_totals_add_log_likelihoods_and_use_the_group_n_and_k():
-    def row(ds, aic_ll, k, n):
-        return RankRow(ds, "a", "exact", n, k, 1.0, 1.0, 1.0, aic_ll + 2 * k, math.nan, math.nan, likelihood="known",
-                       neg2loglik=aic_ll, k_lik=k)
+def test_group_totals_are_sums_over_the_separately_fitted_members():
+    def row(ds, ll, k, n):
+        aic = ll + 2 * k
+        return RankRow(ds, "a", "exact", n, k, 1.0, 1.0, 1.0, aic, aic + 2 * k * (k + 1) / (n - k - 1),
+                       ll + k * math.log(n), likelihood="known", neg2loglik=ll, k_lik=k)
 
     rows = _rank([row("d1", 10.0, 1, 20)], 0.01) + _rank([row("d2", -4.0, 2, 30)], 0.01)
     g = next(r for r in rank_groups(rows) if r.dataset == "ALL")
     assert g.aic == pytest.approx(6.0 + 2 * 3)
-    assert g.aicc == pytest.approx(12.0 + 2 * 3 * 4 / (50 - 3 - 1))
-    assert g.bic == pytest.approx(6.0 + 3 * math.log(50))
+    # separate fits: AICc and BIC are sums over the members, each with its own n and k (not the pooled n, k)
+    assert g.aicc == pytest.approx((12.0 + 2 * 1 * 2 / 18) + (0.0 + 2 * 2 * 3 / 27))
+    assert g.bic == pytest.approx((10.0 + math.log(20)) + (-4.0 + 2 * math.log(30)))
+    assert g.bic != pytest.approx(6.0 + 3 * math.log(50))
 
 
 def test_builtin_datasets_declare_their_noise():
