@@ -283,7 +283,7 @@ def _per_dataset(model, values, models, k_each, J=None) -> list[DatasetFit]:
                 chi_p = ratio_pvalue(est, float(z @ z), J[start:start + z.size])
         start += z.size
         per.append(DatasetFit(tg, solver_i, p, scene, m, float(r @ r), float(np.sqrt(np.mean(r**2))),
-                              float(z @ z), goodness(z, k, kind, est.df if est else math.inf, chi_p)))
+                              float(np.sum(z**2)), goodness(z, k, kind, est.df if est else math.inf, chi_p)))
     return per
 
 
