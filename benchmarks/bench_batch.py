@@ -28,6 +28,8 @@ them far less than wall time. Scene families (random, seeded):
    largest size per family (see ``scaling``). Targets: per-scene cost flat within 1.2x from 1k to
    100k scenes; peak <= 2x the results.
 4. The share of the numpy engine's batch time spent filling outputs from the dense interpolant.
+0. Cold start (first, in fresh processes): import, the first batch (the compiled kernel loaded from numba's
+   cache, or compiled with an empty cache) and a warm 10k-scene batch, so one-off costs sit beside the ratios.
 """
 from __future__ import annotations
 
@@ -120,9 +122,10 @@ def bare_coulomb(batch, mu):
 
 
 def bare_wear(batch, lam):
-    """Wear law on a half-sine area: eq (6) and its Bessel-series integral, inline numpy, with the
-    same sums as the library (every weight in one ive call, sin(k x) by the recurrence
-    sin((k+1)x) = 2 cos(x) sin(kx) - sin((k-1)x), stopping at the first negligible term)."""
+    """Wear law on a half-sine area: eq (6) and its Bessel-series integral, inline numpy as a careful user
+    writes it: every weight in one ive call, sin(k x) by the recurrence sin((k+1)x) = 2 cos(x) sin(kx) -
+    sin((k-1)x), stopping at the first negligible term, and every grid-sized product written in place
+    (three work arrays, no temporaries in the loop)."""
     v = batch.values
     u0, A0, tc = v["u0"][:, None], v["area.peak"][:, None], v["area.contact_time"][:, None]
     lam = lam[:, None]
@@ -131,22 +134,36 @@ def bare_wear(batch, lam):
     phi = np.pi / tc
     b = lam * A0 / (M * phi)
     x = phi * t
-    u = u0 * np.exp(b * np.cos(x) - b)
+    cos_x = np.cos(x)
+    u = cos_x - 1.0
+    u *= b
+    np.exp(u, out=u)
+    u *= u0
     kmax = int(math.ceil(math.sqrt(2.0 * max(float(b.max()), 1.0) * 45.0))) + 20
     k = np.arange(kmax + 1, dtype=float)[:, None, None]
     w = ive(k, b)
     small = (2.0 * w[1:] <= 1e-17 * k[1:] * w[0]).reshape(kmax, -1).all(axis=1)
     last = int(np.argmax(small)) + 1 if small.any() else kmax
+    coef = 2.0 * w[1:] / (k[1:] * phi)
     integral = w[0] * t
-    two_cos = 2.0 * np.cos(x)
-    s_prev, s_k = np.zeros_like(x), np.sin(x)
+    two_cos = np.multiply(cos_x, 2.0, out=cos_x)
+    s_prev, s_k, tmp = np.zeros_like(x), np.sin(x), np.empty_like(x)
     for j in range(last):
-        integral = integral + 2.0 * w[j + 1] / ((j + 1) * phi) * s_k
-        s_prev, s_k = s_k, two_cos * s_k - s_prev
+        np.multiply(coef[j], s_k, out=tmp)
+        integral += tmp
+        if j + 1 < last:  # s_prev becomes sin((k+1)x), in place
+            np.multiply(two_cos, s_k, out=tmp)
+            np.subtract(tmp, s_prev, out=s_prev)
+            s_prev, s_k = s_k, s_prev
     J = M * (u0 - u)
     omega = R * J / I
-    theta = R * M * (u0 * t - u0 * integral) / I
-    F = lam * A0 * np.sin(x) * u
+    integral *= -u0
+    integral += u0 * t
+    theta = integral
+    theta *= R * M / I
+    F = np.sin(x, out=x)
+    F *= lam * A0
+    F *= u
     return u, u.copy(), omega, theta, F
 
 
@@ -239,6 +256,62 @@ def warm_jit(args):
           f"call {time.perf_counter() - t0:.2f} s wall, {clock() - c0:.2f} s CPU (kernel cache hits "
           f"{sum(st.cache_hits.values())}, "
           f"misses {sum(st.cache_misses.values())}), not in any timing below")
+
+
+COLD = """
+import json, sys, time
+w0, c0 = time.perf_counter(), time.process_time()
+import numpy as np
+from frictionlab.solve import compiled
+from frictionlab.solve.batch import simulate_batch
+sys.path.insert(0, {bench!r})
+from bench_batch import coulomb_family
+if {numpy_only}:
+    compiled.available = lambda: False
+b, p = coulomb_family(2, np.random.default_rng(0))
+w1, c1 = time.perf_counter(), time.process_time()
+r = simulate_batch("coulomb", b, p, solver="DOP853", n=101)
+w2, c2 = time.perf_counter(), time.process_time()
+b, p = coulomb_family(10_000, np.random.default_rng(1))
+simulate_batch("coulomb", b, p, solver="DOP853", n=101)
+w3, c3 = time.perf_counter(), time.process_time()
+print(json.dumps({{"import": [w1 - w0, c1 - c0], "first": [w2 - w1, c2 - c1], "batch10k": [w3 - w2, c3 - c2],
+                  "engine": r.info.get("engine")}}))
+"""
+
+
+def cold_start(args):
+    """What a fresh process pays before its first batch: importing, then the first (2-scene) batch, which
+    with numba loads the compiled kernel from numba's cache (or compiles it, with an empty cache), beside a
+    warm 10k-scene batch in the same process; numpy engine alone for comparison. Wall and CPU seconds."""
+    import json
+    import subprocess
+    import sys
+    import tempfile
+
+    bench = os.path.dirname(os.path.abspath(__file__))
+    runs = [("numpy engine (no numba import)", True, None)]
+    if args.numba and compiled.available():
+        runs += [("compiled, kernel from numba's cache", False, None),
+                 ("compiled, empty cache (compiles)", False, "fresh")]
+    print("\n[cold start] a fresh process: import, first batch (2 Coulomb scenes), then one warm 10k-scene batch")
+    for label, numpy_only, cache in runs:
+        env = dict(os.environ)
+        with tempfile.TemporaryDirectory() as tmp:
+            if cache:
+                env["NUMBA_CACHE_DIR"] = tmp
+            code = COLD.format(bench=bench, numpy_only=numpy_only)
+            subprocess.run([sys.executable, "-c", code], env=env, capture_output=True)  # a first run fills the cache
+            if cache:  # ...except where the compile itself is measured
+                env["NUMBA_CACHE_DIR"] = tempfile.mkdtemp(dir=tmp)
+            out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+        if out.returncode:
+            print(f"  {label}: failed: {out.stderr.strip().splitlines()[-1:]}")
+            continue
+        r = json.loads(out.stdout.strip().splitlines()[-1])
+        print(f"  {label:38s} import {r['import'][0]:.2f} s wall ({r['import'][1]:.2f} CPU); first batch "
+              f"{r['first'][0]:.2f} s wall ({r['first'][1]:.2f} CPU); then 10k scenes {r['batch10k'][0]:.2f} s wall "
+              f"({r['batch10k'][1]:.2f} CPU; {r['engine']} engine)")
 
 
 def rk_vs_plain(name, law, batch, params, args, rng):
@@ -423,11 +496,11 @@ def dense_share(args, rng):
     """How much of the batch's time goes to filling outputs from the dense interpolant."""
     from frictionlab.solve import vecrk
 
-    print(f"\n[dense output] numpy engine: share of batch DOP853 time in vecrk._dense and vecrk._fill_dense, "
+    print(f"\n[dense output] numpy engine: share of batch DOP853 time in vecrk.dense_output and vecrk.fill_dense, "
           f"{args.n} scenes x {NT}")
     for fam, law in ((coulomb_family, "coulomb"), (wear_family, "wear")):
         b, p = fam(args.n, rng)
-        spent = {"_dense": 0.0, "_fill_dense": 0.0}
+        spent = {"dense_output": 0.0, "fill_dense": 0.0}
         orig = {k: getattr(vecrk, k) for k in spent}
 
         def timed(k):
@@ -447,8 +520,8 @@ def dense_share(args, rng):
         finally:
             for k, f in orig.items():
                 setattr(vecrk, k, f)
-        print(f"  {law:8s}: {t:.3f} s, interpolant {spent['_dense'] / t:.0%}, filling outputs "
-              f"{spent['_fill_dense'] / t:.0%}")
+        print(f"  {law:8s}: {t:.3f} s, interpolant {spent['dense_output'] / t:.0%}, filling outputs "
+              f"{spent['fill_dense'] / t:.0%}")
 
 
 def main(argv=None):
@@ -467,6 +540,7 @@ def main(argv=None):
           f"{', '.join(f'{x:.1f}' for x in os.getloadavg())} on {os.cpu_count()} cores")
     print(f"n = {args.n} scenes per family, loop timed on {args.sample}, rtol = {args.rtol:g}, "
           f"median of {args.repeats} repeats, seed {args.seed}")
+    cold_start(args)
     warm_jit(args)
     cb, cp = coulomb_family(args.n, rng)
     wb, wp = wear_family(args.n, rng)

@@ -6,7 +6,7 @@ Each fit runs in this process after the imports (``fit("area-rate", [dataset])``
 defaults); prints its CPU seconds (process time around the call, and the fit's own ``cpu_time``), its
 number of model evaluations, status and fitted values with standard errors (None: not determined).
 With eta' > 0 most rolling impacts stick, break away and slide again before the contact ends; the
-batch engine's closed forms finish those phases vectorized (``batch._exact_phases``).
+batch engine's closed forms finish those phases vectorized (``batchexact.exact_phases``).
 """
 import sys
 import time

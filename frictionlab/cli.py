@@ -101,15 +101,28 @@ def load_file(path: str) -> None:
 
 
 def main(argv=None) -> int:
+    """Run the command line ``argv``; the exit status: 0 done, 2 bad input or a refused output, 1 a bug,
+    130/143/129 interrupted, terminated or hung up, 141 the reader of the output went away."""
+    from .core.terminal import guarded_streams
+
     argv = sys.argv[1:] if argv is None else list(argv)
+    with guarded_streams() as (out, err):  # all output inert and encodable; a failing stream named
+        rc = _main(argv)
+        out.flush()
+        if out.failure is not None and rc != 141:
+            print(f"frictionlab: error: cannot write to {out.name}: {out.failure.strerror or out.failure} "
+                  "(files the run wrote are complete)", file=sys.stderr)
+            rc = rc or 2
+        return rc
+
+
+def _main(argv: list[str]) -> int:
     try:
         parser = build_parser()
     except Exception as exc:  # a command module that fails to import
         if "--debug" in argv:
             raise
-        print(f"frictionlab: internal error: {type(exc).__name__}: {one_line(exc)} "
-              "(rerun with --debug for the traceback)", file=sys.stderr)
-        return 1
+        return _say(f"internal error: {type(exc).__name__}: {one_line(exc)} (rerun with --debug for the traceback)", 1)
     try:
         args = parser.parse_args(argv)
     except SystemExit as exc:  # argparse already printed its one-line usage error
@@ -120,10 +133,22 @@ def main(argv=None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    return _run(args)
+
+
+def _say(message: str, status: int) -> int:
+    print(f"frictionlab: {message}", file=sys.stderr)
+    return status
+
+
+def _run(args) -> int:
+    """Run the parsed command; every way it can end becomes one line on stderr and an exit status."""
+    from .core.inputs import inputs_of_run
+
     formatwarning = warnings.formatwarning
-    sigterm = _terminate_cleanly()
+    restore = _signals_end_cleanly()
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), inputs_of_run():  # outputs keep clear of every file the run reads
             warnings.simplefilter("default")
             warnings.formatwarning = lambda m, c, *a, **k: f"warning: {one_line(m)}\n"
             for path in args.load:
@@ -132,53 +157,87 @@ def main(argv=None) -> int:
     except FrictionLabError as exc:
         if args.debug:
             raise
-        print(f"frictionlab: error: {one_line(exc)}", file=sys.stderr)
-        return 2
+        return _say(f"error: {one_line(exc)}", 2)
     except BrokenPipeError:  # the reader of our output went away (| head): stop quietly, as cat does
-        try:
-            import os
-
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        except (OSError, ValueError):
-            pass
+        _silence_stdout()
         return 141
     except OSError as exc:  # the file system refused (permissions, a full disk): the user's to fix
         if args.debug:
             raise
         where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
-        print(f"frictionlab: error: {where}{one_line(exc.strerror or exc)}", file=sys.stderr)
-        return 2
+        return _say(f"error: {where}{one_line(exc.strerror or exc)}", 2)
     except KeyboardInterrupt:
-        print("frictionlab: interrupted", file=sys.stderr)
-        return 130
-    except Terminated:
-        print("frictionlab: terminated", file=sys.stderr)
-        return 143
+        return _say("interrupted", 130)
+    except Terminated as exc:
+        return _say(exc.word(), 128 + exc.signum)
     except Exception as exc:  # a bug, not bad input: say so in one line, exit 1
         if args.debug:
             raise
-        print(f"frictionlab: internal error: {type(exc).__name__}: {one_line(exc)} "
-              "(a bug in frictionlab or a plugin; rerun with --debug for the traceback)", file=sys.stderr)
-        return 1
+        return _say(f"internal error: {type(exc).__name__}: {one_line(exc)} "
+                    "(a bug in frictionlab or a plugin; rerun with --debug for the traceback)", 1)
     finally:
         warnings.formatwarning = formatwarning
-        sigterm()
+        restore()
 
 
-def _terminate_cleanly():
-    """Make SIGTERM an exception (errors.Terminated) while a command runs, so that clean-up runs:
-    workers stopped, temporary output removed, locks released. Returns the function that undoes it."""
+def _silence_stdout() -> None:
+    try:
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
+def _signals_end_cleanly():
+    """Make SIGTERM and SIGHUP an exception (errors.Terminated) while a command runs, so that clean-up
+    runs: workers stopped, temporary output removed, locks released. Returns the function that undoes it."""
     import signal
     import threading
 
     if threading.current_thread() is not threading.main_thread():
         return lambda: None
 
-    def on_sigterm(signum, frame):
+    def on_signal(signum, frame):
+        if not caught:  # a plugin's bare except: may swallow the exception: then end anyway, cleanly
+            timer = threading.Timer(HARD_EXIT_AFTER, _hard_exit, (signum,))
+            timer.daemon = True
+            timer.start()
+            caught.append(timer)
+        else:
+            _hard_exit(signum)
         raise Terminated(signum)
 
-    old = signal.signal(signal.SIGTERM, on_sigterm)
-    return lambda: signal.signal(signal.SIGTERM, old)
+    caught = []
+    sigs = [s for s in (getattr(signal, "SIGTERM", None), getattr(signal, "SIGHUP", None)) if s is not None]
+    old = {s: signal.signal(s, on_signal) for s in sigs}
+
+    def restore():
+        for t in caught:
+            t.cancel()
+        for s, h in old.items():
+            signal.signal(s, h)
+    return restore
+
+
+#: Seconds after SIGTERM or SIGHUP before the process ends even if the exception raised was swallowed.
+HARD_EXIT_AFTER = 3.0
+
+
+def _hard_exit(signum: int) -> None:
+    """End now: temporary output and locks removed, one line said; workers end with us (PDEATHSIG)."""
+    import os
+
+    from .core.errors import Terminated
+    from .core.files import remove_leftovers
+
+    remove_leftovers()
+    try:
+        sys.stderr.write(f"frictionlab: {Terminated(signum).word()}\n")
+        sys.stderr.flush()
+    except Exception:  # noqa: BLE001 (nothing more can be said)
+        pass
+    os._exit(128 + int(signum))
 
 
 if __name__ == "__main__":  # pragma: no cover

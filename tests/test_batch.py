@@ -222,7 +222,7 @@ def test_errors_are_one_line():
 def test_sweep_in_chunks_on_an_executor_equals_one_call():
     from concurrent.futures import ThreadPoolExecutor
 
-    from frictionlab.solve.batch import simulate_sweep
+    from frictionlab.solve.sweep import simulate_sweep
 
     rng = np.random.default_rng(3)
     batch = SceneBatch.sweep(oblique(40.0, 0.5), {"u0": rng.uniform(2, 30, 11)})

@@ -81,7 +81,9 @@ def test_failed_run_leaves_no_folder(tiny, tmp_path, monkeypatch):
     def boom(*a, **k):
         raise bench.FrictionLabError("disk full")
 
-    monkeypatch.setattr(bench, "plot_case", boom)
+    from frictionlab.pipeline import benchplot
+
+    monkeypatch.setattr(benchplot, "plot_case", boom)
     assert main(["bench", "--out", str(out), "--quick", "--no-fits"]) == 2
     assert not out.exists() and not list(tmp_path.iterdir())
 

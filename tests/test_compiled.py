@@ -223,7 +223,7 @@ def test_refused_where_not_served(monkeypatch):
 
 def test_per_scene_time_grids_are_the_same(monkeypatch):
     """Output times given per scene (not a multiple of one grid) and one shared grid: the kernel takes them as
-    batch._scaled_grid does."""
+    batchrk.scaled_grid does."""
     rng = np.random.default_rng(9)
     sc = oblique(rng, 12)
     p = {"mu": rng.uniform(0.1, 0.5, 12)}

@@ -24,7 +24,8 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from ..pipeline.bench import run_bench, write_bench
+    from ..pipeline.bench import run_bench
+    from ..pipeline.benchplot import write_bench
 
     _check_out(args)
     import datetime as _dt

@@ -46,6 +46,10 @@ def add_parser(sub):
     p.add_argument("--force", action="store_true", help="replace an existing report folder")
     p.add_argument("--jobs", type=int, default=min(os.cpu_count() or 1, 4),
                    help="worker processes (default: number of CPUs, at most 4)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run the fits, refits, tests, bootstrap and figures on the Dask cluster whose scheduler is "
+                        "at ADDRESS (e.g. tcp://10.0.0.5:8786; needs pip install 'frictionlab[dask]'); --jobs is "
+                        "then unused")
     p.add_argument("--no-equivalence", action="store_true", help="skip the equivalence (discrimination) tests")
     p.add_argument("--replicates", type=int, default=REPLICATES, metavar="R",
                    help=f"the most replicate datasets per law in the equivalence test's sequential parametric bootstrap "
@@ -71,10 +75,8 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from ..core.files import check_target, output_lock
-    from ..core.workers import long_run_gc
-    from ..pipeline.comparison import compare
-    from ..report import write_report
+    from ..core.cluster import connect
+    from ..io.dataset import builtin_names, load_dataset
     from .fit import parse_free
 
     parent = args.out.parent if str(args.out.parent) else Path(".")
@@ -92,16 +94,31 @@ def run(args) -> int:
     if args.replicates < MIN_REPLICATES:
         raise ParameterError(f"--replicates must be at least {MIN_REPLICATES}, got {args.replicates}")
     free = parse_free(args.free)
+    datasets = [load_dataset(d) for d in args.data or builtin_names()]  # read first: --out keeps clear of them
+    client = connect(args.scheduler) if args.scheduler else None
+    try:
+        return _run(args, free, datasets, client)
+    finally:
+        if client is not None:
+            client.close()
+
+
+def _run(args, free, datasets, client) -> int:
+    from ..core.files import check_target, output_lock
+    from ..core.workers import long_run_gc
+    from ..pipeline.comparison import compare
+    from ..report import write_report
+
     with output_lock(args.out), long_run_gc():  # a second run to the same --out fails now, not after the work
         check_target(args.out, args.force)
         with Progress("compare", quiet=args.quiet) as bar:
-            result = compare(laws=args.laws or None, datasets=args.data or None, solvers=args.solver or None,
+            result = compare(laws=args.laws or None, datasets=datasets, solvers=args.solver or None,
                              free=free, equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar,
                              bootstrap=args.bootstrap, seed=args.seed, bootstrap_all=args.bootstrap_all,
                              tolerance=TOLERANCE_RTOLS if args.tolerance else (), fit_timeout=args.fit_timeout,
-                             replicates=args.replicates, transfer=args.transfer)
+                             replicates=args.replicates, transfer=args.transfer, client=client)
         with Progress("report", quiet=args.quiet) as bar:
-            out = write_report(result, args.out, force=args.force, progress=bar, jobs=args.jobs)
+            out = write_report(result, args.out, force=args.force, progress=bar, jobs=args.jobs, client=client)
     ok = sum(f.ok for f in result.fits)
     n_laws, n_data = len(result.laws), len(result.fitted_datasets)
     print(f"compared {n_laws} law{'s' * (n_laws != 1)} on {n_data} dataset{'s' * (n_data != 1)}: {ok} fits, "

@@ -141,8 +141,10 @@ def _to_file_unit(d, column: str) -> float:
 def _template(args) -> int:
     from ..core.errors import OutputError
     from ..core.files import atomic_write_text
+    from ..core.names import check_name
     from ..io.template import template
 
+    check_name(args.name, "datasets template --name", OutputError)  # before any path is made of it
     if not args.out.is_dir():
         raise OutputError(f"{args.out}: folder does not exist")
     toml_path, csv_path = args.out / f"{args.name}.toml", args.out / f"{args.name}.csv"

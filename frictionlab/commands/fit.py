@@ -98,15 +98,23 @@ def parse_fix(law, items) -> dict:
 
 
 def run(args) -> int:
-    from ..inference.fitting import fit
+    from ..core.inputs import check_apart
+    from ..core.workers import process_pool
+    from ..io.dataset import load_dataset
+    from ..pipeline.budget import fit_within_budget
     from ..physics.registry import get_law
     from ..report import fit_json as _fit_json
 
     law = get_law(args.law)
     if args.json and not args.json.parent.is_dir():  # before the work, not after
         raise OutputError(f"{args.json}: cannot write: folder {args.json.parent} does not exist")
-    result = fit(law, args.datasets, solver=args.solver, free=parse_free(args.free), fixed=parse_fix(law, args.fix),
-                 local=args.local, observable=args.observable, derive=args.derive, timeout=args.fit_timeout)
+    datasets = [load_dataset(d) for d in args.datasets]
+    if args.json:
+        check_apart(args.json)  # never over a file the fit reads
+    options = dict(solver=args.solver, free=parse_free(args.free), fixed=parse_fix(law, args.fix), local=args.local,
+                   observable=args.observable, derive=args.derive, timeout=args.fit_timeout)
+    with process_pool(1, "fit"):  # no pool: a lost fitting process becomes one line naming the stage
+        result = fit_within_budget(law, datasets, **options)
     if result.status == "skipped":  # asked for explicitly, an inapplicable solver is an error, not a skip
         raise SolverError(result.reason)
     print(result.summary())

@@ -9,9 +9,10 @@ simulation and figure succeeded, so a failed run writes nothing.
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
-from ..core.errors import ParameterError, SolverError
+from ..core.errors import OutputError, ParameterError, SolverError
 
 RPM = 60.0 / (2.0 * math.pi)
 PLOT_POINTS = 501
@@ -72,6 +73,8 @@ def run(args) -> int:
     for path in (args.out, args.plot):
         if path is not None:
             check_writable(path)
+    if args.out is not None and args.plot is not None and os.path.realpath(args.out) == os.path.realpath(args.plot):
+        raise OutputError(f"{args.out}: --out and --plot name the same file; give two paths")
     if ds.kind == "impact-outcome":
         text, summary, figure = _outcomes(law, ds, params, args)
     else:

@@ -20,6 +20,18 @@ NAMES = {"omega": "spin omega", "theta": "rotation angle theta", "v": "velocity 
          "mu": "friction coefficient mu (spring force / N)"}
 
 
+def pyplot():
+    """matplotlib.pyplot drawing off screen (Agg), with mathtext off: a label is shown as written,
+    so a name or description holding '$' (a plugin named 'cost$\\frac$law') cannot be parsed as TeX."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=True)
+    matplotlib.rcParams["text.parse_math"] = False
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
 def unit(name: str) -> tuple[str, float]:
     """(display unit, factor) for an observable or series name; SI with factor 1 if unknown."""
     return OBSERVABLE_UNITS.get(name, ("SI", 1.0))

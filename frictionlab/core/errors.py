@@ -42,5 +42,13 @@ class OutputError(FrictionLabError):
 
 
 class Terminated(BaseException):
-    """The process received SIGTERM (raised by the handler frictionlab installs while it runs, so that
-    clean-up code runs: worker processes stopped, temporary output removed, locks released)."""
+    """The process received SIGTERM or SIGHUP (raised by the handler frictionlab installs while it runs,
+    so that clean-up code runs: worker processes stopped, temporary output removed, locks released)."""
+
+    @property
+    def signum(self) -> int:
+        return int(self.args[0]) if self.args and isinstance(self.args[0], int) else 15
+
+    def word(self) -> str:
+        """'terminated' (SIGTERM) or 'hung up' (SIGHUP)."""
+        return "hung up" if self.signum == 1 else "terminated"

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import errno
 import os
-import re
 import shutil
 import stat
 import tempfile
@@ -31,16 +30,13 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from .errors import DatasetError, OutputError
+from .inputs import check_apart, note_input
 
 MAX_TOML_BYTES = 1 << 20  # 1 MiB: a dataset's sidecar is a few kB
 MAX_CSV_BYTES = 256 << 20  # 256 MiB
 MAX_TOML_DEPTH = 16
 #: File that marks a folder written by frictionlab (a report, a bench report, rebuilt datasets).
 MARKER = ".frictionlab-output"
-#: A name that becomes a file name (a dataset's name): a letter or digit, then letters, digits
-#: and . _ + -, at most MAX_NAME characters.
-MAX_NAME = 100
-_SLUG = re.compile(r"[A-Za-z0-9][A-Za-z0-9._+-]*")
 
 
 # --- reading --------------------------------------------------------------------------------
@@ -56,6 +52,7 @@ def read_bytes(path, limit: int, within=None, error=DatasetError) -> bytes:
     """The bytes of the regular file ``path``, at most ``limit`` of them; ``within``: a folder the
     file's real path must lie in. Raises ``error`` with a one-line message naming the path."""
     path = Path(path)
+    note_input(path)
     if within is not None:
         real, base = os.path.realpath(path), os.path.realpath(within)
         if os.path.commonpath([real, base]) != base:
@@ -148,17 +145,6 @@ def read_toml(path, error=DatasetError) -> dict:
         raise error(f"{path}: TOML nests too deeply to parse") from None
 
 
-def check_name(name: str, where: str) -> str:
-    """``name`` if it can become part of a file name (see _SLUG), else a one-line DatasetError."""
-    shown = name if len(name) <= 40 else name[:37] + "..."
-    if len(name) > MAX_NAME:
-        raise DatasetError(f"{where}: {shown!r} is {len(name)} characters long; at most {MAX_NAME}")
-    if not _SLUG.fullmatch(name):
-        raise DatasetError(f"{where}: {shown!r} must start with a letter or digit and hold only letters, digits "
-                           "and . _ + - (it becomes part of file names)")
-    return name
-
-
 # --- writing --------------------------------------------------------------------------------
 def _umask() -> int:
     with _umask_lock:
@@ -180,6 +166,7 @@ def check_writable(path) -> Path:
     """Raise OutputError unless a file can be written at ``path`` (its folder exists and is a folder)."""
     path = Path(path)
     parent = path.parent if str(path.parent) else Path(".")
+    check_apart(path)
     if not parent.exists():
         raise OutputError(f"{path}: folder {parent} does not exist")
     if not parent.is_dir():
@@ -191,20 +178,44 @@ def check_writable(path) -> Path:
     return path
 
 
+_leftovers: set[str] = set()  # temporary files and folders, and locks, of this process not yet removed
+
+
+def _remove(path: str) -> None:
+    if os.path.isdir(path) and not os.path.islink(path):
+        shutil.rmtree(path, ignore_errors=True)
+    else:
+        try:
+            os.unlink(path)
+        except OSError:
+            pass
+    _leftovers.discard(path)
+
+
+def remove_leftovers() -> None:
+    """Remove every temporary file, folder and lock this process made and has not removed yet (for an
+    exit that cannot run the normal clean-up: a plugin that swallowed SIGTERM)."""
+    for path in list(_leftovers):
+        _remove(path)
+
+
 def atomic_write_bytes(path, data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file in the same folder, then rename."""
     path = check_writable(path)
     tmp = None
     try:
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        _leftovers.add(tmp)
         os.fchmod(fd, 0o666 & ~_umask())
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
         os.replace(tmp, path)
+        _leftovers.discard(tmp)
     except OSError as exc:
-        if tmp is not None and os.path.exists(tmp):
-            os.unlink(tmp)
         raise _oserror(path, exc) from None
+    finally:  # on any exit, ^C and SIGTERM included
+        if tmp is not None and tmp in _leftovers:
+            _remove(tmp)
 
 
 def atomic_write_text(path, text: str) -> None:
@@ -219,8 +230,6 @@ _held: dict[str, int] = {}  # lock file -> times held by this process
 def output_lock(path):
     """Hold an exclusive lock on the output ``path`` (a file ``.NAME.lock`` beside it, removed on
     release). A second holder, in this process or another, fails at once with an OutputError."""
-    import fcntl
-
     path = Path(path)
     parent = path.parent if str(path.parent) else Path(".")
     lock = parent / f".{path.name}.lock"
@@ -234,13 +243,45 @@ def output_lock(path):
         return
     busy = OutputError(f"{path}: another frictionlab run is writing this output (lock {lock}); "
                        "wait for it to finish or choose another --out")
-    while True:
+    fd = _take_lock(lock, path, parent, busy)
+    _held[key] = 1
+    _leftovers.add(str(lock))
+    try:
+        yield
+    finally:
+        del _held[key]
+        _remove(str(lock))
+        os.close(fd)
+
+
+_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+
+
+def _take_lock(lock: Path, path: Path, parent: Path, busy: OutputError) -> int:
+    """A descriptor of the lock file ``lock``, created with O_EXCL|O_NOFOLLOW (a planted link is never
+    followed) and flock-ed. A lock file left by a run that died is taken over (nobody holds its flock);
+    one held is ``busy``; a symbolic link or anything but a regular file there is refused."""
+    import fcntl
+
+    planted = OutputError(f"{path}: the lock file {lock} is a symbolic link or not a regular file (not made by "
+                          "frictionlab); remove it and run again")
+    for _ in range(100):
         try:
-            fd = os.open(lock, os.O_RDWR | os.O_CREAT | getattr(os, "O_CLOEXEC", 0), 0o666 & ~_umask())
+            try:
+                fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_EXCL | _NOFOLLOW, 0o666 & ~_umask())
+            except FileExistsError:  # another run's, or one left behind: held if its flock is
+                fd = os.open(lock, os.O_RDWR | _NOFOLLOW | getattr(os, "O_NONBLOCK", 0))
         except FileNotFoundError:
-            raise OutputError(f"{path}: parent folder {parent} does not exist") from None
+            if not parent.is_dir():
+                raise OutputError(f"{path}: parent folder {parent} does not exist") from None
+            continue  # released between the two opens: create it again
         except OSError as exc:
+            if exc.errno == errno.ELOOP or os.path.islink(lock):
+                raise planted from None
             raise _oserror(path, exc, "cannot lock") from None
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            os.close(fd)
+            raise planted
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:
@@ -249,22 +290,12 @@ def output_lock(path):
                 raise busy from None
             raise _oserror(path, exc, "cannot lock") from None
         try:  # the holder before us may have removed the file after we opened it: lock the new one
-            same = os.fstat(fd).st_ino == os.stat(lock).st_ino
+            if os.fstat(fd).st_ino == os.lstat(lock).st_ino:
+                return fd
         except FileNotFoundError:
-            same = False
-        if same:
-            break
-        os.close(fd)
-    _held[key] = 1
-    try:
-        yield
-    finally:
-        del _held[key]
-        try:
-            os.unlink(lock)
-        except OSError:
             pass
         os.close(fd)
+    raise busy
 
 
 def _replaceable(path: Path) -> bool:
@@ -275,6 +306,7 @@ def _replaceable(path: Path) -> bool:
 def check_target(path, force: bool = False) -> Path:
     """Raise OutputError unless an output folder may be created (or, with ``force``, replaced) at ``path``."""
     path = Path(path)
+    check_apart(path)
     if os.path.lexists(path):
         if not force:
             raise OutputError(f"{path}: output folder exists; choose another --out or pass --force")
@@ -307,6 +339,7 @@ def atomic_dir(path, force: bool = False, marker: str = "frictionlab output\n"):
             tmp = Path(tempfile.mkdtemp(dir=parent, prefix=f".{path.name}.", suffix=".tmp"))
         except OSError as exc:
             raise _oserror(path, exc) from None
+        _leftovers.add(str(tmp))
         try:
             try:
                 os.chmod(tmp, 0o777 & ~_umask())
@@ -320,6 +353,7 @@ def atomic_dir(path, force: bool = False, marker: str = "frictionlab output\n"):
             try:
                 if os.path.lexists(path):
                     old = Path(tempfile.mkdtemp(dir=parent, prefix=f".{path.name}.", suffix=".old"))
+                    _leftovers.add(str(old))
                     os.replace(path, old / "x")
                 os.replace(tmp, path)
             except OSError as exc:
@@ -328,9 +362,9 @@ def atomic_dir(path, force: bool = False, marker: str = "frictionlab output\n"):
                 raise _oserror(path, exc) from None
             finally:
                 if old is not None:
-                    shutil.rmtree(old, ignore_errors=True)
+                    _remove(str(old))
         finally:
-            shutil.rmtree(tmp, ignore_errors=True)
+            _remove(str(tmp))
 
 
 def _fix_modes(folder: Path) -> None:

@@ -78,7 +78,9 @@ class Progress:
         if self.bar is None:
             from tqdm import tqdm
 
-            self.bar = tqdm(total=total, desc=self.desc, file=self.stream, dynamic_ncols=True, leave=True,
+            # the bar redraws with carriage returns, which the inert stream (core.terminal) would drop: it
+            # draws on the stream beneath; its text is names and numbers (core.names), nothing to neutralise
+            self.bar = tqdm(total=total, desc=self.desc, file=getattr(self.stream, "unfiltered", self.stream), dynamic_ncols=True, leave=True,
                             bar_format="{desc}: {bar} {n_fmt}/{total_fmt} [{elapsed}<{remaining}] {postfix}")
         if self.bar.total != total:
             self.bar.total = total

@@ -13,10 +13,11 @@ import signal
 import sys
 import threading
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from multiprocessing import get_context
 
-from .errors import Terminated
+from .errors import FrictionLabError, Terminated
 
 #: Allocations between two collections of the youngest generation during a long run (Python's default is
 #: 700): a fit's short-lived objects are mostly freed by reference counting before a collection finds them.
@@ -40,6 +41,9 @@ def long_run_gc(young: int = GC_YOUNG):
             gc.unfreeze()
 
 
+LOST = "a worker process was lost (killed, out of memory, or a law plugin that ends its process)"
+
+
 def _worker_init(parent: int) -> None:
     """In a worker: ^C goes to the parent, which stops the pool; SIGTERM ends the worker at once;
     and (on Linux) the worker gets SIGTERM when the parent dies, even by SIGKILL, so no worker
@@ -61,20 +65,25 @@ def _on_sigterm(signum, frame):
 
 
 @contextmanager
-def process_pool(jobs: int):
-    """A process pool of ``jobs`` forked workers, or None (run here) for one job or without fork.
+def process_pool(jobs: int, stage: str = "frictionlab"):
+    """A process pool of ``jobs`` forked workers, or None (run here) for one job, without fork, or
+    where the pool cannot start (a read-only /dev/shm: a warning says so and the run goes on as --jobs 1).
 
     On any exception, ^C (KeyboardInterrupt) and SIGTERM included, the workers are terminated and
     reaped before the exception goes on: no worker outlives the call. SIGTERM becomes the exception
     ``errors.Terminated`` while the pool lives (when called from the main thread and nothing else
-    handles SIGTERM).
+    handles SIGTERM). A worker lost (killed, out of memory, a plugin ending its process) is a
+    FrictionLabError naming ``stage``.
     """
     try:
         ctx = get_context("fork") if jobs > 1 else None
     except ValueError:  # no fork on this platform: run serially
         ctx = None
     if ctx is None:
-        yield None
+        try:
+            yield None
+        except BrokenProcessPool:  # a process of bounded() lost
+            raise FrictionLabError(f"{stage}: {LOST}") from None
         return
     handle = (threading.current_thread() is threading.main_thread()
               and signal.getsignal(signal.SIGTERM) == signal.SIG_DFL)
@@ -84,20 +93,38 @@ def process_pool(jobs: int):
     # passes (the workers' and the parent's) skip it instead of touching, and so copying, every page of it
     frozen = gc.get_freeze_count()  # a caller's freeze (long_run_gc) is the caller's to undo
     gc.freeze()
-    pool = ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init,
-                               initargs=(os.getpid(),))
+    pool = _start(jobs, ctx)
     try:
         yield pool
-    except BaseException:
+    except BrokenProcessPool:
         _stop(pool)
+        raise FrictionLabError(f"{stage}: {LOST}") from None
+    except BaseException:
+        if pool is not None:
+            _stop(pool)
         raise
     else:
-        pool.shutdown(wait=True)
+        if pool is not None:
+            pool.shutdown(wait=True)
     finally:
         if not frozen:
             gc.unfreeze()
         if handle:
             signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def _start(jobs: int, ctx) -> ProcessPoolExecutor | None:
+    """The pool, or None with a warning where it cannot start (no semaphores: /dev/shm read-only or missing)."""
+    try:
+        return ProcessPoolExecutor(max_workers=jobs, mp_context=ctx, initializer=_worker_init,
+                                   initargs=(os.getpid(),))
+    except (OSError, ImportError, NotImplementedError) as exc:
+        import warnings
+
+        why = getattr(exc, "strerror", None) or exc
+        warnings.warn(f"cannot start worker processes ({why}; they need shared memory in /dev/shm); "
+                      "running with --jobs 1", RuntimeWarning, stacklevel=4)
+        return None
 
 
 def _stop(pool: ProcessPoolExecutor) -> None:
@@ -117,3 +144,88 @@ def _stop(pool: ProcessPoolExecutor) -> None:
     manager = getattr(pool, "_executor_manager_thread", None)
     if manager is not None:
         manager.join(5)
+
+
+class OverBudget(Exception):
+    """A call run by ``bounded`` ran past its limit; its process was ended."""
+
+
+def bounded(fn, limit: float, *args):
+    """``fn(*args)`` run in a forked child process that is ended (SIGKILL) once it has run ``limit``
+    seconds: a time budget enforced from outside the code it bounds (a plugin's ``except:`` cannot keep
+    it). The result or the exception comes back pickled; OverBudget past the limit; BrokenProcessPool
+    if the child died without a result. Runs here where there is no fork."""
+    import pickle
+    import select
+    import time
+
+    if not hasattr(os, "fork"):
+        return fn(*args)
+    read, write = os.pipe()
+    with _quiet_fork():
+        pid = os.fork()
+    if pid == 0:  # the child: never returns into the caller's code
+        status = 0
+        try:
+            os.close(read)
+            _worker_init(os.getppid())
+            try:
+                payload = pickle.dumps((True, fn(*args)))
+            except BaseException as exc:  # noqa: BLE001 (sent back as it is)
+                payload = _pickled_error(exc)
+            with os.fdopen(write, "wb") as fh:
+                fh.write(payload)
+        except BaseException:  # noqa: BLE001
+            status = 1
+        finally:
+            os._exit(status)
+    os.close(write)
+    chunks, deadline = [], time.monotonic() + limit
+    try:
+        while True:
+            left = deadline - time.monotonic()
+            if left <= 0 or not select.select([read], [], [], left)[0]:
+                raise OverBudget(f"ran past {limit:g} s")
+            chunk = os.read(read, 1 << 16)
+            if not chunk:
+                break
+            chunks.append(chunk)
+    finally:
+        os.close(read)
+        _end(pid)
+    if not chunks:  # the child died (killed, or a plugin's os._exit): as a pool's lost worker
+        raise BrokenProcessPool("the process running it ended without a result")
+    ok, value = pickle.loads(b"".join(chunks))
+    if ok:
+        return value
+    raise value
+
+
+def _pickled_error(exc: BaseException) -> bytes:
+    import pickle
+
+    try:
+        return pickle.dumps((False, exc))
+    except Exception:  # an exception that does not pickle: its type and text
+        return pickle.dumps((False, RuntimeError(f"{type(exc).__name__}: {exc}")))
+
+
+def _end(pid: int) -> None:
+    """Kill the child ``pid`` if it still runs, and reap it."""
+    try:
+        done, _ = os.waitpid(pid, os.WNOHANG)
+        if not done:
+            os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+    except ChildProcessError:
+        pass
+
+
+@contextmanager
+def _quiet_fork():
+    """Python warns when a process with threads forks; the child here only computes and exits."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", category=DeprecationWarning, message=".*fork.*")
+        yield

@@ -37,6 +37,7 @@ from collections.abc import Mapping, Sequence
 import attrs
 import numpy as np
 
+from ..core.arguments import as_items, check_type
 from ..core.errors import DatasetError, FrictionLabError, ParameterError
 from ..physics.registry import get_law
 from . import levmar
@@ -106,9 +107,10 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     """
     import lmfit  # slow to import: only when fitting
 
+    check_type(solver, str, "fit: solver", "a solver name such as 'auto', 'exact' or 'ode'")
     law = get_law(law)
     clock = (time.perf_counter(), time.thread_time())
-    items = datasets if isinstance(datasets, (list, tuple)) else [datasets]
+    items = as_items(datasets, "fit: datasets")
     if not items:
         raise DatasetError("fit: no datasets given")
     names = tuple(d.name if hasattr(d, "name") else str(d) for d in items)  # str() of a Target prints its arrays
@@ -122,6 +124,9 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     except SkipDataset as exc:
         return give_up("skipped", str(exc))
     names = tuple(t.name for t in targets)
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:  # its points would count twice and the error bars shrink by sqrt(2)
+        raise DatasetError(f"fit: dataset '{twice[0]}' is given more than once; give each dataset once")
     _check_arguments(law, fixed, local, initial, rtol, timeout)
     solvers = _solvers(law, targets, solver, rtol)
     if isinstance(solvers, str):

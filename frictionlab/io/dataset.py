@@ -20,7 +20,8 @@ import attrs
 import numpy as np
 
 from ..core.errors import DatasetError, FrictionLabError
-from ..core.files import MAX_CSV_BYTES, check_name, read_bytes, read_text, read_toml
+from ..core.files import MAX_CSV_BYTES, read_bytes, read_text, read_toml
+from ..core.names import check_name
 from ..core.units import MAX_SI, check_text, check_time_scale, unit_factor
 from ..physics.scene import KINDS, Scene
 from ..solve.outcome import OUTCOMES, OutcomeScene
@@ -144,12 +145,12 @@ def _table(meta, key, path, where=None):
 
 def from_meta(meta: dict, path: Path) -> Dataset:
     """Build a Dataset from a parsed TOML dict whose CSV sits beside ``path``."""
-    name = check_name(_req(meta, "name", path), f"{path}: name")
+    name = check_name(_req(meta, "name", path), f"{path}: name", DatasetError)
     group = meta.get("group", "")
     if "group" in meta:
         if not isinstance(group, str):
             raise DatasetError(f"{path}: group = {group!r}, expected a quoted name (letters, digits, . _ + -)")
-        group = check_name(group, f"{path}: group")
+        group = check_name(group, f"{path}: group", DatasetError)
     kind = _req(meta, "kind", path)
     if kind not in DATA_KINDS:
         raise DatasetError(f"{path}: kind = {kind!r}, expected one of {', '.join(DATA_KINDS)}")

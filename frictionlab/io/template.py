@@ -11,6 +11,7 @@ from __future__ import annotations
 import tomllib
 
 from ..core.errors import DatasetError
+from ..core.names import check_name
 
 KINDS = ("impact", "incline", "impact-outcome")
 
@@ -132,6 +133,7 @@ def template(kind: str, name: str = "my-data") -> tuple[str, str]:
 
     if kind not in KINDS:
         raise DatasetError(f"datasets template: kind {kind!r}; expected one of {', '.join(KINDS)}")
+    check_name(name, "datasets template: --name", DatasetError)
     head = {"impact": _IMPACT, "incline": _INCLINE, "impact-outcome": _OUTCOME}[kind]
     law, params, units = {"impact": ("wear", {"lam": 1.8e6}, {"lam": "Pa s/m"}),
                           "incline": ("couette", {"eta": 0.1, "h": 4e-5}, {"eta": "Pa s", "h": "m"}),

@@ -27,6 +27,7 @@ the law's force at vanishing slip can hold it (rate-and-state, whose force turns
 """
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Mapping
 from typing import ClassVar
@@ -123,6 +124,23 @@ class NormalAreaRateForm:
     c: float  # [N s/m^2]
 
 
+_PLUGIN_METHODS = ("force", "form", "rates", "steady_state", "initial_states", "__init__")
+
+
+def _fenced(fn):
+    """``fn`` with numpy's error state restored after each call."""
+    @functools.wraps(fn)
+    def call(*args, **kwargs):
+        saved = np.geterr()
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            np.seterr(**saved)
+
+    call.__fenced__ = True
+    return call
+
+
 class FrictionLaw:
     """Base class of a law plugin. Subclasses set the class attributes and ``force``."""
 
@@ -137,6 +155,17 @@ class FrictionLaw:
     states: ClassVar[tuple[StateSpec, ...]] = ()
     #: A law with memory whose force jumps at zero slip: stick events instead of integrating through zero.
     jumps_at_zero_slip: ClassVar[bool] = False
+
+    def __init_subclass__(cls, **kwargs):
+        """A plugin's methods are fenced: numpy's error state (np.seterr) is restored after each call,
+        so a plugin that sets it cannot change how the rest of the program computes."""
+        super().__init_subclass__(**kwargs)
+        if cls.__module__.startswith("frictionlab."):
+            return
+        for name in _PLUGIN_METHODS:
+            fn = cls.__dict__.get(name)
+            if callable(fn) and not hasattr(fn, "__fenced__"):
+                setattr(cls, name, _fenced(fn))
 
     def force(self, p: Mapping[str, float], c: Contact) -> np.ndarray:
         """Friction force [N] at each sample of ``c`` for parameters ``p`` (SI floats)."""
@@ -173,6 +202,9 @@ class FrictionLaw:
         p = self.defaults()
         for name, value in (values or {}).items():
             s = self.spec(name)
+            if isinstance(value, (bool, np.bool_)):  # True is not 1 m
+                raise ParameterError(f"law '{self.name}': {name} = {value!r} is a boolean, not a number "
+                                     f"(SI value in {s.unit or 'plain units'})")
             try:
                 v = float(value)
             except (TypeError, ValueError):

@@ -20,6 +20,8 @@ import attrs
 import numpy as np
 
 from ..core.errors import FrictionLabError, LawError, RegistryError
+from ..core.inputs import note_input
+from ..core.names import check_name
 from .law import (
     QUANTITIES,
     AreaSlipForm,
@@ -37,6 +39,8 @@ class PluginWarning(UserWarning):
     """A law plugin was skipped."""
 
 
+#: numpy's error state before any plugin ran: entry points are loaded and probed in it.
+_NUMPY_STATE = np.geterr()
 _laws: dict[str, FrictionLaw] = {}
 _sources: dict[str, str] = {}
 _runtime: list[tuple[FrictionLaw, str]] = []
@@ -62,8 +66,7 @@ def validate_law(law: FrictionLaw, source: str) -> None:
     for attr in ("name", "formula", "citation", "params", "requires"):
         if not hasattr(law, attr):
             raise LawError(f"law plugin {source}: missing class attribute '{attr}'")
-    if not isinstance(law.name, str) or not law.name or any(ch.isspace() for ch in law.name):
-        raise LawError(f"law plugin {source}: name must be a non-empty word, got {law.name!r}")
+    check_name(law.name, f"law plugin {source}: name", LawError)
     if not isinstance(law.requires, (set, frozenset)) or not all(isinstance(q, str) for q in law.requires):
         raise LawError(f"law '{law.name}' ({source}): requires must be a frozenset of quantity names, "
                        f"got {law.requires!r}")
@@ -178,11 +181,12 @@ def _load() -> None:
             seen.add(key)
             source = f"entry point '{ep.name} = {ep.value}' of {dist_name}"
             try:
-                try:
-                    obj = ep.load()
-                except FrictionLabError as exc:  # e.g. a degenerate ParamSpec or StateSpec at import
-                    raise LawError(f"law plugin {source}: {exc}") from None
-                law = _as_law(obj, source)
+                with np.errstate(**_NUMPY_STATE):  # as before any plugin, whatever one set; restored after
+                    try:
+                        obj = ep.load()
+                    except FrictionLabError as exc:  # e.g. a degenerate ParamSpec or StateSpec at import
+                        raise LawError(f"law plugin {source}: {exc}") from None
+                    law = _as_law(obj, source)
             except FrictionLabError as exc:
                 warnings.warn(f"frictionlab: skipped law plugin: {exc}", PluginWarning, stacklevel=3)
                 continue
@@ -285,6 +289,7 @@ def load_law_file(path) -> None:
     from pathlib import Path
 
     p = Path(path)
+    note_input(p)
     if p.suffix != ".py":
         raise RegistryError(f"--load {path}: expected a Python file ending in .py")
     try:
@@ -299,7 +304,8 @@ def load_law_file(path) -> None:
     module = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = module
     try:
-        spec.loader.exec_module(module)
+        with np.errstate():  # a plugin's np.seterr at import stays in the plugin (restored after)
+            spec.loader.exec_module(module)
     except FrictionLabError as exc:
         del sys.modules[spec.name]
         msg = str(exc)

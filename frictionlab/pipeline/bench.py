@@ -6,8 +6,9 @@ the closed form ('exact') and the paper's series where they exist, the batch eng
 (``frictionlab.solve.batch``) and, beside the library's ODE path, what a user writes without it: scipy's
 solve_ivp with a plain Python right-hand side of the same scaled problem ('scipy:METHOD (plain)').
 The closed form and the batch are timed at throughput, per scene in a batch of ``BATCH_SIZE``
-scenes (the closed form's evaluation cost, not the fixed cost of one call); every point carries
-its rtol. The error of a run is the largest,
+different scenes (``varied``: the case's scene and others around it), and drawn on their own axes;
+the closed form is also timed as one call (what a fit pays per evaluation), beside the single-call
+solvers; every point carries its rtol. The error of a run is the largest,
 over slip u, spin omega and rotation angle theta, of the max-norm error on the sample grid
 divided by that series' largest magnitude. The reference is the closed form where one exists,
 else DOP853 at rtol 1e-13 (checked against Radau at 1e-12; their difference is reported).
@@ -18,7 +19,6 @@ repeat) as a bar. An error below ``ROUND_OFF`` is drawn on the line 'exact to ro
 """
 from __future__ import annotations
 
-import json
 import math
 import os
 import platform
@@ -38,6 +38,7 @@ from ..physics.scene import (
     Scene,
     WeightNormal,
 )
+from .plainref import plain_solver
 
 ODE_METHODS = ("RK45", "DOP853", "LSODA", "Radau", "BDF")
 RTOLS = tuple(10.0 ** -k for k in range(3, 13))
@@ -45,10 +46,15 @@ QUICK_RTOLS = (1e-3, 1e-6, 1e-9)
 BATCH_METHODS = ("DOP853", "RK45")
 PLAIN_METHODS = ("DOP853", "LSODA")  # the plain-scipy reference lines
 BATCH_SIZE, QUICK_BATCH_SIZE = 10_000, 1_000  # scenes per batch: closed form and batch timed at throughput
+#: Methods timed per call (a solve's cost) and methods timed per scene in a batch (throughput): the diagrams
+#: draw them on separate axes.
+BATCH_COSTS = ("batch:", "exact")
+SINGLE_EXACT = "exact, one call"
 ROUND_OFF = 1e-15  # errors below this are drawn as 'exact to round-off'
 MIN_LOOP = 0.02  # s of CPU per timed repeat
 REFERENCE_RTOL = 1e-13
 CHECK_RTOL = 1e-12  # Radau run that checks the reference where no closed form exists
+
 clock = time.process_time
 
 
@@ -150,80 +156,21 @@ def reference(law, params, scene, t):
         return ref, f"ode:DOP853 at rtol {REFERENCE_RTOL:g}", _error(check, ref)
 
 
-def plain_solver(law, params, scene):
-    """What a user writes without frictionlab for the four bench cases: solve_ivp on a plain Python
-    right-hand side of the same scaled problem (time by the span, velocities by u0 or the drive's
-    reach, as ``solvers.ode.state_scales``), with slip reaching zero as a terminal event after which
-    the ball rolls (slip 0, spin constant). Returns solve(method, rtol, t) -> Trajectory-like."""
-    from types import SimpleNamespace
+def varied(scene, n: int, seed: int = 0) -> list:
+    """The scene and n - 1 others around it: the initial slip (or, from rest, the incline) scaled by factors
+    uniform in [0.8, 1.2], so a batch times scenes that differ, not one scene n times (scene 0 is the
+    case's own, the one whose error is reported)."""
+    import attrs
 
-    from scipy.integrate import solve_ivp
-
-    from ..physics.registry import get_law
-    from ..solve.plan import make_plan
-    from ..solve.solvers.ode import state_scales
-
-    plan = make_plan(scene, get_law(law))
-    T = scene.duration
-    sc = state_scales(plan, T)
-    m, r = scene.mass, scene.radius or 0.0
-    inertia = 0.4 * m * r * r if scene.radius else 1.0
-    drive = G * math.sin(scene.incline) if "gravity" in scene.effects else 0.0
-    coupled, spin = plan.coupled, plan.has_spin
-    area, normal = scene.area, scene.normal
-    if law == "wear":
-        k = params["lam"]
-    elif law == "couette":
-        k = params["eta"] / params["h"]
-    mu = params.get("mu", 0.0)
-
-    def friction(t, v, u, x):
-        if law == "coulomb":
-            tc, peak = normal.contact_time, normal.impulse * math.pi / (2.0 * normal.contact_time)
-            return mu * (peak * math.sin(math.pi * t / tc) if t < tc else 0.0) * (1.0 if u > 0 else -1.0)
-        if isinstance(area, HalfSineArea):
-            a = area.peak * math.sin(math.pi * t / area.contact_time) if t < area.contact_time else 0.0
-        elif isinstance(area, GrowthArea):
-            a = area.initial + area.rate * x
-        else:
-            a = area.area
-        return k * a * u
-
-    names = plan.states
-
-    def rhs(s, z):
-        t = s * T
-        y = z * sc
-        v = y[0]
-        u = v - r * y[1] if coupled else v
-        F = friction(t, v, u, y[names.index("x")] if "x" in names else 0.0)
-        rates = {"v": drive - F / m, "omega": F * r / inertia, "theta": y[1] if spin else 0.0, "x": abs(u)}
-        return [rates[n] * T / sc[i] for i, n in enumerate(names)]
-
-    def slip(s, z):
-        return (z[0] * sc[0] - r * z[1] * sc[1]) / sc[0] if coupled else z[0]
-
-    slip.terminal, slip.direction = True, -1
-
-    def solve(method, rtol, t):
-        y0 = np.array([scene.u0 if n == "v" else 0.0 for n in names])
-        sol = solve_ivp(rhs, (0.0, 1.0), y0 / sc, method=method, t_eval=t / T, rtol=rtol, atol=rtol,
-                        events=slip if scene.u0 != 0 else None)  # from rest on an incline slip only grows
-        reached = sol.y.shape[1]
-        Y = np.empty((len(names), t.size))
-        Y[:, :reached] = sol.y * sc[:, None]
-        if reached < t.size:  # slip stopped: the ball rolls on, spin frozen, angle growing with it
-            te, ye = sol.t_events[0][0] * T, sol.y_events[0][0] * sc
-            Y[:, reached:] = ye[:, None]
-            if spin:
-                Y[2, reached:] = ye[2] + ye[1] * (t[reached:] - te)
-        omega = Y[1] if spin else np.zeros(t.size)
-        u = Y[0] - r * omega if coupled else Y[0].copy()
-        u[reached:] = 0.0
-        return SimpleNamespace(u=u, omega=omega, theta=Y[2] if spin else np.zeros(t.size),
-                               info={"nfev": int(sol.nfev)})
-
-    return solve
+    rng = np.random.default_rng(seed)
+    f = rng.uniform(0.8, 1.2, n - 1)
+    if scene.u0 != 0.0:
+        return [scene] + [attrs.evolve(scene, u0=scene.u0 * x) for x in f]
+    normal = scene.normal
+    return [scene] + [attrs.evolve(scene, incline=scene.incline * x,
+                                   normal=attrs.evolve(normal, value=normal.value * math.cos(scene.incline * x)
+                                                       / math.cos(scene.incline)))
+                      for x in f]
 
 
 def measure_case(name, law, params, scene, rtols, repeats, batch_size, n_t=201, progress=None) -> tuple[list, dict]:
@@ -266,14 +213,15 @@ def measure_case(name, law, params, scene, rtols, repeats, batch_size, n_t=201, 
     for method in PLAIN_METHODS if plain else ():
         for rtol in rtols:
             record(f"scipy:{method} (plain)", rtol, lambda m=method, r=rtol: plain(m, r, t))
-    many = [scene] * batch_size
+    many = varied(scene, batch_size)
     for method in BATCH_METHODS:
         for rtol in rtols:  # noqa: B007
             record(f"batch:{method}", rtol,
                    lambda m=method, r=rtol: simulate_batch(law, many, params, solver=m, rtol=r, t=t), per=batch_size,
                    nfev=lambda out: int(out.info["nfev_per_scene"][0]))
-    try:  # the closed form at its evaluation cost: per scene in a batch
+    try:  # the closed form: one call (what a fit pays per evaluation), and per scene in a batch
         simulate_batch(law, [scene], params, solver="exact", t=t)
+        record(SINGLE_EXACT, None, lambda: simulate(law, scene, params, solver="exact", t=t))
         record("exact", None, lambda: simulate_batch(law, many, params, solver="exact", t=t), per=batch_size,
                nfev=lambda out: 0)
     except FrictionLabError:
@@ -317,175 +265,3 @@ def run_bench(quick: bool = False, progress=None, fits: bool = True) -> dict:
             fit_rows += fit_tolerance_study(laws, dataset, QUICK_FIT_METHODS if quick else FIT_METHODS,
                                             QUICK_FIT_RTOLS if quick else FIT_RTOLS, progress=progress)
     return {"env": env, "settings": settings, "cases": info, "rows": all_rows, "fit_rows": fit_rows}
-
-
-# --- writing --------------------------------------------------------------------------------------------
-STYLE = {  # method -> (color, marker, line style)
-    "ode:RK45": ("#1f77b4", "o", "-"), "ode:DOP853": ("#ff7f0e", "s", "-"), "ode:LSODA": ("#2ca02c", "^", "-"),
-    "ode:Radau": ("#d62728", "v", "-"), "ode:BDF": ("#9467bd", "D", "-"), "batch:DOP853": ("#8c564b", "P", "-"),
-    "batch:RK45": ("#e377c2", "X", "-"), "exact": ("#000000", "*", "-"), "series": ("#bcbd22", "h", "-"),
-    "scipy:DOP853 (plain)": ("#ff7f0e", "s", ":"), "scipy:LSODA (plain)": ("#2ca02c", "^", ":"),
-}
-
-
-def plot_case(path, name, case, rows, env) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(9.0, 6.2), dpi=110, layout="constrained")
-    floor = ROUND_OFF / 3
-    for method in dict.fromkeys(r["method"] for r in rows):
-        pts = [r for r in rows if r["method"] == method and r["status"] == "ok"]
-        if not pts:
-            continue
-        color, marker, ls = STYLE.get(method, ("#333333", "o", "-"))
-        x = np.array([p["error"] if p["error"] >= ROUND_OFF else floor for p in pts])
-        y = np.array([p["time_median_s"] for p in pts])
-        spread = np.array([[p["time_median_s"] - p["time_min_s"] for p in pts],
-                           [p["time_max_s"] - p["time_median_s"] for p in pts]])
-        single = len(pts) == 1
-        ax.errorbar(x, y, yerr=spread, marker=marker, color=color, ms=11 if single else 5.5, lw=0 if single else 1.4,
-                    ls=ls, elinewidth=0.8, capsize=2, mfc="white" if "plain" in method else color,
-                    label=method + (" (one point)" if single else ""))
-        for p, xi, yi in zip(pts, x, y):  # each point carries its rtol (log10)
-            if p["rtol"]:
-                ax.annotate(f"{math.log10(p['rtol']):.0f}", (xi, yi), xytext=(3, 2), textcoords="offset points",
-                            fontsize=6, color=color)
-    ax.axvline(floor, color="#999999", lw=0.8, ls="--")
-    ax.text(floor, ax.get_ylim()[1], " exact to round-off", rotation=90, va="top", ha="right", fontsize=7.5,
-            color="#555555")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("error: max-norm of u, omega, theta vs reference, relative to each series' peak")
-    ax.set_ylabel("median CPU time per scene [s] (bar: fastest to slowest repeat)")
-    ax.set_title(f"{case['title']}", fontsize=11)
-    ax.grid(True, which="major", alpha=0.4)
-    ax.grid(True, which="minor", alpha=0.12)
-    meta = case["meta"]
-    rt = [r["rtol"] for r in rows if r["rtol"]]
-    note = (f"numbers at points: log10 rtol ({min(rt):.0e}..{max(rt):.0e}, atol = rtol on the scaled problem); "
-            f"reference: {meta['reference']}" + (f" (Radau {CHECK_RTOL:g} differs by {meta['reference_check']:.1e})"
-                                                 if meta["reference_check"] else "")
-            + "\nexact and batch" + (f" ({meta['batch_engine']} engine)" if meta.get("batch_engine") else "")
-            + f": per scene in a batch of {meta['batch_size']} (throughput); scipy (plain): solve_ivp "
-              "on a plain Python right-hand side, what a user writes without frictionlab"
-            + f"\n{env['cpu']}, {env['cores']} cores; numpy {env['versions'].get('numpy')}, scipy "
-              f"{env['versions'].get('scipy')}; errors below {ROUND_OFF:g} drawn at the dashed line")
-    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
-    fig.text(0.0, 0.0, note, fontsize=7, color="#444444", va="bottom")
-    fig.get_layout_engine().set(rect=(0, 0.07, 1, 0.93))
-    fig.savefig(path)
-    plt.close(fig)
-
-
-def reading(name, rows) -> str:
-    """A few sentences on what one diagram says, from its rows."""
-    ok = [r for r in rows if r["status"] == "ok"]
-
-    def at(method, rtol=None):
-        return next((r for r in ok if r["method"] == method and (rtol is None or r["rtol"] == rtol)), None)
-
-    rt = 1e-6 if any(r["rtol"] == 1e-6 for r in ok) else max((r["rtol"] for r in ok if r["rtol"]), default=None)
-    parts = []
-    ex = at("exact")
-    if ex:
-        parts.append(f"the closed form costs {ex['time_median_s'] * 1e6:.2g} us per scene"
-                     + (" and is exact to round-off" if ex["error"] < ROUND_OFF else f" (error {ex['error']:.1e})"))
-    se = at("series")
-    if se:
-        parts.append(f"the paper's series is off by {se['error']:.2g} of the peak")
-    if rt:
-        lib = {m: at(m, rt) for m in ("ode:LSODA", "ode:DOP853", "scipy:DOP853 (plain)", "batch:DOP853")}
-        if lib["ode:DOP853"] and lib["scipy:DOP853 (plain)"]:
-            parts.append(f"at rtol {rt:.0e} the library's ode:DOP853 takes {lib['ode:DOP853']['time_median_s'] * 1e3:.2g} ms "
-                         f"(error {lib['ode:DOP853']['error']:.1e}) against {lib['scipy:DOP853 (plain)']['time_median_s'] * 1e3:.2g} "
-                         f"ms for plain solve_ivp (error {lib['scipy:DOP853 (plain)']['error']:.1e}), "
-                         f"{lib['ode:DOP853']['time_median_s'] / lib['scipy:DOP853 (plain)']['time_median_s']:.1f}x")
-        if lib["batch:DOP853"] and lib["scipy:DOP853 (plain)"]:
-            parts.append(f"the batch engine at the same rtol costs {lib['batch:DOP853']['time_median_s'] * 1e6:.3g} us per "
-                         f"scene, {lib['scipy:DOP853 (plain)']['time_median_s'] / lib['batch:DOP853']['time_median_s']:.0f}x "
-                         f"less than the plain loop (error {lib['batch:DOP853']['error']:.1e})")
-    ode = [r for r in ok if r["method"].startswith("ode:")]
-    if ode:
-        best = min(ode, key=lambda r: r["time_median_s"] / max(-math.log10(max(r["error"], ROUND_OFF)), 0.5))
-        parts.append(f"per digit of accuracy the cheapest ODE point is {best['method']} at rtol {best['rtol']:.0e} "
-                     f"(error {best['error']:.1e}, {best['time_median_s'] * 1e3:.2g} ms)")
-    return ("Reading: " + "; ".join(parts) + ".") if parts else ""
-
-def _fmt(x, spec=".3g"):
-    if x is None or (isinstance(x, float) and math.isnan(x)):
-        return "-"
-    return format(x, spec)
-
-
-def markdown(result) -> str:
-    env, st = result["env"], result["settings"]
-    lines = ["# Work-precision", "",
-             f"Hardware: {env['cpu']}, {env['cores']} cores; {env['platform']}.",
-             "Versions: " + ", ".join(f"{k} {v}" for k, v in env["versions"].items()) + ".",
-             f"Times: {st['clock']}, median of {st['repeats']} repeats, each a loop of at least {st['min_loop_s']} s; "
-             f"load average at start {st['load_average_at_start']}.",
-             f"Tolerances: rtol in {', '.join(f'{r:.0e}' for r in st['rtols'])}; atol {st['atol']}.",
-             "Error: the largest over u, omega, theta of the max-norm error on the sample grid, each relative to "
-             "that series' peak; 'exact' and 'batch:*' times are per scene in a batch of identical scenes (throughput); "
-             "'scipy:* (plain)' is solve_ivp on a plain Python right-hand side of the same scaled problem.", ""]
-    for name, case in result["cases"].items():
-        meta = case["meta"]
-        lines += [f"## {name}", "", case["title"] + ".", "",
-                  f"Law `{case['law']}` with {case['params']}; reference: {meta['reference']}"
-                  + (f" (Radau at {CHECK_RTOL:g} differs from it by {meta['reference_check']:.1e})" if meta["reference_check"] else "")
-                  + (f"; slip sticks at {meta['stick_time_s'] * 1e6:.1f} us" if meta["stick_time_s"] else "") + ".",
-                  f"![work-precision {name}](workprecision_{name}.png)", "",
-                  "| method | rtol | error | median time [s] | time / best | nfev | status |",
-                  "|---|---|---|---|---|---|---|"]
-        rows = [r for r in result["rows"] if r["case"] == name]
-        lines[-3:-3] = [reading(name, rows), ""]
-        best = min((r["time_median_s"] for r in rows if r["status"] == "ok"), default=math.nan)
-        for r in rows:
-            lines.append(f"| {r['method']} | {_fmt(r['rtol'], '.0e')} | {_fmt(r['error'], '.2e')} | "
-                         f"{_fmt(r['time_median_s'], '.3e')} | {_fmt(r['time_median_s'] / best, '.1f')} | "
-                         f"{_fmt(r['nfev'], 'd') if isinstance(r['nfev'], int) else '-'} | {r['status']} |")
-        lines.append("")
-    return "\n".join(lines)
-
-
-def write_bench(out, result, force: bool = False) -> list[str]:
-    """Write PNGs, workprecision.csv, workprecision.md and environment.json into ``out``, whole or not at all."""
-    import csv
-
-    from ..core.files import atomic_dir
-
-    written = []
-    with atomic_dir(out, force=force) as tmp:
-        for name, case in result["cases"].items():
-            rows = [r for r in result["rows"] if r["case"] == name]
-            plot_case(tmp / f"workprecision_{name}.png", name, case, rows, result["env"])
-            written.append(f"workprecision_{name}.png")
-        fields = ["case", "method", "rtol", "error", "time_median_s", "time_min_s", "time_max_s", "nfev", "status"]
-        with open(tmp / "workprecision.csv", "w", newline="", encoding="utf-8") as fh:
-            w = csv.DictWriter(fh, fieldnames=fields)
-            w.writeheader()
-            for r in result["rows"]:
-                w.writerow({k: ("" if r[k] is None else r[k]) for k in fields})
-        md = markdown(result)
-        if result.get("fit_rows"):
-            from ..inference import fitcost
-
-            fit_fields = list(result["fit_rows"][0])
-            with open(tmp / "fit_tolerance.csv", "w", newline="", encoding="utf-8") as fh:
-                w = csv.DictWriter(fh, fieldnames=fit_fields)
-                w.writeheader()
-                for r in result["fit_rows"]:
-                    w.writerow({k: ("" if r[k] is None else r[k]) for k in fit_fields})
-            md += "\n## What the tolerance does to a fit\n\n"
-            for ds in dict.fromkeys(r["dataset"] for r in result["fit_rows"]):
-                md += f"### {ds}\n\n" + fitcost.markdown([r for r in result["fit_rows"] if r["dataset"] == ds]) + "\n\n"
-            written.append("fit_tolerance.csv")
-        (tmp / "workprecision.md").write_text(md + "\n", encoding="utf-8")
-        meta = {k: result[k] for k in ("env", "settings")}
-        meta["cases"] = {k: {**v, "meta": {**v["meta"]}} for k, v in result["cases"].items()}
-        (tmp / "environment.json").write_text(json.dumps(meta, indent=2, default=str) + "\n", encoding="utf-8")
-        written += ["workprecision.csv", "workprecision.md", "environment.json"]
-    return written

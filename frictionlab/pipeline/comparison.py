@@ -24,6 +24,7 @@ from collections.abc import Sequence
 import attrs
 import numpy as np
 
+from ..core.arguments import as_items
 from ..core.errors import FrictionLabError
 from ..inference.equivalence import PAIRS, REPLICATES, EquivalenceResult
 from ..inference.fitting import FitResult
@@ -125,7 +126,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             *, free: dict | None = None, equivalence: bool = True, jobs: int = 1,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
             tolerance: Sequence[float] = (), fit_timeout: float | None = None, replicates: int = REPLICATES,
-            pairs: Sequence = PAIRS, transfer: bool = True, stages: Sequence[str] | None = None) -> Comparison:
+            pairs: Sequence = PAIRS, transfer: bool = True, stages: Sequence[str] | None = None,
+            client=None) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
 
     laws: registered names, None for DEFAULT_LAWS, or "all" for every registered law; datasets: built-in names, TOML paths or Datasets
@@ -142,41 +144,51 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     series, are tested only with bootstrap_all. transfer: run the transfer stage.
     stages: the names of the stages to run (``stages.STAGES``: fit, rank, equivalence, transfer,
     tolerance, bootstrap, answer), None for every stage the options above switch on; ``run_stages``
-    runs more of them on the result later.
+    runs more of them on the result later. client: a dask.distributed Client; the fits, refits, tests and
+    bootstrap then run on its workers instead of ``jobs`` local processes (the same numbers either way).
     """
     started = time.perf_counter()
     settings = Settings(laws=(), solvers=tuple(solvers) if solvers else None,
                         free=dict(free or {}), equivalence=equivalence, jobs=jobs, bootstrap=bootstrap, seed=seed,
                         bootstrap_all=bootstrap_all, tolerance=tuple(tolerance), fit_timeout=fit_timeout,
-                        replicates=replicates, pairs=tuple(pairs), transfer=transfer)
+                        replicates=replicates, pairs=tuple(pairs), transfer=transfer, cluster=cluster_name(client))
     settings = attrs.evolve(settings, laws=select_laws(laws))
     chosen = select(STAGES, stages)
-    dss = unique_datasets(load_dataset(d) for d in (datasets if datasets is not None else builtin_names()))
+    dss = unique_datasets(load_dataset(d) for d in (as_items(datasets, "compare: datasets") if datasets is not None
+                                                    else builtin_names()))
     if not dss:
         raise FrictionLabError("compare: no datasets to compare")
-    run = _make_run(settings, dss, progress)
+    run = _make_run(settings, dss, progress, client)
     settings.check_replicates()
     c = Comparison(laws=settings.laws, datasets=dss, fits=run.plan.skipped_fits, ranking=(), groups=(),
                    equivalence=(), skipped_datasets=run.plan.skipped_datasets, wall_time=0.0, versions=versions(),
                    settings=settings.as_dict(), options=settings)
-    if jobs > 1:
+    if jobs > 1 and client is None:
         _import_before_fork(run)
     c = run_stages_with(c, run, chosen, forced=stages is not None)
     return attrs.evolve(c, wall_time=time.perf_counter() - started)
 
 
-def run_stages(comparison: Comparison, stages: Sequence[str], *, progress: Progress | None = None,
+def run_stages(comparison: Comparison, stages: Sequence[str], *, progress: Progress | None = None, client=None,
                **options) -> Comparison:
     """Run the named stages (``stages.STAGES``) on a comparison made by ``compare``, e.g.
     ``run_stages(c, ["bootstrap", "answer"], bootstrap=150)``; ``options`` override the comparison's
     settings (the keyword arguments of ``compare``). Returns a new Comparison."""
-    settings = attrs.evolve(comparison.options, **options)
-    run = _make_run(settings, comparison.datasets, progress)
+    settings = attrs.evolve(comparison.options, **options, cluster=cluster_name(client))
+    run = _make_run(settings, comparison.datasets, progress, client)
     c = attrs.evolve(comparison, settings=settings.as_dict(), options=settings)
     return run_stages_with(c, run, select(STAGES, stages), forced=True)
 
 
-def _make_run(settings: Settings, dss, progress) -> Run:
+def cluster_name(client) -> str:
+    """How the report names a Dask cluster: its scheduler's address and number of workers ("" without one)."""
+    if client is None:
+        return ""
+    workers = len(client.scheduler_info().get("workers", {}))
+    return f"Dask cluster at {client.scheduler.address} ({workers} worker{'s' * (workers != 1)})"
+
+
+def _make_run(settings: Settings, dss, progress, client=None) -> Run:
     """The plan of the fits and tests, and the progress total: fits, equivalence pairs, bootstrapped
     datasets and the tolerance check."""
     plan = plan_fits(settings.laws, dss, settings.solvers, settings.free)
@@ -184,7 +196,7 @@ def _make_run(settings: Settings, dss, progress) -> Run:
     n_boot = (len({f.datasets[0] for f in plan.skipped_fits} | {t[1].name for t in plan.tasks})
               if settings.bootstrap else 0)
     total = len(plan.tasks) + len(eq_pairs) + n_boot + (1 if settings.tolerance else 0)
-    return Run(settings=settings, plan=plan, eq_pairs=eq_pairs, progress=progress, total=total)
+    return Run(settings=settings, plan=plan, eq_pairs=eq_pairs, progress=progress, total=total, client=client)
 
 
 def _import_before_fork(run: Run) -> None:

@@ -14,7 +14,7 @@ from concurrent.futures.process import BrokenProcessPool
 import attrs
 
 from ..core.errors import FrictionLabError, ParameterError
-from ..core.workers import process_pool
+from ..core.cluster import executor
 from .planning import FitPlan
 from .settings import Settings
 
@@ -30,6 +30,7 @@ class Run:
     eq_pairs: list
     progress: Progress | None = None
     pool: object = None  # a concurrent.futures executor, or None to run here
+    client: object = None  # a dask.distributed Client: the stages' tasks run on its workers instead of a local pool
     total: int = 0
     done: int = 0
 
@@ -86,11 +87,11 @@ def select(stages: Sequence[Stage], names: Sequence[str] | None) -> list[Stage]:
 
 
 def run_stages(comparison, run: Run, stages: Sequence[Stage], forced: bool = False):
-    """Run ``stages`` on one pool of ``run.settings.jobs`` workers: each stage wanted by the settings (or
+    """Run ``stages`` on one pool of ``run.settings.jobs`` workers (or on ``run.client``'s cluster): each stage wanted by the settings (or
     every one given, when ``forced``), timed; returns the comparison with every stage's fields filled."""
     chosen = [s for s in stages if forced or s.wanted(run)]
     timings = dict(comparison.timings)
-    with process_pool(run.settings.jobs) as pool:
+    with executor(run.settings.jobs, run.client, "compare") as pool:
         run.pool = pool
         side, pending = ThreadPoolExecutor(1), []
         try:

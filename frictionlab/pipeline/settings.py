@@ -6,6 +6,7 @@ from collections.abc import Sequence
 import attrs
 import numpy as np
 
+from ..core.arguments import as_items
 from ..core.errors import ParameterError
 from ..inference.equivalence import MIN_REPLICATES, PAIRS, REPLICATES
 from ..physics.registry import available_laws, get_law
@@ -17,12 +18,7 @@ DEFAULT_LAWS = ("coulomb", "area-rate", "wear", "couette")
 
 def select_laws(laws: Sequence[str] | None) -> tuple[str, ...]:
     """Law names to compare: None -> DEFAULT_LAWS; "all" (alone or in the list) -> every registered law."""
-    if laws is None:
-        names = DEFAULT_LAWS
-    elif isinstance(laws, str):
-        names = (laws,)
-    else:
-        names = tuple(laws)
+    names = DEFAULT_LAWS if laws is None else tuple(as_items(laws, "compare: laws"))
     if "all" in names:
         names = tuple(available_laws()) + tuple(n for n in names if n != "all")
     return tuple(dict.fromkeys(get_law(n).name for n in names))
@@ -45,6 +41,7 @@ class Settings:
     replicates: int = REPLICATES
     pairs: tuple = PAIRS
     transfer: bool = True
+    cluster: str = ""  # where the tasks ran when not on a local pool: "Dask cluster at ADDRESS (N workers)"
 
     def __attrs_post_init__(self):
         from ..solve.solvers import parse_solver
@@ -79,4 +76,4 @@ class Settings:
                 "bootstrap": int(self.bootstrap), "seed": int(self.seed), "bootstrap_all": bool(self.bootstrap_all),
                 "tolerance": [float(r) for r in self.tolerance], "fit_timeout": self.fit_timeout,
                 "replicates": int(self.replicates), "pairs": [list(p) for p in self.pairs],
-                "transfer": bool(self.transfer)}
+                "transfer": bool(self.transfer)} | ({"cluster": self.cluster} if self.cluster else {})

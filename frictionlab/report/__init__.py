@@ -30,14 +30,17 @@ and add ``mysection`` to ``SECTIONS`` at the place it belongs. Return None to le
 from __future__ import annotations
 
 import json
+import os
 import threading
 from concurrent.futures import as_completed
 from pathlib import Path
 
 import attrs
 
+from ..core.arguments import check_type
 from ..core.errors import OutputError
 from ..core.files import atomic_dir
+from ..core.inputs import check_apart
 from . import (
     bootstrap,
     datasets,
@@ -63,6 +66,9 @@ TITLE = "frictionlab: friction laws compared"
 #: The report's sections, in order; the first screen first.
 SECTIONS = (first_screen, summary, datasets, ranking, bootstrap, fits, rebound, equivalence, transfer, derivation,
             tolerance, identifiability, method)
+#: The index page's sections when the report has a page per group (``pages``); the list of groups goes before
+#: the last.
+INDEX_SECTIONS = (first_screen, summary, method)
 
 __all__ = ["SCHEMA", "SECTIONS", "Context", "Section", "build", "clean", "fit_json", "results_json",
            "tolerance_verdicts", "write_report"]
@@ -99,10 +105,18 @@ def _draw(i: int) -> bytes:
 _DRAWING = threading.Lock()  # one report at a time hands its figures to forked workers through _FIGURES
 
 
-def _drawn(figs, jobs: int):
-    """(index, PNG bytes) of every figure, in the order they finish: on ``jobs`` forked workers when jobs > 1."""
+def _drawn(figs, jobs: int, client=None):
+    """(index, PNG bytes) of every figure, in the order they finish: on ``jobs`` forked workers when jobs > 1,
+    or on a dask.distributed ``client``'s workers (the draw closures travel by cloudpickle)."""
+    from ..core.cluster import executor
     from ..core.workers import process_pool
 
+    if client is not None and len(figs) > 1:
+        with executor(1, client) as ex:
+            futures = {ex.submit(f.draw): i for i, f in enumerate(figs)}
+            for fut in as_completed(futures):
+                yield futures[fut], fut.result()
+        return
     if jobs <= 1 or len(figs) <= 1:
         for i, f in enumerate(figs):
             yield i, f.draw()
@@ -113,7 +127,7 @@ def _drawn(figs, jobs: int):
     with _DRAWING:
         _FIGURES[:] = figs
         try:
-            with process_pool(jobs) as pool:
+            with process_pool(jobs, "report: drawing the figures") as pool:
                 if pool is None:  # no fork on this platform
                     for i, f in enumerate(figs):
                         yield i, f.draw()
@@ -125,31 +139,67 @@ def _drawn(figs, jobs: int):
             _FIGURES.clear()
 
 
-def write_report(c, out, force: bool = False, progress=None, jobs: int = 1) -> Path:
+def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, client=None) -> Path:
     """Write the report folder ``out`` whole or not at all; an existing folder is replaced only with force=True.
 
     progress(done, total, label), if given, is called after each figure and file. jobs: worker
-    processes drawing the figures (the same PNG bytes as one process draws).
+    processes drawing the figures (the same PNG bytes as one process draws); client: a dask.distributed
+    Client whose workers draw them instead. A comparison of more than ``pages.GROUP_PAGES_AT`` dataset groups
+    is written as an index (report.html/.md: every group's verdict, the summary, a link per group) and one
+    page per group (groups/GROUP.html/.md, its figures in figures/GROUP/).
     """
+    from ..pipeline.comparison import Comparison
+
+    check_type(c, Comparison, "write_report: c", "a Comparison (what frictionlab.compare returns)")
+    check_type(out, (str, os.PathLike), "write_report: out", "a folder path")
+    check_apart(out, [p for d in c.datasets if d.path is not None for p in (d.path, d.path.with_suffix(".csv"))])
     out = Path(out)
     if out.exists() and not force:  # said in Python's terms; the command line checks before its work
         raise OutputError(f"{out}: the folder exists; pass force=True to replace it, or choose another folder")
     with atomic_dir(out, force=force) as tmp:
-        sections, extra = build(c)
-        figs = [f for s in sections for f in s.figures]
+        built, extra = _built_pages(c)
+        figs = [(figdir, f) for _, sections, figdir in built for s in sections for f in s.figures]
         total, images = len(figs) + 1, {}
-        (tmp / "figures").mkdir()
-        for done, (i, png) in enumerate(_drawn(figs, jobs), 1):
-            images[figs[i].name] = png
-            (tmp / "figures" / figs[i].name).write_bytes(png)
+        for done, (i, png) in enumerate(_drawn([f for _, f in figs], jobs, client), 1):
+            figdir, f = figs[i]
+            images[(figdir, f.name)] = png
+            (tmp / figdir).mkdir(parents=True, exist_ok=True)
+            (tmp / figdir / f.name).write_bytes(png)
             if progress:
-                progress(done, total, f"figure {figs[i].name}")
-        images = {f.name: images[f.name] for f in figs}  # in report order
-        (tmp / "report.md").write_text(markdown(TITLE, sections), encoding="utf-8")
-        (tmp / "report.html").write_text(html_page(TITLE, sections, images), encoding="utf-8")
+                progress(done, total, f"figure {f.name}")
+        (tmp / "figures").mkdir(exist_ok=True)
+        for path, sections, figdir in built:
+            page = tmp / path
+            page.parent.mkdir(parents=True, exist_ok=True)
+            up = "../" * path.count("/")
+            title = TITLE if path == "report" else f"{TITLE}: {path.split('/', 1)[1]}"
+            own = {f.name: images[(figdir, f.name)] for s in sections for f in s.figures}  # in page order
+            page.with_suffix(".md").write_text(markdown(title, sections, up + figdir), encoding="utf-8")
+            page.with_suffix(".html").write_text(html_page(title, sections, own), encoding="utf-8")
         (tmp / "ranking.csv").write_text(ranking_csv(c), encoding="utf-8")
         (tmp / "results.json").write_text(json.dumps(results_json(c, extra), indent=1, allow_nan=False),
                                           encoding="utf-8")
         if progress:
             progress(total, total, "report.md, report.html, ranking.csv, results.json")
     return out
+
+
+def _built_pages(c):
+    """[(page path without suffix, sections, figure folder)] and the extra numbers for results.json: one
+    page, or (many groups) the index and a page per group."""
+    from . import pages
+
+    if len(pages.groups_of(c)) <= pages.GROUP_PAGES_AT:
+        sections, extra = build(c)
+        return [("report", sections, "figures")], extra
+    built, extra = [], {}
+    for path, cc, modules, figdir, groups in pages.pages(c, SECTIONS, INDEX_SECTIONS):
+        sections, more = build(cc, modules)
+        if groups:
+            sections.insert(len(sections) - 1, pages.index_section(groups))
+        elif sections:  # a group's page: the way back to the index first
+            sections[0].blocks.insert(0, ("links", [("all dataset groups (the index)", "../report.html")]))
+        built.append((path, sections, figdir))
+        for k, v in more.items():  # one level deep: numbers per dataset from every page
+            extra[k] = {**extra.get(k, {}), **v} if isinstance(v, dict) else v
+    return built, extra

@@ -88,6 +88,12 @@ class Section:
         if rows:
             self.blocks.append(("table", Table(list(headers), rows)))
 
+    def links(self, items):
+        """A list of (label, relative address) links to other pages of the report."""
+        items = list(items)
+        if items:
+            self.blocks.append(("links", items))
+
     def fig(self, name: str, caption: str, draw: Callable[[], bytes], side: str = ""):
         """A figure file ``name`` (characters other than letters, digits, '.', '-' and '_' become '_'),
         optionally with a text ``side`` shown beside it."""

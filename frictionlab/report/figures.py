@@ -19,12 +19,9 @@ SAME_CURVE = 1e-3
 
 
 def _plt():
-    import matplotlib
+    from ..core.display import pyplot
 
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
-
-    return plt
+    return pyplot()
 
 
 def _png(fig) -> bytes:

@@ -1,8 +1,9 @@
 """Markdown and self-contained HTML from Sections, through the jinja2 templates in ``templates/``.
 
 Text in a Section may use **bold** and `code`; everything else is escaped: in HTML by jinja2's
-autoescape, in Markdown by turning < > & into entities (a dataset name or description never
-becomes raw HTML in either file).
+autoescape, in Markdown by ``md_text`` (entities for < > &, brackets escaped, lines joined, control
+characters dropped): a dataset name or description never becomes raw HTML, a link, an image, a
+heading or a table in either file.
 """
 from __future__ import annotations
 
@@ -13,6 +14,7 @@ from functools import lru_cache
 
 from markupsafe import Markup
 
+from ..core.terminal import inert
 from .doc import is_numeric
 
 
@@ -23,13 +25,28 @@ def inline_html(text: str) -> Markup:
     return Markup(re.sub(r"`(.+?)`", r"<code>\1</code>", s))
 
 
+#: What could open a block at the start of a line: a heading, a list item, a numbered item, a rule,
+#: a fence (a quote '>' is already an entity).
+_BLOCK_START = re.compile(r"^(\d+)?(#|[-+*](?=\s)|[.)](?=\s|$)|```|~~~)")
+
+
 def md_text(text: str) -> str:
-    """Text for Markdown: HTML specials as entities, newlines kept."""
-    return html.escape(str(text), quote=False)
+    """Text for Markdown, inert: control characters dropped; lines joined (a multi-line description
+    cannot start a heading or a table); HTML specials as entities; backslashes and a ']' before '(',
+    '[' or ':' escaped (no link, image or reference can open: no remote image, no javascript: link);
+    a leading block marker escaped.
+    ``**bold**`` and ```code``` still work, as in the HTML."""
+    return _BLOCK_START.sub(lambda m: (m.group(1) or "") + "\\" + m.group(2), _md_inline(text))
+
+
+def _md_inline(text: str) -> str:
+    s = re.sub(r"\s*\n\s*", " ", inert(str(text))).strip()
+    s = html.escape(s, quote=False).replace("\\", "\\\\")
+    return re.sub(r"\](?=[(\[:])", r"\\]", s)  # '](', '][', ']:' escaped: no link, image or reference opens
 
 
 def md_cell(text: str) -> str:
-    return md_text(text).replace("|", "\\|").replace("\n", " ")
+    return _md_inline(text).replace("|", "\\|")
 
 
 def sort_key(cell: str) -> str:
@@ -54,8 +71,9 @@ def environment():
     return env
 
 
-def markdown(title: str, sections) -> str:
-    return environment().get_template("report.md.j2").render(title=title, sections=sections)
+def markdown(title: str, sections, figdir: str = "figures") -> str:
+    """The page's Markdown; figures are linked from ``figdir`` (relative to the page)."""
+    return environment().get_template("report.md.j2").render(title=title, sections=sections, figdir=figdir)
 
 
 def html_page(title: str, sections, images: dict[str, bytes]) -> str:

@@ -35,7 +35,8 @@ def build(ctx) -> Section:
           f"{c.versions.get('frictionlab')}; the comparison took {c.wall_time:.1f} s"
           + (" (" + ", ".join(f"{k} {v:.1f} s" for k, v in c.timings.items()) + ", partly in parallel)"
              if len(c.timings) > 1 else "")
-          + f" on {jobs} worker process{'es' * (jobs != 1)}. Laws: {', '.join(c.laws)}. "
+          + (f" on a {c.settings['cluster']}" if c.settings.get("cluster") else
+             f" on {jobs} worker process{'es' * (jobs != 1)}") + f". Laws: {', '.join(c.laws)}. "
           f"Datasets: {len(c.datasets)} ({len(fitted)} fitted).")
     if [n for k, v in kinds.items() if k != "measured" for n in v]:
         parts = [f"{len(v)} {PROVENANCE_WORDS.get(k, k)} ({', '.join(v)})" for k, v in kinds.items()]

@@ -20,7 +20,7 @@ against the numpy engine to 1e-12. The kernel's right-hand side ``_rhs`` is the 
 forms' derivatives as ``Plan.derivatives`` computes them (branch slip included); it is the one place
 physics is written here, and the tests check it against ``Plan.derivatives``.
 
-``scatter_stuck`` does the bookkeeping of ``batch._fill_stuck`` (which outputs a stuck phase owns, and
+``scatter_stuck`` does the bookkeeping of ``batchstick.fill_stuck`` (which outputs a stuck phase owns, and
 writing them) in one compiled pass for the same batches; the stuck states themselves come from
 ``solvers.stick.stuck_states``.
 
@@ -102,22 +102,12 @@ def _normal_code(model):
     return {HalfSineNormal: HALF_SINE, WeightNormal: CONSTANT, ConstantNormal: CONSTANT}.get(type(model))
 
 
-def prepare(law, plan, p, n: int):
-    """A ``Prepared`` for the n scenes of the batch view ``plan`` (arrays over scenes) and batch
-    parameters p, or None where the compiled path does not serve them (numba absent, plugin law, law
-    with memory, unknown scene model or state)."""
-    from ..physics.law import AreaSlipForm, NormalAreaRateForm
+def _form_codes(law, plan, form):
+    """(form code, area code, normal code, a or k, c) of the law's closed-form family on this plan, or None
+    where the kernel does not know the form or a model it reads."""
+    from ..physics.law import AreaSlipForm
 
-    if not type(law).__module__.startswith("frictionlab.laws."):
-        return None
     s = plan.scene
-    if plan.law_states or s.spring is not None:
-        return None
-    if plan.states not in (("v",), ("v", "omega", "theta")):
-        return None
-    form = law.form(p)
-    if not isinstance(form, (AreaSlipForm, NormalAreaRateForm)) or not available():
-        return None
     req = law.requires
     area = _area_code(s.area) if plan.needs_area else NONE
     normal = _normal_code(s.normal) if plan.needs_normal else NONE
@@ -126,20 +116,24 @@ def prepare(law, plan, p, n: int):
     if isinstance(form, AreaSlipForm):
         if "A" not in req or area == NONE:
             return None
-        code, a, c = FORM_AS, form.k, 0.0
-    else:
-        if "N" not in req or normal == NONE:
-            return None
-        code, a, c = FORM_NAR, form.a, form.c
-        if np.any(np.asarray(c) != 0.0) and ("dAdt" not in req or area == NONE):
-            return None
+        return FORM_AS, area, normal, form.k, 0.0
+    if "N" not in req or normal == NONE:
+        return None
+    if np.any(np.asarray(form.c) != 0.0) and ("dAdt" not in req or area == NONE):
+        return None
+    return FORM_NAR, area, normal, form.a, form.c
+
+
+def _columns(plan, n, area, normal, a, c):
+    """The kernel's per-scene numbers (n, NCOL): body, drive, form coefficients, contact models, breaks."""
+    from .solvers.stick import vanishing_slip
+
+    s = plan.scene
     cols = np.zeros((n, NCOL))
     spin = plan.has_spin
 
     def put(col, value):
         cols[:, col] = np.broadcast_to(np.asarray(value, dtype=float), (n,))
-
-    from .solvers.stick import vanishing_slip
 
     put(MASS, s.mass)
     put(RADIUS, s.radius if spin else 0.0)
@@ -160,12 +154,34 @@ def prepare(law, plan, p, n: int):
         put(NORMAL_TC, s.normal.contact_time)
     elif normal == CONSTANT:
         put(NORMAL_CONST, s.normal.value)
-    # breaks as ``batch._breaks`` takes them: every half-sine model's end of contact, read or not
+    # breaks as ``batchrk.breaks`` takes them: every half-sine model's end of contact, read or not
     put(BREAK_AREA, getattr(s.area, "contact_time", np.nan))
     put(BREAK_NORMAL, getattr(s.normal, "contact_time", np.nan))
+    return cols
+
+
+def prepare(law, plan, p, n: int):
+    """A ``Prepared`` for the n scenes of the batch view ``plan`` (arrays over scenes) and batch
+    parameters p, or None where the compiled path does not serve them (numba absent, plugin law, law
+    with memory, unknown scene model or state)."""
+    from ..physics.law import AreaSlipForm, NormalAreaRateForm
+
+    if not type(law).__module__.startswith("frictionlab.laws."):
+        return None
+    if plan.law_states or plan.scene.spring is not None:
+        return None
+    if plan.states not in (("v",), ("v", "omega", "theta")):
+        return None
+    form = law.form(p)
+    if not isinstance(form, (AreaSlipForm, NormalAreaRateForm)) or not available():
+        return None
+    found = _form_codes(law, plan, form)
+    if found is None:
+        return None
+    code, area, normal, a, c = found
     need_dadt = code == FORM_NAR and bool(np.any(np.asarray(c) != 0.0))
-    codes = np.array([code, area, normal, int(plan.coupled), int(spin), int(need_dadt)], dtype=np.int64)
-    return Prepared(codes, cols)
+    codes = np.array([code, area, normal, int(plan.coupled), int(plan.has_spin), int(need_dadt)], dtype=np.int64)
+    return Prepared(codes, _columns(plan, n, area, normal, a, c))
 
 
 def _tableau(method):
@@ -196,7 +212,7 @@ class Prepared:
 
     def integrate(self, ids, t0, y0, direction, span, scale, T, method, rtol, atol=None, out=None) -> vecrk.Result:
         """One sliding phase of scenes ``ids`` (positions in the chunk) on the scaled problem, as
-        ``batch._slide_rk`` with ``vecrk.integrate``: t0 (n,) [s], y0 (d, n), direction (n,), span (n,) [s] and
+        ``batchrk.slide_rk`` with ``vecrk.integrate``: t0 (n,) [s], y0 (d, n), direction (n,), span (n,) [s] and
         scale (d, n) over the whole chunk; T (n, m) the chunk's output times [s]. The Result's Y is in the
         states' units (``scaled=False``), written into ``out`` (d, k, m) when given."""
         kern = _compiled().kernel
@@ -204,7 +220,7 @@ class Prepared:
         d, k, m = y0.shape[0], ids.size, T.shape[1]
         rel = np.linspace(0.0, 1.0, m)
         per_row = not (T.strides[0] == 0 and np.all(span[ids] == span[ids[0]]))
-        grid = np.ascontiguousarray(T) if per_row else (T[0] / span[ids[0]])[None, :]  # as batch._scaled_grid
+        grid = np.ascontiguousarray(T) if per_row else (T[0] / span[ids[0]])[None, :]  # as batchrk.scaled_grid
         Y = np.empty((d, k, m)) if out is None else out
         reached = np.empty((k, m), dtype=bool)  # every entry written
         t_event = np.full(k, np.nan)
@@ -227,7 +243,7 @@ class Prepared:
 
 
 def scatter_stuck(Ys, rows, Ts, t_from, t_to, done, stuck_mask, Y):
-    """``compiled_kernel.scatter_stuck`` (the bookkeeping of ``batch._fill_stuck``) for states Y (d, n, m)."""
+    """``compiled_kernel.scatter_stuck`` (the bookkeeping of ``batchstick.fill_stuck``) for states Y (d, n, m)."""
     d = Y.shape[0]
     _compiled().scatter_stuck(np.ascontiguousarray(Ys), np.ascontiguousarray(rows, dtype=np.int64),
                               np.ascontiguousarray(Ts), np.ascontiguousarray(t_from, dtype=float),

@@ -88,7 +88,7 @@ def _constants(cols, g):
 
 @jit
 def _comb(coef, K, nterm):
-    """sum_j coef[j] K[j] over the nonzero coefficients, added in order (as ``vecrk._vec_dot``)."""
+    """sum_j coef[j] K[j] over the nonzero coefficients, added in order (as ``vecdense.vec_dot``)."""
     a0 = a1 = a2 = 0.0
     first = True
     for j in range(nterm):
@@ -106,7 +106,7 @@ def _comb(coef, K, nterm):
 
 @jit
 def _dense(Fc, nc, dop, x, h, y0, y1, y2):
-    """The step's dense output at fraction x (``vecrk._Dense``: DOP853's nested x, 1 - x products, or
+    """The step's dense output at fraction x (``vecdense.Dense``: DOP853's nested x, 1 - x products, or
     RK45's polynomial times h)."""
     a0, a1, a2 = Fc[nc - 1, 0] * x, Fc[nc - 1, 1] * x, Fc[nc - 1, 2] * x
     if dop:
@@ -143,7 +143,7 @@ def kernel(A, B, Cn, E, AX, CX, D, order, exponent, dop, codes, cols, ids, t0a, 
     into t_event[i], y_event[:, i], evaluations into nfev[i]; a failure into stat. Returns the most
     step attempts of a scene. Output times: grid[0] (scaled) for every scene, or with per_row each scene's
     row of grid (times [s], the chunk's rows), taken as exactly ``rel`` where it is span * rel (as
-    ``batch._scaled_grid`` takes them), else divided by the span."""
+    ``batchrk.scaled_grid`` takes them), else divided by the span."""
     d = y0a.shape[0]
     k = ids.size
     m = grid.shape[1]
@@ -310,7 +310,7 @@ def kernel(A, B, Cn, E, AX, CX, D, order, exponent, dop, codes, cols, ids, t0a, 
                 stop = g_new <= 0.0 and g_old > 0.0
                 g_old = g_new
                 if stop or (ptr < m and gr[ptr] <= t_new):
-                    if dop:  # DOP853's extra stages and interpolant (vecrk._dense)
+                    if dop:  # DOP853's extra stages and interpolant (vecdense.dense_output)
                         for j in range(nx):
                             sx = ns + 1 + j
                             c0, c1, c2 = _comb(AX[j], K, sx)
@@ -405,7 +405,7 @@ def kernel(A, B, Cn, E, AX, CX, D, order, exponent, dop, codes, cols, ids, t0a, 
 
 @numba.njit(cache=True)
 def scatter_stuck(Ys, rows, Ts, t_from, t_to, done, stuck_mask, Y0, Y1, Y2):
-    """Bookkeeping of ``batch._fill_stuck`` in one pass: the stuck states Ys (d, k, m) of scenes rows at
+    """Bookkeeping of ``batchstick.fill_stuck`` in one pass: the stuck states Ys (d, k, m) of scenes rows at
     their output times Ts (k, m) into the outputs of those scenes in [t_from, t_to] not yet done (rows
     of Y0, Y1, Y2), marking them done and stuck. No physics: Ys comes from ``stick.stuck_states``."""
     d = Ys.shape[0]

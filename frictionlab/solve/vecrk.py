@@ -18,11 +18,13 @@ import numpy as np
 from scipy.integrate import DOP853, RK45
 
 from ..core.errors import SolverError
+from .vecdense import dense_output, fill_at_start, fill_dense, has_outputs, rows_dot, vec_dot
 
 METHODS = ("RK45", "DOP853")
 SAFETY, MIN_FACTOR, MAX_FACTOR = 0.9, 0.2, 10.0
 MAX_ITERATIONS = 200_000
 BISECTIONS = 60  # event location: interval shrinks by 2^-60, below double resolution
+EPS4 = 1 + 4 * np.finfo(float).eps
 
 
 @attrs.frozen
@@ -41,41 +43,176 @@ class Result:
     scaled: bool = True
 
 
-def _rows_dot(M, K, out=None, tmp=None):
-    """M @ K, row by row (see ``_vec_dot``)."""
-    out = np.empty((M.shape[0], K.shape[1])) if out is None else out
-    tmp = np.empty(K.shape[1]) if tmp is None else tmp
-    for i, row in enumerate(M):
-        _vec_dot(row, K, out[i], tmp)
-    return out
-
-
-def _vec_dot(a, K, out=None, tmp=None):
-    """a @ K for a (s,), K (s, n): the terms of nonzero coefficients added in order, in place (tmp: a
-    scratch row).
-
-    Not BLAS or einsum: those may start threads (on a shared machine costing several times the CPU they
-    save) and sum in an order that depends on n, so a scene's result would depend on its batch's size."""
-    out = np.empty(K.shape[1]) if out is None else out
-    first = True
-    for j, c in enumerate(a.tolist()):
-        if c == 0.0:
-            continue
-        if first:
-            np.multiply(K[j], c, out=out)
-            first = False
-        else:
-            if tmp is None:
-                tmp = np.empty_like(out)
-            np.multiply(K[j], c, out=tmp)
-            out += tmp
-    if first:
-        out.fill(0.0)
-    return out
-
-
 def _rms(x):
     return np.sqrt(np.mean(x * x, axis=0))
+
+
+class _Run:
+    """One ``integrate`` call: every problem's time, state, step and output pointer; ``step`` advances the
+    unfinished ones by one step attempt."""
+
+    def __init__(self, make_rhs, t0, y0, t_end, t_out, method, rtol, atol, make_event, breaks, out):
+        if method not in METHODS:
+            raise SolverError(f"batch: unknown method {method!r}; choose one of {', '.join(METHODS)}")
+        self.cls = cls = {"RK45": RK45, "DOP853": DOP853}[method]
+        self.method, self.make_rhs, self.make_event, self.breaks = method, make_rhs, make_event, breaks
+        self.rtol, self.atol = rtol, rtol if atol is None else atol
+        t0 = np.asarray(t0, dtype=float)
+        self.y = y = np.array(y0, dtype=float)
+        d, n = y.shape
+        self.t_end = np.broadcast_to(np.asarray(t_end, dtype=float), (n,))
+        t_out = np.asarray(t_out, dtype=float)
+        self.m = m = t_out.shape[-1]
+        self.shared = shared = t_out if t_out.ndim == 1 else (t_out[0] if np.all(t_out == t_out[:1]) else None)
+        self.t_out = shared[None, :] if shared is not None else t_out  # one grid: row 0 for every problem (``times``)
+        self.Y = np.full((d, n, m), np.nan) if out is None else out
+        if out is not None:
+            assert out.shape == (d, n, m) and all(o.flags.c_contiguous for o in out)  # written through flat views
+            self.Y.fill(np.nan)
+        self.t_event = np.full(n, np.nan)
+        self.y_event = np.full((d, n), np.nan)
+        self.nfev = np.zeros(n, dtype=np.int64)
+        # next output index per problem: first t_out >= t0 (outputs exactly at t0 are the initial state)
+        self.ptr = np.searchsorted(shared, t0, side="left") if shared is not None else (self.t_out < t0[:, None]).sum(axis=1)
+        self.t = t0.copy()
+        self.active = np.nonzero(self.t < self.t_end)[0]
+        self.ptr0 = self.ptr.copy()  # outputs are filled contiguously from here: reached is [ptr0, ptr) at the end
+        fill_at_start(self.Y, self.ptr, self.t_out, self.t, y)
+        self.iterations = 0
+        self.exponent = -1.0 / (cls.error_estimator_order + 1)
+        self.nk = cls.n_stages + 1 + (len(cls.C_EXTRA) if cls is DOP853 else 0)  # stages, f_new, DOP853's extras
+        self.E = np.array([cls.E5, cls.E3]) if cls is DOP853 else cls.E[None]
+
+    def result(self) -> Result:
+        return Result(self.Y, _reached(self.ptr0, self.ptr, self.m), self.t_event, self.y_event, self.nfev,
+                      self.iterations)
+
+    def start(self):
+        """The right-hand side, event and first step of every active problem (scipy's initial step)."""
+        t, y, active, breaks = self.t, self.y, self.active, self.breaks
+        d, n = y.shape
+        self.rhs = rhs = self.make_rhs(active)
+        self.g = g = self.make_event(active) if self.make_event else None
+        f = rhs(t[active], y[:, active])
+        self.nfev[active] += 1
+        g_old = g(t[active], y[:, active]) if g else None
+        h = _initial_step(rhs, t[active], y[:, active], f, self.t_end[active] - t[active], self.cls.order, self.rtol,
+                          self.atol)
+        if breaks is not None:  # a first step that would cross a break is sized to reach it
+            h = np.minimum(h, np.where(breaks[active] > t[active, None], breaks[active] - t[active, None],
+                                       np.inf).min(axis=1))
+        self.nfev[active] += 1
+        self.F = np.empty((d, n))
+        self.F[:, active] = f
+        self.H = np.zeros(n)
+        self.H[active] = h
+        self.Gold = np.full(n, np.nan)
+        if g:
+            self.Gold[active] = g_old
+        self.rejected = np.zeros(n, dtype=bool)
+
+    def _step_size(self, ta):
+        """This attempt's steps: the proposed ones, cut at the end and at the next break; underflow is an error."""
+        active, t, breaks = self.active, self.t, self.breaks
+        ha = np.minimum(self.H[active], self.t_end[active] - ta)
+        if breaks is not None:
+            b = breaks[active]
+            ahead = np.where(b > ta[:, None] * EPS4, b, np.inf).min(axis=1)
+            np.minimum(ha, ahead - ta, out=ha)
+        min_step = 10.0 * np.abs(np.nextafter(ta, np.inf) - ta)
+        if np.any(ha < min_step):
+            bad = active[np.argmax(ha < min_step)]
+            raise SolverError(f"batch {self.method}: step size underflow in problem {bad} at t = {t[bad]:g}")
+        return ha
+
+    def _attempt(self, ta, ya, ha):
+        """The stages of one step as scipy's rk_step takes them (dy = h (K[:s]^T a), one product per stage):
+        (stages K, y_new, f_new, error norm)."""
+        cls, rhs, active = self.cls, self.rhs, self.active
+        d, k = ya.shape
+        A, B, C, ns = cls.A, cls.B, cls.C, cls.n_stages
+        K = np.empty((self.nk, d, k))
+        Kf = K.reshape(self.nk, d * k)
+        tmp = np.empty(d * k)  # scratch row of the stage combinations
+        np.take(self.F, active, axis=1, out=K[0])
+        for s in range(1, ns):
+            dy = vec_dot(A[s, :s], Kf[:s], tmp=tmp).reshape(d, k)
+            dy *= ha
+            dy += ya
+            K[s] = rhs(ta + C[s] * ha, dy)
+        y_new = vec_dot(B, Kf[:ns], tmp=tmp).reshape(d, k)
+        y_new *= ha
+        y_new += ya
+        K[ns] = f_new = rhs(ta + ha, y_new)
+        self.nfev[active] += ns
+        scale = np.maximum(np.abs(ya), np.abs(y_new))
+        scale *= self.rtol
+        scale += self.atol
+        err = _error_norm(cls, rows_dot(self.E, Kf[: ns + 1], tmp=tmp).reshape(len(self.E), d, k), ha, scale)
+        return K, y_new, f_new, err
+
+    def step(self):
+        """One step attempt of every unfinished problem: accepted steps move on, fill outputs and locate events."""
+        self.iterations += 1
+        if self.iterations > MAX_ITERATIONS:
+            raise SolverError(f"batch {self.method}: more than {MAX_ITERATIONS} steps; the problem is stiff or singular")
+        active = self.active
+        ta, ya = self.t[active], self.y[:, active]
+        ha = self._step_size(ta)
+        K, y_new, f_new, err = self._attempt(ta, ya, ha)
+        t_new = ta + ha
+        ok = err < 1.0
+        with np.errstate(divide="ignore"):
+            factor = np.where(err == 0.0, MAX_FACTOR, SAFETY * np.float_power(err, self.exponent))  # libm pow, as scipy
+        factor = np.where(ok, np.minimum(MAX_FACTOR, factor), np.maximum(MIN_FACTOR, factor))
+        factor = np.where(ok & self.rejected[active], np.minimum(1.0, factor), factor)
+        self.H[active] = ha * factor
+        self.rejected[active] = ~ok
+        acc = np.nonzero(ok)[0]
+        if acc.size:
+            self._accept(acc, ta, ya, ha, K, y_new, t_new, f_new)
+
+    def _accept(self, acc, ta, ya, ha, K, y_new, t_new, f_new):
+        """Accepted steps (rows acc of the active set): events, outputs on the dense output, the new states."""
+        active, g = self.active, self.g
+        k = active.size
+        ia = active[acc]
+        stop = np.zeros(acc.size, dtype=bool)
+        if g:
+            g_new = g(t_new, y_new)[acc]
+            stop = (g_new <= 0.0) & (self.Gold[ia] > 0.0)
+            self.Gold[ia] = g_new
+        needs_dense = stop | has_outputs(self.t_out, self.ptr, ia, t_new[acc])
+        if needs_dense.any():
+            dense = dense_output(self.cls, self.rhs, K, ta, ha, ya, y_new, f_new)
+            if self.cls is DOP853:
+                self.nfev[active] += 3
+            t_stop_acc = t_new[acc]
+            if stop.any():
+                je = np.nonzero(stop)[0]
+                ts, ys = _locate(self.make_event, ia[je], dense, acc[je], ta[acc[je]], ha[acc[je]])
+                t_stop_acc = t_stop_acc.copy()
+                t_stop_acc[je] = ts
+                self.t_event[ia[je]] = ts
+                self.y_event[:, ia[je]] = ys
+            jd = np.nonzero(needs_dense)[0]
+            fill_dense(self.Y, self.ptr, self.t_out, ia[jd], acc[jd], t_stop_acc[jd], dense, self.shared)
+        if acc.size == k:
+            self.t[ia] = t_new
+            self.y[:, ia] = y_new
+            self.F[:, ia] = f_new
+        else:
+            self.t[ia] = t_new[acc]
+            self.y[:, ia] = y_new[:, acc]
+            self.F[:, ia] = f_new[:, acc]
+        done = stop | (t_new[acc] >= self.t_end[ia])
+        if done.any():
+            keep = np.ones(k, dtype=bool)
+            keep[acc[done]] = False
+            self.active = active = active[keep]
+            if active.size:
+                self.rhs = self.make_rhs(active)
+                self.g = self.make_event(active) if self.make_event else None
 
 
 def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: float = 1e-8, atol: float | None = None,
@@ -90,143 +227,12 @@ def integrate(make_rhs, t0, y0, t_end, t_out, method: str = "DOP853", rtol: floa
     crosses one, so a short forcing window before it cannot be stepped over. out (n_states, n, m), each
     out[j] C-contiguous, if given, receives the outputs (a view into a caller's larger array).
     """
-    if method not in METHODS:
-        raise SolverError(f"batch: unknown method {method!r}; choose one of {', '.join(METHODS)}")
-    cls = {"RK45": RK45, "DOP853": DOP853}[method]
-    atol = rtol if atol is None else atol
-    t0 = np.asarray(t0, dtype=float)
-    y = np.array(y0, dtype=float)
-    d, n = y.shape
-    t_end = np.broadcast_to(np.asarray(t_end, dtype=float), (n,))
-    t_out = np.asarray(t_out, dtype=float)
-    m = t_out.shape[-1]
-    shared = t_out if t_out.ndim == 1 else (t_out[0] if np.all(t_out == t_out[:1]) else None)  # one grid for all
-    if shared is not None:
-        t_out = shared[None, :]  # indexed as row 0 for every problem (``_times``)
-    Y = np.full((d, n, m), np.nan) if out is None else out
-    if out is not None:
-        assert out.shape == (d, n, m) and all(o.flags.c_contiguous for o in out)  # written through flat views
-        Y.fill(np.nan)
-    t_event = np.full(n, np.nan)
-    y_event = np.full((d, n), np.nan)
-    nfev = np.zeros(n, dtype=np.int64)
-    # next output index per problem: first t_out >= t0 (outputs exactly at t0 are the initial state)
-    ptr = np.searchsorted(shared, t0, side="left") if shared is not None else (t_out < t0[:, None]).sum(axis=1)
-    t = t0.copy()
-    active = np.nonzero(t < t_end)[0]
-    ptr0 = ptr.copy()  # outputs are filled contiguously from here: reached is [ptr0, ptr) at the end
-    _fill_at_start(Y, ptr, t_out, t, y)
-    if active.size == 0:
-        return Result(Y, _reached(ptr0, ptr, m), t_event, y_event, nfev, 0)
-
-    order = cls.error_estimator_order
-    exponent = -1.0 / (order + 1)
-    A, B, C = cls.A, cls.B, cls.C
-    ns = cls.n_stages
-    nk = ns + 1 + (len(cls.C_EXTRA) if cls is DOP853 else 0)  # stages, f_new, DOP853's extra dense stages
-    E = np.array([cls.E5, cls.E3]) if cls is DOP853 else cls.E[None]
-    rhs = make_rhs(active)
-    g = make_event(active) if make_event else None
-    f = rhs(t[active], y[:, active])
-    nfev[active] += 1
-    g_old = g(t[active], y[:, active]) if g else None
-    h = _initial_step(rhs, t[active], y[:, active], f, t_end[active] - t[active], cls.order, rtol, atol)
-    if breaks is not None:  # a first step that would cross a break is sized to reach it
-        h = np.minimum(h, np.where(breaks[active] > t[active, None], breaks[active] - t[active, None], np.inf).min(axis=1))
-    nfev[active] += 1
-    F = np.empty((d, n))
-    F[:, active] = f
-    H = np.zeros(n)
-    H[active] = h
-    Gold = np.full(n, np.nan)
-    if g:
-        Gold[active] = g_old
-    rejected = np.zeros(n, dtype=bool)
-    iterations = 0
-    eps4 = 1 + 4 * np.finfo(float).eps
-    while active.size:
-        iterations += 1
-        if iterations > MAX_ITERATIONS:
-            raise SolverError(f"batch {method}: more than {MAX_ITERATIONS} steps; the problem is stiff or singular")
-        k = active.size
-        ta, ya = t[active], y[:, active]
-        ha = np.minimum(H[active], t_end[active] - ta)
-        if breaks is not None:
-            b = breaks[active]
-            ahead = np.where(b > ta[:, None] * eps4, b, np.inf).min(axis=1)
-            np.minimum(ha, ahead - ta, out=ha)
-        min_step = 10.0 * np.abs(np.nextafter(ta, np.inf) - ta)
-        if np.any(ha < min_step):
-            bad = active[np.argmax(ha < min_step)]
-            raise SolverError(f"batch {method}: step size underflow in problem {bad} at t = {t[bad]:g}")
-        # stages as scipy's rk_step takes them: dy = h (K[:s]^T a), one matrix product per stage
-        K = np.empty((nk, d, k))
-        Kf = K.reshape(nk, d * k)
-        tmp = np.empty(d * k)  # scratch row of the stage combinations
-        np.take(F, active, axis=1, out=K[0])
-        for s in range(1, ns):
-            dy = _vec_dot(A[s, :s], Kf[:s], tmp=tmp).reshape(d, k)
-            dy *= ha
-            dy += ya
-            K[s] = rhs(ta + C[s] * ha, dy)
-        y_new = _vec_dot(B, Kf[:ns], tmp=tmp).reshape(d, k)
-        y_new *= ha
-        y_new += ya
-        t_new = ta + ha
-        K[ns] = f_new = rhs(t_new, y_new)
-        nfev[active] += ns
-        scale = np.maximum(np.abs(ya), np.abs(y_new))
-        scale *= rtol
-        scale += atol
-        err = _error_norm(cls, _rows_dot(E, Kf[: ns + 1], tmp=tmp).reshape(len(E), d, k), ha, scale)
-        ok = err < 1.0
-        with np.errstate(divide="ignore"):
-            factor = np.where(err == 0.0, MAX_FACTOR, SAFETY * np.float_power(err, exponent))  # libm pow, as scipy
-        factor = np.where(ok, np.minimum(MAX_FACTOR, factor), np.maximum(MIN_FACTOR, factor))
-        factor = np.where(ok & rejected[active], np.minimum(1.0, factor), factor)
-        H[active] = ha * factor
-        rejected[active] = ~ok
-        acc = np.nonzero(ok)[0]
-        if acc.size == 0:
-            continue
-        ia = active[acc]
-        stop = np.zeros(acc.size, dtype=bool)
-        if g:
-            g_new = g(t_new, y_new)[acc]
-            stop = (g_new <= 0.0) & (Gold[ia] > 0.0)
-            Gold[ia] = g_new
-        needs_dense = stop | _has_outputs(t_out, ptr, ia, t_new[acc])
-        if needs_dense.any():
-            dense = _dense(cls, rhs, K, ta, ha, ya, y_new, f_new)
-            if cls is DOP853:
-                nfev[active] += 3
-            t_stop_acc = t_new[acc]
-            if stop.any():
-                je = np.nonzero(stop)[0]
-                ts, ys = _locate(make_event, ia[je], dense, acc[je], ta[acc[je]], ha[acc[je]])
-                t_stop_acc = t_stop_acc.copy()
-                t_stop_acc[je] = ts
-                t_event[ia[je]] = ts
-                y_event[:, ia[je]] = ys
-            jd = np.nonzero(needs_dense)[0]
-            _fill_dense(Y, ptr, t_out, ia[jd], acc[jd], t_stop_acc[jd], dense, shared)
-        if acc.size == k:
-            t[ia] = t_new
-            y[:, ia] = y_new
-            F[:, ia] = f_new
-        else:
-            t[ia] = t_new[acc]
-            y[:, ia] = y_new[:, acc]
-            F[:, ia] = f_new[:, acc]
-        done = stop | (t_new[acc] >= t_end[ia])
-        if done.any():
-            keep = np.ones(active.size, dtype=bool)
-            keep[acc[done]] = False
-            active = active[keep]
-            if active.size:
-                rhs = make_rhs(active)
-                g = make_event(active) if make_event else None
-    return Result(Y, _reached(ptr0, ptr, m), t_event, y_event, nfev, iterations)
+    run = _Run(make_rhs, t0, y0, t_end, t_out, method, rtol, atol, make_event, breaks, out)
+    if run.active.size:
+        run.start()
+        while run.active.size:
+            run.step()
+    return run.result()
 
 
 def _reached(ptr0, ptr, m):
@@ -260,147 +266,6 @@ def _initial_step(rhs, t0, y0, f0, span, order, rtol, atol):
     with np.errstate(divide="ignore"):
         h1 = np.where(big <= 1e-15, np.maximum(1e-6, h0 * 1e-3), (0.01 / np.where(big > 0, big, 1.0)) ** (1.0 / (order + 1)))
     return np.minimum(np.minimum(100 * h0, h1), span)
-
-
-def _times(t_out, rows, cols):
-    """t_out[rows, cols] of an (n, m) grid, or of one grid for all problems (a (1, m) row)."""
-    return t_out[0, cols] if t_out.shape[0] == 1 else t_out[rows, cols]
-
-
-def _has_outputs(t_out, ptr, idx, t_new):
-    m = t_out.shape[1]
-    p = np.minimum(ptr[idx], m - 1)
-    return (ptr[idx] < m) & (_times(t_out, idx, p) <= t_new)
-
-
-class _Dense:
-    """Dense output over the steps [t_old, t_old + h] of the active problems.
-
-    Coefficients are stored as (d, n_coef, k) so that evaluating many output times per problem is a
-    Horner scheme on (d, q, c) arrays broadcast from the problems' coefficients, with no gathering
-    per output time."""
-
-    def __init__(self, kind, t_old, h, y_old, coef):
-        self.kind, self.t_old, self.h, self.y_old = kind, t_old, h, y_old
-        self.coef = coef.transpose(1, 0, 2)  # (d, nc, k) view
-
-    def subset(self, rows) -> "_Dense":
-        """The dense output of rows only (so repeated calls need no gathering)."""
-        out = object.__new__(_Dense)
-        out.kind = self.kind
-        out.t_old, out.h, out.y_old, out.coef = self.t_old[rows], self.h[rows], self.y_old[:, rows], self.coef[:, :, rows]
-        return out
-
-    def __call__(self, x, rows=None):
-        """States at fractions x of the step, x (q,) or (q, c), for problems rows (q,) (None: all) -> (d,) + x.shape."""
-        if rows is None:
-            C, y0, h = self.coef, self.y_old, self.h
-        else:
-            C, y0, h = self.coef[:, :, rows], self.y_old[:, rows], self.h[rows]
-        nc = C.shape[1]
-        if x.ndim == 2:
-            C, y0, h = C[..., None], y0[..., None], h[:, None]
-        acc = C[:, nc - 1] * x
-        if self.kind == "RK45":  # y_old + h * sum_j Q_j x^(j+1)
-            for j in range(nc - 2, -1, -1):
-                acc += C[:, j]
-                acc *= x
-            acc *= h
-        else:  # DOP853: nested x, (1 - x) products
-            om = 1.0 - x
-            for i, j in enumerate(range(nc - 2, -1, -1), start=1):
-                acc += C[:, j]
-                acc *= x if i % 2 == 0 else om
-        acc += y0
-        return acc
-
-
-def _dense(cls, rhs, K, t_old, h, y_old, y_new, f_new):
-    """Dense output of the steps just taken by the whole active set (rejected rows are never read).
-
-    K (n_k, d, k) holds the stages and f_new; DOP853's extra stages are written into its last rows."""
-    nk, d, k = K.shape
-    Kf = K.reshape(nk, d * k)
-    if cls is RK45:
-        return _Dense("RK45", t_old, h, y_old, _rows_dot(cls.P.T, Kf[: cls.n_stages + 1]).reshape(-1, d, k))
-    from scipy.integrate._ivp import (
-        dop853_coefficients as dc,  # INTERPOLATOR_POWER only
-    )
-
-    s0 = cls.n_stages + 1
-    for j, (a, c) in enumerate(zip(cls.A_EXTRA, cls.C_EXTRA)):
-        s = s0 + j
-        dy = _vec_dot(a[:s], Kf[:s]).reshape(d, k)
-        dy *= h
-        dy += y_old
-        K[s] = rhs(t_old + c * h, dy)
-    Fc = np.empty((dc.INTERPOLATOR_POWER, d, k))
-    dyv = np.subtract(y_new, y_old, out=Fc[0])
-    np.multiply(K[0], h, out=Fc[1])
-    Fc[1] -= dyv
-    np.add(f_new, K[0], out=Fc[2])
-    Fc[2] *= -h
-    Fc[2] += 2 * dyv
-    _rows_dot(cls.D, Kf, out=Fc[3:].reshape(len(cls.D), d * k))
-    Fc[3:] *= h
-    return _Dense("DOP853", t_old, h, y_old, Fc)
-
-
-def _fill_at_start(Y, ptr, t_out, t, y):
-    """Outputs requested exactly at each problem's start time take its initial state."""
-    m = t_out.shape[1]
-    rows = np.nonzero((ptr < m))[0]
-    if rows.size == 0:
-        return
-    at = _times(t_out, rows, ptr[rows]) == t[rows]
-    r = rows[at]
-    Y[:, r, ptr[r]] = y[:, r]
-    ptr[r] += 1
-
-
-def _fill_dense(Y, ptr, t_out, idx, pos, t_stop, dense, shared=None):
-    """Fill every output t_out[i, ptr_i:] <= t_stop_i of problems idx (rows pos of the dense output)."""
-    start = ptr[idx]
-    m = t_out.shape[1]
-    Yf = [y.reshape(-1) for y in Y]  # each Y[j] C-contiguous (n, m): flat views
-    if shared is not None:  # one grid for all problems: each problem's outputs here are columns start..stop-1
-        stop = np.maximum(np.searchsorted(shared, t_stop, side="right"), start)
-        counts = stop - start
-        width = int(counts.max(initial=0))
-        if width == 0:
-            return
-        keep = counts > 0
-        if not keep.all():
-            idx, pos, start, counts = idx[keep], pos[keep], start[keep], counts[keep]
-        cols = start[:, None] + np.arange(width)[None, :]
-        valid = cols < (start + counts)[:, None]
-        np.minimum(cols, m - 1, out=cols)
-        x = shared[cols]
-        x -= dense.t_old[pos, None]
-        x /= dense.h[pos, None]
-        np.copyto(x, 0.0, where=~valid)  # padding beyond a problem's outputs: evaluated, never stored
-        vals = dense(x, None if pos.size == dense.h.size and np.array_equal(pos, np.arange(pos.size)) else pos)
-        flat = (idx[:, None] * m + cols).ravel()
-        vals = vals.reshape(vals.shape[0], -1)
-        if not valid.all():  # integer take and put: several times faster than boolean-mask indexing
-            sel = np.flatnonzero(valid)
-            flat, vals = flat[sel], np.take(vals, sel, axis=1)
-        for j in range(len(Yf)):
-            np.put(Yf[j], flat, vals[j])
-        ptr[idx] = start + counts
-        return
-    within = (np.arange(m)[None, :] >= start[:, None]) & (t_out[idx] <= t_stop[:, None])
-    rows, cols = np.nonzero(within)
-    if rows.size == 0:
-        return
-    stop = within.sum(axis=1) + start
-    tq = t_out[idx[rows], cols]
-    p = pos[rows]
-    x = (tq - dense.t_old[p]) / dense.h[p]
-    vals, flat = dense(x, p), idx[rows] * m + cols
-    for j in range(len(Yf)):
-        np.put(Yf[j], flat, vals[j])
-    ptr[idx] = np.maximum(ptr[idx], stop)
 
 
 def root_bracketed(make_fn, lo, hi, glo, ghi, tol, gtol=0.0):

@@ -143,12 +143,17 @@ def _bessel_series(b, phi, t):
     coef = 2.0 * w[1:] / (k[1:] * phi)
     x = phi * t
     out = w[0] * t
-    two_cos = 2.0 * np.cos(x)
-    s_prev, s_k = np.zeros_like(x), np.sin(x)
-    for j in range(last):
-        out = out + coef[j] * s_k
-        if j + 1 < last:
-            s_prev, s_k = s_k, two_cos * s_k - s_prev
+    out = out if out.shape == x.shape else np.broadcast_to(out, x.shape).copy()
+    two_cos = np.cos(x)
+    two_cos *= 2.0
+    s_prev, s_k, tmp = np.zeros_like(x), np.sin(x), np.empty_like(x)
+    for j in range(last):  # in place: the grid's arrays are the memory traffic, the same numbers as plainly
+        np.multiply(coef[j], s_k, out=tmp)
+        out += tmp
+        if j + 1 < last:  # s_prev becomes sin((k+1)x)
+            np.multiply(two_cos, s_k, out=tmp)
+            np.subtract(tmp, s_prev, out=s_prev)
+            s_prev, s_k = s_k, s_prev
     return out
 
 
@@ -307,7 +312,8 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
             return J, K, None
         return J, K, float(min(half_sine_stop(plan, form, u_s), T))
     grid = np.unique(np.concatenate([np.linspace(t0, T, SCAN), t]))
-    g = sgn * slip(grid) + margin
+    signed = sgn * slip(grid)
+    g = signed + margin
     bad = np.nonzero(g[1:] <= 0.0)[0]
     if bad.size == 0:
         return J, K, None
@@ -317,7 +323,7 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
                                                          xtol=xtol, rtol=rtol)
     # the margin only detects the stop; the stop itself is where slip is zero, found from the
     # last time slip was strictly of the phase's sign (the closed form is exact, keep it so)
-    ahead = np.nonzero(sgn * slip(grid[:i]) > 0.0)[0]
+    ahead = np.nonzero(signed[:i] > 0.0)[0]  # the scan's values, not evaluated again
     if ahead.size == 0:
         return J, K, t_margin
     lo = float(grid[int(ahead[-1])])

@@ -134,59 +134,69 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
             return np.repeat(np.asarray(y0, dtype=float)[:, None], len(t_out), axis=1), None, None, {"nfev": 0}
         T = float(t_out[-1])
         scale = phase_scales(plan, p, t0, T, y0, direction)
-        tscale = T
-        compliant = "xi" in plan.states
-
-        calls = [0]
-        rates = plan.bound(p, direction)
-
-        def f(s, z):
-            calls[0] += 1
-            if calls[0] > MAX_NFEV:
-                raise SolverError(f"ode:{method}: law '{plan.law.name}' needed more than {MAX_NFEV} right-hand-side "
-                                  f"evaluations (stopped at t = {s * tscale:.6g} s): too stiff for {method} here")
-            return rates(s * tscale, z * scale) * tscale / scale
-
-        event = None
-        if not compliant and direction != 0:
-            r, iw = (plan.scene.radius, plan.index("omega")) if plan.coupled else (0.0, 0)
-            sv, sw = float(scale[0]), float(scale[iw])
-
-            def zero_slip(s, z):
-                # slip / its scale (plan.rigid_slip on the scaled state), fired once slip has passed zero by a
-                # hair (SLIP_MARGIN of its scale), so that round-off at a restart from rest is not a new stop
-                return (z[0] * sv - r * (z[iw] * sw)) / sv + direction * SLIP_MARGIN
-
-            event = zero_slip
-        s_eval = np.clip(np.asarray(t_out, dtype=float) / tscale, t0 / tscale, T / tscale)
-        s_eval, back = np.unique(s_eval, return_inverse=True)  # repeated times (e.g. a resample) solved once
-        failed = f"ode:{method}: integration failed for law '{plan.law.name}'"
-        # where the right-hand side jumps (a load-point velocity step) the integration restarts
-        cuts = [b / tscale for b in plan.breaks if t0 < b < T] if event is None else []
-        edges = [t0 / tscale] + cuts + [T / tscale]
-        z0, parts, stats = np.asarray(y0, dtype=float) / scale, [], {"nfev": 0, "njev": 0, "nlu": 0}
-        try:
-            for k, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
-                last = k == len(edges) - 2
-                inside = s_eval[(s_eval >= a) & ((s_eval <= b) if last else (s_eval < b))]
-                Z, s_stop, z_stop, solver = solve(f, a, b, z0, method, inside, rtol, atol, event, -direction, failed)
-                parts.append(Z)
-                for key in stats:
-                    stats[key] += int(getattr(solver, key))
-                z0 = solver.y
-        except FrictionLabError:
-            raise
-        except Exception as exc:  # a law raising inside the integrator
-            raise SolverError(f"{failed}: {exc}") from exc
-        Z = np.hstack(parts)
-        Y = Z[:, back[back < Z.shape[1]]] * scale[:, None]  # a stop ends the samples reached
-        t_stop = y_stop = None
-        if s_stop is not None:
-            t_stop = float(s_stop) * tscale
-            y_stop = z_stop * scale
-        info = {**stats, "method": method, "rtol": rtol, "atol": atol}
-        return Y, t_stop, y_stop, info
+        f, event = _scaled_problem(plan, p, direction, T, scale, method)
+        return _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method, rtol, atol)
 
     return slide
+
+
+def _scaled_problem(plan, p, direction, tscale, scale, method):
+    """(right-hand side, zero-slip event or None) of a sliding phase on the scaled problem (time / tscale,
+    states / scale); the right-hand side stops with a clear error beyond MAX_NFEV evaluations."""
+    calls = [0]
+    rates = plan.bound(p, direction)
+
+    def f(s, z):
+        calls[0] += 1
+        if calls[0] > MAX_NFEV:
+            raise SolverError(f"ode:{method}: law '{plan.law.name}' needed more than {MAX_NFEV} right-hand-side "
+                              f"evaluations (stopped at t = {s * tscale:.6g} s): too stiff for {method} here")
+        return rates(s * tscale, z * scale) * tscale / scale
+
+    if "xi" in plan.states or direction == 0:
+        return f, None
+    r, iw = (plan.scene.radius, plan.index("omega")) if plan.coupled else (0.0, 0)
+    sv, sw = float(scale[0]), float(scale[iw])
+
+    def zero_slip(s, z):
+        # slip / its scale (plan.rigid_slip on the scaled state), fired once slip has passed zero by a
+        # hair (SLIP_MARGIN of its scale), so that round-off at a restart from rest is not a new stop
+        return (z[0] * sv - r * (z[iw] * sw)) / sv + direction * SLIP_MARGIN
+
+    return f, zero_slip
+
+
+def _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method, rtol, atol):
+    """solve_ivp over [t0, T] (restarted at the plan's breaks when no event watches slip): (states at t_out
+    reached, stop time, state at the stop, counters)."""
+    tscale = T
+    s_eval = np.clip(np.asarray(t_out, dtype=float) / tscale, t0 / tscale, T / tscale)
+    s_eval, back = np.unique(s_eval, return_inverse=True)  # repeated times (e.g. a resample) solved once
+    failed = f"ode:{method}: integration failed for law '{plan.law.name}'"
+    # where the right-hand side jumps (a load-point velocity step) the integration restarts
+    cuts = [b / tscale for b in plan.breaks if t0 < b < T] if event is None else []
+    edges = [t0 / tscale] + cuts + [T / tscale]
+    z0, parts, stats = np.asarray(y0, dtype=float) / scale, [], {"nfev": 0, "njev": 0, "nlu": 0}
+    try:
+        for k, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
+            last = k == len(edges) - 2
+            inside = s_eval[(s_eval >= a) & ((s_eval <= b) if last else (s_eval < b))]
+            Z, s_stop, z_stop, solver = solve(f, a, b, z0, method, inside, rtol, atol, event, -direction, failed)
+            parts.append(Z)
+            for key in stats:
+                stats[key] += int(getattr(solver, key))
+            z0 = solver.y
+    except FrictionLabError:
+        raise
+    except Exception as exc:  # a law raising inside the integrator
+        raise SolverError(f"{failed}: {exc}") from exc
+    Z = np.hstack(parts)
+    Y = Z[:, back[back < Z.shape[1]]] * scale[:, None]  # a stop ends the samples reached
+    t_stop = y_stop = None
+    if s_stop is not None:
+        t_stop = float(s_stop) * tscale
+        y_stop = z_stop * scale
+    info = {**stats, "method": method, "rtol": rtol, "atol": atol}
+    return Y, t_stop, y_stop, info
 
 

@@ -25,6 +25,25 @@ COUNTERS = ("nfev", "njev", "nlu")  # solver statistics summed over segments
 
 def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
     t_eval = np.asarray(t_eval, dtype=float)
+    Y, F, sliding, dirs, info, stick_time = _phases(plan, p, t_eval, slide, solver_name)
+    return _trajectory(plan, p, t_eval, Y, F, sliding, dirs, info, stick_time, solver_name)
+
+
+def _start(plan, p, T, y0):
+    """The first phase ('slide' or 'stuck') and its slip direction."""
+    u_start = float(plan.rigid_slip(y0))
+    direction = float(np.sign(u_start))
+    if plan.continuous:
+        return "slide", 0.0
+    if "xi" in plan.states or u_start != 0.0:
+        return "slide", direction
+    tb = stick.breakaway(plan, p, 0.0, max(T, 0.0), y0, 0.0)
+    return ("slide" if tb == 0.0 else "stuck"), stick.hold_direction(plan, 0.0)
+
+
+def _phases(plan, p, t_eval, slide, solver_name):
+    """Sliding and stuck phases in turn over t_eval: (states Y, stuck force F, sliding mask, slip direction
+    of each sample's sliding phase, info, first stick time or None)."""
     n, T = t_eval.size, float(t_eval[-1])
     Y = np.empty((len(plan.states), n))
     F = np.empty(n)
@@ -34,17 +53,7 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
     t0, y0 = 0.0, plan.initial_state(p)
     info: dict = {"nfev": 0, "segments": 0}
     stick_time = None
-    compliant = "xi" in plan.states
-    u_start = float(plan.rigid_slip(y0))
-    direction = float(np.sign(u_start))
-    if plan.continuous:
-        phase, direction = "slide", 0.0
-    elif compliant or u_start != 0.0:
-        phase = "slide"
-    else:
-        tb = stick.breakaway(plan, p, 0.0, max(T, 0.0), y0, 0.0)
-        phase = "slide" if tb == 0.0 else "stuck"
-        direction = stick.hold_direction(plan, 0.0)
+    phase, direction = _start(plan, p, T, y0)
     last_direction = direction or 1.0
     while True:
         info["segments"] += 1
@@ -70,9 +79,7 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
             phase = "stuck"
         else:
             tb = stick.breakaway(plan, p, t0, T, y0, last_direction)
-            end = T if tb is None else tb
-            sel = todo & (t_eval <= end)
-            idx = np.nonzero(sel)[0]
+            idx = np.nonzero(todo & (t_eval <= (T if tb is None else tb)))[0]
             Y[:, idx], F[idx] = stick.stuck_states(plan, t_eval[idx], t0, y0)
             done[idx] = True
             if tb is None:
@@ -83,6 +90,13 @@ def run(plan, p, t_eval, slide, solver_name: str) -> Trajectory:
             phase = "slide"
     if not done.all():
         raise SolverError(f"{solver_name}: solution ended at t = {t0:g} s before the last requested time {T:g} s")
+    return Y, F, sliding, dirs, info, stick_time
+
+
+def _trajectory(plan, p, t_eval, Y, F, sliding, dirs, info, stick_time, solver_name):
+    """Slip, force and contact on t_eval from the phases' states, checked finite, as a Trajectory."""
+    n = t_eval.size
+    compliant = "xi" in plan.states
     u = np.empty(n)
     if compliant:  # the force on the body is the spring's and damper's, also while the patch sticks
         for i in np.nonzero(sliding)[0]:

@@ -1,0 +1,136 @@
+"""compare on a Dask cluster: 1 and 2 worker processes against the local run, on many datasets.
+
+    python benchmarks/bench_cluster.py [--datasets 20] [--bootstrap 40] [--repeat 1]
+
+Workload: ``--datasets`` synthetic variants of built-in time series (impact-golf-v28, impact-golf-v61,
+incline-oil-a100/a200/a400, incline-dry-d10), each the original with Gaussian noise of its stated sigma
+added (seeded), under its own name and group; the four default laws, equivalence test, transfer,
+tolerance check and ``--bootstrap`` replicates, then the report (its figures drawn where the fits ran).
+These variants exist only to give the cluster work; they are not data.
+Runs, in one process, in this order and then again in reverse (the machine's speed drifts): the local
+run with one process (``jobs=1``), a LocalCluster of 1 worker process, one of 2 worker processes (each
+cluster started and its workers' imports warmed before the clock starts: a cluster is long-lived).
+Prints wall seconds per run and the ratios; every run's numbers are checked equal to the local run's.
+Targets: 2 workers at least 1.6x faster than 1; 1 worker no slower than the local run.
+"""
+from __future__ import annotations
+
+import argparse
+import statistics
+import tempfile
+import time
+
+import attrs
+import numpy as np
+
+BASES = ("impact-golf-v28", "impact-golf-v61", "incline-oil-a100", "incline-oil-a200", "incline-oil-a400",
+         "incline-dry-d10")
+
+
+def workload(n: int, seed: int = 7) -> list:
+    from frictionlab.io.dataset import load_dataset
+
+    rng = np.random.default_rng(seed)
+    out = []
+    for i in range(n):
+        base = load_dataset(BASES[i % len(BASES)])
+        cols = dict(base.columns)
+        y = cols[base.observable]
+        cols[base.observable] = y + rng.normal(0.0, base.sigma, y.shape)
+        name = f"{base.name}-variant{i:03d}"
+        out.append(attrs.evolve(base, name=name, group=name, columns=cols, path=None))
+    return out
+
+
+def warm(client) -> None:
+    """Import what a fit needs on every worker (and load numba's cache), as a long-lived cluster has."""
+    def imports():
+        import lmfit  # noqa: F401
+
+        from frictionlab.inference.fitting import fit  # noqa: F401
+        from frictionlab.report import figures  # noqa: F401
+        from frictionlab.solve.compiled import available
+
+        available()
+        figures._plt()
+        return True
+
+    client.run(imports)
+
+
+def one_run(dss, bootstrap, workers):
+    """Wall seconds of compare + report: local (workers None) or on a LocalCluster of ``workers`` processes."""
+    from frictionlab.pipeline.comparison import compare
+    from frictionlab.report import write_report
+
+    opts = dict(datasets=dss, bootstrap=bootstrap, tolerance=(1e-3, 1e-10))
+    with tempfile.TemporaryDirectory() as tmp:
+        if workers is None:
+            t0 = time.perf_counter()
+            c = compare(jobs=1, **opts)
+            write_report(c, f"{tmp}/r", jobs=1)
+            return time.perf_counter() - t0, c
+        import distributed
+
+        with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                      dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+            warm(client)
+            t0 = time.perf_counter()
+            c = compare(client=client, **opts)
+            write_report(c, f"{tmp}/r", client=client)
+            return time.perf_counter() - t0, c
+
+
+def first_difference(a, b, path="") -> str:
+    """Where two results first differ (a JSON path and both values)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        for k in a.keys() | b.keys():
+            d = first_difference(a.get(k), b.get(k), f"{path}/{k}")
+            if d:
+                return d
+        return ""
+    if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+        return next((d for i, (x, y) in enumerate(zip(a, b)) if (d := first_difference(x, y, f"{path}[{i}]"))), "")
+    return "" if a == b else f"{path}: {str(a)[:200]!r} != {str(b)[:200]!r}"
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--datasets", type=int, default=20)
+    ap.add_argument("--bootstrap", type=int, default=40)
+    args = ap.parse_args(argv)
+    import logging
+    import os
+
+    logging.getLogger("distributed").setLevel(logging.ERROR)
+    import sys
+
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
+    from test_cluster import numbers
+
+    dss = workload(args.datasets)
+    print(f"{len(dss)} datasets (synthetic variants of {', '.join(BASES)}), bootstrap {args.bootstrap}; "
+          f"{os.cpu_count()} CPUs, load average at start {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
+    times = {"local": [], 1: [], 2: []}
+    ref = None
+    for order in (("local", 1, 2), (2, 1, "local")):
+        for w in order:
+            t, c = one_run(dss, args.bootstrap, None if w == "local" else w)
+            times[w].append(t)
+            got = numbers(c)
+            ref = ref if ref is not None else got
+            same = got == ref
+            print(f"  {'local, 1 process' if w == 'local' else f'Dask, {w} worker process' + 'es' * (w > 1):28s} "
+                  f"{t:6.1f} s wall; numbers {'equal to the first run' if same else 'DIFFER'}", flush=True)
+            if not same:
+                raise SystemExit("the numbers differ between runs: " + first_difference(ref, got))
+    med = {k: statistics.median(v) for k, v in times.items()}
+    r21, r1l = med[1] / med[2], med[1] / med["local"]
+    print(f"median wall: local {med['local']:.1f} s, 1 worker {med[1]:.1f} s, 2 workers {med[2]:.1f} s")
+    print(f"RATIO 1 worker / 2 workers = {r21:.2f}x (target >= 1.6: {'met' if r21 >= 1.6 else 'NOT met'})")
+    print(f"RATIO 1 worker / local = {r1l:.2f} (target <= 1: {'met' if r1l <= 1.0 else 'NOT met'})")
+    print(f"load average at end {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
+
+
+if __name__ == "__main__":
+    main()

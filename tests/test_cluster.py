@@ -1,0 +1,62 @@
+"""Compare on a Dask cluster (LocalCluster, worker processes): the same numbers as the local run whatever the
+number of workers, the report's figures drawn there, and the command's one-line error for a bad scheduler."""
+import pytest
+
+from frictionlab.cli import main
+
+distributed = pytest.importorskip("distributed")
+
+LAWS = ["wear", "coulomb"]
+DATA = ["incline-oil-a100", "impact-golf-v28"]
+OPTIONS = dict(laws=LAWS, datasets=DATA, bootstrap=12, tolerance=(1e-3,), replicates=20, seed=3)
+
+
+def numbers(c):
+    """Everything results.json records but the clocks (times, dates) and where it ran."""
+    import json
+    import re
+
+    from frictionlab.report import results_json
+
+    def strip(x):
+        if isinstance(x, str):  # a sentence quoting a measured time ("its fit took 1.4 CPU s")
+            return re.sub(r"\d+(\.\d+)? (CPU )?s\b", "# s", x)
+        if isinstance(x, dict):
+            return {k: strip(v) for k, v in x.items()
+                    if not any(w in k for w in ("time", "timings", "cpu", "wall", "created", "settings", "versions"))}
+        if isinstance(x, list):
+            return [strip(v) for v in x]
+        return x
+
+    return strip(json.loads(json.dumps(results_json(c, {}))))
+
+
+@pytest.fixture(scope="module")
+def local():
+    from frictionlab.pipeline.comparison import compare
+
+    return compare(jobs=1, **OPTIONS)
+
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_cluster_gives_the_local_numbers(local, workers, tmp_path):
+    from frictionlab.pipeline.comparison import compare
+    from frictionlab.report import build, write_report
+
+    with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        c = compare(client=client, **OPTIONS)
+        assert f"({workers} worker" in c.settings["cluster"]
+        assert numbers(c) == numbers(local)
+        if workers == 2:  # the figures drawn on the workers are the local ones, byte for byte
+            out = write_report(c, tmp_path / "r", client=client)
+            figs = [f for s in build(c)[0] for f in s.figures]
+            for f in figs[:3]:
+                assert (out / "figures" / f.name).read_bytes() == f.draw()
+
+
+def test_bad_scheduler_is_one_line(tmp_path, capsys):
+    assert main(["compare", "--scheduler", "nonsense://nowhere", "--out", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--scheduler nonsense://nowhere" in err[0]
+    assert not (tmp_path / "r").exists()
