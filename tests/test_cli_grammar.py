@@ -79,7 +79,8 @@ def test_datasets_show_in_units_a_person_reads(capsys):
     assert main(["datasets", "show", "impact-golf-v28"]) == 0
     out = capsys.readouterr().out
     assert "np.float64" not in out and "Scene(" not in out
-    for text in ("mass: 46 g", "radius: 21.3 mm", "peak: 130 mm^2", "contact_time: 500 µs", "omega ± 200 rpm"):
+    for text in ("mass: 46 g", "radius: 21.3 mm", "peak: 130 mm^2", "contact_time: 500 µs", "noise:       none (",
+                 "t_peak = 260 µs ± 10 µs", "omega_peak = 6700 rpm ± 100 rpm"):
         assert text in out
     assert main(["datasets", "show", "impact-outcome-synthetic"]) == 0
     assert "SpeedLaw(" not in capsys.readouterr().out

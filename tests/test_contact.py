@@ -330,6 +330,7 @@ speed = "m/s"
 incidence = "deg"
 rebound_spin = "rad/s"
 [noise]
+kind = "known"
 rebound_spin = "5 rad/s"
 [provenance]
 kind = "synthetic"

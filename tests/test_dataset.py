@@ -23,7 +23,7 @@ def test_every_builtin_loads_with_honest_provenance():
         if d.provenance.kind == "measured":
             assert "MEASURED" in d.description and "@" in d.provenance.source  # repository path @ commit
         assert d.provenance.command == "frictionlab datasets rebuild"
-        assert np.all(np.isfinite(d.y)) and d.sigma > 0
+        assert np.all(np.isfinite(d.y)) and (d.sigma > 0 if d.noise_kind != "none" else d.provenance.kind == "reconstructed")
         if d.provenance.kind == "synthetic":
             assert d.provenance.seed is not None and "law" in d.provenance.truth
             assert "SYNTHETIC" in d.description
@@ -32,8 +32,9 @@ def test_every_builtin_loads_with_honest_provenance():
 def test_golf_units_become_si():
     d = fl.load_dataset("impact-golf-v28")
     assert d.t[1] == pytest.approx(10e-6)
-    assert d.observable == "theta" and d.sigma == pytest.approx(math.radians(0.5))
-    assert d.noise["omega"] == pytest.approx(200 * RPM)
+    assert d.observable == "theta" and d.noise_kind == "none" and d.noise == {}  # noise-free: no sigma at all
+    assert d.stated["omega_peak"] == pytest.approx((6700 * RPM, 100 * RPM))
+    assert d.stated["theta_max"] == pytest.approx((math.radians(13), math.radians(1)))
     s = d.scene
     assert (s.mass, s.radius, s.u0) == pytest.approx((0.046, 0.0213, 12.0))
     assert s.area.peak == pytest.approx(130e-6) and s.area.contact_time == pytest.approx(500e-6)
@@ -141,11 +142,14 @@ def test_cli_error_is_one_line_exit_2(run_cli, golf_copy):
     assert out.returncode != 0 and "Traceback" in out.stderr
 
 
-def test_group_key_declares_the_group_and_defaults_to_the_name_stem(golf_copy):
+def test_group_key_declares_the_group_and_nothing_is_inferred_from_names(golf_copy):
     from frictionlab.inference.answers import group_of
 
     d = fl.load_dataset(golf_copy)
-    assert d.group == "" and group_of(d) == d.name.rsplit("-", 1)[0]
+    assert d.group == "impact-golf" and group_of(d) == "impact-golf"  # the built-in file declares it
+    _edit(golf_copy, 'group = "impact-golf"\n', '')
+    d = fl.load_dataset(golf_copy)
+    assert d.group == "" and group_of(d) == d.name  # no key: its own group, never "impact-golf" from the name
     _edit(golf_copy, 'kind = "impact"', 'group = "golf-balls"\nkind = "impact"')
     d = fl.load_dataset(golf_copy)
     assert d.group == "golf-balls" and group_of(d) == "golf-balls"

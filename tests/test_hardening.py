@@ -203,7 +203,7 @@ class _StallsLater(_Sluggish):
 
 
 def test_refits_of_the_equivalence_test_bootstrap_and_transfer_keep_the_time_budget():
-    from frictionlab.inference.bootstrap import bootstrap_fits
+    from frictionlab.inference.ranking_bootstrap import bootstrap_fits
     from frictionlab.inference.equivalence import MIN_REPLICATES, analyze_equivalence
     from frictionlab.inference.transfer import shared_fit
 

@@ -59,6 +59,7 @@ omega = "{u['omega']}"
 theta = "{u['theta']}"
 
 [noise]
+kind = "known"
 omega = "{q(20.0, SPIN, u['omega'])}"
 
 [scene]

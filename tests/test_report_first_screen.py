@@ -50,7 +50,7 @@ def test_without_answers_nothing_is_declared_to_fit(comp):
     md = markdown("t", _first(attrs.evolve(comp, answers=()))[0])
     assert "`Comparison.answers` is empty)" in md and "lowest AIC (not a fit test)" in md
     assert "Not in this comparison: a goodness-of-fit test." in md
-    assert "differ by more than the noise when sigma" in md  # the discrimination test's threshold is shown
+    assert "misses it by χ² 3.84" in md  # the discrimination test's threshold is shown
 
 
 def test_answers_are_rendered_and_empty_columns_said(comp):

@@ -187,10 +187,16 @@ def _show(args) -> int:
     if d.description:
         print(f"  description: {d.description}")
     print("  columns:     " + ", ".join(f"{c} [{u or '-'}]" for c, u in d.units.items()))
-    sigmas = ", ".join(f"{c} ± {quantity_text(v * _to_file_unit(d, c), d.units.get(c, ''))}"
-                       if d.units.get(c) else f"{c} ± {v:.4g}" for c, v in d.noise.items())
-    print(f"  noise:       {d.noise_kind} ({NOISE_MEANING.get(d.noise_kind, 'see the README')})"
-          + (f": {sigmas}" if sigmas else ""))
+    def sd(c, v):
+        return f"{c} ± {quantity_text(v * _to_file_unit(d, c), d.units.get(c, ''))}" if d.units.get(c) else f"{c} ± {v:.4g}"
+
+    values = ", ".join(sd(c, v) for c, v in d.noise.items() if d.noise_kind != "none")
+    print(f"  noise:       {d.noise_kind}{': ' + values if values else ''} ({d.noise_note})")
+    if d.stated:
+        from ..io.noise import STATED
+
+        print("  stated:      " + ", ".join(f"{k} = {quantity_text(v, STATED[k])} ± {quantity_text(p, STATED[k])}"
+                                            for k, (v, p) in d.stated.items()))
     if d.time_zero:
         print(f"  time zero:   t = 0 at {d.time_zero:.10g} s of the file's clock (subtracted from column t)")
     print(f"  provenance:  {pv.kind}; {pv.source}")
@@ -215,11 +221,6 @@ def _show(args) -> int:
         for line in lines[1:]:
             print("             " + line)
     return 0
-
-
-#: What each [noise] kind means, in the words ``datasets show`` prints.
-NOISE_MEANING = {"known": "sigma measured, used as it is", "assumed": "a guess: the fit profiles sigma out",
-                 "estimated": "sigma estimated from the data alone", "none": "noise-free numbers"}
 
 
 def _to_file_unit(d, column: str) -> float:

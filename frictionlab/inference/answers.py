@@ -49,9 +49,6 @@ class Answer:
 
 
 def group_of(dataset) -> str:
-    """The group a dataset belongs to: its declared ``group``, else its name without the last ``-suffix``."""
-    declared = getattr(dataset, "group", "") or ""
-    if declared:
-        return declared
-    name = dataset.name
-    return name.rsplit("-", 1)[0] if "-" in name else name
+    """The group a dataset belongs to: its declared ``group`` (TOML key), else its own name. Nothing is
+    inferred from names: datasets are pooled only where their files say they belong together."""
+    return getattr(dataset, "group", "") or dataset.name

@@ -2,17 +2,19 @@
 
 Two tests per fitted dataset, on the normalized residuals z = (model - data) / sigma:
 
-* chi-square: p = P(chi2 with n - k degrees of freedom >= observed chi2). Only where the
-  dataset's sigma is known (measured); with an assumed sigma the chi-square carries no
-  information about fit (sigma is profiled out), so p is NaN and only the structure test applies.
+* chi-square: p = P(chi2 with n - k degrees of freedom >= observed chi2) where the dataset's sigma
+  is known (measured). Where sigma is estimated from the data (io/noise.py, nu effective degrees of
+  freedom) the estimate's own uncertainty is carried in: the F test p = P(F(n - k, nu) >= chi2 / (n - k))
+  (conservative: residuals and estimate share the noise), sharpened where it does not already reject
+  by the exact null of both from common noise (``noise.ratio_pvalue``, done by the fit).
 * residual structure: the Wald-Wolfowitz runs test on the signs of z (zeros dropped), one-sided:
   a law that misses the data's shape leaves long runs of one sign (too few runs). Normal
   approximation with continuity correction; needs at least RUNS_MIN nonzero residuals, else NaN.
   The lag-1 autocorrelation r1 of z is reported beside it (one-sided p from r1 sqrt(n) ~ N(0, 1)),
   not used by the rule.
 
-Rule (``FITS_LEVEL`` = 0.01): a candidate fits a dataset when chi2 p >= 0.01 (known sigma only)
-and runs p >= 0.01. 1% per test keeps the false alarm rate of a true law low on the handful of
+Rule (``FITS_LEVEL`` = 0.01, family-wise over the two tests): a candidate fits a dataset when
+both p-values are at least ``TEST_LEVEL`` = 0.005 (Bonferroni over the two tests). The level keeps the false alarm rate of a true law low on the handful of
 built-in known-truth sets while a misfit of several sigma over tens of points fails by orders of
 magnitude. Over a group of m datasets the p-values are Bonferroni-adjusted (m times the smallest,
 capped at 1), so the group rule is the same rule at the same 1% family-wise level.
@@ -24,7 +26,8 @@ import math
 import attrs
 import numpy as np
 
-FITS_LEVEL = 0.01
+FITS_LEVEL = 0.01  # family-wise level of the fit tests (chi-square or F, and runs) on one dataset or group
+TEST_LEVEL = FITS_LEVEL / 2  # each of the two tests (Bonferroni)
 RUNS_MIN = 10
 
 
@@ -32,8 +35,8 @@ RUNS_MIN = 10
 class Goodness:
     """Goodness of fit of one candidate on one dataset (or a group: Bonferroni-adjusted p-values)."""
 
-    likelihood: str  # 'known' | 'assumed' | 'none' (no valid likelihood, e.g. a smoothed derived series)
-    chi2_p: float  # NaN unless sigma is known
+    likelihood: str  # 'known' | 'estimated' | 'mixed' | 'none' (no valid likelihood: a smoothed derived series)
+    chi2_p: float  # chi-square (known sigma) or F (estimated sigma) p-value; NaN without a likelihood
     runs_p: float  # NaN when too few nonzero residuals
     runs: int  # observed runs of residual signs (group: summed)
     runs_expected: float
@@ -62,7 +65,7 @@ class Goodness:
     @property
     def short(self) -> str:
         """'fits: chi2 p = 0.96' / 'fails: runs p = 8e-10': the verdict and the p-value closest to failing."""
-        ps = [(name, p) for name, p in (("χ²", self.chi2_p), ("runs", self.runs_p)) if math.isfinite(p)]
+        ps = [(name, p) for name, p in (("χ²" if self.likelihood != "estimated" else "χ²/σ̂²", self.chi2_p), ("runs", self.runs_p)) if math.isfinite(p)]
         if self.fits is None or not ps:
             return "not testable"
         name, p = min(ps, key=lambda x: x[1])
@@ -123,31 +126,44 @@ def lag1(z: np.ndarray) -> tuple[float, float]:
     return r, float(ndtr(-(r * math.sqrt(z.size))))
 
 
-def goodness(z: np.ndarray, k: int, likelihood: str) -> Goodness:
-    """Goodness of one fitted dataset from its normalized residuals z and k fitted parameters."""
+def f_pvalue(chisqr: float, dof: int, df_sigma: float) -> float:
+    """P(F(dof, df_sigma) >= chisqr / dof): the chi-square test when sigma^2 is an estimate with df_sigma
+    degrees of freedom (the chi-square p as df_sigma -> infinity)."""
+    from scipy.special import fdtrc
+
+    if not math.isfinite(df_sigma):
+        return chi2_pvalue(chisqr, dof)
+    return float(fdtrc(dof, df_sigma, chisqr / dof)) if dof > 0 and math.isfinite(chisqr) else math.nan
+
+
+def goodness(z: np.ndarray, k: int, likelihood: str, df_sigma: float = math.inf, chi_p: float | None = None) -> Goodness:
+    """Goodness of one fitted dataset from its normalized residuals z, k fitted parameters and the
+    degrees of freedom of its sigma (infinite when measured); chi_p: the fit test's p where the caller
+    has a sharper one (``noise.ratio_pvalue``)."""
     z = np.asarray(z, dtype=float)
     if likelihood == "none":
         return Goodness("none", math.nan, math.nan, 0, math.nan, math.nan, math.nan, None,
-                        "no test: the fitted points are not independent (a smoothed, derived series)")
-    chi_p = chi2_pvalue(float(z @ z), z.size - k) if likelihood == "known" else math.nan
+                        "no test: no valid likelihood (a smoothed, derived series or a noise-free curve)")
+    if chi_p is None:
+        chi_p = f_pvalue(float(z @ z), z.size - k, df_sigma if likelihood == "estimated" else math.inf)
     runs, expected, runs_p = runs_test(z)
     r1, r1_p = lag1(z)
     return _decide(likelihood, chi_p, runs_p, runs, expected, r1, r1_p)
 
 
 def _decide(likelihood, chi_p, runs_p, runs, expected, r1, r1_p) -> Goodness:
-    tests = [(name, p) for name, p in (("chi-square", chi_p), ("runs test", runs_p)) if math.isfinite(p)]
+    tests = [(name, p) for name, p in (("chi-square" if likelihood != "estimated" else "chi-square at estimated sigma", chi_p), ("runs test", runs_p)) if math.isfinite(p)]
     if not tests:
         return Goodness(likelihood, chi_p, runs_p, runs, expected, r1, r1_p, None, "no test possible (too few points)")
-    failed = [f"{name} p = {_p(p)} < {FITS_LEVEL}" for name, p in tests if p < FITS_LEVEL]
+    failed = [f"{name} p = {_p(p)} < {TEST_LEVEL:g}" for name, p in tests if p < TEST_LEVEL]
     if failed:
         why = "; ".join(failed)
         if "runs" in why:
             why += f" ({runs} runs of residual signs where {expected:.0f} are expected: systematic misfit)"
         return Goodness(likelihood, chi_p, runs_p, runs, expected, r1, r1_p, False, why)
-    why = " and ".join(f"{name} p >= {FITS_LEVEL}" for name, _ in tests)
-    if likelihood == "assumed":
-        why += " (sigma assumed: the chi-square cannot test the fit)"
+    why = " and ".join(f"{name} p >= {TEST_LEVEL:g}" for name, _ in tests)
+    if len(tests) > 1:
+        why += f" (each at {TEST_LEVEL:g}: {FITS_LEVEL:g} family-wise)"
     return Goodness(likelihood, chi_p, runs_p, runs, expected, r1, r1_p, True, why)
 
 

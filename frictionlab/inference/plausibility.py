@@ -11,8 +11,9 @@ impact row), law-agnostic:
 * work: the friction force does net negative work over the record, W = integral of F u dt <
   -``WORK_TOL`` x integral of |F u| dt: friction as a net source of energy.
 * no effect: a fitted law parameter that can be set to 0 (0 within its bounds) changes the weighted
-  residual by less than ``EFFECT_CHI2`` = 1 (in units of the dataset's variance: chi2 with known
-  sigma, chi2 / reduced chi2 with assumed sigma): the fit rests on a parameter without measurable
+  chi2 by no more than round-off, ``NIL_REL`` x max(chi2, n) (in units of the dataset's variance):
+  the parameter's effect is structurally nil, not merely insignificant (a parameter within a
+  standard error or so of 0 is an ordinary fit result, never flagged): the fit rests on a parameter without
   effect (e.g. eta' dA/dt integrates to zero over a closed contact pulse). Found by sensitivity,
   never by law name.
 
@@ -27,7 +28,7 @@ import numpy as np
 
 RANGE = 10.0
 WORK_TOL = 0.01
-EFFECT_CHI2 = 1.0
+NIL_REL = 1e-9  # a change of chi2 below this fraction of max(chi2, n) is round-off: no effect at all
 
 
 def _trajectories(law, d):
@@ -99,11 +100,12 @@ def check_plausibility(law, per, model, slots, values, likelihood) -> tuple[list
                      "it supplies energy")
     effect = _effects(model, slots, values, likelihood)
     numbers["effect_dchi2"] = effect
+    nil = NIL_REL * max(float(sum(d.chisqr for d in per)), float(sum(d.target.y.size for d in per)))
     for name, dchi in effect.items():
-        if dchi < EFFECT_CHI2:
+        if abs(dchi) <= nil:
             v = next(values[s.pname] for s in slots if s.display == name)
             flags.append(f"rests on {name} = {v:.3g}, which has no measurable effect: setting it to 0 changes "
-                         f"chi2 by {dchi:.2g} (< {EFFECT_CHI2:g})")
+                         f"chi2 by {dchi:.2g}, round-off (at most {nil:.2g})")
     return flags, numbers
 
 
@@ -112,7 +114,7 @@ def _effects(model, slots, values, likelihood) -> dict[str, float]:
     base = model.residual(values)
     chi = float(base @ base)
     n_free = sum(s.vary for s in slots)
-    unit = 1.0 if likelihood == "known" else max(chi / max(base.size - n_free, 1), np.finfo(float).tiny)
+    unit = 1.0 if likelihood in ("known", "estimated", "stated") else max(chi / max(base.size - n_free, 1), np.finfo(float).tiny)
     out = {}
     for s in slots:
         if not (s.vary and s.kind == "law" and s.lower <= 0.0 <= s.upper and values[s.pname] != 0.0):

@@ -70,6 +70,10 @@ def make_target(dataset, observable: str | None = None, derive: str | None = Non
     ds = load_dataset(dataset)
     if ds.kind == "contact-area":
         raise SkipDataset(f"dataset '{ds.name}' is a contact-area series: supporting data, not fitted")
+    if ds.noise_kind == "none" and ds.stated and observable in (None, "stated") and not derive:
+        names = list(ds.stated)
+        return Target(ds, "stated", np.array([ds.stated[k][0] for k in names]),
+                      np.array([ds.stated[k][1] for k in names]), "")
     obs = observable or ds.observable
     if derive:
         from ..physics.derive import derive_omega
@@ -108,9 +112,34 @@ def takes_rtol(fn) -> bool:
     return any(p.name == "rtol" or p.kind is p.VAR_KEYWORD for p in ps)
 
 
+#: Points of the grid over the contact on which the stated numbers of a reconstruction are read off
+#: (fixed: the prediction must not depend on how densely the reconstruction was sampled).
+STATED_GRID = 401
+
+
+def stated_numbers(tr, contact_time: float) -> dict[str, float]:
+    """The numbers a paper states about an impact's spin, read off a trajectory on [0, t_c]: peak spin
+    and its time (a parabola through the grid's three highest points), spin at t_c, the largest angle."""
+    t, w = np.asarray(tr.t), np.asarray(tr["omega"])
+    i = int(np.clip(np.argmax(w), 1, w.size - 2))
+    y0, y1, y2 = w[i - 1], w[i], w[i + 1]
+    den = y0 - 2 * y1 + y2
+    shift = 0.5 * (y0 - y2) / den if den < 0 else 0.0
+    shift = float(np.clip(shift, -1.0, 1.0))
+    h = t[1] - t[0]
+    return {"omega_peak": float(y1 - 0.25 * (y0 - y2) * shift) if den < 0 else float(np.max(w)),
+            "t_peak": float(t[i] + shift * h) if den < 0 else float(t[np.argmax(w)]),
+            "omega_end": float(w[-1]), "theta_max": float(np.max(np.asarray(tr["theta"])))}
+
+
 def _predict_series(law, target, scene, params, solver, rtol=FIT_RTOL):
     from ..solve.solvers import simulate
 
+    if target.observable == "stated":  # a reconstruction's stated numbers (io.noise.STATED)
+        tc = scene.area.contact_time
+        tr = simulate(law, scene, params, solver=solver, t=np.linspace(0.0, tc, STATED_GRID), rtol=rtol)
+        got = stated_numbers(tr, tc)
+        return np.array([got[k] for k in target.dataset.stated])
     if target.observable not in SERIES:
         raise SkipDataset(f"dataset '{target.name}': observable '{target.observable}' is not a simulated series "
                           f"({', '.join(SERIES)})")

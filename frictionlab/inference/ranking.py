@@ -64,9 +64,9 @@ class RankRow:
     status: str = "ok"  # ok | tied | indistinguishable | failed | skipped | incomplete
     reason: str = ""
     tied_with: tuple[str, ...] = ()  # candidates within NEAR_TIE (tied: within TIE_AIC)
-    likelihood: str = ""  # 'known' | 'assumed' | 'mixed' | 'none' (fitting.Stats.likelihood)
+    likelihood: str = ""  # 'known' | 'estimated' | 'mixed' | 'none' (fitting.Stats.likelihood)
     neg2loglik: float = math.nan
-    k_lik: int = 0  # parameters counted by the criteria (plus a profiled sigma where noise is assumed)
+    k_lik: int = 0  # parameters counted by the criteria 
     chi2_p: float = math.nan
     runs_p: float = math.nan
     lag1: float = math.nan
@@ -240,7 +240,8 @@ def rank_groups(rows: list[RankRow], kinds: dict[str, str] | None = None, tie: f
 
 
 def _group_row(gname: str, law: str, solver: str, good: list[RankRow]) -> RankRow:
-    """A candidate over a group: -2 ln L and k add; AIC, AICc, BIC from the group's n and k."""
+    """A candidate over a group of separately fitted members: -2 ln L, k, AIC, AICc and BIC are sums over the
+    members (each member's AICc and BIC with its own n and k)."""
     from .goodness import combine
 
     n = sum(r.n_points for r in good)
@@ -249,12 +250,13 @@ def _group_row(gname: str, law: str, solver: str, good: list[RankRow]) -> RankRo
     chi = sum(r.redchi * (r.n_points - r.n_params) for r in good)
     ll = sum(r.neg2loglik for r in good)
     aic = ll + 2 * kl
-    aicc = aic + (2 * kl * (kl + 1) / (n - kl - 1) if n - kl - 1 > 0 else math.inf)
+    aicc = sum(r.aicc for r in good)
+    bic = sum(r.bic for r in good)
     kinds = {r.likelihood for r in good}
     g = combine([r.goodness for r in good]) if all(r.goodness is not None for r in good) else None
     flags = tuple(f"{r.dataset}: {f}" for r in good for f in r.flags)
     return RankRow(gname, law, solver, n, k, math.nan, math.nan, chi / (n - k) if n > k else math.inf, aic, aicc,
-                   ll + kl * math.log(n), likelihood=kinds.pop() if len(kinds) == 1 else "mixed", neg2loglik=ll,
+                   bic, likelihood=kinds.pop() if len(kinds) == 1 else "mixed", neg2loglik=ll,
                    k_lik=kl, chi2_p=g.chi2_p if g else math.nan, runs_p=g.runs_p if g else math.nan,
                    lag1=g.lag1 if g else math.nan, fits=g.fits if g else None, goodness=g, flags=flags,
                    members=good[0].members, parameterizations=" | ".join(

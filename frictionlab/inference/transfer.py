@@ -147,7 +147,8 @@ class TransferResult:
         (``best`` as in Answer.best, 'wear = couette [series]'; default: the best-predicting candidate) serve
         every member, by the shared-against-separate test."""
         if self.status == "skipped":
-            return "no transfer: " + ("different observables" if "observables" in self.reason else self.reason)
+            return "no transfer: " + ("different observables" if "observables" in self.reason else
+                                      "no fitting law" if "no fitting law" in self.reason else self.reason)
         sh = {s.candidate: s for s in self.shared if s.status == "ok"}
         rank = self.ranking()
         mine = _candidates(best) if best else ([rank[0]["candidate"]] if rank else [])
@@ -188,7 +189,7 @@ def _neg2ll(f: FitResult) -> float:
 
 
 def _k(f: FitResult) -> int:
-    """Parameters the likelihood counts (``Stats.k_lik``: plus a profiled sigma per assumed-noise dataset)."""
+    """Parameters the likelihood counts (``Stats.k_lik``)."""
     return int(getattr(f.stats, "k_lik", 0) or f.stats.n_params)
 
 
@@ -278,17 +279,32 @@ def untransferable(datasets) -> str:
     return ""
 
 
-def skipped(datasets, group_of=None) -> list[TransferResult]:
-    """A skipped TransferResult, with its reason, for each group of ``datasets`` that cannot be transferred."""
-    return [TransferResult(group=g, datasets=tuple(d.name for d in dss), predictions=(), shared=(),
-                           status="skipped", reason=why)
-            for g, dss in _members(datasets, group_of).items() if (why := untransferable(dss))]
+def skipped(datasets, group_of=None, fits: Sequence[FitResult] = ()) -> list[TransferResult]:
+    """A skipped TransferResult, with its reason, for each group of ``datasets`` that cannot be transferred:
+    different observables, or (given ``fits``) no law that passes its fit tests on every member."""
+    out = [TransferResult(group=g, datasets=tuple(d.name for d in dss), predictions=(), shared=(),
+                          status="skipped", reason=why)
+           for g, dss in _members(datasets, group_of).items() if (why := untransferable(dss))]
+    if fits:
+        fitting = candidates_by_group(fits, datasets, group_of)
+        tried = candidates_by_group(fits, datasets, group_of, only_fitting=False)
+        out += [TransferResult(group=g, datasets=tuple(f.datasets[0] for f in next(iter(c.values()))), predictions=(),
+                               shared=(), status="skipped", reason="no fitting law was available to transfer (no "
+                               "candidate passes its fit tests on every member)")
+                for g, c in tried.items() if g not in fitting]
+    return out
+
+
+def _fits_all(fs: Sequence[FitResult]) -> bool:
+    """Whether every fit passes its own fit tests (a law that misfits has nothing to transfer)."""
+    return all(f.goodness is not None and f.goodness.fits is True and not f.flags for f in fs)
 
 
 def candidates_by_group(fits: Sequence[FitResult], datasets: Sequence | None = None,
-                        group_of=None) -> dict[str, dict[str, list[FitResult]]]:
+                        group_of=None, only_fitting: bool = True) -> dict[str, dict[str, list[FitResult]]]:
     """group -> candidate label -> its single-dataset fits, for every group of ``datasets`` (default:
-    those the successful fits are of) with at least two members, and candidates that fitted all of them."""
+    those the successful fits are of) with at least two members, and candidates that fitted all of them
+    (only_fitting: and pass their fit tests on every member)."""
     if group_of is None:
         from .answers import group_of
     ok = [f for f in fits if f.ok and len(f.datasets) == 1]
@@ -304,7 +320,7 @@ def candidates_by_group(fits: Sequence[FitResult], datasets: Sequence | None = N
         if len(names) < 2:
             continue
         for cand, d in by.items():
-            if all(n in d for n in names):
+            if all(n in d for n in names) and (not only_fitting or _fits_all([d[n] for n in names])):
                 out.setdefault(g, {})[cand] = [d[n] for n in names]
     return out
 
@@ -316,6 +332,8 @@ def transfer(fits: Sequence[FitResult], datasets: Sequence | None = None, free: 
     for g, cands in candidates_by_group(fits, datasets, group_of).items():
         parts = {c: transfer_candidate(fs, free) for c, fs in cands.items()}
         out.append(assemble(g, cands, parts))
+    if datasets is not None:
+        out += [r for r in skipped(datasets, group_of, fits) if r.group not in {o.group for o in out}]
     return out
 
 

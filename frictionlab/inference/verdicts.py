@@ -88,7 +88,8 @@ def _verdict(rows: list[RankRow]):
     near = [r for r in rows if r not in firsts and not r.flags and r.aic - top.aic < NEAR_TIE]
     fits = bool(top.fits) and not top.flags
     g = top.goodness
-    noise = {"known": "sigma known", "assumed": "sigma assumed, profiled", "mixed": "sigma known and assumed",
+    noise = {"known": "sigma known", "estimated": "sigma estimated from the data", "mixed": "sigma known and estimated",
+             "stated": "stated numbers at their stated precision",
              "none": "no likelihood"}.get(top.likelihood, top.likelihood)
     goodness = f"{g.text if g else 'no test'}; {noise}"
     if fits:
@@ -101,7 +102,7 @@ def _verdict(rows: list[RankRow]):
     elif top.fits and top.flags:  # every candidate is flagged: the flag is part of the headline
         headline = f"best: {best}, flagged: {top.flags[0]}"
         short = f"{best} (flagged implausible)"
-    elif top.fits is None:  # no test possible (too few points for the runs test and sigma only assumed)
+    elif top.fits is None:  # no test possible (too few points and no valid likelihood)
         headline = f"fit not testable (top-ranked by AIC: {best}): {g.reason if g else 'no goodness of fit'}"
         short = f"untestable (lowest AIC: {best})"
     else:

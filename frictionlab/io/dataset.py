@@ -1,10 +1,12 @@
 """Datasets: a CSV series plus a TOML sidecar of the same stem, loaded into SI arrays.
 
 The TOML holds ``name``, optionally ``group`` (datasets of one material and setup compared
-together; default: the name without its last ``-suffix``), ``kind``, ``observable``, ``[columns]`` (column -> unit),
-``[noise]`` (observable -> quantity, and ``kind = "known" | "assumed"``: whether sigma was
-measured or is a guess; default assumed), ``[scene]``, ``[fixed]`` law parameters,
-``[provenance]`` and optionally ``[reported]`` and ``time_zero`` (the file's time of t = 0, subtracted
+together; without it a dataset is its own group: nothing is inferred from names), ``kind``, ``observable``, ``[columns]`` (column -> unit),
+``[noise]`` (``kind = "known" | "estimated" | "none"`` and column -> quantity: see NOISE_KINDS;
+no table means estimated), ``[scene]``, ``[fixed]`` law parameters,
+``[provenance]`` and optionally ``[reported]``, ``[stated]`` (the numbers a noise-free
+reconstruction was drawn through, each ``name = ["value", "precision"]``, names from STATED: what
+its laws are compared on) and ``time_zero`` (the file's time of t = 0, subtracted
 from column t; a time column that starts elsewhere without it is an error). Loading validates everything and fails
 with a one-line ``DatasetError`` naming the file and the field.
 """
@@ -25,10 +27,8 @@ from ..physics.scene import KINDS, Scene
 from .csvread import _line_of_row, read_csv
 from .provenance import PROVENANCE_KINDS, Provenance, _provenance  # noqa: F401  (re-exported)
 from ..solve.outcome import OUTCOMES, OutcomeScene
+from .noise import NOISE_KINDS, STATED, noise_table, stated_table  # noqa: F401 (NOISE_KINDS, STATED: read from here too)
 
-#: What a dataset says about its noise: 'known' (sigma measured: the likelihood uses it) or
-#: 'assumed' (a guess: the fit profiles sigma out). Absent means assumed.
-NOISE_KINDS = ("known", "assumed")
 DATA_KINDS = KINDS + ("contact-area",)
 
 #: SI unit of each well-known column; other columns must declare a unit of their own.
@@ -57,8 +57,12 @@ class Dataset:
     description: str = ""
     reported: dict = attrs.field(factory=dict)
     fixed_units: dict = attrs.field(factory=dict)
-    noise_kind: str = "assumed"  # NOISE_KINDS: is the [noise] sigma measured ('known') or a guess ('assumed')?
-    group: str = ""  # declared group (TOML 'group'); "" -> answers.group_of derives it from the name
+    noise_kind: str = "estimated"  # NOISE_KINDS: sigma measured ('known'), from the data ('estimated'), or 'none'
+    noise_df: dict = attrs.field(factory=dict)  # column -> effective degrees of freedom of an estimated sigma
+    noise_est: dict = attrs.field(factory=dict, repr=False)  # column -> noise.NoiseEstimate (estimated kind)
+    noise_note: str = ""  # which noise is used, and why (one sentence, for the report and `datasets show`)
+    stated: dict = attrs.field(factory=dict)  # STATED name -> (value, precision) in SI ([stated])
+    group: str = ""  # declared group (TOML 'group'); "": the dataset is its own group (nothing is inferred from names)
     time_zero: float = 0.0  # the file's time of t = 0 [s] (TOML 'time_zero'), already subtracted from columns['t']
 
     @property
@@ -73,7 +77,8 @@ class Dataset:
 
     @property
     def sigma(self) -> float:
-        return self.noise[self.observable]
+        """The observable's sigma [SI]: measured or estimated; nan for a noise-free reconstruction."""
+        return self.noise.get(self.observable, math.nan) if self.noise_kind == "none" else self.noise[self.observable]
 
     def __len__(self) -> int:
         return len(next(iter(self.columns.values())))
@@ -152,7 +157,8 @@ def from_meta(meta: dict, path: Path) -> Dataset:
     columns = _columns(raw, units, path, csv)
     time_zero = _time_origin(meta, columns, raw, kind, path, csv)
     _check_series(columns, raw, kind, csv)
-    noise, noise_kind = _noise(meta, path, observable, columns)
+    noise, noise_kind, noise_est, noise_note = noise_table(_table(meta, "noise", path, "[noise]"), path, observable,
+                                                           columns, _si_of)
     provenance = _provenance(meta.get("provenance"), path)
     scene = _scene(meta, path, kind, observable, columns, units, csv)
     fixed, fixed_units = _fixed(_table(meta, "fixed", path, "[fixed]"), path)
@@ -160,7 +166,9 @@ def from_meta(meta: dict, path: Path) -> Dataset:
     return Dataset(name=name, kind=kind, observable=observable, path=path, columns=columns, units=dict(units),
                    noise=noise, scene=scene, fixed=fixed, provenance=provenance,
                    description=meta.get("description", ""), reported=reported,
-                   fixed_units=fixed_units, noise_kind=noise_kind, group=group, time_zero=time_zero)
+                   fixed_units=fixed_units, noise_kind=noise_kind, group=group, time_zero=time_zero,
+                   noise_df={k: e.df for k, e in noise_est.items()}, noise_est=noise_est, noise_note=noise_note,
+                   stated=stated_table(_table(meta, "stated", path, "[stated]"), path, kind, noise_kind, _quantity))
 
 
 def _header(meta, path):
@@ -252,25 +260,9 @@ def _check_series(columns, raw, kind, csv) -> None:
         if col in columns and np.any(columns[col] < 0):
             raise DatasetError(f"{csv}: column '{col}' has negative values")
 
-
-def _noise(meta, path, observable, columns):
-    """The [noise] table: sigma [SI] by column and the noise kind."""
-    noise_spec = _table(meta, "noise", path, "[noise]")
-    if observable not in noise_spec:
-        raise DatasetError(f"{path}: [noise] must give the noise of the observable, e.g. {observable} = '100 rpm'")
-    noise_spec = dict(noise_spec)
-    noise_kind = noise_spec.pop("kind", "assumed")
-    if noise_kind not in NOISE_KINDS:
-        raise DatasetError(f"{path}: noise.kind = {noise_kind!r}, expected one of {', '.join(NOISE_KINDS)} "
-                           "(known: sigma measured; assumed: a guess, profiled out by the fit)")
-    noise = {}
-    for col, value in noise_spec.items():
-        if col not in columns:
-            raise DatasetError(f"{path}: noise.{col} names no declared column")
-        noise[col] = _quantity(value, COLUMN_SI[col], f"{path}: noise.{col}")
-        if not noise[col] > 0:
-            raise DatasetError(f"{path}: noise.{col} must be positive, got {value!r}")
-    return noise, noise_kind
+def _si_of(col, value, where):
+    """A declared noise value of column ``col`` in SI."""
+    return _quantity(value, COLUMN_SI[col], where)
 
 
 def _scene(meta, path, kind, observable, columns, units, csv):
@@ -317,7 +309,7 @@ def _fixed(table, path):
 def _rest(meta, path, provenance) -> dict:
     """No unknown top-level key; [reported] and provenance.truth readable later; returns [reported]."""
     extra = set(meta) - {"name", "group", "kind", "observable", "columns", "noise", "scene", "fixed", "provenance",
-                         "reported", "description", "time_zero"}
+                         "reported", "description", "time_zero", "stated"}
     if extra:
         raise DatasetError(f"{path}: unknown top-level key(s) {sorted(extra)}")
     reported = _table(meta, "reported", path, "[reported]")
@@ -381,6 +373,11 @@ def _check_outcome_rows(columns, observable, path, csv, scene) -> None:
 def _names(columns) -> str:
     """Column names for a one-line message (repr when a name holds odd characters)."""
     return ", ".join(c if c.isprintable() and "," not in c else repr(c) for c in columns)
+
+
+def _si_of(col, value, where):
+    """A declared noise value of column ``col`` in SI."""
+    return _quantity(value, COLUMN_SI[col], where)
 
 
 def _quantity(value, si, where):

@@ -149,9 +149,9 @@ def slow_pair(fa: FitResult, fb: FitResult, replicates: int) -> str:
     if ode:
         cpu = sum(f.cpu_time for f in ode)
         return (f"{' and '.join(f'{f.law} [{f.solver}]' for f in ode)} need{'s' * (len(ode) == 1)} the ODE solver "
-                f"(its fit took {cpu:.1f} CPU s; the test refits both laws {4 * replicates} times); add "
+                f"(its fit took {cpu:.1f} CPU s; the test refits both laws up to {4 * replicates} times); add "
                 "--bootstrap-all to include it")
     if fa.ok and fa.per_dataset[0].target.t is None:
         return (f"an {fa.per_dataset[0].target.dataset.kind} set simulates every row at each evaluation "
-                f"(the test refits both laws {4 * replicates} times); add --bootstrap-all to include it")
+                f"(the test refits both laws up to {4 * replicates} times); add --bootstrap-all to include it")
     return ""

@@ -15,10 +15,10 @@ from __future__ import annotations
 import functools
 
 from ..core.errors import FrictionLabError
-from ..inference import equivalence as _equivalence
+from ..inference import equivalence_groups as _equivalence
 from ..inference import transfer as _transfer
 from ..inference.answers import group_of
-from ..inference.bootstrap import bootstrap_fits
+from ..inference.ranking_bootstrap import bootstrap_fits
 from ..inference.equivalence import EquivalenceResult, analyze_equivalence
 from ..inference.fitcost import tolerance_check
 from ..inference.fitting import FitResult
@@ -90,7 +90,7 @@ def transfer(c, run: Run) -> dict:
     parts = run.map(_transfer_task, [(fs, free, run.settings.fit_timeout) for _, _, fs in tasks])
     results = [_transfer.assemble(g, cands, {cand: p for (gg, cand, _), p in zip(tasks, parts) if gg == g})
                for g, cands in by_group.items()]
-    return {"transfer": tuple(results + _transfer.skipped(c.datasets))}
+    return {"transfer": tuple(results + _transfer.skipped(c.datasets, fits=c.fits))}
 
 
 def _transfer_task(args):

@@ -4,7 +4,7 @@ from __future__ import annotations
 import math
 
 from ..core.display import fmt, interval_text, param_text
-from ..inference.bootstrap import parameter_table, ranking_table
+from ..inference.ranking_bootstrap import parameter_table, ranking_table
 from ..inference.ranking import TIE_AIC
 from .doc import Section
 from .summary import first_share
@@ -23,8 +23,8 @@ def build(ctx) -> Section:
               "--bootstrap N` to add them.")
         return sec
     sec.p(f"Each candidate (law [solver]) was refitted to the same {n} **parametric replicates** of its dataset: the "
-          "best unflagged fit plus Gaussian noise of the dataset's declared (known) sigma, so the time structure of "
-          "a series is never resampled; datasets whose sigma is only assumed get no firmness figure. Each refit "
+          "best unflagged fit plus Gaussian noise of the sigma the likelihood uses (measured, or estimated from the data), so the time structure of "
+          "a series is never resampled; noise-free reconstructions get no firmness figure. Each refit "
           "starts from the "
           "candidate's best fit on the original data (no grid scan, one Levenberg-Marquardt run). Parameter "
           "intervals are 95% **percentile intervals** (2.5th to 97.5th percentile of the refitted values). "
@@ -38,6 +38,12 @@ def build(ctx) -> Section:
                    for d, why in c.bootstrap_skipped.items()])
     if not c.bootstrap:
         return sec
+    _first_places(sec, c)
+    _parameters(sec, c)
+    return sec
+
+
+def _first_places(sec: Section, c) -> None:
     rows = []
     for rb in c.bootstrap:
         best = [r for r in c.ranking if r.dataset == rb.datasets[0] and r.rank == 1]
@@ -53,6 +59,9 @@ def build(ctx) -> Section:
           "split each first place between them; their shares are summed here. results.json has each one's share.")
     sec.table(["dataset", "best on the original data", "its first places", "others ever first: share (95% interval)",
                "never first"], rows)
+
+
+def _parameters(sec: Section, c) -> None:
     sec.h3("Parameter intervals")
     sec.p("Beside each fitted value and its lmfit standard error: the bootstrap median and 95% interval, and the "
           "interval's width relative to ±1.96 standard errors. Near 1 the two agree; well above 1 the standard "
@@ -81,4 +90,3 @@ def build(ctx) -> Section:
               "as eta/h, is in the table):")
         sec.items([f"{params} ({', '.join(cands)} on {', '.join(dss)}): {'each ' if ',' in params else ''}{why}"
                    for (params, why), (cands, dss) in undetermined.items()])
-    return sec

@@ -18,15 +18,18 @@ def build(ctx) -> list[Section]:
         "scaled by their typical size so the optimizer sees order-one numbers; a grid of starts is scored first "
         "and the best few distinct ones are refined; dataset `[fixed]` values are held.",
         "Likelihood and standard errors follow each dataset's `[noise] kind`: known σ (measured): −2 ln L = χ² + "
-        "Σ ln(2πσ²), standard errors from the covariance unscaled; assumed σ (a guess, the default): σ profiled, "
-        "−2 ln L = n ln(χ²/n) + n + Σ ln(2πσ²), one more parameter, standard errors scaled by √(reduced χ²). "
+        "Σ ln(2πσ²), standard errors from the covariance unscaled; estimated σ (the default, when none is measured): "
+        "σ from the data alone by Gasser-Sroka-Jennen-Steinmetz differences or the spread of replicates, the same "
+        "for every law, used the same way, its degrees of freedom carried into the F test of fit; none (a "
+        "noise-free reconstruction): no likelihood. No guessed σ is used. "
         "A fit to ω derived from θ by a smoother has correlated points: no likelihood, criteria or error bars.",
-        "Statistics: χ² = Σ((model − data)/σ)², reduced χ² = χ²/(n − k), AIC = −2 ln L + 2k′, "
-        "AICc = AIC + 2k′(k′+1)/(n − k′ − 1), BIC = −2 ln L + k′ ln n, k′ = k plus the profiled σ. k counts the "
+        "Statistics: χ² = Σ((model − data)/σ)², reduced χ² = χ²/(n − k), AIC = −2 ln L + 2k, "
+        "AICc = AIC + 2k(k+1)/(n − k − 1), BIC = −2 ln L + k ln n. k counts the "
         "identifiable directions (rank of the Jacobian): a pair entering only as a ratio counts once, a "
         "parameter without effect not at all. Groups add −2 ln L and k and use the group's n.",
-        "Goodness of fit: χ² p-value (known σ only) and the Wald-Wolfowitz runs test on residual signs (one-sided: "
-        "too few runs); a candidate fits when both are ≥ 0.01 (Bonferroni-adjusted over a group); the top "
+        "Goodness of fit: χ² p-value (known σ; an F test with the estimate's degrees of freedom for estimated σ) and "
+        "the Wald-Wolfowitz runs test on residual signs (one-sided: too few runs); a candidate fits when both are "
+        "≥ 0.005, one family-wise level of 0.01 (Bonferroni-adjusted over a group); the top "
         "candidate is called best only if it fits and carries no plausibility flag.",
         "Plausibility: flagged when slip or r|ω| exceeds 10× the starting speed, friction does net negative work, or "
         "a fitted law parameter can be set to 0 changing χ² (in variance units) by less than 1; flagged fits rank "

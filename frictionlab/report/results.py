@@ -10,7 +10,7 @@ results.json:
           parameters{name: {value, stderr, unit, kind: law|scene|derived, vary, fixed_by, lower, upper}},
           correlations[{a, b, r}],
           statistics{observable, observable_unit, n_points, n_params, n_free, chisqr, redchi, rss, rmse,
-                     aic, aicc, bic, likelihood: known|assumed|mixed|none, likelihood_reason, neg2loglik, k_lik},
+                     aic, aicc, bic, likelihood: known|estimated|mixed|none, likelihood_reason, neg2loglik, k_lik},
           goodness{likelihood, chi2_p, runs_p, runs, runs_expected, lag1, lag1_p, fits, reason, members},
           flags[] (plausibility), plausibility{max_slip_ratio, max_spin_ratio, work_fraction, effect_dchi2{}},
           identifiability{verdict, warnings[], at_bounds[], missing_stderr{name: reason},
@@ -53,7 +53,7 @@ import math
 
 import numpy as np
 
-from ..inference.bootstrap import parameter_table, ranking_table
+from ..inference.ranking_bootstrap import parameter_table, ranking_table
 from ..inference.predict import FIT_RTOL
 from ..inference.ranking import COLUMNS, to_csv
 from ..io.dataset import COLUMN_SI

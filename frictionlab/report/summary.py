@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import datetime as _dt
 
-from ..inference.bootstrap import wilson
+from ..inference.ranking_bootstrap import wilson
 from ..inference.equivalence import AREA_RATE, WEAR
 from .doc import Section
 from .text import PROVENANCE_WORDS, pct

@@ -40,10 +40,21 @@ STATED = {
              u0=27.0, A0=270e-6, lam=0.96e6, b=0.83),
 }
 #: Assumed (not stated in the paper): restitution of a golf ball for the half-sine normal-force
-#: model, falling with speed as the paper's ref 4 describes; noise of the reconstructed series.
+#: model, falling with speed as the paper's ref 4 describes.
 RESTITUTION = {28: 0.80, 61: 0.70}
-NOISE_RPM = {28: 200, 61: 450}
-NOISE_THETA_DEG = 0.5
+#: Precision of each stated number: one unit of its last significant digit (6,700 rpm: 100 rpm;
+#: 13 deg: 1 deg), the camera's framing interval for a time. The series has no noise ([noise] kind
+#: = 'none'): laws are compared on these numbers ([stated]), the curve is drawn for figures.
+PRECISION = dict(omega_peak=100 * RPM, t_peak=FRAME, omega_c=100 * RPM, theta_max=math.radians(1))
+
+
+def stated_table(s: dict) -> dict:
+    """The [stated] table of a golf dataset: [value, precision] of each stated number, in rpm, us, deg."""
+    rpm = lambda x: f"{x / RPM:.0f} rpm"  # noqa: E731
+    return {"omega_peak": [rpm(s["omega_peak"]), rpm(PRECISION["omega_peak"])],
+            "t_peak": [f"{s['t_peak'] * 1e6:g} us", f"{PRECISION['t_peak'] * 1e6:g} us"],
+            "omega_end": [rpm(s["omega_c"]), rpm(PRECISION["omega_c"])],
+            "theta_max": [f"{math.degrees(s['theta_max']):g} deg", f"{math.degrees(PRECISION['theta_max']):g} deg"]}
 
 
 def spin_curve(s: dict) -> PchipInterpolator:
@@ -61,46 +72,55 @@ def build(out_dir: Path) -> list[Path]:
     for speed, s in STATED.items():
         curve = spin_curve(s)
         t = np.arange(0, round(s["t_c"] / FRAME) + 1) * FRAME
-        omega = curve(t)
-        theta = curve.antiderivative()(t)
-        vn = speed * math.cos(math.radians(30))
-        meta = {
-            "name": f"impact-golf-v{speed}",
-            "kind": "impact",
-            "observable": "theta",
-            "description": (f"Golf ball (46 g, 42.6 mm) in oblique impact on a rigid steel target inclined 30 deg, "
-                            f"inbound {speed} m/s: spin and rotation angle during contact, at the 10 us framing "
-                            "interval. A reconstruction that agrees with every number the paper states; "
-                            "not the camera measurements themselves."),
-            "columns": {"t": "us", "omega": "rpm", "theta": "deg"},
-            "noise": {"kind": "assumed", "omega": f"{NOISE_RPM[speed]} rpm", "theta": f"{NOISE_THETA_DEG} deg"},
-            "scene": {
-                "mass": "46 g", "radius": "21.3 mm", "inertia_factor": 0.4,
-                "u0": f"{s['u0']:g} m/s",
-                "effects": ["spin"],
-                "area": {"model": "half-sine", "peak": f"{s['A0'] * 1e6:g} mm^2", "contact_time": f"{s['t_c'] * 1e6:g} us"},
-                "normal": {"model": "half-sine", "normal_speed": f"{vn:.4f} m/s", "restitution": RESTITUTION[speed]},
-            },
-            "provenance": {
-                "kind": "reconstructed",
-                "source": SOURCE,
-                "method": ("PCHIP through (0,0), (t_p/2, f*omega_p), (t_p, omega_p), (t_c, omega_c); f solved so that "
-                           "the integral of omega over the contact equals the stated largest rotation angle; "
-                           "theta is that integral. Noise levels and the restitution of the normal-force model "
-                           "are assumptions, not stated in the paper. See frictionlab/io/datagen/golf.py."),
-                "command": "frictionlab datasets rebuild",
-            },
-            "reported": {
-                "impact_speed": f"{speed} m/s", "incidence": "30 deg",
-                "omega_peak": f"{s['omega_peak'] / RPM:g} rpm", "t_peak": f"{s['t_peak'] * 1e6:g} us",
-                "omega_at_contact_end": f"{s['omega_c'] / RPM:g} rpm", "contact_time": f"{s['t_c'] * 1e6:g} us",
-                "theta_max": f"{math.degrees(s['theta_max']):g} deg", "u0": f"{s['u0']:g} m/s",
-                "A0": f"{s['A0'] * 1e6:g} mm^2", "lam": f"{s['lam']:g} Pa s/m", "b": s["b"],
-            },
-        }
-        cols = {"t": t * 1e6, "omega": omega / RPM, "theta": np.degrees(theta)}
-        written += write_pair(out_dir, meta["name"], meta, cols, 8, __name__)
+        cols = {"t": t * 1e6, "omega": curve(t) / RPM, "theta": np.degrees(curve.antiderivative()(t))}
+        written += write_pair(out_dir, f"impact-golf-v{speed}", _golf_meta(speed, s), cols, 8, __name__)
+    return written + _area_pair(out_dir)
 
+
+def _golf_meta(speed: int, s: dict) -> dict:
+    """The TOML of the golf reconstruction at ``speed`` m/s from its stated values ``s``."""
+    vn = speed * math.cos(math.radians(30))
+    return {
+        "name": f"impact-golf-v{speed}",
+        "group": "impact-golf",  # one ball and target at two speeds
+        "kind": "impact",
+        "observable": "theta",
+        "description": (f"Golf ball (46 g, 42.6 mm) in oblique impact on a rigid steel target inclined 30 deg, "
+                        f"inbound {speed} m/s: spin and rotation angle during contact, at the 10 us framing "
+                        "interval. A reconstruction that agrees with every number the paper states; "
+                        "not the camera measurements themselves."),
+        "columns": {"t": "us", "omega": "rpm", "theta": "deg"},
+        "noise": {"kind": "none"},
+        "stated": stated_table(s),
+        "scene": {
+            "mass": "46 g", "radius": "21.3 mm", "inertia_factor": 0.4,
+            "u0": f"{s['u0']:g} m/s",
+            "effects": ["spin"],
+            "area": {"model": "half-sine", "peak": f"{s['A0'] * 1e6:g} mm^2", "contact_time": f"{s['t_c'] * 1e6:g} us"},
+            "normal": {"model": "half-sine", "normal_speed": f"{vn:.4f} m/s", "restitution": RESTITUTION[speed]},
+        },
+        "provenance": {
+            "kind": "reconstructed",
+            "source": SOURCE,
+            "method": ("PCHIP through (0,0), (t_p/2, f*omega_p), (t_p, omega_p), (t_c, omega_c); f solved so that "
+                       "the integral of omega over the contact equals the stated largest rotation angle; "
+                       "theta is that integral. Noise-free: laws are compared on the stated numbers at their "
+                       "stated precision ([stated]). The restitution of the normal-force model is an "
+                       "assumption, not stated in the paper. See frictionlab/io/datagen/golf.py."),
+            "command": "frictionlab datasets rebuild",
+        },
+        "reported": {
+            "impact_speed": f"{speed} m/s", "incidence": "30 deg",
+            "omega_peak": f"{s['omega_peak'] / RPM:g} rpm", "t_peak": f"{s['t_peak'] * 1e6:g} us",
+            "omega_at_contact_end": f"{s['omega_c'] / RPM:g} rpm", "contact_time": f"{s['t_c'] * 1e6:g} us",
+            "theta_max": f"{math.degrees(s['theta_max']):g} deg", "u0": f"{s['u0']:g} m/s",
+            "A0": f"{s['A0'] * 1e6:g} mm^2", "lam": f"{s['lam']:g} Pa s/m", "b": s["b"],
+        },
+    }
+
+
+def _area_pair(out_dir: Path) -> list[Path]:
+    """The contact-area series at 32 m/s (eq (1) of the paper): a supporting series, not fitted."""
     t_c = 440e-6
     t = np.arange(0, round(t_c / FRAME) + 1) * FRAME
     A = 150e-6 * np.sin(math.pi * t / t_c)
@@ -111,16 +131,14 @@ def build(out_dir: Path) -> list[Path]:
         "description": ("Contact area of a golf ball on a transparent PMMA target at 32 m/s, as eq (1) of the paper "
                         "describes it; a supporting series (scenes may use it as a measured-area column), not fitted."),
         "columns": {"t": "us", "A": "mm^2"},
-        "noise": {"kind": "assumed", "A": "5 mm^2"},
+        "noise": {"kind": "none"},
         "provenance": {
             "kind": "reconstructed",
             "source": SOURCE + "; Fig. 2a: peak 150 mm^2 at 220 us",
             "method": ("eq (1), A = A0 sin(pi t / t_c) with A0 = 150 mm^2 and t_c = 2 x 220 us = 440 us, sampled "
-                       "every 10 us; the measured points of Fig. 2a are not published as numbers. The noise level "
-                       "is an assumption."),
+                       "every 10 us; the measured points of Fig. 2a are not published as numbers. Noise-free."),
             "command": "frictionlab datasets rebuild",
         },
         "reported": {"A_peak": "150 mm^2", "t_peak": "220 us", "impact_speed": "32 m/s"},
     }
-    written += write_pair(out_dir, meta["name"], meta, {"t": t * 1e6, "A": A * 1e6}, 8, __name__)
-    return written
+    return write_pair(out_dir, meta["name"], meta, {"t": t * 1e6, "A": A * 1e6}, 8, __name__)

@@ -62,6 +62,7 @@ def _oil(out_dir, a_mm2, seed):
     name = f"incline-oil-a{a_mm2}"
     meta = {
         "name": name,
+        "group": "incline-oil",  # one rubber, oil and incline at three contact areas
         "kind": "incline",
         "observable": "v",
         "description": (f"PU-rubber-like block ({c['mass'] * 1e3:g} g, contact area {a_mm2} mm^2) sliding from rest "
@@ -99,6 +100,7 @@ def _dry(out_dir, d_mm, a0_mm2, seed):
     name = f"incline-dry-d{d_mm:g}".replace(".", "p")
     meta = {
         "name": name,
+        "group": "incline-dry",  # one PTFE-on-glass setup at two contact sizes
         "kind": "incline",
         "observable": "v",
         "description": (f"PTFE sphere ({d_mm:g} mm, {mass * 1e3:.3g} g) sliding from rest down a {c['incline_deg']:g} deg "

@@ -22,7 +22,8 @@ The paper's stated measurement uncertainty is not quoted in either source. The [
 dataset is the transcription uncertainty we can measure: the RMS difference between the two
 independent digitizations of the same markers (spin: 4.7 rad/s; restitution: 0.0073; incidence read
 off the axis: 0.17 deg, used for the contact-point angle that only Kratos digitized). It is a lower
-bound on the experimental scatter, and is stated as such in every file.
+bound on the experimental scatter, and is stated as such in every file; the fits use neither it nor a
+guess: [noise] kind = 'estimated' (sigma from the data's own scatter, io/noise.py).
 
 Material data (not from the paper, which we could not read): alumina E = 380 GPa, nu = 0.23,
 density 4000 kg/m^3, diameter 5 mm; soda-lime glass E = 70 GPa, nu = 0.25; friction coefficient
@@ -192,9 +193,10 @@ def build(out_dir: Path) -> list[Path]:
                             f"3.9 m/s, against the impact angle from the normal (Kharaz, Gorham and Salman 2001), "
                             "transcribed from a public digitization of the paper's figure. Noise is the "
                             "transcription uncertainty only (the paper's stated uncertainty is not quoted in "
-                            "the sources): a lower bound on the experimental scatter."),
+                            "the sources): a lower bound on the experimental scatter, so the fits estimate sigma from the "
+                            "data's own scatter instead."),
             "columns": {"speed": "m/s", "incidence": "deg", obs: unit},
-            "noise": {obs: shown},
+            "noise": {"kind": "estimated", obs: shown},
             "scene": scene(),
             "provenance": {
                 "kind": "measured",

@@ -94,12 +94,13 @@ def build(out_dir: Path) -> list[Path]:
         law_name = law if isinstance(law, str) else law.name
         meta = {
             "name": name,
+            **({"group": name.rsplit("-", 1)[0]} if name.startswith(("kt-speeds", "kt-twolam")) else {}),
             "kind": "impact",
             "observable": "omega",
             "description": (f"Known-truth impact: golf-ball-like scene, u0 = {u0:g} m/s, A0 = {A0 * 1e6:g} mm^2, "
                             f"t_c = {tc * 1e6:g} us; spin generated with {law_name}. SYNTHETIC, not measured."),
             "columns": {"t": "us", "omega": "rpm"},
-            "noise": {"omega": f"{sigma:g} rpm"},
+            "noise": {"kind": "known", "omega": f"{sigma:g} rpm"},
             "scene": spec,
             "provenance": {
                 "kind": "synthetic",

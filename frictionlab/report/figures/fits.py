@@ -14,8 +14,12 @@ def fit_figure(dataset, fits, rows) -> bytes:
     (rows are impacts) goes to ``outcome_figure``."""
     if "t" not in dataset.columns:
         return outcome_figure(dataset, fits, rows)
-    plt = base._plt()
     curves = base.distinct_curves(fits)
+    if curves and curves[0][0].per_dataset[0].target.observable == "stated":
+        from .stated import stated_figure
+
+        return stated_figure(dataset, curves, rows)
+    plt = base._plt()
     target = curves[0][0].per_dataset[0].target if curves else None
     obs = target.observable if curves else dataset.observable
     uname, uf = unit(obs)

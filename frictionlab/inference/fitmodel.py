@@ -1,0 +1,312 @@
+"""The fit's machinery: parameter slots (law parameters and freed scene quantities, scaled for the
+optimizer), the weighted-residual model, the time budget, and the multi-start Levenberg-Marquardt search."""
+from __future__ import annotations
+
+import math
+import re
+import signal
+import threading
+import time
+from collections.abc import Mapping
+from contextlib import contextmanager
+
+import attrs
+import numpy as np
+
+from ..core.errors import FrictionLabError, ParameterError, SolverError
+from . import levmar
+from .predict import SCENE_QUANTITIES, SkipDataset, get_scene_quantity, has_scene_quantity, predict, set_scene_quantity
+
+PENALTY = 1e4  # weighted residual per point when the model cannot be evaluated
+ODE_STARTS = 2  # at most this many starts are refined when a dataset needs the (costlier) ODE solver
+VALLEY_R = 0.999  # |correlation| at an ODE fit's optimum above which further starts are not run (see _valley)
+FTOL = 1e-6  # relative chi-square and step tolerances of Levenberg-Marquardt
+
+
+@attrs.frozen
+class _Slot:
+    pname: str  # lmfit identifier
+    display: str
+    kind: str
+    key: str
+    targets: tuple[int, ...]
+    value: float  # SI start value
+    lower: float
+    upper: float
+    scale: float
+    unit: str
+    vary: bool
+    fixed_by: str = ""
+
+
+def _ident(text: str) -> str:
+    s = re.sub(r"\W", "_", text)
+    return s if re.match(r"[A-Za-z_]", s) else f"p_{s}"
+
+
+def _law_slots(law, targets, fixed, local, initial) -> list[_Slot]:
+    slots = []
+    multi = len(targets) > 1
+    for spec in law.params:
+        n = spec.name
+        start = float(initial.get(n, spec.default))
+        common = dict(kind="law", key=n, lower=spec.lower, upper=spec.upper, scale=spec.scale, unit=spec.unit)
+        if n in fixed:
+            slots.append(_Slot(_ident(n), n, targets=tuple(range(len(targets))), value=float(fixed[n]), vary=False,
+                               fixed_by="held by the caller", **common))
+            continue
+        held = {i: float(t.dataset.fixed[n]) for i, t in enumerate(targets) if n in t.dataset.fixed}
+        if not multi or (len(held) == len(targets) and len(set(held.values())) == 1):
+            if held:
+                slots.append(_Slot(_ident(n), n, targets=tuple(range(len(targets))), value=next(iter(held.values())),
+                                   vary=False, fixed_by=f"[fixed] in dataset {targets[0].name}"
+                                   if not multi else "[fixed] in every dataset", **common))
+            else:
+                slots.append(_Slot(_ident(n), n, targets=tuple(range(len(targets))), value=start, vary=True, **common))
+            continue
+        free = [i for i in range(len(targets)) if i not in held]
+        for i, v in held.items():
+            slots.append(_Slot(_ident(f"{n}__{i}"), f"{n}[{targets[i].name}]", targets=(i,), value=v, vary=False,
+                               fixed_by=f"[fixed] in dataset {targets[i].name}", **common))
+        if n in local:
+            for i in free:
+                slots.append(_Slot(_ident(f"{n}__{i}"), f"{n}[{targets[i].name}]", targets=(i,), value=start,
+                                   vary=True, **common))
+        elif free:
+            slots.append(_Slot(_ident(n), n, targets=tuple(free), value=start, vary=True, **common))
+    return slots
+
+
+def _scene_slots(targets, free) -> list[_Slot]:
+    slots = []
+    for name, bounds in free.items():
+        if not (isinstance(bounds, (tuple, list)) and len(bounds) in (2, 3)):
+            raise ParameterError(f"free scene quantity '{name}': give (lower, upper) or (lower, upper, start) in SI")
+        lo, hi = float(bounds[0]), float(bounds[1])
+        if not lo < hi:
+            raise ParameterError(f"free scene quantity '{name}': lower bound {lo:g} must be below upper {hi:g}")
+        if len(bounds) == 3 and not lo <= float(bounds[2]) <= hi:
+            raise ParameterError(f"free scene quantity '{name}': start {float(bounds[2]):g} is outside its bounds "
+                                 f"[{lo:g}, {hi:g}]")
+        having = [i for i, tg in enumerate(targets) if has_scene_quantity(tg.dataset.scene, name)]
+        if not having:  # a quantity freed for a comparison applies to the datasets whose scene has it
+            get_scene_quantity(targets[0].dataset.scene, name)  # the one-line error naming what is missing
+        for i in having:
+            tg = targets[i]
+            current = get_scene_quantity(tg.dataset.scene, name)
+            start = float(bounds[2]) if len(bounds) == 3 else min(max(current, lo), hi)
+            disp = name if len(targets) == 1 else f"{name}[{tg.name}]"
+            slots.append(_Slot(_ident(f"scene_{name}__{i}"), disp, "scene", name, (i,), start, lo, hi,
+                               max(abs(start), abs(lo), abs(hi), 1e-300) if start == 0 else abs(start),
+                               SCENE_QUANTITIES[name], True))
+    return slots
+
+
+def _lmfit_bound(b: float, slot: _Slot) -> float:
+    """Bounds far outside the parameter's scale are passed as infinite (the law still checks them)."""
+    return b if abs(b) <= 1e4 * slot.scale else math.copysign(math.inf, b)
+
+
+class FitTimeout(BaseException):
+    """A fit ran past its time budget (a BaseException, so that no handler of a law's errors keeps it)."""
+
+
+@contextmanager
+def _alarm(seconds: float | None):
+    """Raise FitTimeout in the main thread after ``seconds`` (no-op elsewhere, or if an alarm is set)."""
+    if (seconds is None or not hasattr(signal, "setitimer") or threading.current_thread() is not threading.main_thread()
+            or signal.getitimer(signal.ITIMER_REAL)[0] > 0):
+        yield
+        return
+
+    def ring(signum, frame):
+        raise FitTimeout()
+
+    old = signal.signal(signal.SIGALRM, ring)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+
+
+class _Model:
+    """Evaluates the weighted residual for a vector of scaled parameter values."""
+
+    def __init__(self, law, targets, solvers, slots, rtol=None, deadline=None):
+        self.law, self.targets, self.solvers, self.slots, self.rtol = law, targets, solvers, slots, rtol
+        self.deadline = deadline  # time.monotonic() after which an evaluation raises FitTimeout
+        self.failures = 0
+        self.last_error = ""
+        self.nfev = 0
+        self._last = None  # (values, models, residual) of the last evaluation that solved every target
+        self.progress = None  # fitprogress.FitProgress, told of every evaluation
+
+    def split(self, values: Mapping[str, float]):
+        """Per-target law parameters and scenes for SI slot values (by lmfit name)."""
+        out = []
+        for i, tg in enumerate(self.targets):
+            p, scene = {}, tg.dataset.scene
+            for s in self.slots:
+                if i in s.targets:
+                    if s.kind == "law":
+                        p[s.key] = values[s.pname]
+                    else:
+                        scene = set_scene_quantity(scene, s.key, values[s.pname])
+            out.append((p, scene))
+        return out
+
+    def models(self, values):
+        """Each target's model at SI slot values; the last evaluation's when it was at these values
+        (lmfit's last call is at its best values, where the fit reads the models next)."""
+        if self._last is not None and self._last[0] == values:
+            return list(self._last[1])
+        return [predict(self.law, tg, p, solver, scene, self.rtol)
+                for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values))]
+
+    def residual(self, values) -> np.ndarray:
+        if self.deadline is not None and time.monotonic() > self.deadline:
+            raise FitTimeout()
+        if self._last is not None and self._last[0] == values:  # scipy's leastsq calls at the start point twice
+            return self._last[2].copy()
+        self.nfev += 1
+        self._last = None
+        if self.progress is not None:
+            self.progress.tick()
+        out, ms = [], []
+        for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values)):
+            try:
+                m = predict(self.law, tg, p, solver, scene, self.rtol)
+                if m.shape != tg.y.shape or not np.isfinite(m).all():
+                    raise SolverError(f"prediction for '{tg.name}' is not finite or has the wrong shape")
+                out.append((m - tg.y) / tg.sigma)
+                ms.append(m)
+            except SkipDataset:
+                raise
+            except FrictionLabError as exc:
+                self.failures += 1
+                self.last_error = str(exc)
+                out.append(np.full(tg.y.shape, PENALTY))
+        r = np.concatenate(out)
+        if len(ms) == len(self.targets):
+            self._last = (dict(values), ms, r.copy())
+        return r
+
+
+def _si(params, slots) -> dict[str, float]:
+    return {s.pname: params[s.pname].value * s.scale for s in slots}
+
+
+def _start_grid(slots, rng, limit: int) -> list[dict[str, float]]:
+    """Candidate starts in scaled units, the given start first: log-spaced multiples of the start
+    for positive quantities, steps of the scale around it for signed ones, the bounds' span for
+    scene quantities; clipped into the bounds. A full grid if it has at most ``limit`` points."""
+    levels = max(3, min(15, int(round(limit ** (1.0 / len(slots))))))
+    axes = []
+    for s in slots:
+        x0 = s.value / s.scale
+        lo, hi = s.lower / s.scale, s.upper / s.scale
+        if s.kind == "scene":
+            c = np.linspace(lo, hi, levels)
+        elif lo >= 0 and x0 > 0:
+            c = x0 * np.logspace(-1.5, 1.5, levels)
+        else:
+            c = x0 + np.sinh(np.linspace(-4.0, 4.0, levels))  # dense near the start, out to +/- 27 scales
+        axes.append(np.unique(np.clip(c, lo, hi)))
+    start = [s.value / s.scale for s in slots]
+    total = math.prod(len(a) for a in axes)
+    if total <= limit:
+        grid = np.array(np.meshgrid(*axes, indexing="ij")).reshape(len(axes), -1).T
+    else:
+        grid = np.array([[rng.choice(a) for a in axes] for _ in range(limit)])
+    grid = np.vstack([start, grid])
+    return [dict(zip((s.pname for s in slots), row)) for row in grid]
+
+
+def _distinct(scored: list[tuple], n: int) -> list[dict]:
+    """Up to n starts from (cost, order, candidate) sorted by cost: each differs from those taken by
+    more than 10% in some coordinate and has a different cost (equal costs mean a plateau, such as
+    a body stuck throughout, where a second start teaches nothing)."""
+    out, costs = [], []
+    for cost, _, c in scored:
+        if any(abs(cost - k) <= 1e-9 * max(abs(cost), 1e-300) for k in costs):
+            continue
+        if all(any(abs(c[k] - o[k]) > 0.1 * max(abs(c[k]), abs(o[k]), 1e-3) for k in c) for o in out):
+            out.append(c)
+            costs.append(cost)
+        if len(out) == n:
+            break
+    return out
+
+
+def _valley(result) -> str:
+    """Why a converged Levenberg-Marquardt run ended in a valley the data do not close ('' if not):
+    two parameters correlated beyond VALLEY_R, or a parameter at a bound. Another start ends in the
+    same valley (the comparison's area-rate fit on a dry incline walks mu -> 0, eta' -> infinity
+    with mu eta' fixed, from either start), so an ODE fit does not pay for it twice."""
+    for p in result.params.values():
+        if not p.vary:
+            continue
+        if any(abs(v - p.value) <= 1e-9 * max(abs(p.value), 1.0) for v in (p.min, p.max) if math.isfinite(v)):
+            return f"{p.name} at a bound"
+        for other, r in (p.correl or {}).items():
+            if abs(r) >= VALLEY_R:
+                return f"{p.name} and {other} correlated at r = {r:.4f}"
+    return ""
+
+
+def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: int, max_nfev, scale_covar: bool = True,
+            direct: bool = False):
+    """Score a grid of starts, refine the best distinct ones with Levenberg-Marquardt, keep the lowest
+    chi-square. Returns (parameters, success, message, lmfit MinimizerResult or None, notes). scale_covar:
+    scale lmfit's error bars by sqrt(reduced chi2) (only when sigma is not known). direct: run lmfit's
+    Levenberg-Marquardt through ``levmar.leastsq`` (the same numbers without lmfit's bookkeeping; its
+    result is not a MinimizerResult), lmfit itself where that declines."""
+    varying = [s for s in slots if s.vary]
+    if not varying:
+        return params, True, "nothing to fit: every parameter is held", None, []
+    slow = any(x.startswith("ode") for x in solvers)
+    starts = [{s.pname: params[s.pname].value for s in varying}]
+    if model.progress is not None:
+        from .fitprogress import LM_EVALS
+
+        lm = LM_EVALS * (len(varying) + 1)
+        model.progress.stage("scanning start points", scan, total=scan + n_starts * lm + 2 * len(varying) + 2)
+    if scan:
+        fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
+        scored = []
+        for cand in _start_grid(varying, np.random.default_rng(0), scan):
+            vals = {**fixed_part, **cand}
+            r = model.residual({s.pname: vals[s.pname] * s.scale for s in slots})
+            scored.append((float(r @ r), len(scored), cand))
+        scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins
+        starts = _distinct(scored, min(n_starts, ODE_STARTS) if slow else n_starts)
+    best, notes = None, []
+    for i, start in enumerate(starts):
+        for k, v in start.items():  # every varying parameter; lmfit works on its own copy
+            params[k].set(value=v)
+        budget = max_nfev or 200 * (len(varying) + 1)
+        if model.progress is not None:
+            model.progress.stage(f"Levenberg-Marquardt start {i + 1} of {len(starts)}", lm,
+                                 total=model.progress.done + (len(starts) - i) * lm + 2 * len(varying) + 2)
+        r = None
+        if direct:
+            before = model.nfev, model.failures, model.last_error, model._last
+            r = levmar.leastsq(lambda v: model.residual({s.pname: v[s.pname] * s.scale for s in slots}), params,
+                               scale_covar, budget, epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
+            if r is None:  # lmfit takes another path here: run it, from the same state of the model
+                model.nfev, model.failures, model.last_error, model._last = before
+        if r is None:
+            mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), levmar.lmfit_parameters(params),
+                                   scale_covar=scale_covar, max_nfev=budget)
+            r = mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
+        if best is None or (r.success, -r.chisqr) > (best.success, -best.chisqr):
+            best = r
+        why = _valley(r) if slow and r.success and i + 1 < len(starts) else ""
+        if why:
+            notes.append(f"one Levenberg-Marquardt start of {len(starts)}: the first ended where the data do not "
+                         f"determine the parameters ({why}), where another start ends too")
+            break
+    return best.params, bool(best.success), str(best.message), best, notes
+

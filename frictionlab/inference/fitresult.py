@@ -1,0 +1,196 @@
+"""What a fit returns: parameters with their errors, statistics, per-dataset fits (see ``fitting``)."""
+from __future__ import annotations
+
+import math
+import warnings
+
+import attrs
+import numpy as np
+
+from ..physics.scene import Scene
+from .identifiability import Identifiability
+from .predict import Target
+
+
+@attrs.frozen
+class ParamResult:
+    """A fitted (or held) parameter: SI value and standard error, unit, bounds and role."""
+
+    name: str  # display name: 'lam', or 'u0[impact-golf-v28]' for a per-dataset quantity
+    key: str  # law parameter or scene quantity
+    kind: str  # 'law' | 'scene'
+    value: float
+    stderr: float | None
+    unit: str
+    vary: bool
+    initial: float
+    lower: float
+    upper: float
+    datasets: tuple[str, ...]
+    fixed_by: str = ""  # why it is held: '' when fitted
+
+
+@attrs.frozen
+class Stats:
+    """Fit statistics. chisqr uses noise-weighted residuals; rss and rmse are in the observable's
+    SI unit (single-dataset fits only, else nan). n_params counts identifiable directions."""
+
+    n_points: int
+    n_params: int
+    n_free: int
+    chisqr: float
+    redchi: float
+    rss: float
+    rmse: float
+    aic: float
+    aicc: float
+    bic: float
+    likelihood: str = "estimated"  # 'known' | 'estimated' | 'mixed' | 'none' (see fitting's docstring)
+    neg2loglik: float = math.nan  # -2 ln L at the best fit, constant included
+    k_lik: int = 0  # parameters counted by AIC/AICc/BIC: n_params (sigma is measured or estimated without the law)
+    likelihood_reason: str = ""  # why this likelihood (the dataset's [noise] kind)
+
+
+@attrs.frozen(eq=False)
+class DatasetFit:
+    """One dataset's part of a fit: data, best model, residuals (SI) and what produced them."""
+
+    target: Target
+    solver: str
+    params: dict  # law parameters at the best fit (SI)
+    scene: Scene
+    model: np.ndarray
+    rss: float
+    rmse: float
+    chisqr: float
+    goodness: object = None  # goodness.Goodness of this dataset's residuals
+
+    @property
+    def name(self) -> str:
+        return self.target.name
+
+    @property
+    def residual(self) -> np.ndarray:
+        return self.model - self.target.y
+
+    def trajectory(self, law, t=None, n: int = 401):
+        """The best-fit trajectory on times t (default: n points over the scene), or None for
+        kinds without a time series."""
+        from ..solve.solvers import simulate
+
+        if self.target.t is None:
+            return None
+        if t is None:
+            t = np.linspace(0.0, max(self.scene.duration, float(self.target.t[-1])), n)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return simulate(law, self.scene, self.params, solver=self.solver, t=t)
+
+
+@attrs.frozen(eq=False)
+class FitResult:
+    """Outcome of ``fit``: parameters with errors, statistics, identifiability, per-dataset fits."""
+
+    law: str
+    solver: str
+    datasets: tuple[str, ...]
+    status: str  # 'ok' | 'failed' | 'skipped'
+    reason: str = ""
+    params: dict = attrs.field(factory=dict)  # display name -> ParamResult
+    correlations: dict = attrs.field(factory=dict)  # (a, b) -> r, free parameters only
+    stats: Stats | None = None
+    identifiability: Identifiability | None = None
+    per_dataset: tuple[DatasetFit, ...] = ()
+    nfev: int = 0
+    wall_time: float = 0.0  # seconds on the clock
+    cpu_time: float = 0.0  # CPU seconds of the fitting thread
+    message: str = ""
+    notes: tuple[str, ...] = ()
+    goodness: object = None  # goodness.Goodness over the fitted datasets (Bonferroni over a group)
+    flags: tuple[str, ...] = ()  # plausibility.check: why the fit is physically implausible ('' if none)
+    plausibility: dict = attrs.field(factory=dict)  # the numbers behind the flags (SI)
+    #: lmfit's MinimizerResult of the best start, in SI (None when nothing was fitted); its parameter
+    #: names are identifiers ('lam', 'scene_u0__0'); ``params`` holds the display names.
+    minimizer_result: object = attrs.field(default=None, repr=False)
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    @property
+    def lmfit_params(self):
+        """The parameters as ``lmfit.Parameters`` in SI (values, standard errors, bounds, correlations),
+        named as in ``params`` with characters lmfit does not accept replaced by '_'."""
+        from .frames import lmfit_parameters
+
+        return lmfit_parameters(self)
+
+    def fit_report(self, **kwargs) -> str:
+        """lmfit's fit report of this fit (SI units, ours statistics first); kwargs go to lmfit.fit_report."""
+        from .frames import fit_report
+
+        return fit_report(self, **kwargs)
+
+    def to_dataframe(self):
+        """The parameters as a tidy pandas DataFrame, one row per parameter, with units."""
+        from .frames import parameters_frame
+
+        return parameters_frame([self])
+
+    def __repr__(self) -> str:
+        on = ", ".join(self.datasets)
+        if not self.ok:
+            return f"<FitResult {self.law} [{self.solver}] on {on}: {self.status}: {self.reason}>"
+        from ..core.display import param_text
+
+        ps = ", ".join(f"{p.name} = {param_text(p.value, p.stderr, p.unit)}" for p in self.params.values()
+                       if p.vary or p.kind == "derived")
+        return f"<FitResult {self.law} [{self.solver}] on {on}: {ps}; reduced chi2 {self.stats.redchi:.3g}>"
+
+    def _repr_html_(self) -> str:
+        from .frames import fit_html
+
+        return fit_html(self)
+
+    def value(self, name: str) -> float:
+        return self.params[name].value
+
+    @property
+    def determined(self) -> tuple[str, ...]:
+        """Names of the parameters the data determine: the fitted ones, except those without effect
+        or entering only through a ratio, plus the derived combinations (e.g. 'eta/h')."""
+        ident = self.identifiability
+        arbitrary = set(ident.no_effect) | {k for pair in ident.ratio_only for k in pair} if ident else set()
+        return tuple(k for k, p in self.params.items()
+                     if (p.vary and not {k, p.key} & arbitrary) or p.kind == "derived")
+
+    def stderr(self, name: str) -> float | None:
+        return self.params[name].stderr
+
+    def summary(self) -> str:
+        """A few lines for the terminal."""
+        on = ", ".join(d.target.label for d in self.per_dataset) if self.per_dataset else ", ".join(self.datasets)
+        head = f"{self.law} [{self.solver}] on {on}: {self.status}"
+        if not self.ok:
+            return f"{head}: {self.reason}"
+        s = self.stats
+        lines = [head, f"  chi2 = {s.chisqr:.5g}, reduced chi2 = {s.redchi:.4g}, AIC = {s.aic:.5g}, "
+                       f"BIC = {s.bic:.5g}, n = {s.n_points}, k = {s.n_params}, nfev = {self.nfev}, "
+                       f"{self.wall_time:.2f} s"]
+        lines.append(f"  likelihood: {s.likelihood} sigma ({s.likelihood_reason})" if s.likelihood != "none"
+                     else f"  likelihood: none ({s.likelihood_reason})")
+        if self.goodness is not None:
+            verdict = {True: "fits", False: "does not fit", None: "not tested"}[self.goodness.fits]
+            lines.append(f"  goodness of fit: {verdict}: {self.goodness.text} ({self.goodness.reason})")
+        for flag in self.flags:
+            lines.append(f"  FLAG (implausible): {flag}")
+        for p in self.params.values():
+            err = "held" if not p.vary and p.kind != "derived" else ("no error bar" if p.stderr is None else f"+/- {p.stderr:.3g}")
+            why = f" ({p.fixed_by})" if p.fixed_by else ""
+            lines.append(f"  {p.name:<28} = {p.value:.6g} {p.unit} {err}{why}")
+        for w in self.identifiability.warnings:
+            lines.append(f"  warning: {w}")
+        for n in self.notes:
+            lines.append(f"  note: {n}")
+        return "\n".join(lines)
+
