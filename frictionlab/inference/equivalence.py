@@ -200,7 +200,7 @@ def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = RE
     if fit_a.stats.likelihood not in ("known", "estimated", "stated"):
         return EquivalenceResult(**base, status="skipped",
                                  reason=f"no likelihood to test with ({fit_a.stats.likelihood_reason})")
-    common = _common(fit_a, fit_b)
+    common = _common(fit_a, fit_b, timeout)
     d_ab, d_ba = cross_chi2(fit_a, fit_b, timeout), cross_chi2(fit_b, fit_a, timeout)
     t_obs = float(fit_a.stats.chisqr - fit_b.stats.chisqr)
     tol = TIE_REL * max(common["n_points"], fit_a.stats.chisqr, fit_b.stats.chisqr)
@@ -223,8 +223,9 @@ def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = RE
     return EquivalenceResult(**res, status="ok", verdict=verdict, explanation=why)
 
 
-def _common(fit_a: FitResult, fit_b: FitResult) -> dict:
-    """The fields of a result that describe the data and the two fits."""
+def _common(fit_a: FitResult, fit_b: FitResult, timeout: float | None = None) -> dict:
+    """The fields of a result that describe the data and the two fits (the qualitative comparison, which
+    simulates both fitted laws, within the time budget of a refit)."""
     da, db = fit_a.per_dataset[0], fit_b.per_dataset[0]
     target = da.target
     sig = np.asarray(target.sigma, dtype=float)
@@ -235,9 +236,20 @@ def _common(fit_a: FitResult, fit_b: FitResult) -> dict:
                 fitted={f.law: {k: p.value for k, p in f.params.items() if p.kind == "law"} for f in (fit_a, fit_b)},
                 decomposition=decomposition(fit_a) or decomposition(fit_b),
                 fits={f.law: (f.goodness.fits if f.goodness is not None else None) for f in (fit_a, fit_b)},
-                qualitative=qualitative(fit_a, fit_b),
+                qualitative=_qualitative_within(fit_a, fit_b, timeout),
                 chi2={fit_a.law: fit_a.stats.chisqr, fit_b.law: fit_b.stats.chisqr},
                 k={fit_a.law: fit_a.stats.n_params, fit_b.law: fit_b.stats.n_params})
+
+
+def _qualitative_within(fit_a, fit_b, timeout: float | None) -> dict:
+    """``qualitative`` within ``timeout`` seconds (None: no limit); past it, 'not applicable'."""
+    from .fitmodel import FitTimeout, _alarm
+
+    try:
+        with _alarm(timeout):
+            return qualitative(fit_a, fit_b)
+    except FitTimeout:
+        return {"verdict": "not applicable", "differs": "", "data_differs": {}, "features": {}, "dt": float("nan")}
 
 
 def _sample(fit_a, fit_b, most, seed, t_obs, tol, executor, chunk, timeout):
