@@ -191,7 +191,7 @@ def _show(args) -> int:
         return f"{c} ± {quantity_text(v * _to_file_unit(d, c), d.units.get(c, ''))}" if d.units.get(c) else f"{c} ± {v:.4g}"
 
     values = ", ".join(sd(c, v) for c, v in d.noise.items() if d.noise_kind != "none")
-    print(f"  noise:       {d.noise_kind}{': ' + values if values else ''} ({d.noise_note})")
+    print(f"  noise:       {d.noise_kind} ({d.noise_note}){': ' + values if values else ''}")
     if d.stated:
         from ..io.noise import STATED
 

@@ -101,9 +101,15 @@ def _against_time(ax, d, target, curves) -> str:
     """The fitted column against time with each fit's dense curve; returns the time axis' label."""
     tname, tf = time_unit(float(d.t[-1]))
     obs = target.observable
-    uname, uf = unit(obs)
-    ax.errorbar(target.t * tf, target.y * uf, yerr=target.sigma * uf, fmt="o", ms=3, color="black", ecolor="0.75",
-                elinewidth=0.7, label=f"data ({d.provenance.kind})", zorder=1)
+    if obs == "stated":  # fitted on a few stated numbers: the noise-free curve drawn through them, for the eye only
+        obs = "omega" if "omega" in d.columns else d.observable
+        uname, uf = unit(obs)
+        ax.plot(d.t * tf, d.columns[obs] * uf, color="0.6", lw=3, alpha=0.6,
+                label=f"{d.provenance.kind} curve (figure only, not fitted)", zorder=1)
+    else:
+        uname, uf = unit(obs)
+        ax.errorbar(target.t * tf, target.y * uf, yerr=target.sigma * uf, fmt="o", ms=3, color="black",
+                    ecolor="0.75", elinewidth=0.7, label=f"data ({d.provenance.kind})", zorder=1)
     for f, label, style in curves:
         base.draw_fit(ax, f, obs, d.t, tf, uf, label, **style)
     name = NAMES.get(obs, obs.replace("_", " "))
