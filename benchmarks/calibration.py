@@ -69,8 +69,9 @@ def threshold(truth: str) -> float:
     return math.sqrt(max(cross_chi2(fw, fa), cross_chi2(fa, fw)) / CRITICAL)
 
 
-def one(args) -> tuple[bool, bool, int]:
-    """(true law rejected, other law rejected, replicates drawn) for one simulated dataset."""
+def one(args) -> tuple[bool, bool, int, float]:
+    """(true law rejected by the rule, other law rejected by the rule, replicates drawn per null, the true
+    law's one-sided p) for one simulated dataset."""
     truth, noise, sigma, seed = args
     from frictionlab import analyze_equivalence, fit
     from frictionlab.inference.equivalence import ALPHA
@@ -79,12 +80,12 @@ def one(args) -> tuple[bool, bool, int]:
     fw, fa = fit("wear", ds), fit("area-rate", ds)
     e = analyze_equivalence(fw, fa, seed=seed)
     if not e.ok:
-        return False, False, 0
+        return False, False, 0, math.nan
     rejects = e.p < ALPHA
     wear_rejected = rejects and e.p_a <= e.p_b
     area_rejected = rejects and e.p_b < e.p_a
     true_rej, other_rej = (wear_rejected, area_rejected) if truth == "wear" else (area_rejected, wear_rejected)
-    return bool(true_rej), bool(other_rej), int(e.t_a.size)
+    return bool(true_rej), bool(other_rej), int(e.s_a.size), float(e.p_a if truth == "wear" else e.p_b)
 
 
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
@@ -96,7 +97,14 @@ def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
     return c - h, c + h
 
 
+def _pct(row: dict, key: str) -> str:
+    lo, hi = row[key + "_ci"]
+    return f"{100 * row[key]:.1f}% [{100 * lo:.1f}, {100 * hi:.1f}]"
+
+
 def run(n: int, truths, noises, scales, jobs: int, seed: int) -> list[dict]:
+    from frictionlab.inference.equivalence import ALPHA
+
     rows = []
     with ProcessPoolExecutor(jobs) as pool:
         for truth in truths:
@@ -110,15 +118,16 @@ def run(n: int, truths, noises, scales, jobs: int, seed: int) -> list[dict]:
                     res = list(pool.map(one, tasks, chunksize=4))
                     k_size = sum(r[0] for r in res)
                     k_pow = sum(r[1] for r in res)
+                    k_p = sum(r[3] < ALPHA for r in res)
                     reps = np.mean([r[2] for r in res])
                     row = dict(truth=truth, noise=noise, scale=scale, n=n, size=k_size / n, size_ci=wilson(k_size, n),
-                               power=k_pow / n, power_ci=wilson(k_pow, n), replicates=reps,
-                               seconds=time.perf_counter() - t0)
+                               p_size=k_p / n, p_size_ci=wilson(k_p, n), power=k_pow / n, power_ci=wilson(k_pow, n),
+                               replicates=reps, seconds=time.perf_counter() - t0)
                     rows.append(row)
-                    print(f"truth {truth:9s} noise {noise:9s} sigma {scale:g} x threshold: size {row['size']:.3f} "
-                          f"[{row['size_ci'][0]:.3f}, {row['size_ci'][1]:.3f}], power {row['power']:.3f} "
-                          f"[{row['power_ci'][0]:.3f}, {row['power_ci'][1]:.3f}] over {n} datasets "
-                          f"(mean {reps:.0f} replicates per null, {row['seconds']:.0f} s)", flush=True)
+                    print(f"truth {truth:9s} noise {noise:9s} sigma {scale:g} x threshold: "
+                          f"p(true) < {ALPHA:g} {_pct(row, 'p_size')}; rule rejects the true law {_pct(row, 'size')}, "
+                          f"the other law (power) {_pct(row, 'power')}; {n} datasets, mean {reps:.0f} replicates "
+                          f"per null, {row['seconds']:.0f} s", flush=True)
     return rows
 
 
