@@ -88,6 +88,25 @@ def one(args) -> tuple[bool, bool, int, float]:
     return bool(true_rej), bool(other_rej), int(e.s_a.size), float(e.p_a if truth == "wear" else e.p_b)
 
 
+def pivot(truth: str, n: int) -> None:
+    """Why T is centred: over ``n`` datasets of ``truth`` at the threshold noise (sigma known), the
+    correlation of T = chi2(wear) - chi2(area-rate) with its location at each fitted law (the other law
+    refitted to that law's best curve)."""
+    from frictionlab import fit
+    from frictionlab.inference.replicates import cross_chi2
+
+    thr = threshold(truth)
+    rows = []
+    for i in range(n):
+        ds = _dataset(truth, thr, "known", 500 + i)
+        fw, fa = fit("wear", ds), fit("area-rate", ds)
+        rows.append((fw.stats.chisqr - fa.stats.chisqr, cross_chi2(fw, fa), -cross_chi2(fa, fw)))
+    r = np.array(rows)
+    print(f"{truth} truth, {n} datasets at sigma = threshold: T mean {r[:, 0].mean():.3g} sd {r[:, 0].std():.3g}; "
+          f"correlation of T with its location under area-rate's fit {np.corrcoef(r[:, 0], r[:, 1])[0, 1]:.3f}, "
+          f"under wear's fit {np.corrcoef(r[:, 0], r[:, 2])[0, 1]:.3f}")
+
+
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
     if n == 0:
         return math.nan, math.nan
@@ -139,7 +158,12 @@ def main(argv=None) -> int:
     p.add_argument("--scale", nargs="+", type=float, default=[0.25, 1.0, 4.0])
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--pivot", action="store_true", help="print how T moves with the fitted parameters and stop")
     a = p.parse_args(argv)
+    if a.pivot:
+        for truth in a.truth:
+            pivot(truth, 40)
+        return 0
     run(a.n, a.truth, a.noise, a.scale, a.jobs, a.seed)
     return 0
 
