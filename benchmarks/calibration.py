@@ -1,7 +1,7 @@
 """Calibration of the equivalence test, measured: false-rejection rate of the true law (size) and power.
 
     python benchmarks/calibration.py [--n 200] [--truth wear area-rate] [--noise known estimated]
-                                     [--scale 0.25 1 4] [--jobs 2] [--seed 0]
+                                     [--scale 0.25 1 4] [--jobs 2] [--seed 0] [--pivot]
 
 Per case (truth law, noise kind, sigma as a multiple of the pair's noise threshold) it simulates ``n``
 independent impacts (the paper's golf scene, 41 spin samples over the contact) from the truth, with
@@ -9,8 +9,14 @@ Gaussian noise of that sigma; with noise 'known' the dataset declares the true s
 it declares none and sigma is estimated from the data (io/noise.py). It fits wear and area-rate and
 runs ``analyze_equivalence`` (wear as A, area-rate as B). It prints, with 95% Wilson intervals:
 
-* size: the share of datasets where the test rejects the true law (two-sided rule at alpha = 0.05);
-* power: the share where it rejects the other law.
+* p(true) < alpha: the share of datasets where the true law's own p-value (p_A for wear truth, p_B for
+  area-rate truth) falls below alpha = 0.05: the size of that law's test at the stated alpha, 5% if
+  the p-value is calibrated;
+* the share where the two-sided rule (p = 2 min(p_A, p_B) < alpha) rejects the true law: nominally
+  alpha / 2 = 2.5%, the rule's false rejection of a true law that differs from the other;
+* power: the share where the rule rejects the other law.
+
+    python benchmarks/calibration.py --pivot   # why T is centred: T against its fitted location
 
 The threshold sigma* of the pair is the larger noise at which one law refitted to the other's curve
 misses it by chi-square 3.84 (``EquivalenceResult.threshold``), computed per truth from its noise-free
