@@ -406,7 +406,7 @@ def _verdict(e: EquivalenceResult) -> tuple[str, str]:
         good_law = e.law_b if rej_a else e.law_a
         q = e.q_b if rej_a else e.q_a
         if q < ALPHA / 2:
-            which = (f"the data reject {bad}, and T lies beyond {good}'s replicates on its favourable side "
+            which = (f"the data reject {bad}, and lie beyond {good}'s replicates on its favourable side "
                      f"(p = {q:.2g}): the data are not like {good}'s either")
         elif e.fits.get(good_law) is False:
             which = f"the data reject {bad} against {good}, but {good} fails its own fit tests: the data are like neither"
