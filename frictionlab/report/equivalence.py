@@ -68,8 +68,9 @@ def _figures(sec: Section, c) -> None:
         tested = [e for e in c.equivalence if e.dataset == d.name and e.ok]
         if tested:
             sec.fig(f"discrimination-{d.name}.png",
-                    f"{d.name}: T under each law's fit (histograms) and on the data (line); a law is rejected when "
-                    "the line lies in the far tail of its histogram.",
+                    f"{d.name}: T under each law's fit (histograms) and on the data (line): where the histograms "
+                    "overlap, data of this noise cannot tell the laws apart. Each law's p is taken on T centred at "
+                    "that law's own fit (the text gives both).",
                     lambda d=d, tested=tested: figures.discrimination_figure(d.name, tested))
     for e in c.equivalence:
         if e.decomposition is not None:
