@@ -106,11 +106,13 @@ def pivot(truth: str, n: int) -> None:
     for i in range(n):
         ds = _dataset(truth, thr, "known", 500 + i)
         fw, fa = fit("wear", ds), fit("area-rate", ds)
-        rows.append((fw.stats.chisqr - fa.stats.chisqr, cross_chi2(fw, fa), -cross_chi2(fa, fw)))
+        rows.append((fw.stats.chisqr - fa.stats.chisqr, cross_chi2(fw, fa), -cross_chi2(fa, fw),
+                     fa.value("eta_prime") / TRUTH["area-rate"]["eta_prime"]))
     r = np.array(rows)
     print(f"{truth} truth, {n} datasets at sigma = threshold: T mean {r[:, 0].mean():.3g} sd {r[:, 0].std():.3g}; "
           f"correlation of T with its location under area-rate's fit {np.corrcoef(r[:, 0], r[:, 1])[0, 1]:.3f}, "
-          f"under wear's fit {np.corrcoef(r[:, 0], r[:, 2])[0, 1]:.3f}")
+          f"under wear's fit {np.corrcoef(r[:, 0], r[:, 2])[0, 1]:.3f}; area-rate's fitted eta' spans "
+          f"{r[:, 3].min():.2g}-{r[:, 3].max():.2g} x {TRUTH['area-rate']['eta_prime']:g}")
 
 
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
