@@ -1,4 +1,4 @@
-"""The equivalence test's size, measured (slow: about ten minutes per case on 2 cores): over 200 independent
+"""The equivalence test's size, measured (slow: 10 to 30 minutes per case on 2 shared cores): over 200 independent
 known-truth impacts at the pair's threshold noise, the true law's own p-value falls below alpha (5%) in at
 most 8% of them, the two-sided rule rejects it (nominally alpha / 2) in at most 8%, and the other law is
 rejected more often than the true one. ``benchmarks/calibration.py`` prints every case."""
