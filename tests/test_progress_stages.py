@@ -157,3 +157,15 @@ def test_a_delayed_progress_is_silent_for_a_quick_run_and_speaks_after_the_delay
         bar(3, 3, "c")
     lines = slow.getvalue().splitlines()
     assert "x: 1/3" not in slow.getvalue() and lines[-1].split(" x: ")[1].startswith("3/3 (100%) c; took")
+
+
+def test_a_count_that_moved_gets_its_plain_line_with_eta_from_the_heartbeat():
+    clock, out = FakeClock(), io.StringIO()
+    with Progress("bench", stream=out, tty=False, clock=clock, thread=False) as bar:
+        bar(0, 10, "a")
+        clock.t += 1
+        bar(3, 10, "d")  # within 'every' of the last line: not written now
+        clock.t += 4.5
+        bar.beat()
+    last = out.getvalue().splitlines()[-1]
+    assert last.endswith("bench: 3/10 (30%) d; ETA 0:00:13") and "still working" not in out.getvalue()

@@ -95,8 +95,8 @@ class Progress:
             self.beat()
 
     def beat(self) -> None:
-        """One heartbeat: a 'still working' line (a redrawn bar on a terminal) for every count silent for
-        ``heartbeat`` seconds and not finished."""
+        """One heartbeat: for every count not finished and without a line for ``heartbeat`` seconds, its
+        plain line if it moved since, else a 'still working' line (on a terminal: the bar redrawn)."""
         with self._lock:
             watched = [self] + list(self._children)
         now = self.clock()
@@ -108,7 +108,8 @@ class Progress:
                     p.last_line = now
                     p.bar.refresh()
                 continue
-            p._write(p.still(now), now)
+            # the count moved since the last line: the plain line with its ETA; else 'still working'
+            p._write(p.line(p.done, p.total, p.label, now) if now - p.since < p.heartbeat else p.still(now), now)
 
     def still(self, now: float) -> str:
         """The 'still working' line: count, how long nothing finished, the last label."""
