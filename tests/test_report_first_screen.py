@@ -75,6 +75,11 @@ def test_groups_without_a_fitted_law_fold_into_one_line_under_the_table(comp):
     none = [Answer(group=g, datasets=(), best=None, **kw) for g in ("slider-a", "slider-b")]
     md = markdown("t", _first(attrs.evolve(comp, answers=(fitted, *none)))[0])
     assert "Not fitted (no law compared applies): slider-a, slider-b." in md
+    hint = "rate-state-aging, rate-state-slip (--laws rate-state-aging,rate-state-slip)"
+    none = [attrs.evolve(a, headline=f"not fitted: none applies; registered laws that apply: {hint}",
+                         short={"best": "not fitted: no law compared applies"}) for a in none]
+    md = markdown("t", _first(attrs.evolve(comp, answers=(fitted, *none)))[0])
+    assert f"Not fitted (no law compared applies): slider-a, slider-b; registered laws that apply: {hint}." in md
     assert not [line for line in md.splitlines() if line.startswith("| **slider")]
 
 
@@ -208,3 +213,18 @@ def test_the_command_lines_closing_answers_fold_groups_without_a_fitted_law(comp
     fitted = Answer(group="impact", datasets=("impact-x",), best="wear [exact]", **{**kw, "headline": "best: wear"})
     lines = answer_lines(attrs.evolve(comp, answers=(none[0], fitted, none[1])))
     assert lines[1].startswith("  impact: ") and lines[2:] == ["  slider-a, slider-b: not fitted: no law compared applies"]
+
+
+def test_a_candidate_under_a_higher_ranked_one_is_named_in_its_legend_not_drawn():
+    from types import SimpleNamespace as NS
+
+    import numpy as np
+
+    from frictionlab.report.figures.finding import _merged
+
+    fit = lambda y: NS(per_dataset=[NS(model=np.asarray(y, float))])  # noqa: E731
+    curves = [(fit([0, 50, 100]), "#1 area-rate [exact]", {}), (fit([0, 30, 90]), "#2 wear [series], ΔAIC 9.0", {}),
+              (fit([0, 30.5, 90.4]), "#3 wear [exact], ΔAIC 9.4", {})]
+    out = _merged(curves, span=100.0)  # #3 is within 1.5% of the span of #2 everywhere; #2 is 20% off #1
+    assert [label for _, label, _ in out] == ["#1 area-rate [exact]", "#2 wear [series], ΔAIC 9.0 (hides #3 wear [exact])"]
+    assert len(_merged(curves, span=10.0)) == 3  # on a tenth of the span they are told apart

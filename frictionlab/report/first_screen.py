@@ -103,9 +103,14 @@ ABSENT = {"best": "a best law", "goodness": "a goodness-of-fit test",
 def _answer_table(sec: Section, answers):
     """The verdict table: groups without a fitted law fold into one line under it, columns without data go."""
     folded: dict[str, list[str]] = {}
+    hints: dict[str, dict] = {}  # the registered laws that would apply, from each folded row's headline
     for a in answers:
         if a.best is None:
-            folded.setdefault(a.cell("best") or "no law could be fitted", []).append(a.group)
+            key = a.cell("best") or "no law could be fitted"
+            folded.setdefault(key, []).append(a.group)
+            hint = a.headline.partition("registered laws that apply: ")[2]
+            if hint:
+                hints.setdefault(key, {})[hint] = None
     shown = [a for a in answers if a.best is not None]
     cols = [(key, head) for key, head in COLUMNS if any(a.cell(key) for a in shown)]
     rows, notes = [], []
@@ -125,7 +130,8 @@ def _answer_table(sec: Section, answers):
         sec.more("Each verdict in full (datasets, tests, p-values, thresholds per dataset)", notes)
     for reason, groups in folded.items():
         head, _, why = reason.partition(": ")
-        sec.p(f"{head[0].upper()}{head[1:]}" + (f" ({why})" if why else "") + f": {', '.join(groups)}.")
+        sec.p(f"{head[0].upper()}{head[1:]}" + (f" ({why})" if why else "") + f": {', '.join(groups)}"
+              + "".join(f"; registered laws that apply: {h}" for h in hints.get(reason, ())) + ".")
     absent = [ABSENT[key] for key, _ in COLUMNS if key not in dict(cols)]
     if shown and absent:
         sec.p("Not in this comparison: " + "; ".join(absent) + ".")
