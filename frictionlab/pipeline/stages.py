@@ -72,11 +72,11 @@ def equivalence(c, run: Run) -> dict:
                                           status="skipped", reason=why, replicates=s.replicates, seed=s.seed))
         else:
             tasks.append((fa, fb, s.replicates, s.seed, s.fit_timeout))
-    results = run.map(_equivalence_task, tasks, lambda t: f"equivalence on {t[0].datasets[0]}: {t[0].law} "
-                                                          f"[{t[0].solver}] vs {t[1].law} [{t[1].solver}]")
-    if slow:
+    if slow:  # counted first: the count then ends with the last test run
         run.tally().total += len(slow)
         run.step(f"{len(slow)} pairs skipped (slow; --bootstrap-all tests them)", advance=len(slow))
+    results = run.map(_equivalence_task, tasks, lambda t: f"equivalence on {t[0].datasets[0]}: {t[0].law} "
+                                                          f"[{t[0].solver}] vs {t[1].law} [{t[1].solver}]")
     order = {d.name: i for i, d in enumerate(c.datasets)}
     key = lambda e: (order[e.dataset], pair_index(s.pairs, e), "series" in (e.solver_a, e.solver_b))  # noqa: E731
     return {"equivalence": tuple(sorted(results + slow, key=key))}

@@ -92,8 +92,8 @@ def data_figure(views, title: str) -> bytes:
             ax.set_xlabel(xlabel)
         else:  # the slip panel below carries the time axis
             ax.tick_params(labelbottom=False)
-        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2 if ax.get_xlabel() else -0.03),
-                  ncol=2)  # below the panel: never over the data
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.27 if ax.get_xlabel() else -0.03),
+                  ncol=2)  # below the panel (and its time axis): never over the data
     fig.suptitle(base.wrapped(title, width, 10.5), fontsize=10.5)
     return base._png(fig)
 
@@ -134,7 +134,7 @@ def _against_time(ax, d, target, curves) -> str:
                     ecolor="0.75", elinewidth=0.7, label=f"data ({d.provenance.kind})", zorder=1)
     for f, label, style in curves:
         base.draw_fit(ax, f, obs, d.t, tf, uf, label, **style)
-    name = NAMES.get(obs, obs.replace("_", " "))
+    name = NAMES.get(obs, obs.replace("_", " ")).split(" (")[0]  # the short name: the panel is small
     ax.set_ylabel(f"{name} [{uname}]")
     return f"time [{tname}]"
 
