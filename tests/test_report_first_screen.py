@@ -228,3 +228,18 @@ def test_a_candidate_under_a_higher_ranked_one_is_named_in_its_legend_not_drawn(
     out = _merged(curves, span=100.0)  # #3 is within 1.5% of the span of #2 everywhere; #2 is 20% off #1
     assert [label for _, label, _ in out] == ["#1 area-rate [exact]", "#2 wear [series], ΔAIC 9.0 (hides #3 wear [exact])"]
     assert len(_merged(curves, span=10.0)) == 3  # on a tenth of the span they are told apart
+
+
+def test_a_plain_number_is_quoted_without_a_unit_dash_in_the_data_sentence():
+    from types import SimpleNamespace as NS
+
+    import numpy as np
+
+    from frictionlab.report.data_view import _shape
+
+    t = np.linspace(0.0, 30.0, 31)
+    y = np.where(t < 10, 0.601, 0.593)
+    y[10] = 0.615
+    target = NS(observable="mu", y=y, t=t, sigma=np.full(31, 5e-4))
+    text = _shape(NS(fits=[NS(per_dataset=[NS(target=target)])], dataset=NS(name="block-b")))
+    assert "goes from 0.601 to 0.593 over 30 s, peaking at 0.615 at 10 s" in text and " - " not in text
