@@ -219,7 +219,7 @@ def velstep_toml(name: str, raw: RawRecord, imp: Imported, *, source: str, licen
                  command: str) -> str:
     """The TOML of an imported velocity-step record (provenance 'measured')."""
     v_um = [f"{v * 1e6:g} um/s" for v in imp.velocities]
-    k_note = ("stated with --stiffness" if imp.stiffness_stated else
+    k_note = ("given with --stiffness: a start; fit it with --free spring.stiffness" if imp.stiffness_stated else
               "estimated from d mu/dt = k (V_lp - v) over 1 s after the step: a start; fit it with --free "
               "spring.stiffness")
     trend = (f"friction's slip trend {imp.trend * 1e-6:.4g} per um, fitted to the samples before the step "
