@@ -213,6 +213,11 @@ def test_the_command_lines_closing_answers_fold_groups_without_a_fitted_law(comp
     fitted = Answer(group="impact", datasets=("impact-x",), best="wear [exact]", **{**kw, "headline": "best: wear"})
     lines = answer_lines(attrs.evolve(comp, answers=(none[0], fitted, none[1])))
     assert lines[1].startswith("  impact: ") and lines[2:] == ["  slider-a, slider-b: not fitted: no law compared applies"]
+    hinted = attrs.evolve(none[0], headline="not fitted: none; registered laws that apply: rate-state-slip (--laws "
+                          "rate-state-slip)", short={"best": "not fitted: no law compared applies"})
+    lines = answer_lines(attrs.evolve(comp, answers=(fitted, hinted)))
+    assert lines[2:] == ["  slider-a: not fitted: no law compared applies; registered laws that apply: rate-state-slip "
+                         "(--laws rate-state-slip)"]
 
 
 def test_a_candidate_under_a_higher_ranked_one_is_named_in_its_legend_not_drawn():
