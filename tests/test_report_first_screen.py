@@ -248,3 +248,18 @@ def test_a_plain_number_is_quoted_without_a_unit_dash_in_the_data_sentence():
     target = NS(observable="mu", y=y, t=t, sigma=np.full(31, 5e-4))
     text = _shape(NS(fits=[NS(per_dataset=[NS(target=target)])], dataset=NS(name="block-b")))
     assert "goes from 0.601 to 0.593 over 30 s, peaking at 0.615 at 10 s" in text and " - " not in text
+
+
+def test_a_spring_slider_report_has_its_fit_figure_and_no_force_figure(tmp_path):
+    """A slider's friction is mu N, which the fit figure already shows (a force axis from 0 hid the step)."""
+    from frictionlab import compare
+    from frictionlab.io.template import template
+    from frictionlab.report import write_report
+
+    toml, csv = template("spring-slider", "slider")
+    (tmp_path / "slider.toml").write_text(toml)
+    (tmp_path / "slider.csv").write_text(csv)
+    c = compare(laws=["rate-state-aging"], datasets=[str(tmp_path / "slider.toml")], equivalence=False,
+                transfer=False)
+    names = {p.name for p in (write_report(c, tmp_path / "rep") / "figures").iterdir()}
+    assert "fit-slider.png" in names and "force-slider.png" not in names
