@@ -267,6 +267,12 @@ def get_law(name: str | FrictionLaw) -> FrictionLaw:
         raise RegistryError(f"unknown law '{name}'; registered laws: {', '.join(sorted(_laws))}") from None
 
 
+def is_third_party(law) -> bool:
+    """True for a law whose class is defined outside frictionlab (a plugin, a --load file, a notebook):
+    its code is not trusted to stop at a time budget (``inference.guard``)."""
+    return not type(get_law(law)).__module__.startswith("frictionlab.")
+
+
 def available_laws() -> dict[str, FrictionLaw]:
     """All registered laws by name, in registration order."""
     _load()

