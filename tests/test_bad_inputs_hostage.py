@@ -97,7 +97,12 @@ def test_built_in_laws_are_not_forked(monkeypatch, fitted):
     from frictionlab.inference import guard
 
     calls = []
-    monkeypatch.setattr(guard, "bounded", lambda *a, **k: calls.append(a))
+
+    def bounded(fn, limit, *args):
+        calls.append(fn)
+        raise guard.OverBudget("not run")
+
+    monkeypatch.setattr(guard, "bounded", bounded)
     fl.compare(laws=["coulomb", "wear"], datasets=["incline-oil-a100", "incline-oil-a200"], fit_timeout=30,
                bootstrap=3, tolerance=(1e-3,), replicates=MIN_REPLICATES, bootstrap_all=True)
     assert calls == []
