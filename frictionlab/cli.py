@@ -190,15 +190,24 @@ def _silence_stdout() -> None:
 
 
 def _signals_end_cleanly():
-    """Make SIGTERM and SIGHUP an exception (errors.Terminated) while a command runs, so that clean-up
-    runs: workers stopped, temporary output removed, locks released. Returns the function that undoes it."""
+    """Make SIGTERM and SIGHUP an exception (errors.Terminated), and SIGINT KeyboardInterrupt, while a command
+    runs, so that clean-up runs: workers stopped, temporary output removed, locks released; if the exception
+    is swallowed (a plugin's bare except, a finalizer), the run ends HARD_EXIT_AFTER seconds later all the
+    same. A forked child signalled before it set its own handlers just ends. Returns the function that
+    undoes it."""
+    import os
     import signal
     import threading
 
     if threading.current_thread() is not threading.main_thread():
         return lambda: None
+    me = os.getpid()
 
     def on_signal(signum, frame):
+        if os.getpid() != me:  # a forked worker signalled before it set its own handlers: it just ends
+            signal.signal(signum, signal.SIG_DFL)
+            os.kill(os.getpid(), signum)
+            return
         if not caught:  # a plugin's bare except: may swallow the exception: then end anyway, cleanly
             timer = threading.Timer(HARD_EXIT_AFTER, _hard_exit, (signum,))
             timer.daemon = True
@@ -206,21 +215,30 @@ def _signals_end_cleanly():
             caught.append(timer)
         else:
             _hard_exit(signum)
-        raise Terminated(signum)
+        raise KeyboardInterrupt if signum == signal.SIGINT else Terminated(signum)
+
+    def unraisable(u):  # a signal's exception raised in a finalizer, where Python only prints it: end now
+        if isinstance(u.exc_value, (Terminated, KeyboardInterrupt)) and os.getpid() == me:
+            _hard_exit(getattr(u.exc_value, "signum", signal.SIGINT))
+        hook(u)
 
     caught = []
-    sigs = [s for s in (getattr(signal, "SIGTERM", None), getattr(signal, "SIGHUP", None)) if s is not None]
+    sigs = [getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)]
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:  # ^C ignored by whoever started us
+        sigs.remove(signal.SIGINT)
     old = {s: signal.signal(s, on_signal) for s in sigs}
+    hook, sys.unraisablehook = sys.unraisablehook, unraisable
 
     def restore():
         for t in caught:
             t.cancel()
         for s, h in old.items():
             signal.signal(s, h)
+        sys.unraisablehook = hook
     return restore
 
 
-#: Seconds after SIGTERM or SIGHUP before the process ends even if the exception raised was swallowed.
+#: Seconds after SIGINT, SIGTERM or SIGHUP before the process ends even if the exception raised was swallowed.
 HARD_EXIT_AFTER = 3.0
 
 
@@ -233,7 +251,8 @@ def _hard_exit(signum: int) -> None:
 
     remove_leftovers()
     try:
-        sys.stderr.write(f"frictionlab: {Terminated(signum).word()}\n")
+        word = "interrupted" if signum == 2 else Terminated(signum).word()  # 2: SIGINT
+        sys.stderr.write(f"frictionlab: {word}\n")
         sys.stderr.flush()
     except Exception:  # noqa: BLE001 (nothing more can be said)
         pass
