@@ -107,7 +107,11 @@ def main(argv=None) -> int:
 
     argv = sys.argv[1:] if argv is None else list(argv)
     with guarded_streams() as (out, err):  # all output inert and encodable; a failing stream named
-        rc = _main(argv)
+        try:
+            rc = _main(argv)
+        except (KeyboardInterrupt, Terminated) as exc:  # a signal while the run's ending was being said
+            rc = 128 + int(getattr(exc, "signum", 2))
+            _say_quietly("interrupted" if rc == 130 else exc.word())
         out.flush()
         if out.failure is not None and rc != 141:
             print(f"frictionlab: error: cannot write to {out.name}: {out.failure.strerror or out.failure} "
@@ -136,6 +140,13 @@ def _main(argv: list[str]) -> int:
     return _run(args)
 
 
+def _say_quietly(message: str) -> None:
+    try:
+        print(f"frictionlab: {message}", file=sys.stderr)
+    except (Exception, KeyboardInterrupt, Terminated):  # noqa: BLE001 (nothing more can be said)
+        pass
+
+
 def _say(message: str, status: int) -> int:
     print(f"frictionlab: {message}", file=sys.stderr)
     return status
@@ -150,6 +161,7 @@ def _run(args) -> int:
     try:
         with warnings.catch_warnings(), inputs_of_run():  # outputs keep clear of every file the run reads
             warnings.simplefilter("default")
+            warnings.simplefilter("ignore", ResourceWarning)  # e.g. an import cut short by a signal: not the user's
             warnings.formatwarning = lambda m, c, *a, **k: f"warning: {one_line(m)}\n"
             for path in args.load:
                 load_file(path)
@@ -164,7 +176,7 @@ def _run(args) -> int:
     except OSError as exc:  # the file system refused (permissions, a full disk): the user's to fix
         if args.debug:
             raise
-        where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+        where = f"{exc.filename}: " if getattr(exc, "filename", None) else _cwd_gone()
         return _say(f"error: {where}{one_line(exc.strerror or exc)}", 2)
     except KeyboardInterrupt:
         return _say("interrupted", 130)
@@ -178,6 +190,17 @@ def _run(args) -> int:
     finally:
         warnings.formatwarning = formatwarning
         restore()
+
+
+def _cwd_gone() -> str:
+    """What to say before an OSError that names no file: that the current folder was deleted, if it was."""
+    import os
+
+    try:
+        os.getcwd()
+    except OSError:
+        return "the current folder no longer exists (deleted while in use; cd to an existing folder): "
+    return ""
 
 
 def _silence_stdout() -> None:
