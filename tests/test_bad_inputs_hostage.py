@@ -12,6 +12,7 @@ import time
 import pytest
 
 import frictionlab as fl
+from frictionlab.core.errors import LawError, RegistryError
 from frictionlab.inference.equivalence import MIN_REPLICATES
 from frictionlab.pipeline.comparison import run_stages
 from frictionlab.physics import registry
@@ -109,3 +110,62 @@ def test_built_in_laws_are_not_forked(monkeypatch, fitted):
     c = fl.compare(laws=["swallower"], datasets=["incline-oil-a100"], fit_timeout=30, equivalence=False,
                    transfer=False)
     assert len(calls) == 1 and c.fits[0].status == "failed"  # the check above can fail: a plugin's fit is bounded
+
+
+class _HangsWhenChecked(FrictionLaw):
+    """A law whose force never returns and swallows every exception (so its check at registration hangs)."""
+    name = "hangs-when-checked"
+    formula = "F = k u"
+    citation = "a test of the load time limit"
+    params = (ParamSpec("k", "N s/m", 1.0, 0.0, 100.0, 1.0, "coefficient"),)
+    requires = frozenset({"u"})
+
+    def force(self, p, c):
+        while True:
+            try:
+                time.sleep(0.01)
+            except:  # noqa: E722
+                pass
+
+
+def test_a_law_whose_check_hangs_is_refused_at_the_load_limit(monkeypatch):
+    monkeypatch.setenv("FRICTIONLAB_LOAD_TIMEOUT", "0.5")
+    t0 = time.monotonic()
+    with pytest.raises(LawError, match=r"its check at registration ran past the load time limit of 0.5 s"):
+        fl.register_law(_HangsWhenChecked)
+    assert time.monotonic() - t0 < 30
+    assert "hangs-when-checked" not in fl.available_laws()
+
+
+def test_a_load_file_that_hangs_at_import_leaves_nothing(monkeypatch, tmp_path):
+    import sys
+
+    monkeypatch.setenv("FRICTIONLAB_LOAD_TIMEOUT", "0.5")
+    (tmp_path / "stuck.py").write_text("import time\nwhile True:\n    try:\n        time.sleep(0.01)\n    except:\n"
+                                       "        pass\n")
+    before = set(fl.available_laws())
+    with pytest.raises(RegistryError, match=r"--load .*stuck\.py: importing it .* ran past the load time limit"):
+        registry.load_law_file(tmp_path / "stuck.py")
+    assert "frictionlab_user_stuck" not in sys.modules and set(fl.available_laws()) == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["stuck.py"]
+
+
+def test_a_plugin_that_takes_the_signals_over_in_a_call_gives_them_back():
+    from frictionlab.inference.guard import within_budget
+
+    class Deaf(_Swallower):
+        name = "deaf-in-calls"
+
+        def force(self, p, c):
+            for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+                signal.signal(s, signal.SIG_IGN)
+            return p["k"] * c.u
+
+    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    fl.register_law(Deaf)  # its check calls force here: the handlers come back after it
+    try:
+        assert {s: signal.getsignal(s) for s in before} == before
+        r = within_budget(fl.fit, ["deaf-in-calls"], None, "deaf-in-calls", "incline-oil-a100", over=None)
+        assert r.ok and {s: signal.getsignal(s) for s in before} == before
+    finally:
+        registry.unregister_law("deaf-in-calls")
