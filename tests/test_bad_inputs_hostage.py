@@ -169,3 +169,19 @@ def test_a_plugin_that_takes_the_signals_over_in_a_call_gives_them_back():
         assert r.ok and {s: signal.getsignal(s) for s in before} == before
     finally:
         registry.unregister_law("deaf-in-calls")
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+@pytest.mark.parametrize("stage", ["equivalence", "bootstrap"])
+def test_a_plugin_that_ends_its_process_in_a_refit_is_one_error_naming_the_stage(fitted, monkeypatch, stage, jobs):
+    import os
+
+    from frictionlab.core.errors import WorkerLost
+
+    def quits(self, p, c):
+        os._exit(3)
+
+    monkeypatch.setattr(_Swallower, "force", quits)
+    with pytest.raises(WorkerLost, match=rf"^compare: a worker process (was lost|died while running .*) .*in the {stage} stage$"):
+        run_stages(fitted, [stage], jobs=jobs, fit_timeout=BUDGET, bootstrap=3, replicates=MIN_REPLICATES,
+                   equivalence=True)
