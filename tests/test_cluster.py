@@ -7,7 +7,7 @@ from frictionlab.cli import main
 distributed = pytest.importorskip("distributed")
 
 LAWS = ["wear", "coulomb"]
-DATA = ["incline-oil-a100", "impact-golf-v28"]
+DATA = ["incline-oil-a100", "impact-golf-v28", "spring-slider-slip"]  # the last: nothing to fit (no law applies)
 OPTIONS = dict(laws=LAWS, datasets=DATA, bootstrap=12, tolerance=(1e-3,), replicates=20, seed=3)
 
 

@@ -35,6 +35,7 @@ class Run:
     client: object = None  # a dask.distributed Client: the stages' tasks run on its workers instead of a local pool
     total: int = 0
     done: int = 0
+    part: bool = False  # one dataset's task of a cluster run (pipeline.perdataset): checks over all fits wait
 
     def map(self, fn, tasks: Sequence, label: Callable | None = None) -> list:
         """fn over tasks, on the pool if there is one; results in task order. With ``label``, each
