@@ -9,8 +9,12 @@ tolerance check and ``--bootstrap`` replicates, then the report (its figures dra
 These variants exist only to give the cluster work; they are not data.
 Runs, in one process, in this order and then again in reverse (the machine's speed drifts): the local
 run with one process (``jobs=1``), a LocalCluster of 1 worker process, one of 2 worker processes (each
-cluster started and its workers' imports warmed before the clock starts: a cluster is long-lived).
-Prints wall seconds per run and the ratios; every run's numbers are checked equal to the local run's.
+cluster started and its workers prepared as compare prepares them on its first run, ``core.cluster.prepare``,
+before the clock starts: a cluster is long-lived).
+Prints per run its wall seconds, the CPU seconds of this process (the client and, in a LocalCluster, the
+scheduler) and of each worker, and the load average (wall ratios mean something only on an idle machine:
+with other work on the cores, 2 workers cannot be faster than the cores they get); then the ratios of the
+median walls. Every run's numbers are checked equal to the local run's.
 Targets: 2 workers at least 1.6x faster than 1; 1 worker no slower than the local run.
 """
 from __future__ import annotations
@@ -119,11 +123,13 @@ def main(argv=None):
     print(f"{len(dss)} datasets (synthetic variants of {', '.join(BASES)}), bootstrap {args.bootstrap}; "
           f"{os.cpu_count()} CPUs, load average at start {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
     times = {"local": [], 1: [], 2: []}
+    cpus = {"local": [], 1: [], 2: []}  # (CPU here, [CPU of each worker])
     ref = None
     for order in (("local", 1, 2), (2, 1, "local")):
         for w in order:
             t, own, per_worker, c = one_run(dss, args.bootstrap, None if w == "local" else w)
             times[w].append(t)
+            cpus[w].append((own, per_worker))
             got = numbers(c)
             ref = ref if ref is not None else got
             same = got == ref
@@ -140,6 +146,12 @@ def main(argv=None):
     print(f"median wall: local {med['local']:.1f} s, 1 worker {med[1]:.1f} s, 2 workers {med[2]:.1f} s")
     print(f"RATIO 1 worker / 2 workers = {r21:.2f}x (target >= 1.6: {'met' if r21 >= 1.6 else 'NOT met'})")
     print(f"RATIO 1 worker / local = {r1l:.2f} (target <= 1: {'met' if r1l <= 1.0 else 'NOT met'})")
+    local = statistics.median(own for own, _ in cpus["local"])
+    one = statistics.median(own + sum(ws) for own, ws in cpus[1])
+    busiest = statistics.median(max(ws) for _, ws in cpus[2])
+    print(f"CPU (what the load average does not distort as much): 1 worker and its client / local = {one / local:.2f}; "
+          f"1 worker's CPU / the busier of 2 workers' = {statistics.median(sum(ws) for _, ws in cpus[1]) / busiest:.2f} "
+          "(the most 2 workers can gain on 2 free cores, the client's share aside)")
     print(f"load average at end {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
 
 
