@@ -137,3 +137,21 @@ def test_tolerance_study_on_threads_matches_serial():
     assert [(r["rtol"], r["value"], r["stderr"]) for r in serial] == [(r["rtol"], r["value"], r["stderr"])
                                                                         for r in threaded]
     assert serial[1]["value"] != serial[2]["value"]  # the tolerances really differ
+
+
+def test_log_axes_label_their_ticks_in_plain_text_with_mathtext_off():
+    """pyplot() turns mathtext off; matplotlib's default log labels are mathtext and would print as TeX."""
+    from frictionlab.core.display import plain_log, pyplot
+
+    plt = pyplot()
+    fig, ax = plt.subplots()
+    ax.plot([1e-6, 1e-2], [5e-6, 9e-6])
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    plain_log(ax.xaxis)
+    plain_log(ax.yaxis)
+    fig.canvas.draw()
+    labels = [t.get_text() for t in ax.get_xticklabels() + ax.get_yticklabels(which="both") if t.get_text()]
+    plt.close(fig)
+    assert labels and not [x for x in labels if "$" in x or "mathdefault" in x]
+    assert "1e-04" in [x.replace("\u2212", "-") for x in labels]  # matplotlib writes a true minus sign

@@ -117,7 +117,7 @@ def test_quiet_silences_progress(tmp_path, capsys):
     assert main(argv + ["--out", str(tmp_path / "r1"), "--quiet"]) == 0
     assert capsys.readouterr().err == ""
     assert main(argv + ["--out", str(tmp_path / "r2")]) == 0
-    assert "compare: 1/" in capsys.readouterr().err
+    assert "compare: fit 1/" in capsys.readouterr().err
 
 
 def test_compare_summary_renders_the_answers_only():

@@ -46,7 +46,16 @@ def test_an_absent_or_altered_record_says_where_to_place_it(placed):
     assert external.present() == []
 
 
-def test_the_sepiolite_records_are_named_with_their_license_and_checksum():
+def test_the_steadystate_records_are_named_with_their_license_and_checksum():
     for name, spec in external.RECORDS.items():
-        assert name.startswith("sepiolite-velstep") and spec["license"] == "MIT" and len(spec["sha256"]) == 64
+        assert name.split("-")[0] in ("sepiolite", "basalt") and spec["license"] == "MIT" and len(spec["sha256"]) == 64
         assert "10.1130/GES02739.1" in spec["citation"]
+
+
+def test_a_record_with_a_stated_stiffness_start_is_imported_with_it(placed, monkeypatch):
+    spec = dict(external.RECORDS["lab-step"], stiffness=2e3)
+    monkeypatch.setattr(external, "RECORDS", {"lab-step": spec})
+    d = load_dataset("lab-step")
+    assert d.scene.spring.stiffness == pytest.approx(2e3)
+    assert "--stiffness '0.002 1/um'" in d.provenance.command
+    assert "a start; fit it with --free spring.stiffness" in d.path.read_text()

@@ -6,7 +6,7 @@ import time
 from _fit_helpers import synthetic
 
 from frictionlab import compare, fit
-from frictionlab.core.progress import Progress
+from frictionlab.core.progress import Progress, Running
 
 
 def test_a_fit_names_its_stages_and_counts_evaluations():
@@ -24,12 +24,124 @@ def test_a_fit_names_its_stages_and_counts_evaluations():
     assert scan[-1].endswith(f"{int(scan[-1].split(', ')[-1].split()[0])} evaluations")
 
 
-def test_compare_names_each_stage_as_it_begins():
-    labels = []
+def test_compare_counts_every_stage_apart_and_names_it():
+    calls = []
     ds = synthetic("wear", {"lam": 1.81e6}, seed=4, n=21, name="impact-q")
-    compare(laws=["wear", "coulomb"], datasets=[ds], progress=lambda d, t, label: labels.append(label))
-    started = [x for x in labels if x.startswith("stage ")]
-    assert started[:2] == ["stage fit started", "stage rank started"] and "stage answer started" in started
+    compare(laws=["wear", "coulomb"], datasets=[ds], bootstrap=4, tolerance=(1e-3,), transfer=True,
+            progress=lambda d, t, label: calls.append((d, t, label)))
+    stages = list(dict.fromkeys(label.split(": ")[0] for _, _, label in calls))
+    assert stages[:3] == ["fit", "rank", "equivalence"] and stages[-1] == "answer" and "bootstrap" in stages
+    for stage in stages:  # each stage its own count, ending complete
+        mine = [(d, t) for d, t, label in calls if label.startswith(stage + ": ")]
+        assert all(0 <= d <= t for d, t in mine) and mine[-1][0] == mine[-1][1] > 0, (stage, mine)
+    fits = [label for _, _, label in calls if label.startswith("fit: ")]
+    assert "fit: running wear [exact] on impact-q" in fits and "fit: coulomb [exact] on impact-q" in fits
+    assert calls[-1][2] == "answer: 1 verdict row"
+
+
+class FakeClock:
+    def __init__(self):
+        self.t = 1000.0
+
+    def __call__(self):
+        return self.t
+
+
+def test_a_long_step_gets_a_still_working_line_naming_it_and_how_long():
+    clock, out = FakeClock(), io.StringIO()
+    with Progress("fit", stream=out, tty=False, clock=clock, thread=False) as bar:
+        bar(0, 3, "running lugre [ode] on incline-oil-a100")
+        bar.beat()  # nothing yet: the line above is fresh
+        clock.t += 12
+        bar.beat()
+        clock.t += 2
+        bar.beat()  # written 2 s ago: not again
+    lines = out.getvalue().splitlines()
+    assert len(lines) == 2 and "\r" not in out.getvalue()
+    assert lines[1].endswith("fit: 0/3 done, still working (nothing finished for 0:00:12, 0:00:12 so far); "
+                             "last: running lugre [ode] on incline-oil-a100")
+
+
+def test_stages_have_their_own_count_clock_and_eta():
+    clock, out = FakeClock(), io.StringIO()
+    with Progress("compare", stream=out, tty=False, clock=clock, thread=False, every=0) as root:
+        fit = root.stage("fit")
+        fit(0, 2, "2 queued")
+        clock.t += 100
+        fit(2, 2, "b")
+        fit.close()
+        clock.t += 50
+        boot = root.stage("bootstrap")
+        boot(0, 4, "started")
+        clock.t += 10
+        boot(1, 4, "on x: 1/4 resamples")  # 10 s for one: 30 s for the other three, whatever the fits took
+        clock.t += 60
+        root.beat()
+    lines = [x.split(" compare: ")[1] for x in out.getvalue().splitlines()]
+    assert lines[:4] == ["fit 0/2 (0%) 2 queued; ETA after the first step", "fit 2/2 (100%) b; took 0:01:40",
+                         "bootstrap 0/4 (0%) started; ETA after the first step",
+                         "bootstrap 1/4 (25%) on x: 1/4 resamples; ETA 0:00:30"]
+    assert lines[4].startswith("bootstrap 1/4 done, still working (nothing finished for 0:01:00") and len(lines) == 5
+
+
+def test_running_names_the_tasks_a_pool_runs_now_from_the_parent_alone():
+    clock = FakeClock()
+    running = Running(5, workers=2, clock=clock)
+    names = ["a", "b", "c", "d", "e"].__getitem__
+    clock.t += 3
+    running.finished(1)  # b ends at 3 s: c starts on its worker
+    clock.t += 7
+    assert running.now(names) == "a 10 s, c 7 s"
+    running.finished(0)
+    clock.t += 1
+    assert running.now(names, shown=1) == "c 8 s and 1 more"
+
+
+def test_the_runner_names_running_pool_tasks_while_none_finishes(monkeypatch):
+    """A slow task in a worker: the stage's label names it while the others wait (no timing asserted:
+    the slow task ends only once the label named it)."""
+    import threading
+    from concurrent.futures import ThreadPoolExecutor
+
+    from frictionlab.pipeline import runner
+    from frictionlab.pipeline.settings import Settings
+
+    monkeypatch.setattr(runner, "TICK", 0.01)
+    seen, named = [], threading.Event()
+
+    def told(done, total, label):
+        seen.append((done, total, label))
+        if label.startswith("fit: running: slow"):
+            named.set()
+
+    def work(task):
+        if task == "slow":
+            assert named.wait(30)
+        return task
+
+    run = runner.Run(settings=Settings(laws=("wear",), jobs=2), plan=None, eq_pairs=[], progress=told)
+    run.begin("fit")
+    with ThreadPoolExecutor(2) as pool:
+        run.pool = pool
+        assert run.map(work, ["slow", "quick"], lambda t: t) == ["slow", "quick"]
+    assert seen[0] == (0, 2, "fit: 2 queued on 2 workers") and seen[-1][:2] == (2, 2)
+    assert any(label.startswith("fit: running: slow ") and " s" in label for _, _, label in seen)
+
+
+def test_a_fit_estimates_later_starts_from_the_ones_done():
+    from frictionlab.inference.fitprogress import FitProgress
+
+    calls = []
+    fp = FitProgress(lambda d, t, label: calls.append((d, t, label)), "lugre on x", 10)
+    fp.stage("scanning start points", 10, total=10 + 3 * 20 + 4)
+    for _ in range(10):
+        fp.tick()
+    fp.start(0, 3, guess=20, tail=4)
+    assert calls[-1][:2] == (10, 10 + 3 * 20 + 4)
+    for _ in range(50):  # the first start takes 50 evaluations, not 20
+        fp.tick()
+    fp.start(1, 3, guess=20, tail=4)
+    assert calls[-1] == (60, 60 + 2 * 50 + 4, "lugre on x: Levenberg-Marquardt start 2 of 3, 0 evaluations")
 
 
 def test_a_delayed_progress_is_silent_for_a_quick_run_and_speaks_after_the_delay():
@@ -45,3 +157,15 @@ def test_a_delayed_progress_is_silent_for_a_quick_run_and_speaks_after_the_delay
         bar(3, 3, "c")
     lines = slow.getvalue().splitlines()
     assert "x: 1/3" not in slow.getvalue() and lines[-1].split(" x: ")[1].startswith("3/3 (100%) c; took")
+
+
+def test_a_count_that_moved_gets_its_plain_line_with_eta_from_the_heartbeat():
+    clock, out = FakeClock(), io.StringIO()
+    with Progress("bench", stream=out, tty=False, clock=clock, thread=False) as bar:
+        bar(0, 10, "a")
+        clock.t += 1
+        bar(3, 10, "d")  # within 'every' of the last line: not written now
+        clock.t += 4.5
+        bar.beat()
+    last = out.getvalue().splitlines()[-1]
+    assert last.endswith("bench: 3/10 (30%) d; ETA 0:00:13") and "still working" not in out.getvalue()

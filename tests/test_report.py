@@ -279,7 +279,8 @@ def test_compare_and_fit_commands(tmp_path, capsys):
                  "--bootstrap", "5", "--seed", "2"]) == 0
     captured = capsys.readouterr()
     assert "report:" in captured.out
-    assert re.search(r"compare: \d+/\d+ \(\d+%\) .*; (ETA|took) ", captured.err)  # progress lines, not a bar
+    assert re.search(r"compare: fit \d+/\d+ \(\d+%\) .*; (ETA|took) ", captured.err)  # progress lines, not a bar
+    assert "\r" not in captured.err and re.search(r"compare: bootstrap 5/5 \(100%\) ", captured.err)
     assert re.search(r"report: \d+/\d+ \(\d+%\) figure ", captured.err)
     assert (out / "report.html").exists()
     assert "first in 100% of 5 resamples" in (out / "report.md").read_text()

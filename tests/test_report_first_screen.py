@@ -75,6 +75,11 @@ def test_groups_without_a_fitted_law_fold_into_one_line_under_the_table(comp):
     none = [Answer(group=g, datasets=(), best=None, **kw) for g in ("slider-a", "slider-b")]
     md = markdown("t", _first(attrs.evolve(comp, answers=(fitted, *none)))[0])
     assert "Not fitted (no law compared applies): slider-a, slider-b." in md
+    hint = "rate-state-aging, rate-state-slip (--laws rate-state-aging,rate-state-slip)"
+    none = [attrs.evolve(a, headline=f"not fitted: none applies; registered laws that apply: {hint}",
+                         short={"best": "not fitted: no law compared applies"}) for a in none]
+    md = markdown("t", _first(attrs.evolve(comp, answers=(fitted, *none)))[0])
+    assert f"Not fitted (no law compared applies): slider-a, slider-b; registered laws that apply: {hint}." in md
     assert not [line for line in md.splitlines() if line.startswith("| **slider")]
 
 
@@ -208,3 +213,53 @@ def test_the_command_lines_closing_answers_fold_groups_without_a_fitted_law(comp
     fitted = Answer(group="impact", datasets=("impact-x",), best="wear [exact]", **{**kw, "headline": "best: wear"})
     lines = answer_lines(attrs.evolve(comp, answers=(none[0], fitted, none[1])))
     assert lines[1].startswith("  impact: ") and lines[2:] == ["  slider-a, slider-b: not fitted: no law compared applies"]
+    hinted = attrs.evolve(none[0], headline="not fitted: none; registered laws that apply: rate-state-slip (--laws "
+                          "rate-state-slip)", short={"best": "not fitted: no law compared applies"})
+    lines = answer_lines(attrs.evolve(comp, answers=(fitted, hinted)))
+    assert lines[2:] == ["  slider-a: not fitted: no law compared applies; registered laws that apply: rate-state-slip "
+                         "(--laws rate-state-slip)"]
+
+
+def test_a_candidate_under_a_higher_ranked_one_is_named_in_its_legend_not_drawn():
+    from types import SimpleNamespace as NS
+
+    import numpy as np
+
+    from frictionlab.report.figures.finding import _merged
+
+    fit = lambda y: NS(per_dataset=[NS(model=np.asarray(y, float))])  # noqa: E731
+    curves = [(fit([0, 50, 100]), "#1 area-rate [exact]", {}), (fit([0, 30, 90]), "#2 wear [series], ΔAIC 9.0", {}),
+              (fit([0, 30.5, 90.4]), "#3 wear [exact], ΔAIC 9.4", {})]
+    out = _merged(curves, span=100.0)  # #3 is within 1.5% of the span of #2 everywhere; #2 is 20% off #1
+    assert [label for _, label, _ in out] == ["#1 area-rate [exact]", "#2 wear [series], ΔAIC 9.0 (hides #3 wear [exact])"]
+    assert len(_merged(curves, span=10.0)) == 3  # on a tenth of the span they are told apart
+
+
+def test_a_plain_number_is_quoted_without_a_unit_dash_in_the_data_sentence():
+    from types import SimpleNamespace as NS
+
+    import numpy as np
+
+    from frictionlab.report.data_view import _shape
+
+    t = np.linspace(0.0, 30.0, 31)
+    y = np.where(t < 10, 0.601, 0.593)
+    y[10] = 0.615
+    target = NS(observable="mu", y=y, t=t, sigma=np.full(31, 5e-4))
+    text = _shape(NS(fits=[NS(per_dataset=[NS(target=target)])], dataset=NS(name="block-b")))
+    assert "goes from 0.601 to 0.593 over 30 s, peaking at 0.615 at 10 s" in text and " - " not in text
+
+
+def test_a_spring_slider_report_has_its_fit_figure_and_no_force_figure(tmp_path):
+    """A slider's friction is mu N, which the fit figure already shows (a force axis from 0 hid the step)."""
+    from frictionlab import compare
+    from frictionlab.io.template import template
+    from frictionlab.report import write_report
+
+    toml, csv = template("spring-slider", "slider")
+    (tmp_path / "slider.toml").write_text(toml)
+    (tmp_path / "slider.csv").write_text(csv)
+    c = compare(laws=["rate-state-aging"], datasets=[str(tmp_path / "slider.toml")], equivalence=False,
+                transfer=False)
+    names = {p.name for p in (write_report(c, tmp_path / "rep") / "figures").iterdir()}
+    assert "fit-slider.png" in names and "force-slider.png" not in names

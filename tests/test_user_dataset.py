@@ -61,6 +61,20 @@ def test_a_time_column_not_at_zero_is_an_error_that_says_how_to_declare_it(tmp_p
         load_dataset(_pair(tmp_path, "impact", 10.0))
 
 
+@pytest.mark.parametrize("kind", ["impact", "incline", "spring-slider"])
+def test_the_template_as_written_keeps_the_time_zero_check(kind, tmp_path):
+    """The template declares no time_zero (commented): a CSV pasted into it that starts late is an error."""
+    toml, csv = template(kind, "mine")
+    assert "time_zero" not in tomllib.loads(toml) and "# time_zero" in toml
+    lines = csv.splitlines()
+    head = next(i for i, line in enumerate(lines) if not line.startswith("#"))
+    body = [",".join([f"{float(r.split(',')[0]) + 10:.12g}"] + r.split(",")[1:]) for r in lines[head + 1:]]
+    (tmp_path / "mine.toml").write_text(toml)
+    (tmp_path / "mine.csv").write_text("\n".join(lines[:head + 1] + body) + "\n")
+    with pytest.raises(DatasetError, match=r"column 't' starts at 10, not 0"):
+        load_dataset(tmp_path / "mine.toml")
+
+
 def test_epoch_seconds_are_refused_not_fitted(tmp_path):
     with pytest.raises(DatasetError, match=r"starts at 1700000000, not 0"):
         load_dataset(_pair(tmp_path, "spring-slider", 1.7e9))

@@ -106,3 +106,11 @@ def test_raw_reader_names_the_line_of_a_bad_row(tmp_path):
 def test_other_header_spellings_of_the_source_are_read(tmp_path):
     _record(tmp_path / "raw.txt", header="Time(s)\tDispl(microns)\tFriction\tEffective_Normal_stress(MPa)")
     assert read_raw(tmp_path / "raw.txt").sn.mean() == pytest.approx(30e6, rel=1e-3)
+
+
+def test_a_record_headed_normal_stress_says_normal_not_effective(tmp_path):
+    _record(tmp_path / "raw.txt", header="Time(s)\tDispl(microns)\tFriction\tNormal_stress(MPa)")
+    raw = read_raw(tmp_path / "raw.txt")
+    assert raw.stress == "normal stress" and raw.sn.mean() == pytest.approx(30e6, rel=1e-3)
+    _record(tmp_path / "eff.txt")
+    assert read_raw(tmp_path / "eff.txt").stress == "effective normal stress"

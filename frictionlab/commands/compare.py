@@ -143,18 +143,19 @@ def answer_lines(c) -> list[str]:
     """The report's first screen in a few lines: per dataset group one line of the verdict layer's
     short answers (Comparison.answers; the full sentences are in the report and results.json);
     without answers, says so instead of inventing verdicts."""
+    from ..inference.answers import unfitted
+
     if not c.answers:
         return ["answers: none (the verdict layer filled no Comparison.answers); see the report's tables"]
     out = ["answers (full sentences in report.html and results.json):"]
-    folded: dict[str, list[str]] = {}
     for a in c.answers:
-        if a.best is None:  # groups without a fitted law: one line per reason, as on the report's first screen
-            folded.setdefault(a.cell("best") or "no law could be fitted", []).append(a.group)
+        if a.best is None:  # groups without a fitted law: one line per reason below, as on the first screen
             continue
         eq = a.cell("equivalence")
         parts = [a.cell("best"), a.cell("goodness"),
                  f"lambda A u vs mu N + mu eta' dA/dt: {eq}" if eq and eq != "not tested" else "", a.cell("threshold"), a.cell("series"),
                  a.cell("transfer")]
         out.append(f"  {a.group}: " + "; ".join(p for p in parts if p))
-    out += [f"  {', '.join(groups)}: {reason}" for reason, groups in folded.items()]
+    out += [f"  {', '.join(groups)}: {reason}" + "".join(f"; registered laws that apply: {h}" for h in hints)
+            for reason, groups, hints in unfitted(c.answers)]
     return out

@@ -144,7 +144,7 @@ def _solving(bar, what: str, t_end: float):
 
     def tick(t):
         now = time.monotonic()
-        state["t"] = max(state["t"], float(t))
+        state["t"] = min(max(state["t"], float(t)), t_end)  # a step may probe past the end: report at most t_end
         if now - state["at"] >= 0.25:
             state["at"] = now
             bar(int(1000 * min(state["t"] / t_end, 1.0)), 1000,

@@ -32,6 +32,15 @@ def pyplot():
     return plt
 
 
+def plain_log(axis) -> None:
+    """Tick labels of a log ``axis`` (ax.xaxis, ax.yaxis, a colorbar's) in plain text (1e-05, 0.001, 100):
+    matplotlib's default log labels are mathtext, which ``pyplot`` turns off (they would print as TeX)."""
+    from matplotlib.ticker import LogFormatter
+
+    axis.set_major_formatter(LogFormatter(labelOnlyBase=False))
+    axis.set_minor_formatter(LogFormatter(labelOnlyBase=False, minor_thresholds=(1, 0.4)))
+
+
 def unit(name: str) -> tuple[str, float]:
     """(display unit, factor) for an observable or series name; SI with factor 1 if unknown."""
     return OBSERVABLE_UNITS.get(name, ("SI", 1.0))

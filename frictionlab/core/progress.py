@@ -3,10 +3,16 @@
 ``Progress(desc)`` is a callable ``progress(done, total, label)`` (the signature ``compare``,
 ``write_report`` and the bootstrap take). On a terminal it draws a tqdm bar with the count, the
 rate and the ETA. On anything else (a log file, a pipe) it writes lines such as
-``2026-11-23 01:02:03 compare: 12/40 (30%) wear [exact] on impact-golf-v28; ETA 0:01:10`` to
-stderr, at most one per ``every`` seconds plus the first and the last, and a "still working" line
-when a single step takes longer than ``heartbeat`` seconds, so a redirected run is never silent
-and a log stays short (``delay``: nothing at all from a run shorter than that); the "still working" line names the last label (the stage and item). ``quiet=True`` silences it.
+``2026-11-23 01:02:03 compare: fit 12/40 (30%) wear [exact] on impact-golf-v28; ETA 0:01:10`` to
+stderr, at most one per ``every`` seconds plus the first and the last of a count, never a carriage
+return. A heartbeat (a daemon thread) keeps a long step from being silent: every ``heartbeat``
+seconds without a line it writes a "still working" line naming the count, the last label and how
+long nothing has finished (on a terminal it redraws the bar, whose clock then moves). ``delay``:
+nothing at all from a run shorter than that. ``quiet=True`` silences it.
+
+``progress.stage(name)`` gives a child with its own count, clock and ETA (a pipeline stage: its lines
+read ``compare: fit 3/16 ...``); the parent's heartbeat watches it until it is closed. ``Running``
+tells which tasks of a process pool run now and for how long, from the parent's side alone.
 """
 from __future__ import annotations
 
@@ -21,39 +27,62 @@ def _clock(seconds: float) -> str:
     return f"{seconds // 3600}:{seconds // 60 % 60:02d}:{seconds % 60:02d}"
 
 
+def _stamp() -> str:
+    return _dt.datetime.now().strftime("%Y-%m-%d %H:%M:%S")
+
+
 class Progress:
-    """progress(done, total, label); use as a context manager or call close() at the end."""
+    """progress(done, total, label); use as a context manager or call close() at the end.
+
+    clock: a function returning seconds (time.monotonic; a test passes a fake one); thread=False: no
+    heartbeat thread, the caller calls ``beat()`` (a test)."""
 
     def __init__(self, desc: str, stream=None, quiet: bool = False, every: float = 5.0, tty: bool | None = None,
-                 heartbeat: float = 10.0, delay: float = 0.0):
+                 heartbeat: float = 5.0, delay: float = 0.0, clock=time.monotonic, *, thread: bool = True,
+                 _parent=None, _stage: str = ""):
         self.desc, self.stream, self.quiet, self.every = desc, stream or sys.stderr, quiet, every
         self.tty = (hasattr(self.stream, "isatty") and self.stream.isatty()) if tty is None else tty
-        self.start = time.monotonic()
-        self.last_line = -1e9
+        self.clock, self.heartbeat, self.delay = clock, heartbeat, delay  # delay: seconds of silence
+        self.start = self.since = clock()  # since: when the count last moved
+        self.last_line = -1e18
         self.bar = None
-        self.done, self.total, self.label = 0, 0, ""
-        self.heartbeat = heartbeat
-        self.delay = delay  # seconds during which nothing is shown: a run shorter than that stays silent
+        self.done, self.total, self.label, self.name = 0, 0, "", _stage
+        self.parent = _parent
+        self._lock = _parent._lock if _parent is not None else threading.Lock()
         self._stop = threading.Event()
-        self._lock = threading.Lock()
-        self._beat = None
+        self._children: list[Progress] = []
+        self._beat = None if thread else False
 
     def __call__(self, done: int, total: int, label: str = "") -> None:
         if self.quiet:
             return
-        if self.delay and time.monotonic() - self.start < self.delay:
-            self.done, self.total, self.label = done, total, label
+        now = self.clock()
+        if done != self.done:
+            self.since = now
+        first, moved, back = self.last_line < -1e17, done != self.done, done < self.done
+        self.done, self.total, self.label = done, total, label
+        self._watch()
+        if self.delay and now - self.start < self.delay:
             return
         if self.tty:
             self._draw(done, total, label)
-        else:
-            now = time.monotonic()
-            if done in (1, total) or done < self.done or now - self.last_line >= self.every:
-                self._write(self.line(done, total, label, now), now)
-            if self._beat is None and self.heartbeat:
-                self._beat = threading.Thread(target=self._beats, daemon=True)
-                self._beat.start()
-        self.done, self.total, self.label = done, total, label
+        elif first or back or (moved and done in (1, total)) or now - self.last_line >= self.every:
+            self._write(self.line(done, total, label, now), now)
+
+    def stage(self, name: str) -> "Progress":
+        """A child counting one stage (its own count, clock, ETA and bar); close it when the stage ends."""
+        child = Progress(self.desc, self.stream, self.quiet, self.every, self.tty, self.heartbeat, 0.0, self.clock,
+                         thread=False, _parent=self, _stage=name)
+        with self._lock:
+            self._children.append(child)
+        return child
+
+    def _watch(self) -> None:
+        """Start the heartbeat thread of the root, once."""
+        root = self.parent or self
+        if root._beat is None and root.heartbeat and not root.quiet:
+            root._beat = threading.Thread(target=root._beats, daemon=True)
+            root._beat.start()
 
     def _write(self, text: str, now: float) -> None:
         with self._lock:
@@ -62,23 +91,42 @@ class Progress:
             self.stream.flush()
 
     def _beats(self) -> None:
-        """A 'still working' line whenever nothing was written for ``heartbeat`` seconds."""
-        while not self._stop.wait(min(self.heartbeat, 5.0)):
-            now = time.monotonic()
-            if now - self.last_line >= self.heartbeat and self.done < self.total:
-                stamp = _dt.datetime.now().strftime("%Y-%m-%d %H:%M:%S")
-                self._write(f"{stamp} {self.desc}: {self.done}/{self.total} done, still working "
-                            f"({_clock(now - self.start)} so far)" + (f"; last: {self.label}" if self.label else ""),
-                            now)
+        while not self._stop.wait(min(self.heartbeat, 1.0)):
+            self.beat()
+
+    def beat(self) -> None:
+        """One heartbeat: for every count not finished and without a line for ``heartbeat`` seconds, its
+        plain line if it moved since, else a 'still working' line (on a terminal: the bar redrawn)."""
+        with self._lock:
+            watched = [self] + list(self._children)
+        now = self.clock()
+        for p in watched:
+            if p.done >= p.total or now - p.last_line < p.heartbeat or (p.delay and now - p.start < p.delay):
+                continue
+            if p.tty:
+                if p.bar is not None:
+                    p.last_line = now
+                    p.bar.refresh()
+                continue
+            # the count moved since the last line: the plain line with its ETA; else 'still working'
+            p._write(p.line(p.done, p.total, p.label, now) if now - p.since < p.heartbeat else p.still(now), now)
+
+    def still(self, now: float) -> str:
+        """The 'still working' line: count, how long nothing finished, the last label."""
+        return (f"{_stamp()} {self.desc}: {self._name()}{self.done}/{self.total} done, still working "
+                f"(nothing finished for {_clock(now - self.since)}, {_clock(now - self.start)} so far)"
+                + (f"; last: {self.label}" if self.label else ""))
+
+    def _name(self) -> str:
+        return f"{self.name} " if self.name else ""
 
     def line(self, done: int, total: int, label: str, now: float | None = None) -> str:
-        """The plain progress line: time stamp, count, share, label and ETA."""
-        elapsed = (now if now is not None else time.monotonic()) - self.start
+        """The plain progress line: time stamp, stage, count, share, label and ETA."""
+        elapsed = (now if now is not None else self.clock()) - self.start
         share = done / total if total else 1.0
         eta = (f"ETA {_clock(elapsed * (1 - share) / share)}" if 0 < share < 1 else
                "ETA after the first step" if share == 0 else f"took {_clock(elapsed)}")
-        stamp = _dt.datetime.now().strftime("%Y-%m-%d %H:%M:%S")
-        return f"{stamp} {self.desc}: {done}/{total} ({100 * share:.0f}%) {label}; {eta}"
+        return f"{_stamp()} {self.desc}: {self._name()}{done}/{total} ({100 * share:.0f}%) {label}; {eta}"
 
     def _draw(self, done: int, total: int, label: str) -> None:
         if self.bar is None:
@@ -86,15 +134,21 @@ class Progress:
 
             # the bar redraws with carriage returns, which the inert stream (core.terminal) would drop: it
             # draws on the stream beneath; its text is names and numbers (core.names), nothing to neutralise
-            self.bar = tqdm(total=total, desc=self.desc, file=getattr(self.stream, "unfiltered", self.stream), dynamic_ncols=True, leave=True,
+            self.bar = tqdm(total=total, desc=f"{self.desc} {self.name}".strip(), dynamic_ncols=True, leave=True,
+                            file=getattr(self.stream, "unfiltered", self.stream),
                             bar_format="{desc}: {bar} {n_fmt}/{total_fmt} [{elapsed}<{remaining}] {postfix}")
         if self.bar.total != total:
             self.bar.total = total
         self.bar.n = done
         self.bar.set_postfix_str(label[:60], refresh=False)
         self.bar.refresh()
+        self.last_line = self.clock()
 
     def close(self) -> None:
+        if self.parent is not None:
+            with self._lock:
+                if self in self.parent._children:
+                    self.parent._children.remove(self)
         self._stop.set()
         if self.bar is not None:
             self.bar.close()
@@ -105,3 +159,31 @@ class Progress:
 
     def __exit__(self, *exc):
         self.close()
+
+
+class Running:
+    """Which tasks submitted in order to a pool of ``workers`` processes run now, and since when.
+
+    A process pool hands tasks out in the order they were submitted, one to each free worker, so task
+    i starts when the pool starts (i < workers) or when the (i - workers + 1)-th task finishes: the
+    parent knows it without hearing from the workers. ``finished(i)`` when task i ends; ``now(names)``
+    the running tasks' names with their seconds."""
+
+    def __init__(self, n: int, workers: int, clock=time.monotonic):
+        self.clock, self.workers = clock, max(1, workers)
+        self.t0 = clock()
+        self.ends: list[float] = []
+        self.left = set(range(n))
+
+    def finished(self, i: int) -> None:
+        self.left.discard(i)
+        self.ends.append(self.clock())
+
+    def now(self, names, shown: int = 3) -> str:
+        """'lugre [ode] on X 12 s, dahl [ode] on X 3 s' for the tasks running now (at most ``shown``)."""
+        now, started = self.clock(), self.workers + len(self.ends)
+        running = sorted(i for i in self.left if i < started)
+        parts = [f"{names(i)} {now - (self.t0 if i < self.workers else self.ends[i - self.workers]):.0f} s"
+                 for i in running[:shown]]
+        more = len(running) - shown
+        return ", ".join(parts) + (f" and {more} more" if more > 0 else "")

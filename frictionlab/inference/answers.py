@@ -52,3 +52,17 @@ def group_of(dataset) -> str:
     """The group a dataset belongs to: its declared ``group`` (TOML key), else its own name. Nothing is
     inferred from names: datasets are pooled only where their files say they belong together."""
     return getattr(dataset, "group", "") or dataset.name
+
+
+def unfitted(answers) -> list[tuple[str, list[str], list[str]]]:
+    """The groups without a fitted law, folded by reason: (reason, groups, the registered laws that would
+    apply as their rows' headlines name them, e.g. 'rate-state-aging, rate-state-slip (--laws ...)')."""
+    folded: dict[str, tuple[list, dict]] = {}
+    for a in answers:
+        if a.best is None:
+            groups, hints = folded.setdefault(a.cell("best") or "no law could be fitted", ([], {}))
+            groups.append(a.group)
+            hint = a.headline.partition("registered laws that apply: ")[2]
+            if hint:
+                hints[hint] = None
+    return [(reason, groups, list(hints)) for reason, (groups, hints) in folded.items()]

@@ -57,19 +57,21 @@ def _ranking(fits: dict) -> tuple[tuple[str, ...], dict]:
 def _run_fits(todo, ds, executor, progress, options) -> dict:
     """(solver, rtol, law) -> (FitResult or error, CPU seconds), fitted here or on ``executor``."""
     label = lambda s, r, law: f"fit {law} to {ds.name} with {s}" + (f" rtol={r:g}" if r else "")  # noqa: E731
+    tell = progress or (lambda text, done: None)  # progress(label, done): False as a fit starts, True as it ends
     if executor is None:
         out = {}
         for key in todo:
-            if progress:
-                progress(label(*key))
+            tell(label(*key), False)
             out[key] = _fit(key[2], ds, key[0], key[1], options)
+            tell(label(*key), True)
         return out
     futures = {key: executor.submit(_fit, key[2], ds, key[0], key[1], options) for key in todo}
     out = {}
     for key, fut in futures.items():
+        if not fut.done():
+            tell(label(*key), False)
         out[key] = fut.result()
-        if progress:
-            progress(label(*key))
+        tell(label(*key), True)
     return out
 
 
@@ -83,6 +85,7 @@ def fit_tolerance_study(laws, dataset, methods=("LSODA", "DOP853"), rtols=DEFAUL
     that need no ODE on this dataset: they join every ranking, unchanged. executor: anything with
     ``submit(fn, *args)`` (e.g. a process pool) to run the fits on. fit_options: further keyword
     arguments of every ``fitting.fit`` (e.g. the ``free`` scene quantities of the reference fits).
+    progress(label, done): told as each refit starts (done False) and ends (done True).
     """
     from ..io.dataset import load_dataset
     from .predict import FIT_RTOL, applicable_solvers

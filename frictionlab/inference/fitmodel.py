@@ -288,8 +288,7 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
             params[k].set(value=v)
         budget = max_nfev or 200 * (len(varying) + 1)
         if model.progress is not None:
-            model.progress.stage(f"Levenberg-Marquardt start {i + 1} of {len(starts)}", lm,
-                                 total=model.progress.done + (len(starts) - i) * lm + 2 * len(varying) + 2)
+            model.progress.start(i, len(starts), lm, 2 * len(varying) + 2)
         r = None
         if direct:
             before = model.nfev, model.failures, model.last_error, model._last

@@ -1,6 +1,7 @@
 """Progress of one fit, counted in model evaluations: the start scan, each Levenberg-Marquardt start
-and the error analysis. A start's count is estimated (LM_EVALS per free parameter) and grows by half
-when a start needs more, so the ETA is an estimate that corrects itself.
+and the error analysis. The first start's count is estimated (LM_EVALS per free parameter plus one),
+later ones at the mean of the starts done; a stage that needs more grows by half, so the ETA is an
+estimate that corrects itself.
 
 ``FitProgress(progress, what)`` wraps a ``progress(done, total, label)`` callable (core.progress.Progress);
 the fit calls ``stage`` when a stage begins and ``tick`` after each model evaluation. Calls to
@@ -21,20 +22,30 @@ class FitProgress:
     def __init__(self, progress, what: str, total: int):
         self.progress, self.what, self.total = progress, what, max(1, int(total))
         self.done, self.stage_end, self.label, self.count, self.size, self._last = 0, 0, "", 0, 0, -1e9
+        self.starts: list[int] = []  # evaluations of each Levenberg-Marquardt start done
 
     def stage(self, label: str, size: int, total: int | None = None):
-        """A stage of at most ``size`` evaluations begins (``total``: a new overall total); the count
-        jumps to the end of the previous stage."""
-        self.done = max(self.done, self.stage_end)
-        if total is not None:
+        """A stage of about ``size`` evaluations begins; ``total``: a new overall total counted from the
+        evaluations done, else the count jumps to the estimated end of the previous stage."""
+        if total is None:
+            self.done = max(self.done, self.stage_end)
+        else:
             self.total = max(int(total), self.done + size)
         self.stage_end, self.label, self.count, self.size = self.done + size, label, 0, size
         self._call(force=True)
 
+    def start(self, i: int, n: int, guess: int, tail: int):
+        """Levenberg-Marquardt start ``i + 1`` of ``n`` begins; ``guess``: evaluations of a start before one
+        is done; ``tail``: evaluations after the last start (the error analysis)."""
+        if i > 0:
+            self.starts.append(self.count)
+        size = max(1, round(sum(self.starts) / len(self.starts))) if self.starts else guess
+        self.stage(f"Levenberg-Marquardt start {i + 1} of {n}", size, total=self.done + (n - i) * size + tail)
+
     def tick(self):
         """One model evaluation done."""
         self.count += 1
-        if self.done + 1 >= self.stage_end:  # longer than estimated: extend the stage and the total by half
+        if self.done >= self.stage_end:  # longer than estimated: extend the stage and the total by half
             grow = max(1, self.size // 2)
             self.stage_end, self.size, self.total = self.stage_end + grow, self.size + grow, self.total + grow
         self.done += 1

@@ -30,11 +30,19 @@ def _steadystate(n: int, sha256: str) -> dict:
                        "TR2 exp013, effective normal stress 30 MPa (sn 50 MPa, Pf 20 MPa)")
 
 
-#: dataset name -> where its raw record comes from and how it is imported.
+#: dataset name -> where its raw record comes from and how it is imported (``stiffness``: a start for the
+#: machine stiffness [1/m] where the record's loading after the step does not give one; fitted with --free).
 RECORDS = {
     "sepiolite-velstep1": _steadystate(1, "7c1037b7356a1916e5d3ecd22ed45acc0ffb70f812a6fb908d21648464a8ec29"),
     "sepiolite-velstep2": _steadystate(2, "7702fa500fe97c8ef345866f376222e600682f5da70ed6e4d4f0d9f8fbb72f40"),
     "sepiolite-velstep3": _steadystate(3, "e0d598a177dcb7f3dff040241f490541bec42940e016df541a19559a7b083dc5"),
+    "basalt-velstep4": dict(
+        _STEADYSTATE, file="steadystate/velstep4_BRAVA_expb819_basalt.txt",
+        sha256="0ed7d29f21a37335d8191dcb365320d449bf7e52b6557690de34165fb889c959", stiffness=2e3,
+        source="pgiacomel/steadystate (GitHub) branch Demo-velocity-stepping-tests, commit bfb4c1d, file "
+               "velstep4_BRAVA_expb819_basalt.txt (the same bytes as velstep4_BRAVA_expb819_basalt_Giacomel_et_al_2021.txt "
+               "at commit 0225b97): basalt gouge, BRAVA apparatus experiment b819, normal stress 20 MPa as recorded "
+               "(the column is headed Normal_stress; the source states no pore pressure for it)"),
 }
 
 
@@ -94,9 +102,11 @@ def dataset_toml(name: str) -> Path:
     from ..core.files import atomic_write_text
     from .velstep import velstep_dataset
 
-    command = f"frictionlab datasets import velstep {Path(spec['file']).name} --name {name} --points 600 --steps 1"
+    k = spec.get("stiffness")
+    command = (f"frictionlab datasets import velstep {Path(spec['file']).name} --name {name} --points 600 --steps 1"
+               + (f" --stiffness '{k * 1e-6:g} 1/um'" if k else ""))
     text, csv, _ = velstep_dataset(raw, name, source=spec["source"], license=spec["license"],
-                                   citation=spec["citation"], command=command)
+                                   citation=spec["citation"], command=command, stiffness=k)
     folder.mkdir(parents=True, exist_ok=True)
     atomic_write_text(folder / f"{name}.csv", csv)
     atomic_write_text(toml, text)

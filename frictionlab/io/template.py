@@ -69,7 +69,8 @@ _BODY = {
                            # the surface), u (contact slip), A (contact area: needs [scene.area]) or N (needs
                            # [scene.normal]); the other columns are shown beside it
 description = "A ball in oblique impact on a rigid target: spin during contact. Say what, where and how."
-time_zero = "0 us"         # the file's time of first contact (t = 0): subtracted from column t (see README)
+# time_zero = "0 us"       # only if t does not start at first contact: the file's time of first contact
+                           # (subtracted from t); without it, t must start at 0 (a later start is an error)
 
 [columns]                  # every CSV column with its unit; the time column must be called t
 t = "us"                   # times from first contact, strictly increasing
@@ -95,7 +96,8 @@ impulse = "2.0 N*s"
 ''' + _MATERIALS),
     "incline": ('''observable = "v"           # the fitted column: v (velocity along the incline) or u (slip; equal to v here)
 description = "A block sliding from rest down an incline. Say what, where and how."
-time_zero = "0 s"          # the file's time of release (t = 0): subtracted from column t (see README)
+# time_zero = "0 s"        # only if t does not start at release: the file's time of release (subtracted
+                           # from t); without it, t must start at 0 (a later start is an error)
 
 [columns]                  # every CSV column with its unit; the time column must be called t
 t = "s"                    # times from release, strictly increasing
@@ -138,7 +140,8 @@ peak = "150 mm^2"
 ''' + _MATERIALS),
     "spring-slider": ('''observable = "mu"          # the fitted column: mu, shear stress / effective normal stress (the spring's load)
 description = "A velocity-step test: friction of a layer driven through a spring. Say what, where and how."
-time_zero = "0 s"          # the file's time at which the load-point schedule starts: subtracted from column t
+# time_zero = "0 s"        # only if t does not start with the load-point schedule: the file's time of its
+                           # start (subtracted from t); without it, t must start at 0 (a later start is an error)
 
 [columns]                  # every CSV column with its unit; the time column must be called t
 t = "s"                    # strictly increasing

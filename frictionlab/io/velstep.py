@@ -2,7 +2,7 @@
 
 The raw format is the one of the steadystate routine's sliced records (Giacomel et al., Geosphere
 2024): a header line, then whitespace-separated rows of time [s], load-point displacement [um],
-friction [-] and effective normal stress [MPa], one velocity step per file. The importer finds the
+friction [-] and (effective) normal stress [MPa], one velocity step per file. The importer finds the
 load-point velocities and the step time(s) from the displacement record (a piecewise straight-line
 fit), estimates the machine stiffness from the spring's loading right after the first step (to be
 fitted with ``--free spring.stiffness``), on request (``--detrend``) removes the slip trend of friction
@@ -24,20 +24,22 @@ from ..core.files import MAX_CSV_BYTES, read_text
 from ..core.names import check_name
 
 #: Header names accepted for the four raw columns (case-insensitive; '_' or nothing between words).
-RAW_HEADER = (r"time\(s\)", r"displ(acement)?\(microns\)", r"friction", r"effective_?normal_?stress\(mpa\)")
+RAW_HEADER = (r"time\(s\)", r"displ(acement)?\(microns\)", r"friction", r"(effective_?)?normal_?stress\(mpa\)")
 #: Fewest samples a constant-velocity segment may hold.
 MIN_SEGMENT = 20
 
 
 @attrs.frozen(eq=False)
 class RawRecord:
-    """One raw record in SI units: time [s], displacement [m], friction [-], effective normal stress [Pa]."""
+    """One raw record in SI units: time [s], displacement [m], friction [-], normal stress [Pa] (``stress``:
+    what the file's header calls it: effective normal stress, or normal stress where it does not say)."""
 
     path: Path
     t: np.ndarray
     x: np.ndarray
     mu: np.ndarray
     sn: np.ndarray
+    stress: str = "effective normal stress"
 
 
 def read_raw(path) -> RawRecord:
@@ -50,7 +52,7 @@ def read_raw(path) -> RawRecord:
     header = rows[0][1].split()
     if len(header) != 4 or not all(re.fullmatch(p, h, re.IGNORECASE) for p, h in zip(RAW_HEADER, header)):
         raise DatasetError(f"{path}: line {rows[0][0]}: header {rows[0][1].strip()!r}; expected four columns: "
-                           "Time(s) Displ(microns) Friction EffectiveNormalstress(MPa)")
+                           "Time(s) Displ(microns) Friction EffectiveNormalstress(MPa) (or NormalStress(MPa))")
     data = np.empty((len(rows) - 1, 4))
     for k, (no, line) in enumerate(rows[1:]):
         parts = line.replace(",", " ").split()
@@ -68,8 +70,9 @@ def read_raw(path) -> RawRecord:
     if bad.size:
         raise DatasetError(f"{path}: line {rows[int(bad[0]) + 2][0]}: time does not increase")
     if np.any(sn <= 0):
-        raise DatasetError(f"{path}: effective normal stress must be positive")
-    return RawRecord(path=path, t=t, x=x_um * 1e-6, mu=mu, sn=sn * 1e6)
+        raise DatasetError(f"{path}: normal stress must be positive")
+    stress = "effective normal stress" if "effective" in header[3].lower() else "normal stress"
+    return RawRecord(path=path, t=t, x=x_um * 1e-6, mu=mu, sn=sn * 1e6, stress=stress)
 
 
 def _line_fit_rss(t, x):
@@ -216,7 +219,7 @@ def velstep_toml(name: str, raw: RawRecord, imp: Imported, *, source: str, licen
                  command: str) -> str:
     """The TOML of an imported velocity-step record (provenance 'measured')."""
     v_um = [f"{v * 1e6:g} um/s" for v in imp.velocities]
-    k_note = ("stated with --stiffness" if imp.stiffness_stated else
+    k_note = ("given with --stiffness: a start; fit it with --free spring.stiffness" if imp.stiffness_stated else
               "estimated from d mu/dt = k (V_lp - v) over 1 s after the step: a start; fit it with --free "
               "spring.stiffness")
     trend = (f"friction's slip trend {imp.trend * 1e-6:.4g} per um, fitted to the samples before the step "
@@ -230,7 +233,7 @@ def velstep_toml(name: str, raw: RawRecord, imp: Imported, *, source: str, licen
         f"name = {_q(name)}",
         'kind = "spring-slider"',
         'observable = "mu"',
-        f"description = {_q(f'Velocity step {v_um[0]} -> {v_um[-1]} at {imp.normal_stress / 1e6:.4g} MPa effective normal stress (record {raw.path.name}). MEASURED.')}",
+        f"description = {_q(f'Velocity step {v_um[0]} -> {v_um[-1]} at {imp.normal_stress / 1e6:.4g} MPa {raw.stress} (record {raw.path.name}). MEASURED.')}",
         f'time_zero = "{imp.time_zero:.10g} s"   # the record\'s clock at its first sample',
         "",
         "[columns]",
@@ -244,7 +247,7 @@ def velstep_toml(name: str, raw: RawRecord, imp: Imported, *, source: str, licen
         "[scene]",
         'mass = "1 kg"              # not used by a quasi-static slider',
         "",
-        "[scene.normal]             # the mean effective normal stress on a unit area: only a slider's inertia reads it",
+        f"[scene.normal]             # the mean {raw.stress} on a unit area: only a slider's inertia reads it",
         'model = "constant"',
         f'value = "{imp.normal_stress:.6g} N"',
         "",

@@ -248,7 +248,9 @@ def _steps(progress, total: int):
         return None
     n = [0]
 
-    def step(msg: str):
+    def step(msg: str, done: bool = False):  # counted as it starts (fitcost also tells when a fit ends)
+        if done:
+            return
         n[0] += 1
         progress(n[0] - 1, max(total, n[0]), msg)
     return step

@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 from .bench import BATCH_COSTS, CHECK_RTOL, ROUND_OFF, SINGLE_EXACT
+from ..core.display import plain_log
 
 STYLE = {  # method -> (color, marker, line style)
     "ode:RK45": ("#1f77b4", "o", "-"), "ode:DOP853": ("#ff7f0e", "s", "-"), "ode:LSODA": ("#2ca02c", "^", "-"),
@@ -49,6 +50,8 @@ def _draw(ax, rows, floor) -> None:
     ax.axvline(floor, color="#999999", lw=0.8, ls="--")
     ax.set_xscale("log")
     ax.set_yscale("log")
+    plain_log(ax.xaxis)
+    plain_log(ax.yaxis)
     ax.set_xlabel("error: max-norm of u, omega, theta vs reference,\nrelative to each series' peak")
     ax.grid(True, which="major", alpha=0.4)
     ax.grid(True, which="minor", alpha=0.12)

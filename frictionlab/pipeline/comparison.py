@@ -201,14 +201,10 @@ def cluster_name(client) -> str:
 
 
 def _make_run(settings: Settings, dss, progress, client=None) -> Run:
-    """The plan of the fits and tests, and the progress total: fits, equivalence pairs, bootstrapped
-    datasets and the tolerance check."""
+    """The plan of the fits and tests (each stage counts its own items for the progress)."""
     plan = plan_fits(settings.laws, dss, settings.solvers, settings.free)
     eq_pairs = equivalence_pairs(settings.laws, plan.tasks, settings.pairs) if settings.equivalence else []
-    n_boot = (len({f.datasets[0] for f in plan.skipped_fits} | {t[1].name for t in plan.tasks})
-              if settings.bootstrap else 0)
-    total = len(plan.tasks) + len(eq_pairs) + n_boot + (1 if settings.tolerance else 0)
-    return Run(settings=settings, plan=plan, eq_pairs=eq_pairs, progress=progress, total=total, client=client)
+    return Run(settings=settings, plan=plan, eq_pairs=eq_pairs, progress=progress, client=client)
 
 
 def _import_before_fork(run: Run) -> None:

@@ -36,35 +36,41 @@ def run_per_dataset(c, run: Run, chosen: list) -> tuple[object, list]:
         pairs.setdefault(p[0], []).append(p)
     boot = any(s.name == "bootstrap" for s in mine)
     parts, timings = [], dict(c.timings)
-    with executor(1, run.client, "compare", warm_worker) as ex:
-        futures = {ex.submit(_one_dataset, *_part(c, run, name, ts, pairs.get(name, []), mine)): name
-                   for name, ts in tasks.items()}
-        for fut in as_completed(futures):
-            part, took = fut.result()
-            parts.append(part)
-            for k, v in took.items():
-                timings[k] = timings.get(k, 0.0) + v
-            name = futures[fut]
-            run.done += len(tasks[name]) + len(pairs.get(name, [])) + boot
-            run.step(f"{name}: fits, tests and bootstrap", advance=False)
-    fields = _merge(c, run, parts, set(tasks), {s.name for s in mine})
+    run.begin(", ".join(s.name for s in mine) + " per dataset")  # one count: a dataset's items as it finishes
+    try:
+        run.tally().total += sum(len(ts) + len(pairs.get(name, [])) + boot for name, ts in tasks.items())
+        with executor(1, run.client, "compare", warm_worker) as ex:
+            futures = {ex.submit(_one_dataset, *_part(c, run, name, ts, pairs.get(name, []), mine)): name
+                       for name, ts in tasks.items()}
+            for fut in as_completed(futures):
+                part, took = fut.result()
+                parts.append(part)
+                for k, v in took.items():
+                    timings[k] = timings.get(k, 0.0) + v
+                name = futures[fut]
+                items = len(tasks[name]) + len(pairs.get(name, [])) + boot
+                run.step(f"{name}: fits, tests and bootstrap", advance=items)
+        fields = _merge(c, run, parts, set(tasks), {s.name for s in mine})
+    finally:
+        run.end()
     return attrs.evolve(c, **fields, timings=timings), [s for s in chosen if s.name not in PER_DATASET]
 
 
 def _part(c, run: Run, name: str, tasks: list, pairs: list, stages: list) -> tuple:
-    """The arguments of one dataset's task: its comparison so far, its run (one process there), its stages."""
-    sub_run = Run(settings=attrs.evolve(run.settings, jobs=1), plan=attrs.evolve(run.plan, tasks=tuple(tasks)),
-                  eq_pairs=pairs, part=True)
+    """The arguments of one dataset's task: its comparison so far, its settings (one process there), plan,
+    pairs and stages (a Run is made there: its per-thread progress state does not travel)."""
     sub_c = attrs.evolve(c, datasets=tuple(d for d in c.datasets if d.name == name),
                          fits=tuple(f for f in c.fits if f.datasets[0] == name), timings={})
-    return sub_c, sub_run, tuple(s.name for s in stages)
+    return (sub_c, attrs.evolve(run.settings, jobs=1), attrs.evolve(run.plan, tasks=tuple(tasks)), pairs,
+            tuple(s.name for s in stages))
 
 
-def _one_dataset(c, run: Run, names: tuple) -> tuple[dict, dict]:
+def _one_dataset(c, settings, plan, pairs: list, names: tuple) -> tuple[dict, dict]:
     """On a worker: the stages ``names`` for one dataset; (the fields they fill, their wall seconds)."""
     from .stages import STAGES
 
     started = time.perf_counter()
+    run = Run(settings=settings, plan=plan, eq_pairs=pairs, part=True)
     done = run_stages(c, run, [s for s in STAGES if s.name in names], forced=True)
     fields = {"fits": done.fits, "equivalence": done.equivalence, "bootstrap": done.bootstrap,
               "bootstrap_skipped": done.bootstrap_skipped}

@@ -62,9 +62,11 @@ def _fit_task(args, timeout=None) -> FitResult:
 
 
 def rank(c, run: Run) -> dict:
+    run.tally().total = 1
     ranking = rank_fits(c.fits)
     kinds = {d.name: d.kind for d in c.datasets}
     groups = rank_groups(ranking, kinds, named={d.name: group_of(d) for d in c.datasets})
+    run.step(f"{len(ranking)} fits ranked in {len(groups)} groups")
     return {"ranking": tuple(ranking), "groups": tuple(groups)}
 
 
@@ -80,9 +82,11 @@ def equivalence(c, run: Run) -> dict:
                                           status="skipped", reason=why, replicates=s.replicates, seed=s.seed))
         else:
             tasks.append((fa, fb, s.replicates, s.seed, s.fit_timeout))
+    if slow:  # counted first: the count then ends with the last test run
+        run.tally().total += len(slow)
+        run.step(f"{len(slow)} pairs skipped (slow; --bootstrap-all tests them)", advance=len(slow))
     results = run.map(_equivalence_task, tasks, lambda t: f"equivalence on {t[0].datasets[0]}: {t[0].law} "
                                                           f"[{t[0].solver}] vs {t[1].law} [{t[1].solver}]")
-    run.done += len(slow)
     return {"equivalence": tuple(sorted(results + slow, key=equivalence_order(c, s.pairs)))}
 
 
@@ -101,39 +105,63 @@ def transfer(c, run: Run) -> dict:
     by_group = _transfer.candidates_by_group(c.fits, c.datasets)
     tasks = [(g, cand, fs) for g, cands in by_group.items() for cand, fs in cands.items()]
     free = dict(run.settings.free)
-    parts = run.map(_transfer_task, [(fs, free, run.settings.fit_timeout) for _, _, fs in tasks])
+    parts = run.map(_transfer_task, [(fs, free, run.settings.fit_timeout, g, cand) for g, cand, fs in tasks],
+                    lambda t: f"one parameter set for {t[4]} over group {t[3]}")
     results = [_transfer.assemble(g, cands, {cand: p for (gg, cand, _), p in zip(tasks, parts) if gg == g})
                for g, cands in by_group.items()]
     return {"transfer": tuple(results + _transfer.skipped(c.datasets, fits=c.fits))}
 
 
 def _transfer_task(args):
-    fits, free, timeout = args
+    fits, free, timeout = args[:3]
     return _transfer.transfer_candidate(fits, free, timeout)
 
 
 def tolerance(c, run: Run) -> dict:
-    rows = tolerance_check(c.fits, tuple(run.settings.tolerance), run.pool,
-                           fit_options=run.settings.fit_options() or None)
-    run.step("tolerance check")
+    rtols = tuple(run.settings.tolerance)
+    refits = len(rtols) * _ode_laws(c.fits)  # the laws solved by 'ode' on the first such dataset
+    run.tally().total = max(refits, 1)
+    run.step(f"refitting at rtol {', '.join(f'{r:g}' for r in rtols)}" if refits else
+             "nothing to refit: no law is solved by 'ode' here", advance=not refits)
+    rows = tolerance_check(c.fits, rtols, run.pool, fit_options=run.settings.fit_options() or None,
+                           progress=lambda label, done: run.step(label if done else f"running {label}", advance=done))
     return {"tolerance": tuple(rows)}
 
 
 def bootstrap(c, run: Run) -> dict:
     s = run.settings
+    seen: dict = {}  # dataset -> resamples done; the stage counts resamples over every dataset
+
+    def told(name, k, n):
+        run.tally().total = max(run.tally().total, s.bootstrap * len({f.datasets[0] for f in c.fits}))
+        run.step(f"on {name}: {k}/{n} resamples", advance=k - seen.get(name, 0))
+        seen[name] = k
+
     boots, skipped = bootstrap_fits(
         c.fits, s.bootstrap, s.seed, run.pool, s.bootstrap_all, s.free or None, timeout=s.fit_timeout,
-        progress=lambda name, k, n: run.step(f"bootstrap on {name}: {k}/{n} resamples", advance=k == n))
+        progress=told)
     return {"bootstrap": tuple(boots), "bootstrap_skipped": skipped}
 
 
 def answer(c, run: Run) -> dict:
+    run.tally().total = 1
     fitted = [d for d in c.datasets if d.name not in c.skipped_datasets]
     answers = make_answers(fitted, c.fits, c.ranking, c.groups)
     # the verdict layer's rows; the equivalence and transfer fields are filled by their producers
     answers = _transfer.fill_answers(_equivalence.fill_answers(answers, c.equivalence), c.transfer)
     not_applicable = {k: v for k, v in c.skipped_datasets.items() if k in run.plan.no_law}
-    return {"answers": answers + not_fitted_answers(c.datasets, not_applicable, fitted)}
+    answers = answers + not_fitted_answers(c.datasets, not_applicable, fitted)
+    run.step(f"{len(answers)} verdict row{'s' * (len(answers) != 1)}")
+    return {"answers": answers}
+
+
+def _ode_laws(fits) -> int:
+    """How many laws the tolerance check refits: those solved by 'ode' on the first such dataset."""
+    for name in dict.fromkeys(f.datasets[0] for f in fits):
+        n = len({f.law for f in fits if f.datasets == (name,) and f.ok and f.solver.startswith("ode")})
+        if n:
+            return n
+    return 0
 
 
 #: The pipeline, in order; ``compare(stages=[...])`` runs the ones named, ``run_stages`` continues a comparison.

@@ -112,7 +112,7 @@ def _shape(v: DataView) -> str:
                 f"{sig(float(np.max(y)) * cf)}{' ' + cu if cu else ''}.")
     un, uf = unit(obs)
     t = np.asarray(target.t, float)
-    q = lambda x: f"{sig(float(x) * uf)} {un}"  # noqa: E731
+    q = lambda x: f"{sig(float(x) * uf)}" + (f" {un}" if un not in ("-", "", "1") else "")  # noqa: E731  no unit: no '-'
     i = int(np.argmax(y))
     noise = 2.0 * float(np.median(target.sigma))
     text = f"On {v.dataset.name} the observed {name} goes from {q(y[0])} to {q(y[-1])} over {fmt_time(t[-1])}"

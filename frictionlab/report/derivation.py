@@ -56,8 +56,8 @@ def build(ctx) -> Section | None:
         stats = derivation_stats(d, given, noisy)
         ctx.json.setdefault("derivations", {})[d.name] = stats
         sec.h3(d.name)
-        sec.fig(f"derive-{d.name}.png", f"{d.name}: ω derived from θ by poly9 and spline, without and with "
-                "simulated noise.", lambda d=d, given=given, noisy=noisy, sigma=sigma:
+        sec.fig(f"derive-{d.name}.png", f"{d.name}: ω derived from θ by poly9 and spline, " + (
+                "without and with simulated noise." if sigma else "on the column as given (no θ noise stated)."), lambda d=d, given=given, noisy=noisy, sigma=sigma:
                 figures.derivation_figure(d, given, noisy, sigma or 0.0, DERIVE_SEED))
         uname, uf = unit("omega")
         sec.table(["route", f"RMS vs ω column [{uname}]", f"peak [{uname}]", f"end [{uname}]",

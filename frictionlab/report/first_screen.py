@@ -15,7 +15,7 @@ import attrs
 import numpy as np
 
 from ..core.display import fmt_time
-from ..inference.answers import group_of
+from ..inference.answers import group_of, unfitted
 from ..solve.solvers.series import slip_zero
 from . import figures
 from .data_view import data_views, describe, spin_falls
@@ -102,10 +102,6 @@ ABSENT = {"best": "a best law", "goodness": "a goodness-of-fit test",
 
 def _answer_table(sec: Section, answers):
     """The verdict table: groups without a fitted law fold into one line under it, columns without data go."""
-    folded: dict[str, list[str]] = {}
-    for a in answers:
-        if a.best is None:
-            folded.setdefault(a.cell("best") or "no law could be fitted", []).append(a.group)
     shown = [a for a in answers if a.best is not None]
     cols = [(key, head) for key, head in COLUMNS if any(a.cell(key) for a in shown)]
     rows, notes = [], []
@@ -123,9 +119,10 @@ def _answer_table(sec: Section, answers):
     if rows:
         sec.table(["dataset group"] + [h for _, h in cols], rows)
         sec.more("Each verdict in full (datasets, tests, p-values, thresholds per dataset)", notes)
-    for reason, groups in folded.items():
+    for reason, groups, hints in unfitted(answers):
         head, _, why = reason.partition(": ")
-        sec.p(f"{head[0].upper()}{head[1:]}" + (f" ({why})" if why else "") + f": {', '.join(groups)}.")
+        sec.p(f"{head[0].upper()}{head[1:]}" + (f" ({why})" if why else "") + f": {', '.join(groups)}"
+              + "".join(f"; registered laws that apply: {h}" for h in hints) + ".")
     absent = [ABSENT[key] for key, _ in COLUMNS if key not in dict(cols)]
     if shown and absent:
         sec.p("Not in this comparison: " + "; ".join(absent) + ".")

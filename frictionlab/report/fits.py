@@ -104,7 +104,7 @@ def build(ctx) -> Section:
         if any(f.ok for f in fits):
             sec.fig(f"fit-{d.name}.png", f"{d.name}: data ({d.provenance.kind}) with each law's best fit, and residuals.",
                     lambda d=d, fits=fits, rows=rows: figures.fit_figure(d, fits, rows))
-            if "t" in d.columns:
+            if "t" in d.columns and d.kind != "spring-slider":  # a slider's friction is mu N: the fit figure shows it
                 sec.fig(f"force-{d.name}.png", f"{d.name}: friction force of each best fit.",
                         lambda d=d, fits=fits, rows=rows: figures.force_figure(d, fits, rows))
         prow = []

@@ -40,8 +40,9 @@ def build(ctx) -> list[Section]:
         "Solvers: 'exact' where the law and scene admit a closed form, else 'ode' (LSODA, rtol "
         f"{rtol_text(FIT_RTOL)}; what another tolerance changes is under 'What solver tolerance does to a fit'); 'series' "
         "(the paper's first-order expansion, eqs 7-11) in addition wherever it is defined.",
-        "Bootstrap (`--bootstrap N`, `--seed`): parametric (the best unflagged fit plus noise of the declared σ, "
-        "only where σ is known), every candidate refitted to the same replicates; "
+        "Bootstrap (`--bootstrap N`, `--seed`): parametric (the best unflagged fit plus Gaussian noise of the σ the "
+        "likelihood uses, measured or estimated from the data; none for a noise-free reconstruction), every "
+        "candidate refitted to the same replicates; "
         "95% percentile intervals for parameters, 95% Wilson intervals for first-place shares (see 'Bootstrap').",
         f"Settings: {json.dumps(c.settings)}.",
     ])

@@ -56,8 +56,8 @@ def _provenance_warning(c) -> str:
     parts = [f"{len(v)} {PROVENANCE_WORDS.get(k, k)} ({', '.join(v)})" for k, v in kinds.items()]
     return (("No dataset in this report is a measurement. " if "measured" not in kinds else
              "Not every dataset in this report is a measurement. ") + "; ".join(parts) + ". Reconstructed "
-            "series are curves rebuilt to agree with numbers stated in a paper; synthetic series were generated "
-            "with a known law plus noise. Rankings on them test the method and the claims' internal "
+            "series are curves rebuilt to agree with numbers stated in a paper; synthetic series were made up "
+            "(the built-in ones by a known law plus noise; others as their source says). Rankings on them test the method and the claims' internal "
             "consistency, not nature.")
 
 

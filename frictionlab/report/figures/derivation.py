@@ -8,18 +8,20 @@ from . import base
 
 
 def derivation_figure(dataset, derived: dict, noisy: dict, sigma_theta: float, seed: int) -> bytes:
-    """What each theta -> omega route does: on the theta column as given (left) and on the same
-    column with simulated camera noise of the stated sigma (right)."""
+    """What each theta -> omega route does: on the theta column as given (left) and, where a sigma of
+    theta is known (> 0), on the same column with simulated camera noise of that sigma (right)."""
     plt = base._plt()
     t = dataset.t
     tname, tf = time_unit(float(t[-1]))
     du, df = unit("omega")
     au, af = unit("theta")
-    fig, axes = plt.subplots(2, 2, figsize=(10.5, 6.6), sharex=True, layout="constrained")
+    views = [("theta column as given", derived)]
+    if sigma_theta > 0:  # a noise-free column (no stated sigma): the noisy twin would repeat it
+        views.append((f"with simulated noise σθ = {sigma_theta * af:.2g} {au} (seed {seed})", noisy))
+    fig, axes = plt.subplots(2, len(views), figsize=(5.25 * len(views) + (0 if sigma_theta > 0 else 1.0), 6.6),
+                             sharex=True, layout="constrained", squeeze=False)
     colors = {"poly9": "#d95f02", "spline": "#1b9e77"}
-    for col, (title, res) in enumerate((("theta column as given", derived),
-                                        (f"with simulated noise σθ = {sigma_theta * af:.2g} {au} (seed {seed})",
-                                         noisy))):
+    for col, (title, res) in enumerate(views):
         ax, axw = axes[0, col], axes[1, col]
         source = dataset.columns["theta"] if col == 0 else noisy["_theta"]
         ax.plot(t * tf, source * af, "o", ms=3, color="black", label="theta used")
@@ -47,6 +49,6 @@ def derivation_figure(dataset, derived: dict, noisy: dict, sigma_theta: float, s
             lo = min(float(np.min(ref)), min(float(np.percentile(f, 2)) for f in finite)) - 0.15 * span
             hi = max(float(np.max(ref)), max(float(np.percentile(f, 98)) for f in finite)) + 0.15 * span
             axw.set_ylim(lo, hi)
-    fig.suptitle(f"{dataset.name}: spin derived from rotation angle (shaded: ±1σ each route passes on from θ noise)",
-                 fontsize=11)
+    fig.suptitle(f"{dataset.name}: spin derived from rotation angle" + (
+        " (shaded: ±1σ each route passes on from θ noise)" if sigma_theta > 0 else " (no θ noise stated)"), fontsize=11)
     return base._png(fig)

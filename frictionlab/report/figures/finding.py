@@ -74,6 +74,7 @@ def data_figure(views, title: str) -> bytes:
         d, ax = v.dataset, axes[0, j]
         curves = [(f, label, base._style(f.law, f.solver, i)) for i, (f, label) in enumerate(zip(v.fits, v.labels))]
         target = v.fits[0].per_dataset[0].target
+        curves = _merged(curves, float(np.ptp(target.y)) if np.size(target.y) > 1 else 0.0)
         if target.t is not None:
             xlabel = _against_time(ax, d, target, curves)
         elif angle_column(d) is not None:
@@ -91,10 +92,31 @@ def data_figure(views, title: str) -> bytes:
             ax.set_xlabel(xlabel)
         else:  # the slip panel below carries the time axis
             ax.tick_params(labelbottom=False)
-        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2 if ax.get_xlabel() else -0.03),
-                  ncol=2)  # below the panel: never over the data
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.27 if ax.get_xlabel() else -0.03),
+                  ncol=2)  # below the panel (and its time axis): never over the data
     fig.suptitle(base.wrapped(title, width, 10.5), fontsize=10.5)
     return base._png(fig)
+
+
+#: In the small panels of the first screen a curve within this fraction of the data's span of a higher-ranked
+#: one at every data point cannot be told from it (about two pixels of a 150-pixel panel): drawn once.
+MERGED = 0.015
+
+
+def _merged(curves, span: float) -> list:
+    """The curves (fit, label, style) that can be seen apart; one lying under a higher-ranked curve is not
+    drawn and is named in that curve's legend entry ('(hides #3 wear [exact])')."""
+    out: list = []
+    for f, label, style in curves:
+        m = f.per_dataset[0].model
+        for k, (g, glabel, gstyle) in enumerate(out):
+            mg = g.per_dataset[0].model
+            if span > 0 and mg.shape == m.shape and np.all(np.abs(mg - m) <= MERGED * span):
+                out[k] = (g, f"{glabel} (hides {label.split(', ')[0]})", gstyle)
+                break
+        else:
+            out.append((f, label, style))
+    return out
 
 
 def _against_time(ax, d, target, curves) -> str:
@@ -112,7 +134,7 @@ def _against_time(ax, d, target, curves) -> str:
                     ecolor="0.75", elinewidth=0.7, label=f"data ({d.provenance.kind})", zorder=1)
     for f, label, style in curves:
         base.draw_fit(ax, f, obs, d.t, tf, uf, label, **style)
-    name = NAMES.get(obs, obs.replace("_", " "))
+    name = NAMES.get(obs, obs.replace("_", " ")).split(" (")[0]  # the short name: the panel is small
     ax.set_ylabel(f"{name} [{uname}]")
     return f"time [{tname}]"
 

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...core.display import plain_log
 from . import base
 
 
@@ -37,6 +38,7 @@ def ranking_figure(rows, alias: dict | None = None) -> bytes:
     ax.set_yticks(range(len(cands)), cands, fontsize=8)
     cb = fig.colorbar(im, ax=ax, shrink=0.85)
     cb.set_label("ΔAIC + 1 (log scale; 1 = best)")
+    plain_log(cb.ax.yaxis)
     ax.set_title(base.wrapped("Ranking per dataset: #rank and ΔAIC (solver exact unless named)",
                               fig.get_figwidth() - 1.2, 12), fontsize=12)
     return base._png(fig)
