@@ -38,6 +38,7 @@ class Run:
     progress: Progress | None = None
     pool: object = None  # a concurrent.futures executor, or None to run here
     client: object = None  # a dask.distributed Client: the stages' tasks run on its workers instead of a local pool
+    part: bool = False  # one dataset's task of a cluster run (pipeline.perdataset): checks over all fits wait
     _local: threading.local = attrs.field(factory=threading.local, init=False, repr=False)
 
     def map(self, fn, tasks: Sequence, label: Callable | None = None) -> list:
@@ -163,7 +164,7 @@ def run_stages(comparison, run: Run, stages: Sequence[Stage], forced: bool = Fal
     every one given, when ``forced``), timed; returns the comparison with every stage's fields filled."""
     chosen = [s for s in stages if forced or s.wanted(run)]
     timings = dict(comparison.timings)
-    with executor(run.settings.jobs, run.client, "compare") as pool:
+    with executor(run.settings.jobs, run.client, "compare", warm_worker) as pool:
         run.pool = pool
         side, pending = ThreadPoolExecutor(1), []
         try:
@@ -183,6 +184,17 @@ def run_stages(comparison, run: Run, stages: Sequence[Stage], forced: bool = Fal
             run.pool = None
         side.shutdown(wait=True)
     return attrs.evolve(comparison, timings=timings)
+
+
+def warm_worker() -> None:
+    """On a cluster worker, once: the imports every fit and refit needs (lmfit, the fitting modules, numba's
+    cached kernel), so that no task pays them."""
+    import lmfit  # noqa: F401
+
+    from ..inference.fitting import fit  # noqa: F401
+    from ..solve.compiled import available
+
+    available()
 
 
 def _timed(stage: Stage, comparison, run: Run) -> tuple[dict, float]:
