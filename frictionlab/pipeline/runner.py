@@ -14,7 +14,8 @@ from concurrent.futures.process import BrokenProcessPool
 
 import attrs
 
-from ..core.errors import FrictionLabError, ParameterError
+from ..core.errors import ParameterError, WorkerLost
+from ..core.workers import LOST
 from ..core.cluster import executor
 from ..core.progress import Running
 from .planning import FitPlan
@@ -100,8 +101,8 @@ def _result(fut, what: str):
     try:
         return fut.result()
     except BrokenProcessPool:  # a worker was killed, or a plugin ended its process (os._exit)
-        raise FrictionLabError(f"compare: a worker process died while running {what} "
-                               "(killed, out of memory, or a law plugin that ends its process)") from None
+        raise WorkerLost(f"compare: a worker process died while running {what} "
+                         "(killed, out of memory, or a law plugin that ends its process)") from None
 
 
 @attrs.define
@@ -201,6 +202,10 @@ def _timed(stage: Stage, comparison, run: Run) -> tuple[dict, float]:
     run.begin(stage.name)  # each stage counted apart, named as it begins
     try:
         part = stage.fn(comparison, run)
+    except BrokenProcessPool:  # --jobs 1: the child process of a third-party law's call (inference.guard) died
+        raise WorkerLost(f"compare: {LOST} in the {stage.name} stage") from None
+    except WorkerLost as exc:
+        raise WorkerLost(f"{exc} in the {stage.name} stage") from None
     finally:
         run.end()
     return part, time.perf_counter() - t0

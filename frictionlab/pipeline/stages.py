@@ -24,7 +24,8 @@ from ..inference.fitcost import tolerance_check
 from ..inference.fitting import FitResult
 from ..inference.ranking import family, rank_fits, rank_groups
 from ..inference.verdicts import make_answers, not_fitted_answers
-from .budget import fit_within_budget as fit_one  # a plugin's time budget kept from outside its code
+from ..inference.guard import within_budget  # a plugin's time budget kept from outside its code, every stage
+from .budget import fit_within_budget as fit_one
 from .planning import pair_index, slow_pair
 from .runner import Run, Stage
 
@@ -98,7 +99,11 @@ def equivalence_order(c, pairs):
 
 def _equivalence_task(args) -> EquivalenceResult:
     fa, fb, replicates, seed, timeout = args
-    return analyze_equivalence(fa, fb, replicates=replicates, seed=seed, timeout=timeout)
+    over = lambda why: EquivalenceResult(  # noqa: E731
+        dataset=fa.datasets[0], law_a=fa.law, law_b=fb.law, solver_a=fa.solver, solver_b=fb.solver,
+        replicates=replicates, seed=seed, status="failed", reason=f"a refit {why}")
+    return within_budget(analyze_equivalence, (fa.law, fb.law), timeout, fa, fb, replicates, seed, None, None,
+                         timeout, over=over)
 
 
 def transfer(c, run: Run) -> dict:
@@ -114,7 +119,8 @@ def transfer(c, run: Run) -> dict:
 
 def _transfer_task(args):
     fits, free, timeout = args[:3]
-    return _transfer.transfer_candidate(fits, free, timeout)
+    return within_budget(_transfer.transfer_candidate, (fits[0].law,), timeout, fits, free, timeout,
+                         over=functools.partial(_transfer.failed_candidate, fits))
 
 
 def tolerance(c, run: Run) -> dict:

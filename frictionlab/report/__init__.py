@@ -120,8 +120,12 @@ def _drawn(figs, jobs: int, client=None):
                 yield futures[fut], fut.result()
         return
     if jobs <= 1 or len(figs) <= 1:
+        from ..core.signals import kept_signals
+
         for i, f in enumerate(figs):
-            yield i, f.draw()
+            with kept_signals():  # a law plugin drawn here does not keep SIGINT, SIGTERM or SIGHUP
+                png = f.draw()
+            yield i, png
         return
     from .figures import _plt
 
