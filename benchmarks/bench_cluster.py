@@ -9,13 +9,18 @@ tolerance check and ``--bootstrap`` replicates, then the report (its figures dra
 These variants exist only to give the cluster work; they are not data.
 Runs, in one process, in this order and then again in reverse (the machine's speed drifts): the local
 run with one process (``jobs=1``), a LocalCluster of 1 worker process, one of 2 worker processes (each
-cluster started and its workers' imports warmed before the clock starts: a cluster is long-lived).
-Prints wall seconds per run and the ratios; every run's numbers are checked equal to the local run's.
+cluster started and its workers prepared as compare prepares them on its first run, ``core.cluster.prepare``,
+before the clock starts: a cluster is long-lived).
+Prints per run its wall seconds, the CPU seconds of this process (the client and, in a LocalCluster, the
+scheduler) and of each worker, and the load average (wall ratios mean something only on an idle machine:
+with other work on the cores, 2 workers cannot be faster than the cores they get); then the ratios of the
+median walls. Every run's numbers are checked equal to the local run's.
 Targets: 2 workers at least 1.6x faster than 1; 1 worker no slower than the local run.
 """
 from __future__ import annotations
 
 import argparse
+import resource
 import statistics
 import tempfile
 import time
@@ -43,42 +48,48 @@ def workload(n: int, seed: int = 7) -> list:
 
 
 def warm(client) -> None:
-    """Import what a fit needs on every worker (and load numba's cache), as a long-lived cluster has."""
-    def imports():
-        import lmfit  # noqa: F401
+    """Prepare every worker as compare and write_report do on their first run (``core.cluster.prepare``: the
+    imports a task needs, numba's cached kernel, malloc's thresholds), as a long-lived cluster has been."""
+    from frictionlab.core.cluster import prepare
+    from frictionlab.pipeline.runner import warm_worker
+    from frictionlab.report.figures import _plt
 
-        from frictionlab.inference.fitting import fit  # noqa: F401
-        from frictionlab.report import figures  # noqa: F401
-        from frictionlab.solve.compiled import available
+    prepare(client, warm_worker)
+    prepare(client, _plt)
 
-        available()
-        figures._plt()
-        return True
 
-    client.run(imports)
+def cpu_self() -> float:
+    """CPU seconds (user + system) of the calling process so far."""
+    r = resource.getrusage(resource.RUSAGE_SELF)
+    return r.ru_utime + r.ru_stime
 
 
 def one_run(dss, bootstrap, workers):
-    """Wall seconds of compare + report: local (workers None) or on a LocalCluster of ``workers`` processes."""
+    """(wall seconds of compare + report, CPU seconds of this process (the client, and in a LocalCluster the
+    scheduler), CPU seconds of each worker, the comparison): local (workers None) or on a LocalCluster of
+    ``workers`` processes."""
     from frictionlab.pipeline.comparison import compare
     from frictionlab.report import write_report
 
     opts = dict(datasets=dss, bootstrap=bootstrap, tolerance=(1e-3, 1e-10))
     with tempfile.TemporaryDirectory() as tmp:
         if workers is None:
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), cpu_self()
             c = compare(jobs=1, **opts)
             write_report(c, f"{tmp}/r", jobs=1)
-            return time.perf_counter() - t0, c
+            return time.perf_counter() - t0, cpu_self() - c0, [], c
         import distributed
 
         with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                       dashboard_address=None) as cluster, distributed.Client(cluster) as client:
             warm(client)
-            t0 = time.perf_counter()
+            w0 = client.run(cpu_self)
+            t0, c0 = time.perf_counter(), cpu_self()
             c = compare(client=client, **opts)
             write_report(c, f"{tmp}/r", client=client)
-            return time.perf_counter() - t0, c
+            wall, own = time.perf_counter() - t0, cpu_self() - c0
+            w1 = client.run(cpu_self)
+            return wall, own, [w1[k] - w0[k] for k in sorted(w0)], c
 
 
 def first_difference(a, b, path="") -> str:
@@ -112,16 +123,22 @@ def main(argv=None):
     print(f"{len(dss)} datasets (synthetic variants of {', '.join(BASES)}), bootstrap {args.bootstrap}; "
           f"{os.cpu_count()} CPUs, load average at start {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
     times = {"local": [], 1: [], 2: []}
+    cpus = {"local": [], 1: [], 2: []}  # (CPU here, [CPU of each worker])
     ref = None
     for order in (("local", 1, 2), (2, 1, "local")):
         for w in order:
-            t, c = one_run(dss, args.bootstrap, None if w == "local" else w)
+            t, own, per_worker, c = one_run(dss, args.bootstrap, None if w == "local" else w)
             times[w].append(t)
+            cpus[w].append((own, per_worker))
             got = numbers(c)
             ref = ref if ref is not None else got
             same = got == ref
+            cpu = f"CPU {own:6.1f} s here" + (" (client and scheduler)" if per_worker else "")
+            if per_worker:
+                cpu += ", workers " + " + ".join(f"{x:.1f}" for x in per_worker) + f" = {sum(per_worker):.1f} s"
             print(f"  {'local, 1 process' if w == 'local' else f'Dask, {w} worker process' + 'es' * (w > 1):28s} "
-                  f"{t:6.1f} s wall; numbers {'equal to the first run' if same else 'DIFFER'}", flush=True)
+                  f"{t:6.1f} s wall; {cpu}; load average {os.getloadavg()[0]:.1f}; numbers "
+                  f"{'equal to the first run' if same else 'DIFFER'}", flush=True)
             if not same:
                 raise SystemExit("the numbers differ between runs: " + first_difference(ref, got))
     med = {k: statistics.median(v) for k, v in times.items()}
@@ -129,6 +146,12 @@ def main(argv=None):
     print(f"median wall: local {med['local']:.1f} s, 1 worker {med[1]:.1f} s, 2 workers {med[2]:.1f} s")
     print(f"RATIO 1 worker / 2 workers = {r21:.2f}x (target >= 1.6: {'met' if r21 >= 1.6 else 'NOT met'})")
     print(f"RATIO 1 worker / local = {r1l:.2f} (target <= 1: {'met' if r1l <= 1.0 else 'NOT met'})")
+    local = statistics.median(own for own, _ in cpus["local"])
+    one = statistics.median(own + sum(ws) for own, ws in cpus[1])
+    busiest = statistics.median(max(ws) for _, ws in cpus[2])
+    print(f"CPU (what the load average does not distort as much): 1 worker and its client / local = {one / local:.2f}; "
+          f"1 worker's CPU / the busier of 2 workers' = {statistics.median(sum(ws) for _, ws in cpus[1]) / busiest:.2f} "
+          "(the most 2 workers can gain on 2 free cores, the client's share aside)")
     print(f"load average at end {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
 
 

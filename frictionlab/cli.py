@@ -107,7 +107,11 @@ def main(argv=None) -> int:
 
     argv = sys.argv[1:] if argv is None else list(argv)
     with guarded_streams() as (out, err):  # all output inert and encodable; a failing stream named
-        rc = _main(argv)
+        try:
+            rc = _main(argv)
+        except (KeyboardInterrupt, Terminated) as exc:  # a signal while the run's ending was being said
+            rc = 128 + int(getattr(exc, "signum", 2))
+            _say_quietly("interrupted" if rc == 130 else exc.word())
         out.flush()
         if out.failure is not None and rc != 141:
             print(f"frictionlab: error: cannot write to {out.name}: {out.failure.strerror or out.failure} "
@@ -136,6 +140,13 @@ def _main(argv: list[str]) -> int:
     return _run(args)
 
 
+def _say_quietly(message: str) -> None:
+    try:
+        print(f"frictionlab: {message}", file=sys.stderr)
+    except (Exception, KeyboardInterrupt, Terminated):  # noqa: BLE001 (nothing more can be said)
+        pass
+
+
 def _say(message: str, status: int) -> int:
     print(f"frictionlab: {message}", file=sys.stderr)
     return status
@@ -150,6 +161,7 @@ def _run(args) -> int:
     try:
         with warnings.catch_warnings(), inputs_of_run():  # outputs keep clear of every file the run reads
             warnings.simplefilter("default")
+            warnings.simplefilter("ignore", ResourceWarning)  # e.g. an import cut short by a signal: not the user's
             warnings.formatwarning = lambda m, c, *a, **k: f"warning: {one_line(m)}\n"
             for path in args.load:
                 load_file(path)
@@ -164,7 +176,7 @@ def _run(args) -> int:
     except OSError as exc:  # the file system refused (permissions, a full disk): the user's to fix
         if args.debug:
             raise
-        where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+        where = f"{exc.filename}: " if getattr(exc, "filename", None) else _cwd_gone()
         return _say(f"error: {where}{one_line(exc.strerror or exc)}", 2)
     except KeyboardInterrupt:
         return _say("interrupted", 130)
@@ -180,6 +192,17 @@ def _run(args) -> int:
         restore()
 
 
+def _cwd_gone() -> str:
+    """What to say before an OSError that names no file: that the current folder was deleted, if it was."""
+    import os
+
+    try:
+        os.getcwd()
+    except OSError:
+        return "the current folder no longer exists (deleted while in use; cd to an existing folder): "
+    return ""
+
+
 def _silence_stdout() -> None:
     try:
         import os
@@ -190,15 +213,24 @@ def _silence_stdout() -> None:
 
 
 def _signals_end_cleanly():
-    """Make SIGTERM and SIGHUP an exception (errors.Terminated) while a command runs, so that clean-up
-    runs: workers stopped, temporary output removed, locks released. Returns the function that undoes it."""
+    """Make SIGTERM and SIGHUP an exception (errors.Terminated), and SIGINT KeyboardInterrupt, while a command
+    runs, so that clean-up runs: workers stopped, temporary output removed, locks released; if the exception
+    is swallowed (a plugin's bare except, a finalizer), the run ends HARD_EXIT_AFTER seconds later all the
+    same. A forked child signalled before it set its own handlers just ends. Returns the function that
+    undoes it."""
+    import os
     import signal
     import threading
 
     if threading.current_thread() is not threading.main_thread():
         return lambda: None
+    me = os.getpid()
 
     def on_signal(signum, frame):
+        if os.getpid() != me:  # a forked worker signalled before it set its own handlers: it just ends
+            signal.signal(signum, signal.SIG_DFL)
+            os.kill(os.getpid(), signum)
+            return
         if not caught:  # a plugin's bare except: may swallow the exception: then end anyway, cleanly
             timer = threading.Timer(HARD_EXIT_AFTER, _hard_exit, (signum,))
             timer.daemon = True
@@ -206,21 +238,30 @@ def _signals_end_cleanly():
             caught.append(timer)
         else:
             _hard_exit(signum)
-        raise Terminated(signum)
+        raise KeyboardInterrupt if signum == signal.SIGINT else Terminated(signum)
+
+    def unraisable(u):  # a signal's exception raised in a finalizer, where Python only prints it: end now
+        if isinstance(u.exc_value, (Terminated, KeyboardInterrupt)) and os.getpid() == me:
+            _hard_exit(getattr(u.exc_value, "signum", signal.SIGINT))
+        hook(u)
 
     caught = []
-    sigs = [s for s in (getattr(signal, "SIGTERM", None), getattr(signal, "SIGHUP", None)) if s is not None]
+    sigs = [getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n)]
+    if signal.getsignal(signal.SIGINT) is not signal.default_int_handler:  # ^C ignored by whoever started us
+        sigs.remove(signal.SIGINT)
     old = {s: signal.signal(s, on_signal) for s in sigs}
+    hook, sys.unraisablehook = sys.unraisablehook, unraisable
 
     def restore():
         for t in caught:
             t.cancel()
         for s, h in old.items():
             signal.signal(s, h)
+        sys.unraisablehook = hook
     return restore
 
 
-#: Seconds after SIGTERM or SIGHUP before the process ends even if the exception raised was swallowed.
+#: Seconds after SIGINT, SIGTERM or SIGHUP before the process ends even if the exception raised was swallowed.
 HARD_EXIT_AFTER = 3.0
 
 
@@ -233,7 +274,8 @@ def _hard_exit(signum: int) -> None:
 
     remove_leftovers()
     try:
-        sys.stderr.write(f"frictionlab: {Terminated(signum).word()}\n")
+        word = "interrupted" if signum == 2 else Terminated(signum).word()  # 2: SIGINT
+        sys.stderr.write(f"frictionlab: {word}\n")
         sys.stderr.flush()
     except Exception:  # noqa: BLE001 (nothing more can be said)
         pass

@@ -103,6 +103,8 @@ def prepare(case: dict, tmp: Path, argv: list[str]) -> list[str]:
             os.mkfifo(path)
         elif kind == "symlink":
             path.symlink_to(filled(f["target"]))
+        elif kind == "hardlink":
+            os.link(filled(f["target"]), path)
         elif kind == "dir":
             path.mkdir()
         else:

@@ -1,4 +1,4 @@
-"""The third bad-input corpus, tests/bad_inputs/round3.toml: cases by class (paths and links, names,
+"""The third bad-input corpus, tests/bad_inputs/round3.toml and round3b.toml: cases by class (paths and links, names,
 terminal and Markdown text, plugin numerics and time, API types, environment, signals), each with
 what the user sees.
 
@@ -26,10 +26,11 @@ from frictionlab.core import errors
 
 from test_bad_inputs import ERROR_LINE, PROGRESS_LINE, clean_registry, prepare, snapshot  # noqa: F401 (a fixture)
 
-CASES = tomllib.loads((Path(__file__).parent / "bad_inputs" / "round3.toml").read_text(encoding="utf-8"))["case"]
+CASES = [case for name in ("round3.toml", "round3b.toml")
+         for case in tomllib.loads((Path(__file__).parent / "bad_inputs" / name).read_text(encoding="utf-8"))["case"]]
 CLASSES = ("paths", "names", "text", "plugins", "api", "environment", "signals")
 FIELDS = {"id", "class", "sees", "base", "edit", "files", "argv", "python", "raises", "status", "error", "stdout",
-          "stderr", "never", "report_never", "written", "absent", "how", "env", "stdout_to", "close", "signal", "slow"}
+          "stderr", "never", "report_never", "html_never", "written", "absent", "how", "env", "stdout_to", "close", "signal", "slow"}
 ACTIVE = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f]")  # what a terminal acts on (\t and \n are text)
 
 
@@ -121,10 +122,10 @@ def check(case, rc, out, err, before, tmp: Path):
         assert (tmp / rel).exists(), f"{rel} was not written:\n{shown}"
     for rel in case.get("absent", []):
         assert not os.path.lexists(tmp / rel), f"{rel} exists:\n{shown}"
-    if case.get("report_never"):
-        md = (tmp / "out" / "report.md").read_text(encoding="utf-8")
-        for rx in case["report_never"]:
-            assert not re.search(rx, md), f"report.md holds {rx!r}"
+    for key, name in (("report_never", "report.md"), ("html_never", "report.html")):
+        text = (tmp / "out" / name).read_text(encoding="utf-8") if case.get(key) else ""
+        for rx in case.get(key, []):
+            assert not re.search(rx, text), f"{name} holds {rx!r}"
     if status != 0 and not case.get("written"):  # a run that failed or was stopped leaves the folder as it was
         assert snapshot(tmp) == before, f"the case folder changed:\n{shown}"
 

@@ -7,7 +7,7 @@ from frictionlab.cli import main
 distributed = pytest.importorskip("distributed")
 
 LAWS = ["wear", "coulomb"]
-DATA = ["incline-oil-a100", "impact-golf-v28"]
+DATA = ["incline-oil-a100", "impact-golf-v28", "spring-slider-slip"]  # the last: nothing to fit (no law applies)
 OPTIONS = dict(laws=LAWS, datasets=DATA, bootstrap=12, tolerance=(1e-3,), replicates=20, seed=3)
 
 
@@ -60,3 +60,27 @@ def test_bad_scheduler_is_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--scheduler nonsense://nowhere" in err[0]
     assert not (tmp_path / "r").exists()
+
+
+def test_workers_are_prepared_once_per_warm_function():
+    """``core.cluster.prepare`` runs its warm-up (imports, malloc thresholds) once per worker and function."""
+    from frictionlab.core import cluster
+
+    def warm():  # counts its runs in the worker process's environment
+        import os
+
+        os.environ["FRICTIONLAB_TEST_WARM"] = str(int(os.environ.get("FRICTIONLAB_TEST_WARM", "0")) + 1)
+
+    def runs():
+        import os
+
+        return os.environ.get("FRICTIONLAB_TEST_WARM")
+
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as lc, distributed.Client(lc) as client:
+        key = warm.__qualname__ + "@" + warm.__module__
+        assert set(client.run(cluster._prepared, key).values()) == {False}
+        cluster.prepare(client, warm)
+        cluster.prepare(client, warm)  # the second call finds every worker prepared
+        assert set(client.run(cluster._prepared, key).values()) == {True}
+        assert set(client.run(runs).values()) == {"1"}

@@ -341,3 +341,26 @@ def test_the_scalar_right_hand_side_takes_a_constant_normal_force_built_once():
     assert N is not None and not N.flags.writeable and np.array_equal(N, incline.scene.normal(0.37))
     assert make_plan(load_dataset("impact-golf-v28").scene, get_law("area-rate"))._fixed_normal() is None
     assert make_plan(load_dataset("incline-dry-d10").scene, get_law("wear"))._fixed_normal() is None  # not needed
+
+
+def test_the_impulse_alone_is_the_impulse_of_both_integrals():
+    """The exact solver's stop search reads the friction impulse only (``second=False``): bit for bit the
+    impulse computed beside its integral, for half-sine and constant pulses, small and large (in-place)
+    grids, times past contact, and a factor per scene."""
+    import numpy as np
+
+    from frictionlab.physics.area import ConstantArea, HalfSineArea
+    from frictionlab.physics.normal import HalfSineNormal, WeightNormal
+    from frictionlab.solve.solvers.exact import _area_integrals, _normal_integrals
+
+    rng = np.random.default_rng(5)
+    grids = [np.float64(1.7e-4), rng.uniform(0, 6e-4, 7), np.sort(rng.uniform(0, 4e-4, (3, 40)), axis=1)]
+    for normal in (HalfSineNormal(impulse=1.3, contact_time=5e-4), WeightNormal(value=2.5)):
+        for t in grids:
+            for a in (0.31, rng.uniform(0.1, 1.0, (3, 1)) if np.ndim(t) == 2 else 0.7):
+                both, alone = _normal_integrals(normal, t, a), _normal_integrals(normal, t, a, second=False)
+                assert alone[1] is None and np.array_equal(alone[0], both[0])
+    for area in (HalfSineArea(peak=1.3e-4, contact_time=5e-4), ConstantArea(area=2e-5), None):
+        for t in grids[1:]:
+            alone = _area_integrals(area, t, second=False)
+            assert alone[1] is None and np.array_equal(alone[0], _area_integrals(area, t)[0])

@@ -271,15 +271,21 @@ def _rebuild(args) -> int:
     from ..core.errors import OutputError
 
     out = args.out or home
+    created = not out.exists()
     try:
         out.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise OutputError(f"{out}: cannot create the output folder: {exc.strerror or exc}") from None
     from ..core.files import output_lock
 
-    with output_lock(out), tempfile.TemporaryDirectory(dir=out) as tmp:  # one rebuild of a folder at a time
-        written = rebuild(Path(tmp), generators)
-        for p in written:  # all generated first, then moved: no half-rebuilt folder
-            shutil.move(str(p), out / p.name)
+    try:
+        with output_lock(out), tempfile.TemporaryDirectory(dir=out) as tmp:  # one rebuild of a folder at a time
+            written = rebuild(Path(tmp), generators)
+            for p in written:  # all generated first, then moved: no half-rebuilt folder
+                shutil.move(str(p), out / p.name)
+    except BaseException:  # an error, ^C, SIGTERM, SIGHUP: the folder this run created goes too
+        if created:
+            shutil.rmtree(out, ignore_errors=True)
+        raise
     print(f"wrote {len(written)} files to {out}")
     return 0

@@ -41,6 +41,10 @@ class OutputError(FrictionLabError):
     """An output path that exists or cannot be written."""
 
 
+class WorkerLost(FrictionLabError):
+    """A worker process died without a result (killed, out of memory, a law plugin that ends its process)."""
+
+
 class Terminated(BaseException):
     """The process received SIGTERM or SIGHUP (raised by the handler frictionlab installs while it runs,
     so that clean-up code runs: worker processes stopped, temporary output removed, locks released)."""

@@ -46,14 +46,15 @@ LOST = "a worker process was lost (killed, out of memory, or a law plugin that e
 
 def _worker_init(parent: int) -> None:
     """In a worker: ^C goes to the parent, which stops the pool; SIGTERM ends the worker at once;
-    and (on Linux) the worker gets SIGTERM when the parent dies, even by SIGKILL, so no worker
+    and (on Linux) the worker gets SIGKILL when the parent dies, even by SIGKILL, so no worker
     outlives its run or keeps holding the output lock it inherited."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     if sys.platform.startswith("linux"):
         try:
             import ctypes
-            ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGTERM))  # 1 = PR_SET_PDEATHSIG
+            # SIGKILL, not SIGTERM: a plugin that ignores SIGTERM cannot keep an orphaned worker alive
+            ctypes.CDLL(None, use_errno=True).prctl(1, int(signal.SIGKILL))  # 1 = PR_SET_PDEATHSIG
         except (OSError, AttributeError):
             return
         if os.getppid() != parent:  # the parent died before the request took effect
@@ -150,14 +151,25 @@ class OverBudget(Exception):
     """A call run by ``bounded`` ran past its limit; its process was ended."""
 
 
+#: In a child of ``bounded``: the pipe to the parent, on which ``beat`` writes (None elsewhere).
+_beat_fd: int | None = None
+
+
+def beat() -> None:
+    """In a child of ``bounded``: a new call into law code starts now, so the limit counts afresh from here
+    (``fitting.fit`` beats at its start: a batch of refits in one child has the budget of one refit each).
+    A no-op in any other process."""
+    if _beat_fd is not None:
+        os.write(_beat_fd, b"b")
+
+
 def bounded(fn, limit: float, *args):
     """``fn(*args)`` run in a forked child process that is ended (SIGKILL) once it has run ``limit``
-    seconds: a time budget enforced from outside the code it bounds (a plugin's ``except:`` cannot keep
-    it). The result or the exception comes back pickled; OverBudget past the limit; BrokenProcessPool
-    if the child died without a result. Runs here where there is no fork."""
+    seconds since it started or last called ``beat``: a time budget enforced from outside the code it
+    bounds (a plugin's ``except:`` cannot keep it). The result or the exception comes back pickled;
+    OverBudget past the limit; BrokenProcessPool if the child died without a result. Runs here where
+    there is no fork."""
     import pickle
-    import select
-    import time
 
     if not hasattr(os, "fork"):
         return fn(*args)
@@ -165,42 +177,66 @@ def bounded(fn, limit: float, *args):
     with _quiet_fork():
         pid = os.fork()
     if pid == 0:  # the child: never returns into the caller's code
-        status = 0
-        try:
-            os.close(read)
-            _worker_init(os.getppid())
-            try:
-                payload = pickle.dumps((True, fn(*args)))
-            except BaseException as exc:  # noqa: BLE001 (sent back as it is)
-                payload = _pickled_error(exc)
-            with os.fdopen(write, "wb") as fh:
-                fh.write(payload)
-        except BaseException:  # noqa: BLE001
-            status = 1
-        finally:
-            os._exit(status)
+        _child(read, write, fn, args)
     os.close(write)
-    chunks, deadline = [], time.monotonic() + limit
     try:
-        while True:
-            left = deadline - time.monotonic()
-            if left <= 0 or not select.select([read], [], [], left)[0]:
-                raise OverBudget(f"ran past {limit:g} s")
-            chunk = os.read(read, 1 << 16)
-            if not chunk:
-                break
-            chunks.append(chunk)
+        payload = _receive(read, limit)
     finally:
         os.close(read)
         _end(pid)
-    if not chunks:  # the child died (killed, or a plugin's os._exit): as a pool's lost worker
+    if payload is None:  # the child died (killed, or a plugin's os._exit): as a pool's lost worker
         raise BrokenProcessPool("the process running it ended without a result")
-    ok, value = pickle.loads(b"".join(chunks))
+    ok, value = pickle.loads(payload)
     if ok:
         return value
     raise value
 
 
+def _child(read: int, write: int, fn, args) -> None:
+    """The child of ``bounded``: run, send b'r' and the pickled outcome, and exit (never returns)."""
+    global _beat_fd
+    import pickle
+
+    status = 0
+    try:
+        os.close(read)
+        _worker_init(os.getppid())
+        _beat_fd = write
+        try:
+            payload = pickle.dumps((True, fn(*args)))
+        except BaseException as exc:  # noqa: BLE001 (sent back as it is)
+            payload = _pickled_error(exc)
+        os.write(write, b"r")
+        with os.fdopen(write, "wb") as fh:
+            fh.write(payload)
+    except BaseException:  # noqa: BLE001
+        status = 1
+    finally:
+        os._exit(status)
+
+
+def _receive(read: int, limit: float) -> bytes | None:
+    """What the child sends after b'r' (None if it ended first); each b'b' before it restarts the limit."""
+    import select
+    import time
+
+    chunks, deadline, started = [], time.monotonic() + limit, False
+    while True:
+        left = deadline - time.monotonic()
+        if left <= 0 or not select.select([read], [], [], left)[0]:
+            raise OverBudget(f"ran past {limit:g} s")
+        chunk = os.read(read, 1 << 16)
+        if not chunk:
+            return b"".join(chunks) if started else None
+        if not started:
+            beats = len(chunk) - len(chunk.lstrip(b"b"))
+            if beats:
+                deadline = time.monotonic() + limit
+            chunk = chunk[beats:]
+            if chunk[:1] == b"r":
+                started, chunk = True, chunk[1:]
+        if started:
+            chunks.append(chunk)
 def _pickled_error(exc: BaseException) -> bytes:
     import pickle
 

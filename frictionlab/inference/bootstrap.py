@@ -179,16 +179,27 @@ def _run_chunk(fit_fns, datasets, models, method, seeds):
     return out
 
 
+def _guarded_chunk(fit_fns, datasets, models, method, seeds):
+    """``_run_chunk``, in a child ended past the refits' time budget when a candidate is a third-party law
+    (``inference.guard``); then every refit of the chunk failed with that reason."""
+    from .guard import within_budget
+
+    timeout = min((dict(fn.options).get("timeout") or math.inf for fn, _ in fit_fns), default=math.inf)
+    over = lambda why: [[(None, math.nan, why)] * len(fit_fns) for _ in seeds]  # noqa: E731
+    return within_budget(_run_chunk, [fn.law for fn, _ in fit_fns], None if math.isinf(timeout) else timeout,
+                         fit_fns, datasets, models, method, seeds, over=over)
+
+
 def _dispatch(executor, fit_fns, datasets, models, method, seed, n, chunk, progress=None):
     """Rows of _run_chunk over n resamples in batches of ``chunk``; progress(done, n) after each batch."""
     seeds = np.random.SeedSequence(seed).spawn(n)
     chunk = max(1, int(chunk or math.ceil(n / 16)))
     groups = [seeds[i:i + chunk] for i in range(0, n, chunk)]
     parts, done = [], 0
-    futures = None if executor is None else [executor.submit(_run_chunk, fit_fns, datasets, models, method, g)
+    futures = None if executor is None else [executor.submit(_guarded_chunk, fit_fns, datasets, models, method, g)
                                              for g in groups]
     for i, g in enumerate(groups):
-        parts.append(_run_chunk(fit_fns, datasets, models, method, g) if futures is None else futures[i].result())
+        parts.append(_guarded_chunk(fit_fns, datasets, models, method, g) if futures is None else futures[i].result())
         done += len(g)
         if progress:
             progress(done, n)

@@ -271,8 +271,10 @@ def _common(fit_a: FitResult, fit_b: FitResult, timeout: float | None = None) ->
 
 def _qualitative_within(fit_a, fit_b, timeout: float | None) -> dict:
     """``qualitative`` within ``timeout`` seconds (None: no limit); past it, 'not applicable'."""
+    from ..core.workers import beat
     from .fitmodel import FitTimeout, _alarm
 
+    beat()  # in a child of inference.guard: the simulations have the budget of one refit
     try:
         with _alarm(timeout):
             return qualitative(fit_a, fit_b)

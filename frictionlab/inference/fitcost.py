@@ -24,7 +24,16 @@ DEFAULT_RTOLS = (1e-3, 1e-5, 1e-7, 1e-10)
 
 
 def _fit(law, dataset, solver, rtol, options=None):
-    """(FitResult or the one-line error, CPU seconds of the fit)."""
+    """(FitResult or the one-line error, CPU seconds of the fit); a third-party law's fit within its
+    budget from outside its code (``inference.guard``)."""
+    from .guard import within_budget
+
+    timeout = (options or {}).get("timeout")
+    return within_budget(_fit_here, (law,), timeout, law, dataset, solver, rtol, options,
+                         over=lambda why: (FrictionLabError(f"{law}: {why}"), math.nan))
+
+
+def _fit_here(law, dataset, solver, rtol, options=None):
     from .fitting import fit
 
     try:

@@ -39,6 +39,7 @@ import numpy as np
 
 from ..core.arguments import as_items, check_type
 from ..core.errors import DatasetError, FrictionLabError, ParameterError
+from ..core.workers import beat
 from ..physics.registry import get_law
 from . import levmar
 from .fitmodel import ODE_STARTS, PENALTY, FitTimeout, _alarm, _law_slots, _lmfit_bound, _Model, _scene_slots, _search, _si
@@ -109,6 +110,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     """
     import lmfit  # slow to import: only when fitting
 
+    beat()  # in a child of inference.guard, this fit's time budget counts from now
     check_type(solver, str, "fit: solver", "a solver name such as 'auto', 'exact' or 'ode'")
     law = get_law(law)
     clock = (time.perf_counter(), time.thread_time())

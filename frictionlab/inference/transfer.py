@@ -260,6 +260,15 @@ def transfer_candidate(fits: Sequence[FitResult], free: dict | None = None,
     return preds, shared_fit(fits, free, timeout)
 
 
+def failed_candidate(fits: Sequence[FitResult], reason: str) -> tuple[list[Prediction], SharedFit]:
+    """``transfer_candidate``'s answer when its run was ended (``inference.guard``): everything failed, with ``reason``."""
+    f0 = fits[0]
+    preds = [Prediction(law=f0.law, solver=f0.solver, source=s.datasets[0], target=t.datasets[0], status="failed",
+                        reason=reason) for s in fits for t in fits if s is not t]
+    return preds, SharedFit(law=f0.law, solver=f0.solver, datasets=tuple(f.datasets[0] for f in fits),
+                            status="failed", reason=reason, separate={f.datasets[0]: _determined(f) for f in fits})
+
+
 def _members(datasets, group_of=None) -> dict[str, list]:
     if group_of is None:
         from .answers import group_of

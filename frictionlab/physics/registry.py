@@ -22,6 +22,7 @@ import numpy as np
 from ..core.errors import FrictionLabError, LawError, RegistryError
 from ..core.inputs import note_input
 from ..core.names import check_name
+from ..core.signals import kept_signals
 from .law import (
     QUANTITIES,
     AreaSlipForm,
@@ -48,6 +49,49 @@ _loaded = False
 _loading = False
 
 
+#: Seconds a --load file's import, or a third-party law's check at registration, may take (environment
+#: variable FRICTIONLAB_LOAD_TIMEOUT): past it, the process doing it is ended and the load refused.
+LOAD_TIMEOUT = 30.0
+
+
+def load_timeout() -> float:
+    """``LOAD_TIMEOUT``, or FRICTIONLAB_LOAD_TIMEOUT when that is a positive number of seconds."""
+    import os
+
+    try:
+        value = float(os.environ.get("FRICTIONLAB_LOAD_TIMEOUT", ""))
+    except ValueError:
+        return LOAD_TIMEOUT
+    return value if 0 < value < math.inf else LOAD_TIMEOUT
+
+
+def within_load_limit(fn, *args, what: str, error=RegistryError):
+    """``fn(*args)`` tried first in a forked child ended past ``load_timeout()`` seconds (the code it runs
+    is not trusted to stop; a plugin's ``except:`` cannot keep the limit), then, if it came back in time,
+    run here. Past the limit, or if the child ended without an answer, ``error`` naming ``what``. Inside
+    such a child already (a --load file's trial import), it runs here at once."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    from ..core import workers
+
+    if workers._beat_fd is None:
+        limit = load_timeout()
+        try:
+            workers.bounded(_tried, limit, fn, *args)
+        except workers.OverBudget:
+            raise error(f"{what} ran past the load time limit of {limit:g} s (FRICTIONLAB_LOAD_TIMEOUT); "
+                        "its process was ended and nothing was loaded") from None
+        except BrokenProcessPool:
+            raise error(f"{what} ended its process; nothing was loaded") from None
+    with kept_signals():  # a plugin that takes SIGINT, SIGTERM or SIGHUP over gives them back
+        return fn(*args)
+
+
+def _tried(fn, *args) -> None:
+    """``fn(*args)``, its value dropped (a child's answer unpickled here would import a plugin's module)."""
+    fn(*args)
+
+
 def _as_law(obj, source: str) -> FrictionLaw:
     try:
         law = obj() if inspect.isclass(obj) else obj
@@ -57,7 +101,11 @@ def _as_law(obj, source: str) -> FrictionLaw:
         raise LawError(f"law plugin {source}: creating the law raised {type(exc).__name__}: {exc}") from None
     if not isinstance(law, FrictionLaw):
         raise LawError(f"law plugin {source}: {obj!r} is not a frictionlab.FrictionLaw")
-    validate_law(law, source)
+    if type(law).__module__.startswith("frictionlab."):
+        validate_law(law, source)
+    else:  # a third-party law's check runs its code: within the load time limit
+        within_load_limit(validate_law, law, source, what=f"law plugin {source}: its check at registration",
+                          error=LawError)
     return law
 
 
@@ -183,7 +231,8 @@ def _load() -> None:
             try:
                 with np.errstate(**_NUMPY_STATE):  # as before any plugin, whatever one set; restored after
                     try:
-                        obj = ep.load()
+                        obj = (ep.load() if ep.value.startswith("frictionlab.")
+                               else within_load_limit(ep.load, what="its import"))
                     except FrictionLabError as exc:  # e.g. a degenerate ParamSpec or StateSpec at import
                         raise LawError(f"law plugin {source}: {exc}") from None
                     law = _as_law(obj, source)
@@ -267,6 +316,12 @@ def get_law(name: str | FrictionLaw) -> FrictionLaw:
         raise RegistryError(f"unknown law '{name}'; registered laws: {', '.join(sorted(_laws))}") from None
 
 
+def is_third_party(law) -> bool:
+    """True for a law whose class is defined outside frictionlab (a plugin, a --load file, a notebook):
+    its code is not trusted to stop at a time budget (``inference.guard``)."""
+    return not type(get_law(law)).__module__.startswith("frictionlab.")
+
+
 def available_laws() -> dict[str, FrictionLaw]:
     """All registered laws by name, in registration order."""
     _load()
@@ -310,6 +365,14 @@ def load_law_file(path) -> None:
     spec = importlib.util.spec_from_file_location(f"frictionlab_user_{p.stem}", p)
     if spec is None or spec.loader is None:
         raise RegistryError(f"--load {path}: cannot be imported as a Python module")
+    within_load_limit(_import, spec, path, what=f"--load {path}: importing it (and checking the laws it registers)")
+
+
+def _import(spec, path) -> None:
+    """Import the module of ``spec`` (the --load file ``path``), its errors one line naming the file."""
+    import importlib.util
+    import sys
+
     module = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = module
     try:

@@ -38,6 +38,7 @@ from .planning import (  # noqa: F401
     plan_fits,
     unique_datasets,
 )
+from .perdataset import run_per_dataset
 from .runner import Progress, Run, select
 from .runner import run_stages as run_stages_with
 from .settings import DEFAULT_LAWS, Settings, select_laws  # noqa: F401
@@ -146,9 +147,9 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     tolerance, bootstrap, answer), None for every stage the options above switch on; ``run_stages``
     runs more of them on the result later. client: a dask.distributed Client; the fits, refits, tests and
     bootstrap then run on its workers instead of ``jobs`` local processes (the same numbers either way).
-    The command line's ``frictionlab compare`` differs in three defaults (said in its --help): bootstrap
-    150, the tolerance check on (commands.compare.TOLERANCE_RTOLS), fit_timeout 900 s; here each runs only when
-    asked for.
+    The command line's ``frictionlab compare`` differs in two defaults (said in its --help): bootstrap
+    150 and fit_timeout 900 s; here each runs only when asked for. Neither runs the tolerance check unless
+    asked (``--tolerance``; here ``tolerance=(1e-3, 1e-10)``).
     """
     started = time.perf_counter()
     settings = Settings(laws=(), solvers=tuple(solvers) if solvers else None,
@@ -168,7 +169,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                    settings=settings.as_dict(), options=settings)
     if jobs > 1 and client is None:
         _import_before_fork(run)
-    c = run_stages_with(c, run, chosen, forced=stages is not None)
+    c = _run_stages(c, run, chosen, forced=stages is not None)
     return attrs.evolve(c, wall_time=time.perf_counter() - started)
 
 
@@ -180,7 +181,15 @@ def run_stages(comparison: Comparison, stages: Sequence[str], *, progress: Progr
     settings = attrs.evolve(comparison.options, **options, cluster=cluster_name(client))
     run = _make_run(settings, comparison.datasets, progress, client)
     c = attrs.evolve(comparison, settings=settings.as_dict(), options=settings)
-    return run_stages_with(c, run, select(STAGES, stages), forced=True)
+    return _run_stages(c, run, select(STAGES, stages), forced=True)
+
+
+def _run_stages(c: Comparison, run: Run, stages: list, forced: bool) -> Comparison:
+    """``runner.run_stages``; on a cluster, a run that fits goes first in one task per dataset (``perdataset``)."""
+    chosen = [s for s in stages if forced or s.wanted(run)]
+    if run.client is not None and any(s.name == "fit" for s in chosen):
+        c, chosen = run_per_dataset(c, run, chosen)
+    return run_stages_with(c, run, chosen, forced=True)
 
 
 def cluster_name(client) -> str:

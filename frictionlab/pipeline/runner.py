@@ -14,7 +14,8 @@ from concurrent.futures.process import BrokenProcessPool
 
 import attrs
 
-from ..core.errors import FrictionLabError, ParameterError
+from ..core.errors import ParameterError, WorkerLost
+from ..core.workers import LOST
 from ..core.cluster import executor
 from ..core.progress import Running
 from .planning import FitPlan
@@ -37,6 +38,7 @@ class Run:
     progress: Progress | None = None
     pool: object = None  # a concurrent.futures executor, or None to run here
     client: object = None  # a dask.distributed Client: the stages' tasks run on its workers instead of a local pool
+    part: bool = False  # one dataset's task of a cluster run (pipeline.perdataset): checks over all fits wait
     _local: threading.local = attrs.field(factory=threading.local, init=False, repr=False)
 
     def map(self, fn, tasks: Sequence, label: Callable | None = None) -> list:
@@ -99,8 +101,8 @@ def _result(fut, what: str):
     try:
         return fut.result()
     except BrokenProcessPool:  # a worker was killed, or a plugin ended its process (os._exit)
-        raise FrictionLabError(f"compare: a worker process died while running {what} "
-                               "(killed, out of memory, or a law plugin that ends its process)") from None
+        raise WorkerLost(f"compare: a worker process died while running {what} "
+                         "(killed, out of memory, or a law plugin that ends its process)") from None
 
 
 @attrs.define
@@ -162,7 +164,7 @@ def run_stages(comparison, run: Run, stages: Sequence[Stage], forced: bool = Fal
     every one given, when ``forced``), timed; returns the comparison with every stage's fields filled."""
     chosen = [s for s in stages if forced or s.wanted(run)]
     timings = dict(comparison.timings)
-    with executor(run.settings.jobs, run.client, "compare") as pool:
+    with executor(run.settings.jobs, run.client, "compare", warm_worker) as pool:
         run.pool = pool
         side, pending = ThreadPoolExecutor(1), []
         try:
@@ -184,11 +186,26 @@ def run_stages(comparison, run: Run, stages: Sequence[Stage], forced: bool = Fal
     return attrs.evolve(comparison, timings=timings)
 
 
+def warm_worker() -> None:
+    """On a cluster worker, once: the imports every fit and refit needs (lmfit, the fitting modules, numba's
+    cached kernel), so that no task pays them."""
+    import lmfit  # noqa: F401
+
+    from ..inference.fitting import fit  # noqa: F401
+    from ..solve.compiled import available
+
+    available()
+
+
 def _timed(stage: Stage, comparison, run: Run) -> tuple[dict, float]:
     t0 = time.perf_counter()
     run.begin(stage.name)  # each stage counted apart, named as it begins
     try:
         part = stage.fn(comparison, run)
+    except BrokenProcessPool:  # --jobs 1: the child process of a third-party law's call (inference.guard) died
+        raise WorkerLost(f"compare: {LOST} in the {stage.name} stage") from None
+    except WorkerLost as exc:
+        raise WorkerLost(f"{exc} in the {stage.name} stage") from None
     finally:
         run.end()
     return part, time.perf_counter() - t0

@@ -53,6 +53,8 @@ class Settings:
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
                 raise ParameterError(f"compare: {name} must be a non-negative integer, got {v!r}")
+        if isinstance(self.jobs, bool) or not isinstance(self.jobs, (int, np.integer)) or self.jobs < 1:
+            raise ParameterError(f"compare: jobs must be a whole number of worker processes, at least 1, got {self.jobs!r}")
         t = self.fit_timeout
         if t is not None and (isinstance(t, bool) or not isinstance(t, (int, float)) or not 0 < t < float("inf")):
             raise ParameterError(f"compare: fit_timeout must be a positive number of seconds, got {t!r}")

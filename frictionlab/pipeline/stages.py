@@ -24,7 +24,8 @@ from ..inference.fitcost import tolerance_check
 from ..inference.fitting import FitResult
 from ..inference.ranking import family, rank_fits, rank_groups
 from ..inference.verdicts import make_answers, not_fitted_answers
-from .budget import fit_within_budget as fit_one  # a plugin's time budget kept from outside its code
+from ..inference.guard import within_budget  # a plugin's time budget kept from outside its code, every stage
+from .budget import fit_within_budget as fit_one
 from .planning import pair_index, slow_pair
 from .runner import Run, Stage
 
@@ -33,14 +34,24 @@ def fit(c, run: Run) -> dict:
     timeout = run.settings.fit_timeout
     results = run.map(functools.partial(_fit_task, timeout=timeout), run.plan.tasks,
                       lambda t: f"{t[0]} [{t[2]}] on {t[1].name}")
+    fits = sorted(list(c.fits) + results, key=fit_order(c))
+    if not run.part:  # a cluster's per-dataset task: checked once its parts are merged (pipeline.perdataset)
+        check_some_fit(fits)
+    return {"fits": tuple(fits)}
+
+
+def fit_order(c):
+    """The sort key of the comparison's fits: dataset, law, the paper's series last (a stable sort)."""
     order = {d.name: i for i, d in enumerate(c.datasets)}
-    fits = list(c.fits) + results
-    fits.sort(key=lambda f: (order[f.datasets[0]], c.laws.index(f.law), family(f.solver) == "series"))
+    return lambda f: (order[f.datasets[0]], c.laws.index(f.law), family(f.solver) == "series")
+
+
+def check_some_fit(fits) -> None:
+    """The one-line error when no candidate could be fitted at all."""
     if all(f.status == "skipped" for f in fits):
         reasons = list(dict.fromkeys(f.reason for f in fits))
         raise FrictionLabError("compare: no fit could be made: " + "; ".join(reasons[:3])
                                + (f" (and {len(reasons) - 3} more reasons)" if len(reasons) > 3 else ""))
-    return {"fits": tuple(fits)}
 
 
 def _fit_task(args, timeout=None) -> FitResult:
@@ -77,14 +88,22 @@ def equivalence(c, run: Run) -> dict:
         run.step(f"{len(slow)} pairs skipped (slow; --bootstrap-all tests them)", advance=len(slow))
     results = run.map(_equivalence_task, tasks, lambda t: f"equivalence on {t[0].datasets[0]}: {t[0].law} "
                                                           f"[{t[0].solver}] vs {t[1].law} [{t[1].solver}]")
+    return {"equivalence": tuple(sorted(results + slow, key=equivalence_order(c, s.pairs)))}
+
+
+def equivalence_order(c, pairs):
+    """The sort key of the equivalence results: dataset, pair, the paper's series last (a stable sort)."""
     order = {d.name: i for i, d in enumerate(c.datasets)}
-    key = lambda e: (order[e.dataset], pair_index(s.pairs, e), "series" in (e.solver_a, e.solver_b))  # noqa: E731
-    return {"equivalence": tuple(sorted(results + slow, key=key))}
+    return lambda e: (order[e.dataset], pair_index(pairs, e), "series" in (e.solver_a, e.solver_b))
 
 
 def _equivalence_task(args) -> EquivalenceResult:
     fa, fb, replicates, seed, timeout = args
-    return analyze_equivalence(fa, fb, replicates=replicates, seed=seed, timeout=timeout)
+    over = lambda why: EquivalenceResult(  # noqa: E731
+        dataset=fa.datasets[0], law_a=fa.law, law_b=fb.law, solver_a=fa.solver, solver_b=fb.solver,
+        replicates=replicates, seed=seed, status="failed", reason=f"a refit {why}")
+    return within_budget(analyze_equivalence, (fa.law, fb.law), timeout, fa, fb, replicates, seed, None, None,
+                         timeout, over=over)
 
 
 def transfer(c, run: Run) -> dict:
@@ -100,7 +119,8 @@ def transfer(c, run: Run) -> dict:
 
 def _transfer_task(args):
     fits, free, timeout = args[:3]
-    return _transfer.transfer_candidate(fits, free, timeout)
+    return within_budget(_transfer.transfer_candidate, (fits[0].law,), timeout, fits, free, timeout,
+                         over=functools.partial(_transfer.failed_candidate, fits))
 
 
 def tolerance(c, run: Run) -> dict:

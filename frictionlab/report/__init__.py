@@ -112,14 +112,20 @@ def _drawn(figs, jobs: int, client=None):
     from ..core.workers import process_pool
 
     if client is not None and len(figs) > 1:
-        with executor(1, client) as ex:
+        from .figures import _plt
+
+        with executor(1, client, "report", warm=_plt) as ex:  # pyplot imported once per worker
             futures = {ex.submit(f.draw): i for i, f in enumerate(figs)}
             for fut in as_completed(futures):
                 yield futures[fut], fut.result()
         return
     if jobs <= 1 or len(figs) <= 1:
+        from ..core.signals import kept_signals
+
         for i, f in enumerate(figs):
-            yield i, f.draw()
+            with kept_signals():  # a law plugin drawn here does not keep SIGINT, SIGTERM or SIGHUP
+                png = f.draw()
+            yield i, png
         return
     from .figures import _plt
 

@@ -1,7 +1,7 @@
 """Markdown and self-contained HTML from Sections, through the jinja2 templates in ``templates/``.
 
 Text in a Section may use **bold** and `code`; everything else is escaped: in HTML by jinja2's
-autoescape, in Markdown by ``md_text`` (entities for < > &, brackets escaped, lines joined, control
+autoescape (and every printed value stripped of control characters), in Markdown by ``md_text`` (entities for < > &, brackets escaped, lines joined, control
 characters dropped): a dataset name or description never becomes raw HTML, a link, an image, a
 heading or a table in either file.
 """
@@ -59,13 +59,22 @@ def b64(data: bytes) -> str:
     return base64.b64encode(data).decode("ascii")
 
 
+def _inert_value(value):
+    """Every value a template prints, without control characters or escape sequences (``cat report.html``
+    in a terminal must not act on a description's OSC or CSI sequence); escaped Markup stays Markup."""
+    if isinstance(value, Markup):
+        return Markup(inert(value))
+    return inert(value) if isinstance(value, str) else value
+
+
 @lru_cache(maxsize=1)
 def environment():
     import jinja2
 
     env = jinja2.Environment(loader=jinja2.PackageLoader("frictionlab.report", "templates"),
                              autoescape=jinja2.select_autoescape(["html", "html.j2"]),
-                             trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True)
+                             trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True,
+                             finalize=_inert_value)
     env.filters.update(inline=inline_html, md=md_text, mdcell=md_cell, sortkey=sort_key, b64=b64)
     env.tests["numeric"] = is_numeric
     return env

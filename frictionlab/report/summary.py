@@ -120,6 +120,9 @@ def _series_items(c) -> list[str]:
 def _tolerance_items(c) -> list[str]:
     from .tolerance import tolerance_verdicts
 
+    if not c.settings.get("tolerance"):
+        return ["**Solver tolerance**: not checked in this run (on demand: `frictionlab compare --tolerance`; see "
+                "'What solver tolerance does to a fit')"]
     verdicts = tolerance_verdicts(c)
     if not verdicts:
         return []

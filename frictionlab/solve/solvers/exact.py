@@ -212,18 +212,21 @@ def _area_slip(plan, k, t0, y0, t):
 
 
 # --- F = s (a N + c dA/dt) --------------------------------------------------------------
-def _normal_integrals(normal, t, a=1.0):
+def _normal_integrals(normal, t, a=1.0, second=True):
     """a IN and a IIN: IN = int_0^t N, IIN = int_0^t IN, for half-sine or constant N (a: a factor per
-    scene, folded into the coefficients; the term of times after contact skipped when there are none)."""
+    scene, folded into the coefficients; the term of times after contact skipped when there are none).
+    second=False: (a IN, None), the same a IN for less work (a stop search reads the impulse only)."""
     t = np.asarray(t, dtype=float)
     if isinstance(normal, WeightNormal):
-        return a * normal.value * t, a * normal.value * t * t / 2.0
+        return a * normal.value * t, (a * normal.value * t * t / 2.0 if second else None)
     tc = normal.contact_time
     phi = math.pi / tc
     c = a * normal.peak / phi
     after = bool(((t.max(axis=-1, keepdims=True) if t.ndim else t) > tc).any())  # each row's latest time
     tau = np.minimum(t, tc) if after else t
     x = phi * tau
+    if not second:
+        return c * (1.0 - np.cos(x)), None
     if x.ndim == 0 or np.broadcast_shapes(x.shape, np.shape(c)) != x.shape:  # small inputs: plainly
         IN, IIN = c * (1.0 - np.cos(x)), c * (tau - np.sin(x) / phi)
     else:  # large grids: in place, no temporaries
@@ -239,17 +242,17 @@ def _normal_integrals(normal, t, a=1.0):
     return IN, IIN
 
 
-def _area_integrals(area, t):
-    """A(t) and int_0^t A, for half-sine or constant A (zeros without an area model)."""
+def _area_integrals(area, t, second=True):
+    """A(t) and int_0^t A, for half-sine or constant A (zeros without an area model); second=False: (A, None)."""
     if area is None:
-        return np.zeros_like(t), np.zeros_like(t)
+        return np.zeros_like(t), (np.zeros_like(t) if second else None)
     if isinstance(area, ConstantArea):
-        return np.full_like(t, area.area), area.area * t
+        return np.full_like(t, area.area), (area.area * t if second else None)
     tc = area.contact_time
     phi = math.pi / tc
     tau = np.minimum(t, tc)
     A = np.where(t <= tc, area.peak * np.sin(phi * tau), 0.0)
-    return A, area.peak / phi * (1.0 - np.cos(phi * tau))
+    return A, (area.peak / phi * (1.0 - np.cos(phi * tau)) if second else None)
 
 
 def closed_stop_applies(plan, form, t0) -> bool:
@@ -294,13 +297,22 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
             J, K = J + form.c * (A - A0), K + form.c * (IA - IA0 - A0 * (tt - t0))
         return (J, K) if (sgn == 1.0).all() else (sgn * J, sgn * K)
 
+    def impulse(tt):
+        # JK's J alone, by the same operations (tests/test_fit_path.py checks the two agree bit for bit)
+        J = _normal_integrals(s.normal, tt, form.a, second=False)[0]
+        if (t0_ != 0.0).any():
+            J = J - _normal_integrals(s.normal, t0_, form.a, second=False)[0]
+        if area is not None:
+            J = J + form.c * (_area_integrals(area, tt, second=False)[0] - _area_integrals(area, t0_, second=False)[0])
+        return J if (sgn == 1.0).all() else sgn * J
+
     J, K = JK(t)
     if not find_stop or t.size == 0:
         return J, K, None
     u_s = float(plan.rigid_slip(y0))
 
     def slip(tt):
-        return u_s + plan.drive * (tt - t0) - plan.kappa * JK(np.atleast_1d(tt))[0]
+        return u_s + plan.drive * (tt - t0) - plan.kappa * impulse(np.atleast_1d(tt))
 
     T = float(t[-1])
     # slip must pass zero by a hair (as in the ode solver's event): at a restart from rest,
