@@ -1,7 +1,7 @@
 """Calibration of the equivalence test, measured: false-rejection rate of the true law (size) and power.
 
     python benchmarks/calibration.py [--n 200] [--truth wear area-rate] [--noise known estimated]
-                                     [--scale 0.25 1 4] [--jobs 2] [--seed 0]
+                                     [--scale 0.25 1 4] [--jobs 2] [--seed 0] [--pivot]
 
 Per case (truth law, noise kind, sigma as a multiple of the pair's noise threshold) it simulates ``n``
 independent impacts (the paper's golf scene, 41 spin samples over the contact) from the truth, with
@@ -9,8 +9,14 @@ Gaussian noise of that sigma; with noise 'known' the dataset declares the true s
 it declares none and sigma is estimated from the data (io/noise.py). It fits wear and area-rate and
 runs ``analyze_equivalence`` (wear as A, area-rate as B). It prints, with 95% Wilson intervals:
 
-* size: the share of datasets where the test rejects the true law (two-sided rule at alpha = 0.05);
-* power: the share where it rejects the other law.
+* p(true) < alpha: the share of datasets where the true law's own p-value (p_A for wear truth, p_B for
+  area-rate truth) falls below alpha = 0.05: the size of that law's test at the stated alpha, 5% if
+  the p-value is calibrated;
+* the share where the two-sided rule (p = 2 min(p_A, p_B) < alpha) rejects the true law: nominally
+  alpha / 2 = 2.5%, the rule's false rejection of a true law that differs from the other;
+* power: the share where the rule rejects the other law.
+
+    python benchmarks/calibration.py --pivot   # why T is centred: T against its fitted location
 
 The threshold sigma* of the pair is the larger noise at which one law refitted to the other's curve
 misses it by chi-square 3.84 (``EquivalenceResult.threshold``), computed per truth from its noise-free
@@ -69,8 +75,9 @@ def threshold(truth: str) -> float:
     return math.sqrt(max(cross_chi2(fw, fa), cross_chi2(fa, fw)) / CRITICAL)
 
 
-def one(args) -> tuple[bool, bool, int]:
-    """(true law rejected, other law rejected, replicates drawn) for one simulated dataset."""
+def one(args) -> tuple[bool, bool, int, float]:
+    """(true law rejected by the rule, other law rejected by the rule, replicates drawn per null, the true
+    law's one-sided p) for one simulated dataset."""
     truth, noise, sigma, seed = args
     from frictionlab import analyze_equivalence, fit
     from frictionlab.inference.equivalence import ALPHA
@@ -79,12 +86,33 @@ def one(args) -> tuple[bool, bool, int]:
     fw, fa = fit("wear", ds), fit("area-rate", ds)
     e = analyze_equivalence(fw, fa, seed=seed)
     if not e.ok:
-        return False, False, 0
+        return False, False, 0, math.nan
     rejects = e.p < ALPHA
     wear_rejected = rejects and e.p_a <= e.p_b
     area_rejected = rejects and e.p_b < e.p_a
     true_rej, other_rej = (wear_rejected, area_rejected) if truth == "wear" else (area_rejected, wear_rejected)
-    return bool(true_rej), bool(other_rej), int(e.t_a.size)
+    return bool(true_rej), bool(other_rej), int(e.s_a.size), float(e.p_a if truth == "wear" else e.p_b)
+
+
+def pivot(truth: str, n: int) -> None:
+    """Why T is centred: over ``n`` datasets of ``truth`` at the threshold noise (sigma known), the
+    correlation of T = chi2(wear) - chi2(area-rate) with its location at each fitted law (the other law
+    refitted to that law's best curve)."""
+    from frictionlab import fit
+    from frictionlab.inference.replicates import cross_chi2
+
+    thr = threshold(truth)
+    rows = []
+    for i in range(n):
+        ds = _dataset(truth, thr, "known", 500 + i)
+        fw, fa = fit("wear", ds), fit("area-rate", ds)
+        rows.append((fw.stats.chisqr - fa.stats.chisqr, cross_chi2(fw, fa), -cross_chi2(fa, fw),
+                     fa.value("eta_prime") / TRUTH["area-rate"]["eta_prime"]))
+    r = np.array(rows)
+    print(f"{truth} truth, {n} datasets at sigma = threshold: T mean {r[:, 0].mean():.3g} sd {r[:, 0].std():.3g}; "
+          f"correlation of T with its location under area-rate's fit {np.corrcoef(r[:, 0], r[:, 1])[0, 1]:.3f}, "
+          f"under wear's fit {np.corrcoef(r[:, 0], r[:, 2])[0, 1]:.3f}; area-rate's fitted eta' spans "
+          f"{r[:, 3].min():.2g}-{r[:, 3].max():.2g} x {TRUTH['area-rate']['eta_prime']:g}")
 
 
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
@@ -96,7 +124,14 @@ def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
     return c - h, c + h
 
 
+def _pct(row: dict, key: str) -> str:
+    lo, hi = row[key + "_ci"]
+    return f"{100 * row[key]:.1f}% [{100 * lo:.1f}, {100 * hi:.1f}]"
+
+
 def run(n: int, truths, noises, scales, jobs: int, seed: int) -> list[dict]:
+    from frictionlab.inference.equivalence import ALPHA
+
     rows = []
     with ProcessPoolExecutor(jobs) as pool:
         for truth in truths:
@@ -110,15 +145,16 @@ def run(n: int, truths, noises, scales, jobs: int, seed: int) -> list[dict]:
                     res = list(pool.map(one, tasks, chunksize=4))
                     k_size = sum(r[0] for r in res)
                     k_pow = sum(r[1] for r in res)
+                    k_p = sum(r[3] < ALPHA for r in res)
                     reps = np.mean([r[2] for r in res])
                     row = dict(truth=truth, noise=noise, scale=scale, n=n, size=k_size / n, size_ci=wilson(k_size, n),
-                               power=k_pow / n, power_ci=wilson(k_pow, n), replicates=reps,
-                               seconds=time.perf_counter() - t0)
+                               p_size=k_p / n, p_size_ci=wilson(k_p, n), power=k_pow / n, power_ci=wilson(k_pow, n),
+                               replicates=reps, seconds=time.perf_counter() - t0)
                     rows.append(row)
-                    print(f"truth {truth:9s} noise {noise:9s} sigma {scale:g} x threshold: size {row['size']:.3f} "
-                          f"[{row['size_ci'][0]:.3f}, {row['size_ci'][1]:.3f}], power {row['power']:.3f} "
-                          f"[{row['power_ci'][0]:.3f}, {row['power_ci'][1]:.3f}] over {n} datasets "
-                          f"(mean {reps:.0f} replicates per null, {row['seconds']:.0f} s)", flush=True)
+                    print(f"truth {truth:9s} noise {noise:9s} sigma {scale:g} x threshold: "
+                          f"p(true) < {ALPHA:g} {_pct(row, 'p_size')}; rule rejects the true law {_pct(row, 'size')}, "
+                          f"the other law (power) {_pct(row, 'power')}; {n} datasets, mean {reps:.0f} replicates "
+                          f"per null, {row['seconds']:.0f} s", flush=True)
     return rows
 
 
@@ -130,7 +166,12 @@ def main(argv=None) -> int:
     p.add_argument("--scale", nargs="+", type=float, default=[0.25, 1.0, 4.0])
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--pivot", action="store_true", help="print how T moves with the fitted parameters and stop")
     a = p.parse_args(argv)
+    if a.pivot:
+        for truth in a.truth:
+            pivot(truth, 40)
+        return 0
     run(a.n, a.truth, a.noise, a.scale, a.jobs, a.seed)
     return 0
 

@@ -1,5 +1,7 @@
-"""The equivalence test's size, measured (slow: about ten minutes on 2 cores): over 200 independent known-truth
-impacts at the pair's threshold noise, the true law is rejected in at most 8% (alpha is 5%)."""
+"""The equivalence test's size, measured (slow: 10 to 30 minutes per case on 2 shared cores): over 200 independent
+known-truth impacts at the pair's threshold noise, the true law's own p-value falls below alpha (5%) in at
+most 8% of them, the two-sided rule rejects it (nominally alpha / 2) in at most 8%, and the other law is
+rejected more often than the true one. ``benchmarks/calibration.py`` prints every case."""
 import sys
 from pathlib import Path
 
@@ -9,10 +11,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("truth", ["wear", "area-rate"])
 @pytest.mark.parametrize("noise", ["known", "estimated"])
-def test_size_of_the_equivalence_test_is_at_most_8_percent(noise):
+def test_size_of_the_equivalence_test_is_at_most_8_percent(truth, noise):
     import calibration
 
-    (row,) = calibration.run(200, ["wear"], [noise], [1.0], jobs=2, seed=1)
-    assert row["size"] <= 0.08, row
+    (row,) = calibration.run(200, [truth], [noise], [1.0], jobs=2, seed=1)
+    assert row["p_size"] <= 0.08 and row["size"] <= 0.08, row
     assert row["power"] > row["size"]  # at the threshold the false law is rejected more often than the true one

@@ -220,7 +220,8 @@ def test_refits_of_the_equivalence_test_bootstrap_and_transfer_keep_the_time_bud
     finally:
         _StallsLater.stall = False
         registry.unregister_law("stalls-later")
-    assert e.status == "failed" and f"{2 * MIN_REPLICATES} of {2 * MIN_REPLICATES} replicate refits failed" in e.reason
+    # its refit to wear's curve (the centring of T, before any replicate) stops at the budget: the test fails there
+    assert e.status == "failed" and "T cannot be centred" in e.reason and e.s_a.size == 0
     assert math.isnan(e.d_ab) and math.isfinite(e.d_ba)  # its refit to wear's curve stalled; wear's to its curve did not
     (b,) = boots
     stalled = b.results["stalls-later [ode]"]

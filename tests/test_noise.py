@@ -57,14 +57,16 @@ def test_a_dataset_without_noise_table_loads_as_estimated_and_the_old_assumed_me
 
 def test_a_sigma_declared_ten_times_too_large_changes_no_verdict_once_it_is_not_trusted(tmp_path):
     """The same data with the true sigma declared (known) and with ten times it as a guess ('assumed', read as
-    estimated): the same best law, the same fit verdicts."""
-    true = fl.compare(laws=["coulomb", "wear", "area-rate"], datasets=["incline-oil-a100"], equivalence=False,
-                      transfer=False, bootstrap=0)
+    estimated): the same best law, the same fit verdicts, the same equivalence verdicts."""
+    true = fl.compare(laws=["coulomb", "wear", "area-rate"], datasets=["incline-oil-a100"], transfer=False,
+                      bootstrap=0)
     p = _copy(tmp_path, "incline-oil-a100", 'kind = "known"\nv = "3 mm/s"', 'kind = "assumed"\nv = "30 mm/s"')
-    guess = fl.compare(laws=["coulomb", "wear", "area-rate"], datasets=[str(p)], equivalence=False, transfer=False,
-                       bootstrap=0)
+    guess = fl.compare(laws=["coulomb", "wear", "area-rate"], datasets=[str(p)], transfer=False, bootstrap=0)
     (a,), (b,) = true.answers, guess.answers
-    assert (a.best, a.fits) == (b.best, b.fits) and a.fits
+    assert (a.best, a.fits, a.equivalence) == (b.best, b.fits, b.equivalence) and a.fits
+    verdicts = [[(e.law_a, e.law_b, e.verdict, e.p_a < e.p_b) for e in c.equivalence] for c in (true, guess)]
+    assert verdicts[0] == verdicts[1] and len(verdicts[0]) == 2, verdicts
+    assert guess.equivalence[0].noise == "estimated" and true.equivalence[0].noise == "known"
     fits_a = {f.law: f.goodness.fits for f in true.fits}
     fits_b = {f.law: f.goodness.fits for f in guess.fits}
     assert fits_a == fits_b and fits_a["coulomb"] is False

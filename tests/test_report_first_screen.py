@@ -200,7 +200,7 @@ def test_a_group_row_shows_its_first_flag_and_counts_the_others():
     row = RankRow("ALL", "area-rate", "exact", 650, 16, aic=1.0, rank=3,
                   flags=("a: rests on eta_prime", "b: slip reaches 10.9 u0", "c: rests on eta_prime"))
     (cells,) = group_table([row])[1]
-    assert cells[-1].endswith("; FLAG (ranked after every unflagged candidate): a: rests on eta_prime; 2 more flags: "
+    assert cells[-1].endswith("; FLAG (ranked after every unflagged candidate that fits): a: rests on eta_prime; 2 more flags: "
                               "see each dataset's table")
 
 

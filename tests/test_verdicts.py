@@ -223,6 +223,26 @@ def test_near_ties_are_indistinguishable_and_flagged_fits_rank_last():
     assert rows["x"].delta_aic == 0.0 and rows["a"].delta_aic == 10.0  # delta-AIC stays honest
 
 
+def test_a_flag_never_puts_a_fitting_candidate_after_one_that_fails_its_fit_tests():
+    """The issue's case (impact-outcome-synthetic): a flagged area-rate that fits must not rank after a
+    wear = couette that fails its fit tests by the flag alone; AIC decides there. After an unflagged
+    candidate that fits, a flagged one still ranks last whatever its AIC."""
+    def row(law, aic, fits, flags=()):
+        return RankRow("d", law, "exact", 20, 1, 1.0, 1.0, 1.0, aic, aic, aic, fits=fits, flags=flags)
+
+    flag = ("eta_prime = 0.1 can be set to 0 changing chi2 by 0.3",)
+    rows = {r.law: r for r in _rank([row("wear = couette", 50.0, False), row("area-rate", 10.0, True, flag)], 0.01)}
+    assert rows["area-rate"].rank == 1 and rows["wear = couette"].rank == 2
+    rows = {r.law: r for r in _rank([row("wear = couette", 50.0, False), row("area-rate", 10.0, True, flag),
+                                     row("coulomb", 30.0, True)], 0.01)}
+    assert [rows[k].rank for k in ("coulomb", "area-rate", "wear = couette")] == [1, 2, 3]
+    assert rows["area-rate"].delta_aic == 0.0  # the numbers stay the candidate's own
+    # a flagged candidate that fails is still placed by its AIC among those that fail
+    rows = {r.law: r for r in _rank([row("wear = couette", 50.0, False), row("area-rate", 60.0, False, flag),
+                                     row("coulomb", 30.0, True)], 0.01)}
+    assert [rows[k].rank for k in ("coulomb", "wear = couette", "area-rate")] == [1, 2, 3]
+
+
 # --- 6. plausibility -----------------------------------------------------------------------------
 def test_a_parameter_without_effect_is_found_by_sensitivity():
     # constant contact area: dA/dt = 0, so eta' does nothing; started away from 0 it stays there

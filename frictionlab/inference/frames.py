@@ -48,7 +48,7 @@ def _rank_effect(r) -> str:
     """What a plausibility flag did to the candidate's place ('' without flags)."""
     if not r.flags:
         return ""
-    return ("ranked after every unflagged candidate, whatever its AIC" if r.rank is not None else
+    return ("ranked after every unflagged candidate that fits (or is untested), whatever its AIC" if r.rank is not None else
             "flagged; not ranked")
 
 

@@ -10,8 +10,10 @@ Rules, stated once:
 * Structural identity: laws whose closed-form family is the same (``law.form()`` of one class,
   each law spanning the whole family, e.g. wear and couette: F = k A u with k = lam = eta/h) are
   ONE candidate, labelled 'wear = couette', carrying every member's parameterization.
-* Order: unflagged candidates by AIC, then flagged ones by AIC (a physically implausible fit
-  never ranks ahead of a plausible one; its row says why). Competition rank (1, 1, 3): only
+* Order: by AIC, except that a flagged candidate (``plausibility.py``) ranks after every unflagged one
+  not rejected by its fit tests (a physically implausible fit never ranks ahead of a plausible one
+  that fits; its row says why). The flag alone never puts it after a candidate that fails its fit
+  tests: against those, AIC decides. Competition rank (1, 1, 3): only
   candidates within ``TIE_AIC`` of each other share a rank (the same curve).
 * Near-ties: candidates within delta-AIC < ``NEAR_TIE`` (2) of each other are 'indistinguishable
   by these data' (Burnham and Anderson 2002: Delta < 2 means substantial support for both).
@@ -72,7 +74,7 @@ class RankRow:
     lag1: float = math.nan
     fits: bool | None = None  # passes the goodness-of-fit rule (goodness.FITS_LEVEL)
     goodness: object = None  # goodness.Goodness
-    flags: tuple[str, ...] = ()  # plausibility flags: such a candidate ranks after the unflagged ones
+    flags: tuple[str, ...] = ()  # plausibility flags: such a candidate ranks after the unflagged ones that fit
     members: tuple[str, ...] = ()  # laws of one closed-form family merged into this candidate
     parameterizations: str = ""  # each member's parameters, e.g. "wear: lam = 2e4 Pa s/m; couette: eta/h = ..."
 
@@ -102,8 +104,11 @@ def _rank(rows: list[RankRow], tie: float) -> list[RankRow]:
     weights = {id(r): math.exp(-(r.aic - best) / 2) for r in ok}
     total = sum(weights.values())
 
-    def ahead(o, r):  # o ranks strictly ahead of r: unflagged first, then lower AIC beyond the tie
-        return (bool(o.flags), o.aic + tie) < (bool(r.flags), r.aic)
+    eff = _placing_aic(ok)
+
+    def ahead(o, r):  # o ranks strictly ahead of r: lower placing AIC beyond the tie, then unflagged first
+        d = eff[id(o)] - eff[id(r)]
+        return d < -tie or (abs(d) <= tie and not o.flags and bool(r.flags))
 
     out = []
     for r in rows:
@@ -111,12 +116,21 @@ def _rank(rows: list[RankRow], tie: float) -> list[RankRow]:
             out.append(r)
             continue
         rank = 1 + sum(1 for o in ok if ahead(o, r))
-        same = [o for o in ok if o is not r and abs(o.aic - r.aic) <= tie and bool(o.flags) == bool(r.flags)]
+        same = [o for o in ok if o is not r and abs(eff[id(o)] - eff[id(r)]) <= tie and bool(o.flags) == bool(r.flags)]
         near = tuple(o.candidate for o in ok if o is not r and abs(o.aic - r.aic) < NEAR_TIE)
         status = "tied" if same else ("indistinguishable" if near else "ok")
         out.append(attrs.evolve(r, delta_aic=r.aic - best, akaike_weight=weights[id(r)] / total, rank=rank,
                                 status=status, tied_with=near))
     return sorted(out, key=lambda r: (r.rank is None, r.rank or 0, r.law, r.solver))
+
+
+def _placing_aic(ok: list[RankRow]) -> dict[int, float]:
+    """The AIC each candidate is placed by: its own, but a flagged one's at least the largest AIC of the
+    unflagged candidates not rejected by their fit tests, so that it ranks after each of them and, by the
+    flag alone, never after one that fails its fit tests."""
+    plain = [r.aic for r in ok if not r.flags and r.fits is not False]
+    floor = max(plain) if plain else -math.inf
+    return {id(r): max(r.aic, floor) if r.flags else r.aic for r in ok}
 
 
 def fit_row(f: FitResult) -> RankRow:

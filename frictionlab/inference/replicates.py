@@ -40,19 +40,50 @@ def cross_chi2(own: FitResult, other: FitResult, timeout: float | None = None) -
     return float(r.stats.chisqr) if r.ok else math.nan
 
 
-def replicate_chunk(law_a, opts_a, law_b, opts_b, target, model_a, model_b, seeds) -> list[tuple[float, float]]:
-    """(T under A, T under B) per seed; nan where a refit failed. Runs in a worker."""
+def centring(law: str, opts: dict, start: FitResult | None, target: Target, curve: np.ndarray) -> float:
+    """``law`` refitted to the noise-free ``curve`` (on ``target``'s points and sigma), warm-started at
+    ``start``'s values (``opts``' when None): the chi-square it is left with, the plug-in for the
+    location of T under the law that made ``curve`` (nan if the refit fails)."""
+    if start is not None:
+        now = {p.key: p.value for p in start.params.values()}
+        opts = opts | {"initial": {k: now.get(k, v) for k, v in opts["initial"].items()},
+                       "free": {k: (lo, hi, now.get(k, v)) for k, (lo, hi, v) in opts["free"].items()}}
+    try:
+        r = refit(law, opts, with_y(target, curve, "a fitted curve"))
+    except FrictionLabError:
+        return math.nan
+    return float(r.stats.chisqr) if r.ok else math.nan
+
+
+def replicate_chunk(law_a, opts_a, law_b, opts_b, target, model_a, model_b, seeds,
+                    df: float = math.inf) -> list[tuple[float, float, float, float]]:
+    """(T, S_A) on a replicate of A's fit and (T, S_B) on one of B's, per seed; nan where a refit failed.
+    S_A = T + (B refitted to A's refitted curve), S_B = T - (A refitted to B's refitted curve): T centred
+    at its location under the replicate's own fit (``equivalence``, module docstring). With an estimated
+    sigma of ``df`` degrees of freedom each replicate's chi-squares are at its own estimate
+    sigma^2 chi2_df / df. Runs in a worker."""
     out = []
     for ss in seeds:
-        eps = np.random.default_rng(ss).standard_normal(target.y.size) * target.sigma
+        rng = np.random.default_rng(ss)
+        eps = rng.standard_normal(target.y.size) * target.sigma
+        scale = df / rng.chisquare(df) if math.isfinite(df) else 1.0
         row = []
-        for model in (model_a, model_b):
+        for null, model in (("a", model_a), ("b", model_b)):
             tg = with_y(target, model + eps, "parametric bootstrap replicate")
             try:
                 ra, rb = refit(law_a, opts_a, tg), refit(law_b, opts_b, tg)
-                row.append(ra.stats.chisqr - rb.stats.chisqr if ra.ok and rb.ok else math.nan)
             except FrictionLabError:
-                row.append(math.nan)
+                row += [math.nan, math.nan]
+                continue
+            if not (ra.ok and rb.ok):
+                row += [math.nan, math.nan]
+                continue
+            t = ra.stats.chisqr - rb.stats.chisqr
+            if null == "a":
+                s = t + centring(law_b, opts_b, rb, target, ra.per_dataset[0].model)
+            else:
+                s = t - centring(law_a, opts_a, ra, target, rb.per_dataset[0].model)
+            row += [scale * t, scale * s]
         out.append(tuple(row))
     return out
 

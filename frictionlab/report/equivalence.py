@@ -20,11 +20,13 @@ def build(ctx) -> Section:
     sec.p("The paper claims that the wear law λAu is 'qualitatively equivalent' to the empirical μN + μη′dA/dt. "
           "Per dataset, each pair of laws is put to a Cox-type discrimination test: the statistic is "
           "T = χ²(A) − χ²(B) at the σ the likelihood uses (measured, estimated from the data, or a "
-          "reconstruction's stated precision; −2 ln of the likelihood ratio). Replicate datasets are simulated "
-          "from each law's best fit with that same σ and both laws refitted to each, sequentially in batches of "
+          "reconstruction's stated precision; −2 ln of the likelihood ratio), each law tested with T centred at "
+          "its location under that law's fit (the other law refitted to its best curve: Cox's statistic). Replicate "
+          "datasets are simulated from each law's best fit with that same σ (an estimated σ re-drawn per replicate "
+          "from its chi-square law), both laws refitted to each and T re-centred, sequentially in batches of "
           f"{BATCH} (at most {R} per law): sampling stops once every p-value's 99% Monte-Carlo interval lies "
-          f"above {ALPHA / 2:g}, or one lies below it, or T lies beyond all of a law's replicates with an "
-          "exponential-tail p far below it. One two-sided rule at "
+          f"above {ALPHA / 2:g}, or one lies below it, or the data lie beyond all of a law's replicates with a "
+          "conservative exponential-tail p far below it. One two-sided rule at "
           f"α = {ALPHA:g} (p = 2 min(p_A, p_B)): **not equivalent** if T rejects a law (the text says which, and never "
           "calls data consistent with a law that fails its own fit tests); **equivalent** if T rejects neither "
           f"and the two null distributions overlap (each law's replicates reject the other less than {POWER:.0%} of "
@@ -66,8 +68,9 @@ def _figures(sec: Section, c) -> None:
         tested = [e for e in c.equivalence if e.dataset == d.name and e.ok]
         if tested:
             sec.fig(f"discrimination-{d.name}.png",
-                    f"{d.name}: T under each law's fit (histograms) and on the data (line); a law is rejected when "
-                    "the line lies in the far tail of its histogram.",
+                    f"{d.name}: T under each law's fit (histograms) and on the data (line): where the histograms "
+                    "overlap, data of this noise cannot tell the laws apart. Each law's p is taken on T centred at "
+                    "that law's own fit (the text gives both).",
                     lambda d=d, tested=tested: figures.discrimination_figure(d.name, tested))
     for e in c.equivalence:
         if e.decomposition is not None:

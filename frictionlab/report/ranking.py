@@ -80,7 +80,7 @@ def _flags(r, limit: int | None = None) -> str:
     flags are its members', each in full in that dataset's table)."""
     shown = r.flags if limit is None else r.flags[:limit]
     more = len(r.flags) - len(shown)
-    head = "; FLAG (ranked after every unflagged candidate): " if r.flags and r.rank else "; FLAG: "
+    head = "; FLAG (ranked after every unflagged candidate that fits): " if r.flags and r.rank else "; FLAG: "
     return "".join((head if i == 0 else "; FLAG: ") + f for i, f in enumerate(shown)) + (f"; {more} more flag{'s' * (more > 1)}: see each dataset's table"
                                                      if more else "")
 
