@@ -570,3 +570,22 @@ def test_datasets_rebuild_into_a_locked_folder_fails_at_once_and_writes_nothing(
     assert list(out.iterdir()) == []
     assert cli.main(["datasets", "rebuild", "--out", str(out)]) == 0  # released: the rebuild goes through
     assert len(list(out.iterdir())) > 10 and not (tmp_path / ".data.lock").exists()
+
+
+def test_a_pool_stopped_by_an_exception_has_its_manager_thread_finished():
+    """After ^C in a run with workers, the pool's manager thread is joined before the exception goes on:
+    otherwise the interpreter's exit hook races it and prints "OSError: Bad file descriptor" after the
+    run's one-line message (ProcessPoolExecutor.shutdown forgets the thread, so it is taken before)."""
+    from frictionlab.core.workers import process_pool
+
+    managers = []
+    with pytest.raises(KeyboardInterrupt):
+        with process_pool(2) as pool:
+            pool.submit(time.sleep, 0.2).result()
+            manager = pool._executor_manager_thread
+            closing = manager.join_executor_internals
+            manager.join_executor_internals = lambda: (time.sleep(0.5), closing())  # a slow close: the race, widened
+            managers.append(manager)
+            pool.submit(time.sleep, 5)
+            raise KeyboardInterrupt
+    assert managers[0] is not None and not managers[0].is_alive()

@@ -131,6 +131,7 @@ def _start(jobs: int, ctx) -> ProcessPoolExecutor | None:
 def _stop(pool: ProcessPoolExecutor) -> None:
     """Cancel what is queued, terminate the workers (SIGTERM, then SIGKILL after 5 s) and reap them."""
     procs = list((getattr(pool, "_processes", None) or {}).values())
+    manager = getattr(pool, "_executor_manager_thread", None)  # taken now: shutdown() forgets it
     pool.shutdown(wait=False, cancel_futures=True)
     for p in procs:
         if p.is_alive():
@@ -142,7 +143,6 @@ def _stop(pool: ProcessPoolExecutor) -> None:
             p.join()
     # let the pool's manager thread finish closing its wake-up pipe now: otherwise the interpreter's
     # exit hook may race it and print "OSError: Bad file descriptor" after our one-line message
-    manager = getattr(pool, "_executor_manager_thread", None)
     if manager is not None:
         manager.join(5)
 
