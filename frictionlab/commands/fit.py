@@ -119,7 +119,7 @@ def run(args) -> int:
     options = dict(solver=args.solver, free=parse_free(args.free), fixed=parse_fix(law, args.fix), local=args.local,
                    observable=args.observable, derive=args.derive, timeout=args.fit_timeout, rtol=args.rtol)
     from ..core.progress import Progress
-    from ..pipeline.budget import is_third_party
+    from ..physics.registry import is_third_party
 
     with process_pool(1, "fit"), Progress("fit", quiet=args.quiet, delay=2.0) as bar:  # a quick fit stays silent
         if args.fit_timeout is None or not is_third_party(law):  # fitted here (not in a child): it can report

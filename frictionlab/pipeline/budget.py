@@ -2,7 +2,7 @@
 
 ``fit`` keeps its own budget with an alarm that raises in the fitting process; a law plugin's bare
 ``except:`` can swallow that. So a fit of a third-party law with a budget runs in a forked child
-process ended once the budget and a grace of ``grace(timeout)`` seconds have passed: the fit is then
+process ended once the budget and a grace of ``guard.grace(timeout)`` seconds have passed: the fit is then
 'failed' with the reason, and the next fit gets a fresh process. Built-in laws run here.
 """
 from __future__ import annotations
@@ -10,8 +10,8 @@ from __future__ import annotations
 import time
 
 from ..inference.fitting import FitResult, fit
-from ..inference.guard import grace, within_budget  # noqa: F401 (grace: re-exported)
-from ..physics.registry import get_law, is_third_party  # noqa: F401 (is_third_party: re-exported)
+from ..inference.guard import within_budget
+from ..physics.registry import get_law
 
 
 def fit_within_budget(law, datasets, *, timeout: float | None = None, **options) -> FitResult:
