@@ -84,3 +84,46 @@ def test_workers_are_prepared_once_per_warm_function():
         cluster.prepare(client, warm)  # the second call finds every worker prepared
         assert set(client.run(cluster._prepared, key).values()) == {True}
         assert set(client.run(runs).values()) == {"1"}
+
+
+def _profiling(dask_worker) -> bool:
+    """Whether the worker's statistical profiler runs (both its periodic callbacks)."""
+    from frictionlab.core.cluster import PROFILER
+
+    return all(dask_worker.periodic_callbacks[name].is_running() for name in PROFILER)
+
+
+def _profiler_paused_within(seconds: float) -> bool:
+    """In a task: whether the worker's profiler is seen paused within ``seconds`` (the pause is queued on its loop)."""
+    import time
+
+    from distributed import get_worker
+
+    from frictionlab.core.cluster import PROFILER
+
+    worker, end = get_worker(), time.monotonic() + seconds
+    while time.monotonic() < end:
+        if not any(worker.periodic_callbacks[name].is_running() for name in PROFILER):
+            return True
+        time.sleep(0.01)
+    return False
+
+
+def test_profiler_paused_only_while_frictionlab_tasks_run():
+    """``core.cluster.executor``'s tasks pause the worker's statistical profiler; it runs again afterwards,
+    and a task submitted on the client directly (not frictionlab's) leaves it alone."""
+    import time
+
+    from frictionlab.core.cluster import executor
+
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as lc, distributed.Client(lc) as client:
+        assert set(client.run(_profiling).values()) == {True}
+        assert client.submit(_profiler_paused_within, 0.5, pure=False).result() is False
+        with executor(1, client) as ex:
+            futures = [ex.submit(_profiler_paused_within, 5.0) for _ in range(3)]
+            assert [f.result() for f in futures] == [True] * 3
+        end = time.monotonic() + 5
+        while time.monotonic() < end and set(client.run(_profiling).values()) != {True}:
+            time.sleep(0.05)
+        assert set(client.run(_profiling).values()) == {True}

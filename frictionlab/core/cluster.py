@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import ctypes
 import sys
+import threading
+import uuid
 from contextlib import contextmanager
 
 from .errors import ParameterError
@@ -19,13 +21,14 @@ def executor(jobs: int, client=None, stage: str = "frictionlab", warm=None):
     """A dask.distributed ``client``'s workers (``client.get_executor``: futures of ``concurrent.futures``;
     tasks and their arguments are pickled, never hashed; each worker prepared once, ``prepare(client,
     warm)``) or, without one, ``workers.process_pool(jobs, stage)`` (None: run here). The client is the
-    caller's: it stays open afterwards; on any exception the run's queued tasks are cancelled."""
+    caller's: it stays open afterwards; on any exception the run's queued tasks are cancelled. While one of its
+    tasks runs on a worker, that worker's statistical profiler is paused (``unprofiled``)."""
     if client is None:
         with process_pool(jobs, stage) as pool:
             yield pool
         return
     prepare(client, warm)
-    ex = client.get_executor(pure=False)
+    ex = Unprofiled(client.get_executor(pure=False))
     try:
         yield ex
     except BaseException:
@@ -33,6 +36,68 @@ def executor(jobs: int, client=None, stage: str = "frictionlab", warm=None):
         raise
     else:
         ex.shutdown(wait=True)
+
+
+class Unprofiled:
+    """A ``client.get_executor`` whose tasks run through ``unprofiled`` (the task keeps its function's name)."""
+
+    def __init__(self, ex):
+        self._ex = ex
+
+    def submit(self, fn, *args, **kwargs):
+        key = f"{getattr(fn, '__name__', 'task')}-{uuid.uuid4().hex}"
+        return self._ex.submit(unprofiled, fn, *args, key=key, **kwargs)
+
+    def shutdown(self, wait: bool = True) -> None:
+        self._ex.shutdown(wait=wait)
+
+
+#: The worker's periodic callbacks of Dask's statistical profiler (``distributed.worker.profile``).
+PROFILER = ("profile", "profile-cycle")
+#: In a worker process: how many of frictionlab's tasks run now, and the profiler callbacks they paused.
+_QUIET: dict = {"running": 0, "paused": []}
+_QUIET_LOCK = threading.Lock()
+
+
+def unprofiled(fn, *args, **kwargs):
+    """On a Dask worker: ``fn(*args, **kwargs)`` with the worker's statistical profiler paused while any of
+    frictionlab's tasks runs there (resumed as the last one ends). The profiler samples the computing
+    thread's whole stack every 10 ms on the worker's event loop: with the fits' deep stacks that cost about
+    a twentieth of a worker's CPU, half of it in the event loop holding the GIL (``benchmarks/bench_cluster.py``).
+    Elsewhere (no worker), just ``fn(*args, **kwargs)``."""
+    try:
+        from distributed import get_worker
+
+        worker = get_worker()
+    except (ImportError, ValueError):
+        return fn(*args, **kwargs)
+    _quiet(worker, +1)
+    try:
+        return fn(*args, **kwargs)
+    finally:
+        _quiet(worker, -1)
+
+
+def _quiet(worker, step: int) -> None:
+    """Count a task in (+1) or out (-1); the first in pauses the profiler, the last out resumes it (both on
+    the worker's event loop, in the order counted: the callbacks are queued under the lock)."""
+    with _QUIET_LOCK:
+        _QUIET["running"] += step
+        if _QUIET["running"] == (1 if step > 0 else 0):
+            worker.loop.add_callback(_pause if step > 0 else _resume, worker)
+
+
+def _pause(worker) -> None:
+    pcs = [worker.periodic_callbacks.get(name) for name in PROFILER]
+    _QUIET["paused"] = [pc for pc in pcs if pc is not None and pc.is_running()]
+    for pc in _QUIET["paused"]:
+        pc.stop()
+
+
+def _resume(worker) -> None:
+    for pc in _QUIET["paused"]:
+        pc.start()
+    _QUIET["paused"] = []
 
 
 def prepare(client, warm=None) -> None:
