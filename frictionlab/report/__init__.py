@@ -105,20 +105,29 @@ def _draw(i: int) -> bytes:
 _DRAWING = threading.Lock()  # one report at a time hands its figures to forked workers through _FIGURES
 
 
+#: Figures drawn by one task on a cluster: a few per task (fewer round trips, closures pickled together)
+DRAW_BATCH = 4
+
+
 def _drawn(figs, jobs: int, client=None):
-    """(index, PNG bytes) of every figure, in the order they finish: on ``jobs`` forked workers when jobs > 1,
-    or on a dask.distributed ``client``'s workers (the draw closures travel by cloudpickle)."""
+    """(index, PNG bytes) of every figure of the iterable ``figs``, in the order they finish; ``figs`` is used up
+    before the first comes back. On ``jobs`` forked workers when jobs > 1, or on a dask.distributed ``client``'s
+    workers in tasks of DRAW_BATCH figures, each sent as soon as its figures are built (the draw closures travel
+    by cloudpickle), so that the workers draw while the next pages are built."""
     from ..core.cluster import executor
     from ..core.workers import process_pool
 
-    if client is not None and len(figs) > 1:
+    if client is not None:
         from .figures import _plt
 
         with executor(1, client, "report", warm=_plt) as ex:  # pyplot imported once per worker
-            futures = {ex.submit(f.draw): i for i, f in enumerate(figs)}
+            futures = {ex.submit(_draw_each, [f.draw for f in batch]): first
+                       for first, batch in _batches(figs, DRAW_BATCH)}
             for fut in as_completed(futures):
-                yield futures[fut], fut.result()
+                for k, png in enumerate(fut.result()):
+                    yield futures[fut] + k, png
         return
+    figs = list(figs)
     if jobs <= 1 or len(figs) <= 1:
         from ..core.signals import kept_signals
 
@@ -145,6 +154,24 @@ def _drawn(figs, jobs: int, client=None):
             _FIGURES.clear()
 
 
+def _draw_each(draws) -> list[bytes]:
+    return [draw() for draw in draws]
+
+
+def _batches(items, n: int):
+    """(index of its first item, list of up to ``n`` items) of consecutive items of the iterable ``items``."""
+    batch, first = [], 0
+    for i, item in enumerate(items):
+        if not batch:
+            first = i
+        batch.append(item)
+        if len(batch) == n:
+            yield first, batch
+            batch = []
+    if batch:
+        yield first, batch
+
+
 def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, client=None) -> Path:
     """Write the report folder ``out`` whole or not at all; an existing folder is replaced only with force=True.
 
@@ -163,16 +190,24 @@ def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, clie
     if out.exists() and not force:  # said in Python's terms; the command line checks before its work
         raise OutputError(f"{out}: the folder exists; pass force=True to replace it, or choose another folder")
     with atomic_dir(out, force=force) as tmp:
-        built, extra = _built_pages(c)
-        figs = [(figdir, f) for _, sections, figdir in built for s in sections for f in s.figures]
-        total, images = len(figs) + 1, {}
-        for done, (i, png) in enumerate(_drawn([f for _, f in figs], jobs, client), 1):
+        built, figs, extra = [], [], {}
+
+        def figures():  # page by page as each is built: a cluster draws a page's figures while the next is built
+            for page in _pages(c, extra):
+                built.append(page)
+                for sec in page[1]:
+                    for f in sec.figures:
+                        figs.append((page[2], f))
+                        yield f
+
+        images = {}
+        for done, (i, png) in enumerate(_drawn(figures(), jobs, client), 1):  # every page is built by now
             figdir, f = figs[i]
             images[(figdir, f.name)] = png
             (tmp / figdir).mkdir(parents=True, exist_ok=True)
             (tmp / figdir / f.name).write_bytes(png)
             if progress:
-                progress(done, total, f"figure {f.name}")
+                progress(done, len(figs) + 1, f"figure {f.name}")
         (tmp / "figures").mkdir(exist_ok=True)
         for path, sections, figdir in built:
             page = tmp / path
@@ -186,26 +221,26 @@ def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, clie
         (tmp / "results.json").write_text(json.dumps(results_json(c, extra), indent=1, allow_nan=False),
                                           encoding="utf-8")
         if progress:
-            progress(total, total, "report.md, report.html, ranking.csv, results.json")
+            progress(len(figs) + 1, len(figs) + 1, "report.md, report.html, ranking.csv, results.json")
     return out
 
 
-def _built_pages(c):
-    """[(page path without suffix, sections, figure folder)] and the extra numbers for results.json: one
-    page, or (many groups) the index and a page per group."""
+def _pages(c, extra: dict):
+    """(page path without suffix, sections, figure folder) of each page, as it is built: one page, or (many
+    groups) the index and a page per group; ``extra`` gets the numbers for results.json."""
     from . import pages
 
     if len(pages.groups_of(c)) <= pages.GROUP_PAGES_AT:
-        sections, extra = build(c)
-        return [("report", sections, "figures")], extra
-    built, extra = [], {}
+        sections, more = build(c)
+        extra.update(more)
+        yield "report", sections, "figures"
+        return
     for path, cc, modules, figdir, groups in pages.pages(c, SECTIONS, INDEX_SECTIONS):
         sections, more = build(cc, modules)
         if groups:
             sections.insert(len(sections) - 1, pages.index_section(groups))
         elif sections:  # a group's page: the way back to the index first
             sections[0].blocks.insert(0, ("links", [("all dataset groups (the index)", "../report.html")]))
-        built.append((path, sections, figdir))
         for k, v in more.items():  # one level deep: numbers per dataset from every page
             extra[k] = {**extra.get(k, {}), **v} if isinstance(v, dict) else v
-    return built, extra
+        yield path, sections, figdir
