@@ -10,7 +10,9 @@ These variants exist only to give the cluster work; they are not data.
 Runs, in one process, in this order and then again in reverse (the machine's speed drifts): the local
 run with one process (``jobs=1``), a LocalCluster of 1 worker process, one of 2 worker processes (each
 cluster started and its workers prepared as compare prepares them on its first run, ``core.cluster.prepare``,
-before the clock starts: a cluster is long-lived).
+before the clock starts: a cluster is long-lived), after one untimed local run on one variant of each base
+(so that this process, which is the local run and every Dask run's client, has its imports and caches warm
+before the first timed run, as the prepared workers have theirs).
 Prints per run its wall seconds, the CPU seconds of this process (the client and, in a LocalCluster, the
 scheduler) and of each worker, and the load average (wall ratios mean something only on an idle machine:
 with other work on the cores, 2 workers cannot be faster than the cores they get); then the ratios of the
@@ -56,6 +58,16 @@ def warm(client) -> None:
 
     prepare(client, warm_worker)
     prepare(client, _plt)
+
+
+def warm_here(dss) -> None:
+    """One untimed local compare and report on one variant of each base: this process's imports and caches
+    warm before the first timed run (the local run's; and the clients' of the Dask runs)."""
+    from frictionlab.pipeline.comparison import compare
+    from frictionlab.report import write_report
+
+    with tempfile.TemporaryDirectory() as tmp:
+        write_report(compare(jobs=1, datasets=dss[:len(BASES)], bootstrap=2, tolerance=(1e-3,)), f"{tmp}/r", jobs=1)
 
 
 def cpu_self() -> float:
@@ -122,6 +134,7 @@ def main(argv=None):
     dss = workload(args.datasets)
     print(f"{len(dss)} datasets (synthetic variants of {', '.join(BASES)}), bootstrap {args.bootstrap}; "
           f"{os.cpu_count()} CPUs, load average at start {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
+    warm_here(dss)
     times = {"local": [], 1: [], 2: []}
     cpus = {"local": [], 1: [], 2: []}  # (CPU here, [CPU of each worker])
     ref = None
