@@ -184,3 +184,17 @@ def test_replicate_refits_without_error_analysis_give_the_same_statistic(coulomb
     full = analyze_equivalence(fc, fw, replicates=R)
     assert np.array_equal(full.t_a, e.t_a) and np.array_equal(full.t_b, e.t_b)
     assert (full.d_ab, full.d_ba, full.verdict) == (e.d_ab, e.d_ba, e.verdict)
+
+
+def test_a_kept_law_whose_own_p_is_below_half_alpha_is_rejected_too(coulomb_data):
+    """The rule rejects each law whose own p is below alpha / 2: the law with the larger p is not called
+    consistent with the data when its own p is below that too."""
+    from frictionlab.inference.equivalence import ALPHA, _verdict
+
+    _, _, _, e = coulomb_data  # A = coulomb (the truth, kept), B = wear (rejected)
+    kept = attrs.evolve(e, q_a=0.5)  # nothing on coulomb's favourable side
+    assert "consistent with coulomb [exact]" in _verdict(kept)[1]
+    both = attrs.evolve(kept, p_a=0.4 * ALPHA)
+    verdict, text = _verdict(both)
+    assert verdict == "not equivalent"
+    assert "reject wear [exact], and coulomb [exact] too" in text and "consistent" not in text

@@ -43,15 +43,17 @@ METHODS = ("parametric", "residual", "case")
 class LawFit:
     """A picklable fit function: ``fitting.fit(law, data, solver, **options)``.
 
-    ``warm(values)`` returns a copy that starts from ``values`` with no grid scan and one
-    Levenberg-Marquardt run, without the plausibility flags (``fit(checks=False)``): replicates
-    start at the original best fit, which is where the bootstrap asks how far the optimum moves.
+    ``warm(values, n_params)`` returns a copy that starts from ``values`` with no grid scan and one
+    Levenberg-Marquardt run, without the plausibility flags or the error analysis (``fit(checks=False,
+    errors=False)``, its AIC counting the base fit's ``n_params``): replicates start at the original best
+    fit, which is where the bootstrap asks how far the optimum moves, and read only values and AIC.
     """
 
     law: str
     solver: str = "auto"
     options: tuple = ()  # sorted (key, value) pairs of fitting.fit keyword arguments
     start: tuple = ()  # sorted (name, value) law-parameter start values, SI
+    n_params: int | None = None  # a replicate's parameter count for its AIC: its base fit's
     name: str = ""  # the candidate's name when it differs from the law's (e.g. 'wear = couette')
 
     def __call__(self, data):
@@ -59,11 +61,12 @@ class LawFit:
 
         kw = dict(self.options)
         if self.start:  # a replicate: only its values and AIC are read, so no plausibility flags
-            kw.update(initial={**dict(kw.get("initial") or {}), **dict(self.start)}, scan=0, n_starts=1, checks=False)
+            kw.update(initial={**dict(kw.get("initial") or {}), **dict(self.start)}, scan=0, n_starts=1, checks=False,
+                      errors=False, n_params=self.n_params)
         return fit(self.law, data, solver=self.solver, **kw)
 
-    def warm(self, values: Mapping[str, float]) -> "LawFit":
-        return attrs.evolve(self, start=tuple(sorted(values.items())))
+    def warm(self, values: Mapping[str, float], n_params: int | None = None) -> "LawFit":
+        return attrs.evolve(self, start=tuple(sorted(values.items())), n_params=n_params)
 
     @property
     def label(self) -> str:
@@ -232,7 +235,7 @@ def _prepare(fit_fn, dataset, method, base=None):
     names = base.determined
     units = tuple(base.params[k].unit for k in names)
     law_values = {p.key: p.value for p in base.params.values() if p.vary and p.kind == "law"}
-    replicate_fn = fit_fn.warm(law_values) if hasattr(fit_fn, "warm") else fit_fn
+    replicate_fn = fit_fn.warm(law_values, base.stats.n_params) if isinstance(fit_fn, LawFit) else fit_fn
     return datasets, base, models, names, units, replicate_fn
 
 

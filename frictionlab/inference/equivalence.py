@@ -33,9 +33,9 @@ law B to one dataset (each with its own solver) and asks whether the data can te
    otherwise sit on. The Monte-Carlo standard error sqrt(p (1 - p) / m) of each p is reported, and how
    many replicates were drawn.
 4. One two-sided rule at ALPHA: p = min(1, 2 min(p_A, p_B)); the two laws are told apart when p < ALPHA
-   (**not equivalent**; the text says which law is rejected, and a law that fails its own fit tests
-   is never called consistent with the data). A true law is so rejected with probability ALPHA / 2
-   (its own p below ALPHA / 2); where the two laws are one curve at this noise, either is, with
+   (**not equivalent**; the text says which law is rejected, both when the other's own p is below
+   ALPHA / 2 too, and a law that fails its own fit tests is never called consistent with the data).
+   A true law is so rejected with probability ALPHA / 2 (its own p below ALPHA / 2); where the two laws are one curve at this noise, either is, with
    probability up to ALPHA. Otherwise **equivalent** when the two null distributions of T overlap (each
    law's replicates fall beyond the other's central 1 - ALPHA of T less often than POWER), else
    **cannot tell at this noise**.
@@ -407,7 +407,11 @@ def _verdict(e: EquivalenceResult) -> tuple[str, str]:
         bad, good = (a, b) if rej_a else (b, a)
         good_law = e.law_b if rej_a else e.law_a
         q = e.q_b if rej_a else e.q_a
-        if q < ALPHA / 2:
+        own = e.p_b if rej_a else e.p_a  # the kept law's own p: below alpha / 2 it is rejected too
+        if own < ALPHA / 2:
+            which = (f"the data reject {bad}, and {good} too (p = {own:.2g} under {good}, below α/2): "
+                     "the data are like neither")
+        elif q < ALPHA / 2:
             which = (f"the data reject {bad}, and lie beyond {good}'s replicates on its favourable side "
                      f"(p = {q:.2g}): the data are not like {good}'s either")
         elif e.fits.get(good_law) is False:

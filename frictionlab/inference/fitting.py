@@ -84,7 +84,8 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
         fixed: Mapping[str, float] | None = None, local: Sequence[str] = (),
         initial: Mapping[str, float] | None = None, observable: str | None = None, derive: str | None = None,
         scan: int = 125, n_starts: int = 3, max_nfev: int | None = None, rtol: float | None = None,
-        timeout: float | None = None, checks: bool = True, errors: bool = True, progress=None) -> FitResult:
+        timeout: float | None = None, checks: bool = True, errors: bool = True, n_params: int | None = None,
+        progress=None) -> FitResult:
     """Fit ``law`` to one dataset or a group of them (a global fit) and return a FitResult.
 
     law: name or FrictionLaw. datasets: a Dataset, name, path or Target, or a list of them.
@@ -105,6 +106,9 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     errors: False skips the error analysis beyond lmfit's (the Jacobian, and what it shows: parameters
     without effect, ratio-only pairs, identifiable directions; every free parameter counts in k): for
     refits that read only the values and the chi-square (the equivalence test's replicates).
+    n_params: with errors=False, the number of parameters the information criteria and fit tests count
+    (a bootstrap replicate takes its base fit's ``stats.n_params``, which the skipped analysis found);
+    None counts every free parameter.
     progress(done, total, label): told the stage (start scan, each Levenberg-Marquardt start, error
     analysis) and its count of model evaluations (core.progress.Progress takes it).
     """
@@ -155,7 +159,7 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     values, models, best_params, best, outcome = found
     solver_label = solver if solver != "auto" else "+".join(dict.fromkeys(solvers))
     return _result(law, names, solver_label, model, slots, values, models, best_params, best, outcome,
-                   likelihood, checks, errors, clock)
+                   likelihood, checks, errors, clock, n_params)
 
 
 def _run_search(lmfit, model, params, slots, solvers, budget, likelihood, checks, timeout):
@@ -233,7 +237,7 @@ def _parameters(lmfit, slots, checks: bool):
 
 
 def _result(law, names, solver_label, model, slots, values, models, best_params, best, outcome, likelihood,
-            checks, errors, clock) -> FitResult:
+            checks, errors, clock, n_params=None) -> FitResult:
     """The FitResult at the best parameters: per-dataset fits and goodness, statistics, error bars,
     identifiability and plausibility. outcome: (success, message, notes) of the search."""
     success, message, search_notes = outcome
@@ -244,7 +248,8 @@ def _result(law, names, solver_label, model, slots, values, models, best_params,
         J = jacobian(model, slots, values)
         structure = find_structure(law, slots, values, J)
     else:
-        structure = {"at_bounds": (), "ratios": (), "no_effect": (), "k_eff": len(varying), "n_free": len(varying)}
+        k = len(varying) if n_params is None else int(n_params)
+        structure = {"at_bounds": (), "ratios": (), "no_effect": (), "k_eff": k, "n_free": len(varying)}
     per = _per_dataset(model, values, models, structure["k_eff"] / len(targets), J if errors else None)
     chisqr = sum(d.chisqr for d in per)
     stats = _stats(sum(t.y.size for t in targets), structure["k_eff"], len(varying), chisqr, per)

@@ -80,14 +80,15 @@ def _figures(sec: Section, c) -> None:
                       if fa is not None and fa.ok else "")
             sec.p(f"{e.dataset}: the paper's decomposition of the wear series fit (b = {dec.b:.3g}) implies "
                   f"μ = {dec.mu:.3g}, η′ = {dec.eta_prime:.4g} N s/m²{fitted} (projection R² = {dec.r2:.2f}).")
-    for d in c.fitted_datasets:
-        mine = [e for e in c.equivalence if e.dataset == d.name and e.ok and (e.law_a, e.law_b) == (WEAR, AREA_RATE)]
+    for d in c.fitted_datasets:  # the forces alone are in the fits section's force figure: drawn once, not here
+        mine = [e for e in c.equivalence if e.dataset == d.name and e.ok and (e.law_a, e.law_b) == (WEAR, AREA_RATE)
+                and e.decomposition is not None]
         if not mine:
             continue
         fa = c.fit_for(d.name, AREA_RATE, mine[0].solver_b)
         fws = [c.fit_for(d.name, WEAR, e.solver_a) for e in mine]
-        sec.fig(f"equivalence-{d.name}.png", f"{d.name}: friction force of the wear and area-rate fits"
-                + (", and the paper's decomposition of the series fit with its projection onto μN + μη′dA/dt."
-                   if any(e.decomposition for e in mine) else "."),
+        sec.fig(f"equivalence-{d.name}.png", f"{d.name}: the paper's decomposition of the wear series fit and its "
+                "projection onto μN + μη′dA/dt, over the friction force of both fits (every fit's force: "
+                f"force-{d.name}.png).",
                 lambda d=d, fws=fws, fa=fa, mine=mine: figures.equivalence_figure(d, fws, fa,
                                                                                   [e.decomposition for e in mine]))

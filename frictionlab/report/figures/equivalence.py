@@ -8,8 +8,9 @@ from . import base
 
 
 def equivalence_figure(dataset, fw_list, fa, decomps) -> bytes:
-    """Friction force of the wear fits, the area-rate fit, and the paper's two-term decomposition
-    of each wear fit with its projection onto mu N + mu eta' dA/dt."""
+    """The paper's two-term decomposition of each wear fit (a panel per fit in ``fw_list``, each with its
+    decomposition in ``decomps``) with its projection onto mu N + mu eta' dA/dt, over the friction force
+    of that wear fit and the area-rate fit ``fa``. Forces in N, time in the display unit."""
     plt = base._plt()
     s = fa.per_dataset[0].scene
     t_end = float(dataset.t[-1])
