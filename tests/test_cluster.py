@@ -87,44 +87,42 @@ def test_workers_are_prepared_once_per_warm_function():
         assert set(client.run(runs).values()) == {"1"}
 
 
-def _profiling(dask_worker) -> bool:
-    """Whether the worker's statistical profiler runs (both its periodic callbacks)."""
-    from frictionlab.core.cluster import PROFILER
+def _watching(dask_worker) -> dict:
+    """Of each of the worker's callbacks that ``core.cluster.quietly`` quietens: its period in ms, None if stopped."""
+    from frictionlab.core.cluster import QUIET
 
-    return all(dask_worker.periodic_callbacks[name].is_running() for name in PROFILER)
+    pcs = {name: dask_worker.periodic_callbacks[name] for name in QUIET}
+    return {name: pc.callback_time if pc.is_running() else None for name, pc in pcs.items()}
 
 
-def _profiler_paused_within(seconds: float) -> bool:
-    """In a task: whether the worker's profiler is seen paused within ``seconds`` (the pause is queued on its loop)."""
+def _quiet_within(seconds: float) -> dict:
+    """In a task: the worker's watching callbacks once quietened (within ``seconds``: it is queued on its loop)."""
     import time
 
     from distributed import get_worker
 
-    from frictionlab.core.cluster import PROFILER
-
     worker, end = get_worker(), time.monotonic() + seconds
-    while time.monotonic() < end:
-        if not any(worker.periodic_callbacks[name].is_running() for name in PROFILER):
-            return True
+    while time.monotonic() < end and _watching(worker)["profile"] is not None:
         time.sleep(0.01)
-    return False
+    return _watching(worker)
 
 
-def test_profiler_paused_only_while_frictionlab_tasks_run():
-    """``core.cluster.executor``'s tasks pause the worker's statistical profiler; it runs again afterwards,
-    and a task submitted on the client directly (not frictionlab's) leaves it alone."""
+def test_worker_quietened_only_while_frictionlab_tasks_run():
+    """``core.cluster.executor``'s tasks stop the worker's profiler and slow its tick and system monitor; all
+    run as before afterwards, and a task submitted on the client directly (not frictionlab's) changes nothing."""
     import time
 
-    from frictionlab.core.cluster import executor
+    from frictionlab.core.cluster import QUIET, executor
 
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as lc, distributed.Client(lc) as client:
-        assert set(client.run(_profiling).values()) == {True}
-        assert client.submit(_profiler_paused_within, 0.5, pure=False).result() is False
+        (before,) = client.run(_watching).values()
+        assert None not in before.values() and before["tick"] < QUIET["tick"]
+        assert client.submit(_quiet_within, 0.5, pure=False).result() == before
         with executor(1, client) as ex:
-            futures = [ex.submit(_profiler_paused_within, 5.0) for _ in range(3)]
-            assert [f.result() for f in futures] == [True] * 3
+            futures = [ex.submit(_quiet_within, 5.0) for _ in range(3)]
+            assert [f.result() for f in futures] == [QUIET] * 3
         end = time.monotonic() + 5
-        while time.monotonic() < end and set(client.run(_profiling).values()) != {True}:
+        while time.monotonic() < end and list(client.run(_watching).values()) != [before]:
             time.sleep(0.05)
-        assert set(client.run(_profiling).values()) == {True}
+        assert list(client.run(_watching).values()) == [before]

@@ -22,13 +22,14 @@ def executor(jobs: int, client=None, stage: str = "frictionlab", warm=None):
     tasks and their arguments are pickled, never hashed; each worker prepared once, ``prepare(client,
     warm)``) or, without one, ``workers.process_pool(jobs, stage)`` (None: run here). The client is the
     caller's: it stays open afterwards; on any exception the run's queued tasks are cancelled. While one of its
-    tasks runs on a worker, that worker's statistical profiler is paused (``unprofiled``)."""
+    tasks runs on a worker, that worker's profiler is stopped and its health tick and system monitor slowed
+    (``quietly``)."""
     if client is None:
         with process_pool(jobs, stage) as pool:
             yield pool
         return
     prepare(client, warm)
-    ex = Unprofiled(client.get_executor(pure=False))
+    ex = Quiet(client.get_executor(pure=False))
     try:
         yield ex
     except BaseException:
@@ -38,66 +39,78 @@ def executor(jobs: int, client=None, stage: str = "frictionlab", warm=None):
         ex.shutdown(wait=True)
 
 
-class Unprofiled:
-    """A ``client.get_executor`` whose tasks run through ``unprofiled`` (the task keeps its function's name)."""
+class Quiet:
+    """A ``client.get_executor`` whose tasks run through ``quietly`` (the task keeps its function's name)."""
 
     def __init__(self, ex):
         self._ex = ex
 
     def submit(self, fn, *args, **kwargs):
         key = f"{getattr(fn, '__name__', 'task')}-{uuid.uuid4().hex}"
-        return self._ex.submit(unprofiled, fn, *args, key=key, **kwargs)
+        return self._ex.submit(quietly, fn, *args, key=key, **kwargs)
 
     def shutdown(self, wait: bool = True) -> None:
         self._ex.shutdown(wait=wait)
 
 
-#: The worker's periodic callbacks of Dask's statistical profiler (``distributed.worker.profile``).
-PROFILER = ("profile", "profile-cycle")
-#: In a worker process: how many of frictionlab's tasks run now, and the profiler callbacks they paused.
-_QUIET: dict = {"running": 0, "paused": []}
-_QUIET_LOCK = threading.Lock()
+#: The worker's periodic callbacks that watch it, and their period (ms) while frictionlab's tasks run there
+#: (None: stopped): Dask's statistical profiler (``distributed.worker.profile``), the event loop's health tick
+#: (``distributed.admin.tick``, 20 ms) and the system monitor (``distributed.admin.system-monitor``, 500 ms).
+#: The memory monitor (spilling, pausing) is left as it is.
+QUIET = {"profile": None, "profile-cycle": None, "tick": 1000, "monitor": 5000}
+#: In a worker process: how many of frictionlab's tasks run now, and (callback, its period, stopped) changed.
+_STATE: dict = {"running": 0, "changed": []}
+_STATE_LOCK = threading.Lock()
 
 
-def unprofiled(fn, *args, **kwargs):
-    """On a Dask worker: ``fn(*args, **kwargs)`` with the worker's statistical profiler paused while any of
-    frictionlab's tasks runs there (resumed as the last one ends). The profiler samples the computing
-    thread's whole stack every 10 ms on the worker's event loop: with the fits' deep stacks that cost about
-    a twentieth of a worker's CPU, half of it in the event loop holding the GIL (``benchmarks/bench_cluster.py``).
-    Elsewhere (no worker), just ``fn(*args, **kwargs)``."""
+def quietly(fn, *args, **kwargs):
+    """On a Dask worker: ``fn(*args, **kwargs)`` with the worker's callbacks in QUIET stopped or slowed while any
+    of frictionlab's tasks runs there (restored as the last one ends). Each wakes the worker's event loop,
+    which then takes the GIL from the computing thread at every system call: with their default periods
+    a worker's compute thread was switched out about 3,000 times a second and spent 7% more CPU on the
+    same fits than a plain process, its event loop 1.3 CPU s more per 33 s (``benchmarks/bench_cluster.py``;
+    the profiler also walks the fits' deep stacks every 10 ms). Elsewhere (no worker), just ``fn(*args, **kwargs)``."""
     try:
         from distributed import get_worker
 
         worker = get_worker()
     except (ImportError, ValueError):
         return fn(*args, **kwargs)
-    _quiet(worker, +1)
+    _count(worker, +1)
     try:
         return fn(*args, **kwargs)
     finally:
-        _quiet(worker, -1)
+        _count(worker, -1)
 
 
-def _quiet(worker, step: int) -> None:
-    """Count a task in (+1) or out (-1); the first in pauses the profiler, the last out resumes it (both on
-    the worker's event loop, in the order counted: the callbacks are queued under the lock)."""
-    with _QUIET_LOCK:
-        _QUIET["running"] += step
-        if _QUIET["running"] == (1 if step > 0 else 0):
-            worker.loop.add_callback(_pause if step > 0 else _resume, worker)
+def _count(worker, step: int) -> None:
+    """Count a task in (+1) or out (-1); the first in quietens the worker, the last out restores it (both on
+    its event loop, in the order counted: the callbacks are queued under the lock)."""
+    with _STATE_LOCK:
+        _STATE["running"] += step
+        if _STATE["running"] == (1 if step > 0 else 0):
+            worker.loop.add_callback(_quieten if step > 0 else _restore, worker)
 
 
-def _pause(worker) -> None:
-    pcs = [worker.periodic_callbacks.get(name) for name in PROFILER]
-    _QUIET["paused"] = [pc for pc in pcs if pc is not None and pc.is_running()]
-    for pc in _QUIET["paused"]:
-        pc.stop()
+def _quieten(worker) -> None:
+    for name, period in QUIET.items():
+        pc = worker.periodic_callbacks.get(name)
+        if pc is None or not pc.is_running() or (period is not None and pc.callback_time >= period):
+            continue
+        _STATE["changed"].append((pc, pc.callback_time, period is None))
+        if period is None:
+            pc.stop()
+        else:
+            pc.callback_time = period
 
 
-def _resume(worker) -> None:
-    for pc in _QUIET["paused"]:
-        pc.start()
-    _QUIET["paused"] = []
+def _restore(worker) -> None:
+    for pc, period, stopped in _STATE["changed"]:
+        if stopped:
+            pc.start()
+        else:
+            pc.callback_time = period
+    _STATE["changed"] = []
 
 
 def prepare(client, warm=None) -> None:
