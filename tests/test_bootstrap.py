@@ -108,3 +108,20 @@ def test_slow_datasets_are_left_out_with_the_reason_and_the_flag():
     f = fit("wear", "impact-outcome-synthetic")
     done, skipped = bootstrap_fits([f], 5)
     assert done == [] and "impact-outcome set" in skipped[f.datasets[0]] and "--bootstrap-all" in skipped[f.datasets[0]]
+
+
+def test_a_replicate_refit_without_error_analysis_has_the_full_fits_aic():
+    """fit(errors=False, n_params=k) skips the Jacobian but counts k parameters: on an incline, where
+    area-rate's eta' has no effect (dA/dt = 0), its AIC is the full analysis's, not that of every free one."""
+    from frictionlab import fit, load_dataset
+
+    ds = load_dataset("incline-oil-a200")
+    full = fit("area-rate", ds)
+    start = {p.key: p.value for p in full.params.values() if p.kind == "law" and p.vary}
+    every = fit("area-rate", ds, initial=start, scan=0, n_starts=1, errors=False)
+    counted = fit("area-rate", ds, initial=start, scan=0, n_starts=1, errors=False, n_params=full.stats.n_params)
+    assert full.stats.n_params < every.stats.n_params  # the analysis found a parameter without effect
+    assert counted.stats.aic == pytest.approx(full.stats.aic, rel=1e-9, abs=1e-9)
+    assert every.stats.aic != pytest.approx(full.stats.aic, rel=1e-9, abs=1e-9)
+    with pytest.raises(ParameterError, match="n_params"):
+        fit("area-rate", ds, n_params=1)  # only with errors=False

@@ -35,10 +35,10 @@ law B to one dataset (each with its own solver) and asks whether the data can te
 4. One two-sided rule at ALPHA: p = min(1, 2 min(p_A, p_B)); the two laws are told apart when p < ALPHA
    (**not equivalent**; the text says which law is rejected, both when the other's own p is below
    ALPHA / 2 too, and a law that fails its own fit tests is never called consistent with the data).
-   A true law is so rejected with probability ALPHA / 2 (its own p below ALPHA / 2); where the two laws are one curve at this noise, either is, with
-   probability up to ALPHA. Otherwise **equivalent** when the two null distributions of T overlap (each
-   law's replicates fall beyond the other's central 1 - ALPHA of T less often than POWER), else
-   **cannot tell at this noise**.
+   A true law is so rejected with probability ALPHA / 2 (its own p below ALPHA / 2); where the two laws
+   are one curve at this noise, either is, with probability up to ALPHA. Otherwise **equivalent** when
+   the two null distributions of T overlap (each law's replicates fall beyond the other's central
+   1 - ALPHA of T less often than POWER), else **cannot tell at this noise**.
 
 Noise threshold, both directions: law A refitted to B's noise-free best curve leaves D_AB (at the sigma
 used); with every sigma scaled by s the refit does not move and D scales as 1 / s^2, so at

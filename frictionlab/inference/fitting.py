@@ -136,6 +136,9 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     if twice:  # its points would count twice and the error bars shrink by sqrt(2)
         raise DatasetError(f"fit: dataset '{twice[0]}' is given more than once; give each dataset once")
     _check_arguments(law, fixed, local, initial, rtol, timeout)
+    if n_params is not None and (isinstance(n_params, bool) or not isinstance(n_params, int) or n_params < 0
+                                 or errors):
+        raise ParameterError(f"fit: n_params must be a whole number >= 0 given with errors=False, got {n_params!r}")
     solvers = _solvers(law, targets, solver, rtol)
     if isinstance(solvers, str):
         return give_up("skipped", solvers)
