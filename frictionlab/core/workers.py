@@ -237,6 +237,8 @@ def _receive(read: int, limit: float) -> bytes | None:
                 started, chunk = True, chunk[1:]
         if started:
             chunks.append(chunk)
+
+
 def _pickled_error(exc: BaseException) -> bytes:
     import pickle
 

@@ -18,19 +18,18 @@ def equivalence_figure(dataset, fw_list, fa, decomps) -> bytes:
     t = np.linspace(0.0, t_end, 400)
     fig, axes = plt.subplots(1, max(1, len(fw_list)), figsize=(5.4 * max(1, len(fw_list)), 4.7), squeeze=False, layout="constrained")
     Fa = fa.per_dataset[0].trajectory(fa.law, t).force
+    A, dA = s.area(t)
+    A = np.where(t <= s.area.contact_time, A, 0.0)
+    N = s.normal(t, A)  # the decomposition's terms, the same for every panel
     for ax, fw, dec in zip(axes[0], fw_list, decomps):
         Fw = fw.per_dataset[0].trajectory(fw.law, t).force
         ax.plot(t * tf, Fw, color=base.LAW_COLORS["wear"], lw=2, ls="--" if fw.solver == "series" else "-",
                 label=f"wear [{fw.solver}]")
         ax.plot(t * tf, Fa, color=base.LAW_COLORS["area-rate"], lw=2, label=f"area-rate [{fa.solver}]")
-        if dec is not None:
-            A, dA = s.area(t)
-            A = np.where(t <= s.area.contact_time, A, 0.0)
-            N = s.normal(t, A)
-            ax.plot(t * tf, dec.c_area * A, color="0.45", lw=1, ls="-.", label="λu0(1−b)A")
-            ax.plot(t * tf, dec.c_area_rate * A * dA, color="0.45", lw=1, ls=":", label="(λu0b/(φA0)) A dA/dt")
-            ax.plot(t * tf, dec.mu * (N + dec.eta_prime * dA), color="#e7298a", lw=1.2,
-                    label=f"implied μN+μη'dA/dt (μ = {dec.mu:.3g}, η' = {dec.eta_prime:.3g} N s/m²)")
+        ax.plot(t * tf, dec.c_area * A, color="0.45", lw=1, ls="-.", label="λu0(1−b)A")
+        ax.plot(t * tf, dec.c_area_rate * A * dA, color="0.45", lw=1, ls=":", label="(λu0b/(φA0)) A dA/dt")
+        ax.plot(t * tf, dec.mu * (N + dec.eta_prime * dA), color="#e7298a", lw=1.2,
+                label=f"implied μN+μη'dA/dt (μ = {dec.mu:.3g}, η' = {dec.eta_prime:.3g} N s/m²)")
         ax.axhline(0, color="0.3", lw=0.8)
         ax.set_xlabel(f"time [{tname}]")
         ax.set_ylabel("friction force [N]")
