@@ -364,3 +364,54 @@ def test_the_impulse_alone_is_the_impulse_of_both_integrals():
         for t in grids[1:]:
             alone = _area_integrals(area, t, second=False)
             assert alone[1] is None and np.array_equal(alone[0], _area_integrals(area, t)[0])
+
+
+def test_refits_of_resampled_data_share_the_evaluations_the_data_do_not_change(monkeypatch):
+    """A model never reads the data it is fitted to: refits warm-started at one fit's values (replicates) share
+    their first evaluations (the start, its finite-difference steps), computed once; the numbers are those of
+    refits that compute every evaluation. A copy with other times, or a kind a third party predicts, shares none."""
+    import attrs
+    import numpy as np
+
+    from frictionlab import get_law
+    from frictionlab.inference import fitmodel, predict as predict_module
+    from frictionlab.inference.replicates import refit, refit_options, with_y
+
+    data = synthetic("area-rate", TRUTH["area-rate"], n=21, name="shared-evals", rel_noise=0.03)
+    base = fit("area-rate", data, solver="exact")
+    opts, tg, model = refit_options(base), base.per_dataset[0].target, base.per_dataset[0].model
+    rng = np.random.default_rng(1)
+    replicates = [with_y(tg, model + rng.standard_normal(tg.y.size) * tg.sigma, "replicate") for _ in range(3)]
+    computed = [0]
+    real = fitmodel.predict
+
+    def counted(*a, **k):
+        computed[0] += 1
+        return real(*a, **k)
+
+    monkeypatch.setattr(fitmodel, "predict", counted)
+    fitmodel._SHARED.clear()
+    shared, counts = [], []
+    for r in replicates:
+        before = computed[0]
+        shared.append(refit("area-rate", opts, r))
+        counts.append(computed[0] - before)
+    monkeypatch.setattr(fitmodel, "design", lambda target: None)  # every evaluation computed afresh
+    fresh = [refit("area-rate", opts, r) for r in replicates]
+    for a, b in zip(shared, fresh):
+        assert a.nfev == b.nfev and a.stats.chisqr == b.stats.chisqr
+        assert {k: p.value for k, p in a.params.items()} == {k: p.value for k, p in b.params.items()}
+    assert len(counts) == 3 and counts[1] <= counts[0] - 3 and counts[2] <= counts[0] - 3  # start and two steps
+
+    monkeypatch.setattr(fitmodel, "design", predict_module.design)
+    later = with_y(tg, tg.y, "times moved")
+    later = attrs.evolve(later, dataset=attrs.evolve(tg.dataset, columns={**tg.dataset.columns,
+                                                                          "t": tg.dataset.columns["t"] * 0.9}))
+    p = {k: v.value for k, v in base.params.items()}
+    law = get_law("area-rate")
+    got = fitmodel._shared_predict(law, later, p, "exact", later.dataset.scene, None)
+    assert np.array_equal(got, real(law, later, p, "exact", later.dataset.scene, None))
+    assert not np.array_equal(got, fitmodel._shared_predict(law, tg, p, "exact", tg.dataset.scene, None))
+    assert not got.flags.writeable
+    monkeypatch.setitem(predict_module.PREDICTORS, tg.dataset.kind, lambda *a, **k: model)
+    assert predict_module.design(tg) is None

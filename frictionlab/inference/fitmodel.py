@@ -15,12 +15,28 @@ import numpy as np
 
 from ..core.errors import FrictionLabError, ParameterError, SolverError
 from . import levmar
-from .predict import SCENE_QUANTITIES, SkipDataset, get_scene_quantity, has_scene_quantity, predict, set_scene_quantity
+from .predict import (
+    SCENE_QUANTITIES,
+    SkipDataset,
+    design,
+    get_scene_quantity,
+    has_scene_quantity,
+    predict,
+    set_scene_quantity,
+)
 
 PENALTY = 1e4  # weighted residual per point when the model cannot be evaluated
 ODE_STARTS = 2  # at most this many starts are refined when a dataset needs the (costlier) ODE solver
 VALLEY_R = 0.999  # |correlation| at an ODE fit's optimum above which further starts are not run (see _valley)
 FTOL = 1e-6  # relative chi-square and step tolerances of Levenberg-Marquardt
+SHARED_MAX = 512  # predictions kept by ``_shared_predict`` (cleared when full)
+
+#: Predictions by (law, what the predictor reads of the dataset (``predict.design``), solver, scene, rtol,
+#: parameters), the objects compared by identity and kept alive with the entry. Refits warm-started at one fit's
+#: values (an equivalence test's and a bootstrap's replicates) begin with the same evaluations, since a model
+#: never reads the data it is fitted to: the start and its finite-difference steps. A deterministic prediction is
+#: computed once for all of them.
+_SHARED: dict = {}
 
 
 @attrs.frozen
@@ -177,7 +193,7 @@ class _Model:
         out, ms = [], []
         for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values)):
             try:
-                m = predict(self.law, tg, p, solver, scene, self.rtol)
+                m = _shared_predict(self.law, tg, p, solver, scene, self.rtol)
                 if m.shape != tg.y.shape or not np.isfinite(m).all():
                     raise SolverError(f"prediction for '{tg.name}' is not finite or has the wrong shape")
                 out.append((m - tg.y) / tg.sigma)
@@ -192,6 +208,25 @@ class _Model:
         if len(ms) == len(self.targets):
             self._last = (dict(values), ms, r.copy())
         return r
+
+
+def _shared_predict(law, tg, p: dict, solver: str, scene, rtol) -> np.ndarray:
+    """``predict``, read-only, from ``_SHARED`` when the same law, dataset, observable, solver, scene, rtol and
+    parameter values were predicted before in this process (bitwise the same array)."""
+    reads = design(tg)
+    if reads is None:
+        return predict(law, tg, p, solver, scene, rtol)
+    objs = (law, scene) + reads
+    key = tuple(map(id, objs)) + (solver, rtol, tuple(p.items()))
+    hit = _SHARED.get(key)
+    if hit is not None and all(a is b for a, b in zip(hit[0], objs)):
+        return hit[1]
+    m = predict(law, tg, p, solver, scene, rtol)
+    m.flags.writeable = False
+    if len(_SHARED) >= SHARED_MAX:
+        _SHARED.clear()
+    _SHARED[key] = (objs, m)
+    return m
 
 
 def _si(params, slots) -> dict[str, float]:

@@ -167,6 +167,16 @@ register_predictor("spring-slider", _predict_series)
 register_predictor("impact-outcome", outcome_predictor)
 
 
+def design(target: Target) -> tuple | None:
+    """What a built-in predictor reads from ``target``'s dataset: its kind, the observable, the stated
+    numbers' table and every column but the observed one (a resampled copy of the data shares them all); None
+    for a kind predicted by a third party's function, which may read anything."""
+    ds = target.dataset
+    if PREDICTORS.get(ds.kind) not in (_predict_series, outcome_predictor):
+        return None
+    return (ds.kind, target.observable, ds.stated) + tuple(v for k, v in ds.columns.items() if k != target.observable)
+
+
 def predict(law, target: Target, params: Mapping[str, float], solver: str = "exact",
             scene: Scene | None = None, rtol: float | None = None) -> np.ndarray:
     """The law's prediction of ``target.y`` (SI) for law parameters ``params`` (SI), on ``scene``
