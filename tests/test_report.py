@@ -216,25 +216,6 @@ def test_figures_drawn_by_worker_processes_are_the_ones_drawn_here(comparison, r
     assert not (tmp_path / "bad").exists()
 
 
-def test_figures_laid_out_before_saving_are_those_of_a_plain_savefig(comparison, report_dir, tmp_path, monkeypatch):
-    """figures.base._png runs the constrained layout itself and saves without the layout engine (one draw fewer):
-    every figure of the report is the same bytes as matplotlib's own savefig with constrained layout."""
-    from frictionlab.report import figures
-
-    def plain(fig):
-        buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=figures.DPI)
-        figures._plt().close(fig)
-        return buf.getvalue()
-
-    monkeypatch.setattr(figures.base, "_png", plain)  # every figure module saves through base
-    out = write_report(comparison, tmp_path / "plain")
-    names = sorted(p.name for p in (report_dir / "figures").iterdir())
-    assert len(names) > 2 and names == sorted(p.name for p in (out / "figures").iterdir())
-    for name in names:
-        assert (out / "figures" / name).read_bytes() == (report_dir / "figures" / name).read_bytes(), name
-
-
 def _write_dataset(folder: Path) -> Path:
     ds = synthetic("wear", {"lam": 1.2e6}, seed=4, n=21)
     t = ds.t * 1e6

@@ -113,12 +113,15 @@ def psi_curves(scene: OutcomeScene, speed: float, incidence_deg=None, models=MOD
 def psi_figure(curves: dict[str, np.ndarray], measured: tuple[np.ndarray, np.ndarray] | None = None,
                title: str = "") -> bytes:
     """PNG: Psi2 against Psi1 for the rigid closed form, the rigid and Mindlin simulations, and measured points."""
+    import textwrap
+
     import matplotlib
 
     matplotlib.use("Agg", force=True)
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    w, h = 5.7, 4.2  # inches
+    fig, ax = plt.subplots(figsize=(w, h))
     p1 = curves["psi1"]
     ax.plot(p1, curves["closed_form"], color="#7f7f7f", lw=3, alpha=0.5, label="rigid sphere, closed form")
     ax.plot(p1, curves["rigid"], color="#1b9e77", ls="--", lw=1.5, label="rigid sphere, simulated")
@@ -134,11 +137,16 @@ def psi_figure(curves: dict[str, np.ndarray], measured: tuple[np.ndarray, np.nda
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlabel("Ψ1 (normalized incidence of the contact point)")
     ax.set_ylabel("Ψ2 (normalized rebound of the contact point)")
-    ax.set_title(title or "Maw-Barber-Fawcett diagram, Coulomb friction at the stated μ", fontsize=10)
+    title = textwrap.fill(title or "Maw-Barber-Fawcett diagram, Coulomb friction at the stated μ", 60)  # 60 characters: the axes' width at 10 pt
+    ax.set_title(title, fontsize=10)
     ax.legend(fontsize=8, loc="upper left")
     ax.grid(alpha=0.3)
+    # fixed margins in inches (left: tick labels and y label; top: the title's lines), so that it is drawn once
+    # (bbox_inches="tight" draws it twice); the report's figures are placed the same way (figures.base.margins)
+    lines = title.count("\n") + 1
+    fig.subplots_adjust(left=0.72 / w, right=1 - 0.12 / w, bottom=0.5 / h, top=1 - (0.15 + 0.17 * lines) / h)
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+    fig.savefig(buf, format="png", dpi=110, pil_kwargs={"compress_level": 3})
     plt.close(fig)
     return buf.getvalue()
 

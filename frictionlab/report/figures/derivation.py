@@ -19,7 +19,7 @@ def derivation_figure(dataset, derived: dict, noisy: dict, sigma_theta: float, s
     if sigma_theta > 0:  # a noise-free column (no stated sigma): the noisy twin would repeat it
         views.append((f"with simulated noise σθ = {sigma_theta * af:.2g} {au} (seed {seed})", noisy))
     fig, axes = plt.subplots(2, len(views), figsize=(5.25 * len(views) + (0 if sigma_theta > 0 else 1.0), 6.6),
-                             sharex=True, layout="constrained", squeeze=False)
+                             sharex=True, squeeze=False)
     colors = {"poly9": "#d95f02", "spline": "#1b9e77"}
     for col, (title, res) in enumerate(views):
         ax, axw = axes[0, col], axes[1, col]
@@ -49,6 +49,9 @@ def derivation_figure(dataset, derived: dict, noisy: dict, sigma_theta: float, s
             lo = min(float(np.min(ref)), min(float(np.percentile(f, 2)) for f in finite)) - 0.15 * span
             hi = max(float(np.max(ref)), max(float(np.percentile(f, 98)) for f in finite)) + 0.15 * span
             axw.set_ylim(lo, hi)
-    fig.suptitle(f"{dataset.name}: spin derived from rotation angle" + (
-        " (shaded: ±1σ each route passes on from θ noise)" if sigma_theta > 0 else " (no θ noise stated)"), fontsize=11)
+    title = base.wrapped(f"{dataset.name}: spin derived from rotation angle" + (
+        " (shaded: ±1σ each route passes on from θ noise)" if sigma_theta > 0 else " (no θ noise stated)"),
+        fig.get_figwidth() - 0.3, 11)
+    top = base.suptitle(fig, title, 11) + max(base.title_in(ax.get_title(), 10) for ax in axes[0])
+    base.margins(fig, top=top, bottom=base.XAXIS + base.EDGE, hspace=base.GAP)
     return base._png(fig)

@@ -16,7 +16,7 @@ def equivalence_figure(dataset, fw_list, fa, decomps) -> bytes:
     t_end = float(dataset.t[-1])
     tname, tf = time_unit(t_end)
     t = np.linspace(0.0, t_end, 400)
-    fig, axes = plt.subplots(1, max(1, len(fw_list)), figsize=(5.4 * max(1, len(fw_list)), 4.7), squeeze=False, layout="constrained")
+    fig, axes = plt.subplots(1, max(1, len(fw_list)), figsize=(5.4 * max(1, len(fw_list)), 4.7), squeeze=False)
     Fa = fa.per_dataset[0].trajectory(fa.law, t).force
     A, dA = s.area(t)
     A = np.where(t <= s.area.contact_time, A, 0.0)
@@ -35,8 +35,10 @@ def equivalence_figure(dataset, fw_list, fa, decomps) -> bytes:
         ax.set_ylabel("friction force [N]")
         ax.set_title(f"wear [{fw.solver}] vs area-rate", fontsize=10)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.2))  # below: never over a curve
-    fig.suptitle(f"{dataset.name}: is λAu equivalent to μN + μη' dA/dt?", fontsize=11)
+        below = base.legend_below(ax, fontsize=7, ncol=2)
+    title = base.wrapped(f"{dataset.name}: is λAu equivalent to μN + μη' dA/dt?", fig.get_figwidth() - 0.3, 11)
+    base.margins(fig, top=base.suptitle(fig, title, 11) + base.title_in(axes[0, 0].get_title(), 10),
+                 bottom=below + base.EDGE)
     return base._png(fig)
 
 
@@ -55,8 +57,7 @@ def discrimination_figure(dataset: str, results) -> bytes:
     plt = base._plt()
     drawn = [e for e in results if not one_curve(e)]
     same = [e for e in results if one_curve(e)]
-    fig, axes = plt.subplots(1, max(1, len(drawn)), figsize=(4.6 * max(1, len(drawn)), 3.4), squeeze=False,
-                             layout="constrained")
+    fig, axes = plt.subplots(1, max(1, len(drawn)), figsize=(4.6 * max(1, len(drawn)), 3.4), squeeze=False)
     for ax, e in zip(axes[0], drawn):
         both = np.concatenate([e.t_a, e.t_b, [e.t_obs]])
         span = float(np.ptp(both))
@@ -70,7 +71,8 @@ def discrimination_figure(dataset: str, results) -> bytes:
         ax.ticklabel_format(axis="x", style="sci", scilimits=(-3, 4))  # text offset: mathtext is off (core.display.pyplot)
         ax.set_xlabel(f"T = χ²({e.law_a}) − χ²({e.law_b})")
         ax.set_ylabel("replicates")
-        ax.set_title(f"{e.law_a} [{e.solver_a}] vs {e.law_b} [{e.solver_b}]: {e.verdict}", fontsize=9)
+        ax.set_title(base.wrapped(f"{e.law_a} [{e.solver_a}] vs {e.law_b} [{e.solver_b}]: {e.verdict}", 4.4, 9),
+                     fontsize=9)
         ax.grid(alpha=0.3)
     if not drawn:
         axes[0, 0].set_axis_off()
@@ -78,5 +80,8 @@ def discrimination_figure(dataset: str, results) -> bytes:
     if same:
         title += "\n" + "; ".join(f"{e.law_a} [{e.solver_a}] = {e.law_b} [{e.solver_b}]" for e in same) + \
             ": one curve (T = 0 on the data and on every replicate), not drawn"
-    fig.suptitle(title, fontsize=11 if len(drawn) > 1 else 9.5)
+    pt = 11 if len(drawn) > 1 else 9.5
+    title = "\n".join(base.wrapped(line, fig.get_figwidth() - 0.3, pt) for line in title.split("\n"))
+    top = base.suptitle(fig, title, pt) + max((base.title_in(ax.get_title(), 9) for ax in axes[0]), default=0.0)
+    base.margins(fig, top=top, bottom=base.XAXIS + base.EDGE)
     return base._png(fig)

@@ -12,8 +12,7 @@ def finding_figure(findings) -> bytes:
     exact fit of the same law (top), the slip u(t) of each (bottom), the series' zero crossing marked."""
     plt = base._plt()
     n = len(findings)
-    fig, axes = plt.subplots(2, n, figsize=(4.6 * n + 0.4, 3.7), sharex="col", squeeze=False, layout="constrained",
-                             gridspec_kw={"height_ratios": [1.5, 1]})
+    fig, axes = plt.subplots(2, n, figsize=(4.6 * n + 0.4, 3.7), sharex="col", squeeze=False, gridspec_kw={"height_ratios": [1.5, 1]})
     su, sf = unit("omega")
     for j, f in enumerate(findings):
         d = f.dataset
@@ -45,16 +44,18 @@ def finding_figure(findings) -> bytes:
                          arrowprops={"arrowstyle": "->", "color": "0.3"})
         ax.axvline(f.contact_time * tf, color="0.6", lw=0.8)
         axu.axvline(f.contact_time * tf, color="0.6", lw=0.8)
-        ax.set_title(f"{d.name}" + ("" if d.provenance.kind == "measured" else f" ({d.provenance.kind} data)"),
-                     fontsize=10)
+        ax.set_title(base.wrapped(d.name + ("" if d.provenance.kind == "measured" else f" ({d.provenance.kind} data)"),
+                                  4.4, 10), fontsize=10)
         ax.set_ylabel(f"spin ω [{su}]")
         axu.set_ylabel("slip u [m/s]")
         axu.set_xlabel(f"time [{tname}] (grey line: end of contact t_c)")
         ax.legend(fontsize=7, loc="lower right")
         for a in (ax, axu):
             a.grid(alpha=0.3)
-    fig.suptitle(base.wrapped("Why the paper's spin falls: its truncated series' slip turns negative; the exact solution's "
-                         "never does", 4.6 * n + 0.4, 10.5), fontsize=10.5)
+    title = base.wrapped("Why the paper's spin falls: its truncated series' slip turns negative; the exact solution's "
+                         "never does", 4.6 * n + 0.1, 10.5)
+    top = base.suptitle(fig, title, 10.5) + max(base.title_in(ax.get_title(), 10) for ax in axes[0])
+    base.margins(fig, top=top, bottom=base.XAXIS + base.EDGE, hspace=base.GAP)
     return base._png(fig)
 
 
@@ -69,7 +70,8 @@ def data_figure(views, title: str) -> bytes:
     slips = any(v.series is not None for v in views)
     width = 5.2 * n + 0.6
     fig, axes = plt.subplots(2 if slips else 1, n, figsize=(width, 4.15 if slips else 3.7), squeeze=False,
-                             layout="constrained", gridspec_kw={"height_ratios": [1.5, 1]} if slips else None)
+                             gridspec_kw={"height_ratios": [1.5, 1]} if slips else None)
+    below = base.XAXIS
     for j, v in enumerate(views):
         d, ax = v.dataset, axes[0, j]
         curves = [(f, label, base._style(f.law, f.solver, i)) for i, (f, label) in enumerate(zip(v.fits, v.labels))]
@@ -83,8 +85,8 @@ def data_figure(views, title: str) -> bytes:
         else:
             ax.set_axis_off()
             continue
-        ax.set_title(d.name + ("" if d.provenance.kind == "measured" else f" ({d.provenance.kind} data)"),
-                     fontsize=10)
+        ax.set_title(base.wrapped(d.name + ("" if d.provenance.kind == "measured" else f" ({d.provenance.kind} data)"),
+                                  5.0, 10), fontsize=10)
         ax.grid(alpha=0.3)
         if slips:
             _slip_panel(axes[1, j], v.series, xlabel) if v.series is not None else axes[1, j].set_axis_off()
@@ -92,9 +94,13 @@ def data_figure(views, title: str) -> bytes:
             ax.set_xlabel(xlabel)
         else:  # the slip panel below carries the time axis
             ax.tick_params(labelbottom=False)
-        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.27 if ax.get_xlabel() else -0.03),
-                  ncol=2)  # below the panel (and its time axis): never over the data
-    fig.suptitle(base.wrapped(title, width, 10.5), fontsize=10.5)
+        below = max(below, base.legend_below(ax, base.XAXIS if ax.get_xlabel() else 0.1, fontsize=7, ncol=2))
+    title = base.wrapped(title, width - 0.3, 10.5)
+    top = base.suptitle(fig, title, 10.5) + max(base.title_in(ax.get_title(), 10) for ax in axes[0])
+    if slips:  # the legends between the rows, the slip panels' time axes at the bottom
+        base.margins(fig, top=top, bottom=base.XAXIS + base.EDGE, hspace=below + base.GAP)
+    else:
+        base.margins(fig, top=top, bottom=below + base.EDGE)
     return base._png(fig)
 
 

@@ -25,8 +25,7 @@ def fit_figure(dataset, fits, rows) -> bytes:
     uname, uf = unit(obs)
     t = dataset.t
     tname, tf = time_unit(float(t[-1]))
-    fig, (ax, axr) = plt.subplots(2, 1, figsize=(7.6, 6.0), sharex=True, gridspec_kw={"height_ratios": [3, 1.6]},
-                                  layout="constrained")
+    fig, (ax, axr) = plt.subplots(2, 1, figsize=(7.6, 6.0), sharex=True, gridspec_kw={"height_ratios": [3, 1.6]})
     y = target.y if curves else dataset.columns[obs]
     sigma = target.sigma if curves else np.full(t.shape, dataset.noise.get(obs, np.nan))
     kind = dataset.provenance.kind
@@ -42,12 +41,15 @@ def fit_figure(dataset, fits, rows) -> bytes:
     ax.set_ylabel(f"{NAMES.get(obs, obs)} [{uname}]")
     axr.set_ylabel(f"model − data [{uname}]")
     axr.set_xlabel(f"time [{tname}]")
-    ax.set_title(f"{dataset.name}: fits of every law" + ("" if kind == "measured" else f"  ({kind} data)"))
+    title = base.wrapped(f"{dataset.name}: fits of every law" + ("" if kind == "measured" else f"  ({kind} data)"),
+                         6.7, 12)
+    ax.set_title(title)
     ax.legend(fontsize=8, loc="best", framealpha=0.9)
     axr.legend(fontsize=8, loc="best")
     for a in (ax, axr):
         a.grid(alpha=0.3)
     _residual_limits(axr, [f.per_dataset[0].residual * uf for f, _ in curves], sigma * uf)
+    base.margins(fig, top=base.EDGE + base.title_in(title, 12), bottom=base.XAXIS + base.EDGE, hspace=base.GAP)
     return base._png(fig)
 
 
@@ -76,8 +78,7 @@ def outcome_figure(dataset, fits, rows) -> bytes:
     curves = base.visible_curves(base.distinct_curves(fits), float(np.ptp(dataset.columns[obs])))
     sigma = dataset.noise.get(obs, 0.0) * uf
     angle = angle_column(dataset)
-    fig, (axp, axa) = plt.subplots(1, 2, figsize=(11.0, 5.2), layout="constrained",
-                                   gridspec_kw={"width_ratios": [1, 1.35]})
+    fig, (axp, axa) = plt.subplots(1, 2, figsize=(11.0, 5.2), gridspec_kw={"width_ratios": [1, 1.35]})
     lo, hi = float(np.min(y)), float(np.max(y))
     for i, (f, laws, hidden) in enumerate(curves):
         st = base._style(f.law, f.solver, i)
@@ -90,17 +91,20 @@ def outcome_figure(dataset, fits, rows) -> bytes:
     axp.set_ylabel(f"predicted {ylab}")
     axp.set_title("predicted against observed", fontsize=10)
     axp.legend(fontsize=7.5)
+    below = base.XAXIS
     if angle is not None:
         against_angle(axa, dataset, [(f, base._label(f, rows, laws, hidden), base._style(f.law, f.solver, i))
                                      for i, (f, laws, hidden) in enumerate(curves)])
-        axa.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.16))  # below: never over data
+        below = base.legend_below(axa, fontsize=7, ncol=2)
     else:
         axa.set_visible(False)
     for a in (axp, axa):
         a.grid(alpha=0.3)
     kind = dataset.provenance.kind
-    fig.suptitle(f"{dataset.name}: fits of every law" + ("" if kind == "measured" else f"  ({kind} data)"),
-                 fontsize=11)
+    title = base.wrapped(f"{dataset.name}: fits of every law" + ("" if kind == "measured" else f"  ({kind} data)"),
+                         10.7, 11)
+    base.margins(fig, top=base.suptitle(fig, title, 11) + base.title_in(axa.get_title() or axp.get_title(), 10),
+                 bottom=below + base.EDGE)
     return base._png(fig)
 
 
@@ -155,7 +159,7 @@ def force_figure(dataset, fits, rows=()) -> bytes:
     curves = base.visible_curves(curves, span)  # a force history under another's: named in its entry
     t_end = float(dataset.t[-1])
     tname, tf = time_unit(t_end)
-    fig, ax = plt.subplots(figsize=(7.6, 3.8), layout="constrained")
+    fig, ax = plt.subplots(figsize=(7.6, 3.8))
     drawn = 0
     for i, (f, laws, hidden) in enumerate(curves):
         try:
@@ -167,11 +171,13 @@ def force_figure(dataset, fits, rows=()) -> bytes:
     ax.axhline(0, color="0.3", lw=0.8)
     ax.set_xlabel(f"time [{tname}]")
     ax.set_ylabel("friction force F [N] (positive opposes slip)")
-    ax.set_title(f"{dataset.name}: friction force of each best fit")
+    title = base.wrapped(f"{dataset.name}: friction force of each best fit", 6.7, 12)
+    ax.set_title(title)
     ax.grid(alpha=0.3)
     if drawn:
         ax.legend(fontsize=8)
     else:
         ax.text(0.5, 0.5, "no fit's force history could be drawn\n(each exceeded the solver's budget)",
                 transform=ax.transAxes, ha="center", va="center", color="0.3")
+    base.margins(fig, top=base.EDGE + base.title_in(title, 12), bottom=base.XAXIS + base.EDGE)
     return base._png(fig)

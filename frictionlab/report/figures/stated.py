@@ -19,8 +19,7 @@ def stated_figure(dataset, curves, rows) -> bytes:
     tname, tf = time_unit(float(t[-1]))
     uname, uf = unit("omega")
     st = dataset.stated
-    fig, (ax, axr) = plt.subplots(2, 1, figsize=(7.6, 6.0), gridspec_kw={"height_ratios": [3, 1.6]},
-                                  layout="constrained")
+    fig, (ax, axr) = plt.subplots(2, 1, figsize=(7.6, 6.0), gridspec_kw={"height_ratios": [3, 1.6]})
     if "omega" in dataset.columns:
         ax.plot(t * tf, dataset.columns["omega"] * uf, color="0.6", lw=3, alpha=0.6,
                 label=f"{dataset.provenance.kind} curve (figure only, not fitted)")
@@ -45,9 +44,12 @@ def stated_figure(dataset, curves, rows) -> bytes:
     axr.set_ylabel("(model − stated) / precision")
     ax.set_ylabel(f"spin ω [{uname}]")
     ax.set_xlabel(f"time [{tname}]")
-    ax.set_title(f"{dataset.name}: fits to the stated numbers ({dataset.provenance.kind} data)")
+    title = base.wrapped(f"{dataset.name}: fits to the stated numbers ({dataset.provenance.kind} data)", 6.7, 12)
+    ax.set_title(title)
     ax.legend(fontsize=8, loc="best", framealpha=0.9)
     axr.legend(fontsize=8, loc="best")
     for a in (ax, axr):
         a.grid(alpha=0.3)
+    base.margins(fig, top=base.EDGE + base.title_in(title, 12), bottom=base.XTICKS + base.EDGE,
+                 hspace=base.XAXIS + base.GAP)
     return base._png(fig)
