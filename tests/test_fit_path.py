@@ -265,9 +265,9 @@ def test_a_repeated_evaluation_reused_gives_the_fit_of_the_general_path(law, sol
     fast = fit(law, data, solver=solver, **options)
     fresh = fitting._Model.residual
 
-    def always_fresh(self, values):
+    def always_fresh(self, values, given=None):
         self._last = None
-        return fresh(self, values)
+        return fresh(self, values, given)
 
     monkeypatch.setattr(fitting._Model, "residual", always_fresh)
     slow = fit(law, data, solver=solver, **options)
@@ -415,3 +415,26 @@ def test_refits_of_resampled_data_share_the_evaluations_the_data_do_not_change(m
     assert not got.flags.writeable
     monkeypatch.setitem(predict_module.PREDICTORS, tg.dataset.kind, lambda *a, **k: model)
     assert predict_module.design(tg) is None
+
+
+@pytest.mark.parametrize("dataset", ["kharaz2001-spin", "impact-outcome-synthetic"])
+def test_the_start_scan_of_impact_outcomes_in_one_batch_gives_the_fit_of_the_scan_one_by_one(dataset, monkeypatch):
+    """A start scan of an impact-outcome fit predicts every grid point's rows in one call of the batch engine:
+    each prediction bitwise that of ``predict`` alone, and the fit number for number the one-by-one scan's."""
+    import numpy as np
+
+    from frictionlab.inference import fitmodel
+    from frictionlab.inference.predict import make_target, predict, predict_many
+
+    tg = make_target(dataset)
+    sets = [{"mu": mu, "eta_prime": eta} for mu in (0.05, 0.3, 2.0) for eta in (-3e4, 0.0, 5e2)]
+    many = predict_many("area-rate", tg, sets, "exact")
+    assert many is not None and len(many) == len(sets)
+    for p, m in zip(sets, many):
+        assert np.array_equal(m, predict("area-rate", tg, p, "exact"))
+    assert predict_many("area-rate", tg, sets, "ode") is None  # no batch of the ODE path: one by one
+    batched = fit("area-rate", dataset, solver="exact", scan=25, n_starts=2)
+    monkeypatch.setattr(fitmodel, "predict_many", lambda *a, **k: None)
+    alone = fit("area-rate", dataset, solver="exact", scan=25, n_starts=2)
+    assert batched.ok and alone.ok and batched.nfev == alone.nfev
+    assert _numbers(batched) == _numbers(alone)

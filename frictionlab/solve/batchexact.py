@@ -115,6 +115,14 @@ def exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts, ys, last_dir, segs, t
     return dirs
 
 
+def whole_batch_branch(form) -> tuple[bool, bool]:
+    """What ``exact_stop`` decides for a whole batch from the form: no area term anywhere (c = 0), and a >= 0
+    everywhere (``exact.closed_stop_applies``). Scenes batched with others of the same branch get, bit for bit,
+    the answer of their own batch; every other step runs row by row."""
+    c, a = getattr(form, "c", 0.0), getattr(form, "a", 0.0)
+    return bool(np.all(np.asarray(c) == 0.0)), bool(np.all(np.asarray(a) >= 0.0))
+
+
 def exact_stop(law, batch, p, ids, plan, form, t0, y0, u_s, sgn, t_end):
     """First time after t0 each scene's slip reaches zero under F = s (a N + c dA/dt), NaN if not before t_end.
 
