@@ -150,6 +150,12 @@ def exact_stop(law, batch, p, ids, plan, form, t0, y0, u_s, sgn, t_end):
     c_zero = np.all(np.asarray(form.c) == 0.0)
     monotone = not restart and c_zero and (isinstance(batch.template.normal, exact.WeightNormal)
                                            or np.all(sgn * np.broadcast_to(plan.drive, (k, 1))[:, 0] <= 0.0))
+    wave = None if restart or monotone else exact._pulse_slip(plan, form, sgn[:, None], u_s[:, None])
+    if wave is not None:  # in closed form (exact.pulse_stop): where slip, falling, first reaches zero
+        C0, B, S, phi = (np.broadcast_to(x, (k, 1))[:, 0] for x in wave)
+        tc = np.broadcast_to(plan.scene.normal.contact_time, (k, 1))[:, 0]
+        ts = exact.pulse_stop(C0, B, S, phi, np.minimum(t_end, tc), 0.0)
+        return np.where(ts < t_end, ts, np.nan)
     if monotone:
         g_end = make_g(None)(t_end[:, None])[:, 0]
         rows = np.nonzero(g_end <= 0.0)[0]
