@@ -296,8 +296,9 @@ def _line_stop(g0, rate, t0, T, margin):
 
 
 def _pulse_slip(plan, form, sgn, u_s):
-    """From first contact, with half-sine N and A (or none) of one contact time and no drive, sgn slip is
-    C0 + B cos(phi t) + S sin(phi t): (C0, B, S, phi); else None. Works on a batch's columns."""
+    """From first contact, sliding (sgn slip > 0), with half-sine N and A (or none) of one contact time and no
+    drive, sgn slip is C0 + B cos(phi t) + S sin(phi t): (C0, B, S, phi); else None. Works on a batch's columns
+    (the batch engine solves rows that start without slip one by one)."""
     s = plan.scene
     area = s.area if np.any(np.asarray(form.c) != 0.0) else None
     if (not isinstance(s.normal, HalfSineNormal) or np.any(np.asarray(plan.drive) != 0.0)
@@ -378,7 +379,7 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     line = _linear_slip(plan, form, sgn, u_s)
     if line is not None:
         return J, K, _line_stop(*line, t0, T, margin)
-    wave = _pulse_slip(plan, form, sgn, u_s) if t0 == 0.0 else None
+    wave = _pulse_slip(plan, form, sgn, u_s) if t0 == 0.0 and sgn * u_s > 0.0 else None
     if wave is not None:
         ts = float(pulse_stop(*wave, min(T, plan.scene.normal.contact_time), margin))
         return J, K, (ts if ts <= T else None)
