@@ -30,7 +30,7 @@ PENALTY = 1e4  # weighted residual per point when the model cannot be evaluated
 ODE_STARTS = 2  # at most this many starts are refined when a dataset needs the (costlier) ODE solver
 VALLEY_R = 0.999  # |correlation| at an ODE fit's optimum above which further starts are not run (see _valley)
 FTOL = 1e-6  # relative chi-square and step tolerances of Levenberg-Marquardt
-SHARED_MAX = 512  # predictions kept by ``_shared_predict`` (cleared when full)
+SHARED_MAX = (512, 2**22)  # predictions and their floats kept by ``_shared_predict`` (all dropped when either is reached)
 
 #: Predictions by (law, what the predictor reads of the dataset (``predict.design``), solver, scene, rtol,
 #: parameters), the objects compared by identity and kept alive with the entry. Refits warm-started at one fit's
@@ -38,6 +38,7 @@ SHARED_MAX = 512  # predictions kept by ``_shared_predict`` (cleared when full)
 #: never reads the data it is fitted to: the start and its finite-difference steps. A deterministic prediction is
 #: computed once for all of them.
 _SHARED: dict = {}
+_SHARED_FLOATS = [0]  # floats held in _SHARED's predictions
 
 
 @attrs.frozen
@@ -234,9 +235,11 @@ def _shared_predict(law, tg, p: dict, solver: str, scene, rtol) -> np.ndarray:
         return hit[1]
     m = predict(law, tg, p, solver, scene, rtol)
     m.flags.writeable = False
-    if len(_SHARED) >= SHARED_MAX:
+    if len(_SHARED) >= SHARED_MAX[0] or _SHARED_FLOATS[0] >= SHARED_MAX[1]:
         _SHARED.clear()
+        _SHARED_FLOATS[0] = 0
     _SHARED[key] = (objs, m)
+    _SHARED_FLOATS[0] += m.size
     return m
 
 
