@@ -265,9 +265,9 @@ def test_a_repeated_evaluation_reused_gives_the_fit_of_the_general_path(law, sol
     fast = fit(law, data, solver=solver, **options)
     fresh = fitting._Model.residual
 
-    def always_fresh(self, values):
+    def always_fresh(self, values, given=None):
         self._last = None
-        return fresh(self, values)
+        return fresh(self, values, given)
 
     monkeypatch.setattr(fitting._Model, "residual", always_fresh)
     slow = fit(law, data, solver=solver, **options)
@@ -415,3 +415,100 @@ def test_refits_of_resampled_data_share_the_evaluations_the_data_do_not_change(m
     assert not got.flags.writeable
     monkeypatch.setitem(predict_module.PREDICTORS, tg.dataset.kind, lambda *a, **k: model)
     assert predict_module.design(tg) is None
+
+
+@pytest.mark.parametrize("dataset", ["kharaz2001-spin", "impact-outcome-synthetic"])
+def test_the_start_scan_of_impact_outcomes_in_one_batch_gives_the_fit_of_the_scan_one_by_one(dataset, monkeypatch):
+    """A start scan of an impact-outcome fit predicts every grid point's rows in one call of the batch engine:
+    each prediction bitwise that of ``predict`` alone, and the fit number for number the one-by-one scan's."""
+    import numpy as np
+
+    from frictionlab.inference import fitmodel
+    from frictionlab.inference.predict import make_target, predict, predict_many
+
+    tg = make_target(dataset)
+    sets = [{"mu": mu, "eta_prime": eta} for mu in (0.05, 0.3, 2.0) for eta in (-3e4, 0.0, 5e2)]
+    many = predict_many("area-rate", tg, sets, "exact")
+    assert many is not None and len(many) == len(sets)
+    for p, m in zip(sets, many):
+        assert np.array_equal(m, predict("area-rate", tg, p, "exact"))
+    assert predict_many("area-rate", tg, sets, "ode") is None  # no batch of the ODE path: one by one
+    batched = fit("area-rate", dataset, solver="exact", scan=25, n_starts=2)
+    monkeypatch.setattr(fitmodel, "predict_many", lambda *a, **k: None)
+    alone = fit("area-rate", dataset, solver="exact", scan=25, n_starts=2)
+    assert batched.ok and alone.ok and batched.nfev == alone.nfev
+    assert _numbers(batched) == _numbers(alone)
+
+
+def _area_rate_sweep(seed: int, n: int):
+    """n random impacts with half-sine N and A of one contact time, slip coupling, and area-rate parameters of both
+    signs of eta' (stops early, late or never): (SceneBatch, params, contact times [s])."""
+    import numpy as np
+
+    from frictionlab.physics.scene import HalfSineArea, HalfSineNormal, Scene
+    from frictionlab.solve import batch as B
+
+    rng = np.random.default_rng(seed)
+    tc = rng.uniform(400e-6, 500e-6, n)
+    template = Scene(kind="impact", mass=0.046, u0=1.0, duration=tc[0], radius=0.0213,
+                     normal=HalfSineNormal(1.0, tc[0]), area=HalfSineArea(1e-4, tc[0]),
+                     effects=frozenset({"slip-coupling", "spin"}))
+    sb = B.SceneBatch.sweep(template, {"u0": rng.uniform(2, 40, n), "normal.impulse": rng.uniform(0.5, 4, n),
+                                       "area.peak": rng.uniform(2e-5, 2e-4, n), "normal.contact_time": tc,
+                                       "area.contact_time": tc, "duration": tc})
+    params = {"mu": rng.uniform(0.05, 0.6, n), "eta_prime": rng.choice([-1, 1], n) * 10 ** rng.uniform(0, 4, n)}
+    return sb, params, tc
+
+
+def test_the_closed_form_stop_of_area_rate_impacts_equals_the_scan_and_root_finder(monkeypatch):
+    """Area-rate on half-sine N and A slips as C0 + R cos(phi t - delta): its first stop in closed form
+    (exact.pulse_stop), scalar and batch, against the scan and bracketed root search (closed form switched off)."""
+    import numpy as np
+
+    from frictionlab import simulate
+    from frictionlab.solve import batch as B
+    from frictionlab.solve.solvers import exact
+
+    sb, params, tc = _area_rate_sweep(5, 60)
+    n = len(tc)
+    t = np.linspace(0.0, 1.0, 41)[None, :] * tc[:, None]
+    one = [{k: float(v[i]) for k, v in params.items()} for i in range(n)]
+    fast = B.simulate_batch("area-rate", sb, params, solver="exact", t=t)
+    scalar_fast = [simulate("area-rate", sb.scene(i), one[i], solver="exact", t=t[i]) for i in range(n)]
+    monkeypatch.setattr(exact, "_pulse_slip", lambda *a: None)
+    slow = B.simulate_batch("area-rate", sb, params, solver="exact", t=t)
+    scalar_slow = [simulate("area-rate", sb.scene(i), one[i], solver="exact", t=t[i]) for i in range(n)]
+    stops = np.isfinite(slow.stick_time)
+    assert 10 < stops.sum() < n - 10 and np.array_equal(stops, np.isfinite(fast.stick_time))
+    assert np.allclose(fast.stick_time[stops], slow.stick_time[stops], rtol=0, atol=1e-12 * tc.max())
+    for f, s_ in zip(scalar_fast, scalar_slow):
+        assert (f.stick_time is None) == (s_.stick_time is None)
+        if f.stick_time is not None:
+            assert abs(f.stick_time - s_.stick_time) <= 1e-12 * tc.max()
+        assert np.allclose(f.omega, s_.omega, rtol=1e-10, atol=1e-10 * np.max(np.abs(s_.omega)))
+
+
+def test_the_closed_form_stop_of_a_block_on_an_incline_equals_the_scan_and_root_finder(monkeypatch):
+    """On an incline (weight normal force, no area term) slip is linear in time: its stop in closed form against
+    the scan and bracketed root search, for blocks thrown up and down the slope, sliding on or stopping."""
+    import attrs
+    import numpy as np
+
+    from frictionlab import simulate
+    from frictionlab.solve.solvers import exact
+
+    rng = np.random.default_rng(3)
+    base = incline_scene()
+    cases = [(attrs.evolve(base, u0=float(rng.uniform(-3, 3))), law,
+              {"mu": float(10 ** rng.uniform(-1.5, 0.3))} | ({"eta_prime": 10.0} if law == "area-rate" else {}))
+             for law in ("coulomb", "area-rate") for _ in range(40)]
+    fast = [simulate(law, s, p, solver="exact") for s, law, p in cases]
+    monkeypatch.setattr(exact, "_linear_slip", lambda *a: None)
+    slow = [simulate(law, s, p, solver="exact") for s, law, p in cases]
+    stopped = sum(s_.stick_time is not None for s_ in slow)
+    assert 10 < stopped < len(cases) - 10
+    for f, s_, (scene, _, _) in zip(fast, slow, cases):
+        assert (f.stick_time is None) == (s_.stick_time is None)
+        if f.stick_time is not None:
+            assert abs(f.stick_time - s_.stick_time) <= 1e-12 * scene.duration
+        assert np.allclose(f.v, s_.v, rtol=1e-12, atol=1e-12 * np.max(np.abs(s_.v)))

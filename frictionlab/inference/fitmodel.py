@@ -22,6 +22,7 @@ from .predict import (
     get_scene_quantity,
     has_scene_quantity,
     predict,
+    predict_many,
     set_scene_quantity,
 )
 
@@ -29,7 +30,7 @@ PENALTY = 1e4  # weighted residual per point when the model cannot be evaluated
 ODE_STARTS = 2  # at most this many starts are refined when a dataset needs the (costlier) ODE solver
 VALLEY_R = 0.999  # |correlation| at an ODE fit's optimum above which further starts are not run (see _valley)
 FTOL = 1e-6  # relative chi-square and step tolerances of Levenberg-Marquardt
-SHARED_MAX = 512  # predictions kept by ``_shared_predict`` (cleared when full)
+SHARED_MAX = (512, 2**22)  # predictions and their floats kept by ``_shared_predict`` (all dropped when either is reached)
 
 #: Predictions by (law, what the predictor reads of the dataset (``predict.design``), solver, scene, rtol,
 #: parameters), the objects compared by identity and kept alive with the entry. Refits warm-started at one fit's
@@ -37,6 +38,7 @@ SHARED_MAX = 512  # predictions kept by ``_shared_predict`` (cleared when full)
 #: never reads the data it is fitted to: the start and its finite-difference steps. A deterministic prediction is
 #: computed once for all of them.
 _SHARED: dict = {}
+_SHARED_FLOATS = [0]  # floats held in _SHARED's predictions
 
 
 @attrs.frozen
@@ -181,7 +183,8 @@ class _Model:
         return [predict(self.law, tg, p, solver, scene, self.rtol)
                 for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values))]
 
-    def residual(self, values) -> np.ndarray:
+    def residual(self, values, given=None) -> np.ndarray:
+        """The weighted residual at SI slot values; ``given``: the one target's prediction there, made already."""
         if self.deadline is not None and time.monotonic() > self.deadline:
             raise FitTimeout()
         if self._last is not None and self._last[0] == values:  # scipy's leastsq calls at the start point twice
@@ -193,7 +196,7 @@ class _Model:
         out, ms = [], []
         for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values)):
             try:
-                m = _shared_predict(self.law, tg, p, solver, scene, self.rtol)
+                m = _shared_predict(self.law, tg, p, solver, scene, self.rtol) if given is None else given
                 if m.shape != tg.y.shape or not np.isfinite(m).all():
                     raise SolverError(f"prediction for '{tg.name}' is not finite or has the wrong shape")
                 out.append((m - tg.y) / tg.sigma)
@@ -209,6 +212,15 @@ class _Model:
             self._last = (dict(values), ms, r.copy())
         return r
 
+    def residuals(self, points: list) -> list[np.ndarray]:
+        """``residual`` at each of ``points`` (SI slot values), in order; one target's predictions made in one
+        vectorized call where its kind offers one (``predict_many``; a start scan of impact outcomes)."""
+        many = None
+        if len(self.targets) == 1 and not any(s.kind == "scene" for s in self.slots) and len(points) > 1:
+            tg = self.targets[0]
+            many = predict_many(self.law, tg, [self.split(v)[0][0] for v in points], self.solvers[0])
+        return [self.residual(v, None if many is None else many[i]) for i, v in enumerate(points)]
+
 
 def _shared_predict(law, tg, p: dict, solver: str, scene, rtol) -> np.ndarray:
     """``predict``, read-only, from ``_SHARED`` when the same law, dataset, observable, solver, scene, rtol and
@@ -223,9 +235,11 @@ def _shared_predict(law, tg, p: dict, solver: str, scene, rtol) -> np.ndarray:
         return hit[1]
     m = predict(law, tg, p, solver, scene, rtol)
     m.flags.writeable = False
-    if len(_SHARED) >= SHARED_MAX:
+    if len(_SHARED) >= SHARED_MAX[0] or _SHARED_FLOATS[0] >= SHARED_MAX[1]:
         _SHARED.clear()
+        _SHARED_FLOATS[0] = 0
     _SHARED[key] = (objs, m)
+    _SHARED_FLOATS[0] += m.size
     return m
 
 
@@ -310,11 +324,9 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
         model.progress.stage("scanning start points", scan, total=scan + n_starts * lm + 2 * len(varying) + 2)
     if scan:
         fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
-        scored = []
-        for cand in _start_grid(varying, np.random.default_rng(0), scan):
-            vals = {**fixed_part, **cand}
-            r = model.residual({s.pname: vals[s.pname] * s.scale for s in slots})
-            scored.append((float(r @ r), len(scored), cand))
+        grid = _start_grid(varying, np.random.default_rng(0), scan)
+        points = [{s.pname: vals[s.pname] * s.scale for s in slots} for vals in ({**fixed_part, **c} for c in grid)]
+        scored = [(float(r @ r), i, c) for i, (r, c) in enumerate(zip(model.residuals(points), grid))]
         scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins
         starts = _distinct(scored, min(n_starts, ODE_STARTS) if slow else n_starts)
     best, notes = None, []

@@ -22,7 +22,7 @@ from ..io.dataset import Dataset, load_dataset
 from ..physics.freeable import SCENE_QUANTITIES
 from ..physics.registry import get_law
 from ..physics.scene import Scene
-from ..solve.outcome import OUTCOMES, predict_outcomes, rows_of
+from ..solve.outcome import OUTCOMES, predict_outcomes, predict_outcomes_many, rows_of
 
 #: Trajectory series that a time-series observable reads.
 SERIES = {"omega": "omega", "theta": "theta", "v": "v", "u": "u", "mu": "load"}
@@ -192,6 +192,22 @@ def predict(law, target: Target, params: Mapping[str, float], solver: str = "exa
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # series accuracy warnings are recorded in the result instead
         return np.asarray(fn(law, target, scene or target.dataset.scene, params, solver, **kw), dtype=float)
+
+
+def predict_many(law, target: Target, params_list, solver: str, scene: Scene | None = None) -> list | None:
+    """``predict`` at each parameter set of ``params_list`` (SI) in one vectorized call where the kind offers one
+    (the closed forms of impact outcomes, each set's rows on the batch engine at once); None where it does not,
+    or refuses, and ``predict`` one set at a time gives each answer or error."""
+    law = get_law(law)
+    if (solver != "exact" or target.dataset.kind != "impact-outcome" or target.observable not in OUTCOMES
+            or target.observable in ("psi1", "psi2") or PREDICTORS.get("impact-outcome") is not outcome_predictor):
+        return None
+    rows = rows_of(target.dataset)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        out = predict_outcomes_many(law, scene or target.dataset.scene, params_list, speed=rows["speed"],
+                                    incidence=rows["incidence"], spin=rows["spin"])
+    return None if out is None else [np.asarray(o[target.observable], dtype=float) for o in out]
 
 
 def applicable_solvers(law, scene: Scene) -> dict[str, str | None]:

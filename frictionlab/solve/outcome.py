@@ -122,6 +122,39 @@ def predict_outcomes(law, dataset_or_scene, params: Mapping[str, float] | None =
     return _outcomes(template, rows, imps, v2, w2, rolled)
 
 
+def predict_outcomes_many(law, scene: OutcomeScene, params_list, *, speed, incidence, spin=None):
+    """``predict_outcomes(law, scene, params, 'exact', ...)`` for each parameter set of ``params_list``: the
+    closed forms of every set's impacts in one call of the batch engine (a fit's start scan). None where that
+    path does not apply (no closed-form batch: one row, Mindlin-Deresiewicz compliance) or refuses the batch;
+    then ``predict_outcomes`` one set at a time gives each answer or error."""
+    from ..physics.registry import get_law
+    from .batch import simulate_batch
+    from .batchexact import whole_batch_branch
+
+    law = get_law(law)
+    rows, fixed, template = _rows(law, scene, speed, incidence, spin)
+    imps = _inbound(template, rows)
+    if len(imps) < 2 or getattr(template.compliance, "model", None) == "mindlin-deresiewicz":
+        return None
+    n, out = len(imps), [None] * len(params_list)
+    try:
+        ps = [law.resolve({**fixed, **(params or {})}) for params in params_list]
+        groups: dict = {}  # sets by the branch the engine takes for a whole batch: each set's own answer
+        for j, q in enumerate(ps):
+            groups.setdefault(whole_batch_branch(law.form(q)), []).append(j)
+        t = np.array([[0.0, imp.contact_time] for imp in imps])
+        for js in groups.values():
+            p = {name: np.repeat([ps[j][name] for j in js], n) for name in law.param_names}
+            br = simulate_batch(law, _scene_batch(imps).tile(len(js)), p, t=np.tile(t, (len(js), 1)), solver="exact")
+            for i, j in enumerate(js):
+                rows_i = slice(i * n, (i + 1) * n)
+                out[j] = _outcomes(template, rows, imps, br.v[rows_i, -1], br.omega[rows_i, -1],
+                                   ~np.isnan(br.stick_time[rows_i]))
+    except Exception:  # a refusal, or a third-party law's error: one set at a time says which and why
+        return None
+    return out
+
+
 def _outcomes(template, rows, imps, v2, w2, rolled):
     """The outcome arrays of the rows from their end-of-contact tangential velocity v2 and spin w2."""
     n = len(rows["speed"])

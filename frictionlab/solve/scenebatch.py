@@ -113,6 +113,10 @@ class SceneBatch:
         idx = np.arange(self.n)[idx]
         return SceneBatch(self.template, {k: v[idx] for k, v in self.values.items()}, int(idx.size))
 
+    def tile(self, k: int) -> "SceneBatch":
+        """The batch k times over: scene i of copy j is scene j n + i."""
+        return SceneBatch(self.template, {f: np.tile(v, k) for f, v in self.values.items()}, self.n * k)
+
     def __len__(self) -> int:
         return self.n
 

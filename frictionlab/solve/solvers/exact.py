@@ -274,6 +274,59 @@ def half_sine_stop(plan, form, u_s):
         return np.where(q <= 2.0, 2.0 / phi * np.arcsin(np.sqrt(np.minimum(q, 2.0) / 2.0)), np.inf)
 
 
+# --- where slip reaches zero, in closed form where it has one --------------------------
+def _linear_slip(plan, form, sgn, u_s):
+    """(sgn slip at the phase's start, its rate) when slip is linear in time: a weight normal force and no area
+    term (none, or a constant area), as on an incline; else None."""
+    s = plan.scene
+    if not isinstance(s.normal, WeightNormal) or not (form.c == 0.0 or isinstance(s.area, ConstantArea)):
+        return None
+    return sgn * u_s, sgn * plan.drive - plan.kappa * form.a * s.normal.value
+
+
+def _line_stop(g0, rate, t0, T, margin):
+    """Stop of slip g0 + rate (t - t0) [s] by the rule of the scan: it must pass zero by ``margin``; the stop is its
+    zero when it started ahead (g0 > 0), else the time it passed; None if not by T."""
+    if not rate < 0.0:
+        return None
+    passed = t0 + (margin + g0) / -rate
+    if passed > T:
+        return None
+    return t0 + g0 / -rate if g0 > 0.0 else passed
+
+
+def _pulse_slip(plan, form, sgn, u_s):
+    """From first contact, sliding (sgn slip > 0), with half-sine N and A (or none) of one contact time and no
+    drive, sgn slip is C0 + B cos(phi t) + S sin(phi t): (C0, B, S, phi); else None. Works on a batch's columns
+    (the batch engine solves rows that start without slip one by one)."""
+    s = plan.scene
+    area = s.area if np.any(np.asarray(form.c) != 0.0) else None
+    if (not isinstance(s.normal, HalfSineNormal) or np.any(np.asarray(plan.drive) != 0.0)
+            or not (area is None or (isinstance(area, HalfSineArea)
+                                     and np.all(np.asarray(area.contact_time) == s.normal.contact_time)))):
+        return None
+    phi = math.pi / s.normal.contact_time
+    B = plan.kappa * form.a * s.normal.peak / phi
+    S = -plan.kappa * form.c * area.peak if area is not None else 0.0
+    return sgn * u_s - B, B, S, phi
+
+
+def pulse_stop(C0, B, S, phi, t_end, margin):
+    """First stop [s] of slip g = C0 + B cos(phi t) + S sin(phi t) = C0 + R cos(phi t - delta) after t = 0, where
+    g(0) > 0 (``_pulse_slip``): where g, falling, passes -margin by t_end, its zero on that falling arc; inf where it
+    does not. g falls on the arcs phi t = delta + arccos(level) (+ 2 pi), one per period, so the first arc after 0
+    is the one. Arrays broadcast (a batch)."""
+    R = np.hypot(B, S)
+    delta = np.arctan2(S, B)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        level, zero = (-margin - C0) / R, -C0 / R
+    a_level, a_zero = np.arccos(np.clip(level, -1.0, 1.0)), np.arccos(np.clip(zero, -1.0, 1.0))
+    x_pass = delta + a_level
+    x_pass = np.where(x_pass > 0.0, x_pass, x_pass + 2.0 * math.pi)
+    passes = (R > 0.0) & (level >= -1.0) & (x_pass <= phi * t_end)
+    return np.where(passes, (x_pass - (a_level - a_zero)) / phi, np.inf)
+
+
 def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     """Friction impulse J and its integral K from t0 at times t (and, with find_stop, the stop).
 
@@ -323,6 +376,13 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
         if sgn * slip(T)[0] + margin > 0.0:
             return J, K, None
         return J, K, float(min(half_sine_stop(plan, form, u_s), T))
+    line = _linear_slip(plan, form, sgn, u_s)
+    if line is not None:
+        return J, K, _line_stop(*line, t0, T, margin)
+    wave = _pulse_slip(plan, form, sgn, u_s) if t0 == 0.0 and sgn * u_s > 0.0 else None
+    if wave is not None:
+        ts = float(pulse_stop(*wave, min(T, plan.scene.normal.contact_time), margin))
+        return J, K, (ts if ts <= T else None)
     grid = np.unique(np.concatenate([np.linspace(t0, T, SCAN), t]))
     signed = sgn * slip(grid)
     g = signed + margin
