@@ -23,7 +23,8 @@ def comparisons():
     ds = synthetic("area-rate", TRUTH["area-rate"], seed=11, name=LONG)
     outcome = load_dataset("impact-outcome-synthetic")
     return {"impact, long name": compare(laws=["wear", "area-rate"], datasets=[ds]),
-            "impact outcomes, long name": compare(laws=["coulomb", "wear"], datasets=[attrs.evolve(outcome, name=LONG)]),
+            "impact outcomes, long name": compare(laws=["coulomb", "wear"],
+                                                  datasets=[attrs.evolve(outcome, name=LONG)]),
             "stated numbers": compare(laws=["wear", "coulomb"], datasets=[load_dataset("impact-golf-v28")])}
 
 

@@ -137,7 +137,8 @@ def psi_figure(curves: dict[str, np.ndarray], measured: tuple[np.ndarray, np.nda
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set_xlabel("Ψ1 (normalized incidence of the contact point)")
     ax.set_ylabel("Ψ2 (normalized rebound of the contact point)")
-    title = textwrap.fill(title or "Maw-Barber-Fawcett diagram, Coulomb friction at the stated μ", 60)  # 60 characters: the axes' width at 10 pt
+    default = "Maw-Barber-Fawcett diagram, Coulomb friction at the stated μ"
+    title = textwrap.fill(title or default, 60)  # 60 characters: about the axes' width at 10 pt
     ax.set_title(title, fontsize=10)
     ax.legend(fontsize=8, loc="upper left")
     ax.grid(alpha=0.3)

@@ -19,7 +19,8 @@ def _plt():
     return pyplot()
 
 
-#: PNG compression (zlib level): 3 costs about a third less CPU than matplotlib's 6 for 1-2% larger files.
+#: PNG compression (zlib level): 3 takes about a quarter less CPU than the default 6 for files under 1% larger
+#: (the default report's figures: 0.30 against 0.42 CPU s, 2.24 against 2.22 MB; levels 1 and 2 are no faster).
 COMPRESS = 3
 
 

@@ -12,7 +12,8 @@ def finding_figure(findings) -> bytes:
     exact fit of the same law (top), the slip u(t) of each (bottom), the series' zero crossing marked."""
     plt = base._plt()
     n = len(findings)
-    fig, axes = plt.subplots(2, n, figsize=(4.6 * n + 0.4, 3.7), sharex="col", squeeze=False, gridspec_kw={"height_ratios": [1.5, 1]})
+    fig, axes = plt.subplots(2, n, figsize=(4.6 * n + 0.4, 3.7), sharex="col", squeeze=False,
+                             gridspec_kw={"height_ratios": [1.5, 1]})
     su, sf = unit("omega")
     for j, f in enumerate(findings):
         d = f.dataset
