@@ -29,8 +29,6 @@ and add ``mysection`` to ``SECTIONS`` at the place it belongs. Return None to le
 """
 from __future__ import annotations
 
-import contextlib
-import gc
 import json
 import os
 import threading
@@ -43,6 +41,7 @@ from ..core.arguments import check_type
 from ..core.errors import OutputError
 from ..core.files import atomic_dir
 from ..core.inputs import check_apart
+from ..core.workers import long_run_gc
 from . import (
     bootstrap,
     datasets,
@@ -191,7 +190,9 @@ def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, clie
     out = Path(out)
     if out.exists() and not force:  # said in Python's terms; the command line checks before its work
         raise OutputError(f"{out}: the folder exists; pass force=True to replace it, or choose another folder")
-    with atomic_dir(out, force=force) as tmp, _collected_apart():
+    # what is alive before (the comparison) frozen meanwhile: drawing makes many short-lived objects, and each
+    # full collection would walk the comparison too (about 0.2 of the default report's 4 CPU s)
+    with atomic_dir(out, force=force) as tmp, long_run_gc():
         built, figs, extra = [], [], {}
 
         def figures():  # page by page as each is built: a cluster draws a page's figures while the next is built
@@ -225,18 +226,6 @@ def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, clie
         if progress:
             progress(len(figs) + 1, len(figs) + 1, "report.md, report.html, ranking.csv, results.json")
     return out
-
-
-@contextlib.contextmanager
-def _collected_apart():
-    """What is alive before the report is written (the comparison) set apart from garbage collection meanwhile
-    (gc.freeze): drawing makes many short-lived objects, and every full collection would walk the comparison
-    too (about 0.2 of the default report's 4 CPU s). Back under collection after, whatever happens."""
-    gc.freeze()
-    try:
-        yield
-    finally:
-        gc.unfreeze()
 
 
 def _pages(c, extra: dict):
