@@ -88,7 +88,6 @@ def test_tick_labels_of_any_size_keep_their_room(scale, comparisons, checked, tm
     """Spin shown in a unit 1e5 or 1e-4 times rpm: tick labels like 1e+08 (an offset above the axis) or 0.0004."""
     name, factor = display.OBSERVABLE_UNITS["omega"]
     monkeypatch.setitem(display.OBSERVABLE_UNITS, "omega", (name, factor * scale))
-    monkeypatch.setitem(display.OBSERVABLE_UNITS, "force", ("N", scale))
     write_report(comparisons["impact, long name"], tmp_path / "rep")
     assert [(n, f) for n, f, _ in checked if f] == []
 
