@@ -55,9 +55,10 @@ class Quiet:
 
 #: The worker's periodic callbacks that watch it, and their period (ms) while frictionlab's tasks run there
 #: (None: stopped): Dask's statistical profiler (``distributed.worker.profile``), the event loop's health tick
-#: (``distributed.admin.tick``, 20 ms) and the system monitor (``distributed.admin.system-monitor``, 500 ms).
-#: The memory monitor (spilling, pausing) is left as it is.
-QUIET = {"profile": None, "profile-cycle": None, "tick": 1000, "monitor": 5000}
+#: (``distributed.admin.tick``, 20 ms), the system monitor (``distributed.admin.system-monitor``, 500 ms) and
+#: the memory monitor (``distributed.worker.memory.monitor-interval``, 100 ms: it spills and pauses at most a
+#: second later; the nanny's own monitor, which ends a worker over its memory limit, is left as it is).
+QUIET = {"profile": None, "profile-cycle": None, "tick": 1000, "monitor": 5000, "memory_monitor": 1000}
 #: In a worker process: how many of frictionlab's tasks run now, and (callback, its period, stopped) changed.
 _STATE: dict = {"running": 0, "changed": []}
 _STATE_LOCK = threading.Lock()
