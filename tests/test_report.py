@@ -345,3 +345,17 @@ def test_a_long_step_is_not_silent():
         _time.sleep(1.2)  # one long step: heartbeat lines, not silence
     lines = pipe.getvalue().splitlines()
     assert len(lines) >= 2 and all(" compare: 1/3 done, still working (" in x for x in lines[1:])
+
+
+def test_laws_of_one_closed_form_family_are_one_curve_in_the_figures():
+    """Wear and Couette fitted to one dataset are the ranking's one candidate 'wear = couette': the figures draw
+    them as one curve under that name, even where their best fits differ by the optimizer's tolerance by more
+    than a thousandth of the noise at some point (golf-v28's stated numbers: the legend once named it twice)."""
+    from frictionlab import fit
+    from frictionlab.report.figures import base
+
+    wear, couette = fit("wear", "impact-golf-v28", solver="exact"), fit("couette", "impact-golf-v28", solver="exact")
+    curves = base.distinct_curves([wear, couette])
+    assert [laws for _, laws in curves] == [["wear", "couette"]]
+    coulomb = fit("coulomb", "impact-golf-v28", solver="exact")
+    assert len(base.distinct_curves([wear, coulomb])) == 2

@@ -171,9 +171,15 @@ def draw_fit(ax, f, obs: str, t, tf: float, uf: float, label: str, **style):
 
 def same_curve(a, b) -> bool:
     """Whether two fits of one dataset with one solver predict the same curve at every data point (within
-    SAME_CURVE sigma): laws of one functional form, or a law whose extra term has no effect there."""
+    SAME_CURVE sigma), or are the ranking's one candidate (laws spanning one closed-form family, fitted to one
+    dataset: 'wear = couette'; their best fits differ only by the optimizer's tolerance): laws of one
+    functional form, or a law whose extra term has no effect there."""
+    from ...inference.ranking import family_key
+
     if a.solver != b.solver or len(a.per_dataset) != len(b.per_dataset):
         return False
+    if a.datasets == b.datasets and family_key(a) is not None and family_key(a) == family_key(b):
+        return True
     for da, db in zip(a.per_dataset, b.per_dataset):
         if da.model.shape != db.model.shape or not np.all(np.abs(da.model - db.model) <= SAME_CURVE * da.target.sigma):
             return False
