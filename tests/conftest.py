@@ -1,4 +1,5 @@
 import os
+import signal
 import subprocess
 import sys
 
@@ -6,6 +7,12 @@ import matplotlib
 import pytest
 
 matplotlib.use("Agg")
+
+# A suite started in the background (`cmd &` in a script) inherits SIGINT ignored, and so would every command
+# it runs, so the tests of ^C would find it ignored; the suite takes SIGINT as a terminal delivers it, and so
+# do the commands it starts (a handled signal is back to its default in a new program).
+if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture
