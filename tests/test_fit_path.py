@@ -402,6 +402,7 @@ def test_refits_of_resampled_data_share_the_evaluations_the_data_do_not_change(m
         assert a.nfev == b.nfev and a.stats.chisqr == b.stats.chisqr
         assert {k: p.value for k, p in a.params.items()} == {k: p.value for k, p in b.params.items()}
     assert len(counts) == 3 and counts[1] <= counts[0] - 3 and counts[2] <= counts[0] - 3  # start and two steps
+    assert all(r.per_dataset[0].model.flags.writeable for r in shared)  # a result's model is its own array
 
     monkeypatch.setattr(fitmodel, "design", predict_module.design)
     later = with_y(tg, tg.y, "times moved")

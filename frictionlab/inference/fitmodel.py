@@ -179,7 +179,7 @@ class _Model:
         """Each target's model at SI slot values; the last evaluation's when it was at these values
         (lmfit's last call is at its best values, where the fit reads the models next)."""
         if self._last is not None and self._last[0] == values:
-            return list(self._last[1])
+            return [m.copy() for m in self._last[1]]  # the fit result's own: shared predictions are read-only
         return [predict(self.law, tg, p, solver, scene, self.rtol)
                 for tg, solver, (p, scene) in zip(self.targets, self.solvers, self.split(values))]
 
