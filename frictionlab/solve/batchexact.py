@@ -115,14 +115,6 @@ def exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts, ys, last_dir, segs, t
     return dirs
 
 
-def whole_batch_branch(form) -> tuple[bool, bool]:
-    """What ``exact_stop`` decides for a whole batch from the form: no area term anywhere (c = 0), and a >= 0
-    everywhere (``exact.closed_stop_applies``). Scenes batched with others of the same branch get, bit for bit,
-    the answer of their own batch; every other step runs row by row."""
-    c, a = getattr(form, "c", 0.0), getattr(form, "a", 0.0)
-    return bool(np.all(np.asarray(c) == 0.0)), bool(np.all(np.asarray(a) >= 0.0))
-
-
 def exact_stop(law, batch, p, ids, plan, form, t0, y0, u_s, sgn, t_end):
     """First time after t0 each scene's slip reaches zero under F = s (a N + c dA/dt), NaN if not before t_end.
 
@@ -147,7 +139,7 @@ def exact_stop(law, batch, p, ids, plan, form, t0, y0, u_s, sgn, t_end):
         return g
 
     noise = 8 * np.finfo(float).eps * np.abs(u_s)  # slip is u_s minus terms of its size
-    c_zero = np.all(np.asarray(form.c) == 0.0)
+    c_zero = exact.form_branch(form)[0]
     monotone = not restart and c_zero and (isinstance(batch.template.normal, exact.WeightNormal)
                                            or np.all(sgn * np.broadcast_to(plan.drive, (k, 1))[:, 0] <= 0.0))
     wave = None if restart or monotone else exact._pulse_slip(plan, form, sgn[:, None], u_s[:, None])

@@ -129,7 +129,7 @@ def predict_outcomes_many(law, scene: OutcomeScene, params_list, *, speed, incid
     then ``predict_outcomes`` one set at a time gives each answer or error."""
     from ..physics.registry import get_law
     from .batch import simulate_batch
-    from .batchexact import whole_batch_branch
+    from .solvers.exact import form_branch
 
     law = get_law(law)
     rows, fixed, template = _rows(law, scene, speed, incidence, spin)
@@ -139,9 +139,9 @@ def predict_outcomes_many(law, scene: OutcomeScene, params_list, *, speed, incid
     n, out = len(imps), [None] * len(params_list)
     try:
         ps = [law.resolve({**fixed, **(params or {})}) for params in params_list]
-        groups: dict = {}  # sets by the branch the engine takes for a whole batch: each set's own answer
+        groups: dict = {}  # sets by the branch the engine takes for a whole batch (form_branch): each its own answer
         for j, q in enumerate(ps):
-            groups.setdefault(whole_batch_branch(law.form(q)), []).append(j)
+            groups.setdefault(form_branch(law.form(q)), []).append(j)
         t = np.array([[0.0, imp.contact_time] for imp in imps])
         for js in groups.values():
             p = {name: np.repeat([ps[j][name] for j in js], n) for name in law.param_names}

@@ -41,15 +41,20 @@ XTICKS = 0.28
 GAP = 0.15
 
 
+def _lines_in(text: str, pt: float) -> float:
+    """Inches the lines of ``text`` take at ``pt`` points."""
+    return (text.count("\n") + 1) * 1.2 * pt / 72
+
+
 def title_in(text: str, pt: float) -> float:
     """Inches an axes title ``text`` (its lines at ``pt`` points, and the pad under it) takes; 0 for none."""
-    return (text.count("\n") + 1) * 1.2 * pt / 72 + 0.08 if text else 0.0
+    return _lines_in(text, pt) + 0.08 if text else 0.0
 
 
 def suptitle(fig, text: str, pt: float) -> float:
     """The figure's title ``text`` at ``pt`` points, EDGE inches under the top; returns the inches it takes."""
     fig.suptitle(text, fontsize=pt, y=1 - EDGE / fig.get_figheight())
-    return EDGE + (text.count("\n") + 1) * 1.2 * pt / 72 + 0.02
+    return EDGE + _lines_in(text, pt) + 0.02
 
 
 def margins(fig, top: float, bottom: float, right: float = EDGE, hspace: float = 0.0, left: float | None = None,

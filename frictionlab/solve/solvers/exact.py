@@ -255,10 +255,19 @@ def _area_integrals(area, t, second=True):
     return A, (area.peak / phi * (1.0 - np.cos(phi * tau)) if second else None)
 
 
+def form_branch(form) -> tuple[bool, bool]:
+    """What the stop search decides from a NormalAreaRateForm for all its scenes at once (arrays on a batch): no
+    area term anywhere (c = 0), and a >= 0 everywhere. Scenes batched only with others of the same branch get,
+    bit for bit, the answer of their own batch; every other step runs row by row. (True, True) for any other
+    form (F = k A u has no stop search)."""
+    c, a = getattr(form, "c", 0.0), getattr(form, "a", 0.0)
+    return bool((np.asarray(c) == 0.0).all()), bool((np.asarray(a) >= 0.0).all())
+
+
 def closed_stop_applies(plan, form, t0) -> bool:
     """Whether ``half_sine_stop`` gives the stop: F = s a N (a >= 0, no area term), N a half-sine
     pulse, no drive, from first contact (Coulomb on an impact)."""
-    return bool((np.asarray(t0) == 0.0).all() and (np.asarray(form.c) == 0.0).all() and (np.asarray(form.a) >= 0.0).all()
+    return bool((np.asarray(t0) == 0.0).all() and form_branch(form) == (True, True)
                 and isinstance(plan.scene.normal, HalfSineNormal) and (np.asarray(plan.drive) == 0.0).all())
 
 
