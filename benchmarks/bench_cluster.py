@@ -14,7 +14,7 @@ before the clock starts: a cluster is long-lived), after one untimed local run o
 (so that this process, which is the local run and every Dask run's client, has its imports and caches warm
 before the first timed run, as the prepared workers have theirs).
 Prints per run its wall seconds, the CPU seconds of this process (the client and, in a LocalCluster, the
-scheduler) and of each worker, and the load average (wall ratios mean something only on an idle machine:
+scheduler) and of each worker with its child processes (where its tasks run), and the load average (wall ratios mean something only on an idle machine:
 with other work on the cores, 2 workers cannot be faster than the cores they get); then the ratios of the
 median walls. Every run's numbers are checked equal to the local run's.
 Targets: 2 workers at least 1.6x faster than 1; 1 worker no slower than the local run.
@@ -76,6 +76,16 @@ def cpu_self() -> float:
     return r.ru_utime + r.ru_stime
 
 
+def cpu_tree() -> float:
+    """CPU seconds (user + system) so far of the calling process and its live child processes (a worker's
+    tasks run in its children, ``core.taskhost``)."""
+    import psutil
+
+    procs = [psutil.Process()]
+    procs += procs[0].children(recursive=True)
+    return sum(sum(p.cpu_times()[:2]) for p in procs)
+
+
 def one_run(dss, bootstrap, workers):
     """(wall seconds of compare + report, CPU seconds of this process (the client, and in a LocalCluster the
     scheduler), CPU seconds of each worker, the comparison): local (workers None) or on a LocalCluster of
@@ -83,8 +93,10 @@ def one_run(dss, bootstrap, workers):
     from frictionlab.pipeline.comparison import compare
     from frictionlab.report import write_report
 
+    from frictionlab.core.workers import long_run_gc
+
     opts = dict(datasets=dss, bootstrap=bootstrap, tolerance=(1e-3, 1e-10))
-    with tempfile.TemporaryDirectory() as tmp:
+    with tempfile.TemporaryDirectory() as tmp, long_run_gc():  # as `frictionlab compare` runs, locally or not
         if workers is None:
             t0, c0 = time.perf_counter(), cpu_self()
             c = compare(jobs=1, **opts)
@@ -95,12 +107,12 @@ def one_run(dss, bootstrap, workers):
         with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                       dashboard_address=None) as cluster, distributed.Client(cluster) as client:
             warm(client)
-            w0 = client.run(cpu_self)
+            w0 = client.run(cpu_tree)
             t0, c0 = time.perf_counter(), cpu_self()
             c = compare(client=client, **opts)
             write_report(c, f"{tmp}/r", client=client)
             wall, own = time.perf_counter() - t0, cpu_self() - c0
-            w1 = client.run(cpu_self)
+            w1 = client.run(cpu_tree)
             return wall, own, [w1[k] - w0[k] for k in sorted(w0)], c
 
 

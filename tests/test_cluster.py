@@ -64,10 +64,13 @@ def test_bad_scheduler_is_one_line(tmp_path, capsys):
 
 
 def test_workers_are_prepared_once_per_warm_function():
-    """``core.cluster.prepare`` runs its warm-up (imports, malloc thresholds) once per worker and function."""
+    """``core.cluster.prepare`` starts a child process per worker thread and runs its warm-up there, once per
+    worker and function; the worker process itself runs nothing of it."""
+    import os
+
     from frictionlab.core import cluster
 
-    def warm():  # counts its runs in the worker process's environment
+    def warm():  # counts its runs in the child process's environment
         import os
 
         os.environ["FRICTIONLAB_TEST_WARM"] = str(int(os.environ.get("FRICTIONLAB_TEST_WARM", "0")) + 1)
@@ -75,7 +78,7 @@ def test_workers_are_prepared_once_per_warm_function():
     def runs():
         import os
 
-        return os.environ.get("FRICTIONLAB_TEST_WARM")
+        return os.environ.get("FRICTIONLAB_TEST_WARM"), os.getpid()
 
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as lc, distributed.Client(lc) as client:
@@ -84,45 +87,53 @@ def test_workers_are_prepared_once_per_warm_function():
         cluster.prepare(client, warm)
         cluster.prepare(client, warm)  # the second call finds every worker prepared
         assert set(client.run(cluster._prepared, key).values()) == {True}
-        assert set(client.run(runs).values()) == {"1"}
+        workers = client.run(os.getpid)
+        assert {r[0] for r in client.run(runs).values()} == {None}  # not in the worker processes
+        with cluster.executor(1, client, warm=warm) as ex:
+            done = [f.result() for f in [ex.submit(runs) for _ in range(6)]]
+        assert {d[0] for d in done} == {"1"}
+        assert not {d[1] for d in done} & set(workers.values())
 
 
-def _watching(dask_worker) -> dict:
-    """Of each of the worker's callbacks that ``core.cluster.quietly`` quietens: its period in ms, None if stopped."""
-    from frictionlab.core.cluster import QUIET
+def _child(kind: str):
+    """A task for ``test_tasks_run_in_a_child_of_the_worker``."""
+    import os
+    import sys
 
-    pcs = {name: dask_worker.periodic_callbacks[name] for name in QUIET}
-    return {name: pc.callback_time if pc.is_running() else None for name, pc in pcs.items()}
-
-
-def _quiet_within(seconds: float) -> dict:
-    """In a task: the worker's watching callbacks once quietened (within ``seconds``: it is queued on its loop)."""
-    import time
-
-    from distributed import get_worker
-
-    worker, end = get_worker(), time.monotonic() + seconds
-    while time.monotonic() < end and _watching(worker)["profile"] is not None:
-        time.sleep(0.01)
-    return _watching(worker)
+    if kind == "where":
+        print("a task's own output on stdout")  # not on the pipe the reply takes
+        return os.getpid(), os.getppid(), "MALLOC_TRIM_THRESHOLD_" in os.environ, list(sys.path)
+    if kind == "raise":
+        raise KeyError("the task's own error")
+    os.kill(os.getpid(), 9)
 
 
-def test_worker_quietened_only_while_frictionlab_tasks_run():
-    """``core.cluster.executor``'s tasks stop the worker's profiler and slow its tick and system monitor; all
-    run as before afterwards, and a task submitted on the client directly (not frictionlab's) changes nothing."""
-    import time
+def test_tasks_run_in_a_child_of_the_worker(tmp_path):
+    """On a worker, ``core.cluster.executor``'s tasks run in a child process of it (``core.taskhost``), reused
+    from task to task, with the worker's sys.path and not the nanny's malloc setting; the task's exception
+    comes back as itself; a child that dies is a one-line WorkerLost, and the next task gets a new child."""
+    import os
 
-    from frictionlab.core.cluster import QUIET, executor
+    from frictionlab.core.cluster import executor
+    from frictionlab.core.errors import WorkerLost
+
+    def add_path(path):
+        import sys
+
+        sys.path.append(path)
 
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as lc, distributed.Client(lc) as client:
-        (before,) = client.run(_watching).values()
-        assert None not in before.values() and before["tick"] < QUIET["tick"]
-        assert client.submit(_quiet_within, 0.5, pure=False).result() == before
+        (worker,) = client.run(os.getpid).values()
+        client.run(add_path, str(tmp_path))  # as client.upload_file does: the child starts with the worker's path
         with executor(1, client) as ex:
-            futures = [ex.submit(_quiet_within, 5.0) for _ in range(3)]
-            assert [f.result() for f in futures] == [QUIET] * 3
-        end = time.monotonic() + 5
-        while time.monotonic() < end and list(client.run(_watching).values()) != [before]:
-            time.sleep(0.05)
-        assert list(client.run(_watching).values()) == [before]
+            first, again = ex.submit(_child, "where").result(), ex.submit(_child, "where").result()
+            assert first[1] == worker and first[0] != worker and again[0] == first[0]
+            assert first[2] is False and str(tmp_path) in first[3]
+            with pytest.raises(KeyError, match="the task's own error"):
+                ex.submit(_child, "raise").result()
+            with pytest.raises(WorkerLost, match="child process of the Dask worker died") as lost:
+                ex.submit(_child, "die").result()
+            assert "\n" not in str(lost.value)
+            after = ex.submit(_child, "where").result()
+            assert after[1] == worker and after[0] != first[0]

@@ -1,0 +1,195 @@
+"""On a Dask worker: frictionlab's tasks run in child processes of the worker (``hosted``), one per task running.
+
+A worker's event loop shares the worker process's GIL with the thread that computes a task. Each time the loop
+wakes (heartbeats, monitors, messages: tens of times a second) it takes the GIL from the computing thread,
+and a fit, which gives the GIL up and takes it back around numpy's calls, then spends about a tenth more CPU
+for the same work than in a plain process (an asyncio loop waking ten times a second does the same in a plain
+process; ``benchmarks/bench_cluster.py``). A child process has no event loop: the worker's thread sends it the
+task (cloudpickle, over a pipe) and waits for the reply without holding the GIL.
+
+A child starts with the worker's ``sys.path`` and environment, less the nanny's MALLOC_TRIM_THRESHOLD_ (so
+malloc behaves as in a plain process), collects garbage as ``compare``'s own process does (``long_run_gc``: what
+its warm-ups built is frozen), runs every warm-up function the worker was prepared with
+(``cluster.prepare``), and then one task after another. It ends with its worker (SIGKILL when the thread that
+started it ends, on Linux; otherwise at the end of its pipe). A child that dies during a task (killed, out of
+memory, a plugin ending its process) is the task's ``WorkerLost`` error; the next task starts another.
+"""
+from __future__ import annotations
+
+import os
+import pickle
+import subprocess
+import sys
+import threading
+
+from .errors import FrictionLabError, WorkerLost
+
+#: the nanny's allocator setting that a child does not inherit (it also fixes glibc's mmap threshold at 128 KiB)
+NOT_INHERITED = ("MALLOC_TRIM_THRESHOLD_",)
+_IDLE: list = []  # in a worker process: the children waiting for a task
+_WARM: dict = {}  # in a worker process: the warm-up functions every child runs first, by key
+_LOCK = threading.Lock()
+
+
+def hosted(fn, *args, **kwargs):
+    """``fn(*args, **kwargs)``: in a child process when called in a Dask worker's task, here otherwise."""
+    try:
+        from distributed import get_worker
+
+        get_worker()
+    except (ImportError, ValueError):
+        return fn(*args, **kwargs)
+    host = _take()
+    try:
+        return host.call(fn, args, kwargs)
+    finally:
+        if host.alive():
+            with _LOCK:
+                _IDLE.append(host)
+
+
+def warm_children(key: str, warm, count: int) -> None:
+    """In a worker: every child (at least ``count``, started now) runs ``warm()``; later children run it first."""
+    with _LOCK:
+        _WARM[key] = warm
+        idle = [h for h in _IDLE if h.alive()]
+        _IDLE[:] = []
+    idle += [Host() for _ in range(count - len(idle))]
+    try:
+        for host in idle:
+            host.warm(warm)
+    finally:
+        with _LOCK:
+            _IDLE.extend(h for h in idle if h.alive())
+
+
+def _take() -> "Host":
+    """An idle live child, or a new one (warmed)."""
+    with _LOCK:
+        while _IDLE:
+            host = _IDLE.pop()
+            if host.alive():
+                return host
+        warms = list(_WARM.values())
+    host = Host()
+    for warm in warms:
+        host.warm(warm)
+    return host
+
+
+class Host:
+    """One child process and the two pipes to it."""
+
+    def __init__(self):
+        import cloudpickle  # noqa: F401  (a dependency of dask.distributed: a worker has it)
+
+        to_child, from_parent = os.pipe()
+        to_parent, from_child = os.pipe()
+        env = {k: v for k, v in os.environ.items() if k not in NOT_INHERITED}
+        try:
+            self.proc = subprocess.Popen(
+                [sys.executable, "-m", "frictionlab.core.taskhost", str(to_child), str(from_child), str(os.getpid())],
+                pass_fds=(to_child, from_child), env=env, stdin=subprocess.DEVNULL)
+        finally:
+            os.close(to_child)
+            os.close(from_child)
+        self.outbox, self.inbox = os.fdopen(from_parent, "wb"), os.fdopen(to_parent, "rb")
+        self.call(_set_path, (list(sys.path),), {})
+
+    def alive(self) -> bool:
+        return self.proc.poll() is None
+
+    def warm(self, warm) -> None:
+        """``warm()`` in the child (None: nothing), then what it built frozen (``gc.freeze``)."""
+        self.call(_warmed, (warm,), {})
+
+    def call(self, fn, args: tuple, kwargs: dict):
+        """``fn(*args, **kwargs)`` in the child: its value, or its exception raised here."""
+        try:
+            _send(self.outbox, (fn, args, kwargs))
+            ok, value = _receive(self.inbox)
+        except (EOFError, BrokenPipeError):
+            self.proc.wait()
+            raise WorkerLost(f"a child process of the Dask worker died while running {_name(fn)} (exit status "
+                             f"{self.proc.returncode}: killed, out of memory, or a law plugin that ends its "
+                             "process)") from None
+        if ok:
+            return value
+        raise value
+
+
+def _name(fn) -> str:
+    return getattr(fn, "__qualname__", None) or repr(fn)
+
+
+def _warmed(warm) -> None:
+    import gc
+
+    if warm is not None:
+        warm()
+    gc.freeze()
+
+
+def _set_path(path: list) -> None:
+    sys.path[:] = path
+
+
+def _send(f, obj) -> None:
+    import cloudpickle
+
+    data = cloudpickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+    f.write(len(data).to_bytes(8, "little"))
+    f.write(data)
+    f.flush()
+
+
+def _receive(f):
+    head = f.read(8)
+    if len(head) < 8:
+        raise EOFError
+    size = int.from_bytes(head, "little")
+    data = f.read(size)
+    if len(data) < size:
+        raise EOFError
+    return pickle.loads(data)
+
+
+def _serve(inbox, outbox) -> None:
+    """The child's loop: a task from ``inbox``, its (ok, value or exception) to ``outbox``, until the pipe ends."""
+    while True:
+        try:
+            task = _receive(inbox)
+        except EOFError:
+            return
+        except BaseException as exc:  # a task that does not unpickle here (a module the worker has, not its child)
+            reply = (False, exc)
+        else:
+            fn, args, kwargs = task
+            try:
+                reply = (True, fn(*args, **kwargs))
+            except BaseException as exc:
+                reply = (False, exc)
+            del task, fn, args, kwargs
+        try:
+            _send(outbox, reply)
+        except BrokenPipeError:
+            return
+        except Exception as exc:  # a value or exception that does not pickle: say so, in one line
+            _send(outbox, (False, FrictionLabError(f"a task's {'value' if reply[0] else 'exception'} could not be "
+                                                   f"sent back from the worker's child process ({exc})")))
+        del reply
+
+
+def main(argv: list[str]) -> int:
+    """The child: its tasks run with the collector settings of ``compare``'s own process (``long_run_gc``)."""
+    from .workers import _worker_init, long_run_gc
+
+    inbox, outbox, parent = int(argv[0]), int(argv[1]), int(argv[2])
+    _worker_init(parent)
+    with long_run_gc():
+        _serve(os.fdopen(inbox, "rb"), os.fdopen(outbox, "wb"))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
