@@ -64,16 +64,16 @@ def test_bad_scheduler_is_one_line(tmp_path, capsys):
 
 
 def test_workers_are_prepared_once_per_warm_function():
-    """``core.cluster.prepare`` starts a child process per worker thread and runs its warm-up there, once per
-    worker and function; the worker process itself runs nothing of it."""
+    """``core.cluster.prepare`` runs its warm-up once per worker and function, in the worker process (which
+    unpickles what its children send back) and in a child process per worker thread, where the tasks run."""
     import os
 
     from frictionlab.core import cluster
 
-    def warm():  # counts its runs in the child process's environment
+    def warm():  # appends this process's id to a list in its environment (a child inherits the worker's)
         import os
 
-        os.environ["FRICTIONLAB_TEST_WARM"] = str(int(os.environ.get("FRICTIONLAB_TEST_WARM", "0")) + 1)
+        os.environ["FRICTIONLAB_TEST_WARM"] = os.environ.get("FRICTIONLAB_TEST_WARM", "") + f"{os.getpid()},"
 
     def runs():
         import os
@@ -87,12 +87,13 @@ def test_workers_are_prepared_once_per_warm_function():
         cluster.prepare(client, warm)
         cluster.prepare(client, warm)  # the second call finds every worker prepared
         assert set(client.run(cluster._prepared, key).values()) == {True}
-        workers = client.run(os.getpid)
-        assert {r[0] for r in client.run(runs).values()} == {None}  # not in the worker processes
+        workers = set(client.run(os.getpid).values())
+        assert all(ran == f"{pid}," for ran, pid in client.run(runs).values())
         with cluster.executor(1, client, warm=warm) as ex:
-            done = [f.result() for f in [ex.submit(runs) for _ in range(6)]]
-        assert {d[0] for d in done} == {"1"}
-        assert not {d[1] for d in done} & set(workers.values())
+            done = {f.result() for f in [ex.submit(runs) for _ in range(6)]}
+        for ran, pid in done:  # in a child: the worker's run (inherited) and its own
+            parent, own = ran.rstrip(",").split(",")
+            assert int(parent) in workers and int(own) == pid and pid not in workers
 
 
 def _child(kind: str):

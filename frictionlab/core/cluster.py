@@ -64,7 +64,10 @@ def _prepared(key: str) -> bool:
 
 
 def _prepare(key: str, warm, dask_worker=None) -> bool:
-    """In a worker: a child process per worker thread, each having run ``warm()`` (``taskhost.warm_children``)."""
+    """In a worker: ``warm()`` (the worker unpickles what its children send back) and a child process per worker
+    thread, each having run ``warm()`` (``taskhost.warm_children``)."""
+    if warm is not None:
+        warm()
     warm_children(key, warm, max(1, getattr(dask_worker, "nthreads", 1)))
     _PREPARED.add(key)
     return True
