@@ -202,6 +202,7 @@ def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, clie
                     for f in sec.figures:
                         figs.append((page[2], f))
                         yield f
+            _write_texts(tmp, c, built, extra)  # every page built: while a pool or cluster draws the last figures
 
         images = {}
         for done, (i, png) in enumerate(_drawn(figures(), jobs, client), 1):  # every page is built by now
@@ -212,20 +213,28 @@ def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, clie
             if progress:
                 progress(done, len(figs) + 1, f"figure {f.name}")
         (tmp / "figures").mkdir(exist_ok=True)
-        for path, sections, figdir in built:
-            page = tmp / path
-            page.parent.mkdir(parents=True, exist_ok=True)
-            up = "../" * path.count("/")
-            title = TITLE if path == "report" else f"{TITLE}: {path.split('/', 1)[1]}"
+        for path, sections, figdir in built:  # the HTML pages carry their figures
             own = {f.name: images[(figdir, f.name)] for s in sections for f in s.figures}  # in page order
-            page.with_suffix(".md").write_text(markdown(title, sections, up + figdir), encoding="utf-8")
-            page.with_suffix(".html").write_text(html_page(title, sections, own), encoding="utf-8")
-        (tmp / "ranking.csv").write_text(ranking_csv(c), encoding="utf-8")
-        (tmp / "results.json").write_text(json.dumps(results_json(c, extra), indent=1, allow_nan=False),
-                                          encoding="utf-8")
+            (tmp / path).with_suffix(".html").write_text(html_page(_title(path), sections, own), encoding="utf-8")
         if progress:
             progress(len(figs) + 1, len(figs) + 1, "report.md, report.html, ranking.csv, results.json")
     return out
+
+
+def _title(path: str) -> str:
+    return TITLE if path == "report" else f"{TITLE}: {path.split('/', 1)[1]}"
+
+
+def _write_texts(tmp: Path, c, built: list, extra: dict) -> None:
+    """What needs no figure's bytes: each page's Markdown (its figures linked), ranking.csv and results.json."""
+    for path, sections, figdir in built:
+        page = tmp / path
+        page.parent.mkdir(parents=True, exist_ok=True)
+        up = "../" * path.count("/")
+        page.with_suffix(".md").write_text(markdown(_title(path), sections, up + figdir), encoding="utf-8")
+    (tmp / "ranking.csv").write_text(ranking_csv(c), encoding="utf-8")
+    (tmp / "results.json").write_text(json.dumps(results_json(c, extra), indent=1, allow_nan=False),
+                                      encoding="utf-8")
 
 
 def _pages(c, extra: dict):
