@@ -1,13 +1,13 @@
 """compare on a Dask cluster: 1 and 2 worker processes against the local run, on many datasets.
 
-    python benchmarks/bench_cluster.py [--datasets 20] [--bootstrap 40] [--repeat 1]
+    python benchmarks/bench_cluster.py [--datasets 20] [--bootstrap 40] [--rounds 2]
 
 Workload: ``--datasets`` synthetic variants of built-in time series (impact-golf-v28, impact-golf-v61,
 incline-oil-a100/a200/a400, incline-dry-d10), each the original with Gaussian noise of its stated sigma
 added (seeded), under its own name and group; the four default laws, equivalence test, transfer,
 tolerance check and ``--bootstrap`` replicates, then the report (its figures drawn where the fits ran).
 These variants exist only to give the cluster work; they are not data.
-Runs, in one process, in this order and then again in reverse (the machine's speed drifts): the local
+Runs, in one process, ``--rounds`` times in this order and then again in reverse (the machine's speed drifts): the local
 run with one process (``jobs=1``), a LocalCluster of 1 worker process, one of 2 worker processes (each
 cluster started and its workers prepared as compare prepares them on its first run, ``core.cluster.prepare``,
 before the clock starts: a cluster is long-lived), after one untimed local run on one variant of each base
@@ -133,6 +133,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--datasets", type=int, default=20)
     ap.add_argument("--bootstrap", type=int, default=40)
+    ap.add_argument("--rounds", type=int, default=2, help="rounds of the six runs (forward, then reversed)")
     args = ap.parse_args(argv)
     import logging
     import os
@@ -150,7 +151,7 @@ def main(argv=None):
     times = {"local": [], 1: [], 2: []}
     cpus = {"local": [], 1: [], 2: []}  # (CPU here, [CPU of each worker])
     ref = None
-    for order in (("local", 1, 2), (2, 1, "local")):
+    for order in (("local", 1, 2), (2, 1, "local")) * args.rounds:
         for w in order:
             t, own, per_worker, c = one_run(dss, args.bootstrap, None if w == "local" else w)
             times[w].append(t)
