@@ -1,11 +1,12 @@
 """On a Dask worker: frictionlab's tasks run in child processes of the worker (``hosted``), one per task running.
 
-A worker's event loop shares the worker process's GIL with the thread that computes a task. Each time the loop
-wakes (heartbeats, monitors, messages: tens of times a second) it takes the GIL from the computing thread,
-and a fit, which gives the GIL up and takes it back around numpy's calls, then spends about a tenth more CPU
-for the same work than in a plain process (an asyncio loop waking ten times a second does the same in a plain
-process; ``benchmarks/bench_cluster.py``). A child process has no event loop: the worker's thread sends it the
-task (cloudpickle, over a pipe) and waits for the reply without holding the GIL.
+A worker's event loop runs in the process that computes its tasks, and wakes tens of times a second
+(heartbeats, monitors, messages) to take the GIL. The same fits cost about a tenth more CPU in a worker's task
+thread than in a plain process: 1,589 against 1,777 area-rate fits of impact-golf-v28 per 8 CPU s of the
+computing thread (medians of 4, alternated), and 1,754 in a child process of the same worker; a plain process
+whose asyncio loop wakes ten times a second loses as much. A child process has no event loop: the worker's
+thread sends it the task (pickle, or cloudpickle where pickle cannot) over a pipe and waits for the reply
+without holding the GIL.
 
 A child starts with the worker's ``sys.path`` and environment, less the nanny's MALLOC_TRIM_THRESHOLD_ (so
 malloc behaves as in a plain process), collects garbage as ``compare``'s own process does (``long_run_gc``: what
@@ -38,6 +39,8 @@ def hosted(fn, *args, **kwargs):
 
         get_worker()
     except (ImportError, ValueError):
+        return fn(*args, **kwargs)
+    if os.name != "posix":  # no pipes passed to a child (pass_fds): in the worker's thread, as Dask runs tasks
         return fn(*args, **kwargs)
     host = _take()
     try:
@@ -84,6 +87,7 @@ class Host:
         to_child, from_parent = os.pipe()
         to_parent, from_child = os.pipe()
         env = {k: v for k, v in os.environ.items() if k not in NOT_INHERITED}
+        env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)  # frictionlab found wherever the worker has it
         try:
             self.proc = subprocess.Popen(
                 [sys.executable, "-m", "frictionlab.core.taskhost", str(to_child), str(from_child), str(os.getpid())],
