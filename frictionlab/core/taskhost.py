@@ -1,10 +1,11 @@
 """On a Dask worker: frictionlab's tasks run in child processes of the worker (``hosted``), one per task running.
 
 A worker's event loop runs in the process that computes its tasks, and wakes tens of times a second
-(heartbeats, monitors, messages) to take the GIL. The same fits cost about a tenth more CPU in a worker's task
-thread than in a plain process: 1,589 against 1,777 area-rate fits of impact-golf-v28 per 8 CPU s of the
-computing thread (medians of 4, alternated), and 1,754 in a child process of the same worker; a plain process
-whose asyncio loop wakes ten times a second loses as much. A child process has no event loop: the worker's
+(heartbeats, monitors, messages) to take the GIL. The same fits cost about a sixth more CPU in a worker's task
+thread than in a plain process: 1,487 against 1,730 area-rate fits of impact-golf-v28 per 8 CPU s of the
+computing thread, and 1,736 in a child process of the same worker (medians of 4, alternated: ``python
+benchmarks/bench_worker_thread.py``); a plain process whose asyncio loop wakes ten times a second loses about
+as much. A child process has no event loop: the worker's
 thread sends it the task (pickle, or cloudpickle where pickle cannot) over a pipe and waits for the reply
 without holding the GIL.
 
