@@ -4,8 +4,7 @@ A worker's event loop runs in the process that computes its tasks, and wakes ten
 (heartbeats, monitors, messages) to take the GIL. The same fits cost about a sixth more CPU in a worker's task
 thread than in a plain process: 1,487 against 1,730 area-rate fits of impact-golf-v28 per 8 CPU s of the
 computing thread, and 1,736 in a child process of the same worker (medians of 4, alternated: ``python
-benchmarks/bench_worker_thread.py``); a plain process whose asyncio loop wakes ten times a second loses about
-as much. A child process has no event loop: the worker's
+benchmarks/bench_worker_thread.py``). A child process has no event loop: the worker's
 thread sends it the task (pickle, or cloudpickle where pickle cannot) over a pipe and waits for the reply
 without holding the GIL.
 
