@@ -9,7 +9,8 @@ a plain Python process (started by this one); a task submitted to a LocalCluster
 submits it (``client.submit``: it runs in the worker's task thread, next to the worker's event loop); and the
 same task sent through ``core.cluster.executor``, as every task of ``compare`` and ``write_report`` on a cluster
 (it runs in the worker's child process, ``core.taskhost``). Prints each round's fits and the medians, and the
-ratios of the medians to the plain process's (1.00: as fast per CPU second).
+ratios of the medians to the plain process's (1.00: as fast per CPU second), and the worker's and its child's
+resident memory after the warm-ups.
 """
 from __future__ import annotations
 
@@ -32,6 +33,14 @@ def fits_per_cpu(seconds: float) -> int:
         fit("area-rate", ds)
         n += 1
     return n
+
+
+def resident() -> tuple:
+    """(this process's resident memory, each child process's) in MiB."""
+    import psutil
+
+    me = psutil.Process()
+    return me.memory_info().rss >> 20, [c.memory_info().rss >> 20 for c in me.children()]
 
 
 def plain(seconds: float) -> int:
@@ -60,6 +69,8 @@ def main(argv=None) -> None:
             distributed.Client(lc) as client, executor(1, client) as hosted:
         client.submit(fits_per_cpu, 2.0, pure=False).result()
         hosted.submit(fits_per_cpu, 2.0).result()
+        ((worker, children),) = client.run(resident).values()
+        print(f"resident memory after the warm-ups: worker {worker} MiB, its child process {children} MiB")
         for r in range(args.rounds):
             got["plain process"].append(plain(args.seconds))
             got["worker's task thread"].append(client.submit(fits_per_cpu, args.seconds, pure=False).result())
