@@ -327,7 +327,7 @@ def pulse_stop(C0, B, S, phi, t_end, margin):
     is the one. Arrays broadcast (a batch)."""
     R = np.hypot(B, S)
     delta = np.arctan2(S, B)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # R tiny: level +-inf, handled below
         level, zero = (-margin - C0) / R, -C0 / R
     a_level, a_zero = np.arccos(np.clip(level, -1.0, 1.0)), np.arccos(np.clip(zero, -1.0, 1.0))
     x_pass = delta + a_level
