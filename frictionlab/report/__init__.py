@@ -29,6 +29,7 @@ and add ``mysection`` to ``SECTIONS`` at the place it belongs. Return None to le
 """
 from __future__ import annotations
 
+import collections
 import json
 import os
 import threading
@@ -200,22 +201,28 @@ def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, clie
                 built.append(page)
                 for sec in page[1]:
                     for f in sec.figures:
-                        figs.append((page[2], f))
+                        figs.append((len(built) - 1, f))
                         yield f
             _write_texts(tmp, c, built, extra)  # every page built: while a pool or cluster draws the last figures
 
-        images = {}
+        images, missing = {}, None  # missing: per page, how many of its figures are still to come
         for done, (i, png) in enumerate(_drawn(figures(), jobs, client), 1):  # every page is built by now
-            figdir, f = figs[i]
+            k, f = figs[i]
+            figdir = built[k][2]
             images[(figdir, f.name)] = png
             (tmp / figdir).mkdir(parents=True, exist_ok=True)
             (tmp / figdir / f.name).write_bytes(png)
+            if missing is None:
+                missing = collections.Counter(k for k, _ in figs)
+            missing[k] -= 1
+            if not missing[k]:  # the page's last figure: its HTML now, while the others are drawn
+                _write_html(tmp, built[k], images)
             if progress:
                 progress(done, len(figs) + 1, f"figure {f.name}")
         (tmp / "figures").mkdir(exist_ok=True)
-        for path, sections, figdir in built:  # the HTML pages carry their figures
-            own = {f.name: images[(figdir, f.name)] for s in sections for f in s.figures}  # in page order
-            (tmp / path).with_suffix(".html").write_text(html_page(_title(path), sections, own), encoding="utf-8")
+        for k, page in enumerate(built):
+            if k not in (missing or {}):  # a page without figures
+                _write_html(tmp, page, images)
         if progress:
             progress(len(figs) + 1, len(figs) + 1, "report.md, report.html, ranking.csv, results.json")
     return out
@@ -223,6 +230,13 @@ def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, clie
 
 def _title(path: str) -> str:
     return TITLE if path == "report" else f"{TITLE}: {path.split('/', 1)[1]}"
+
+
+def _write_html(tmp: Path, page: tuple, images: dict) -> None:
+    """One page's HTML, which carries its figures (``images``: PNG bytes by figure folder and name)."""
+    path, sections, figdir = page
+    own = {f.name: images[(figdir, f.name)] for s in sections for f in s.figures}  # in page order
+    (tmp / path).with_suffix(".html").write_text(html_page(_title(path), sections, own), encoding="utf-8")
 
 
 def _write_texts(tmp: Path, c, built: list, extra: dict) -> None:
