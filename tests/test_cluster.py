@@ -138,3 +138,52 @@ def test_tasks_run_in_a_child_of_the_worker(tmp_path):
             assert "\n" not in str(lost.value)
             after = ex.submit(_child, "where").result()
             assert after[1] == worker and after[0] != first[0]
+
+
+SCRIPT_LAW = '''
+import logging
+import numpy as np
+import distributed
+import frictionlab as fl
+from frictionlab import FrictionLaw, ParamSpec, register_law
+
+
+@register_law
+class MainStribeck(FrictionLaw):
+    """Velocity-weakening friction, registered in the script that runs compare (its __main__)."""
+
+    name = "main-stribeck"
+    formula = "F = N (mu_k + (mu_s - mu_k) exp(-|u| / v_s)) sign(u)"
+    citation = "test"
+    params = (ParamSpec("mu_s", "", 0.4, 0.0, 5.0, 0.3, "static"), ParamSpec("mu_k", "", 0.2, 0.0, 5.0, 0.3, "kinetic"),
+              ParamSpec("v_s", "m/s", 0.1, 1e-6, 100.0, 0.1, "Stribeck velocity"))
+    requires = frozenset({"u", "N"})
+
+    def force(self, p, c):
+        return (p["mu_k"] + (p["mu_s"] - p["mu_k"]) * np.exp(-np.abs(c.u) / p["v_s"])) * c.N * np.sign(c.u)
+
+
+if __name__ == "__main__":
+    logging.getLogger("distributed").setLevel(logging.ERROR)
+    opts = dict(laws=["main-stribeck"], datasets=["incline-dry-d10"], bootstrap=0, tolerance=(), equivalence=False)
+    here = fl.compare(jobs=1, **opts)
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as lc, \\
+            distributed.Client(lc) as client:
+        there = fl.compare(client=client, **opts)
+    print([(f.status, f.reason) for f in there.fits])
+    assert [f.status for f in there.fits] == ["ok"], [f.reason for f in there.fits]
+    assert [f.params["mu_k"].value for f in there.fits] == [f.params["mu_k"].value for f in here.fits]
+    print("SAME")
+'''
+
+
+def test_a_law_registered_in_the_main_script_fits_on_the_cluster(tmp_path):
+    """A law registered at import in the script that calls compare is known where the tasks run, as it is in the
+    worker (multiprocessing imports the script there as __mp_main__): the child process starts the same way."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "with_my_law.py"
+    script.write_text(SCRIPT_LAW)
+    run = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert run.returncode == 0 and "SAME" in run.stdout, run.stdout[-2000:] + run.stderr[-2000:]

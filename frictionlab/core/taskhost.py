@@ -8,8 +8,10 @@ benchmarks/bench_worker_thread.py``). A child process has no event loop: the wor
 thread sends it the task (pickle, or cloudpickle where pickle cannot) over a pipe and waits for the reply
 without holding the GIL.
 
-A child starts with the worker's ``sys.path`` and environment, less the nanny's MALLOC_TRIM_THRESHOLD_ (so
-malloc behaves as in a plain process), collects garbage as ``compare``'s own process does (``long_run_gc``: what
+A child starts as multiprocessing starts a spawned child of the worker (``multiprocessing.spawn.prepare``: the
+worker's ``sys.path``, directory and main module, imported as ``__mp_main__``, so that laws registered there at
+import are registered in the child too, as they are in the worker) with the worker's environment, less the
+nanny's MALLOC_TRIM_THRESHOLD_ (so malloc behaves as in a plain process), collects garbage as ``compare``'s own process does (``long_run_gc``: what
 its warm-ups built is frozen), runs every warm-up function the worker was prepared with
 (``cluster.prepare``), and then one task after another. It ends with its worker (SIGKILL when the thread that
 started it ends, on Linux; otherwise at the end of its pipe). A child that dies during a task (killed, out of
@@ -96,7 +98,10 @@ class Host:
             os.close(to_child)
             os.close(from_child)
         self.outbox, self.inbox = os.fdopen(from_parent, "wb"), os.fdopen(to_parent, "rb")
-        self.call(_set_path, (list(sys.path),), {})
+        from multiprocessing import spawn
+
+        ready = {k: v for k, v in spawn.get_preparation_data("frictionlab-task-host").items() if k != "authkey"}
+        self.call(spawn.prepare, (ready,), {})
 
     def alive(self) -> bool:
         return self.proc.poll() is None
@@ -130,10 +135,6 @@ def _warmed(warm) -> None:
     if warm is not None:
         warm()
     gc.freeze()
-
-
-def _set_path(path: list) -> None:
-    sys.path[:] = path
 
 
 def _send(f, obj) -> None:
