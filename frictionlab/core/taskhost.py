@@ -5,7 +5,7 @@ A worker's event loop runs in the process that computes its tasks, and wakes ten
 thread than in a plain process: 1,487 against 1,730 area-rate fits of impact-golf-v28 per 8 CPU s of the
 computing thread, and 1,736 in a child process of the same worker (medians of 4, alternated: ``python
 benchmarks/bench_worker_thread.py``). A child process has no event loop: the worker's
-thread sends it the task (pickle, or cloudpickle where pickle cannot) over a pipe and waits for the reply
+thread sends it the task (cloudpickle) over a pipe and waits for the reply
 without holding the GIL.
 
 A child starts as multiprocessing starts a spawned child of the worker (``multiprocessing.spawn.prepare``: the
@@ -36,13 +36,7 @@ _LOCK = threading.Lock()
 
 def hosted(fn, *args, **kwargs):
     """``fn(*args, **kwargs)``: in a child process when called in a Dask worker's task, here otherwise."""
-    try:
-        from distributed import get_worker
-
-        get_worker()
-    except (ImportError, ValueError):
-        return fn(*args, **kwargs)
-    if os.name != "posix":  # no pipes passed to a child (pass_fds): in the worker's thread, as Dask runs tasks
+    if os.name != "posix" or not _on_worker():  # (no pass_fds elsewhere: in the worker's thread, as Dask runs it)
         return fn(*args, **kwargs)
     host = _take()
     try:
@@ -53,30 +47,46 @@ def hosted(fn, *args, **kwargs):
                 _IDLE.append(host)
 
 
+def _on_worker() -> bool:
+    try:
+        from distributed import get_worker
+
+        get_worker()
+    except (ImportError, ValueError):
+        return False
+    return True
+
+
 def warm_children(key: str, warm, count: int) -> None:
     """In a worker: every child (at least ``count``, started now) runs ``warm()``; later children run it first."""
     with _LOCK:
         _WARM[key] = warm
         idle = [h for h in _IDLE if h.alive()]
         _IDLE[:] = []
-    idle += [Host() for _ in range(count - len(idle))]
     try:
         for host in idle:
             host.warm(warm)
+        idle += [_started() for _ in range(count - len(idle))]
     finally:
         with _LOCK:
             _IDLE.extend(h for h in idle if h.alive())
 
 
 def _take() -> "Host":
-    """An idle live child, or a new one (warmed)."""
+    """An idle live child, or a new one."""
     with _LOCK:
         while _IDLE:
             host = _IDLE.pop()
             if host.alive():
                 return host
-        warms = list(_WARM.values())
+    return _started()
+
+
+def _started() -> "Host":
+    """A new child that has run every warm-up the worker was prepared with."""
     host = Host()
+    with _LOCK:
+        warms = list(_WARM.values())
     for warm in warms:
         host.warm(warm)
     return host
@@ -138,14 +148,11 @@ def _warmed(warm) -> None:
 
 
 def _send(f, obj) -> None:
-    """``obj`` pickled (by cloudpickle where pickle cannot, e.g. a function sent by value from the client:
-    pickle is several times faster on frictionlab's records) and framed by its length."""
-    try:
-        data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
-    except (pickle.PicklingError, AttributeError, TypeError):
-        import cloudpickle
+    """``obj`` pickled by cloudpickle (as Dask sends a task: a function sent by value from the client, or a
+    figure's draw closure, travels too) and framed by its length."""
+    import cloudpickle
 
-        data = cloudpickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+    data = cloudpickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
     f.write(len(data).to_bytes(8, "little"))
     f.write(data)
     f.flush()

@@ -203,26 +203,22 @@ def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, clie
                     for f in sec.figures:
                         figs.append((len(built) - 1, f))
                         yield f
+            missing.update(k for k, _ in figs)
             _write_texts(tmp, c, built, extra)  # every page built: while a pool or cluster draws the last figures
 
-        images, missing = {}, None  # missing: per page, how many of its figures are still to come
+        images, missing = {}, collections.Counter()  # missing: per page, how many of its figures are still to come
         for done, (i, png) in enumerate(_drawn(figures(), jobs, client), 1):  # every page is built by now
             k, f = figs[i]
             figdir = built[k][2]
             images[(figdir, f.name)] = png
             (tmp / figdir).mkdir(parents=True, exist_ok=True)
             (tmp / figdir / f.name).write_bytes(png)
-            if missing is None:
-                missing = collections.Counter(k for k, _ in figs)
             missing[k] -= 1
             if not missing[k]:  # the page's last figure: its HTML now, while the others are drawn
                 _write_html(tmp, built[k], images)
             if progress:
                 progress(done, len(figs) + 1, f"figure {f.name}")
         (tmp / "figures").mkdir(exist_ok=True)
-        for k, page in enumerate(built):
-            if k not in (missing or {}):  # a page without figures
-                _write_html(tmp, page, images)
         if progress:
             progress(len(figs) + 1, len(figs) + 1, "report.md, report.html, ranking.csv, results.json")
     return out
@@ -240,12 +236,15 @@ def _write_html(tmp: Path, page: tuple, images: dict) -> None:
 
 
 def _write_texts(tmp: Path, c, built: list, extra: dict) -> None:
-    """What needs no figure's bytes: each page's Markdown (its figures linked), ranking.csv and results.json."""
+    """What needs no figure's bytes: each page's Markdown (its figures linked), the HTML of a page without
+    figures, ranking.csv and results.json."""
     for path, sections, figdir in built:
         page = tmp / path
         page.parent.mkdir(parents=True, exist_ok=True)
         up = "../" * path.count("/")
         page.with_suffix(".md").write_text(markdown(_title(path), sections, up + figdir), encoding="utf-8")
+        if not any(s.figures for s in sections):
+            _write_html(tmp, (path, sections, figdir), {})
     (tmp / "ranking.csv").write_text(ranking_csv(c), encoding="utf-8")
     (tmp / "results.json").write_text(json.dumps(results_json(c, extra), indent=1, allow_nan=False),
                                       encoding="utf-8")
