@@ -14,7 +14,8 @@ before the clock starts: a cluster is long-lived), after one untimed local run o
 (so that this process, which is the local run and every Dask run's client, has its imports and caches warm
 before the first timed run, as the prepared workers have theirs).
 Prints per run its wall seconds, the CPU seconds of this process (the client and, in a LocalCluster, the
-scheduler) and of each worker with its child processes (where its tasks run), and the load average (wall ratios mean something only on an idle machine:
+scheduler) and of each worker with its child processes (where its tasks run; also apart), each worker's and its children's
+resident memory at the end, and the load average (wall ratios mean something only on an idle machine:
 with other work on the cores, 2 workers cannot be faster than the cores they get); then the ratios of the
 median walls. Every run's numbers are checked equal to the local run's.
 Targets: 2 workers at least 1.6x faster than 1; 1 worker no slower than the local run.
@@ -76,20 +77,27 @@ def cpu_self() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def cpu_tree() -> float:
-    """CPU seconds (user + system) so far of the calling process and its live child processes (a worker's
-    tasks run in its children, ``core.taskhost``)."""
+def cpu_tree() -> tuple:
+    """(CPU seconds (user + system) so far of the calling process, of its live child processes): a worker's
+    tasks run in its children (``core.taskhost``); the worker passes them on."""
     import psutil
 
-    procs = [psutil.Process()]
-    procs += procs[0].children(recursive=True)
-    return sum(sum(p.cpu_times()[:2]) for p in procs)
+    me = psutil.Process()
+    return sum(me.cpu_times()[:2]), sum(sum(p.cpu_times()[:2]) for p in me.children(recursive=True))
+
+
+def resident() -> tuple:
+    """(the calling process's resident memory, its child processes' summed) in MiB."""
+    import psutil
+
+    me = psutil.Process()
+    return me.memory_info().rss >> 20, sum(c.memory_info().rss for c in me.children(recursive=True)) >> 20
 
 
 def one_run(dss, bootstrap, workers):
     """(wall seconds of compare + report, CPU seconds of this process (the client, and in a LocalCluster the
-    scheduler), CPU seconds of each worker, the comparison): local (workers None) or on a LocalCluster of
-    ``workers`` processes."""
+    scheduler), CPU seconds of each worker, the comparison, each worker's ``resident()`` at the end): local
+    (workers None) or on a LocalCluster of ``workers`` processes."""
     from frictionlab.pipeline.comparison import compare
     from frictionlab.report import write_report
 
@@ -101,7 +109,7 @@ def one_run(dss, bootstrap, workers):
             t0, c0 = time.perf_counter(), cpu_self()
             c = compare(jobs=1, **opts)
             write_report(c, f"{tmp}/r", jobs=1)
-            return time.perf_counter() - t0, cpu_self() - c0, [], c
+            return time.perf_counter() - t0, cpu_self() - c0, [], c, []
         import distributed
 
         with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
@@ -113,7 +121,9 @@ def one_run(dss, bootstrap, workers):
             write_report(c, f"{tmp}/r", client=client)
             wall, own = time.perf_counter() - t0, cpu_self() - c0
             w1 = client.run(cpu_tree)
-            return wall, own, [w1[k] - w0[k] for k in sorted(w0)], c
+            mem = client.run(resident)
+            split = [(w1[k][0] - w0[k][0], w1[k][1] - w0[k][1]) for k in sorted(w0)]
+            return wall, own, split, c, [mem[k] for k in sorted(mem)]
 
 
 def first_difference(a, b, path="") -> str:
@@ -150,18 +160,23 @@ def main(argv=None):
     warm_here(dss)
     times = {"local": [], 1: [], 2: []}
     cpus = {"local": [], 1: [], 2: []}  # (CPU here, [CPU of each worker])
+    children = {"local": [], 1: [], 2: []}  # CPU of the workers' child processes
     ref = None
     for order in (("local", 1, 2), (2, 1, "local")) * args.rounds:
         for w in order:
-            t, own, per_worker, c = one_run(dss, args.bootstrap, None if w == "local" else w)
+            t, own, split, c, mem = one_run(dss, args.bootstrap, None if w == "local" else w)
+            per_worker = [a + b for a, b in split]
             times[w].append(t)
             cpus[w].append((own, per_worker))
+            children[w].append(sum(b for _, b in split))
             got = numbers(c)
             ref = ref if ref is not None else got
             same = got == ref
             cpu = f"CPU {own:6.1f} s here" + (" (client and scheduler)" if per_worker else "")
             if per_worker:
-                cpu += ", workers " + " + ".join(f"{x:.1f}" for x in per_worker) + f" = {sum(per_worker):.1f} s"
+                cpu += ", workers " + " + ".join(f"{x:.1f}" for x in per_worker) + f" = {sum(per_worker):.1f} s ("
+                cpu += " + ".join(f"worker {a:.1f}, children {b:.1f}" for a, b in split) + ")"
+                cpu += "; resident MiB (worker + its children) " + ", ".join(f"{a} + {b}" for a, b in mem)
             print(f"  {'local, 1 process' if w == 'local' else f'Dask, {w} worker process' + 'es' * (w > 1):28s} "
                   f"{t:6.1f} s wall; {cpu}; load average {os.getloadavg()[0]:.1f}; numbers "
                   f"{'equal to the first run' if same else 'DIFFER'}", flush=True)
@@ -178,6 +193,8 @@ def main(argv=None):
     print(f"CPU (what the load average does not distort as much): 1 worker and its client / local = {one / local:.2f}; "
           f"1 worker's CPU / the busier of 2 workers' = {statistics.median(sum(ws) for _, ws in cpus[1]) / busiest:.2f} "
           "(the most 2 workers can gain on 2 free cores, the client's share aside)")
+    print(f"CPU of 1 worker's child process (its tasks, their unpickling and pickling) / local = "
+          f"{statistics.median(children[1]) / local:.3f} (1: the tasks cost there what the whole local run costs)")
     print(f"load average at end {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
 
 

@@ -64,13 +64,13 @@ def test_bad_scheduler_is_one_line(tmp_path, capsys):
 
 
 def test_workers_are_prepared_once_per_warm_function():
-    """``core.cluster.prepare`` runs its warm-up once per worker and function, in the worker process (which
-    unpickles what its children send back) and in a child process per worker thread, where the tasks run."""
+    """``core.cluster.prepare`` runs its warm-up once per worker and function, in a child process per worker
+    thread, where the tasks run, and not in the worker process, which passes tasks and replies on unread."""
     import os
 
     from frictionlab.core import cluster
 
-    def warm():  # appends this process's id to a list in its environment (a child inherits the worker's)
+    def warm():  # appends this process's id to a list in its environment
         import os
 
         os.environ["FRICTIONLAB_TEST_WARM"] = os.environ.get("FRICTIONLAB_TEST_WARM", "") + f"{os.getpid()},"
@@ -88,12 +88,17 @@ def test_workers_are_prepared_once_per_warm_function():
         cluster.prepare(client, warm)  # the second call finds every worker prepared
         assert set(client.run(cluster._prepared, key).values()) == {True}
         workers = set(client.run(os.getpid).values())
-        assert all(ran == f"{pid}," for ran, pid in client.run(runs).values())
+        assert all(ran is None for ran, pid in client.run(runs).values())
+        worker_modules = client.run(lambda: sorted(m for m in __import__("sys").modules if m.startswith("frictionlab")))
         with cluster.executor(1, client, warm=warm) as ex:
             done = {f.result() for f in [ex.submit(runs) for _ in range(6)]}
-        for ran, pid in done:  # in a child: the worker's run (inherited) and its own
-            parent, own = ran.rstrip(",").split(",")
-            assert int(parent) in workers and int(own) == pid and pid not in workers
+        assert len(done) <= 2  # at most one child per worker (one thread each), reused
+        for ran, pid in done:  # in a child: its own warm-up, once
+            assert ran == f"{pid}," and pid not in workers
+        for modules in worker_modules.values():  # the worker imports no more of frictionlab than passing tasks on
+            assert set(modules) <= {"frictionlab", "frictionlab.core", "frictionlab.core.errors",
+                                    "frictionlab.core.taskhost", "frictionlab.core.cluster",
+                                    "frictionlab.core.workers"}, modules
 
 
 def _child(kind: str):

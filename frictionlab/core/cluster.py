@@ -2,10 +2,11 @@
 from __future__ import annotations
 
 import uuid
+from concurrent.futures import Future
 from contextlib import contextmanager
 
 from .errors import ParameterError
-from .taskhost import hosted, warm_children
+from .taskhost import pack, pack_warm_up, relay, unpack, warm_children
 from .workers import process_pool
 
 @contextmanager
@@ -31,18 +32,41 @@ def executor(jobs: int, client=None, stage: str = "frictionlab", warm=None):
 
 
 class Hosted:
-    """A ``client.get_executor`` whose tasks run in the workers' child processes (``taskhost.hosted``; the task
-    keeps its function's name)."""
+    """A ``client.get_executor`` whose tasks run in the workers' child processes (``taskhost.relay``): each task
+    pickled here, passed on unread by the scheduler and the worker, and its reply unpickled here (the task keeps
+    its function's name)."""
 
     def __init__(self, ex):
         self._ex = ex
 
-    def submit(self, fn, *args, **kwargs):
+    def submit(self, fn, *args, **kwargs) -> Future:
+        name = getattr(fn, "__qualname__", None) or repr(fn)
         key = f"{getattr(fn, '__name__', 'task')}-{uuid.uuid4().hex}"
-        return self._ex.submit(hosted, fn, *args, key=key, **kwargs)
+        return _unpacked(self._ex.submit(relay, name, pack(fn, args, kwargs), key=key))
 
     def shutdown(self, wait: bool = True) -> None:
         self._ex.shutdown(wait=wait)
+
+
+def _unpacked(packed: Future) -> Future:
+    """A future of ``packed``'s reply unpacked (``taskhost.unpack``); cancelling either cancels both."""
+    out = Future()
+
+    def settle(f: Future) -> None:
+        if f.cancelled():
+            out.cancel()
+            out.set_running_or_notify_cancel()  # (wakes wait() and as_completed())
+        elif f.exception() is not None:
+            out.set_exception(f.exception())
+        else:
+            try:
+                out.set_result(unpack(f.result()))
+            except BaseException as exc:
+                out.set_exception(exc)
+
+    out.add_done_callback(lambda o: o.cancelled() and packed.cancel())
+    packed.add_done_callback(settle)
+    return out
 
 
 def prepare(client, warm=None) -> None:
@@ -53,7 +77,7 @@ def prepare(client, warm=None) -> None:
     done = client.run(_prepared, key)
     todo = [w for w, ok in done.items() if not ok]
     if todo:
-        client.run(_prepare, key, warm, workers=todo)
+        client.run(_prepare, key, pack_warm_up(warm), workers=todo)
 
 
 _PREPARED: set = set()  # in a worker process: the keys of the warm functions its children run
@@ -63,11 +87,10 @@ def _prepared(key: str) -> bool:
     return key in _PREPARED
 
 
-def _prepare(key: str, warm, dask_worker=None) -> bool:
-    """In a worker: ``warm()`` (the worker unpickles what its children send back) and a child process per worker
-    thread, each having run ``warm()`` (``taskhost.warm_children``)."""
-    if warm is not None:
-        warm()
+def _prepare(key: str, warm: bytes, dask_worker=None) -> bool:
+    """In a worker: a child process per worker thread, each having run the packed warm-up ``warm``
+    (``taskhost.warm_children``). The worker itself neither runs nor unpickles it: it only passes tasks and
+    replies on, and stays as lean as Dask leaves it."""
     warm_children(key, warm, max(1, getattr(dask_worker, "nthreads", 1)))
     _PREPARED.add(key)
     return True

@@ -1,12 +1,13 @@
-"""On a Dask worker: frictionlab's tasks run in child processes of the worker (``hosted``), one per task running.
+"""On a Dask worker: frictionlab's tasks run in child processes of the worker (``relay``), one per task running.
 
 A worker's event loop runs in the process that computes its tasks, and wakes tens of times a second
 (heartbeats, monitors, messages) to take the GIL. The same fits cost about a sixth more CPU in a worker's task
 thread than in a plain process: 1,487 against 1,730 area-rate fits of impact-golf-v28 per 8 CPU s of the
 computing thread, and 1,736 in a child process of the same worker (medians of 4, alternated: ``python
-benchmarks/bench_worker_thread.py``). A child process has no event loop: the worker's
-thread sends it the task (cloudpickle) over a pipe and waits for the reply
-without holding the GIL.
+benchmarks/bench_worker_thread.py``). A child process has no event loop. The client packs a task
+(``pack``: cloudpickle); the worker's thread passes the bytes to its child over a pipe, unread, and waits
+for the packed reply without holding the GIL; the client unpacks it (``unpack``). The worker never unpickles
+frictionlab's objects nor imports more of it than this module.
 
 A child starts as multiprocessing starts a spawned child of the worker (``multiprocessing.spawn.prepare``: the
 worker's ``sys.path``, directory and main module, imported as ``__mp_main__``, so that laws registered there at
@@ -30,17 +31,39 @@ from .errors import FrictionLabError, WorkerLost
 #: the nanny's allocator setting that a child does not inherit (it also fixes glibc's mmap threshold at 128 KiB)
 NOT_INHERITED = ("MALLOC_TRIM_THRESHOLD_",)
 _IDLE: list = []  # in a worker process: the children waiting for a task
-_WARM: dict = {}  # in a worker process: the warm-up functions every child runs first, by key
+_WARM: dict = {}  # in a worker process: the packed warm-ups every child runs first, by key
 _LOCK = threading.Lock()
 
 
-def hosted(fn, *args, **kwargs):
-    """``fn(*args, **kwargs)``: in a child process when called in a Dask worker's task, here otherwise."""
+def pack(fn, args: tuple, kwargs: dict) -> bytes:
+    """A task as the client sends it (cloudpickle: a function sent by value from the client, or a figure's draw
+    closure, travels too)."""
+    import cloudpickle
+
+    return cloudpickle.dumps((fn, args, kwargs), protocol=pickle.HIGHEST_PROTOCOL)
+
+
+def pack_warm_up(warm) -> bytes:
+    """A warm-up for the children (``warm_children``): ``warm()`` (None: nothing), then what it built frozen."""
+    return pack(_warmed, (warm,), {})
+
+
+def unpack(reply: bytes):
+    """A task's value from its packed reply, or its exception raised here."""
+    ok, value = pickle.loads(reply)
+    if ok:
+        return value
+    raise value
+
+
+def relay(name: str, task: bytes) -> bytes:
+    """The packed ``task``'s packed reply: run in a child process when called in a Dask worker's task (the
+    worker passes the bytes on, unread), here otherwise. ``name`` names the task in a ``WorkerLost`` error."""
     if os.name != "posix" or not _on_worker():  # (no pass_fds elsewhere: in the worker's thread, as Dask runs it)
-        return fn(*args, **kwargs)
+        return _replied(task)
     host = _take()
     try:
-        return host.call(fn, args, kwargs)
+        return host.exchange(task, name)
     finally:
         if host.alive():
             with _LOCK:
@@ -57,8 +80,9 @@ def _on_worker() -> bool:
     return True
 
 
-def warm_children(key: str, warm, count: int) -> None:
-    """In a worker: every child (at least ``count``, started now) runs ``warm()``; later children run it first."""
+def warm_children(key: str, warm: bytes, count: int) -> None:
+    """In a worker: every child (at least ``count``, started now) runs the packed warm-up ``warm`` (``pack_warm_up``);
+    later children run it first."""
     with _LOCK:
         _WARM[key] = warm
         idle = [h for h in _IDLE if h.alive()]
@@ -116,23 +140,24 @@ class Host:
     def alive(self) -> bool:
         return self.proc.poll() is None
 
-    def warm(self, warm) -> None:
-        """``warm()`` in the child (None: nothing), then what it built frozen (``gc.freeze``)."""
-        self.call(_warmed, (warm,), {})
+    def warm(self, warm: bytes) -> None:
+        """The packed warm-up ``warm`` (``pack_warm_up``) run in the child."""
+        unpack(self.exchange(warm, "a warm-up"))
 
     def call(self, fn, args: tuple, kwargs: dict):
         """``fn(*args, **kwargs)`` in the child: its value, or its exception raised here."""
+        return unpack(self.exchange(pack(fn, args, kwargs), _name(fn)))
+
+    def exchange(self, task: bytes, name: str) -> bytes:
+        """The packed ``task`` sent to the child, and its packed reply."""
         try:
-            _send(self.outbox, (fn, args, kwargs))
-            ok, value = _receive(self.inbox)
+            _send(self.outbox, task)
+            return _receive(self.inbox)
         except (EOFError, BrokenPipeError):
             self.proc.wait()
-            raise WorkerLost(f"a child process of the Dask worker died while running {_name(fn)} (exit status "
+            raise WorkerLost(f"a child process of the Dask worker died while running {name} (exit status "
                              f"{self.proc.returncode}: killed, out of memory, or a law plugin that ends its "
                              "process)") from None
-        if ok:
-            return value
-        raise value
 
 
 def _name(fn) -> str:
@@ -140,6 +165,7 @@ def _name(fn) -> str:
 
 
 def _warmed(warm) -> None:
+    """``warm()`` (None: nothing), then what it built frozen (``gc.freeze``)."""
     import gc
 
     if warm is not None:
@@ -147,18 +173,14 @@ def _warmed(warm) -> None:
     gc.freeze()
 
 
-def _send(f, obj) -> None:
-    """``obj`` pickled by cloudpickle (as Dask sends a task: a function sent by value from the client, or a
-    figure's draw closure, travels too) and framed by its length."""
-    import cloudpickle
-
-    data = cloudpickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+def _send(f, data: bytes) -> None:
+    """``data`` framed by its length."""
     f.write(len(data).to_bytes(8, "little"))
     f.write(data)
     f.flush()
 
 
-def _receive(f):
+def _receive(f) -> bytes:
     head = f.read(8)
     if len(head) < 8:
         raise EOFError
@@ -166,32 +188,41 @@ def _receive(f):
     data = f.read(size)
     if len(data) < size:
         raise EOFError
-    return pickle.loads(data)
+    return data
+
+
+def _replied(task: bytes) -> bytes:
+    """The packed task run: its packed (True, value), or (False, exception) where it does not unpickle, raises,
+    or its value does not pickle (then said in one line)."""
+    import cloudpickle
+
+    try:
+        fn, args, kwargs = pickle.loads(task)  # (a module the worker has and its child not: the task's error)
+        reply = (True, fn(*args, **kwargs))
+    except BaseException as exc:
+        reply = (False, exc)
+    del task
+    try:
+        return cloudpickle.dumps(reply, protocol=pickle.HIGHEST_PROTOCOL)
+    except Exception as exc:
+        return cloudpickle.dumps((False, FrictionLabError(
+            f"a task's {'value' if reply[0] else 'exception'} could not be sent back from the worker's child "
+            f"process ({exc})")), protocol=pickle.HIGHEST_PROTOCOL)
 
 
 def _serve(inbox, outbox) -> None:
-    """The child's loop: a task from ``inbox``, its (ok, value or exception) to ``outbox``, until the pipe ends."""
+    """The child's loop: a packed task from ``inbox``, its packed reply to ``outbox``, until the pipe ends."""
     while True:
         try:
             task = _receive(inbox)
         except EOFError:
             return
-        except BaseException as exc:  # a task that does not unpickle here (a module the worker has, not its child)
-            reply = (False, exc)
-        else:
-            fn, args, kwargs = task
-            try:
-                reply = (True, fn(*args, **kwargs))
-            except BaseException as exc:
-                reply = (False, exc)
-            del task, fn, args, kwargs
+        reply = _replied(task)
+        del task
         try:
             _send(outbox, reply)
         except BrokenPipeError:
             return
-        except Exception as exc:  # a value or exception that does not pickle: say so, in one line
-            _send(outbox, (False, FrictionLabError(f"a task's {'value' if reply[0] else 'exception'} could not be "
-                                                   f"sent back from the worker's child process ({exc})")))
         del reply
 
 
