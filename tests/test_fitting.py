@@ -257,3 +257,28 @@ def test_a_flag_and_what_it_did_to_the_rank_are_in_the_ranking_frame():
     df = ranking_frame(C())
     assert isinstance(df, pd.DataFrame) and list(df["plausibility_flags"]) == ["rests on eta_prime", ""]
     assert df["rank_effect"].iloc[0].startswith("ranked after every unflagged") and df["rank_effect"].iloc[1] == ""
+
+
+def test_a_parameter_without_effect_does_not_stop_the_others_short_of_their_minimum():
+    """Area-rate with eta' of no effect on the data predicts what Coulomb does, so at its minimum its
+    chi-square is Coulomb's. Levenberg-Marquardt with eta' free stopped at mu = 0.0939, chi-square 27.044, where
+    Coulomb reaches 27.021 at mu = 0.0925 (kharaz2001-tangential-cor); the fit now refits the others with
+    such a parameter held, says so in its notes, and ends at Coulomb's minimum."""
+    ds = "kharaz2001-tangential-cor"
+    area, coulomb = fit("area-rate", ds), fit("coulomb", ds)
+    assert area.identifiability.no_effect == ("eta_prime",)
+    assert area.stats.chisqr <= coulomb.stats.chisqr * (1 + 1e-6)
+    assert area.params["mu"].value == pytest.approx(coulomb.params["mu"].value, abs=0.01 * coulomb.params["mu"].stderr)
+    assert any("stopped short of the minimum beside eta_prime" in n for n in area.notes)
+    held = fit("area-rate", ds, fixed={"eta_prime": area.params["eta_prime"].value})  # the same minimum
+    assert area.stats.chisqr <= held.stats.chisqr * (1 + 1e-6)
+    steady = fit("area-rate", "incline-oil-a100")  # eta' without effect, Levenberg-Marquardt at the minimum
+    assert not any("stopped short" in n for n in steady.notes)
+
+
+def test_a_fit_with_every_parameter_held_is_scored_where_the_noise_is_estimated():
+    """Nothing to fit on a dataset whose sigma is estimated from the data (the goodness test then has a
+    Jacobian with no columns): the result at the held values, not an IndexError."""
+    r = fit("couette", "kharaz2001-spin", fixed={"eta": 30.0, "h": 2.5e-8})
+    assert r.ok and r.stats.n_free == 0 and math.isfinite(r.stats.chisqr)
+    assert 0.0 < r.goodness.chi2_p < 1.0

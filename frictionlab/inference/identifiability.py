@@ -37,7 +37,7 @@ def jacobian(model, slots, values) -> np.ndarray:
         lo[s.pname] = (x - h) * s.scale
         hi[s.pname] = (x + h) * s.scale
         cols.append((model.residual(hi) - model.residual(lo)) / (2 * h))
-    return np.array(cols).T if cols else np.zeros((0, 0))
+    return np.array(cols).T if cols else np.zeros((model.residual(values).size, 0))  # points x free parameters
 
 
 def find_structure(law, slots, values, J) -> dict:
