@@ -17,7 +17,8 @@ Prints per run its wall seconds, the CPU seconds of this process (the client and
 scheduler) and of each worker with its child processes (where its tasks run; also apart), each worker's and its children's
 resident memory at the end, and the load average (wall ratios mean something only on an idle machine:
 with other work on the cores, 2 workers cannot be faster than the cores they get); then the ratios of the
-median walls. Every run's numbers are checked equal to the local run's.
+median walls and, pass by pass, the 1-worker run over that pass's local run. Every run's numbers are checked equal to
+the local run's.
 Targets: 2 workers at least 1.6x faster than 1; 1 worker no slower than the local run.
 """
 from __future__ import annotations
@@ -187,6 +188,9 @@ def main(argv=None):
     print(f"median wall: local {med['local']:.1f} s, 1 worker {med[1]:.1f} s, 2 workers {med[2]:.1f} s")
     print(f"RATIO 1 worker / 2 workers = {r21:.2f}x (target >= 1.6: {'met' if r21 >= 1.6 else 'NOT met'})")
     print(f"RATIO 1 worker / local = {r1l:.2f} (target <= 1: {'met' if r1l <= 1.0 else 'NOT met'})")
+    pairs = [a / b for a, b in zip(times[1], times["local"])]  # each pass's 1-worker run / its local run
+    print(f"paired, each pass's 1-worker run / its local run: {', '.join(f'{x:.3f}' for x in pairs)} (median "
+          f"{statistics.median(pairs):.3f}, {sum(x <= 1.0 for x in pairs)} of {len(pairs)} at most 1)")
     local = statistics.median(own for own, _ in cpus["local"])
     one = statistics.median(own + sum(ws) for own, ws in cpus[1])
     busiest = statistics.median(max(ws) for _, ws in cpus[2])
