@@ -89,3 +89,21 @@ def test_parallel_comparison_gives_the_same_results():
     two = compare(laws=["wear", "coulomb"], datasets=[ds], jobs=2)
     assert [(r.candidate, r.rank) for r in one.ranking] == [(r.candidate, r.rank) for r in two.ranking]
     assert [r.aic for r in one.ranking] == pytest.approx([r.aic for r in two.ranking], rel=1e-12)
+
+
+def test_one_curve_of_an_unflagged_and_a_flagged_law_is_one_row_with_both_flags():
+    """Coulomb and an area-rate whose eta' has no effect predict one curve; the flagged area-rate ranks as
+    merely indistinguishable from the unflagged Coulomb (a flag breaks a tie), yet in the table they are one
+    row: 'same curve', not 'indistinguishable' from nobody, and area-rate's flag stays on it, as its own."""
+    from frictionlab.report.ranking import candidate_table
+
+    flagged = attrs.evolve(row("d", "area-rate", 10.0), flags=("slip reaches 7e6 times the starting speed",))
+    rows = _rank([row("d", "coulomb", 10.0), flagged, row("d", "wear", 30.0)], tie=0.01)
+    assert {r.law: r.status for r in rows} == {"coulomb": "indistinguishable", "area-rate": "indistinguishable",
+                                                "wear": "ok"}
+    labels = {("coulomb", "exact"): "coulomb = area-rate", ("area-rate", "exact"): "coulomb = area-rate"}
+    headers, table = candidate_table(rows, "cm_tangential_cor", labels)
+    status = {r[1]: r[-1] for r in table}
+    assert set(status) == {"coulomb = area-rate [exact]", "wear [exact]"}
+    assert status["coulomb = area-rate [exact]"] == \
+        "same curve; FLAG (area-rate only): slip reaches 7e6 times the starting speed"

@@ -44,7 +44,9 @@ def law_aliases(c) -> dict[str, str]:
 def candidate_table(rows, observable: str, labels: dict | None = None,
                     display: tuple[str, float] | None = None) -> tuple[list[str], list[list]]:
     """One row per candidate; candidates whose fits are one curve (``labels``) share one row, their Akaike
-    weights summed. display: (unit, factor from SI) of the RMSE, default the observable's display unit."""
+    weights summed, the first's rank and status ('same curve' when only they are near) and every member's
+    flags (another member's marked as its own: e.g. a flagged area-rate whose eta' has no effect, on the
+    row of an unflagged Coulomb). display: (unit, factor from SI) of the RMSE, default the observable's display unit."""
     uname, uf = display or unit(observable)
     headers = ["rank", "law [solver]", "n", "k", f"RMSE [{uname}]", "reduced χ²", "AIC", "AICc", "BIC", "ΔAIC",
                "Akaike weight", "fits? (χ² p, runs p)", "status"]
@@ -58,12 +60,13 @@ def candidate_table(rows, observable: str, labels: dict | None = None,
         r = rs[0]
         same = len(rs) > 1
         tied = [t for t in r.tied_with if t not in {x.candidate for x in rs}]
-        status = ("same curve" if same and r.status == "tied" and not tied else r.status) \
+        status = ("same curve" if same and r.status in ("tied", "indistinguishable") and not tied else r.status) \
             + (f" (with {', '.join(tied)})" if tied else "") + (f": {r.reason}" if r.reason else "")
+        others = "".join(f"; FLAG ({x.law} only): {f}" for x in rs[1:] for f in x.flags if f not in r.flags)
         weight = sum(x.akaike_weight for x in rs) if r.rank else r.akaike_weight
         out.append([r.rank or "–", name, r.n_points or "", r.n_params if r.rank else "",
                     fmt(r.rmse * uf) if math.isfinite(r.rmse) else "", fmt(r.redchi), fmt(r.aic), fmt(r.aicc),
-                    fmt(r.bic), fixed(r.delta_aic, 2), fixed(weight, 3), _fits_cell(r), status + _flags(r)])
+                    fmt(r.bic), fixed(r.delta_aic, 2), fixed(weight, 3), _fits_cell(r), status + _flags(r) + others])
     return headers, out
 
 
