@@ -6,7 +6,7 @@ from concurrent.futures import Future
 from contextlib import contextmanager
 
 from .errors import ParameterError
-from .taskhost import pack, pack_warm_up, relay, unpack, warm_children
+from .taskhost import pack, pack_warm_up, relay, task_name, unpack, warm_children
 from .workers import process_pool
 
 @contextmanager
@@ -40,9 +40,8 @@ class Hosted:
         self._ex = ex
 
     def submit(self, fn, *args, **kwargs) -> Future:
-        name = getattr(fn, "__qualname__", None) or repr(fn)
         key = f"{getattr(fn, '__name__', 'task')}-{uuid.uuid4().hex}"
-        return _unpacked(self._ex.submit(relay, name, pack(fn, args, kwargs), key=key))
+        return _unpacked(self._ex.submit(relay, task_name(fn), pack(fn, args, kwargs), key=key))
 
     def shutdown(self, wait: bool = True) -> None:
         self._ex.shutdown(wait=wait)

@@ -38,9 +38,18 @@ _LOCK = threading.Lock()
 def pack(fn, args: tuple, kwargs: dict) -> bytes:
     """A task as the client sends it (cloudpickle: a function sent by value from the client, or a figure's draw
     closure, travels too)."""
+    return _dumps((fn, args, kwargs))
+
+
+def _dumps(obj) -> bytes:
     import cloudpickle
 
-    return cloudpickle.dumps((fn, args, kwargs), protocol=pickle.HIGHEST_PROTOCOL)
+    return cloudpickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+
+
+def task_name(fn) -> str:
+    """What a task is called in errors: its function's qualified name."""
+    return getattr(fn, "__qualname__", None) or repr(fn)
 
 
 def pack_warm_up(warm) -> bytes:
@@ -146,7 +155,7 @@ class Host:
 
     def call(self, fn, args: tuple, kwargs: dict):
         """``fn(*args, **kwargs)`` in the child: its value, or its exception raised here."""
-        return unpack(self.exchange(pack(fn, args, kwargs), _name(fn)))
+        return unpack(self.exchange(pack(fn, args, kwargs), task_name(fn)))
 
     def exchange(self, task: bytes, name: str) -> bytes:
         """The packed ``task`` sent to the child, and its packed reply."""
@@ -158,10 +167,6 @@ class Host:
             raise WorkerLost(f"a child process of the Dask worker died while running {name} (exit status "
                              f"{self.proc.returncode}: killed, out of memory, or a law plugin that ends its "
                              "process)") from None
-
-
-def _name(fn) -> str:
-    return getattr(fn, "__qualname__", None) or repr(fn)
 
 
 def _warmed(warm) -> None:
@@ -194,20 +199,16 @@ def _receive(f) -> bytes:
 def _replied(task: bytes) -> bytes:
     """The packed task run: its packed (True, value), or (False, exception) where it does not unpickle, raises,
     or its value does not pickle (then said in one line)."""
-    import cloudpickle
-
     try:
         fn, args, kwargs = pickle.loads(task)  # (a module the worker has and its child not: the task's error)
         reply = (True, fn(*args, **kwargs))
     except BaseException as exc:
         reply = (False, exc)
-    del task
     try:
-        return cloudpickle.dumps(reply, protocol=pickle.HIGHEST_PROTOCOL)
+        return _dumps(reply)
     except Exception as exc:
-        return cloudpickle.dumps((False, FrictionLabError(
-            f"a task's {'value' if reply[0] else 'exception'} could not be sent back from the worker's child "
-            f"process ({exc})")), protocol=pickle.HIGHEST_PROTOCOL)
+        return _dumps((False, FrictionLabError(f"a task's {'value' if reply[0] else 'exception'} could not be sent "
+                                               f"back from the worker's child process ({exc})")))
 
 
 def _serve(inbox, outbox) -> None:

@@ -305,6 +305,14 @@ def _valley(result) -> str:
     return ""
 
 
+def lmfit_leastsq(lmfit, model: _Model, slots, params, scale_covar: bool, budget: int):
+    """lmfit's Levenberg-Marquardt on ``model`` from lmfit ``params`` (values / scale), at most ``budget``
+    evaluations: its MinimizerResult."""
+    mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), params, scale_covar=scale_covar,
+                           max_nfev=budget)
+    return mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
+
+
 def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: int, max_nfev, scale_covar: bool = True,
             direct: bool = False):
     """Score a grid of starts, refine the best distinct ones with Levenberg-Marquardt, keep the lowest
@@ -344,9 +352,7 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
             if r is None:  # lmfit takes another path here: run it, from the same state of the model
                 model.nfev, model.failures, model.last_error, model._last = before
         if r is None:
-            mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), levmar.lmfit_parameters(params),
-                                   scale_covar=scale_covar, max_nfev=budget)
-            r = mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
+            r = lmfit_leastsq(lmfit, model, slots, levmar.lmfit_parameters(params), scale_covar, budget)
         if best is None or (r.success, -r.chisqr) > (best.success, -best.chisqr):
             best = r
         why = _valley(r) if slow and r.success and i + 1 < len(starts) else ""

@@ -42,7 +42,8 @@ from ..core.errors import DatasetError, FrictionLabError, ParameterError
 from ..core.workers import beat
 from ..physics.registry import get_law
 from . import levmar
-from .fitmodel import FTOL, ODE_STARTS, PENALTY, FitTimeout, _alarm, _law_slots, _lmfit_bound, _Model, _scene_slots, _search, _si
+from .fitmodel import (FTOL, ODE_STARTS, PENALTY, FitTimeout, _alarm, _law_slots, _lmfit_bound, _Model, _scene_slots,
+                       _search, _si, lmfit_leastsq)
 from .fitresult import DatasetFit, FitResult, ParamResult, Stats
 from .fitstats import (
     AS_GIVEN,
@@ -184,27 +185,21 @@ def _polished(lmfit, law, model, slots, found, scale_covar: bool, timeout):
     held = [s for s in varying if s.display in structure["no_effect"]]
     if not held or len(held) == len(varying) or not outcome[0]:
         return found, (J, structure)
-    r = np.concatenate([(m - tg.y) / tg.sigma for tg, m in zip(model.targets, models)])
+    z = np.concatenate([(m - tg.y) / tg.sigma for tg, m in zip(model.targets, models)])
     others = J[:, [i for i, s in enumerate(varying) if s not in held]]
-    step = np.linalg.lstsq(others, r, rcond=None)[0]
-    if float(np.sum((others @ step) ** 2)) <= FTOL * float(r @ r):  # Gauss-Newton gains nothing: at the minimum
+    step = np.linalg.lstsq(others, z, rcond=None)[0]
+    if float(np.sum((others @ step) ** 2)) <= FTOL * float(z @ z):  # Gauss-Newton gains nothing: at the minimum
         return found, (J, structure)
     budget = 200 * (len(varying) + 1)
-
-    def lm(params):
-        mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), params, scale_covar=scale_covar,
-                               max_nfev=budget)
-        return mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
-
     try:
         with _alarm(timeout):
             params = levmar.lmfit_parameters(best_params).copy()
             for s in held:
                 params[s.pname].set(vary=False)
-            first = lm(params)
+            first = lmfit_leastsq(lmfit, model, slots, params, scale_covar, budget)
             for s in held:
                 first.params[s.pname].set(vary=True)
-            r = lm(first.params)
+            r = lmfit_leastsq(lmfit, model, slots, first.params, scale_covar, budget)
     except (FitTimeout, FrictionLabError):
         return found, (J, structure)
     if not (r.success and r.chisqr < best.chisqr * (1 - FTOL)):
@@ -303,8 +298,10 @@ def _result(law, names, solver_label, model, slots, values, models, best_params,
     if model.progress is not None:
         model.progress.stage("error analysis", 2 * len(varying) + 2)
     if errors:
-        J, structure = known or (jacobian(model, slots, values), None)
-        structure = structure or find_structure(law, slots, values, J)
+        if known is None:
+            J = jacobian(model, slots, values)
+            known = (J, find_structure(law, slots, values, J))
+        J, structure = known
     else:
         k = len(varying) if n_params is None else int(n_params)
         structure = {"at_bounds": (), "ratios": (), "no_effect": (), "k_eff": k, "n_free": len(varying)}
