@@ -141,3 +141,16 @@ def test_golf_answer_states_the_quantitative_and_the_qualitative_verdict_from_th
     assert e.observable == "stated" and e.n_points == 4  # four stated numbers, not 51 curve points
     assert e.qualitative["features"]["data"]["t_peak"] == pytest.approx(260e-6)
     assert e.qualitative["features"]["wear"]["peak"] is False  # the exact wear spin has no peak before t_c
+
+
+def test_a_noise_value_without_kind_is_an_error_naming_the_file_and_the_two_kinds(tmp_path):
+    """A sigma written without saying whether it was measured would be silently ignored: refused instead. A
+    table with only a kind, or with the correlation model another part of the loader reads, is not refused."""
+    p = _copy(tmp_path, "incline-oil-a100", 'kind = "known"\nv = "3 mm/s"', 'v = "3 mm/s"')
+    from frictionlab.core.errors import DatasetError
+
+    with pytest.raises(DatasetError, match=r'incline-oil-a100\.toml: \[noise\] gives v without kind: add kind = '
+                                              r'"known" .* or kind = "estimated"'):
+        load_dataset(p)
+    p.write_text(p.read_text().replace('v = "3 mm/s"', 'kind = "estimated"\ncorrelation = "ar1"'))
+    assert load_dataset(p).noise_kind == "estimated"

@@ -182,6 +182,12 @@ def noise_table(spec: dict, path, observable: str, columns: dict, si_of) -> tupl
     """(sigma by column, kind, NoiseEstimate by estimated column, note) from the [noise] table ``spec``;
     si_of(column, text, where) parses a declared value into SI."""
     spec = dict(spec)
+    spec.pop("correlation", None)  # the noise's correlation model: read by the fit where supported, not a column
+    values = [k for k in spec if k != "kind"]
+    if "kind" not in spec and values:  # a sigma whose use is not declared would be silently ignored
+        raise DatasetError(f"{path}: [noise] gives {', '.join(values)} without kind: add kind = \"known\" (the "
+                           "values are a measured sigma, used as given) or kind = \"estimated\" (sigma from the "
+                           "data alone; the values are then not used)")
     kind = spec.pop("kind", "estimated")
     if not isinstance(kind, str):
         raise DatasetError(f"{path}: noise.kind must be a string, one of {', '.join(NOISE_KINDS)}")

@@ -3,7 +3,8 @@
 ``template(kind, name)`` returns (toml_text, csv_text) for every scene kind (KINDS). The CSV rows
 are example numbers computed from a law on the template's scene (the file says which), to be
 replaced by the user's data; the TOML explains every field, lists every observable of its kind,
-the [noise] kinds, and, where they apply, [scene.materials] and [scene.compliance] examples.
+the [noise] kinds (the template's own states kind = "estimated"; its sigma values are commented, for kind =
+"known"), and, where they apply, [scene.materials] and [scene.compliance] examples.
 """
 from __future__ import annotations
 
@@ -23,11 +24,11 @@ kind = "{kind}"{kind_note}
 
 #: The [noise] table, written the same way for every kind (the loader's kinds: known | estimated | none).
 _NOISE = '''
-[noise]                    # what you know about the noise of the fitted column:
-# kind = "estimated"       #   the default, also with no [noise] table at all: sigma is estimated from the
-#                          #   data alone (differences of neighbouring points, no law); values below are ignored
-# kind = "known"           #   sigma was measured (repeated runs, the instrument's precision): the values below
-#                          #   are used as they are, and the chi-square of each fit is tested against them
+[noise]                    # what you know about the noise of the fitted column; a sigma needs its kind:
+kind = "estimated"         #   estimated (also what no [noise] table at all means): sigma from the data alone
+                           #   (differences of neighbouring points, no law); sigma values here are not used
+# kind = "known"           #   known: sigma was measured (repeated runs, the instrument's precision): the values
+                           #   below are used as they are, and the chi-square of each fit is tested against them
 # kind = "none"            #   noise-free numbers (a reconstruction drawn through stated values)
 {noise}
 '''
@@ -76,8 +77,8 @@ description = "A ball in oblique impact on a rigid target: spin during contact. 
 t = "us"                   # times from first contact, strictly increasing
 omega = "rpm"
 theta = "deg"
-''', '''omega = "200 rpm"          # one standard deviation per column, with its unit
-theta = "0.5 deg"''', '''
+''', '''# omega = "200 rpm"        # with kind = "known": one standard deviation per column, with its unit
+# theta = "0.5 deg"''', '''
 [scene]                    # the body and the contact; every dimensional value says its unit
 mass = "46 g"
 radius = "21.3 mm"
@@ -102,7 +103,7 @@ description = "A block sliding from rest down an incline. Say what, where and ho
 [columns]                  # every CSV column with its unit; the time column must be called t
 t = "s"                    # times from release, strictly increasing
 v = "m/s"
-''', '''v = "3 mm/s"               # one standard deviation per column, with its unit''', '''
+''', '''# v = "3 mm/s"             # with kind = "known": one standard deviation per column, with its unit''', '''
 [scene]
 mass = "20 g"
 u0 = "0 m/s"               # velocity at t = 0
@@ -121,7 +122,7 @@ description = "Oblique impacts of a ball on a plate, one per row. Say what, wher
 speed = "m/s"
 incidence = "deg"          # from the surface normal (angle_reference below)
 rebound_spin = "rpm"
-''', '''rebound_spin = "100 rpm"   # one standard deviation per column, with its unit''', '''
+''', '''# rebound_spin = "100 rpm" # with kind = "known": one standard deviation per column, with its unit''', '''
 [scene]
 mass = "45.9 g"
 radius = "21.35 mm"
@@ -146,7 +147,7 @@ description = "A velocity-step test: friction of a layer driven through a spring
 [columns]                  # every CSV column with its unit; the time column must be called t
 t = "s"                    # strictly increasing
 mu = ""                    # friction coefficient (no unit)
-''', '''mu = 0.0005               # one standard deviation per column (no unit for mu)''', '''
+''', '''# mu = 0.0005             # with kind = "known": one standard deviation per column (no unit for mu)''', '''
 [scene]
 mass = "1 kg"              # not used by the spring-slider (its inertia is [scene.spring] mass)
 
