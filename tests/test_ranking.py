@@ -46,8 +46,8 @@ def test_csv_has_the_documented_columns():
     lines = text.splitlines()
     assert lines[0] == ",".join(COLUMNS) == ("dataset,law,solver,n_points,n_params,rss,rmse,redchi,likelihood,aic,"
                                             "aicc,bic,delta_aic,akaike_weight,rank,status,chi2_p,runs_p,lag1,fits,"
-                                            "flags,reason")
-    assert lines[2].endswith(",,failed,,,,,,did not converge")  # no rank, no numbers for a failed fit, its reason
+                                            "flags,at_bounds,reason")
+    assert lines[2].endswith(",,failed,,,,,,,did not converge")  # no rank, no numbers for a failed fit, its reason
 
 
 @pytest.mark.parametrize("law", sorted(TRUTH))

@@ -28,6 +28,12 @@ class ParamResult:
     upper: float
     datasets: tuple[str, ...]
     fixed_by: str = ""  # why it is held: '' when fitted
+    at_bound: str = ""  # 'lower' | 'upper' when the fit ends at that bound (identifiability.AT_BOUND_REL): no error bar
+
+    @property
+    def bound(self) -> float:
+        """The bound the parameter sits at (nan when it is not at one)."""
+        return {"lower": self.lower, "upper": self.upper}.get(self.at_bound, math.nan)
 
 
 @attrs.frozen
@@ -143,8 +149,9 @@ class FitResult:
             return f"<FitResult {self.law} [{self.solver}] on {on}: {self.status}: {self.reason}>"
         from ..core.display import param_text
 
-        ps = ", ".join(f"{p.name} = {param_text(p.value, p.stderr, p.unit)}" for p in self.params.values()
-                       if p.vary or p.kind == "derived")
+        ps = ", ".join(f"{p.name} = {param_text(p.value, p.stderr, p.unit)}"
+                       + (f" (at its {p.at_bound} bound {param_text(p.bound, None, p.unit)}: not identifiable)"
+                          if p.at_bound else "") for p in self.params.values() if p.vary or p.kind == "derived")
         return f"<FitResult {self.law} [{self.solver}] on {on}: {ps}; reduced chi2 {self.stats.redchi:.3g}>"
 
     def _repr_html_(self) -> str:
@@ -186,7 +193,8 @@ class FitResult:
             lines.append(f"  FLAG (implausible): {flag}")
         for p in self.params.values():
             err = "held" if not p.vary and p.kind != "derived" else ("no error bar" if p.stderr is None else f"+/- {p.stderr:.3g}")
-            why = f" ({p.fixed_by})" if p.fixed_by else ""
+            why = f" ({p.fixed_by})" if p.fixed_by else (f" (at its {p.at_bound} bound {p.bound:.6g}: not identifiable)"
+                                                           if p.at_bound else "")
             lines.append(f"  {p.name:<28} = {p.value:.6g} {p.unit} {err}{why}")
         for w in self.identifiability.warnings:
             lines.append(f"  warning: {w}")

@@ -127,12 +127,13 @@ def _param_results(slots, best, targets, structure, jac) -> dict[str, ParamResul
     for s in slots:
         p = best[s.pname]
         err = p.stderr * s.scale if (s.vary and p.stderr is not None and np.isfinite(p.stderr)) else None
-        if s.display in structure["no_effect"] or (s.vary and in_ratio(s, structure)):
-            err = None
+        side = structure.get("sides", {}).get(s.display, "")
+        if side or s.display in structure["no_effect"] or (s.vary and in_ratio(s, structure)):
+            err = None  # at a bound, without effect, or only a ratio determined: no error is defined
         elif s.vary and (err is None or degenerate):
             err = jac["errors"].get(s.display)
         out[s.display] = ParamResult(s.display, s.key, s.kind, p.value * s.scale, err, s.unit, s.vary, s.value,
-                                     s.lower, s.upper, tuple(targets[i].name for i in s.targets), s.fixed_by)
+                                     s.lower, s.upper, tuple(targets[i].name for i in s.targets), s.fixed_by, side)
     for name, (value, err, unit, slot) in jac["derived"].items():
         out[name] = ParamResult(name, name.split("[")[0], "derived", value, err, unit, False, value, 0.0, math.inf,
                                 tuple(targets[i].name for i in slot.targets),

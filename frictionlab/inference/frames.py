@@ -15,7 +15,7 @@ RANKING_COLUMNS = ("dataset", "law", "solver", "candidate", "rank", "status", "o
                    "rss", "rss_unit", "rmse", "rmse_unit", "redchi", "aic", "aicc", "bic", "delta_aic",
                    "akaike_weight", "reason", "plausibility_flags", "fits", "rank_effect")
 PARAMETER_COLUMNS = ("dataset", "law", "solver", "parameter", "value", "stderr", "unit", "kind", "vary", "fixed_by",
-                     "lower", "upper")
+                     "lower", "upper", "at_bound")
 
 
 def _units(observable: str) -> tuple[str, str]:
@@ -64,7 +64,7 @@ def parameters_frame(fits):
             rows.append({"dataset": "+".join(f.datasets), "law": f.law, "solver": f.solver, "parameter": p.name,
                          "value": p.value, "stderr": p.stderr if p.stderr is not None else math.nan,
                          "unit": p.unit, "kind": p.kind, "vary": p.vary, "fixed_by": p.fixed_by,
-                         "lower": p.lower, "upper": p.upper})
+                         "lower": p.lower, "upper": p.upper, "at_bound": p.at_bound})
     return pd.DataFrame(rows, columns=list(PARAMETER_COLUMNS))
 
 

@@ -21,11 +21,75 @@ class Identifiability:
     high_correlations: tuple[tuple[str, str, float], ...] = ()
     ratio_only: tuple[tuple[str, str], ...] = ()
     no_effect: tuple[str, ...] = ()
+    bound_sides: dict = attrs.field(factory=dict)  # name in at_bounds -> 'lower' | 'upper'
 
 
-#: A parameter is at a bound when within this fraction of its typical size (scale) of it: lam = 1655 with
-#: scale 1e6 is 1.7e-3 scales from 0 and not at the bound; an optimizer pressed against 0 ends far closer.
+#: A parameter is at a nonzero bound when within this fraction of the bound's size of it (k = 997,389 1/m
+#: against an upper bound of 1e6 1/m is 0.26% away: at the bound).
+AT_BOUND_REL = 0.01
+#: ... and at a bound of 0 when within this fraction of its typical size (scale): lam = 1655 with scale 1e6
+#: is 1.7e-3 scales from 0 and not at the bound; an optimizer pressed against 0 ends far closer.
 AT_BOUND = 1e-4
+#: What a parameter at its bound means, for every view that shows one.
+AT_BOUND_MEANING = ("the best fit presses against the edge of the parameter's allowed range, so its value is the "
+                    "bound's, not an estimate the data determine (no error bar, not identifiable); widen the bound "
+                    "or hold the parameter")
+
+
+def bound_side(value: float, lower: float, upper: float, scale: float) -> str:
+    """'lower' or 'upper' when ``value`` lies within AT_BOUND_REL of a nonzero bound (relative to the bound)
+    or within AT_BOUND scales of a zero bound; '' otherwise."""
+    for side, b in (("lower", lower), ("upper", upper)):
+        if not math.isfinite(b):
+            continue
+        room = AT_BOUND_REL * abs(b) if b != 0 else AT_BOUND * abs(scale)
+        if abs(value - b) <= room:
+            return side
+    return ""
+
+
+@attrs.frozen
+class BoundHit:
+    """A fitted parameter at a bound of its allowed range (SI)."""
+
+    name: str  # display name
+    side: str  # 'lower' | 'upper'
+    bound: float
+    value: float
+    unit: str
+
+    def text(self) -> str:
+        """'k = 997,389 1/m is at its upper bound 1e+06 1/m'."""
+        from ..core.display import param_text
+
+        return (f"{self.name} = {param_text(self.value, None, self.unit)} is at its {self.side} bound "
+                f"{param_text(self.bound, None, self.unit)}")
+
+
+def at_bounds(fit) -> tuple[BoundHit, ...]:
+    """The fitted parameters of ``fit`` (a FitResult) at a bound, with the side and the bound: the one list
+    every view reads (report, results.json, ranking.csv, reprs)."""
+    ident = getattr(fit, "identifiability", None)
+    if ident is None:
+        return ()
+    out = []
+    for name in ident.at_bounds:
+        p = fit.params.get(name)
+        if p is None:
+            continue
+        side = ident.bound_sides.get(name) or ("lower" if abs(p.value - p.lower) <= abs(p.value - p.upper) else "upper")
+        out.append(BoundHit(name, side, p.lower if side == "lower" else p.upper, p.value, p.unit))
+    return tuple(out)
+
+
+def bounds_text(fit) -> str:
+    """'k = 997,389 1/m is at its upper bound 1e+06 1/m (meaning)' for every parameter of ``fit`` at a bound;
+    '' when none is."""
+    hits = at_bounds(fit)
+    if not hits:
+        return ""
+    return "; ".join(h.text() for h in hits) + f": {AT_BOUND_MEANING}"
+
 
 def jacobian(model, slots, values) -> np.ndarray:
     """Central-difference Jacobian of the weighted residual in scaled units of the free parameters."""
@@ -45,9 +109,9 @@ def find_structure(law, slots, values, J) -> dict:
     that are both free, parameters with no effect, and the number of identifiable directions
     (rank of the column-normalized Jacobian)."""
     varying = [s for s in slots if s.vary]
-    at_bounds = tuple(s.display for s in varying
-                      if any(math.isfinite(b) and abs(values[s.pname] - b) <= AT_BOUND * max(abs(b) * 1e-3, s.scale)
-                             for b in (s.lower, s.upper)))
+    sides = {s.display: bound_side(values[s.pname], s.lower, s.upper, s.scale) for s in varying}
+    sides = {k: v for k, v in sides.items() if v}
+    at_bounds = tuple(sides)
     ratios = []
     for a, b in law.ratio_only:
         for sa in (s for s in varying if s.kind == "law" and s.key == a):
@@ -62,7 +126,7 @@ def find_structure(law, slots, values, J) -> dict:
     if effect.any():
         sv = np.linalg.svd(J[:, effect] / norms[effect], compute_uv=False)
         k_eff = int(np.sum(sv > 1e-6 * sv[0]))
-    return {"at_bounds": at_bounds, "ratios": tuple(ratios), "no_effect": no_effect, "k_eff": k_eff,
+    return {"at_bounds": at_bounds, "sides": sides, "ratios": tuple(ratios), "no_effect": no_effect, "k_eff": k_eff,
             "n_free": len(varying)}
 
 
@@ -119,8 +183,14 @@ def make_verdict(structure, presults, correl) -> Identifiability:
     if not structure["n_free"]:
         return Identifiability("nothing fitted: every parameter is held")
     warn, missing = [], {}
+    sides = structure.get("sides", {})
     for name in structure["at_bounds"]:
-        warn.append(f"{name} is at (or running into) a bound of its allowed range")
+        p = presults.get(name)
+        side = sides.get(name, "")
+        bound = (p.lower if side == "lower" else p.upper) if p is not None else math.nan
+        where = (f"at its {side} bound ({bound:.6g}{' ' + p.unit if p.unit else ''})" if side and p is not None
+                 else "at a bound of its allowed range")
+        warn.append(f"{name} is {where}: {AT_BOUND_MEANING}")
         missing[name] = "at a bound, where the error is not defined"
     for a, b in structure["ratios"]:
         warn.append(f"{a} and {b} enter only as {a}/{b}: their separate values mean nothing and get no error "
@@ -152,4 +222,4 @@ def make_verdict(structure, presults, correl) -> Identifiability:
                                           ("strong correlation", high), ("missing error bars", missing)) if flag]
     verdict = "identifiable" if not problems else "not fully identifiable: " + ", ".join(problems)
     return Identifiability(verdict, tuple(warn), structure["at_bounds"], missing, tuple(high), structure["ratios"],
-                           structure["no_effect"])
+                           structure["no_effect"], dict(sides))

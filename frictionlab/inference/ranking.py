@@ -42,7 +42,7 @@ NEAR_TIE = 2.0
 
 COLUMNS = ("dataset", "law", "solver", "n_points", "n_params", "rss", "rmse", "redchi", "likelihood", "aic", "aicc",
            "bic", "delta_aic", "akaike_weight", "rank", "status", "chi2_p", "runs_p", "lag1", "fits", "flags",
-           "reason")  # reason: why a fit failed or was skipped
+           "at_bounds", "reason")  # at_bounds: 'k at upper bound 1e+06 1/m'; reason: why a fit failed or was skipped
 
 
 @attrs.frozen
@@ -77,6 +77,7 @@ class RankRow:
     flags: tuple[str, ...] = ()  # plausibility flags: such a candidate ranks after the unflagged ones that fit
     members: tuple[str, ...] = ()  # laws of one closed-form family merged into this candidate
     parameterizations: str = ""  # each member's parameters, e.g. "wear: lam = 2e4 Pa s/m; couette: eta/h = ..."
+    at_bounds: tuple[str, ...] = ()  # parameters at a bound of their range ('k at upper bound 1e+06 1/m'): not identifiable
 
     @property
     def candidate(self) -> str:
@@ -85,6 +86,7 @@ class RankRow:
     def as_dict(self) -> dict:
         out = {c: getattr(self, c) for c in COLUMNS}
         out["flags"] = "; ".join(self.flags)
+        out["at_bounds"] = "; ".join(self.at_bounds)
         return out
 
 
@@ -143,7 +145,14 @@ def fit_row(f: FitResult) -> RankRow:
                    likelihood=s.likelihood, neg2loglik=s.neg2loglik, k_lik=s.k_lik,
                    chi2_p=g.chi2_p if g else math.nan, runs_p=g.runs_p if g else math.nan,
                    lag1=g.lag1 if g else math.nan, fits=g.fits if g else None, goodness=g, flags=tuple(f.flags),
-                   members=(f.law,))
+                   members=(f.law,), at_bounds=bound_labels(f))
+
+
+def bound_labels(f: FitResult) -> tuple[str, ...]:
+    """'k at upper bound 1e+06 1/m' per parameter of ``f`` at a bound (``identifiability.at_bounds``)."""
+    from .identifiability import at_bounds
+
+    return tuple(f"{h.name} at {h.side} bound {h.bound:.6g}{' ' + h.unit if h.unit else ''}" for h in at_bounds(f))
 
 
 def family_key(f: FitResult):
@@ -269,11 +278,12 @@ def _group_row(gname: str, law: str, solver: str, good: list[RankRow]) -> RankRo
     kinds = {r.likelihood for r in good}
     g = combine([r.goodness for r in good]) if all(r.goodness is not None for r in good) else None
     flags = tuple(f"{r.dataset}: {f}" for r in good for f in r.flags)
+    bounds = tuple(f"{r.dataset}: {b}" for r in good for b in r.at_bounds)
     return RankRow(gname, law, solver, n, k, math.nan, math.nan, chi / (n - k) if n > k else math.inf, aic, aicc,
                    bic, likelihood=kinds.pop() if len(kinds) == 1 else "mixed", neg2loglik=ll,
                    k_lik=kl, chi2_p=g.chi2_p if g else math.nan, runs_p=g.runs_p if g else math.nan,
                    lag1=g.lag1 if g else math.nan, fits=g.fits if g else None, goodness=g, flags=flags,
-                   members=good[0].members, parameterizations=" | ".join(
+                   members=good[0].members, at_bounds=bounds, parameterizations=" | ".join(
                        f"{r.dataset}: {r.parameterizations}" for r in good if r.parameterizations))
 
 

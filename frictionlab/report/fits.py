@@ -6,6 +6,7 @@ import re
 from ..core.display import param_cells, param_text
 from ..core.errors import FrictionLabError
 from ..core.units import to_si
+from ..inference.identifiability import AT_BOUND_MEANING
 from ..physics.registry import get_law
 from . import figures
 from .doc import Section
@@ -78,6 +79,9 @@ def param_rows(f) -> list[list[str]]:
             role, comment = "fitted", "arbitrary: only the ratio is determined"
         elif p.vary and p.name in f.identifiability.no_effect:
             comment = "arbitrary: it has no effect on these data (the value is where the optimizer stopped)"
+        elif p.vary and p.at_bound:
+            comment = (f"at its {p.at_bound} bound {param_text(p.bound, None, p.unit)}: not identifiable "
+                       f"({AT_BOUND_MEANING})")
         elif p.vary and p.stderr is None:
             comment = f"no error bar: {f.identifiability.missing_stderr.get(p.name, 'see warnings')}"
         flagged = flags_on(f, p.name)

@@ -7,13 +7,15 @@ results.json:
     datasets[{name, kind, observable, n_points, status: fitted|skipped, reason,
               provenance{kind, source, method, command, seed, truth}}],
     fits[{dataset, law, solver, status: ok|failed|skipped, reason, message, nfev, wall_time_s, cpu_time_s,
-          parameters{name: {value, stderr, unit, kind: law|scene|derived, vary, fixed_by, lower, upper}},
+          parameters{name: {value, stderr, unit, kind: law|scene|derived, vary, fixed_by, lower, upper,
+                            at_bound: lower|upper|null}},
           correlations[{a, b, r}],
           statistics{observable, observable_unit, n_points, n_params, n_free, chisqr, redchi, rss, rmse,
                      aic, aicc, bic, likelihood: known|estimated|mixed|none, likelihood_reason, neg2loglik, k_lik},
           goodness{likelihood, chi2_p, runs_p, runs, runs_expected, lag1, lag1_p, fits, reason, members},
           flags[] (plausibility), plausibility{max_slip_ratio, max_spin_ratio, work_fraction, effect_dchi2{}},
-          identifiability{verdict, warnings[], at_bounds[], missing_stderr{name: reason},
+          identifiability{verdict, warnings[], at_bounds[], bounds[{name, side, bound, value, unit, meaning}],
+                          missing_stderr{name: reason},
                           high_correlations[{a, b, r}], ratio_only[[a, b]], no_effect[]},
           notes[]}],
     ranking[row], groups[row] (row: the ranking.csv columns plus reason, tied_with, flags[], members[],
@@ -56,6 +58,7 @@ import numpy as np
 from ..inference.ranking_bootstrap import parameter_table, ranking_table
 from ..inference.predict import FIT_RTOL
 from ..inference.ranking import COLUMNS, to_csv
+from ..inference.identifiability import AT_BOUND_MEANING, at_bounds
 from ..io.dataset import COLUMN_SI
 
 #: Columns ranking.csv adds after ``ranking.COLUMNS``: what rss and rmse are measured in.
@@ -87,7 +90,8 @@ def fit_json(f) -> dict:
     if f.ok:
         obs = f.per_dataset[0].target.observable
         out["parameters"] = {n: {"value": p.value, "stderr": p.stderr, "unit": p.unit, "kind": p.kind, "vary": p.vary,
-                                 "fixed_by": p.fixed_by, "lower": p.lower, "upper": p.upper}
+                                 "fixed_by": p.fixed_by, "lower": p.lower, "upper": p.upper,
+                                 "at_bound": p.at_bound or None}
                              for n, p in f.params.items()}
         out["correlations"] = [{"a": a, "b": b, "r": r} for (a, b), r in f.correlations.items()]
         s = f.stats
@@ -101,6 +105,8 @@ def fit_json(f) -> dict:
         out["plausibility"] = f.plausibility
         i = f.identifiability
         out["identifiability"] = {"verdict": i.verdict, "warnings": list(i.warnings), "at_bounds": list(i.at_bounds),
+                                  "bounds": [{"name": h.name, "side": h.side, "bound": h.bound, "value": h.value,
+                                              "unit": h.unit, "meaning": AT_BOUND_MEANING} for h in at_bounds(f)],
                                   "missing_stderr": dict(i.missing_stderr),
                                   "high_correlations": [{"a": a, "b": b, "r": r} for a, b, r in i.high_correlations],
                                   "ratio_only": [list(p) for p in i.ratio_only], "no_effect": list(i.no_effect)}
