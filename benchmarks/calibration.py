@@ -1,7 +1,8 @@
-"""Calibration of the equivalence test, measured: false-rejection rate of the true law (size) and power.
+"""Calibration of the equivalence test, measured: the size and power of 'different', and how often 'equivalent
+within delta' is said when the curves differ by delta or more.
 
     python benchmarks/calibration.py [--n 200] [--truth wear area-rate] [--noise known estimated]
-                                     [--scale 0.25 1 4] [--jobs 2] [--seed 0] [--pivot]
+                                     [--scale boundary 0.25 1 4] [--margin 1] [--jobs 2] [--seed 0] [--pivot]
 
 Per case (truth law, noise kind, sigma as a multiple of the pair's noise threshold) it simulates ``n``
 independent impacts (the paper's golf scene, 41 spin samples over the contact) from the truth, with
@@ -14,7 +15,14 @@ runs ``analyze_equivalence`` (wear as A, area-rate as B). It prints, with 95% Wi
   the p-value is calibrated;
 * the share where the two-sided rule (p = 2 min(p_A, p_B) < alpha; a law is rejected when its own p is
   below alpha / 2, ``equivalence._verdict``) rejects the true law: nominally alpha / 2 = 2.5%;
-* power: the share where the rule rejects the other law (its own p below alpha / 2).
+* power: the share where the rule rejects the other law (its own p below alpha / 2);
+* D / delta: the RMS distance of the truth's curve from the other law's best fit to it (noise-free), over
+  the margin delta = margin x sigma (``--margin``, default 1 as in the library, at the true sigma);
+* 'equivalent within delta': the share of datasets whose verdict is that (a test of its own, a family of
+  one), and the share whose upper bound of the distance lies below delta (the bound alone, whatever the
+  discrimination test says). Where D / delta >= 1 the curves differ by delta or more and either share is a
+  false claim of equivalence: at most alpha = 5% if the bound is valid. The case 'boundary' puts sigma where
+  D = delta exactly (the least favourable point of that null: the largest false-equivalence rate).
 
     python benchmarks/calibration.py --pivot   # why T is centred: T against its fitted location
     python benchmarks/calibration.py --spread --truth area-rate --scale 4 --n 80   # why a case is conservative
@@ -81,21 +89,36 @@ def threshold(truth: str) -> float:
     return math.sqrt(max(cross_chi2(fw, fa), cross_chi2(fa, fw)) / CRITICAL)
 
 
-def one(args) -> tuple[bool, bool, int, float]:
+def distance(truth: str) -> float:
+    """D [rad/s]: the RMS distance of ``truth``'s noise-free curve from the other law's best fit to it."""
+    from frictionlab import fit
+    from frictionlab.inference.replicates import distance as rms
+
+    ds = attrs.evolve(_dataset(truth, 1e-9, "known", 0), noise={"omega": 1.0})
+    other = "area-rate" if truth == "wear" else "wear"
+    fo = fit(other, ds)
+    return rms(fo.per_dataset[0].target, fo.per_dataset[0].model, ds.columns["omega"])
+
+
+def one(args) -> tuple:
     """(true law rejected by the rule, other law rejected by the rule, replicates drawn per null, the true
-    law's one-sided p) for one simulated dataset."""
-    truth, noise, sigma, seed = args
+    law's one-sided p, the verdict 'equivalent within delta', the distance's bound below delta) for one
+    simulated dataset."""
+    truth, noise, sigma, seed, margin = args
     from frictionlab import analyze_equivalence, fit
-    from frictionlab.inference.equivalence import ALPHA
+    from frictionlab.inference.equivalence import ALPHA, WITHIN
 
     ds = _dataset(truth, sigma, noise, seed)
     fw, fa = fit("wear", ds), fit("area-rate", ds)
-    e = analyze_equivalence(fw, fa, seed=seed)
+    e = analyze_equivalence(fw, fa, seed=seed, margin=margin)
     if not e.ok:
-        return False, False, 0, math.nan
+        return False, False, 0, math.nan, False, False
+    if not e.tested:  # both laws fail their fit tests: no test, no claim
+        return False, False, 0, math.nan, False, False
     p_true, p_other = (e.p_a, e.p_b) if truth == "wear" else (e.p_b, e.p_a)
     # the rule rejects a law whose own p is below alpha / 2 (then p = 2 min(p_A, p_B) < alpha too)
-    return bool(p_true < ALPHA / 2), bool(p_other < ALPHA / 2), int(e.s_a.size), float(p_true)
+    return (bool(p_true < ALPHA / 2), bool(p_other < ALPHA / 2), int(e.s_a.size), float(p_true),
+            e.verdict == WITHIN, bool(e.p_within < ALPHA))
 
 
 def pivot(truth: str, n: int) -> None:
@@ -127,7 +150,7 @@ def _spread_one(args):
 
     ds = _dataset(truth, sigma, "known", 7000 + seed)
     fw, fa = fit("wear", ds), fit("area-rate", ds)
-    c_a, c_b = _centrings(fw, fa, None)
+    (c_a, _), (c_b, _) = _centrings(fw, fa, None, 1.0)
     t = fw.stats.chisqr - fa.stats.chisqr
     da, db = fw.per_dataset[0], fa.per_dataset[0]
     rows = np.array(replicate_chunk("wear", refit_options(fw), "area-rate", refit_options(fa), da.target, da.model,
@@ -144,12 +167,12 @@ def spread(truth: str, scale: float, n: int, jobs: int, m: int = 100) -> None:
     thr = threshold(truth)
     with ProcessPoolExecutor(jobs) as pool:
         res = list(pool.map(_spread_one, [(truth, scale * thr, i, m) for i in range(n)]))
-    col = 3 if truth == "area-rate" else 1  # S_B under area-rate's fit, S_A under wear's
+    col = 4 if truth == "area-rate" else 1  # S_B under area-rate's fit, S_A under wear's (replicates.ROW)
     data = np.array([t - cb if truth == "area-rate" else t + ca for t, ca, cb, _ in res])
     dist = np.array([cb if truth == "area-rate" else ca for _, ca, cb, _ in res])
     reps = np.concatenate([r[np.isfinite(r).all(axis=1)] for *_, r in res])
     rep_s = reps[:, col]
-    rep_c = reps[:, 2] - reps[:, 3] if truth == "area-rate" else reps[:, 1] - reps[:, 0]
+    rep_c = reps[:, 3] - reps[:, 4] if truth == "area-rate" else reps[:, 1] - reps[:, 0]
     clean = attrs.evolve(_dataset(truth, 1e-9, "known", 0), noise={"omega": scale * thr})
     fw, fa = fit("wear", clean), fit("area-rate", clean)
     true_c = cross_chi2(fw, fa) if truth == "area-rate" else cross_chi2(fa, fw)
@@ -198,33 +221,54 @@ def _pct(row: dict, key: str) -> str:
     return f"{100 * row[key]:.1f}% [{100 * lo:.1f}, {100 * hi:.1f}]"
 
 
-def run(n: int, truths, noises, scales, jobs: int, seed: int) -> list[dict]:
+def run(n: int, truths, noises, scales, jobs: int, seed: int, margin: float = 1.0) -> list[dict]:
+    """The cases; a scale is a multiple of the pair's noise threshold, or 'boundary' (the curves' distance D
+    equal to the margin delta = margin x sigma)."""
     from frictionlab.inference.equivalence import ALPHA
+
 
     rows = []
     with ProcessPoolExecutor(jobs) as pool:
         for truth in truths:
-            thr = threshold(truth)
+            thr, dist = threshold(truth), distance(truth)
             print(f"noise threshold of wear vs area-rate on {truth}'s curve: {thr:.4g} rad/s "
-                  f"({thr * 60 / (2 * math.pi):.4g} rpm)", flush=True)
+                  f"({thr * 60 / (2 * math.pi):.4g} rpm); the curves' distance D = {dist:.4g} rad/s RMS, so D = "
+                  f"delta = {margin:g} x sigma at sigma = {dist / margin / thr:.3g} x threshold", flush=True)
             for noise in noises:
                 for scale in scales:
+                    sigma = dist / margin if scale == "boundary" else float(scale) * thr
                     t0 = time.perf_counter()
-                    tasks = [(truth, noise, scale * thr, seed * 100_000 + i) for i in range(n)]
+                    tasks = [(truth, noise, sigma, seed * 100_000 + i, margin) for i in range(n)]
                     res = list(pool.map(one, tasks, chunksize=4))
                     k_size = sum(r[0] for r in res)
                     k_pow = sum(r[1] for r in res)
                     k_p = sum(r[3] < ALPHA for r in res)
+                    k_eq, k_bound = sum(r[4] for r in res), sum(r[5] for r in res)
                     reps = np.mean([r[2] for r in res])
-                    row = dict(truth=truth, noise=noise, scale=scale, n=n, size=k_size / n, size_ci=wilson(k_size, n),
+                    row = dict(truth=truth, noise=noise, scale=scale, sigma_thr=sigma / thr, margin=margin,
+                               d_delta=dist / (margin * sigma), n=n, size=k_size / n, size_ci=wilson(k_size, n),
                                p_size=k_p / n, p_size_ci=wilson(k_p, n), power=k_pow / n, power_ci=wilson(k_pow, n),
+                               eq=k_eq / n, eq_ci=wilson(k_eq, n), bound=k_bound / n, bound_ci=wilson(k_bound, n),
                                replicates=reps, seconds=time.perf_counter() - t0)
                     rows.append(row)
-                    print(f"truth {truth:9s} noise {noise:9s} sigma {scale:g} x threshold: "
-                          f"p(true) < {ALPHA:g} {_pct(row, 'p_size')}; rule rejects the true law {_pct(row, 'size')}, "
-                          f"the other law (power) {_pct(row, 'power')}; {n} datasets, mean {reps:.0f} replicates "
-                          f"per null, {row['seconds']:.0f} s", flush=True)
+                    print(f"truth {truth:9s} noise {noise:9s} sigma {row['sigma_thr']:.3g} x threshold "
+                          f"(D / delta = {row['d_delta']:.3g}): p(true) < {ALPHA:g} {_pct(row, 'p_size')}; rule rejects "
+                          f"the true law {_pct(row, 'size')}, the other law (power) {_pct(row, 'power')}; 'equivalent "
+                          f"within delta' {_pct(row, 'eq')}, bound below delta {_pct(row, 'bound')}; {n} datasets, mean "
+                          f"{reps:.0f} replicates per null, {row['seconds']:.0f} s", flush=True)
     return rows
+
+
+def table(rows: list[dict]) -> str:
+    """The calibration table (Markdown): size and power of 'different', and 'equivalent within delta'."""
+    head = ("| truth | noise | delta / sigma | sigma / threshold | D / delta | p(true) < 0.05 | rule rejects the true law | power | "
+            "says 'equivalent within delta' | bound below delta | mean replicates per law |")
+    lines = [head, "|" + "---|" * head.count(" | ") + "---|"]
+    for r in rows:
+        lines.append(f"| {r['truth']} | {r['noise']} | {r['margin']:g} | {r['sigma_thr']:.3g} | {r['d_delta']:.3g} | {_pct(r, 'p_size')} | "
+                     f"{_pct(r, 'size')} | {_pct(r, 'power')} | {_pct(r, 'eq')} | {_pct(r, 'bound')} | "
+                     f"{r['replicates']:.0f} |")
+    return "\n".join(lines)
 
 
 def main(argv=None) -> int:
@@ -232,7 +276,9 @@ def main(argv=None) -> int:
     p.add_argument("--n", type=int, default=200)
     p.add_argument("--truth", nargs="+", default=list(TRUTH))
     p.add_argument("--noise", nargs="+", default=["known", "estimated"])
-    p.add_argument("--scale", nargs="+", type=float, default=[0.25, 1.0, 4.0])
+    p.add_argument("--scale", nargs="+", default=["boundary", "0.25", "1", "4"],
+                   help="sigma as a multiple of the noise threshold, or 'boundary' (the curves differ by delta exactly)")
+    p.add_argument("--margin", type=float, default=1.0, help="delta as a multiple of sigma (default 1, the library's)")
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--pivot", action="store_true", help="print how T moves with the fitted parameters and stop")
@@ -242,17 +288,25 @@ def main(argv=None) -> int:
     if a.spread:
         for truth in a.truth:
             for scale in a.scale:
-                spread(truth, scale, a.n, a.jobs)
+                spread(truth, float(scale), a.n, a.jobs)
         return 0
     if a.pivot:
         for truth in a.truth:
             pivot(truth, 40)
         return 0
-    rows = run(a.n, a.truth, a.noise, a.scale, a.jobs, a.seed)
+    rows = run(a.n, a.truth, a.noise, a.scale, a.jobs, a.seed, a.margin)
+    print(table(rows))
     worst = max(rows, key=lambda r: r["p_size"])
     print(f"size of the true law's test at alpha = 0.05 (the largest false-rejection rate over the {len(rows)} cases run, "
           f"sup over the null): {_pct(worst, 'p_size')} ({worst['truth']} truth, noise {worst['noise']}, sigma "
-          f"{worst['scale']:g} x threshold); the rule's: {100 * max(r['size'] for r in rows):.1f}% (nominal 2.5%)")
+          f"{worst['sigma_thr']:.3g} x threshold); the rule's: {100 * max(r['size'] for r in rows):.1f}% (nominal 2.5%)")
+    apart = [r for r in rows if r["d_delta"] >= 1.0]
+    if apart:
+        w = max(apart, key=lambda r: (r["eq"], r["bound"]))
+        print(f"'equivalent within delta' said where the curves differ by delta or more (D / delta >= 1, "
+              f"{len(apart)} cases): at most {_pct(w, 'eq')} ({w['truth']} truth, noise {w['noise']}, D / delta = "
+              f"{w['d_delta']:.3g}); the bound alone below delta: at most {100 * max(r['bound'] for r in apart):.1f}% "
+              "(nominal at most 5%)")
     return 0
 
 

@@ -130,11 +130,11 @@ def test_compare_summary_renders_the_answers_only():
     assert answer_lines(C()) == ["answers: none (the verdict layer filled no Comparison.answers); see the report's "
                                  "tables"]
     a = Answer(group="impact-golf", datasets=("a",), provenance="reconstructed", best="wear [exact]", fits=False,
-               headline="no registered law describes these data", goodness="chi2 p < 1e-6", equivalence="not equivalent",
+               headline="no registered law describes these data", goodness="chi2 p < 1e-6", equivalence="different",
                noise_threshold="", series_vs_exact="the series' slip crosses zero at 309 us")
     C.answers = (a,)
     assert answer_lines(C())[1] == ("  impact-golf: no registered law describes these data; chi2 p < 1e-6; lambda A u "
-                                    "vs mu N + mu eta' dA/dt: not equivalent; the series' slip crosses zero at 309 us")
+                                    "vs mu N + mu eta' dA/dt: different; the series' slip crosses zero at 309 us")
 
 
 def test_defaults_that_differ_between_the_command_line_and_the_api_are_said_in_both(capsys):

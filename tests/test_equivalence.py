@@ -1,6 +1,7 @@
-"""The discrimination test: it says 'equivalent' where two laws are one curve, 'not equivalent' where the
-data tell them apart (naming the law they reject), follows the noise, and its noise threshold agrees
-with the parametric bootstrap at that noise."""
+"""The equivalence test: 'equivalent within delta' where two laws are one curve, 'different' where the data
+tell them apart (naming the law they reject), 'cannot tell at this noise' where neither holds, no test where
+both laws fail their fit tests; it follows the noise and the margin, and its noise threshold agrees with the
+parametric bootstrap at that noise."""
 import math
 from concurrent.futures import ThreadPoolExecutor
 
@@ -10,7 +11,7 @@ import pytest
 from _fit_helpers import TC, TRUTH, impact_scene, incline_scene, synthetic
 
 from frictionlab import analyze_equivalence, fit
-from frictionlab.inference.equivalence import CRITICAL, decomposition
+from frictionlab.inference.equivalence import BOTH_FAIL, CANNOT, CRITICAL, DIFFERENT, WITHIN, decomposition
 
 R = 100  # the most replicates per law (sequential: clear cases stop at 20 or 60)
 
@@ -24,10 +25,12 @@ def coulomb_data():
     return ds, fc, fw, analyze_equivalence(fc, fw, replicates=R)
 
 
-def test_wear_and_couette_are_equivalent():
+def test_wear_and_couette_are_equivalent_within_the_margin():
     ds = synthetic("wear", TRUTH["wear"], seed=4)
     e = analyze_equivalence(fit("wear", ds), fit("couette", ds), replicates=R)
-    assert e.status == "ok" and e.verdict == "equivalent", e.explanation
+    assert e.status == "ok" and e.verdict == WITHIN, e.explanation
+    assert e.rms < 1e-4 * e.margin and e.upper < e.margin and e.p_within < 0.05 and e.within
+    assert e.margin == pytest.approx(e.sigma) and "δ = 1 × σ" in e.margin_text  # the default: one noise sigma
     assert e.threshold == 0.0 and "same curve" in e.threshold_text()
     assert 0.2 < e.p_a < 0.8 and 0.2 < e.p_b < 0.8  # T sits in the middle of both nulls
     assert e.power_a == e.power_b == 0.0
@@ -48,12 +51,14 @@ def test_one_closed_form_family_needs_no_refits_and_gives_the_refits_answer(monk
     assert np.max(np.abs(slow.t_a)) <= tol and np.max(np.abs(slow.t_b)) <= tol
     for k in ("verdict", "p_a", "p_b", "q_a", "q_b", "power_a", "power_b", "threshold"):
         assert getattr(fast, k) == getattr(slow, k), k
+    assert fast.p_within == 0.0 and slow.p_within < 1e-12 and slow.upper < 1e-4 * slow.margin
     assert not equivalence.one_family(fw, fit("coulomb", ds))
 
 
-def test_coulomb_against_wear_is_not_equivalent_and_names_the_rejected_law(coulomb_data):
+def test_coulomb_against_wear_is_different_and_names_the_rejected_law(coulomb_data):
     ds, fc, fw, e = coulomb_data
-    assert e.verdict == "not equivalent", e.explanation
+    assert e.verdict == DIFFERENT, e.explanation
+    assert e.upper > e.rms > e.margin and e.p_within > 0.05  # far apart: not within one sigma
     assert e.p_b < 0.05 <= e.p_a  # the data reject wear, the truth (Coulomb) is consistent
     assert "reject wear [exact] and are consistent with coulomb [exact]" in e.explanation
     assert e.power_a > 0.9 and e.power_b > 0.9
@@ -61,17 +66,26 @@ def test_coulomb_against_wear_is_not_equivalent_and_names_the_rejected_law(coulo
     assert e.t_a.size == e.t_b.size and 20 <= e.t_a.size <= R and e.failed == 0 and e.p < 0.05
     # swapping the roles swaps the answer
     s = analyze_equivalence(fw, fc, replicates=R)
-    assert s.verdict == "not equivalent" and s.p_a < 0.05 <= s.p_b
+    assert s.verdict == DIFFERENT and s.p_a < 0.05 <= s.p_b
 
 
-def test_verdict_follows_the_noise(coulomb_data):
-    """The same two laws become indistinguishable when the declared noise is far above the threshold."""
+def test_verdict_follows_the_noise_and_the_margin(coulomb_data):
+    """Far above the threshold noise the data tell the two laws apart no longer, and their curves (0.06 sigma
+    apart) lie within the default margin of one sigma: equivalent within delta. With a margin far below their
+    distance the same data cannot tell; a margin given as a quantity is used as given."""
     ds, fc, fw, e = coulomb_data
     noisy = attrs.evolve(ds, noise={**ds.noise, "omega": 5 * e.threshold})
-    f = analyze_equivalence(fit("coulomb", noisy), fit("wear", noisy), replicates=R)
-    assert f.verdict == "equivalent", f.explanation
+    fa, fb = fit("coulomb", noisy), fit("wear", noisy)
+    f = analyze_equivalence(fa, fb, replicates=R)
+    assert f.verdict == WITHIN and f.upper < f.margin, f.explanation
     assert max(f.power_a, f.power_b) < 0.5
     assert f.threshold == pytest.approx(e.threshold, rel=0.05)  # a property of the two curves, not of sigma
+    tight = analyze_equivalence(fa, fb, replicates=R, margin=0.01)
+    assert tight.verdict == CANNOT and tight.upper > tight.margin and tight.p_within >= 0.05, tight.explanation
+    rpm = 2 * math.pi / 60
+    given = analyze_equivalence(fa, fb, replicates=R, margin="1e5 rpm")
+    assert given.margin == pytest.approx(1e5 * rpm) and given.margin_text.startswith("δ = 1e5 rpm")
+    assert given.verdict == WITHIN
 
 
 def test_noise_threshold_matches_the_bootstrap_at_that_noise(coulomb_data):
@@ -140,9 +154,9 @@ def test_group_answer_states_exact_and_series_separately():
     assert {a["equivalence"], a["equivalence_series"]} <= set(EQUIVALENCE)
     # area-rate is the truth, at a noise far below both thresholds: both forms of wear are rejected
     for e in results:
-        assert e.sigma < e.threshold / 4 and e.verdict == "not equivalent", e.explanation
-        assert e.p_a < 0.025 <= e.p_b and "the data reject wear" in e.explanation
-    assert "on synth-v1: a fit of wear" in a["noise_threshold"] and "the paper's series of wear" in a["noise_threshold"]
+        assert e.sigma < e.threshold / 4 and e.verdict == DIFFERENT, e.explanation
+        assert e.p_a < 0.025 <= e.p_b and "The data reject wear" in e.explanation
+    assert "On synth-v1: a fit of wear" in a["noise_threshold"] and "The truncated series of wear" in a["noise_threshold"]
     assert group_answer(results, ["other"])["equivalence"] == "not tested"
     assert results[0].decomposition is None and results[1].decomposition is not None  # series only
     from frictionlab.inference.answers import Answer
@@ -183,18 +197,70 @@ def test_replicate_refits_without_error_analysis_give_the_same_statistic(coulomb
     monkeypatch.setattr(replicates, "fit", lambda *a, errors=True, **k: fitting.fit(*a, **k))
     full = analyze_equivalence(fc, fw, replicates=R)
     assert np.array_equal(full.t_a, e.t_a) and np.array_equal(full.t_b, e.t_b)
-    assert (full.d_ab, full.d_ba, full.verdict) == (e.d_ab, e.d_ba, e.verdict)
+    assert (full.d_ab, full.d_ba, full.verdict, full.p_within) == (e.d_ab, e.d_ba, e.verdict, e.p_within)
 
 
 def test_a_kept_law_whose_own_p_is_below_half_alpha_is_rejected_too(coulomb_data):
     """The rule rejects each law whose own p is below alpha / 2: the law with the larger p is not called
     consistent with the data when its own p is below that too."""
-    from frictionlab.inference.equivalence import ALPHA, _verdict
+    from frictionlab.inference.equivalence import ALPHA, decide
 
     _, _, _, e = coulomb_data  # A = coulomb (the truth, kept), B = wear (rejected)
     kept = attrs.evolve(e, q_a=0.5)  # nothing on coulomb's favourable side
-    assert "consistent with coulomb [exact]" in _verdict(kept)[1]
-    both = attrs.evolve(kept, p_a=0.4 * ALPHA)
-    verdict, text = _verdict(both)
-    assert verdict == "not equivalent"
-    assert "reject wear [exact], and coulomb [exact] too" in text and "consistent" not in text
+    assert "consistent with coulomb [exact]" in decide(kept).explanation
+    both = decide(attrs.evolve(kept, p_a=0.4 * ALPHA))
+    assert both.verdict == DIFFERENT
+    assert "reject wear [exact], and coulomb [exact] too" in both.explanation and "consistent" not in both.explanation
+
+
+def test_both_laws_failing_their_fit_tests_get_no_p_value_only_their_misfits():
+    """Data of a law neither candidate is (quadratic drag, known truth): Coulomb and wear both fail their fit
+    tests, so neither is a valid null for the other: no replicates, no p-value, the misfits compared."""
+    from pathlib import Path
+
+    from frictionlab import load_dataset
+
+    ds = load_dataset(Path(__file__).resolve().parent.parent / "examples" / "known-truth" / "kt-drag-impact.toml")
+    fc, fw = fit("coulomb", ds), fit("wear", ds)
+    assert fc.goodness.fits is False and fw.goodness.fits is False
+    e = analyze_equivalence(fc, fw, replicates=R)
+    assert e.ok and not e.tested and e.verdict == BOTH_FAIL
+    assert math.isnan(e.p) and math.isnan(e.p_within) and e.t_a.size == 0 and "no replicates" in e.stopped
+    assert e.explanation.startswith("No test: coulomb [exact] and wear [exact] both fail their own fit tests")
+    assert "no p-value" in e.explanation and "two-sided p" not in e.explanation and "upper 95% bound" not in e.explanation
+    assert f"χ² = " in e.explanation and "misses less" in e.explanation
+
+
+def test_a_peak_time_difference_is_quantitative_not_qualitative():
+    """Two curves that both rise, peak inside the record and fall are qualitatively alike whatever their peak
+    times; peaks more than a sampling interval apart are a quantitative difference, named as such."""
+    from frictionlab.inference.qualitative import Features, _first_difference, peak_text
+
+    a = Features(rises=True, peak=True, t_peak=290e-6, falls=True, force_one_sign=True)
+    b = attrs.evolve(a, t_peak=323e-6)
+    assert _first_difference(a, b) == ""
+    assert _first_difference(a, attrs.evolve(b, peak=False, t_peak=math.nan, falls=False)).startswith("a peak inside")
+    assert _first_difference(a, attrs.evolve(b, force_one_sign=False)).startswith("the sign of the friction force")
+    text = peak_text({"a": 290e-6, "b": 323e-6, "shift": 33e-6, "dt": 10e-6, "differs": True}, "wear", "area-rate")
+    assert text == ("the peak times differ: 290 µs (wear) vs 323 µs (area-rate), 33 µs apart, more than the 10 µs "
+                    "sampling interval")
+
+
+def test_a_report_adjusts_every_hypothesis_as_one_family(coulomb_data):
+    """Holm over the two hypotheses of every tested pair: adjusted p-values are at least the raw ones, each
+    verdict is decided on them, and the family is named; 'group' adjusts within each group only."""
+    from frictionlab.inference.equivalence_groups import adjust_family, holm_adjusted
+
+    assert holm_adjusted([0.01, 0.04, 0.03]) == pytest.approx([0.03, 0.06, 0.06])
+    _, fc, fw, e = coulomb_data
+    ds = synthetic("wear", TRUTH["wear"], seed=4)
+    same = analyze_equivalence(fit("wear", ds), fit("couette", ds), replicates=R)
+    borderline = attrs.evolve(e, dataset="other", p_a=0.9, p_b=0.012, p=0.024, p_adjusted=0.024)
+    out = adjust_family([e, same, borderline])
+    assert all(x.family == "Holm over the 6 hypotheses of this report" for x in out)
+    assert all(x.p_adjusted >= x.p and x.p_within_adjusted >= x.p_within for x in out)
+    assert out[0].verdict == DIFFERENT and out[1].verdict == WITHIN
+    assert out[2].p_adjusted == pytest.approx(0.024 * 4) and out[2].verdict == CANNOT  # different alone, not after Holm
+    assert "adjusted p = 0.096" in out[2].explanation
+    per_group = adjust_family([e, same, borderline], "group", {e.dataset: "g1", same.dataset: "g1", "other": "g2"})
+    assert per_group[2].verdict == DIFFERENT and "per-group rule" in per_group[0].family

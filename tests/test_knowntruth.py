@@ -2,6 +2,7 @@
 ``compare`` must match the law that generated each set, for the equivalence test, the transfer test and
 goodness of fit (a law that is not registered)."""
 import filecmp
+import math
 import json
 from pathlib import Path
 
@@ -33,19 +34,35 @@ def test_folder_is_regenerated_bit_for_bit(tmp_path):
 
 
 def test_equivalence_verdicts_match_the_truth():
-    """wear vs couette: equivalent; coulomb vs wear: not equivalent, rejecting the law that did not generate the data."""
+    """wear vs couette: equivalent within the margin; coulomb vs wear: different, rejecting the law that did not
+    generate the data."""
     c = compare(laws=["coulomb", "wear", "couette"], datasets=[kt("kt-coulomb-impact"), kt("kt-wear-impact")],
                 solvers=["exact"], replicates=100, transfer=False)
     got = {(e.dataset, e.law_a, e.law_b): e for e in c.equivalence}
     assert len(got) == 4 and all(e.ok for e in got.values())
     for ds in ("kt-coulomb-impact", "kt-wear-impact"):
-        assert got[(ds, "wear", "couette")].verdict == "equivalent"
+        wc = got[(ds, "wear", "couette")]  # one curve; on Coulomb's data both fail: no test of a pair that fails
+        assert wc.verdict == ("equivalent within δ" if ds == "kt-wear-impact" else "both fail their fit tests"), ds
         e = got[(ds, "coulomb", "wear")]
-        assert e.verdict == "not equivalent", e.explanation
+        assert e.verdict == "different", e.explanation
         truth = kt(ds).provenance.truth["law"]
         rejected = "coulomb" if e.p_a < 0.05 else "wear"
         assert (e.p_a < 0.05) != (e.p_b < 0.05)  # exactly one law is rejected ...
         assert rejected != truth  # ... and it is not the one that generated the data
+
+
+def test_where_no_law_compared_fits_no_pair_gets_a_p_value():
+    """Stribeck friction on an incline: the four laws compared by default each fail their fit tests, so every pair
+    of them is 'both fail their fit tests': no replicates, no p-value, no margin bound; only misfits compared."""
+    c = compare(datasets=[kt("kt-stribeck-incline")], replicates=40, transfer=False)
+    assert all(f.goodness.fits is False for f in c.fits if f.ok) and len([f for f in c.fits if f.ok]) == 4
+    assert len(c.equivalence) == 3
+    for e in c.equivalence:
+        assert e.verdict == "both fail their fit tests" and not e.tested, e.explanation
+        assert math.isnan(e.p) and math.isnan(e.p_adjusted) and math.isnan(e.upper) and e.t_a.size == 0
+        assert "no p-value" in e.explanation and "two-sided p" not in e.explanation
+    (a,) = c.answers
+    assert a.equivalence == "both fail their fit tests" and a.headline.startswith("no registered law describes")
 
 
 def test_transfer_verdicts_match_the_truth():
@@ -122,9 +139,15 @@ def test_compare_command_on_the_folder_matches_every_truth(run_cli, tmp_path):
     eq = {(e["dataset"], e["law_a"], e["solver_a"], e["law_b"]): e for e in data["equivalence"]}
     for d in data["datasets"]:
         truth = d["provenance"]["truth"]["law"]
-        assert eq[(d["name"], "wear", "exact", "couette")]["verdict"] == "equivalent"
+        if truth in ("stribeck", "quadratic drag F = c A u |u| (not registered)"):  # no law compared fits
+            for (name, *_), e in eq.items():
+                if name == d["name"]:
+                    assert e["verdict"] == "both fail their fit tests" and e["p"] is None, e
+            continue
+        assert eq[(d["name"], "wear", "exact", "couette")]["verdict"] == (
+            "both fail their fit tests" if truth == "coulomb" else "equivalent within δ")
         cw = eq[(d["name"], "coulomb", "exact", "wear")]
-        assert cw["verdict"] == "not equivalent"
+        assert cw["verdict"] == "different"
         if truth in ("coulomb", "wear", "couette"):
             assert (cw["p_a"] < 0.05) == (truth != "coulomb")
     # the unregistered law: no registered law (whatever is registered by then) describes its data

@@ -28,6 +28,22 @@ def test_delta_weights_and_competition_ranks_with_ties():
     assert by["a"].tied_with == ("b [exact]",)
 
 
+def test_akaike_weights_compare_the_candidates_that_fit_and_say_so():
+    """A weight is reported with what it compares, and never for a candidate that fails its fit tests."""
+    rows = _rank([attrs.evolve(row("d", "a", 10.0), fits=True), attrs.evolve(row("d", "b", 11.0), fits=True),
+                  attrs.evolve(row("d", "c", 5.0), fits=False)], tie=0.01)
+    by = {r.law: r for r in rows}
+    assert by["c"].rank == 1 and math.isnan(by["c"].akaike_weight) and by["c"].weight_among == ()
+    assert by["a"].akaike_weight + by["b"].akaike_weight == pytest.approx(1.0)
+    assert by["a"].weight_among == ("a [exact]", "b [exact]")
+    assert by["a"].weight_text == f"Akaike weight {by['a'].akaike_weight:.2f} among a [exact], b [exact] (the candidates that fit)"
+    assert by["c"].weight_text.startswith("no Akaike weight: it fails its fit tests")
+    alone = _rank([attrs.evolve(row("d", "a", 10.0), fits=True), attrs.evolve(row("d", "c", 5.0), fits=False)], 0.01)
+    assert next(r for r in alone if r.law == "a").weight_text == "Akaike weight 1 by construction: the only candidate that fits"
+    none = _rank([attrs.evolve(row("d", "a", 10.0), fits=False), attrs.evolve(row("d", "c", 5.0), fits=False)], 0.01)
+    assert all(math.isnan(r.akaike_weight) for r in none) and [r.rank for r in none] == [1, 2]
+
+
 def test_groups_sum_aic_and_mark_incomplete_candidates():
     rows = _rank([row("d1", "a", 10.0), row("d1", "b", 14.0), row("d1", "a", 9.0, solver="series")], 0.01)
     rows += _rank([row("d2", "a", 5.0, solver="ode"), row("d2", "b", 4.0)], 0.01)
@@ -45,8 +61,8 @@ def test_csv_has_the_documented_columns():
     text = to_csv(_rank([row("d", "a", 1.0), failed], 0.01))
     lines = text.splitlines()
     assert lines[0] == ",".join(COLUMNS) == ("dataset,law,solver,n_points,n_params,rss,rmse,redchi,likelihood,aic,"
-                                            "aicc,bic,delta_aic,akaike_weight,rank,status,chi2_p,runs_p,lag1,fits,"
-                                            "flags,at_bounds,reason")
+                                            "aicc,bic,delta_aic,akaike_weight,weight_among,rank,status,chi2_p,runs_p,"
+                                            "lag1,fits,flags,at_bounds,reason")
     assert lines[2].endswith(",,failed,,,,,,,did not converge")  # no rank, no numbers for a failed fit, its reason
 
 
@@ -64,7 +80,8 @@ def test_known_truth_on_the_impact_scene(law):
     first = {r.law for r in ranked if r.rank == 1}
     assert first == ({merged} if law in twins else {law})
     top = next(r for r in ranked if r.rank == 1)
-    assert top.fits and top.akaike_weight == max(r.akaike_weight for r in ranked)
+    assert top.fits and top.akaike_weight == max(r.akaike_weight for r in ranked if r.fits)
+    assert all(math.isnan(r.akaike_weight) and not r.weight_among for r in ranked if r.fits is False)
     own = c.fit_for(ds.name, law, "exact")
     for name, value in TRUTH[law].items():
         p = own.params[name]

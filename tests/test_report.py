@@ -68,7 +68,9 @@ def test_ranking_csv_and_results_json(report_dir):
     assert {(r["law"], r["solver"]) for r in per} == {("wear", "exact"), ("wear", "series"), ("area-rate", "exact")}
     best = [r for r in per if r["rank"] == "1"]
     assert [r["law"] for r in best] == ["area-rate"]
-    assert sum(float(r["akaike_weight"]) for r in per) == pytest.approx(1.0)
+    weighted = [r for r in per if r["akaike_weight"]]  # weights compare the candidates that fit, and only those
+    assert weighted and sum(float(r["akaike_weight"]) for r in weighted) == pytest.approx(1.0)
+    assert all(r["fits"] != "False" for r in weighted) and all(r["weight_among"] for r in weighted)
     assert any(r["dataset"] == "ALL" for r in rows)
 
     data = json.loads((out / "results.json").read_text())

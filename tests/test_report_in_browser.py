@@ -55,13 +55,13 @@ def test_seven_groups_of_long_verdicts_still_leave_the_finding_on_the_first_scre
     ds = synthetic("wear", {"lam": 1.81e6}, seed=2, n=26, name="impact-browser")
     c = compare(laws=["wear", "coulomb"], datasets=[ds], equivalence=False)
     rows = (_answer("impact-golf", "no law fits (best of a poor set: wear = couette [series])",
-                    "fails: runs p = 8e-10", "not equivalent (exact and series)",
+                    "fails: runs p = 8e-10", "different (exact and series)",
                     "differ unless σ > 1.8 / 1.9 deg (σ = 0.5 deg)", "series slip u = 0 at 338 / 369 µs; exact never",
                     "one wear [series] fit for both: no (p = 2e-78)"),
             _answer("impact-outcome", "coulomb [exact] ✓", "fits: runs p = 0.84"),
             _answer("incline-dry", "wear = couette [ode] ✓", "fits: χ² p = 0.2",
                     transfer="one wear [ode] fit for both: yes (p = 0.051)"),
-            _answer("incline-oil", "wear = couette [exact] ✓", "fits: runs p = 0.66", "not equivalent (exact)",
+            _answer("incline-oil", "wear = couette [exact] ✓", "fits: runs p = 0.66", "different (exact)",
                     "differ unless σ > 0.4 / 0.27 / 0.15 m/s (σ = 0.003 m/s)",
                     transfer="one wear [exact] fit for all: yes (p = 0.44)"),
             _answer("kharaz2001", "coulomb [exact] ✓", "fits: runs p = 0.11",

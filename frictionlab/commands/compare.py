@@ -61,6 +61,13 @@ def add_parser(sub):
                    help=f"the most replicate datasets per law in the equivalence test's sequential parametric bootstrap "
                         f"(default: {REPLICATES}; at least 20; sampling stops in batches of 20 once the verdict is "
                         "clear; the Monte-Carlo error of each p-value is reported)")
+    p.add_argument("--margin", default=None, metavar="DELTA",
+                   help="the equivalence margin: two laws are 'equivalent within delta' when an upper 95%% bound of "
+                        "the RMS distance of their best curves lies below delta; a multiple of each dataset's noise "
+                        "sigma (e.g. 2, the default 1) or a quantity in the observable's unit (e.g. '150 rpm')")
+    p.add_argument("--family", choices=("report", "group"), default="report",
+                   help="the family whose error rate the tests keep: 'report' (default: Holm over every hypothesis "
+                        "of the report's equivalence tests) or 'group' (Holm within each dataset group only)")
     p.add_argument("--no-transfer", dest="transfer", action="store_false",
                    help="skip predicting across the datasets of a group and the shared-parameter fits")
     p.add_argument("--bootstrap", type=int, default=BOOTSTRAP_N, metavar="N",
@@ -75,6 +82,9 @@ def add_parser(sub):
                    help="also refit the ODE laws of one dataset at other solver tolerances "
                         f"({' and '.join(f'{r:.0e}'.replace('e-0', 'e-') for r in TOLERANCE_RTOLS)}): a robustness "
                         "check beside the answer, changing no verdict (default: not run, and the report says so)")
+    p.add_argument("--no-accuracy", dest="accuracy", action="store_false",
+                   help="skip 'what accuracy costs' (each solver's error and time against the most accurate one, per "
+                        "law and dataset; by default it runs where it is cheap, and everywhere with --tolerance)")
     p.add_argument("--no-tolerance", dest="tolerance", action="store_false",
                    help="do not run the tolerance check (the default; kept for older scripts)")
     p.add_argument("--fit-timeout", type=fit_timeout, default=FIT_TIMEOUT, metavar="SECONDS",
@@ -103,7 +113,13 @@ def run(args) -> int:
     if args.replicates < MIN_REPLICATES:
         raise ParameterError(f"--replicates must be at least {MIN_REPLICATES}, got {args.replicates}")
     free = parse_free(args.free)
+    from ..inference.margin import parse_margin
+
+    margin = parse_margin(args.margin)
     datasets = [load_dataset(d) for d in args.data or builtin_names()]  # read first: --out keeps clear of them
+    if not args.no_equivalence:
+        margin.check(datasets)
+    args.margin = margin
     client = connect(args.scheduler) if args.scheduler else None
     try:
         return _run(args, free, datasets, client)
@@ -125,7 +141,8 @@ def _run(args, free, datasets, client) -> int:
                              free=free, equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar,
                              bootstrap=args.bootstrap, seed=args.seed, bootstrap_all=args.bootstrap_all,
                              tolerance=TOLERANCE_RTOLS if args.tolerance else (), fit_timeout=args.fit_timeout,
-                             replicates=args.replicates, transfer=args.transfer, client=client)
+                             replicates=args.replicates, transfer=args.transfer, client=client,
+                             margin=args.margin, family=args.family, accuracy=args.accuracy)
         with Progress("report", quiet=args.quiet) as bar:
             out = write_report(result, args.out, force=args.force, progress=bar, jobs=args.jobs, client=client)
     ok = sum(f.ok for f in result.fits)
@@ -153,7 +170,8 @@ def answer_lines(c) -> list[str]:
             continue
         eq = a.cell("equivalence")
         parts = [a.cell("best"), a.cell("goodness"),
-                 f"lambda A u vs mu N + mu eta' dA/dt: {eq}" if eq and eq != "not tested" else "", a.cell("threshold"), a.cell("series"),
+                 f"lambda A u vs mu N + mu eta' dA/dt: {eq}" if eq and eq != "not tested" else "", a.cell("threshold"),
+                 a.cell("series"), f"accuracy {a.short['accuracy']}" if a.short.get("accuracy") else "",
                  a.cell("transfer")]
         out.append(f"  {a.group}: " + "; ".join(p for p in parts if p))
     out += [f"  {', '.join(groups)}: {reason}" + "".join(f"; registered laws that apply: {h}" for h in hints)

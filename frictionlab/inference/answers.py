@@ -13,10 +13,11 @@ import attrs
 
 #: Keys of ``Answer.short``, in table order, with the long field each one summarizes.
 SHORT = {"best": "headline", "goodness": "goodness", "equivalence": "equivalence",
-         "threshold": "noise_threshold", "series": "series_vs_exact", "transfer": "transfer"}
+         "threshold": "noise_threshold", "series": "series_vs_exact", "accuracy": "accuracy", "transfer": "transfer"}
 
-#: The equivalence verdicts a row may carry.
-EQUIVALENCE = ("equivalent", "not equivalent", "cannot tell at this noise", "not tested")
+#: The equivalence verdicts a row may carry: a test's (``equivalence.VERDICTS``) or none.
+EQUIVALENCE = ("different", "equivalent within δ", "cannot tell at this noise", "both fail their fit tests",
+               "not tested")
 
 
 @attrs.frozen
@@ -35,6 +36,8 @@ class Answer:
     series_vs_exact: str  # e.g. "the series' spin falls because its slip crosses zero at 309 us"
     transfer: str = ""  # e.g. "one lambda serves both speeds: no (prediction error 12 sigma)"
     equivalence_series: str = ""  # one of EQUIVALENCE: the paper's series of lambda A u against mu N + mu eta' dA/dt
+    qualitative: str = ""  # do the two laws' fitted curves share the data's features (one sentence)
+    accuracy: str = ""  # what accuracy costs: each solver's error and time against the most accurate one
     details: dict = attrs.field(factory=dict)  # machine-readable numbers behind the texts (SI), for results.json
     #: a few words per cell with the decisive number, for the first screen's table and the CLI's closing lines;
     #: keys SHORT (filled by the producer of the matching long field; absent when it gave none)

@@ -2,7 +2,9 @@
 
 Statistics per candidate: RSS and RMSE (observable's SI unit), reduced chi-square, the
 likelihood used (known or profiled sigma, see ``fitting``), AIC, AICc, BIC, delta-AIC to the
-best candidate, Akaike weight w_i = exp(-delta_i / 2) / sum_j exp(-delta_j / 2), the goodness
+best candidate, Akaike weight w_i = exp(-delta_i / 2) / sum_j exp(-delta_j / 2) over the candidates that pass
+their fit tests (``weight_among``: a weight compares descriptions that hold; a candidate that fails gets
+none, and where none fits there are no weights), the goodness
 of fit (``goodness.py``: chi-square p, runs-test p, lag-1 autocorrelation, and whether it fits)
 and the plausibility flags (``plausibility.py``).
 
@@ -41,8 +43,8 @@ TIE_AIC = 0.01
 NEAR_TIE = 2.0
 
 COLUMNS = ("dataset", "law", "solver", "n_points", "n_params", "rss", "rmse", "redchi", "likelihood", "aic", "aicc",
-           "bic", "delta_aic", "akaike_weight", "rank", "status", "chi2_p", "runs_p", "lag1", "fits", "flags",
-           "at_bounds", "reason")  # at_bounds: 'k at upper bound 1e+06 1/m'; reason: why a fit failed or was skipped
+           "bic", "delta_aic", "akaike_weight", "weight_among", "rank", "status", "chi2_p", "runs_p", "lag1", "fits",
+           "flags", "at_bounds", "reason")  # at_bounds: 'k at upper bound 1e+06 1/m'; reason: why a fit failed or was skipped
 
 
 @attrs.frozen
@@ -78,6 +80,7 @@ class RankRow:
     members: tuple[str, ...] = ()  # laws of one closed-form family merged into this candidate
     parameterizations: str = ""  # each member's parameters, e.g. "wear: lam = 2e4 Pa s/m; couette: eta/h = ..."
     at_bounds: tuple[str, ...] = ()  # parameters at a bound of their range ('k at upper bound 1e+06 1/m'): not identifiable
+    weight_among: tuple[str, ...] = ()  # the candidates the Akaike weight compares (those that pass their fit tests)
 
     @property
     def candidate(self) -> str:
@@ -87,7 +90,14 @@ class RankRow:
         out = {c: getattr(self, c) for c in COLUMNS}
         out["flags"] = "; ".join(self.flags)
         out["at_bounds"] = "; ".join(self.at_bounds)
+        out["weight_among"] = "; ".join(self.weight_among)
         return out
+
+    @property
+    def weight_text(self) -> str:
+        """'Akaike weight 0.72 among coulomb [exact], area-rate [exact] (the candidates that fit)', or why there is
+        none."""
+        return weight_text(self.akaike_weight, self.weight_among, self.fits)
 
 
 def family(solver: str) -> str:
@@ -103,7 +113,11 @@ def _rank(rows: list[RankRow], tie: float) -> list[RankRow]:
     if not ok:
         return rows
     best = min(r.aic for r in ok)
-    weights = {id(r): math.exp(-(r.aic - best) / 2) for r in ok}
+    ranked = {id(r) for r in ok}
+    fitting = [r for r in ok if r.fits is not False]  # weights compare candidates that pass their fit tests
+    among = tuple(r.candidate for r in fitting)
+    low = min((r.aic for r in fitting), default=math.nan)
+    weights = {id(r): math.exp(-(r.aic - low) / 2) for r in fitting}
     total = sum(weights.values())
 
     eff = _placing_aic(ok)
@@ -114,16 +128,28 @@ def _rank(rows: list[RankRow], tie: float) -> list[RankRow]:
 
     out = []
     for r in rows:
-        if id(r) not in weights:
+        if id(r) not in ranked:
             out.append(r)
             continue
         rank = 1 + sum(1 for o in ok if ahead(o, r))
         same = [o for o in ok if o is not r and abs(eff[id(o)] - eff[id(r)]) <= tie and bool(o.flags) == bool(r.flags)]
         near = tuple(o.candidate for o in ok if o is not r and abs(o.aic - r.aic) < NEAR_TIE)
         status = "tied" if same else ("indistinguishable" if near else "ok")
-        out.append(attrs.evolve(r, delta_aic=r.aic - best, akaike_weight=weights[id(r)] / total, rank=rank,
-                                status=status, tied_with=near))
+        weight = weights[id(r)] / total if id(r) in weights else math.nan
+        out.append(attrs.evolve(r, delta_aic=r.aic - best, akaike_weight=weight, rank=rank, status=status,
+                                tied_with=near, weight_among=among if id(r) in weights else ()))
     return sorted(out, key=lambda r: (r.rank is None, r.rank or 0, r.law, r.solver))
+
+
+def weight_text(weight: float, among, fits) -> str:
+    """An Akaike weight with what it compares, or why a candidate has none."""
+    if fits is False:
+        return "no Akaike weight: it fails its fit tests (weights compare candidates that fit)"
+    if not math.isfinite(weight) or not among:
+        return "no Akaike weight"
+    if len(among) == 1:
+        return "Akaike weight 1 by construction: the only candidate that fits"
+    return f"Akaike weight {weight:.2f} among {', '.join(among)} (the candidates that fit)"
 
 
 def _placing_aic(ok: list[RankRow]) -> dict[int, float]:

@@ -44,6 +44,12 @@ def centring(law: str, opts: dict, start: FitResult | None, target: Target, curv
     """``law`` refitted to the noise-free ``curve`` (on ``target``'s points and sigma), warm-started at
     ``start``'s values (``opts``' when None): the chi-square it is left with, the plug-in for the
     location of T under the law that made ``curve`` (nan if the refit fails)."""
+    return centring_fit(law, opts, start, target, curve)[0]
+
+
+def centring_fit(law: str, opts: dict, start: FitResult | None, target: Target,
+                 curve: np.ndarray) -> tuple[float, np.ndarray | None]:
+    """``centring``'s chi-square and the refitted curve itself (None if the refit fails)."""
     if start is not None:
         now = {p.key: p.value for p in start.params.values()}
         opts = opts | {"initial": {k: now.get(k, v) for k, v in opts["initial"].items()},
@@ -51,17 +57,31 @@ def centring(law: str, opts: dict, start: FitResult | None, target: Target, curv
     try:
         r = refit(law, opts, with_y(target, curve, "a fitted curve"))
     except FrictionLabError:
-        return math.nan
-    return float(r.stats.chisqr) if r.ok else math.nan
+        return math.nan, None
+    return (float(r.stats.chisqr), r.per_dataset[0].model) if r.ok else (math.nan, None)
+
+
+def distance(target: Target, a: np.ndarray, b: np.ndarray) -> float:
+    """RMS difference of two curves on ``target``'s points, in the observable's SI unit (stated numbers, whose
+    units differ: in stated precisions)."""
+    d = (np.asarray(a, dtype=float) - np.asarray(b, dtype=float))
+    if target.observable == "stated":
+        d = d / np.asarray(target.sigma, dtype=float)
+    return float(np.sqrt(np.mean(d * d)))
+
+
+#: Columns of a replicate row of ``replicate_chunk``.
+ROW = ("t_a", "s_a", "d_a", "t_b", "s_b", "d_b", "sigma_ratio")
 
 
 def replicate_chunk(law_a, opts_a, law_b, opts_b, target, model_a, model_b, seeds,
-                    df: float = math.inf) -> list[tuple[float, float, float, float]]:
-    """(T, S_A) on a replicate of A's fit and (T, S_B) on one of B's, per seed; nan where a refit failed.
+                    df: float = math.inf) -> list[tuple[float, ...]]:
+    """Per seed a row ``ROW``: (T, S_A, D) on a replicate of A's fit, (T, S_B, D) on one of B's, and the
+    replicate's sigma estimate over the data's (1 for a measured sigma); nan where a refit failed.
     S_A = T + (B refitted to A's refitted curve), S_B = T - (A refitted to B's refitted curve): T centred
-    at its location under the replicate's own fit (``equivalence``, module docstring). With an estimated
-    sigma of ``df`` degrees of freedom each replicate's chi-squares are at its own estimate
-    sigma^2 chi2_df / df. Runs in a worker."""
+    at its location under the replicate's own fit (``equivalence``, module docstring); D the RMS distance of
+    the two refitted curves (``distance``). With an estimated sigma of ``df`` degrees of freedom each
+    replicate's chi-squares are at its own estimate sigma^2 chi2_df / df. Runs in a worker."""
     out = []
     for ss in seeds:
         rng = np.random.default_rng(ss)
@@ -73,18 +93,18 @@ def replicate_chunk(law_a, opts_a, law_b, opts_b, target, model_a, model_b, seed
             try:
                 ra, rb = refit(law_a, opts_a, tg), refit(law_b, opts_b, tg)
             except FrictionLabError:
-                row += [math.nan, math.nan]
+                row += [math.nan] * 3
                 continue
             if not (ra.ok and rb.ok):
-                row += [math.nan, math.nan]
+                row += [math.nan] * 3
                 continue
             t = ra.stats.chisqr - rb.stats.chisqr
             if null == "a":
                 s = t + centring(law_b, opts_b, rb, target, ra.per_dataset[0].model)
             else:
                 s = t - centring(law_a, opts_a, ra, target, rb.per_dataset[0].model)
-            row += [scale * t, scale * s]
-        out.append(tuple(row))
+            row += [scale * t, scale * s, distance(target, ra.per_dataset[0].model, rb.per_dataset[0].model)]
+        out.append(tuple(row) + (1.0 / math.sqrt(scale),))
     return out
 
 

@@ -4,8 +4,8 @@
 from the likelihood each dataset's noise calls for, flagged fits last, structurally identical
 laws merged; see ``ranking``) and states, per group:
 
-* best / headline: the top candidate is named "best" only when it fits (``goodness`` rule:
-  chi2 p >= 0.01 where sigma is known, runs p >= 0.01) and carries no plausibility flag; if it
+* best / headline: the top candidate is named "best" only when it fits (``goodness`` rule, in words
+  ``rules.goodness``) and carries no plausibility flag; if it
   fails, the headline is "no registered law describes these data (best of a poor set: X)".
   Candidates within delta-AIC < 2 of it are named as indistinguishable by these data.
 * series_vs_exact: where the paper's truncated series and the exact solution of the same law
@@ -172,8 +172,9 @@ def series_vs_exact(fits) -> tuple[str, dict]:
         series = (f"crosses zero at {t_series * 1e6:.0f} us" if t_series is not None else "never crosses zero")
         exact = (f"crosses zero at {t_exact * 1e6:.0f} us" if t_exact is not None
                  else f"never does (its minimum is {np.min(ex.u) / sc.u0:.2f} u0)")
-        sentences.append(f"{name}: the series slip {series} (b = {b:.2f}); the exact {law_name} slip {exact}; "
-                         f"series better by delta-AIC {ef.stats.aic - sf.stats.aic:.1f}")
+        gain = ef.stats.aic - sf.stats.aic
+        sentences.append(f"{name}: the series slip {series} (b = {b:.2f}); the exact solution's slip {exact}; "
+                         f"the series {'better' if gain >= 0 else 'worse'} by delta-AIC {abs(gain):.1f}")
     order = [n for n in dict.fromkeys(f.datasets[0] for f in fits) if n in numbers]
     sentences.sort(key=lambda text: next(i for i, n in enumerate(order) if text.startswith(n + ":")))
     return "; ".join(sentences), {n: numbers[n] for n in order}

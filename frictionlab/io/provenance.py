@@ -6,6 +6,9 @@ import attrs
 from ..core.errors import DatasetError
 
 PROVENANCE_KINDS = ("measured", "reported", "reconstructed", "synthetic")
+#: What a provenance source names when its numbers come from the project's seed paper (Arakawa, "An analytical
+#: model of dynamic sliding friction during impact", Sci. Rep. 7, 2017): every part must appear.
+SEED_PAPER = ("Arakawa", "Sci. Rep.", "2017")
 
 
 @attrs.frozen
@@ -18,6 +21,12 @@ class Provenance:
     truth: dict = attrs.field(factory=dict)  # generating law and parameters, for synthetic data
     license: str = ""  # the data's license as the source states it (e.g. "MIT")
     citation: str = ""  # what to cite when using the data
+
+    @property
+    def seed_paper(self) -> bool:
+        """Whether these numbers come from the seed paper (its source cites it, SEED_PAPER) and are not made up:
+        only then may a report speak of 'the paper' about them. Decided by the declared source, not the name."""
+        return self.kind != "synthetic" and all(part in self.source for part in SEED_PAPER)
 
 
 def _provenance(p, path) -> Provenance:

@@ -10,7 +10,7 @@ a fit that fails: it becomes a row with status 'failed' and its reason.
 
 The stages, in order (``stages.py``): fit, rank, equivalence (the discrimination test on the pairs of
 ``equivalence.PAIRS``), transfer (one parameter set across a group), tolerance (ODE laws refitted at
-other tolerances), bootstrap (parametric replicates: intervals and first-place shares), answer (the
+other tolerances), accuracy (what each solver's accuracy costs), bootstrap (parametric replicates: intervals and first-place shares), answer (the
 verdict rows of the first screen). ``runner.run_stages`` holds the pool, the clock and the progress
 count around them; ``run_stages`` below continues a comparison with more stages.
 """
@@ -27,6 +27,7 @@ import numpy as np
 from ..core.arguments import as_items
 from ..core.errors import FrictionLabError
 from ..inference.equivalence import PAIRS, REPLICATES, EquivalenceResult
+from ..inference.margin import MARGIN
 from ..inference.fitting import FitResult
 from ..inference.ranking import RankRow
 from ..inference.transfer import TransferResult
@@ -66,6 +67,7 @@ class Comparison:
     transfer: tuple[TransferResult, ...] = ()  # per dataset group with two or more members
     answers: tuple = ()  # answers.Answer per dataset group: the report's first screen (filled by the verdict layer)
     options: Settings | None = None  # the settings as a record (``settings`` is the same as results.json writes it)
+    accuracy: tuple = ()  # accuracy.SolverCost rows: each solver's error and time per law and dataset
 
     def fit_for(self, dataset: str, law: str, solver: str | None = None) -> FitResult | None:
         for f in self.fits:
@@ -128,7 +130,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
             tolerance: Sequence[float] = (), fit_timeout: float | None = None, replicates: int = REPLICATES,
             pairs: Sequence = PAIRS, transfer: bool = True, stages: Sequence[str] | None = None,
-            client=None) -> Comparison:
+            client=None, margin=MARGIN, family: str = "report", accuracy: bool = True) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
 
     laws: registered names, None for DEFAULT_LAWS, or "all" for every registered law; datasets: built-in names, TOML paths or Datasets
@@ -142,7 +144,13 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     and tolerance check included; a fit past it is a failed row saying so (a refit, a failed replicate). replicates: R per
     law of the equivalence test's parametric bootstrap (seeded by ``seed``); pairs: (law A, law B)
     to test (default equivalence.PAIRS); pairs where a law needs the ODE solver, or without a time
-    series, are tested only with bootstrap_all. transfer: run the transfer stage.
+    series, are tested only with bootstrap_all. transfer: run the transfer stage. margin: the equivalence
+    margin delta, a multiple of each dataset's noise sigma (default MARGIN = 1) or a quantity in the
+    observable's unit ('150 rpm'; ``inference.margin``). family: 'report' (default: Holm over every
+    hypothesis of the report's equivalence tests, one family-wise error rate ALPHA) or 'group' (Holm within
+    each dataset group only; ``inference.equivalence_groups``). accuracy: what accuracy costs (each solver's
+    error and time against the most accurate one at the fitted parameters, ``inference.accuracy``), where it
+    is cheap; with ``tolerance`` given, everywhere.
     stages: the names of the stages to run (``stages.STAGES``: fit, rank, equivalence, transfer,
     tolerance, bootstrap, answer), None for every stage the options above switch on; ``run_stages``
     runs more of them on the result later. client: a dask.distributed Client; the fits, refits, tests and
@@ -155,13 +163,16 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     settings = Settings(laws=(), solvers=tuple(solvers) if solvers else None,
                         free=dict(free or {}), equivalence=equivalence, jobs=jobs, bootstrap=bootstrap, seed=seed,
                         bootstrap_all=bootstrap_all, tolerance=tuple(tolerance), fit_timeout=fit_timeout,
-                        replicates=replicates, pairs=tuple(pairs), transfer=transfer, cluster=cluster_name(client))
+                        replicates=replicates, pairs=tuple(pairs), transfer=transfer, cluster=cluster_name(client),
+                        margin=margin, family=family, accuracy=accuracy)
     settings = attrs.evolve(settings, laws=select_laws(laws))
     chosen = select(STAGES, stages)
     dss = unique_datasets(load_dataset(d) for d in (as_items(datasets, "compare: datasets") if datasets is not None
                                                     else builtin_names()))
     if not dss:
         raise FrictionLabError("compare: no datasets to compare")
+    if equivalence:
+        settings.margin.check(dss)
     run = _make_run(settings, dss, progress, client)
     settings.check_replicates()
     c = Comparison(laws=settings.laws, datasets=dss, fits=run.plan.skipped_fits, ranking=(), groups=(),

@@ -19,7 +19,7 @@ import attrs
 from ..core.cluster import executor
 from ..inference.ranking_bootstrap import bootstrap_fits
 from .runner import Run, run_stages, warm_worker
-from .stages import check_some_fit, equivalence_order, fit_order
+from .stages import check_some_fit, equivalence_order, family_adjusted, fit_order
 
 #: The stages one dataset's task runs (in this order); the others run after the parts are merged.
 PER_DATASET = ("fit", "equivalence", "bootstrap")
@@ -87,7 +87,8 @@ def _merge(c, run: Run, parts: list, sent: set, names: set) -> dict:
         check_some_fit(fields["fits"])
     if "equivalence" in names:
         found = [e for p in parts for e in p["equivalence"]]
-        fields["equivalence"] = tuple(sorted(found, key=equivalence_order(c, run.settings.pairs)))
+        fields["equivalence"] = family_adjusted(c, sorted(found, key=equivalence_order(c, run.settings.pairs)),
+                                                run.settings)
     if "bootstrap" in names:
         s = run.settings
         rest = [f for f in fields.get("fits", c.fits) if f.datasets[0] not in sent]  # nothing fitted there

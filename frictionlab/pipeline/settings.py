@@ -9,6 +9,7 @@ import numpy as np
 from ..core.arguments import as_items
 from ..core.errors import ParameterError
 from ..inference.equivalence import MIN_REPLICATES, PAIRS, REPLICATES
+from ..inference.margin import MARGIN
 from ..physics.registry import available_laws, get_law
 
 #: The laws ``compare`` fits by default: the four of the mission (the seed paper's question). Other
@@ -41,6 +42,9 @@ class Settings:
     replicates: int = REPLICATES
     pairs: tuple = PAIRS
     transfer: bool = True
+    margin: object = MARGIN  # the equivalence margin delta: a multiple of the noise or a quantity (inference.margin)
+    family: str = "report"  # the family a report's test p-values are adjusted in (equivalence_groups.FAMILIES)
+    accuracy: bool = True  # what accuracy costs per law and dataset (inference.accuracy; in full with tolerance)
     cluster: str = ""  # where the tasks ran when not on a local pool: "Dask cluster at ADDRESS (N workers)"
 
     def __attrs_post_init__(self):
@@ -58,6 +62,12 @@ class Settings:
         t = self.fit_timeout
         if t is not None and (isinstance(t, bool) or not isinstance(t, (int, float)) or not 0 < t < float("inf")):
             raise ParameterError(f"compare: fit_timeout must be a positive number of seconds, got {t!r}")
+        from ..inference.equivalence_groups import FAMILIES
+        from ..inference.margin import parse_margin
+
+        object.__setattr__(self, "margin", parse_margin(self.margin))
+        if self.family not in FAMILIES:
+            raise ParameterError(f"compare: family must be one of {', '.join(FAMILIES)}, got {self.family!r}")
         for r in self.tolerance:
             if isinstance(r, bool) or not isinstance(r, (int, float)) or not 0 < r < 1:
                 raise ParameterError(f"compare: every tolerance must be a number in (0, 1), got {r!r}")
@@ -78,4 +88,6 @@ class Settings:
                 "bootstrap": int(self.bootstrap), "seed": int(self.seed), "bootstrap_all": bool(self.bootstrap_all),
                 "tolerance": [float(r) for r in self.tolerance], "fit_timeout": self.fit_timeout,
                 "replicates": int(self.replicates), "pairs": [list(p) for p in self.pairs],
-                "transfer": bool(self.transfer)} | ({"cluster": self.cluster} if self.cluster else {})
+                "transfer": bool(self.transfer), "margin": self.margin.as_text(), "family": self.family,
+                "accuracy": bool(self.accuracy)} | (
+                    {"cluster": self.cluster} if self.cluster else {})

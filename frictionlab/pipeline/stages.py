@@ -1,4 +1,4 @@
-"""The named stages of ``compare``, in order: fit, rank, equivalence, transfer, tolerance, bootstrap,
+"""The named stages of ``compare``, in order: fit, rank, equivalence, transfer, tolerance, accuracy, bootstrap,
 answer. Each reads the comparison so far and returns the fields of ``Comparison`` it fills.
 
 - fit: every planned (law, dataset, solver) fitted (``inference.fitting.fit``) -> ``fits``
@@ -6,6 +6,8 @@ answer. Each reads the comparison so far and returns the fields of ``Comparison`
 - equivalence: the discrimination test per pair and dataset (``inference.equivalence``) -> ``equivalence``
 - transfer: one parameter set across a group's conditions (``inference.transfer``) -> ``transfer``
 - tolerance: the ODE laws of one dataset refitted at other tolerances (``inference.fitcost``) -> ``tolerance``
+- accuracy: what accuracy costs, each solver's error and time against the most accurate one per law and
+  dataset (``inference.accuracy``; by default where cheap, in full with the tolerance check) -> ``accuracy``
 - bootstrap: parametric replicates, intervals and first-place shares (``inference.bootstrap``) ->
   ``bootstrap``, ``bootstrap_skipped``
 - answer: one verdict row per dataset group, the first screen (``inference.verdicts``) -> ``answers``
@@ -15,9 +17,11 @@ from __future__ import annotations
 import functools
 
 from ..core.errors import FrictionLabError
+from ..inference import accuracy as _accuracy
 from ..inference import equivalence_groups as _equivalence
 from ..inference import transfer as _transfer
 from ..inference.answers import group_of
+from ..inference.accuracy import SolverCost, solver_costs, study_fits
 from ..inference.ranking_bootstrap import bootstrap_fits
 from ..inference.equivalence import EquivalenceResult, analyze_equivalence
 from ..inference.fitcost import tolerance_check
@@ -82,13 +86,21 @@ def equivalence(c, run: Run) -> dict:
             slow.append(EquivalenceResult(dataset=d, law_a=la, law_b=lb, solver_a=sa, solver_b=sb,
                                           status="skipped", reason=why, replicates=s.replicates, seed=s.seed))
         else:
-            tasks.append((fa, fb, s.replicates, s.seed, s.fit_timeout))
+            tasks.append((fa, fb, s.replicates, s.seed, s.fit_timeout, s.margin))
     if slow:  # counted first: the count then ends with the last test run
         run.tally().total += len(slow)
         run.step(f"{len(slow)} pairs skipped (slow; --bootstrap-all tests them)", advance=len(slow))
     results = run.map(_equivalence_task, tasks, lambda t: f"equivalence on {t[0].datasets[0]}: {t[0].law} "
                                                           f"[{t[0].solver}] vs {t[1].law} [{t[1].solver}]")
-    return {"equivalence": tuple(sorted(results + slow, key=equivalence_order(c, s.pairs)))}
+    results = tuple(sorted(results + slow, key=equivalence_order(c, s.pairs)))
+    if not run.part:  # a cluster's per-dataset task: adjusted once the parts are merged (pipeline.perdataset)
+        results = family_adjusted(c, results, s)
+    return {"equivalence": results}
+
+
+def family_adjusted(c, results, settings) -> tuple:
+    """The tests' p-values adjusted as one family (``equivalence_groups.adjust_family``)."""
+    return _equivalence.adjust_family(results, settings.family, {d.name: group_of(d) for d in c.datasets})
 
 
 def equivalence_order(c, pairs):
@@ -98,12 +110,12 @@ def equivalence_order(c, pairs):
 
 
 def _equivalence_task(args) -> EquivalenceResult:
-    fa, fb, replicates, seed, timeout = args
+    fa, fb, replicates, seed, timeout, margin = args
     over = lambda why: EquivalenceResult(  # noqa: E731
         dataset=fa.datasets[0], law_a=fa.law, law_b=fb.law, solver_a=fa.solver, solver_b=fb.solver,
         replicates=replicates, seed=seed, status="failed", reason=f"a refit {why}")
     return within_budget(analyze_equivalence, (fa.law, fb.law), timeout, fa, fb, replicates, seed, None, None,
-                         timeout, over=over)
+                         timeout, margin, over=over)
 
 
 def transfer(c, run: Run) -> dict:
@@ -134,6 +146,20 @@ def tolerance(c, run: Run) -> dict:
     return {"tolerance": tuple(rows)}
 
 
+def accuracy(c, run: Run) -> dict:
+    fits = study_fits(c.fits)
+    full = bool(run.settings.tolerance)  # --tolerance asks for the whole study, the costly rows too
+    rows = run.map(functools.partial(_accuracy_task, full=full, timeout=run.settings.fit_timeout), fits,
+                   lambda f: f"what accuracy costs: {f.law} on {f.datasets[0]}")
+    return {"accuracy": tuple(r for part in rows for r in part)}
+
+
+def _accuracy_task(f, full=False, timeout=None):
+    over = lambda why: (SolverCost(dataset=f.datasets[0], law=f.law, solver="all", status="failed",  # noqa: E731
+                                   reason=why),)
+    return within_budget(solver_costs, (f.law,), timeout, f, full, over=over)
+
+
 def bootstrap(c, run: Run) -> dict:
     s = run.settings
     seen: dict = {}  # dataset -> resamples done; the stage counts resamples over every dataset
@@ -155,6 +181,7 @@ def answer(c, run: Run) -> dict:
     answers = make_answers(fitted, c.fits, c.ranking, c.groups)
     # the verdict layer's rows; the equivalence and transfer fields are filled by their producers
     answers = _transfer.fill_answers(_equivalence.fill_answers(answers, c.equivalence), c.transfer)
+    answers = _accuracy.fill_answers(answers, c.accuracy)
     not_applicable = {k: v for k, v in c.skipped_datasets.items() if k in run.plan.no_law}
     answers = answers + not_fitted_answers(c.datasets, not_applicable, fitted)
     run.step(f"{len(answers)} verdict row{'s' * (len(answers) != 1)}")
@@ -177,6 +204,7 @@ STAGES = (
     Stage("equivalence", equivalence, lambda run: run.settings.equivalence and bool(run.eq_pairs)),
     Stage("transfer", transfer, lambda run: run.settings.transfer),
     Stage("tolerance", tolerance, lambda run: bool(run.settings.tolerance), beside=True),
+    Stage("accuracy", accuracy, lambda run: run.settings.accuracy),
     Stage("bootstrap", bootstrap, lambda run: run.settings.bootstrap > 0),
     Stage("answer", answer, lambda run: True),
 )

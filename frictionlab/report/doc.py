@@ -56,7 +56,7 @@ class Section:
     """One part of the report. ``open`` sections are shown in full; the others are collapsible in HTML."""
 
     title: str
-    blocks: list = attrs.field(factory=list)  # (kind, payload) with kind h3 | p | warn | ul | more | table | fig
+    blocks: list = attrs.field(factory=list)  # (kind, payload) with kind h3 | p | warn | ul | more | moretable | table | fig
     open: bool = False
 
     @property
@@ -82,6 +82,12 @@ class Section:
         items = list(items)
         if items:
             self.blocks.append(("more", (summary, items)))
+
+    def more_table(self, summary: str, headers, rows):
+        """A table folded under one line ``summary`` in HTML (opened by a click); in Markdown a bold line and the table."""
+        rows = [[("" if c is None else str(c)) for c in r] for r in rows]
+        if rows:
+            self.blocks.append(("moretable", (summary, Table(list(headers), rows))))
 
     def table(self, headers, rows):
         rows = [[("" if c is None else str(c)) for c in r] for r in rows]

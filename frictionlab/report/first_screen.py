@@ -1,24 +1,31 @@
-"""The first screen: the verdict table (``Comparison.answers``) and the figure of the central finding.
+"""The first screen: the verdict table (``Comparison.answers``), what accuracy costs, and the figure of the data.
 
 The verdict table only renders the answers the verdict layer filled (``frictionlab/inference/answers.py``);
 columns without data are named in one line under it, and groups without a fitted law fold into one
 line. Without answers it shows what the comparison does hold, labelled as such (the AIC ranking's
-first place and the equivalence analysis' verdict), never a verdict of its own. The finding, where
-a dataset's spin falls and the paper's truncated series of a F = k A u law has its slip cross zero:
-that series against the exact solution of the same law, spin above and the slip u(t) of each below,
-with the crossing time (computed here from the fitted series). Elsewhere the figure and sentences
-of ``data_view`` describe the compared data.
+first place and the equivalence analysis' verdict), never a verdict of its own. The full sentences of each
+row follow, folded, each part a labelled run of whole sentences; then, folded, what accuracy costs per law and
+dataset (``inference.accuracy``). The figure (``data_view``) draws each group's data with its top-ranked
+candidates, and the slip of the truncated series against the exact solution where that series is among them.
+
+Kinds of data with a first-screen block of their own plug in at one place, ``KIND_BLOCKS``: a dataset kind
+mapped to a function ``block(ctx, sec, datasets)`` that adds its paragraphs, tables and figures for the
+comparison's fitted datasets of that kind; those datasets are then left out of the generic figure.
 """
 from __future__ import annotations
+
+import math
 
 import attrs
 import numpy as np
 
 from ..core.display import fmt_time
+from ..inference.accuracy import COMMAND as ACCURACY_COMMAND
 from ..inference.answers import group_of, unfitted
+from ..inference.equivalence import sentence
 from ..solve.solvers.series import slip_zero
 from . import figures
-from .data_view import data_views, describe, spin_falls
+from .data_view import describe, group_views, spin_falls
 from .data_view import title as view_title
 from .doc import Section
 from .text import PROVENANCE_WORDS, sig
@@ -27,14 +34,19 @@ TITLE = "Answers"
 #: (Answer.short key, column header) of the verdict table; each cell is the short form, the full
 #: sentences follow in a folded list right below the table.
 COLUMNS = (("best", "best law"), ("goodness", "goodness of fit"),
-           ("equivalence", "λAu ≡ μN + μη′dA/dt?"), ("threshold", "noise threshold"),
-           ("series", "series vs exact"), ("transfer", "one parameter set for all conditions?"))
+           ("equivalence", "λAu vs μN + μη′dA/dt"),
+           ("threshold", "noise threshold"), ("series", "series vs exact"), ("accuracy", "what accuracy costs"),
+           ("transfer", "one parameter set for all conditions?"))
 #: characters a table cell shows (more: cut, the full text is in the notes)
 CELL_LIMIT = 70
 #: (Answer field, label) of the full sentences in the notes below the table.
 NOTES = (("headline", ""), ("goodness", "Goodness"), ("equivalence", "λAu against μN + μη′dA/dt, exact"),
-         ("equivalence_series", "The paper's series"), ("noise_threshold", "Noise threshold"),
-         ("series_vs_exact", "Series vs exact"), ("transfer", "Across conditions"))
+         ("equivalence_series", "The truncated series of λAu against μN + μη′dA/dt"),
+         ("qualitative", "Shared features"), ("noise_threshold", "Noise threshold"),
+         ("series_vs_exact", "Series vs exact"), ("accuracy", "What accuracy costs"), ("transfer", "Across conditions"))
+#: dataset kind -> block(ctx, sec, datasets): a first-screen block of its own for the fitted datasets of that kind
+#: (module docstring); the generic figure leaves those datasets out.
+KIND_BLOCKS: dict = {}
 
 
 @attrs.frozen
@@ -71,32 +83,13 @@ def series_findings(c, law_order=("wear", "couette")) -> list[SeriesFinding]:
     return out
 
 
-def finding_sentence(f: SeriesFinding) -> str:
-    if f.t_cross is None:
-        return (f"On {f.dataset.name} the truncated series' slip stays positive up to t_c, so it cannot explain "
-                "a fall of the spin by itself.")
-    text = (f"On {f.dataset.name} the paper's truncated series of {f.series.law} has its slip u(t) cross zero at "
-            f"{fmt_time(f.t_cross, f.contact_time)} (t_c = {fmt_time(f.contact_time)}): from there its friction "
-            "pushes the other way and the spin falls.")
-    if f.full_min_slip > 0:
-        text += (f" The {f.full.solver} solution of the same law keeps u > 0 (at least {f.full_min_slip:.3g} m/s), "
-                 "so its spin never falls: the fall comes from the truncation, not from the law.")
-    return text
-
-
-def finding_text(shown) -> str:
-    """The first finding in full, the others by their numbers."""
-    text = finding_sentence(shown[0])
-    more = [f"on {f.dataset.name} at {fmt_time(f.t_cross, f.contact_time)} (t_c {fmt_time(f.contact_time)})"
-            for f in shown[1:] if f.t_cross is not None]
-    return text + (" The same " + ("crossing" if len(more) == 1 else "crossings") + ": " + "; ".join(more) + "."
-                   if more else "")
-
-
 #: what each column would have said, for the one line naming the columns this comparison has no data for
 ABSENT = {"best": "a best law", "goodness": "a goodness-of-fit test",
           "equivalence": "the equivalence test of λAu and μN + μη′dA/dt (no dataset fitted with both)",
-          "threshold": "a noise threshold", "series": "the paper's series against the exact solution (no series fitted)",
+          "threshold": "a noise threshold", "series": "the truncated series against the exact solution (no series "
+                                                                 "fitted)",
+          "accuracy": f"what accuracy costs (it runs by default where cheap, unless --no-accuracy; `{ACCURACY_COMMAND}` "
+                      "runs it everywhere)",
           "transfer": "one parameter set across conditions (no group of two or more datasets)"}
 
 
@@ -111,21 +104,35 @@ def _answer_table(sec: Section, answers):
         if flags and "implausible" not in cells[0]:
             cells[0] += " ⚠ implausible"
         rows.append([f"**{a.group}**"] + cells)
-        parts = [f"{label}: {getattr(a, field)}" if label else getattr(a, field)
-                 for field, label in NOTES if getattr(a, field) and getattr(a, field) != "not tested"]
-        if flags:
-            parts.append("implausible: " + "; ".join(flags))
-        notes.append(f"**{a.group}** ({', '.join(a.datasets)}; {a.provenance}): " + ". ".join(parts) + ".")
+        notes.append(f"**{a.group}** ({', '.join(a.datasets)}; {a.provenance}): " + " ".join(note_parts(a, flags)))
     if rows:
         sec.table(["dataset group"] + [h for _, h in cols], rows)
         sec.more("Each verdict in full (datasets, tests, p-values, thresholds per dataset)", notes)
+    absent = [ABSENT[key] for key, _ in COLUMNS if key not in dict(cols)]
+    if shown and absent:
+        sec.p("Not in this comparison: " + "; ".join(absent) + ".")
+
+
+def _unfitted(sec: Section, answers):
+    """One line per reason for the groups without a fitted law."""
     for reason, groups, hints in unfitted(answers):
         head, _, why = reason.partition(": ")
         sec.p(f"{head[0].upper()}{head[1:]}" + (f" ({why})" if why else "") + f": {', '.join(groups)}"
               + "".join(f"; registered laws that apply: {h}" for h in hints) + ".")
-    absent = [ABSENT[key] for key, _ in COLUMNS if key not in dict(cols)]
-    if shown and absent:
-        sec.p("Not in this comparison: " + "; ".join(absent) + ".")
+
+
+def note_parts(a, flags=()) -> list[str]:
+    """The full sentences of one answer row: each field a labelled run of whole sentences ('**Label.** Text.'),
+    so that no field's text can run into another's."""
+    parts = []
+    for field, label in NOTES:
+        text = getattr(a, field)
+        if not text or text == "not tested":
+            continue
+        parts.append((f"**{label}.** " if label else "") + sentence(text))
+    if flags:
+        parts.append("**Implausible.** " + sentence("; ".join(flags)))
+    return parts
 
 
 def _clip(text: str, limit: int = CELL_LIMIT) -> str:
@@ -197,23 +204,63 @@ def build(ctx) -> Section:
                  "The table shows what the comparison holds: the lowest AIC (a relative ranking, not a test that "
                  "the law fits), its reduced χ², and the discrimination test's verdict and noise threshold.")
         _fallback_table(sec, c, findings)
-    story = [f for f in _pick(findings) if f.t_cross is not None and spin_falls(f.dataset)]
-    if story:
-        sec.fig("finding.png", "Spin (top) and slip u(t) (bottom) of the truncated series and the exact solution "
-                "of the same law, fitted to the same data; dotted: where the series' slip crosses zero.",
-                lambda: figures.finding_figure(story), side="**Why the paper's spin falls.** " + finding_text(story))
-        return sec
-    views = data_views(c, findings)
+    own = {}
+    for d in c.fitted_datasets:
+        if d.kind in KIND_BLOCKS:
+            own.setdefault(d.kind, []).append(d)
+    for kind, dss in own.items():
+        KIND_BLOCKS[kind](ctx, sec, dss)
+    views = group_views(c, findings, skip_kinds=tuple(own))
     if views:
-        sec.fig("finding.png", "The data with the top-ranked candidates (#rank, ΔAIC)" + (
-            "; below, where the paper's series was fitted, the slip u(t) of the series and of the exact "
-            "solution of the same law" if any(v.series for v in views) else "") + ".",
-                lambda: figures.data_figure(views, view_title(views)),
-                side="**What the data show.** " + " ".join(describe(v) for v in views))
+        sec.fig("finding.png", "Per dataset group, one of its datasets with the group's top-ranked candidates (#rank)"
+                + ("; under a panel whose candidates include the truncated series, the slip u(t) of that series and "
+                   "of the exact solution of the same law (dotted: where the series' slip crosses zero)"
+                   if any(v.series for v in views) else "") + ".",
+                lambda: figures.group_figure(views, view_title(views)))
+        sec.p(_side(views))
+    _unfitted(sec, c.answers)
+    _accuracy_table(sec, c)
     return sec
 
 
-def _pick(findings, n: int = 2):
-    """At most n findings, those with a zero crossing first (then in dataset order)."""
-    return sorted(findings, key=lambda f: f.t_cross is None)[:n]
+def _side(views) -> str:
+    """The sentences beside the figure; the paper's story heads them only where the paper's data show it."""
+    story = [v for v in views if v.series is not None and v.series.t_cross is not None
+             and v.dataset.provenance.seed_paper and spin_falls(v.dataset)]
+    head = "**Why the paper's spin falls.** " if story else "**What the data show.** "
+    return head + " ".join(describe(v) for v in views)
 
+
+def _accuracy_table(sec: Section, c) -> None:
+    """What accuracy costs per law and dataset, folded under one line below the verdict table."""
+    rows = list(getattr(c, "accuracy", ()))
+    if not rows:
+        return
+    labels = list(dict.fromkeys(r.label for r in rows if r.status == "ok" and not r.reference))
+    table = []
+    for (ds, law) in dict.fromkeys((r.dataset, r.law) for r in rows):
+        mine = [r for r in rows if (r.dataset, r.law) == (ds, law)]
+        ref = next((r for r in mine if r.reference), None)
+        if ref is None:
+            table.append([ds, law, f"{mine[0].status}: {mine[0].reason}"] + [""] * len(labels))
+            continue
+        by = {r.label: r for r in mine}
+        cells = []
+        for label in labels:
+            r = by.get(label)
+            cells.append("" if r is None else (f"{r.status}: {r.reason}" if r.status != "ok" else
+                                               f"{_sigmas(r.error_sigma)}, {sig(r.time_ratio, 2)}×"))
+        table.append([ds, law, f"{ref.label}, {_micro(ref.time_s)}"] + cells)
+    sec.more_table("What accuracy costs, per law and dataset: each solver's error against the most accurate one "
+                   "(in noise σ; stated precisions for stated numbers) and its time as a multiple of that one's, at "
+                   "the law's fitted parameters",
+                   ["dataset", "law", "reference (CPU per prediction)"] + [f"{label}: error, time" for label in labels],
+                   table)
+
+
+def _sigmas(x: float) -> str:
+    return "0" if x == 0 else f"{x:.2g}σ" if math.isfinite(x) else ""
+
+
+def _micro(t: float) -> str:
+    return f"{t * 1e6:.3g} µs" if t < 1e-3 else f"{t * 1e3:.3g} ms" if t < 1 else f"{t:.3g} s"

@@ -4,7 +4,8 @@ from __future__ import annotations
 import json
 
 from ..inference.predict import FIT_RTOL
-from ..inference.ranking import COLUMNS, TIE_AIC
+from ..inference import rules
+from ..inference.ranking import COLUMNS
 from .doc import Section
 from .results import SCHEMA
 from .text import rtol_text
@@ -27,19 +28,14 @@ def build(ctx) -> list[Section]:
         "AICc = AIC + 2k(k+1)/(n − k − 1), BIC = −2 ln L + k ln n. k counts the "
         "identifiable directions (rank of the Jacobian): a pair entering only as a ratio counts once, a "
         "parameter without effect not at all. Groups add −2 ln L and k and use the group's n.",
-        "Goodness of fit: χ² p-value (known σ; an F test with the estimate's degrees of freedom for estimated σ) and "
-        "the Wald-Wolfowitz runs test on residual signs (one-sided: too few runs); a candidate fits when both are "
-        "≥ 0.005, one family-wise level of 0.01 (Bonferroni-adjusted over a group); the top "
-        "candidate is called best only if it fits and carries no plausibility flag.",
-        "Plausibility: flagged when slip or r|ω| exceeds 10× the starting speed, friction does net negative work, or "
-        "a fitted law parameter can be set to 0 changing χ² (in variance units) by less than 1; flagged fits rank "
-        "after unflagged ones.",
-        f"Ties: candidates within ΔAIC ≤ {TIE_AIC} share a rank; within ΔAIC < 2 they are indistinguishable by "
-        "the data. Laws of one closed-form family (law.form()) are one candidate, e.g. wear = couette. "
-        "Akaike weight w = exp(−Δ/2)/Σexp(−Δ/2).",
+        f"Goodness of fit: {rules.goodness()}.",
+        f"Plausibility: {rules.plausibility()}.",
+        f"Ties and weights: {rules.ties()}. Laws of one closed-form family (law.form()) are one candidate, e.g. "
+        f"wear = couette; {rules.weights()}.",
+        f"Identifiability: {rules.bounds()}; {rules.correlation()}.",
         "Solvers: 'exact' where the law and scene admit a closed form, else 'ode' (LSODA, rtol "
         f"{rtol_text(FIT_RTOL)}; what another tolerance changes is under 'What solver tolerance does to a fit'); 'series' "
-        "(the paper's first-order expansion, eqs 7-11) in addition wherever it is defined.",
+        "(the first-order expansion of Arakawa 2017, eqs 7-11) in addition wherever it is defined.",
         "Bootstrap (`--bootstrap N`, `--seed`): parametric (the best unflagged fit plus Gaussian noise of the σ the "
         "likelihood uses, measured or estimated from the data; none for a noise-free reconstruction), every "
         "candidate refitted to the same replicates; "

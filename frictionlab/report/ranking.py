@@ -4,7 +4,8 @@ from __future__ import annotations
 import math
 
 from ..core.display import OBSERVABLE_UNITS, fmt, unit
-from ..inference.ranking import TIE_AIC
+from ..inference import rules
+from ..inference.equivalence import sentence
 from . import figures
 from .doc import Section
 from .text import fixed
@@ -63,11 +64,19 @@ def candidate_table(rows, observable: str, labels: dict | None = None,
         status = ("same curve" if same and r.status in ("tied", "indistinguishable") and not tied else r.status) \
             + (f" (with {', '.join(tied)})" if tied else "") + (f": {r.reason}" if r.reason else "")
         others = "".join(f"; FLAG ({x.law} only): {f}" for x in rs[1:] for f in x.flags if f not in r.flags)
-        weight = sum(x.akaike_weight for x in rs) if r.rank else r.akaike_weight
+        finite = [x.akaike_weight for x in rs if math.isfinite(x.akaike_weight)]
+        weight = (sum(finite) if finite else math.nan) if r.rank else r.akaike_weight
         out.append([r.rank or "–", name, r.n_points or "", r.n_params if r.rank else "",
                     fmt(r.rmse * uf) if math.isfinite(r.rmse) else "", fmt(r.redchi), fmt(r.aic), fmt(r.aicc),
-                    fmt(r.bic), fixed(r.delta_aic, 2), fixed(weight, 3), _fits_cell(r), status + _flags(r) + others])
+                    fmt(r.bic), fixed(r.delta_aic, 2), _weight_cell(weight, r), _fits_cell(r), status + _flags(r) + others])
     return headers, out
+
+
+def _weight_cell(weight: float, r) -> str:
+    """The Akaike weight, or why there is none (it compares the candidates that fit)."""
+    if math.isfinite(weight):
+        return fixed(weight, 3)
+    return "— (fails its fit tests)" if r.fits is False else ("—" if r.rank else "")
 
 
 def _fits_cell(r) -> str:
@@ -92,21 +101,20 @@ def group_table(rows) -> tuple[list[str], list[list]]:
     headers = ["group", "rank", "law [solver]", "n", "k", "reduced χ²", "AIC", "AICc", "BIC", "ΔAIC",
                "Akaike weight", "fits? (χ² p, runs p)", "status"]
     out = [[r.dataset, r.rank or "–", r.candidate, r.n_points or "", r.n_params if r.rank else "", fmt(r.redchi),
-            fmt(r.aic), fmt(r.aicc), fmt(r.bic), fixed(r.delta_aic, 2), fixed(r.akaike_weight, 3), _fits_cell(r),
+            fmt(r.aic), fmt(r.aicc), fmt(r.bic), fixed(r.delta_aic, 2), _weight_cell(r.akaike_weight, r), _fits_cell(r),
             r.status + (f": {r.reason}" if r.reason else "") + _flags(r, limit=1)] for r in rows]
     return headers, out
 
 def build(ctx) -> Section:
     c = ctx.c
     sec = Section(TITLE)
-    sec.p(f"Each law is fitted separately to each dataset and ranked by AIC, unflagged candidates first (a fit "
+    sec.p("Each law is fitted separately to each dataset and ranked by AIC, unflagged candidates first (a fit "
           "flagged as physically implausible ranks after them, its flag in the status); laws of one closed-form "
-          f"family are one candidate (wear = couette); candidates within ΔAIC ≤ {TIE_AIC} share a rank and within "
-          "ΔAIC < 2 are indistinguishable by the data. A candidate fits when χ² p ≥ 0.01 (known σ only) and "
-          "runs-test p ≥ 0.01. The solver is part of the candidate: where the paper's "
-          "truncated series applies it is ranked next to the exact (or numerical) solution of the same law, so the "
-          "effect of the approximation is visible. Weights are Akaike weights within each dataset. Laws whose best "
-          "fits are the same curve (wear and Couette share the form F = k A u) are one row, their weights summed.")
+          f"family are one candidate (wear = couette); {rules.ties()}. Goodness of fit: {rules.goodness()}. "
+          f"{sentence(rules.weights())} The solver is part of the candidate: where the truncated series applies it "
+          "is ranked next to the exact (or numerical) solution of the same law, so the effect of the approximation "
+          "is visible. Laws whose best fits are the same curve (wear and Couette share the form F = k A u) are one "
+          "row, their weights summed.")
     ranking, alias = list(c.ranking), law_aliases(c)
     sec.fig("ranking.png", "Rank and ΔAIC of every law [solver] on every dataset (grey: not fitted); laws whose "
             "fits are the same curve on every dataset share a row.", lambda: figures.ranking_figure(ranking, alias))

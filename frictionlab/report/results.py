@@ -23,10 +23,16 @@ results.json:
     answers[Answer.as_dict()] (answers.py; filled by verdicts.py, equivalence.py, transfer.py; short{best, goodness,
             equivalence, threshold, series, transfer}: the first screen's cells),
     series_slip_zero_s{dataset: time the fitted truncated series' slip crosses zero, null if never},
-    equivalence[EquivalenceResult.as_dict(): {dataset, law_a, law_b, solver_a, solver_b, status, verdict,
+    equivalence[EquivalenceResult.as_dict(): {dataset, law_a, law_b, solver_a, solver_b, status,
+                 verdict: different|equivalent within δ|cannot tell at this noise|both fail their fit tests,
                  explanation, reason, replicates, seed, n_points, chi2{}, k{}, t_obs, t_a[], t_b[], p_a, p_b, q_a, q_b,
+                 p (two-sided; null when both laws fail their fit tests), p_adjusted (Holm over the family),
+                 p_within (distance of delta or more), p_within_adjusted, family, within,
+                 margin (delta, SI or stated precisions), margin_text, rms (the curves' RMS distance), upper (its
+                 upper 95% bound), x_a[], x_b[] (replicate distances / delta), x_null_a, x_null_b,
                  p_a_mc_error, p_b_mc_error, power_a, power_b, failed, d_ab, d_ba, sigma, sigma_varies,
-                 observable, threshold, threshold_text, alpha, power_level, critical_dchi2, fitted{},
+                 observable, threshold, threshold_text, alpha, critical_dchi2, fitted{}, fits{}, goodness{},
+                 qualitative{verdict, differs, data_differs{}, peak_time{a, b, shift, dt, differs}, features{}, dt},
                  decomposition{b, u0, c_area, c_area_rate, mu, eta_prime, r2} | null}],
     transfer[TransferResult.as_dict(): {group, datasets[], alpha, status (ok|skipped), reason, predictions[{law, solver, source, target,
              status, reason, n, chi2, rms_sigma, loglik, own_chi2, params{}}], shared[{law, solver, datasets,
@@ -34,7 +40,8 @@ results.json:
              shared{}, separate{}, serves, alpha}], ranking[{candidate, chi2, n, rms_sigma, loglik, rank}], answer}],
     derivations{dataset: {method: {rms_vs_omega_column, omega_peak, omega_end, noisy_rms_vs_omega_column,
                                    noisy_omega_peak, noisy_omega_end, noisy_median_sigma}}},
-    timings_s{stage: wall-clock seconds} (fit, rank, equivalence, transfer, tolerance, bootstrap, answer: the stages run),
+    timings_s{stage: wall-clock seconds} (fit, rank, equivalence, transfer, tolerance, accuracy, bootstrap, answer:
+              the stages run),
     bootstrap{n (0: not run), seed, method: parametric, level: 0.95, interval: percentile,
               first_place_interval: wilson, all (slow datasets included),
               datasets[{dataset, n_ranked,
@@ -45,7 +52,10 @@ results.json:
               not_bootstrapped{dataset: reason}},
     tolerance{default_rtol, rtols[],
               rows[{dataset, law, solver, rtol, fit_time_s (CPU), reference, ranking, ranking_as_reference,
-                    status, parameter, value, stderr, unit, shift_in_stderr, aic, rank}]}
+                    status, parameter, value, stderr, unit, shift_in_stderr, aic, rank}]},
+    accuracy[{dataset, law, solver, rtol, label, reference, error (RMS against the reference solver: observable SI,
+              'stated': stated precisions), error_sigma, time_s (CPU per prediction), time_ratio, observable, status
+              (ok|not run|failed), reason}] (inference/accuracy.py: what accuracy costs)
   All numbers SI (rad/s, s, m, N) unless the key says otherwise; non-finite numbers are null.
 """
 from __future__ import annotations
@@ -153,7 +163,8 @@ def results_json(c, extra: dict | None = None) -> dict:
                    "derivations": extra.get("derivations", {}), "timings_s": c.timings,
                    "series_slip_zero_s": extra.get("series_slip_zero_s", {}),
                    "answers": [a.as_dict() for a in c.answers],
-                   "bootstrap": _bootstrap_json(c), "tolerance": _tolerance_json(c)})
+                   "bootstrap": _bootstrap_json(c), "tolerance": _tolerance_json(c),
+                   "accuracy": [r.as_dict() for r in getattr(c, "accuracy", ())]})
 
 
 def ranking_csv(c) -> str:

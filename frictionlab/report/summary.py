@@ -2,9 +2,11 @@
 from __future__ import annotations
 
 import datetime as _dt
+import math
 
 from ..inference.ranking_bootstrap import wilson
 from ..inference.equivalence import AREA_RATE, WEAR
+from ..inference.ranking import weight_text
 from .doc import Section
 from .text import PROVENANCE_WORDS, pct
 
@@ -69,10 +71,12 @@ def _best_items(c) -> list[str]:
         best = [r for r in c.ranking if r.dataset == d.name and r.rank == 1]
         if best:
             fits = all(r.fits and not r.flags for r in best)
+            weights = [r.akaike_weight for r in best if math.isfinite(r.akaike_weight)]
+            weight = weight_text(sum(weights) if weights else math.nan, best[0].weight_among,
+                                 False if any(r.fits is False for r in best) else best[0].fits)
             items.append(f"**{d.name}** ({d.provenance.kind}): {'best' if fits else 'top-ranked (does not fit)'} "
                          + " = ".join(r.candidate for r in best)
-                         + f" (Akaike weight {sum(r.akaike_weight for r in best):.2f}"
-                         + (" shared by a tie" if len(best) > 1 else "")
+                         + f" ({weight}" + (", shared by a tie" if len(best) > 1 and weights else "")
                          + (f"; {first_share(boot[d.name], best)}" if d.name in boot else
                             "; not bootstrapped" if d.name in c.bootstrap_skipped else "") + ")")
         else:
@@ -111,7 +115,7 @@ def _series_items(c) -> list[str]:
                          and r.rank), None)
             if ser and full and abs(ser.aic - full.aic) > 2:
                 better = "better" if ser.aic < full.aic else "worse"
-                items.append(f"**{d.name}**: the paper's truncated series of {label} fits {better} than the {full.solver} "
+                items.append(f"**{d.name}**: the truncated series of {label} fits {better} than the {full.solver} "
                              f"solution of the same law (ΔAIC {abs(ser.aic - full.aic):.1f}): the approximation, not "
                              "the law, makes that difference (see the notes under Fits)")
     return items

@@ -13,6 +13,10 @@ TOML's [provenance.truth], with the verdicts a correct analysis must reach:
   F = k A u); Coulomb against wear "not equivalent", rejecting Coulomb.
 - kt-drag-impact: quadratic drag F = c A u |u|, c = 1.5e5 Pa s^2/m^2, a law that is not registered
   (and must stay so): no registered law may describe these data.
+- kt-stribeck-incline: a 20 g block sliding from rest down a 30 deg incline (contact area 100 mm^2) with
+  Stribeck friction, mu_c = 0.2, mu_s = 0.5, vs = 0.05 m/s, sigma2 = 2 s/m, noise 2 mm/s, 101 samples over
+  0.5 s: the velocity rises in an S and levels off, which none of the four laws compared by default (Coulomb,
+  area-rate, wear, Couette) can follow: each fails its fit tests, and no pair of them may get a p-value.
 - kt-speeds-v20 / kt-speeds-v40: one wear law (lambda = 1.2e6 Pa s/m) at two impact speeds (u0 = 8
   and 16 m/s, A0 = 100 and 180 mm^2, t_c = 520 and 460 us): one lambda must serve both (transfer);
   kt-twolam-v20 / kt-twolam-v40: the same two scenes with lambda = 1.8e6 and 0.9e6 Pa s/m (the
@@ -74,6 +78,10 @@ CASES = {
 }
 
 
+#: The incline case: (parameters SI, incline [deg], mass [kg], area [m^2], noise [m/s], samples, duration [s], seed)
+STRIBECK = ({"mu_c": 0.2, "mu_s": 0.5, "vs": 0.05, "sigma2": 2.0}, 30.0, 0.020, 100e-6, 0.002, 101, 0.5, 3109)
+
+
 def scene_spec(u0: float, A0: float, tc: float) -> dict:
     """The [scene] table (quantity strings) of a known-truth impact."""
     return {"mass": f"{MASS * 1e3:g} g", "radius": f"{RADIUS * 1e3:g} mm", "u0": f"{u0:g} m/s", "effects": ["spin"],
@@ -114,4 +122,43 @@ def build(out_dir: Path) -> list[Path]:
             },
         }
         written += write_pair(out_dir, name, meta, {"t": t * 1e6, "omega": omega}, 8, __name__)
-    return written
+    return written + _stribeck_incline(out_dir)
+
+
+def _stribeck_incline(out_dir: Path) -> list[Path]:
+    """kt-stribeck-incline (module docstring)."""
+    params, deg, mass, area, sigma, n, t_end, seed = STRIBECK
+    spec = {"mass": f"{mass * 1e3:g} g", "u0": "0 m/s", "incline": f"{deg:g} deg",
+            "area": {"model": "constant", "area": f"{area * 1e6:g} mm^2"}}
+    s = Scene.from_spec(spec, "incline", "kt-stribeck-incline", {}, np.linspace(0.0, t_end, n))
+    t = np.linspace(0.0, t_end, n)
+    v = simulate("stribeck", s, params, solver="ode:DOP853", t=t, rtol=1e-12).v
+    v = v + np.random.default_rng(seed).normal(0.0, sigma, t.size)
+    name = "kt-stribeck-incline"
+    meta = {
+        "name": name,
+        "kind": "incline",
+        "observable": "v",
+        "description": (f"Known-truth incline: a {mass * 1e3:g} g block sliding from rest down a {deg:g} deg incline, "
+                        f"contact area {area * 1e6:g} mm^2; velocity generated with Stribeck friction. SYNTHETIC, not "
+                        "measured."),
+        "columns": {"t": "s", "v": "m/s"},
+        "noise": {"kind": "known", "v": f"{sigma * 1e3:g} mm/s"},
+        "scene": spec,
+        "fixed": {"eta": "0.1 Pa s"},
+        "provenance": {
+            "kind": "synthetic",
+            "source": "known-truth dataset for testing frictionlab's verdicts",
+            "method": (f"frictionlab.simulate('stribeck', ode:DOP853, rtol 1e-12) on this scene at {n} times, plus "
+                       "Gaussian noise of the stated sigma from numpy default_rng(seed); 8 significant digits. See "
+                       "frictionlab/io/datagen/knowntruth.py."),
+            "command": COMMAND,
+            "seed": seed,
+            "truth": {"law": "stribeck", "mu_c": f"{params['mu_c']:g}", "mu_s": f"{params['mu_s']:g}",
+                      "vs": f"{params['vs']:g} m/s", "sigma2": f"{params['sigma2']:g} s/m",
+                      "noise": f"{sigma * 1e3:g} mm/s",
+                      "expect": "coulomb, area-rate, wear and couette each fail their fit tests; no pair of them "
+                                "gets a p-value"},
+        },
+    }
+    return write_pair(out_dir, name, meta, {"t": t, "v": v}, 8, __name__)

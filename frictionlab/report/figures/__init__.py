@@ -7,10 +7,10 @@ from .base import (DPI, EXTRA_COLORS, LAW_COLORS, SAME_CURVE, _plt, _png, distin
                    simplest_first)
 from .derivation import derivation_figure
 from .equivalence import discrimination_figure, equivalence_figure
-from .finding import data_figure, finding_figure
+from .finding import group_figure
 from .fits import column_unit, fit_figure, force_figure, outcome_figure
 from .ranking import ranking_figure
 
 __all__ = ["DPI", "EXTRA_COLORS", "LAW_COLORS", "SAME_CURVE", "_plt", "_png", "column_unit", "derivation_figure",
-           "data_figure", "discrimination_figure", "distinct_curves", "equivalence_figure", "finding_figure", "fit_figure",
+           "discrimination_figure", "distinct_curves", "equivalence_figure", "fit_figure", "group_figure",
            "force_figure", "is_png", "outcome_figure", "ranking_figure", "same_curve", "simplest_first"]

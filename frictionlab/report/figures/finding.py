@@ -1,4 +1,5 @@
-"""The first screen's finding: the paper's truncated series against the exact solution."""
+"""The first screen's figure: each dataset group's data with its top-ranked candidates, and the slip of the
+truncated series against the exact solution where that series is among them."""
 from __future__ import annotations
 
 import numpy as np
@@ -7,102 +8,72 @@ from ...core.display import NAMES, time_unit, unit
 from . import base
 
 
-def finding_figure(findings) -> bytes:
-    """Per finding (report.first_screen.SeriesFinding), one column: the data's spin with the series and the
-    exact fit of the same law (top), the slip u(t) of each (bottom), the series' zero crossing marked."""
-    plt = base._plt()
-    n = len(findings)
-    fig, axes = plt.subplots(2, n, figsize=(4.6 * n + 0.4, 3.7), sharex="col", squeeze=False,
-                             gridspec_kw={"height_ratios": [1.5, 1]})
-    su, sf = unit("omega")
-    for j, f in enumerate(findings):
-        d = f.dataset
-        ax, axu = axes[0, j], axes[1, j]
-        t_end = float(d.t[-1])
-        tname, tf = time_unit(t_end)
-        t = np.linspace(0.0, t_end, 300)
-        obs = f.series.per_dataset[0].target.observable
-        if obs == "omega":
-            target = f.series.per_dataset[0].target
-            ax.errorbar(d.t * tf, target.y * sf, yerr=target.sigma * sf, fmt="o", ms=2.6, color="black",
-                        ecolor="0.75", elinewidth=0.7, label=f"data ({d.provenance.kind})", zorder=1)
-        elif "omega" in d.columns:  # fitted to another column: the dataset's spin column, as given
-            ax.errorbar(d.t * tf, d.columns["omega"] * sf, yerr=d.noise.get("omega", 0.0) * sf, fmt="o", ms=2.6,
-                        color="black", ecolor="0.75", elinewidth=0.7, zorder=1,
-                        label=f"data ({d.provenance.kind}), spin column")
-        for fit, color, ls in ((f.full, "#1b9e77", "-"), (f.series, "#d95f02", "--")):
-            tr = fit.per_dataset[0].trajectory(fit.law, t)
-            label = f"{fit.law} [{fit.solver}]" + (" (paper's truncated series)" if fit.solver == "series" else "")
-            ax.plot(t * tf, tr["omega"] * sf, color=color, ls=ls, lw=2, label=label, zorder=3)
-            axu.plot(t * tf, tr["u"], color=color, ls=ls, lw=2, label=label)
-        axu.axhline(0, color="0.3", lw=0.8)
-        if f.t_cross is not None:
-            for a in (ax, axu):
-                a.axvline(f.t_cross * tf, color="#d95f02", ls=":", lw=1.3)
-            axu.annotate(f"series slip = 0 at {f.t_cross * tf:.0f} {tname}:\nfriction reverses, spin falls",
-                         xy=(f.t_cross * tf, 0.0), xytext=(0.03, 0.06), textcoords="axes fraction", fontsize=8,
-                         bbox={"fc": "white", "ec": "none", "alpha": 0.85, "pad": 1},
-                         arrowprops={"arrowstyle": "->", "color": "0.3"})
-        ax.axvline(f.contact_time * tf, color="0.6", lw=0.8)
-        axu.axvline(f.contact_time * tf, color="0.6", lw=0.8)
-        ax.set_title(base.wrapped(d.name + ("" if d.provenance.kind == "measured" else f" ({d.provenance.kind} data)"),
-                                  4.4, 10), fontsize=10)
-        ax.set_ylabel(f"spin ω [{su}]")
-        axu.set_ylabel("slip u [m/s]")
-        axu.set_xlabel(f"time [{tname}] (grey line: end of contact t_c)")
-        ax.legend(fontsize=7, loc="lower right")
-        for a in (ax, axu):
-            a.grid(alpha=0.3)
-    title = base.wrapped("Why the paper's spin falls: its truncated series' slip turns negative; the exact solution's "
-                         "never does", 4.6 * n + 0.1, 10.5)
-    top = base.suptitle(fig, title, 10.5) + max(base.title_in(ax.get_title(), 10) for ax in axes[0])
-    base.margins(fig, top=top, bottom=base.XAXIS + base.EDGE, hspace=base.GAP)
-    return base._png(fig)
-
-
-def data_figure(views, title: str) -> bytes:
-    """Per view (report.first_screen.DataView), one column: the data with the top-ranked candidates (top)
-    and, only where the paper's series was fitted, the slip u(t) of the series and the exact fit (bottom).
-    A dataset without time (one impact per row) shows its observable against impact angle."""
+def group_figure(views, title: str) -> bytes:
+    """The first screen's figure: per view (report.data_view.DataView: one dataset of a group with the group's
+    top-ranked candidates) one panel, PER_ROW to a row, and under a panel whose candidates include the
+    truncated series, the slip u(t) of that series and of the exact fit of the same law. A dataset without time
+    (one impact per row) shows its observable against impact angle."""
+    from ..data_view import PER_ROW
     from .fits import against_angle, angle_column
 
     plt = base._plt()
     n = len(views)
-    slips = any(v.series is not None for v in views)
-    width = 5.2 * n + 0.6
-    fig, axes = plt.subplots(2 if slips else 1, n, figsize=(width, 4.15 if slips else 3.7), squeeze=False,
-                             gridspec_kw={"height_ratios": [1.5, 1]} if slips else None)
-    below = base.XAXIS
-    for j, v in enumerate(views):
-        d, ax = v.dataset, axes[0, j]
-        curves = [(f, label, base._style(f.law, f.solver, i)) for i, (f, label) in enumerate(zip(v.fits, v.labels))]
-        target = v.fits[0].per_dataset[0].target
-        curves = _merged(curves, float(np.ptp(target.y)) if np.size(target.y) > 1 else 0.0)
-        if target.t is not None:
-            xlabel = _against_time(ax, d, target, curves)
-        elif angle_column(d) is not None:
-            against_angle(ax, d, curves)
-            xlabel = ax.get_xlabel()
-        else:
-            ax.set_axis_off()
-            continue
-        ax.set_title(base.wrapped(d.name + ("" if d.provenance.kind == "measured" else f" ({d.provenance.kind} data)"),
-                                  5.0, 10), fontsize=10)
-        ax.grid(alpha=0.3)
-        if slips:
-            _slip_panel(axes[1, j], v.series, xlabel) if v.series is not None else axes[1, j].set_axis_off()
-        if not slips or v.series is None:
-            ax.set_xlabel(xlabel)
-        else:  # the slip panel below carries the time axis
-            ax.tick_params(labelbottom=False)
-        below = max(below, base.legend_below(ax, base.XAXIS if ax.get_xlabel() else 0.1, fontsize=7, ncol=2))
-    title = base.wrapped(title, width - 0.3, 10.5)
-    top = base.suptitle(fig, title, 10.5) + max(base.title_in(ax.get_title(), 10) for ax in axes[0])
-    if slips:  # the legends between the rows, the slip panels' time axes at the bottom
-        base.margins(fig, top=top, bottom=base.XAXIS + base.EDGE, hspace=below + base.GAP)
-    else:
-        base.margins(fig, top=top, bottom=below + base.EDGE)
+    cols = min(n, PER_ROW)
+    rows = [views[k:k + cols] for k in range(0, n, cols)]
+    panel_w = {1: 5.4, 2: 4.4}.get(cols, 3.1)  # inches: few panels are drawn larger, five fill the page's width
+    panel_h, slip_h = 1.75 + 0.25 * (panel_w - 3.1), 0.85
+    head = 0.3  # a panel's title above the axes
+    below = base.XAXIS + base.GAP
+    heights = [head + panel_h + below + ((slip_h + base.GAP) if any(v.series for v in row) else 0.0) for row in rows]
+    width = panel_w * cols + 0.5
+    title = base.wrapped(title, width - 0.3, 10)
+    top = base.EDGE + base._lines_in(title, 10) + 0.1
+    fig = plt.figure(figsize=(width, top + sum(heights) + base.EDGE))
+    fig.set_dpi(base.DPI)
+    fig.suptitle(title, fontsize=10, y=1 - base.EDGE / fig.get_figheight())
+    y = top
+    for row, h in zip(rows, heights):
+        slips = any(v.series for v in row)
+        for j, v in enumerate(row):
+            left = 0.55 + j * panel_w
+            ax = fig.add_axes(_box(fig, left, y + head, panel_w - 0.7, panel_h))
+            ax_s = fig.add_axes(_box(fig, left, y + head + panel_h + 0.08, panel_w - 0.7, slip_h)) \
+                if slips and v.series is not None else None
+            d = v.dataset
+            curves = [(f, label, base._style(f.law, f.solver, i)) for i, (f, label) in enumerate(zip(v.fits, v.labels))]
+            target = v.fits[0].per_dataset[0].target
+            curves = _merged(curves, float(np.ptp(target.y)) if np.size(target.y) > 1 else 0.0)
+            if target.t is not None:
+                xlabel = _against_time(ax, d, target, curves)
+            elif angle_column(d) is not None:
+                against_angle(ax, d, curves)
+                xlabel = ax.get_xlabel()
+            else:
+                ax.set_axis_off()
+                continue
+            name = v.group + ("" if v.group == d.name else f": {d.name}")
+            ax.set_title(base.wrapped(name + ("" if d.provenance.kind == "measured" else f" ({d.provenance.kind})"),
+                                      panel_w - 0.6, 9), fontsize=9, pad=2)
+            ax.grid(alpha=0.3)
+            ax.tick_params(labelsize=7)
+            ax.yaxis.label.set_size(8)
+            ax.legend(fontsize=6.5, loc="best", framealpha=0.8, handlelength=1.6, borderaxespad=0.3)
+            if ax_s is not None:
+                _slip_panel(ax_s, v.series, xlabel)
+                ax.tick_params(labelbottom=False)
+                ax_s.tick_params(labelsize=7)
+                ax_s.xaxis.label.set_size(8)
+                ax_s.yaxis.label.set_size(8)
+            else:
+                ax.set_xlabel(xlabel, fontsize=8)
+        y += h
     return base._png(fig)
+
+
+def _box(fig, left: float, top: float, width: float, height: float) -> list[float]:
+    """An axes rectangle in figure fractions from inches: ``left`` and ``top`` from the figure's top-left corner."""
+    w, h = fig.get_size_inches()
+    return [left / w, 1 - (top + height) / h, width / w, height / h]
 
 
 #: In the small panels of the first screen a curve within this fraction of the data's span of a higher-ranked
@@ -147,7 +118,7 @@ def _against_time(ax, d, target, curves) -> str:
 
 
 def _slip_panel(ax, s, xlabel: str):
-    """The slip u(t) of the paper's series and of the exact (or ODE) fit of the same law (a SeriesFinding)."""
+    """The slip u(t) of the truncated series and of the exact (or ODE) fit of the same law (a SeriesFinding)."""
     tname, tf = time_unit(float(s.dataset.t[-1]))
     t = np.linspace(0.0, float(s.dataset.t[-1]), 300)
     for i, fit in enumerate((s.full, s.series)):  # styled as in the panel above: the series dashed
@@ -158,5 +129,5 @@ def _slip_panel(ax, s, xlabel: str):
         ax.axvline(s.t_cross * tf, color="#d95f02", ls=":", lw=1.3)
     ax.set_ylabel("slip u [m/s]")
     ax.set_xlabel(xlabel)
-    ax.legend(fontsize=7, loc="best")
+    ax.legend(fontsize=6.5, loc="best")
     ax.grid(alpha=0.3)
