@@ -81,7 +81,8 @@ def solver_costs(fit, full: bool = False) -> tuple[SolverCost, ...]:
     estimate = fit.cpu_time / max(fit.nfev, 1) * COST_FACTOR
     if not full and estimate > BUDGET:
         return (SolverCost(**base, solver="all", status="not run",
-                           reason=f"about {estimate:.0f} CPU s here (more than {BUDGET:g} s): `{COMMAND}` runs it"),)
+                           reason=f"about {estimate:.0f} CPU s here, more than the {BUDGET:g} s a default run allows; "
+                                  f"`{COMMAND}` runs it"),)
     ok = applicable_solvers(law, scene)
     todo = ([("exact", None)] if ok.get("exact") is None else []) + [("ode", r) for r in RTOLS]
     if ok.get("series") is None:
@@ -145,7 +146,7 @@ def group_texts(rows) -> tuple[str, str]:
     skipped = [r for r in rows if r.status == "not run"]
     if not ok:
         if skipped:
-            return (f"Not run: {skipped[0].reason}.", f"not run ({skipped[0].reason.split(':')[0]}): `{COMMAND}`")
+            return (f"Not run: {skipped[0].reason}.", f"not run ({skipped[0].reason.split(',')[0]}): `{COMMAND}`")
         return "", ""
     refs = sorted({r.label for r in rows if r.reference})
     ref_text = " or ".join("the closed form" if x == "exact" else f"the ODE at {x.removeprefix('ode ')}" for x in refs)

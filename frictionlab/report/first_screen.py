@@ -85,7 +85,7 @@ def series_findings(c, law_order=("wear", "couette")) -> list[SeriesFinding]:
 
 #: what each column would have said, for the one line naming the columns this comparison has no data for
 ABSENT = {"best": "a best law", "goodness": "a goodness-of-fit test",
-          "equivalence": "the equivalence test of λAu and μN + μη′dA/dt (no dataset fitted with both)",
+          "equivalence": "the equivalence test of λAu and μN + μη′dA/dt (no dataset where both were fitted and tested)",
           "threshold": "a noise threshold", "series": "the truncated series against the exact solution (no series "
                                                                  "fitted)",
           "accuracy": f"what accuracy costs (it runs by default where cheap, unless --no-accuracy; `{ACCURACY_COMMAND}` "
@@ -96,7 +96,7 @@ ABSENT = {"best": "a best law", "goodness": "a goodness-of-fit test",
 def _answer_table(sec: Section, answers):
     """The verdict table: groups without a fitted law fold into one line under it, columns without data go."""
     shown = [a for a in answers if a.best is not None]
-    cols = [(key, head) for key, head in COLUMNS if any(a.cell(key) for a in shown)]
+    cols = [(key, head) for key, head in COLUMNS if any(a.cell(key) not in ("", "not tested") for a in shown)]
     rows, notes = [], []
     for a in shown:
         cells = [_clip(a.cell(key)) or "—" for key, _ in cols]

@@ -116,8 +116,9 @@ def build(ctx) -> Section:
           "is visible. Laws whose best fits are the same curve (wear and Couette share the form F = k A u) are one "
           "row, their weights summed.")
     ranking, alias = list(c.ranking), law_aliases(c)
-    sec.fig("ranking.png", "Rank and ΔAIC of every law [solver] on every dataset (grey: not fitted); laws whose "
-            "fits are the same curve on every dataset share a row.", lambda: figures.ranking_figure(ranking, alias))
+    if ranking:  # a page of a group none of whose datasets was fitted has no ranking to draw
+        sec.fig("ranking.png", "Rank and ΔAIC of every law [solver] on every dataset (grey: not fitted); laws whose "
+                "fits are the same curve on every dataset share a row.", lambda: figures.ranking_figure(ranking, alias))
     sec.h3("Over groups of datasets")
     sec.p("−2 ln L and k add over the per-dataset fits (independent, so log-likelihoods add); AIC, AICc and BIC "
           "use the group's n and k; goodness p-values are Bonferroni-adjusted over the members. 'exact' and 'ode' solve the "
