@@ -125,8 +125,9 @@ def _tolerance_items(c) -> list[str]:
     from .tolerance import tolerance_verdicts
 
     if not c.settings.get("tolerance"):
-        return ["**Solver tolerance**: not checked in this run (on demand: `frictionlab compare --tolerance`; see "
-                "'What solver tolerance does to a fit')"]
+        return ["**Solver tolerance**: the fits were not refitted at other tolerances in this run (on demand: "
+                "`frictionlab compare --tolerance`; see 'What solver tolerance does to a fit'); what each solver's "
+                "accuracy costs is on the first screen"]
     verdicts = tolerance_verdicts(c)
     if not verdicts:
         return []

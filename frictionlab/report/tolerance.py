@@ -10,10 +10,13 @@ from .text import rtol_text
 
 TITLE = "What solver tolerance does to a fit"
 #: The section when the check was not asked for (it is on demand: a robustness check beside the answer).
-NOT_RUN = ("**Not run.** This check refits the ODE laws of one dataset at a looser and a tighter solver tolerance to "
+NOT_RUN = ("**Not run.** What each solver's accuracy costs at the fitted parameters (its error against the most "
+           "accurate solver, and its time) is on the first screen, for every law and dataset where that is cheap. "
+           "This further check refits the ODE laws of one dataset at a looser and a tighter solver tolerance to "
            "show that the default tolerance does not move the fits; it changes no fit, ranking or verdict above, so "
            "it runs only on demand: `frictionlab compare --tolerance` (API: `compare(..., tolerance=(1e-3, "
-           "1e-10))`). `frictionlab bench` measures it in full.")
+           "1e-10))`), which also runs the accuracy study where it is not cheap. `frictionlab bench` measures it "
+           "in full.")
 
 
 def build(ctx) -> Section:
