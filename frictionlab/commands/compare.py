@@ -17,7 +17,7 @@ REPLICATES = 400
 #: ODE tolerances at which ``--tolerance`` refits the ODE laws of one dataset for the report: a looser one
 #: and a tighter one than the fits' default (predict.FIT_RTOL, 1e-6), so the report shows the default converged.
 #: A robustness check beside the answer, run on demand: it changes no fit, ranking or verdict, and costs about a
-#: tenth of a default comparison (issue 22); the report says when it was not run and how to run it.
+#: tenth of a default comparison; the report says when it was not run and how to run it.
 TOLERANCE_RTOLS = (1e-3, 1e-10)
 MAX_JOBS = 64  # worker processes: more only forks processes that wait
 MAX_BOOTSTRAP = 100_000  # resamples: far past where percentile intervals stop moving
