@@ -27,7 +27,7 @@ import numpy as np
 from ..core.arguments import as_items
 from ..core.errors import FrictionLabError
 from ..inference.equivalence import PAIRS, REPLICATES, EquivalenceResult
-from ..inference.fitting import FitResult
+from ..inference.fitting import FitResult, scene_ranges
 from ..inference.ranking import RankRow
 from ..inference.transfer import TransferResult
 from ..io.dataset import Dataset, builtin_names, load_dataset
@@ -133,8 +133,9 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
 
     laws: registered names, None for DEFAULT_LAWS, or "all" for every registered law; datasets: built-in names, TOML paths or Datasets
     (default every built-in); solvers: None for the default choice, or a list of 'exact',
-    'series', 'ode[:METHOD]', 'auto'; free: scene quantities fitted per dataset, name -> (lower,
-    upper) in SI (see fitting.SCENE_QUANTITIES); jobs: worker processes; progress(done, total, label).
+    'series', 'ode[:METHOD]', 'auto'; free: scene quantities fitted per dataset, name -> bounds,
+    'low:high' with units or a tuple of SI numbers, quantity strings or pint Quantities (see
+    fitting.SCENE_QUANTITIES); jobs: worker processes; progress(done, total, label).
     bootstrap: parametric replicates per dataset (0: none), drawn from ``seed``; datasets where a law
     needs the ODE, or without a time series, are bootstrapped only with bootstrap_all. tolerance: looser ODE tolerances at
     which the ODE laws of one dataset are refitted (empty: no tolerance check). fit_timeout: time
@@ -153,7 +154,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     """
     started = time.perf_counter()
     settings = Settings(laws=(), solvers=tuple(solvers) if solvers else None,
-                        free=dict(free or {}), equivalence=equivalence, jobs=jobs, bootstrap=bootstrap, seed=seed,
+                        free=scene_ranges(free, "compare: free"), equivalence=equivalence, jobs=jobs, bootstrap=bootstrap, seed=seed,
                         bootstrap_all=bootstrap_all, tolerance=tuple(tolerance), fit_timeout=fit_timeout,
                         replicates=replicates, pairs=tuple(pairs), transfer=transfer, cluster=cluster_name(client))
     settings = attrs.evolve(settings, laws=select_laws(laws))
