@@ -28,6 +28,13 @@ class ParamResult:
     upper: float
     datasets: tuple[str, ...]
     fixed_by: str = ""  # why it is held: '' when fitted
+    shown: str = ""  # the unit the value is shown in everywhere ("": unit); the law's or the scene quantity's
+
+    def text(self) -> str:
+        """'Dc = 397 ± 11 µm': the value in its display unit, rounded to its standard error."""
+        from ..core.display import param_text
+
+        return f"{self.name} = {param_text(self.value, self.stderr, self.unit, self.shown)}"
 
 
 @attrs.frozen
@@ -141,11 +148,17 @@ class FitResult:
         on = ", ".join(self.datasets)
         if not self.ok:
             return f"<FitResult {self.law} [{self.solver}] on {on}: {self.status}: {self.reason}>"
-        from ..core.display import param_text
-
-        ps = ", ".join(f"{p.name} = {param_text(p.value, p.stderr, p.unit)}" for p in self.params.values()
-                       if p.vary or p.kind == "derived")
+        ps = ", ".join(p.text() for p in self.params.values() if p.vary or p.kind == "derived")
         return f"<FitResult {self.law} [{self.solver}] on {on}: {ps}; reduced chi2 {self.stats.redchi:.3g}>"
+
+    def plot(self, ax=None):
+        """The data with the best fit above and the residuals (in units of sigma) below, one column per
+        fitted dataset; returns the matplotlib Figure. With ``ax`` (an Axes, or one per dataset), the data
+        and the fit only, drawn there; returns ``ax``. The legend says whether the fit passes its goodness-of-fit
+        tests."""
+        from .plots import plot_fit
+
+        return plot_fit(self, ax)
 
     def _repr_html_(self) -> str:
         from .frames import fit_html
@@ -168,7 +181,10 @@ class FitResult:
         return self.params[name].stderr
 
     def summary(self) -> str:
-        """A few lines for the terminal."""
+        """A few lines for the terminal: statistics, goodness of fit, and each parameter in its display unit,
+        rounded to its standard error."""
+        from ..core.display import param_text
+
         on = ", ".join(d.target.label for d in self.per_dataset) if self.per_dataset else ", ".join(self.datasets)
         head = f"{self.law} [{self.solver}] on {on}: {self.status}"
         if not self.ok:
@@ -185,9 +201,11 @@ class FitResult:
         for flag in self.flags:
             lines.append(f"  FLAG (implausible): {flag}")
         for p in self.params.values():
-            err = "held" if not p.vary and p.kind != "derived" else ("no error bar" if p.stderr is None else f"+/- {p.stderr:.3g}")
+            held = not p.vary and p.kind != "derived"
+            value = param_text(p.value, None if held else p.stderr, p.unit, p.shown)
+            err = "held" if held else ("no error bar" if p.stderr is None else "")
             why = f" ({p.fixed_by})" if p.fixed_by else ""
-            lines.append(f"  {p.name:<28} = {p.value:.6g} {p.unit} {err}{why}")
+            lines.append(f"  {p.name:<28} = {value}{' ' + err if err else ''}{why}")
         for w in self.identifiability.warnings:
             lines.append(f"  warning: {w}")
         for n in self.notes:

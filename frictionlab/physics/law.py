@@ -49,7 +49,9 @@ QUANTITIES = {
 
 @attrs.frozen
 class ParamSpec:
-    """One law parameter. ``unit`` is the SI unit of the value; ``scale`` its typical size."""
+    """One law parameter. ``unit`` is the SI unit of the value; ``scale`` its typical size; ``display`` the unit
+    the value is shown in everywhere (reports, summaries, notebook views), e.g. "um" for a slip distance in m;
+    "" shows it in ``unit``."""
 
     name: str
     unit: str
@@ -58,6 +60,7 @@ class ParamSpec:
     upper: float
     scale: float
     description: str
+    display: str = ""
 
     def __attrs_post_init__(self):
         if not (self.lower <= self.default <= self.upper):

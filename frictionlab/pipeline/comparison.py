@@ -105,6 +105,27 @@ class Comparison:
         return (f"<Comparison of {len(self.laws)} laws on {len(self.fitted_datasets)} datasets: {ok} fits; "
                 f"lowest AIC: {best}{more}>")
 
+    def plot(self, ax=None, top: int = 3):
+        """The first screen's figure: per dataset group (its first fitted dataset), the data with the
+        ``top`` top-ranked candidates above and their residuals in units of sigma below, each labelled with
+        its rank and whether it passes its goodness-of-fit tests. Returns the matplotlib Figure; with ``ax``
+        (one Axes per group) the data and fits only, drawn there, and returns ``ax``."""
+        from ..inference.answers import group_of
+        from ..inference.plots import fits_text, plot_ranking
+
+        panels, seen = [], set()
+        for d in self.fitted_datasets:
+            group = group_of(d)
+            rows = sorted((r for r in self.ranking if r.dataset == d.name and r.rank is not None), key=lambda r: r.rank)
+            fits = [(self.fit_for(d.name, r.law, r.solver), r) for r in rows]
+            fits = [(f.per_dataset[0], f"{r.rank}. {r.candidate}: fits? {fits_text(r.goodness)}")
+                    for f, r in fits if f is not None and f.ok]
+            if group in seen or not fits:
+                continue
+            seen.add(group)
+            panels.append((group if group == d.name else f"{group}: {d.name}", fits))
+        return plot_ranking(panels, ax, top)
+
     def _repr_html_(self) -> str:
         from ..inference.frames import comparison_html
 
