@@ -43,7 +43,7 @@ def _env() -> dict:
 
 def run_page(page: Path, folder: Path) -> None:
     for i, (lang, code, file) in enumerate(runnable_blocks(page.read_text(encoding="utf-8")), 1):
-        where = f"{page.relative_to(ROOT)}, runnable block {i} ({lang})"
+        where = f"{page.name}, runnable block {i} ({lang})"
         if file:
             (folder / file).write_text(code, encoding="utf-8")
             continue

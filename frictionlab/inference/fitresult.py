@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import attrs
 import numpy as np
@@ -10,6 +12,12 @@ import numpy as np
 from ..physics.scene import Scene
 from .identifiability import Identifiability
 from .predict import Target
+
+if TYPE_CHECKING:  # annotations only
+    import lmfit
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 
 @attrs.frozen
@@ -122,23 +130,24 @@ class FitResult:
 
     @property
     def ok(self) -> bool:
+        """True when the fit succeeded (status 'ok')."""
         return self.status == "ok"
 
     @property
-    def lmfit_params(self):
+    def lmfit_params(self) -> lmfit.Parameters:
         """The parameters as ``lmfit.Parameters`` in SI (values, standard errors, bounds, correlations),
         named as in ``params`` with characters lmfit does not accept replaced by '_'."""
         from .frames import lmfit_parameters
 
         return lmfit_parameters(self)
 
-    def fit_report(self, **kwargs) -> str:
+    def fit_report(self, **kwargs: object) -> str:
         """lmfit's fit report of this fit (SI units, ours statistics first); kwargs go to lmfit.fit_report."""
         from .frames import fit_report
 
         return fit_report(self, **kwargs)
 
-    def to_dataframe(self):
+    def to_dataframe(self) -> pd.DataFrame:
         """The parameters as a tidy pandas DataFrame, one row per parameter, with units."""
         from .frames import parameters_frame
 
@@ -151,7 +160,7 @@ class FitResult:
         ps = ", ".join(p.text() for p in self.params.values() if p.vary or p.kind == "derived")
         return f"<FitResult {self.law} [{self.solver}] on {on}: {ps}; reduced chi2 {self.stats.redchi:.3g}>"
 
-    def plot(self, ax=None):
+    def plot(self, ax: Axes | Sequence[Axes] | None = None) -> Figure | Axes | Sequence[Axes]:
         """The data with the best fit above and the residuals (in units of sigma) below, one column per
         fitted dataset; returns the matplotlib Figure. With ``ax`` (an Axes, or one per dataset), the data
         and the fit only, drawn there; returns ``ax``. The legend says whether the fit passes its goodness-of-fit
@@ -166,6 +175,7 @@ class FitResult:
         return fit_html(self)
 
     def value(self, name: str) -> float:
+        """The fitted (or held) value of parameter ``name``, SI."""
         return self.params[name].value
 
     @property
@@ -178,6 +188,7 @@ class FitResult:
                      if (p.vary and not {k, p.key} & arbitrary) or p.kind == "derived")
 
     def stderr(self, name: str) -> float | None:
+        """The standard error of parameter ``name`` (SI), None where there is none."""
         return self.params[name].stderr
 
     def summary(self) -> str:

@@ -32,7 +32,8 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from typing import TYPE_CHECKING
 
 import attrs
 import numpy as np
@@ -78,6 +79,10 @@ from .predict import (
 __all__ = ["DatasetFit", "FitResult", "ParamResult", "PREDICTORS", "SCENE_QUANTITIES", "SkipDataset", "Stats", "Target",
            "applicable_solvers", "auto_solver", "fit", "get_scene_quantity", "law_values", "make_target", "predict",
            "register_predictor", "scene_ranges", "set_scene_quantity"]
+if TYPE_CHECKING:  # annotations only
+    from ..physics.law import FrictionLaw
+    from .predict import DatasetLike
+
 SHARPEN_BELOW = 1e-3  # an F p-value (conservative) below this already rejects: no simulation needed
 _KEEP = (ODE_STARTS, PENALTY, LIKELIHOOD_REASON, neg2loglik)  # re-exported names other modules read from here
 
@@ -107,12 +112,12 @@ def scene_ranges(free: Mapping[str, object] | None, where: str) -> dict[str, tup
     return out
 
 
-def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, object] | None = None,
+def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], solver: str = "auto", *, free: Mapping[str, object] | None = None,
         fixed: Mapping[str, object] | None = None, local: Sequence[str] = (),
         initial: Mapping[str, object] | None = None, observable: str | None = None, derive: str | None = None,
         scan: int = 125, n_starts: int = 3, max_nfev: int | None = None, rtol: float | None = None,
         timeout: float | None = None, checks: bool = True, errors: bool = True, n_params: int | None = None,
-        progress=None) -> FitResult:
+        progress: Callable[[int, int, str], None] | None = None) -> FitResult:
     """Fit ``law`` to one dataset or a group of them (a global fit) and return a FitResult.
 
     law: name or FrictionLaw. datasets: a Dataset, name, path or Target, or a list of them.

@@ -19,6 +19,8 @@ from pathlib import Path
 import attrs
 import numpy as np
 
+from typing import TYPE_CHECKING
+
 from ..core.errors import DatasetError, FrictionLabError
 from ..core.files import read_toml
 from ..core.names import check_name
@@ -32,6 +34,10 @@ from .noise import NOISE_KINDS, STATED, noise_table, stated_table  # noqa: F401 
 DATA_KINDS = KINDS + ("contact-area",)
 
 #: SI unit of each well-known column; other columns must declare a unit of their own.
+if TYPE_CHECKING:  # annotations only
+    import pandas as pd
+    from matplotlib.axes import Axes
+
 COLUMN_SI = {
     "t": "s", "omega": "rad/s", "theta": "rad", "u": "m/s", "v": "m/s", "A": "m^2", "N": "N", "x": "m",
     "speed": "m/s", "incidence": "rad", "spin": "rad/s", "rebound_spin": "rad/s", "tangential_cor": "",
@@ -67,12 +73,14 @@ class Dataset:
 
     @property
     def t(self) -> np.ndarray:
+        """The time column [s]; a DatasetError for one impact per row (no time)."""
         if "t" not in self.columns:
             raise DatasetError(f"dataset '{self.name}' ({self.kind}) has no time column: one impact per row")
         return self.columns["t"]
 
     @property
     def y(self) -> np.ndarray:
+        """The fitted column (the observable), SI."""
         return self.columns[self.observable]
 
     @property
@@ -83,7 +91,7 @@ class Dataset:
     def __len__(self) -> int:
         return len(next(iter(self.columns.values())))
 
-    def to_dataframe(self):
+    def to_dataframe(self) -> pd.DataFrame:
         """The columns as a pandas DataFrame (SI; units by column in ``df.attrs['units']``, the file's own
         units in ``df.attrs['file_units']``, the noise in ``df.attrs['noise']``)."""
         import pandas as pd
@@ -110,7 +118,7 @@ class Dataset:
                 return (col, *self.shown(col))
         return "", "", 1.0
 
-    def plot(self, y: str | None = None, ax=None, **style):
+    def plot(self, y: str | None = None, ax: Axes | None = None, **style: object) -> Axes:
         """Draw column ``y`` (default: the observable) against time, or against the incidence angle for one
         impact per row, in the units of the dataset's file, with its noise as error bars where sigma is
         known or estimated; returns the Axes (a new figure's if ``ax`` is None)."""

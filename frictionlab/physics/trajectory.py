@@ -1,8 +1,15 @@
 """The one result type of every solver."""
 from __future__ import annotations
 
+import os
+from typing import TYPE_CHECKING
+
 import attrs
 import numpy as np
+
+if TYPE_CHECKING:  # annotations only
+    import pandas as pd
+    from matplotlib.axes import Axes
 
 #: Columns written by ``Trajectory.to_csv``, SI units.
 CSV_UNITS = {"t": "s", "u": "m/s", "v": "m/s", "omega": "rad/s", "theta": "rad", "force": "N", "A": "m^2", "N": "N",
@@ -49,7 +56,7 @@ class Trajectory:
                     if np.shape(v) == np.shape(self.t)})
         return out
 
-    def to_dataframe(self):
+    def to_dataframe(self) -> pd.DataFrame:
         """The columns as a pandas DataFrame (SI; units by column in ``df.attrs['units']``)."""
         import pandas as pd
 
@@ -63,7 +70,7 @@ class Trajectory:
                 f"columns {', '.join(self.columns())}"
                 + (f"; stuck at {self.stick_time:.4g} s" if self.stick_time is not None else "") + ">")
 
-    def plot(self, y: str = "omega", ax=None, **style):
+    def plot(self, y: str = "omega", ax: Axes | None = None, **style: object) -> Axes:
         """Draw the series ``y`` (a column name: omega, theta, u, v, force, A, N, load, or a law state as
         ``state_NAME``) against time on ``ax`` (a new figure if None), in display units; returns the Axes.
         ``style`` goes to matplotlib's ``plot`` (color, ls, label ...)."""
@@ -104,7 +111,7 @@ class Trajectory:
         lines = [",".join(cols)] + [",".join(f"{x:.17g}" for x in row) for row in rows]
         return "\n".join(lines) + "\n"
 
-    def to_csv(self, path) -> None:
+    def to_csv(self, path: str | os.PathLike) -> None:
         """Write the columns (SI) to ``path`` atomically."""
         from ..core.files import atomic_write_text
 

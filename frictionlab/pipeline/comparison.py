@@ -20,6 +20,7 @@ import os
 import platform
 import time
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import attrs
 import numpy as np
@@ -43,6 +44,12 @@ from .runner import Progress, Run, select
 from .runner import run_stages as run_stages_with
 from .settings import DEFAULT_LAWS, Settings, select_laws  # noqa: F401
 from .stages import STAGES
+
+if TYPE_CHECKING:  # annotations only
+    import pandas as pd
+    from dask.distributed import Client
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 
 @attrs.frozen(eq=False)
@@ -68,29 +75,33 @@ class Comparison:
     options: Settings | None = None  # the settings as a record (``settings`` is the same as results.json writes it)
 
     def fit_for(self, dataset: str, law: str, solver: str | None = None) -> FitResult | None:
+        """The fit of ``law`` (with ``solver``, if given) to the single dataset ``dataset``, or None."""
         for f in self.fits:
             if f.datasets == (dataset,) and f.law == law and (solver is None or f.solver == solver):
                 return f
         return None
 
     def fits_on(self, dataset: str) -> list[FitResult]:
+        """Every single-dataset fit to ``dataset``."""
         return [f for f in self.fits if f.datasets == (dataset,)]
 
     def dataset(self, name: str) -> Dataset:
+        """The compared dataset called ``name``."""
         return next(d for d in self.datasets if d.name == name)
 
     @property
     def fitted_datasets(self) -> list[Dataset]:
+        """The datasets that were fitted (not left out with a reason)."""
         return [d for d in self.datasets if d.name not in self.skipped_datasets]
 
-    def to_dataframe(self):
+    def to_dataframe(self) -> pd.DataFrame:
         """The ranking as a tidy pandas DataFrame: one row per dataset and candidate (law, solver), with
         the observable and the units of rss and rmse; group rows (ALL, ALL[kind]) after them."""
         from ..inference.frames import ranking_frame
 
         return ranking_frame(self)
 
-    def parameters_dataframe(self):
+    def parameters_dataframe(self) -> pd.DataFrame:
         """Every fitted parameter as a tidy pandas DataFrame: dataset, law, solver, parameter, value,
         stderr, unit, kind, vary, fixed_by, lower, upper."""
         from ..inference.frames import parameters_frame
@@ -105,7 +116,7 @@ class Comparison:
         return (f"<Comparison of {len(self.laws)} laws on {len(self.fitted_datasets)} datasets: {ok} fits; "
                 f"lowest AIC: {best}{more}>")
 
-    def plot(self, ax=None, top: int = 3):
+    def plot(self, ax: Axes | Sequence[Axes] | None = None, top: int = 3) -> Figure | Axes | Sequence[Axes]:
         """The first screen's figure: per dataset group (its first fitted dataset), the data with the
         ``top`` top-ranked candidates above and their residuals in units of sigma below, each labelled with
         its rank and whether it passes its goodness-of-fit tests. Returns the matplotlib Figure; with ``ax``
@@ -149,7 +160,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
             tolerance: Sequence[float] = (), fit_timeout: float | None = None, replicates: int = REPLICATES,
             pairs: Sequence = PAIRS, transfer: bool = True, stages: Sequence[str] | None = None,
-            client=None) -> Comparison:
+            client: Client | None = None) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
 
     laws: registered names, None for DEFAULT_LAWS, or "all" for every registered law; datasets: built-in names, TOML paths or Datasets
@@ -195,8 +206,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     return attrs.evolve(c, wall_time=time.perf_counter() - started)
 
 
-def run_stages(comparison: Comparison, stages: Sequence[str], *, progress: Progress | None = None, client=None,
-               **options) -> Comparison:
+def run_stages(comparison: Comparison, stages: Sequence[str], *, progress: Progress | None = None,
+               client: Client | None = None, **options: object) -> Comparison:
     """Run the named stages (``stages.STAGES``) on a comparison made by ``compare``, e.g.
     ``run_stages(c, ["bootstrap", "answer"], bootstrap=150)``; ``options`` override the comparison's
     settings (the keyword arguments of ``compare``). Returns a new Comparison."""
