@@ -237,15 +237,17 @@ def is_quantity(value) -> bool:
 
 def as_si(value, si_unit: str, where: str) -> float:
     """A value of the Python API in SI: an SI number as it is, a quantity string (``"1.5e6 Pa s/m"``) or a
-    pint Quantity converted from its unit; anything else, or a unit of the wrong dimension, is a UnitError
-    naming ``where`` (the parameter) and ``si_unit`` (the unit expected)."""
+    pint Quantity converted from its unit (finite, within the accepted magnitudes); a boolean is a
+    ParameterError, anything else or a unit of the wrong dimension a UnitError, each naming ``where`` (the
+    parameter) and ``si_unit`` (the unit expected)."""
     import numbers
 
     example = f"1 {si_unit}" if si_unit else "0.3"
     if isinstance(value, bool) or (hasattr(value, "dtype") and getattr(value.dtype, "kind", "") == "b"):
-        raise UnitError(f"{where}: {value!r} is a boolean; expected {FORMS.format(example=example)}")
+        raise ParameterError(f"{where} = {value!r} is a boolean, not a number; expected "
+                             f"{FORMS.format(example=example)}")
     if isinstance(value, numbers.Real):
-        return check_magnitude(float(value), value, where, si_unit)
+        return float(value)  # SI as given: the caller checks it against the parameter's bounds
     if isinstance(value, str):
         return to_si(value, si_unit, where)
     if is_quantity(value):
