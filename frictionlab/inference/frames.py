@@ -156,7 +156,7 @@ def fit_html(f) -> str:
     for p in f.params.values():
         value, err, unit = param_cells(p.value, p.stderr, p.unit, p.shown)
         role = "fitted" if p.vary else (p.fixed_by or ("derived" if p.kind == "derived" else "held"))
-        rows.append(f"<tr><td>{e(p.name)}</td><td>{e(value)}</td><td>{e(err)}</td><td>{e(unit)}</td><td>{e(role)}</td></tr>")
+        rows.append(f"<tr><td>{e(p.name)}</td><td>{e(value)}</td><td>{e(err)}</td><td>{e(unit or '-')}</td><td>{e(role)}</td></tr>")
     params = ("<table><tr><th>parameter</th><th>value</th><th>standard error</th><th>unit</th><th>role</th></tr>"
               + "".join(rows) + "</table>")
     flags = "".join(f"<p>implausible: {e(x)}</p>" for x in f.flags)

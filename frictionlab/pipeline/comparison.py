@@ -117,9 +117,9 @@ class Comparison:
                 f"lowest AIC: {best}{more}>")
 
     def plot(self, ax: Axes | Sequence[Axes] | None = None, top: int = 3) -> Figure | Axes | Sequence[Axes]:
-        """The first screen's figure: per dataset group (its first fitted dataset), the data with the
-        ``top`` top-ranked candidates above and their residuals in units of sigma below, each labelled with
-        its rank and whether it passes its goodness-of-fit tests. Returns the matplotlib Figure; with ``ax``
+        """What the report's first screen shows per dataset group, as one figure: for each group (its first
+        fitted dataset) the data with the ``top`` top-ranked candidates above and their residuals in units of
+        sigma below, each labelled with its rank and whether it passes its goodness-of-fit tests. Returns the matplotlib Figure; with ``ax``
         (one Axes per group) the data and fits only, drawn there, and returns ``ax``."""
         from ..inference.answers import group_of
         from ..inference.plots import fits_text, plot_ranking
