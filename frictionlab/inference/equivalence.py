@@ -66,6 +66,8 @@ at that noise reject A about half the time. Likewise s_BA. Group answers and the
 """
 from __future__ import annotations
 
+from concurrent.futures import Executor
+
 import math
 
 import attrs
@@ -165,6 +167,7 @@ class EquivalenceResult:
 
     @property
     def ok(self) -> bool:
+        """True when the test was run (status 'ok')."""
         return self.status == "ok"
 
     @property
@@ -174,10 +177,12 @@ class EquivalenceResult:
 
     @property
     def label(self) -> str:
+        """'law A [solver] vs law B [solver] on DATASET'."""
         return f"{self.law_a} [{self.solver_a}] vs {self.law_b} [{self.solver_b}]"
 
     @property
     def involves_series(self) -> bool:
+        """True when one side is the paper's truncated series."""
         return "series" in (self.solver_a, self.solver_b)
 
     @property
@@ -234,6 +239,7 @@ class EquivalenceResult:
                 f"by {rms} RMS")
 
     def as_dict(self) -> dict:
+        """The result as plain values, as results.json records it."""
         d = {k: v for k, v in attrs.asdict(self, recurse=False).items() if k != "decomposition"}
         for k in ("t_a", "t_b", "s_a", "s_b", "x_a", "x_b"):
             d[k] = getattr(self, k).tolist()
@@ -275,8 +281,8 @@ def sentences(*parts: str) -> str:
 
 # --- the test -------------------------------------------------------------------------------------
 def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = REPLICATES, seed: int = 0,
-                        executor=None, chunk: int | None = None, timeout: float | None = None,
-                        margin=MARGIN) -> EquivalenceResult:
+                        executor: Executor | None = None, chunk: int | None = None,
+                        timeout: float | None = None, margin=MARGIN) -> EquivalenceResult:
     """The test of ``fit_a``'s law against ``fit_b``'s on their (common) dataset (module docstring).
 
     replicates: the most replicates per null (sequential sampling stops earlier once the decision is
