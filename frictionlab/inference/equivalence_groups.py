@@ -22,6 +22,8 @@ import attrs
 from ..core.display import unit
 from .equivalence import ALONE, ALPHA, BOTH_FAIL, CANNOT, DIFFERENT, PAIRS, WITHIN, decide
 
+#: The family of a pair without a test (both laws fail their fit tests): none, it has no p-value.
+NO_FAMILY = "none: no p-value (both laws fail their fit tests)"
 #: The families a report's p-values may be adjusted in (``adjust_family``): the whole report (the default) or
 #: each dataset group.
 FAMILIES = ("report", "group")
@@ -62,6 +64,9 @@ def adjust_family(results, family: str = "report", group_of=None) -> tuple:
     results = list(results)
     members: dict[str, list[int]] = {}
     for i, e in enumerate(results):
+        if e.ok and not e.tested:
+            results[i] = attrs.evolve(e, family=NO_FAMILY)
+            continue
         if e.tested and math.isfinite(e.p) and math.isfinite(e.p_within):
             label = (group_of or {}).get(e.dataset, e.dataset) if family == "group" else "report"
             members.setdefault(label, []).append(i)

@@ -147,11 +147,16 @@ def tolerance(c, run: Run) -> dict:
 
 
 def accuracy(c, run: Run) -> dict:
+    """In this process: a few predictions per law and dataset (1.3 CPU s on the built-in data) cost less than
+    sending the fits to the workers."""
     fits = study_fits(c.fits)
     full = bool(run.settings.tolerance)  # --tolerance asks for the whole study, the costly rows too
-    rows = run.map(functools.partial(_accuracy_task, full=full, timeout=run.settings.fit_timeout), fits,
-                   lambda f: f"what accuracy costs: {f.law} on {f.datasets[0]}")
-    return {"accuracy": tuple(r for part in rows for r in part)}
+    run.tally().total = max(len(fits), 1)
+    rows = []
+    for f in fits:
+        rows += _accuracy_task(f, full=full, timeout=run.settings.fit_timeout)
+        run.step(f"what accuracy costs: {f.law} on {f.datasets[0]}")
+    return {"accuracy": tuple(rows)}
 
 
 def _accuracy_task(f, full=False, timeout=None):
