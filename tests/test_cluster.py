@@ -19,8 +19,8 @@ def numbers(c):
     from frictionlab.report import results_json
 
     def strip(x):
-        if isinstance(x, str):  # a sentence quoting a measured time ("its fit took 1.4 CPU s")
-            return re.sub(r"\d+(\.\d+)? (CPU )?s\b", "# s", x)
+        if isinstance(x, str):  # a sentence quoting a measured time ("its fit took 1.4 CPU s", "at 4.8× its time")
+            return re.sub(r"[\d.]+(–[\d.]+)?×", "#×", re.sub(r"\d+(\.\d+)? (CPU )?s\b", "# s", x))
         if isinstance(x, dict):
             return {k: strip(v) for k, v in x.items()
                     if not any(w in k for w in ("time", "timings", "cpu", "wall", "created", "settings", "versions"))}
@@ -51,7 +51,7 @@ def test_cluster_gives_the_local_numbers(local, workers, tmp_path):
         if workers == 2:  # the figures drawn on the workers (several a task) are the local ones, byte for byte
             out = write_report(c, tmp_path / "r", client=client)
             figs = [f for s in build(c)[0] for f in s.figures]
-            assert len(figs) > 2 * DRAW_BATCH
+            assert len(figs) >= 2 * DRAW_BATCH  # two tasks of several figures at least
             for f in figs:
                 assert (out / "figures" / f.name).read_bytes() == f.draw()
 

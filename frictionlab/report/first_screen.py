@@ -165,7 +165,7 @@ def _fallback_table(sec: Section, c, findings):
         rows.append([f"**{d.name}** ({group_of(d)}; {d.provenance.kind})", _tied(best),
                      sig(best[0].redchi) if best else "", "; ".join(eq) or "not tested", "; ".join(thr), ser])
     sec.table(["dataset (group; provenance)", "lowest AIC (not a fit test)", "its reduced χ²",
-               "λAu ≡ μN + μη′dA/dt? (discrimination test)", "noise threshold", "series slip"], rows)
+               "λAu vs μN + μη′dA/dt (equivalence test)", "noise threshold", "series slip"], rows)
     for tr in c.transfer:
         sec.p(f"Across conditions ({tr.group}): {tr.answer()}.")
     sec.p("Not in this comparison: " + ABSENT["goodness"] + ".")
