@@ -228,7 +228,7 @@ def test_both_laws_failing_their_fit_tests_get_no_p_value_only_their_misfits():
     assert math.isnan(e.p) and math.isnan(e.p_within) and e.t_a.size == 0 and "no replicates" in e.stopped
     assert e.explanation.startswith("No test: coulomb [exact] and wear [exact] both fail their own fit tests")
     assert "no p-value" in e.explanation and "two-sided p" not in e.explanation and "upper 95% bound" not in e.explanation
-    assert f"χ² = " in e.explanation and "misses less" in e.explanation
+    assert "χ² = " in e.explanation and "misses less" in e.explanation
 
 
 def test_a_peak_time_difference_is_quantitative_not_qualitative():

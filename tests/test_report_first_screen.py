@@ -4,7 +4,7 @@ import math
 import attrs
 import numpy as np
 import pytest
-from _fit_helpers import TRUTH, synthetic
+from _fit_helpers import synthetic
 
 from frictionlab import compare
 from frictionlab.inference.answers import Answer

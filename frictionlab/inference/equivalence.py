@@ -282,7 +282,7 @@ def sentences(*parts: str) -> str:
 # --- the test -------------------------------------------------------------------------------------
 def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = REPLICATES, seed: int = 0,
                         executor: Executor | None = None, chunk: int | None = None,
-                        timeout: float | None = None, margin=MARGIN) -> EquivalenceResult:
+                        timeout: float | None = None, margin: float | str = MARGIN) -> EquivalenceResult:
     """The test of ``fit_a``'s law against ``fit_b``'s on their (common) dataset (module docstring).
 
     replicates: the most replicates per null (sequential sampling stops earlier once the decision is

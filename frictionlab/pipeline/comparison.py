@@ -162,7 +162,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
             tolerance: Sequence[float] = (), fit_timeout: float | None = None, replicates: int = REPLICATES,
             pairs: Sequence = PAIRS, transfer: bool = True, stages: Sequence[str] | None = None,
-            client: Client | None = None, margin=MARGIN, family: str = "report", accuracy: bool = True) -> Comparison:
+            client: Client | None = None, margin: float | str = MARGIN, family: str = "report",
+            accuracy: bool = True) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
 
     laws: registered names, None for DEFAULT_LAWS, or "all" for every registered law; datasets: built-in names, TOML paths or Datasets

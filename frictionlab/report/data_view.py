@@ -16,10 +16,6 @@ from ..inference.answers import group_of
 from ..inference.ranking import family
 from .text import sig
 
-#: views drawn side by side in one row of the figure
-PER_ROW = 5
-
-
 @attrs.frozen
 class DataView:
     """One dataset of a group with the fits of the group's top-ranked candidates and, where one of them is the

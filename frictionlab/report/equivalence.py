@@ -1,7 +1,6 @@
 """'Equivalence test': can the data tell two laws apart, and are their curves within the margin (``equivalence.py``)?"""
 from __future__ import annotations
 
-import math
 
 from ..core.display import fmt
 from ..inference import rules
@@ -37,7 +36,8 @@ def margin_rule(c) -> str:
 
 def family_rule(c) -> str:
     """The family the report's p-values are adjusted in, and how many hypotheses it holds."""
-    n = 2 * sum(1 for e in c.equivalence if e.tested and math.isfinite(e.p))
+    stored = next((e.family for e in c.equivalence if e.tested), "")  # as adjusted (a page of a group: the report's)
+    n = int(stored.split()[3]) if stored.startswith("Holm over the ") else 2 * sum(1 for e in c.equivalence if e.tested)
     family = (c.options.family if c.options is not None else "report")
     if family == "group":
         return (f"Holm's step-down within each dataset group (the per-group rule, asked for with --family group): "

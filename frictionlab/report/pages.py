@@ -48,6 +48,7 @@ def restrict(c, names, group: str):
         bootstrap=tuple(b for b in c.bootstrap if within(b.datasets)),
         bootstrap_skipped={k: v for k, v in c.bootstrap_skipped.items() if k in keep},
         tolerance=tuple(r for r in c.tolerance if r.get("dataset") in keep),
+        accuracy=tuple(r for r in c.accuracy if r.dataset in keep),
         transfer=tuple(t for t in c.transfer if within(t.datasets)),
         answers=tuple(a for a in c.answers if a.group == group))
 
