@@ -27,22 +27,24 @@ def add_parser(sub):
     from ..cli import ListAction, subcommand
 
     p = subcommand(sub, "compare", help="compare laws on datasets and write a report folder",
-                   description="Fit every law to every dataset (default: the four mission laws, all "
-                               "built-in datasets), rank them, test the paper's equivalence claim, and write report.md, "
+                   description="Fit every law to every dataset (default: the laws of each dataset's kind, the "
+                               "four mission laws on impacts and inclines and rate-and-state aging and slip on "
+                               "spring-sliders, on every built-in dataset and measured record present), rank them, test the paper's equivalence claim, and write report.md, "
                                "report.html, figures/, ranking.csv and results.json. Two defaults differ from "
                                "the library's fl.compare(), which runs only what it is asked for: --bootstrap "
                                f"{BOOTSTRAP_N} (API bootstrap=0) and --fit-timeout {FIT_TIMEOUT:g} s (API "
                                "fit_timeout=None). The tolerance check runs only with --tolerance.",
-                   examples="""  frictionlab compare                          # the four mission laws on every built-in dataset into ./report
+                   examples="""  frictionlab compare                          # each kind's laws on every built-in dataset into ./report
   frictionlab compare --laws wear,area-rate --data impact-golf-v28 --out golf
   frictionlab compare --data my.toml --data impact-golf-v61 --solver exact --solver series
   frictionlab compare --tolerance --out full    # also refit the ODE laws at other solver tolerances
   frictionlab compare --bootstrap 0 --quiet --out quick   # fastest, no progress lines""")
     p.add_argument("--laws", "--law", action=ListAction, metavar="NAME", help="law names, or 'all' for every registered law "
-                   "(default: coulomb, area-rate, wear, couette)")
+                   "(default by dataset kind: coulomb, area-rate, wear, couette on impacts and inclines; "
+                   "rate-state-aging, rate-state-slip on spring-sliders)")
     p.add_argument("--data", action=ListAction, nargs="+", metavar="NAME_OR_TOML",
                    help="datasets, several after one --data (e.g. a shell glob), comma-separated or repeated "
-                        "(default: every built-in)")
+                        "(default: every built-in dataset and every measured record present)")
     p.add_argument("--solver", "--solvers", action=ListAction, metavar="SOLVER",
                    help="exact, series, ode[:METHOD] or auto (default: exact where a closed form exists else ode, "
                         "plus series where it applies)")
@@ -85,7 +87,7 @@ def add_parser(sub):
 
 def run(args) -> int:
     from ..core.cluster import connect
-    from ..io.dataset import builtin_names, load_dataset
+    from ..io.dataset import available_names, load_dataset
     from .fit import parse_free
 
     parent = args.out.parent if str(args.out.parent) else Path(".")
@@ -103,7 +105,7 @@ def run(args) -> int:
     if args.replicates < MIN_REPLICATES:
         raise ParameterError(f"--replicates must be at least {MIN_REPLICATES}, got {args.replicates}")
     free = parse_free(args.free)
-    datasets = [load_dataset(d) for d in args.data or builtin_names()]  # read first: --out keeps clear of them
+    datasets = [load_dataset(d) for d in args.data or available_names()]  # read first: --out keeps clear of them
     client = connect(args.scheduler) if args.scheduler else None
     try:
         return _run(args, free, datasets, client)
@@ -133,10 +135,22 @@ def _run(args, free, datasets, client) -> int:
     print(f"compared {n_laws} law{'s' * (n_laws != 1)} on {n_data} dataset{'s' * (n_data != 1)}: {ok} fits, "
           f"{sum(f.status == 'failed' for f in result.fits)} failed, {sum(f.status == 'skipped' for f in result.fits)} "
           f"skipped, {sum(e.ok for e in result.equivalence)} equivalence tests, in {result.wall_time:.1f} s")
-    for line in answer_lines(result):
+    for line in laws_lines(result) + answer_lines(result):
         print(line)
     print(f"report: {out / 'report.html'} (also report.md, ranking.csv, results.json, figures/)")
     return 0
+
+
+def laws_lines(c) -> list[str]:
+    """Which laws were fitted on which kind of dataset, when that was chosen by kind (the default laws)."""
+    by_kind = c.options.by_kind if c.options is not None else {}
+    kinds = {d.kind for d in c.datasets if d.kind != "contact-area"}
+    groups: dict[tuple, list[str]] = {}
+    for kind, laws in by_kind.items():
+        if kind in kinds:
+            groups.setdefault(tuple(laws), []).append(kind)
+    return [f"laws by dataset kind (the default): " + "; ".join(f"{', '.join(laws)} on {', '.join(k)}"
+                                                               for laws, k in groups.items())] if groups else []
 
 
 def answer_lines(c) -> list[str]:
