@@ -145,7 +145,7 @@ def _import(args) -> int:
     for w, (toml_path, csv_path) in pairs:
         v = " -> ".join(f"{x * 1e6:.4g}" for x in w.velocities)
         print(f"wrote {toml_path} and {csv_path}: lines {raw.line(w.a)} to {raw.line(w.b - 1)} ({w.b - w.a} samples), "
-              f"{v} um/s, k start {w.stiffness * 1e-6:.3g} 1/um ({'given' if k else 'estimated'}; fitted with the law)")
+              f"{v} um/s, k start {w.stiffness * 1e-6:.3g} 1/um ({w.stiffness_from}; fitted with the law)")
     return 0
 
 

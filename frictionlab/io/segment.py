@@ -390,12 +390,15 @@ def joint_velocities(t, x, bounds, times, long_run=None) -> tuple[np.ndarray, np
 
 # --- the segmentation ------------------------------------------------------------------------------
 def segment(t: np.ndarray, x: np.ndarray, where: str = "record",
-            line: Callable[[int], int] | None = None) -> Segmentation:
+            line: Callable[[int], int] | None = None, unit: str = "") -> Segmentation:
     """Steps and jumps of the displacement record x(t) (module docstring); a one-line DatasetError starting
-    with ``where`` and naming the line ``line(i)`` of sample i where the record is not straight pieces."""
+    with ``where`` and naming the line ``line(i)`` of sample i where the record is not straight pieces
+    (displacements in it in ``unit``)."""
     t, x = np.asarray(t, dtype=float), np.asarray(x, dtype=float)
     n = len(t)
     line = line or (lambda i: i + 1)
+
+    u = f" {unit}" if unit else ""
 
     def at(i: int) -> str:
         return f"line {line(i)} (t = {t[i]:.10g} s)"
@@ -419,14 +422,14 @@ def segment(t: np.ndarray, x: np.ndarray, where: str = "record",
         rms, level = math.sqrt(float(line_rss(U.between(a, b))) / (b - a)), noise(a, b)
         if rms > STRAIGHT * level:
             raise DatasetError(f"{where}: the displacement from {at(a)} to {at(b - 1)} is not a straight line: it "
-                               f"strays {rms:.3g} rms from its best line, {rms / level:.1f} times its noise "
-                               f"({level:.3g}); a velocity-step record is straight pieces of constant load-point "
+                               f"strays {rms:.3g}{u} rms from its best line, {rms / level:.1f} times its noise "
+                               f"({level:.3g}{u}); a velocity-step record is straight pieces of constant load-point "
                                "velocity (is the second column the load point's displacement?)")
     if not cut:
         v = np.polyfit(t - t[0], x, 1)[0]
-        stitched = "".join(f"; a jump of {j.size:.4g} at {at(j.index)} stitched" for j in jumps)
+        stitched = "".join(f"; a jump of {j.size:.4g}{u} at {at(j.index)} stitched" for j in jumps)
         raise DatasetError(f"{where}: no velocity step found: the displacement is one straight line within its noise "
-                           f"({noise(0, n):.3g}) from {at(0)} to {at(n - 1)}, at {v:.6g} per s{stitched}")
+                           f"({noise(0, n):.3g}{u}) from {at(0)} to {at(n - 1)}, at {v:.6g}{u or ' '}/s{stitched}")
     for a, b in zip(bounds[:-1], bounds[1:]):
         if b - a < MIN_PIECE:
             what = ("after the start of the record" if a == 0 else "before the end of the record" if b == n

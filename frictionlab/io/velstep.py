@@ -161,6 +161,12 @@ class Window:
     stiffness_note: str
     steps: tuple  # indices of the Steps it holds
 
+    @property
+    def stiffness_from(self) -> str:
+        """'given', 'estimated' or 'a typical value' (the first word of how the start was obtained)."""
+        note = self.stiffness_note
+        return "given" if note.startswith("given") else "a typical value" if "typical" in note else "estimated"
+
 
 @attrs.frozen(eq=False)
 class Imported:
@@ -173,8 +179,8 @@ class Imported:
     notes: tuple  # sentences for the user (jumps stitched, holds, starts in a hold)
 
     @property
-    def x(self) -> np.ndarray:
-        """Load-point displacement [m], jumps stitched."""
+    def x_um(self) -> np.ndarray:
+        """Load-point displacement [um], jumps stitched."""
         return self.seg.x
 
 
@@ -185,14 +191,14 @@ def analyse(raw: RawRecord, name: str, *, joint: bool | None = False, stiffness:
     several). ``stiffness`` [1/m]: the start of every dataset instead of the estimate; ``steps``: the number of
     steps expected (an error if another number is found)."""
     where = str(raw.path)
-    seg = segment(raw.t, raw.x, where, raw.line)
+    seg = segment(raw.t, raw.x * 1e6, where, raw.line, "um")  # in the record's units: um, um/s
     m = len(seg.steps)
     joint = m > 1 if joint is None else joint
     if steps is not None and steps != m:
         found = ", ".join(f"line {raw.line(s.index)} (t = {s.time:.6f} s)" for s in seg.steps)
         raise DatasetError(f"{where}: expected {steps} velocity step{'s' * (steps != 1)} (--steps), found {m}: {found}")
     velocities, notes = _velocities(raw, seg)
-    notes += [f"displacement jump of {j.size * 1e6:.4g} ± {j.size_se * 1e6:.2g} um at line {raw.line(j.index)} "
+    notes += [f"displacement jump of {j.size:.4g} ± {j.size_se:.2g} um at line {raw.line(j.index)} "
               f"(t = {raw.t[j.index]:.10g} s) without a change of velocity: stitched (later samples shifted back)"
               for j in seg.jumps]
     b = seg.bounds
@@ -237,10 +243,10 @@ def analyse(raw: RawRecord, name: str, *, joint: bool | None = False, stiffness:
 
 
 def _velocities(raw: RawRecord, seg: Segmentation) -> tuple[list[float], list[str]]:
-    """The pieces' velocities as written: fitted, a hold (within 3 standard errors of 0) as 0; a load point
-    that moves backwards is refused."""
+    """The pieces' velocities as written [m/s]: fitted, a hold (within 3 standard errors of 0) as 0; a load
+    point that moves backwards is refused."""
     out, notes = [], []
-    for k, (v, se) in enumerate(zip(seg.velocities, seg.velocities_se)):
+    for k, (v, se) in enumerate(zip(np.array(seg.velocities) * 1e-6, np.array(seg.velocities_se) * 1e-6)):
         a, b = seg.bounds[k], seg.bounds[k + 1]
         span = f"lines {raw.line(a)} to {raw.line(b - 1)} (t = {raw.t[a]:.10g} to {raw.t[b - 1]:.10g} s)"
         if abs(v) <= 3 * se:
@@ -304,7 +310,7 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
     v_text = " -> ".join(f"{v * 1e6:.4g}" for v in w.velocities)
     stress = float(np.mean(raw.sn[w.a:w.b]))
     fitted = "; ".join(f"step at {s.time - raw.t[w.a]:.6f} ± {s.time_se:.2g} s" for s in steps)
-    fitted_v = ", ".join(f"{v * 1e6:.7g} ± {seg.velocities_se[k] * 1e6:.2g}"
+    fitted_v = ", ".join(f"{v:.7g} ± {seg.velocities_se[k]:.2g}"
                          for k, v in enumerate(seg.velocities) if k in _pieces(w))
     jumps = [j for j in seg.jumps if w.a < j.index < w.b]
     method = (f"every sample of lines {first} to {last} of {raw.path.name} ({w.b - w.a} samples); load-point "
@@ -372,7 +378,7 @@ def write_csv(fh, imp: Imported, w: Window) -> None:
              "); t in the record's clock (time_zero in the TOML is t = 0)\n" + CSV_HEADER + "\n")
     for lo in range(w.a, w.b, 100_000):
         hi = min(lo + 100_000, w.b)
-        cols = (raw.t[lo:hi].tolist(), (imp.x[lo:hi] * 1e6).tolist(), raw.mu[lo:hi].tolist())
+        cols = (raw.t[lo:hi].tolist(), imp.x_um[lo:hi].tolist(), raw.mu[lo:hi].tolist())
         fh.write("\n".join(f"{a!r},{b!r},{c!r}" for a, b, c in zip(*cols)) + "\n")
 
 
@@ -381,7 +387,7 @@ def columns(imp: Imported, w: Window, rows: int | None = None) -> dict:
     many, evenly spread from the window's first sample to its last."""
     idx = slice(w.a, w.b) if rows is None or w.b - w.a <= rows else \
         np.unique(np.linspace(w.a, w.b - 1, rows).astype(np.int64))
-    return {"t": imp.raw.t[idx], "x": imp.x[idx] * 1e6, "mu": imp.raw.mu[idx]}
+    return {"t": imp.raw.t[idx], "x": imp.x_um[idx], "mu": imp.raw.mu[idx]}
 
 
 def load_window(imp: Imported, w: Window, toml_text: str, path: Path, rows: int | None = None):
@@ -400,14 +406,14 @@ def summary(imp: Imported) -> list[str]:
     raw, seg = imp.raw, imp.seg
     n, m = len(raw.t), len(seg.steps)
     out = [f"{raw.path.name}: {n} samples, t = {raw.t[0]:.10g} to {raw.t[-1]:.10g} s; displacement noise "
-           f"{seg.noise * 1e6:.3g} um; {m} velocity step{'s' * (m != 1)} (segmentation penalty 3 ln n = "
+           f"{seg.noise:.3g} um; {m} velocity step{'s' * (m != 1)} (segmentation penalty 3 ln n = "
            f"{seg.penalty:.1f}), {len(seg.jumps)} jump{'s' * (len(seg.jumps) != 1)} stitched"]
     rows = [("step", "line", "time [s]", "V before [um/s]", "V after [um/s]", "samples before + after")]
     for i, s in enumerate(seg.steps):
         b = seg.bounds
         rows.append((str(i + 1), str(raw.line(s.index)), _pm(s.time, s.time_se),
-                     _pm(imp.velocities[i] * 1e6, seg.velocities_se[i] * 1e6),
-                     _pm(imp.velocities[i + 1] * 1e6, seg.velocities_se[i + 1] * 1e6),
+                     _pm(imp.velocities[i] * 1e6, seg.velocities_se[i]),
+                     _pm(imp.velocities[i + 1] * 1e6, seg.velocities_se[i + 1]),
                      f"{b[i + 1] - b[i]} + {b[i + 2] - b[i + 1]}"))
     widths = [max(len(r[j]) for r in rows) for j in range(len(rows[0]))]
     out += ["  " + "  ".join(c.ljust(wd) for c, wd in zip(r, widths)).rstrip() for r in rows]
