@@ -108,7 +108,8 @@ def _import(args) -> int:
     from ..core.files import check_writable
     from ..core.names import check_name
     from ..core.units import to_si
-    from ..io.velstep import analyse, dataset_toml, load_window, read_raw, summary, write_csv
+    from ..io.dataset import from_meta
+    from ..io.velstep import analyse, dataset_toml, parts, read_raw, summary, write_csv
 
     check_name(args.name, "datasets import --name", OutputError)  # before any path is made of it
     if args.steps is not None and not 1 <= args.steps <= 10_000:
@@ -135,7 +136,8 @@ def _import(args) -> int:
             f" --stiffness {shlex.quote(args.stiffness)}" if k else "")
         toml = dataset_toml(imp, w, source=args.source, license=args.license, citation=args.citation,
                             command=command)
-        load_window(imp, w, toml, paths[0], rows=20_000)  # the pair loads before it is written
+        meta, cols = parts(imp, w, toml, rows=20_000)
+        from_meta(meta, paths[0], raw=cols)  # the pair loads before it is written
         files[paths[1].name] = lambda fh, w=w: write_csv(fh, imp, w)
         files[paths[0].name] = lambda fh, toml=toml: fh.write(toml)
         pairs.append((w, paths))

@@ -136,7 +136,8 @@ def load_dataset(name_or_path: str | Path) -> Dataset:
 
     if isinstance(name_or_path, str) and name_or_path in external.RECORDS \
             and not (builtin_dir() / f"{name_or_path}.toml").exists():
-        return external.load(name_or_path)  # a measured record placed beside the repository, not in it
+        meta, path, raw = external.load(name_or_path)  # a measured record placed beside the repository, not in it
+        return from_meta(meta, path, raw=raw)
     path = resolve(name_or_path)
     return from_meta(read_toml(path), path)
 

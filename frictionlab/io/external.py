@@ -204,12 +204,12 @@ def _write_all(folder: Path, files: dict[str, bytes]) -> None:
                     pass
 
 
-def load(name: str):
-    """The Dataset of external record ``name``: from the cache when every checksum agrees, else imported from
-    the record (and cached when the cache can be written); a one-line error saying where to place the record
-    when it is absent, and how it differs when it is there but is not the one named."""
+def load(name: str) -> tuple[dict, Path, dict]:
+    """(TOML table, TOML path, CSV columns) of external record ``name``, what ``dataset.from_meta`` builds its
+    Dataset from: from the cache when every checksum agrees, else imported from the record (and cached when
+    the cache can be written; the path is then the record's when it is not); a one-line error saying where
+    to place the record when it is absent, and how it differs when it is there but is not the one named."""
     from .csvread import read_csv
-    from .dataset import from_meta
 
     spec = RECORDS[name]
     raw_path, data, why = _find(name)
@@ -231,7 +231,7 @@ def load(name: str):
 
             path = folder / f"{name}.toml"
             meta = tomllib.loads(files["toml"].decode("utf-8"))
-            return from_meta(meta, path, raw=read_csv(path.with_suffix(".csv"), text=files["csv"].decode("utf-8")))
+            return meta, path, read_csv(path.with_suffix(".csv"), text=files["csv"].decode("utf-8"))
         if stale != "absent":
             _note(f"the cached import of {name} in {folder} {stale}: imported again from {raw_path}")
     return _import(name, raw_path, data, folder)
@@ -263,7 +263,7 @@ def _import(name: str, raw_path: Path, data: bytes, folder: Path | None):
     """Import the record; write the CSV, TOML and manifest into ``folder`` when given and writable."""
     import io
 
-    from .velstep import analyse, dataset_toml, load_window, read_raw, write_csv
+    from .velstep import analyse, dataset_toml, parts, read_raw, write_csv
 
     spec = RECORDS[name]
     imp = analyse(read_raw(raw_path, data=data), name, joint=None)
@@ -271,6 +271,7 @@ def _import(name: str, raw_path: Path, data: bytes, folder: Path | None):
     command = f"frictionlab datasets import velstep {raw_path.name} --name {name}" + (" --joint" if len(w.steps) > 1 else "")
     toml = dataset_toml(imp, w, source=spec["source"], license=spec["license"], citation=spec["citation"],
                         command=command)
+    meta, cols = parts(imp, w, toml)
     if folder is not None:
         buf = io.StringIO()
         write_csv(buf, imp, w)
@@ -280,7 +281,7 @@ def _import(name: str, raw_path: Path, data: bytes, folder: Path | None):
                                "csv": _sha256(csv), "file": raw_path.name}, indent=1).encode("utf-8")
         try:
             _write_all(folder, {f"{name}.csv": csv, f"{name}.toml": text, f"{name}.json": manifest})
-            return load_window(imp, w, toml, folder / f"{name}.toml")
+            return meta, folder / f"{name}.toml", cols
         except OSError as exc:
             _note(f"cannot write the cache folder {folder} ({exc.strerror or exc}): {name} imported in memory")
-    return load_window(imp, w, toml, raw_path)
+    return meta, raw_path, cols

@@ -390,15 +390,13 @@ def columns(imp: Imported, w: Window, rows: int | None = None) -> dict:
     return {"t": imp.raw.t[idx], "x": imp.x_um[idx], "mu": imp.raw.mu[idx]}
 
 
-def load_window(imp: Imported, w: Window, toml_text: str, path: Path, rows: int | None = None):
-    """The Dataset of one window, built from its TOML text and the arrays in memory (nothing read from disk):
-    what ``load_dataset`` returns once the pair is written at ``path`` (``rows``: a check on at most that many
-    samples, spread over the window)."""
+def parts(imp: Imported, w: Window, toml_text: str, rows: int | None = None) -> tuple[dict, dict]:
+    """(TOML table, CSV columns) of one window, from its TOML text and the arrays in memory: what
+    ``dataset.from_meta`` builds the Dataset from once the pair is written (``rows``: a check on at most that
+    many samples, spread over the window)."""
     import tomllib
 
-    from .dataset import from_meta
-
-    return from_meta(tomllib.loads(toml_text), Path(path), raw=columns(imp, w, rows))
+    return tomllib.loads(toml_text), columns(imp, w, rows)
 
 
 def summary(imp: Imported) -> list[str]:
