@@ -39,17 +39,22 @@ LIMITS = {"time": 1e12, "displacement": 1e12, "friction": 1e3, "normal stress": 
 
 @attrs.frozen(eq=False)
 class RawRecord:
-    """One raw record in SI units: time [s], displacement [m], friction [-], normal stress [Pa] (``stress``:
-    what the file's header calls it), and the line of the file each sample was read from."""
+    """One raw record: time [s], displacement [um, as recorded; ``x`` in m], friction [-], normal stress [Pa]
+    (``stress``: what the file's header calls it), and the line of the file each sample was read from."""
 
     path: Path
     t: np.ndarray
-    x: np.ndarray
+    x_um: np.ndarray
     mu: np.ndarray
     sn: np.ndarray
     stress: str = "effective normal stress"
     first_line: int = 2  # line of the first sample when every line after the header holds one
     lines: np.ndarray | None = None  # line of each sample otherwise
+
+    @property
+    def x(self) -> np.ndarray:
+        """Displacement [m]."""
+        return self.x_um * 1e-6
 
     def line(self, i: int) -> int:
         """The file's line (1-based) of sample i."""
@@ -96,7 +101,7 @@ def read_raw(path, data: bytes | None = None) -> RawRecord:
         _bad_row(path, bytes(body).decode("utf-8", "replace"), lines)
     del body, data
     first = header_no + 1
-    rec = RawRecord(path=path, t=table[:, 0].copy(), x=table[:, 1] * 1e-6, mu=table[:, 2].copy(),
+    rec = RawRecord(path=path, t=table[:, 0].copy(), x_um=table[:, 1].copy(), mu=table[:, 2].copy(),
                     sn=table[:, 3] * 1e6,
                     stress="effective normal stress" if "effective" in header[3].lower() else "normal stress",
                     first_line=first, lines=lines)
@@ -191,7 +196,7 @@ def analyse(raw: RawRecord, name: str, *, joint: bool | None = False, stiffness:
     several). ``stiffness`` [1/m]: the start of every dataset instead of the estimate; ``steps``: the number of
     steps expected (an error if another number is found)."""
     where = str(raw.path)
-    seg = segment(raw.t, raw.x * 1e6, where, raw.line, "um")  # in the record's units: um, um/s
+    seg = segment(raw.t, raw.x_um, where, raw.line, "um")  # in the record's units: um, um/s
     m = len(seg.steps)
     joint = m > 1 if joint is None else joint
     if steps is not None and steps != m:
@@ -371,14 +376,15 @@ CSV_HEADER = "t,x,mu"
 
 
 def write_csv(fh, imp: Imported, w: Window) -> None:
-    """Every sample of the window as t [s, the record's clock], x [um, jumps stitched], mu, written in chunks."""
+    """Every sample of the window as t [s, the record's clock], x [um, jumps stitched, to 1e-9 um], mu, written
+    in chunks, each number as read (the shortest text that gives it back)."""
     raw = imp.raw
     fh.write(f"# Every sample of lines {raw.line(w.a)} to {raw.line(w.b - 1)} of {raw.path.name}, as recorded "
              f"(x: load-point displacement{', jumps stitched' if any(w.a < j.index < w.b for j in imp.seg.jumps) else ''}"
              "); t in the record's clock (time_zero in the TOML is t = 0)\n" + CSV_HEADER + "\n")
     for lo in range(w.a, w.b, 100_000):
         hi = min(lo + 100_000, w.b)
-        cols = (raw.t[lo:hi].tolist(), imp.x_um[lo:hi].tolist(), raw.mu[lo:hi].tolist())
+        cols = (raw.t[lo:hi].tolist(), np.round(imp.x_um[lo:hi], 9).tolist(), raw.mu[lo:hi].tolist())
         fh.write("\n".join(f"{a!r},{b!r},{c!r}" for a, b, c in zip(*cols)) + "\n")
 
 
