@@ -4,7 +4,7 @@ Raw laboratory records under a third party's license are not committed. RECORDS 
 file, size, SHA-256, source, license and citation); when the file is present in a raw-data folder with
 that checksum, it is imported (``velstep``) into a cache folder once and then listed and loaded like any
 built-in dataset. Raw-data folders: the ``FRICTIONLAB_RAW_DATA`` environment variable (folders separated
-by ':'), else ``../shared/data`` beside the repository.
+by ':'), else ``shared/data`` in the folder that holds the repository's folder.
 
 The cache is ``platformdirs.user_cache_dir("frictionlab")/external`` (``~/.cache/frictionlab/external`` on
 Linux, or under an absolute ``XDG_CACHE_HOME``; a relative one is ignored with a note). Each cached import
