@@ -44,3 +44,14 @@ def test_the_command_line_and_the_report_say_which_laws_went_to_which_kind():
                              "rate-state-slip on spring-slider datasets")
     named = SimpleNamespace(options=Settings(laws=("coulomb",)), settings={}, laws=("coulomb",), datasets=c.datasets)
     assert laws_lines(named) == [] and _laws_text(named) == "coulomb"
+
+
+def test_pairs_of_the_default_laws_are_pairs_within_one_kind():
+    from frictionlab.commands.compare import parse_pairs
+    from frictionlab.core.errors import FrictionLabError
+
+    assert parse_pairs(["rate-state-aging:rate-state-slip"], None) == (("rate-state-aging", "rate-state-slip"),)
+    import pytest
+
+    with pytest.raises(FrictionLabError, match="rate-state-aging is not among the compared laws"):
+        parse_pairs(["rate-state-aging:wear"], None)

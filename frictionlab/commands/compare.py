@@ -126,9 +126,10 @@ def parse_pairs(items, laws) -> tuple[tuple[str, str], ...]:
     from ..physics.registry import get_law
     from ..pipeline.settings import DEFAULT_LAWS_BY_KIND, select_laws
 
-    compared = set(select_laws(laws))
-    if laws is None:  # the default laws of every kind
-        compared |= {get_law(n).name for v in DEFAULT_LAWS_BY_KIND.values() for n in v}
+    # the laws compared together: the named ones, or the default laws of each dataset kind (a pair of laws from
+    # two kinds' defaults is never fitted on one dataset)
+    groups = [set(select_laws(laws))] + ([{get_law(n).name for n in v} for v in DEFAULT_LAWS_BY_KIND.values()]
+                                         if laws is None else [])
     pairs = []
     for item in items:
         a, sep, b = item.partition(":")
@@ -137,8 +138,9 @@ def parse_pairs(items, laws) -> tuple[tuple[str, str], ...]:
         a, b = get_law(a.strip()).name, get_law(b.strip()).name
         if a == b:
             raise ParameterError(f"--pairs {item!r}: a law is always equivalent to itself; name two different laws")
-        missing = [x for x in (a, b) if x not in compared]
-        if missing:
+        if not any({a, b} <= g for g in groups):
+            compared = next((g for g in groups if b in g or a in g), groups[0])
+            missing = [x for x in (a, b) if x not in compared]
             raise ParameterError(f"--pairs {item!r}: {', '.join(missing)} {'is' if len(missing) == 1 else 'are'} not "
                                  f"among the compared laws ({', '.join(sorted(compared))}); add "
                                  f"{'it' if len(missing) == 1 else 'them'} to --laws")
