@@ -376,15 +376,28 @@ def kink_fit(t, x, a: int, b: int, j0: int, long_run: np.ndarray | None = None, 
 
 def joint_velocities(t, x, bounds, times, long_run=None) -> tuple[np.ndarray, np.ndarray]:
     """Velocities of every piece from one continuous piecewise-linear fit with its kinks at ``times`` (least
-    squares), each with the standard error (``errors``) of a line through its own piece's samples."""
-    tc = float(t[0])
-    u = t - tc
-    X = np.column_stack([np.ones_like(u), u] + [np.maximum(u - (s - tc), 0.0) for s in times])
-    p, *_ = np.linalg.lstsq(X, x - x[0], rcond=None)
-    res = x - x[0] - X @ p
-    v = np.tril(np.ones((len(times) + 1, len(times) + 1))) @ p[1:]  # V_k = slope + the first k slope changes
-    se = [errors(np.column_stack([np.ones(b - a), u[a:b]]), res[a:b],
-                 None if long_run is None else long_run[a:b])[1] for a, b in zip(bounds[:-1], bounds[1:])]
+    squares, by normal equations summed in chunks: bounded memory), each with the standard error
+    (``errors``) of a line through its own piece's samples."""
+    tc, x0 = float(t[0]), float(x[0])
+    knots = np.asarray(times, dtype=float) - tc
+
+    def design(a, b):
+        u = t[a:b] - tc
+        return np.column_stack([np.ones_like(u), u] + [np.maximum(u - k, 0.0) for k in knots])
+
+    n, m = len(t), len(times) + 2
+    A, y = np.zeros((m, m)), np.zeros(m)
+    for i in range(0, n, CHUNK):
+        X = design(i, min(i + CHUNK, n))
+        A += X.T @ X
+        y += X.T @ (x[i:i + CHUNK] - x0)
+    p = np.linalg.lstsq(A, y, rcond=None)[0]
+    v = np.tril(np.ones((m - 1, m - 1))) @ p[1:]  # V_k = slope + the first k slope changes
+    se = []
+    for a, b in zip(bounds[:-1], bounds[1:]):
+        res = x[a:b] - x0 - design(a, b) @ p
+        se.append(errors(np.column_stack([np.ones(b - a), t[a:b] - tc]), res,
+                         None if long_run is None else long_run[a:b])[1])
     return v, np.array(se)
 
 
