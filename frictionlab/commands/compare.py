@@ -178,14 +178,12 @@ def _run(args, free, pairs, datasets, client) -> int:
 
 def laws_lines(c) -> list[str]:
     """Which laws were fitted on which kind of dataset, when that was chosen by kind (the default laws)."""
-    by_kind = c.options.by_kind if c.options is not None else {}
-    kinds = {d.kind for d in c.datasets if d.kind != "contact-area"}
-    groups: dict[tuple, list[str]] = {}
-    for kind, laws in by_kind.items():
-        if kind in kinds:
-            groups.setdefault(tuple(laws), []).append(kind)
-    return [f"laws by dataset kind (the default): " + "; ".join(f"{', '.join(laws)} on {', '.join(k)}"
-                                                               for laws, k in groups.items())] if groups else []
+    from ..pipeline.settings import laws_groups
+
+    groups = laws_groups(c.options.by_kind if c.options is not None else {},
+                         {d.kind for d in c.datasets if d.kind != "contact-area"})
+    return ["laws by dataset kind (the default): " + "; ".join(f"{', '.join(laws)} on {', '.join(k)}"
+                                                               for laws, k in groups)] if groups else []
 
 
 def answer_lines(c) -> list[str]:

@@ -222,7 +222,7 @@ def line_rss(D) -> np.ndarray:
 
 def line_params(D) -> tuple:
     """(intercept, slope) of the weighted least-squares line of a range with moment sums D."""
-    W, St, Stt, Sx, Sxx, Stx = D
+    W, St, Stt, Sx, _, Stx = D
     vt = Stt - St * St / W
     slope = (Stx - St * Sx / W) / vt if vt > 0 else LD(0)
     return (Sx - slope * St) / W, slope

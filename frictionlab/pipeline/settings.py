@@ -26,6 +26,15 @@ def select_laws(laws: Sequence[str] | None) -> tuple[str, ...]:
     return tuple(dict.fromkeys(get_law(n).name for n in names))
 
 
+def laws_groups(by_kind: dict, kinds) -> list[tuple[tuple[str, ...], list[str]]]:
+    """(laws, the dataset kinds they were fitted on) for the kinds present, from a kind -> laws mapping."""
+    groups: dict[tuple, list[str]] = {}
+    for kind, laws in by_kind.items():
+        if kind in set(kinds):
+            groups.setdefault(tuple(laws), []).append(kind)
+    return list(groups.items())
+
+
 def default_laws_by_kind(kinds) -> dict[str, tuple[str, ...]]:
     """The default laws of each dataset kind in ``kinds`` (DEFAULT_LAWS_BY_KIND, else DEFAULT_LAWS)."""
     return {k: tuple(get_law(n).name for n in DEFAULT_LAWS_BY_KIND.get(k, DEFAULT_LAWS)) for k in dict.fromkeys(kinds)}
@@ -88,7 +97,3 @@ class Settings:
                 "replicates": int(self.replicates), "pairs": [list(p) for p in self.pairs],
                 "transfer": bool(self.transfer)} | ({"cluster": self.cluster} if self.cluster else {}) | (
                 {"laws_by_kind": {k: list(v) for k, v in self.by_kind.items()}} if self.by_kind else {})
-
-    def laws_of(self, kind: str) -> tuple[str, ...]:
-        """The laws fitted on datasets of ``kind``."""
-        return self.by_kind.get(kind, self.laws) if self.by_kind else self.laws

@@ -48,15 +48,12 @@ def _how_it_ran(c) -> str:
 
 def _laws_text(c) -> str:
     """The laws compared, by dataset kind when they were chosen by kind (the default laws)."""
-    by_kind = c.settings.get("laws_by_kind") or {}
-    kinds = {d.kind for d in c.datasets if d.kind != "contact-area"}
-    groups: dict[tuple, list[str]] = {}
-    for kind, laws in by_kind.items():
-        if kind in kinds:
-            groups.setdefault(tuple(laws), []).append(kind)
+    from ..pipeline.settings import laws_groups
+
+    groups = laws_groups(c.settings.get("laws_by_kind") or {}, {d.kind for d in c.datasets if d.kind != "contact-area"})
     if not groups:
         return ", ".join(c.laws)
-    return "; ".join(f"{', '.join(laws)} on {', '.join(k)} datasets" for laws, k in groups.items())
+    return "; ".join(f"{', '.join(laws)} on {', '.join(k)} datasets" for laws, k in groups)
 
 
 def _provenance_warning(c) -> str:
