@@ -56,6 +56,16 @@ def add_parser(sub):
                    help="run the fits, refits, tests, bootstrap and figures on the Dask cluster whose scheduler is "
                         "at ADDRESS (e.g. tcp://10.0.0.5:8786; needs pip install 'frictionlab[dask]'); --jobs is "
                         "then unused")
+    from ..core.cluster import CONNECT_TIMEOUT, TASK_TIMEOUT, WAIT_WORKERS
+
+    p.add_argument("--connect-timeout", type=fit_timeout, default=CONNECT_TIMEOUT, metavar="SECONDS",
+                   help=f"with --scheduler: how long the scheduler has to answer (default {CONNECT_TIMEOUT:g})")
+    p.add_argument("--wait-workers", type=fit_timeout, default=WAIT_WORKERS, metavar="SECONDS",
+                   help="with --scheduler: how long to wait for a worker when the cluster has none, at the start or "
+                        f"after its last worker is lost (default {WAIT_WORKERS:g})")
+    p.add_argument("--task-timeout", type=fit_timeout, default=TASK_TIMEOUT, metavar="SECONDS",
+                   help="with --scheduler: how long one task (a dataset's fits, tests and bootstrap, or a batch of "
+                        f"figures) may run on a worker (default {TASK_TIMEOUT:g})")
     p.add_argument("--no-equivalence", action="store_true", help="skip the equivalence (discrimination) tests")
     p.add_argument("--replicates", type=int, default=REPLICATES, metavar="R",
                    help=f"the most replicate datasets per law in the equivalence test's sequential parametric bootstrap "
@@ -84,7 +94,7 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from ..core.cluster import connect
+    from ..core.cluster import Waits, close, connect, quiet_logs
     from ..io.dataset import builtin_names, load_dataset
     from .fit import parse_free
 
@@ -104,12 +114,25 @@ def run(args) -> int:
         raise ParameterError(f"--replicates must be at least {MIN_REPLICATES}, got {args.replicates}")
     free = parse_free(args.free)
     datasets = [load_dataset(d) for d in args.data or builtin_names()]  # read first: --out keeps clear of them
-    client = connect(args.scheduler) if args.scheduler else None
-    try:
-        return _run(args, free, datasets, client)
-    finally:
-        if client is not None:
-            client.close()
+    if args.scheduler is None:
+        return _run(args, free, datasets, None)
+    waits = Waits(connect=args.connect_timeout, workers=args.wait_workers, task=args.task_timeout,
+                  say=None if args.quiet else _say)
+    with quiet_logs(args.debug):  # distributed's own log is not the user's to read, unless --debug
+        client = connect(args.scheduler, waits)
+        try:
+            return _run(args, free, datasets, client)
+        finally:
+            close(client, waits)
+
+
+def _say(text: str) -> None:
+    """A wait on the cluster, said as a progress line."""
+    import sys
+
+    from ..core.progress import _stamp
+
+    print(f"{_stamp()} compare: {text}", file=sys.stderr, flush=True)
 
 
 def _run(args, free, datasets, client) -> int:

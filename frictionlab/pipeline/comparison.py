@@ -196,8 +196,10 @@ def cluster_name(client) -> str:
     """How the report names a Dask cluster: its scheduler's address and number of workers ("" without one)."""
     if client is None:
         return ""
-    workers = len(client.scheduler_info().get("workers", {}))
-    return f"Dask cluster at {client.scheduler.address} ({workers} worker{'s' * (workers != 1)})"
+    from ..core.cluster import address_of, waits_of, worker_count
+
+    workers = worker_count(client, waits_of(client).connect)  # asked within the cluster's connect time
+    return f"Dask cluster at {address_of(client)} ({workers} worker{'s' * (workers != 1)})"
 
 
 def _make_run(settings: Settings, dss, progress, client=None) -> Run:
