@@ -22,13 +22,14 @@ def free_port() -> int:
 class Processes:
     """The scheduler and workers started for one test; ``stop()`` ends every one still running (by its pid)."""
 
-    def __init__(self, folder):
-        self.folder, self.procs, self.address = folder, [], None
+    def __init__(self, folder, env=None):
+        self.folder, self.procs, self.address, self.env = folder, [], None, env
 
     def _start(self, module: str, *args: str) -> subprocess.Popen:
         log = open(os.path.join(self.folder, f"dask-{len(self.procs)}.log"), "wb")
         proc = subprocess.Popen([sys.executable, "-m", f"distributed.cli.{module}", *args], stdout=log,
-                                stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, cwd=self.folder)
+                                stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL, cwd=self.folder,
+                                env=self.env)
         log.close()
         self.procs.append(proc)
         return proc

@@ -4,7 +4,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..core.errors import OutputError, ParameterError
+from ..core.errors import FitError, OutputError, ParameterError
 from ..core.progress import Progress
 from .fit import FIT_TIMEOUT, fit_timeout
 
@@ -149,6 +149,11 @@ def _run(args, free, datasets, client) -> int:
                              bootstrap=args.bootstrap, seed=args.seed, bootstrap_all=args.bootstrap_all,
                              tolerance=TOLERANCE_RTOLS if args.tolerance else (), fit_timeout=args.fit_timeout,
                              replicates=args.replicates, transfer=args.transfer, client=client)
+        if not any(f.ok for f in result.fits):  # nothing to compare: an error, and no report of it
+            reasons = list(dict.fromkeys(f"{f.law} on {', '.join(f.datasets)}: {f.reason}" for f in result.fits
+                                         if f.status == "failed"))
+            raise FitError("compare: no fit succeeded: " + "; ".join(reasons[:3])
+                           + (f" (and {len(reasons) - 3} more)" if len(reasons) > 3 else ""))
         with Progress("report", quiet=args.quiet) as bar:
             out = write_report(result, args.out, force=args.force, progress=bar, jobs=args.jobs, client=client)
     ok = sum(f.ok for f in result.fits)

@@ -168,7 +168,7 @@ class Host:
             if limit is not None and not select.select([self.inbox], [], [], limit)[0]:
                 self.proc.kill()
                 self.proc.wait()
-                raise ClusterError(f"{name} ran past the task time limit of {limit:g} s on a Dask worker "
+                raise ClusterError(f"task {name} ran past the task time limit of {limit:g} s on a Dask worker "
                                    "(--task-timeout); its process was ended")
             return _receive(self.inbox)
         except (EOFError, BrokenPipeError):

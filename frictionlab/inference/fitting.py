@@ -73,6 +73,7 @@ from .predict import (
     set_scene_quantity,
     takes_rtol,
 )
+from ..core.fpstate import with_own_errstate
 
 __all__ = ["DatasetFit", "FitResult", "ParamResult", "PREDICTORS", "SCENE_QUANTITIES", "SkipDataset", "Stats", "Target",
            "applicable_solvers", "auto_solver", "fit", "get_scene_quantity", "make_target", "predict",
@@ -81,6 +82,7 @@ SHARPEN_BELOW = 1e-3  # an F p-value (conservative) below this already rejects: 
 _KEEP = (ODE_STARTS, PENALTY, LIKELIHOOD_REASON, neg2loglik)  # re-exported names other modules read from here
 
 
+@with_own_errstate
 def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[float]] | None = None,
         fixed: Mapping[str, float] | None = None, local: Sequence[str] = (),
         initial: Mapping[str, float] | None = None, observable: str | None = None, derive: str | None = None,

@@ -20,6 +20,7 @@ import attrs
 import numpy as np
 
 from ..core.errors import FrictionLabError, LawError, RegistryError
+from ..core.fpstate import own_errstate
 from ..core.inputs import note_input
 from ..core.names import check_name
 from ..core.signals import kept_signals
@@ -40,8 +41,6 @@ class PluginWarning(UserWarning):
     """A law plugin was skipped."""
 
 
-#: numpy's error state before any plugin ran: entry points are loaded and probed in it.
-_NUMPY_STATE = np.geterr()
 _laws: dict[str, FrictionLaw] = {}
 _sources: dict[str, str] = {}
 _runtime: list[tuple[FrictionLaw, str]] = []
@@ -229,7 +228,7 @@ def _load() -> None:
             seen.add(key)
             source = f"entry point '{ep.name} = {ep.value}' of {dist_name}"
             try:
-                with np.errstate(**_NUMPY_STATE):  # as before any plugin, whatever one set; restored after
+                with own_errstate():  # numpy's defaults, whatever a plugin or the caller set; restored after
                     try:
                         obj = (ep.load() if ep.value.startswith("frictionlab.")
                                else within_load_limit(ep.load, what="its import"))

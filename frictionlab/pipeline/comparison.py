@@ -43,6 +43,7 @@ from .runner import Progress, Run, select
 from .runner import run_stages as run_stages_with
 from .settings import DEFAULT_LAWS, Settings, select_laws  # noqa: F401
 from .stages import STAGES
+from ..core.fpstate import with_own_errstate
 
 
 @attrs.frozen(eq=False)
@@ -123,6 +124,7 @@ def versions() -> dict:
             "platform": platform.platform(), "cpus": os.cpu_count()}
 
 
+@with_own_errstate
 def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None, solvers: Sequence[str] | None = None,
             *, free: dict | None = None, equivalence: bool = True, jobs: int = 1,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
@@ -173,6 +175,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     return attrs.evolve(c, wall_time=time.perf_counter() - started)
 
 
+@with_own_errstate
 def run_stages(comparison: Comparison, stages: Sequence[str], *, progress: Progress | None = None, client=None,
                **options) -> Comparison:
     """Run the named stages (``stages.STAGES``) on a comparison made by ``compare``, e.g.

@@ -62,6 +62,7 @@ from .doc import Section
 from .render import html_page, markdown
 from .results import SCHEMA, clean, fit_json, ranking_csv, results_json
 from .tolerance import tolerance_verdicts
+from ..core.fpstate import with_own_errstate
 
 TITLE = "frictionlab: friction laws compared"
 
@@ -174,6 +175,7 @@ def _batches(items, n: int):
         yield first, batch
 
 
+@with_own_errstate
 def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, client=None) -> Path:
     """Write the report folder ``out`` whole or not at all; an existing folder is replaced only with force=True.
 

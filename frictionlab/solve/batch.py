@@ -60,6 +60,7 @@ from .batchrk import run_rk
 from .plan import make_plan
 from .scenebatch import SceneBatch, batch_params, take_params
 from .solvers import exact
+from ..core.fpstate import with_own_errstate
 
 __all__ = ["SOLVERS", "CHUNK", "SceneBatch", "BatchResult", "batch_params", "simulate_batch"]
 
@@ -99,6 +100,7 @@ class BatchResult:
                           solver=f"batch:{self.solver}", law=self.law, stick_time=None if math.isnan(st) else st)
 
 
+@with_own_errstate
 def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol: float = 1e-8,
                    atol: float | None = None, n: int = 201) -> BatchResult:
     """Simulate ``law`` on many scenes of one structure.

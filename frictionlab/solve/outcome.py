@@ -62,6 +62,7 @@ from .outcomescene import (
     SpeedLaw,
     hertz_shape,
 )
+from ..core.fpstate import with_own_errstate
 
 __all__ = ["ANGLE_REFERENCES", "OUTCOMES", "HertzPulse", "Inbound", "OutcomeScene", "SpeedLaw", "hertz_shape",
            "mdr_solvers", "predict_outcomes", "rows_of"]
@@ -98,6 +99,7 @@ def _rows(law, dataset_or_scene, speed, incidence, spin):
                      f"got {type(dataset_or_scene).__name__}")
 
 
+@with_own_errstate
 def predict_outcomes(law, dataset_or_scene, params: Mapping[str, float] | None = None, solver: str = "ode", *,
                      speed=None, incidence=None, spin=None, rtol: float = 1e-10) -> dict[str, np.ndarray]:
     """Simulate every impact and return its outcomes (SI arrays, one entry per row).

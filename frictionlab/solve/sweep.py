@@ -26,6 +26,7 @@ import numpy as np
 from ..core.errors import OutputError, SolverError
 from ..physics.registry import get_law
 from .scenebatch import SceneBatch, batch_params, take_params
+from ..core.fpstate import with_own_errstate
 
 FIELDS = ("u", "v", "omega", "theta", "force", "A", "N")
 
@@ -49,6 +50,7 @@ class Sweep:
         return pd.DataFrame(self.scenes).set_index("scene")
 
 
+@with_own_errstate
 def simulate_sweep(law, scenes, params=None, t=None, solver: str = "auto", rtol: float = 1e-8,
                    atol: float | None = None, n: int = 201, executor=None, chunk: int = 5000, *, out=None,
                    reduce=None, fields=None, force: bool = False):

@@ -11,6 +11,7 @@ from ...physics.registry import get_law
 from ...physics.scene import Scene
 from ..plan import make_plan
 from . import exact, ode, segments, series
+from ...core.fpstate import with_own_errstate
 
 SOLVERS = ("exact", "series", "ode")
 
@@ -30,6 +31,7 @@ def parse_solver(text: str) -> tuple[str, str | None]:
     return name, method or None
 
 
+@with_own_errstate
 def simulate(law, scene, params=None, solver: str = "ode", t=None, rtol: float = 1e-10, atol: float | None = None,
              n: int = 201):
     """Simulate ``law`` on a scene (or a dataset's scene) and return a Trajectory.
