@@ -165,7 +165,12 @@ def _stop(pool: ProcessPoolExecutor) -> None:
 
 
 class OverBudget(Exception):
-    """A call run by ``bounded`` ran past its limit; its process was ended."""
+    """A call run by ``bounded`` ran past its limit; its process was ended. ``doing``: what the call said it was
+    doing last (``doing``), "" if nothing."""
+
+    def __init__(self, text: str, doing: str = ""):
+        super().__init__(text)
+        self.doing = doing
 
 
 #: In a child of ``bounded``: the pipe to the parent, on which ``beat`` writes (None elsewhere).
@@ -178,6 +183,14 @@ def beat() -> None:
     A no-op in any other process."""
     if _beat_fd is not None:
         os.write(_beat_fd, b"b")
+
+
+def doing(text: str) -> None:
+    """In a child of ``bounded``: what it does from now on (said by OverBudget if the limit passes meanwhile). A
+    no-op in any other process."""
+    if _beat_fd is not None:
+        data = text.encode("utf-8", "replace")[:60000]
+        os.write(_beat_fd, b"d" + len(data).to_bytes(2, "little") + data)
 
 
 def bounded(fn, limit: float, *args):
@@ -236,29 +249,32 @@ def _child(read: int, write: int, fn, args) -> None:
 
 def _receive(read: int, limit: float) -> bytes | None:
     """What the child sends after b'r': an 8-byte length and that many bytes (None if the pipe ends first);
-    each b'b' before it restarts the limit. Returns once the answer is whole, never waiting for the pipe to end."""
+    each b'b' before it restarts the limit, each b'd' says what it does (``doing``). Returns once the answer is
+    whole, never waiting for the pipe to end."""
     import select
     import time
 
-    got, deadline, started = bytearray(), time.monotonic() + limit, False
+    got, deadline, started, now_doing = bytearray(), time.monotonic() + limit, False, ""
     while True:
+        while not started and got:  # the messages before the answer: b'b', b'd' + 2-byte length + text, b'r'
+            if got[:1] == b"b":
+                deadline, got = time.monotonic() + limit, got[1:]
+            elif got[:1] == b"d":
+                if len(got) < 3 or len(got) < 3 + int.from_bytes(got[1:3], "little"):
+                    break
+                n = int.from_bytes(got[1:3], "little")
+                now_doing, got = bytes(got[3:3 + n]).decode("utf-8", "replace"), got[3 + n:]
+            else:  # b'r'
+                started, got = True, got[1:]
         if started and len(got) >= 8 and len(got) >= 8 + int.from_bytes(got[:8], "little"):
             return bytes(got[8:8 + int.from_bytes(got[:8], "little")])
         left = deadline - time.monotonic()
         if left <= 0 or not select.select([read], [], [], left)[0]:
-            raise OverBudget(f"ran past {limit:g} s")
+            raise OverBudget(f"ran past {limit:g} s", now_doing)
         chunk = os.read(read, 1 << 16)
         if not chunk:
             return None
-        if not started:
-            beats = len(chunk) - len(chunk.lstrip(b"b"))
-            if beats:
-                deadline = time.monotonic() + limit
-            chunk = chunk[beats:]
-            if chunk[:1] == b"r":
-                started, chunk = True, chunk[1:]
-        if started:
-            got += chunk
+        got += chunk
 
 
 def _pickled_error(exc: BaseException) -> bytes:

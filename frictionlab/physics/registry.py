@@ -77,8 +77,9 @@ def within_load_limit(fn, *args, what: str, error=RegistryError):
         limit = load_timeout()
         try:
             workers.bounded(_tried, limit, fn, *args)
-        except workers.OverBudget:
-            raise error(f"{what} ran past the load time limit of {limit:g} s (FRICTIONLAB_LOAD_TIMEOUT); "
+        except workers.OverBudget as exc:
+            during = f" during {exc.doing}" if exc.doing else ""
+            raise error(f"{what} ran past the load time limit of {limit:g} s (FRICTIONLAB_LOAD_TIMEOUT){during}; "
                         "its process was ended and nothing was loaded") from None
         except BrokenProcessPool:
             raise error(f"{what} ended its process; nothing was loaded") from None
@@ -103,8 +104,13 @@ def _as_law(obj, source: str) -> FrictionLaw:
     if type(law).__module__.startswith("frictionlab."):
         validate_law(law, source)
     else:  # a third-party law's check runs its code: within the load time limit
+        from ..core import workers
+
+        workers.doing(f"the check of law '{getattr(law, 'name', '?')}' at registration (its force, rates and form "
+                      "at its defaults)")
         within_load_limit(validate_law, law, source, what=f"law plugin {source}: its check at registration",
                           error=LawError)
+        workers.doing("the import")
     return law
 
 
@@ -372,6 +378,9 @@ def _import(spec, path) -> None:
     import importlib.util
     import sys
 
+    from ..core import workers
+
+    workers.doing("the import")
     module = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = module
     try:
