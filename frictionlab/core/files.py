@@ -233,14 +233,7 @@ def clear_dead(path) -> None:
     for name in names:
         m = pattern.fullmatch(name)
         if m and not _alive(int(m[1]), int(m[2])):
-            full = os.path.join(parent, name)
-            if os.path.isdir(full) and not os.path.islink(full):
-                shutil.rmtree(full, ignore_errors=True)
-            else:
-                try:
-                    os.unlink(full)
-                except OSError:
-                    pass
+            _remove(os.path.join(parent, name))
 
 
 _leftovers: set[str] = set()  # temporary files and folders, and locks, of this process not yet removed
@@ -355,7 +348,7 @@ def _take_lock(lock: Path, path: Path, parent: Path, busy: OutputError) -> int:
                 stale = _dead_owner(fd) and _same_file(fd, lock)
                 os.close(fd)
                 if stale:  # its owner died; a child it forked holds the flock: this file is free to replace
-                    _unlink(lock)
+                    _remove(str(lock))
                     continue
                 raise busy from None
             os.close(fd)
@@ -396,13 +389,6 @@ def _same_file(fd: int, path: Path) -> bool:
         return os.fstat(fd).st_ino == os.lstat(path).st_ino
     except OSError:
         return False
-
-
-def _unlink(path) -> None:
-    try:
-        os.unlink(path)
-    except OSError:
-        pass
 
 
 def _replaceable(path: Path) -> bool:
