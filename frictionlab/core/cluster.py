@@ -16,6 +16,7 @@ distributed's own log stays off the terminal (``quiet_logs``) unless asked for.
 """
 from __future__ import annotations
 
+import socket
 import threading
 import time
 import uuid
@@ -355,18 +356,22 @@ def connect(address: str, waits: Waits | None = None):
     text, args = check_address(address)
     where = f"--scheduler {address}"
     waits.tell(f"connecting to the Dask scheduler at {text} (waiting up to {waits.connect:g} s, --connect-timeout)")
+    started = time.monotonic()
+    try:  # first a plain connection, for the system's own word on a refusal or a name that does not resolve
+        from distributed.comm.addressing import parse_address, parse_host_port
+
+        socket.create_connection(parse_host_port(parse_address(text)[1]), timeout=waits.connect).close()
+    except OSError as exc:
+        raise ClusterError(f"{where}: cannot connect to a Dask scheduler there within {waits.connect:g} s "
+                           f"(--connect-timeout): {exc.strerror or exc or 'timed out'}") from None
     try:
-        asyncio.run(_handshake(text, waits.connect, args))
+        asyncio.run(_handshake(text, max(0.5, waits.connect - (time.monotonic() - started)), args))
     except (TimeoutError, asyncio.TimeoutError):
         raise ClusterError(f"{where}: no Dask scheduler answered there within {waits.connect:g} s (--connect-timeout): "
                            "something accepts connections there but does not speak Dask's protocol, or is stuck")
     except OSError as exc:
-        root = exc
-        while root.__cause__ is not None:  # distributed wraps the refusal: say what the system said
-            root = root.__cause__
-        why = getattr(root, "strerror", None) or _why(root)
         raise ClusterError(f"{where}: cannot connect to a Dask scheduler there within {waits.connect:g} s "
-                           f"(--connect-timeout): {why}") from None
+                           f"(--connect-timeout): {_why(exc)}") from None
     except Exception as exc:  # noqa: BLE001 (a server that answered something else: an HTTP server, garbage)
         raise ClusterError(f"{where}: what answered there is not a Dask scheduler ({_why(exc)})") from None
     from distributed import Client
