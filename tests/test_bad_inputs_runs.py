@@ -2,9 +2,9 @@
 are a set (a full disk, a run killed with SIGKILL), exit statuses and the messages of numerical failures, and a
 run kept independent of what plugins and callers do to the process.
 
-Every case, whatever its class, is checked as the other corpora are (``test_bad_inputs_round3.check``): its exit
+Every case, whatever its class, is checked as the other corpora are (``test_bad_inputs_by_class.check``): its exit
 status, no traceback, nothing a terminal acts on, and with status 2 exactly one error line matching ``error``
-and the case folder as it was. The fields beyond round3.toml's are described at the top of runs.toml.
+and the case folder as it was. The fields beyond by_class.toml's are described at the top of runs.toml.
 """
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ from pathlib import Path
 import pytest
 
 from test_bad_inputs import clean_registry, prepare, snapshot  # noqa: F401 (a fixture)
-from test_bad_inputs_round3 import check, run_inprocess, run_python
+from test_bad_inputs_by_class import check, run_inprocess, run_python
 
 CASES = tomllib.loads((Path(__file__).parent / "bad_inputs" / "runs.toml").read_text(encoding="utf-8"))["case"]
 CLASSES = ("cluster", "outputs", "statuses", "process")

@@ -33,7 +33,9 @@ import collections
 import json
 import os
 import threading
+from collections.abc import Callable
 from concurrent.futures import as_completed
+from typing import TYPE_CHECKING
 from pathlib import Path
 
 import attrs
@@ -63,6 +65,11 @@ from .render import html_page, markdown
 from .results import SCHEMA, clean, fit_json, ranking_csv, results_json
 from .tolerance import tolerance_verdicts
 from ..core.fpstate import with_own_errstate
+
+if TYPE_CHECKING:  # annotations only
+    from dask.distributed import Client
+
+    from ..pipeline.comparison import Comparison
 
 TITLE = "frictionlab: friction laws compared"
 
@@ -176,7 +183,9 @@ def _batches(items, n: int):
 
 
 @with_own_errstate
-def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, client=None) -> Path:
+def write_report(c: Comparison, out: str | os.PathLike, force: bool = False,
+                 progress: Callable[[int, int, str], None] | None = None, jobs: int = 1,
+                 client: Client | None = None) -> Path:
     """Write the report folder ``out`` whole or not at all; an existing folder is replaced only with force=True.
 
     progress(done, total, label), if given, is called after each figure and file. jobs: worker
