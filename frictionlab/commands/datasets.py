@@ -105,7 +105,7 @@ def _import(args) -> int:
     import shlex
 
     from ..core.errors import OutputError, ParameterError
-    from ..core.files import check_writable
+    from ..core.files import atomic_files
     from ..core.names import check_name
     from ..core.units import to_si
     from ..io.dataset import from_meta
@@ -130,7 +130,6 @@ def _import(args) -> int:
                 raise OutputError(f"{p}: would overwrite the raw record; choose another --name or --out")
             if os.path.lexists(p) and not args.force:
                 raise OutputError(f"{p}: exists; choose another --name or --out, or pass --force")
-            check_writable(p)
         command = "frictionlab datasets import velstep " + " ".join(shlex.quote(a) for a in (
             args.raw.name, "--name", args.name)) + (" --joint" if args.joint else "") + (
             f" --stiffness {shlex.quote(args.stiffness)}" if k else "")
@@ -138,52 +137,26 @@ def _import(args) -> int:
                             command=command)
         meta, cols = parts(imp, w, toml, rows=20_000)
         from_meta(meta, paths[0], raw=cols)  # the pair loads before it is written
-        files[paths[1].name] = lambda fh, w=w: write_csv(fh, imp, w)
-        files[paths[0].name] = lambda fh, toml=toml: fh.write(toml)
+        files[paths[1]] = lambda fh, w=w: write_csv(fh, imp, w)
+        files[paths[0]] = lambda fh, toml=toml: fh.write(toml)
         pairs.append((w, paths))
-    _write_set(args.out, files)
+    with atomic_files(list(files), force=args.force) as staged:  # every file of every step, or none
+        for write, tmp in zip(files.values(), staged):
+            with open(tmp, "w", encoding="utf-8", newline="\n") as fh:
+                write(fh)
     for line in summary(imp):
         print(line)
     for w, (toml_path, csv_path) in pairs:
         v = " -> ".join(f"{x * 1e6:.4g}" for x in w.velocities)
-        print(f"wrote {toml_path} and {csv_path}: lines {raw.line(w.a)} to {raw.line(w.b - 1)} ({w.b - w.a} samples), "
+        print(f"wrote {_shown(toml_path)} and {_shown(csv_path)}: lines {raw.line(w.a)} to {raw.line(w.b - 1)} ({w.b - w.a} samples), "
               f"{v} um/s, k start {w.stiffness * 1e-6:.3g} 1/um ({w.stiffness_from}; fitted with the law)")
     return 0
 
 
-def _write_set(out: Path, files: dict) -> None:
-    """Write files (name -> function writing to a text handle) into ``out`` as a set: all into a temporary
-    folder there, then each moved into place; on a failure the ones moved are taken back (and any file
-    they replaced put back), so the folder holds all of them or none."""
-    from ..core.errors import OutputError
-
-    try:
-        tmp = Path(tempfile.mkdtemp(dir=out, prefix=".import.", suffix=".tmp"))
-    except OSError as exc:
-        raise OutputError(f"{out}: cannot write: {exc.strerror or exc}") from None
-    placed, name = [], ""  # (name, the file it replaced, moved aside) for each file moved into place
-    try:
-        for name, write in files.items():
-            with open(tmp / name, "w", encoding="utf-8", newline="\n") as fh:
-                write(fh)
-        for name in files:
-            old = tmp / f"{name}.old" if os.path.lexists(out / name) else None
-            if old:
-                os.replace(out / name, old)
-            placed.append((name, old))
-            os.replace(tmp / name, out / name)
-    except OSError as exc:
-        for done, old in reversed(placed):
-            try:
-                if old:
-                    os.replace(old, out / done)
-                elif not os.path.lexists(tmp / done):
-                    os.unlink(out / done)
-            except OSError:
-                pass
-        raise OutputError(f"{out / name}: cannot write: {exc.strerror or exc}") from None
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+def _shown(path: Path) -> str:
+    """A path as the user would write it: relative to the current folder when it lies below it."""
+    rel = os.path.relpath(path)
+    return str(path) if rel.startswith("..") else rel
 
 
 def _list(args) -> int:
@@ -281,7 +254,7 @@ def _to_file_unit(d, column: str) -> float:
 
 def _template(args) -> int:
     from ..core.errors import OutputError
-    from ..core.files import atomic_write_text
+    from ..core.files import write_files
     from ..core.names import check_name
     from ..io.template import template
 
@@ -293,8 +266,7 @@ def _template(args) -> int:
         if p.exists() and not args.force:
             raise OutputError(f"{p}: exists; choose another --name or --out, or pass --force")
     toml, csv = template(args.kind, args.name)
-    atomic_write_text(csv_path, csv)
-    atomic_write_text(toml_path, toml)
+    write_files({toml_path: toml, csv_path: csv}, force=args.force)  # both or neither
     print(f"wrote {toml_path} and {csv_path}: replace the example rows with your data, then "
           f"'frictionlab datasets show {toml_path}'")
     return 0

@@ -132,14 +132,20 @@ def noise_by_sample(t: np.ndarray, x: np.ndarray, cuts=()) -> tuple[np.ndarray, 
             rr = rr[~np.isnan(rr)] if len(cuts) else rr
             if rr.size >= 8:
                 scale[k, j] = 1.4826 * float(np.median(rr))
-    floor = float(np.nanmax(scale[0])) * 1e-6 if np.isfinite(scale[0]).any() else 0.0
-    floor = max(floor, 1e-300 ** 0.25)
+    floor = resolution(t, x)
     s1 = np.fmax(np.nan_to_num(scale[0], nan=floor), floor)
     total = np.fmax(np.nan_to_num(np.nanmax(scale, axis=0), nan=floor), s1)
     q = np.clip((s1 / total) ** 2, 1e-4, 1.0)  # AR(1): sigma1^2 / sigma^2 = (1 - phi)(3 - phi) / 3
     phi = np.clip(2.0 - np.sqrt(1.0 + 3.0 * q), 0.0, 0.99)
     per = np.repeat(np.arange(nb), np.diff(edges))
     return s1[per], total[per], (total ** 2 * (1 + phi) / (1 - phi))[per]
+
+
+def resolution(t: np.ndarray, x: np.ndarray) -> float:
+    """The smallest noise a record can show: what double precision resolves of its displacement about the chord
+    through its ends (a record without noise, exact to its last digit, still has pieces of finite cost)."""
+    chord = x[0] + (x[-1] - x[0]) * (t - t[0]) / (t[-1] - t[0])
+    return max(1e-8 * float(np.max(np.abs(x - chord))), 1e-150)
 
 
 class StretchNoise:
@@ -149,6 +155,7 @@ class StretchNoise:
 
     def __init__(self, t, x, grid, floor: np.ndarray):
         self.grid, self.floor = np.asarray(grid), np.concatenate([[0.0], np.cumsum(floor ** 2)])
+        self.least = resolution(t, x)
         self.lags = _lags(len(t), MAX_STRETCH_LAG)
         self.S = []
         for lag in self.lags:  # sums of r^2 by centre index, at the grid positions
@@ -166,7 +173,7 @@ class StretchNoise:
                 best = max(best, float((S[j] - S[i]) / (self.grid[j] - self.grid[i])))
             elif lag == 1:  # too short a stretch: the noise by sample there
                 return math.sqrt((self.floor[b] - self.floor[a]) / (b - a))
-        return math.sqrt(best)
+        return max(math.sqrt(best), self.least)
 
 
 # --- sums and line costs -------------------------------------------------------------------------
