@@ -88,7 +88,7 @@ class Segmentation:
 
     steps: tuple  # Step, in time order
     jumps: tuple  # Jump, in time order
-    bounds: tuple  # sample indices of the pieces between steps: (0, step1.index, ..., n)
+    bounds: tuple  # sample indices of the pieces between steps: (0, steps[0].index, ..., n)
     velocities: tuple  # fitted velocity of each piece, one continuous fit through every kink [x unit/s]
     velocities_se: tuple
     x: np.ndarray = attrs.field(eq=False)  # the displacement, jumps stitched
@@ -459,6 +459,7 @@ def segment(t: np.ndarray, x: np.ndarray, where: str = "record",
                                f"{what}; a step needs at least {MIN_PIECE} samples of each velocity")
     long_run = noise_by_sample(t, x, cut)[2]  # again, now that the steps are known: a kink is not noise
     steps = [kink_fit(t, x, a, b, s, long_run) for a, s, b in zip(bounds[:-2], bounds[1:-1], bounds[2:])]
+    bounds = [0, *(s.index for s in steps), n]  # the pieces now end at the kinks
     v, se = joint_velocities(t, x, bounds, [s.time for s in steps], long_run)
     return Segmentation(steps=tuple(steps), jumps=tuple(jumps), bounds=tuple(bounds), velocities=tuple(v.tolist()),
                         velocities_se=tuple(se.tolist()), x=x, noise=float(np.median(total)), breakpoints=tuple(bps),
