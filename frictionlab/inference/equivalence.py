@@ -81,6 +81,7 @@ from .margin import MARGIN, Margin, parse_margin
 from .qualitative import qualitative
 from .qualitative import text as qual_text
 from .replicates import ROW, centring_fit, cross_chi2, distance, one_family, refit_options, replicate_chunk
+from ..core.fpstate import with_own_errstate
 
 WEAR, AREA_RATE, COUETTE, COULOMB = "wear", "area-rate", "couette", "coulomb"
 #: The pairs ``compare`` tests by default: the paper's claim, the structural identity, and the simplest law against the paper's.
@@ -280,6 +281,7 @@ def sentences(*parts: str) -> str:
 
 
 # --- the test -------------------------------------------------------------------------------------
+@with_own_errstate
 def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = REPLICATES, seed: int = 0,
                         executor: Executor | None = None, chunk: int | None = None,
                         timeout: float | None = None, margin: float | str = MARGIN) -> EquivalenceResult:
