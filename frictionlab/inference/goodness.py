@@ -29,6 +29,7 @@ import numpy as np
 FITS_LEVEL = 0.01  # family-wise level of the fit tests (chi-square or F, and runs) on one dataset or group
 TEST_LEVEL = FITS_LEVEL / 2  # each of the two tests (Bonferroni)
 RUNS_MIN = 10
+SHARPEN_BELOW = 1e-3  # an F p-value (conservative) below this already rejects: no sharper p-value is needed
 
 
 @attrs.frozen
