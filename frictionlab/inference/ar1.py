@@ -181,11 +181,12 @@ def fitted_noise(t, y, residual) -> tuple[np.ndarray, np.ndarray]:
     return sigma_i, phi_i
 
 
-def replicate_noise(target, model, rng) -> np.ndarray:
-    """Noise for a parametric replicate of ``target``'s data around a fit's ``model`` of it: Gaussian of the
-    target's sigma, or, where its dataset declares ``correlation = "ar1"``, AR(1) noise of the model a fit of
-    these data uses (sigma and phi from the data and the fit's residual)."""
-    if getattr(target.dataset, "noise_correlation", "none") != "ar1" or target.t is None:
-        return rng.standard_normal(np.shape(target.y)) * target.sigma
-    sigma_i, phi_i = fitted_noise(target.t, target.y, np.asarray(target.y) - model)
-    return draw(rng, sigma_i, phi_i)
+def noise_drawer(dataset, y, model, sigma):
+    """A function rng -> one draw of noise for a parametric replicate of data y around a fit's ``model`` of them:
+    Gaussian of ``sigma`` (the likelihood's, per sample or one value), or, where ``dataset`` declares
+    ``correlation = "ar1"``, AR(1) noise of the model a fit of these data uses (``fitted_noise``)."""
+    if getattr(dataset, "noise_correlation", "none") != "ar1" or "t" not in dataset.columns:
+        shape = np.shape(y)
+        return lambda rng: rng.standard_normal(shape) * sigma
+    sigma_i, phi_i = fitted_noise(dataset.columns["t"], y, np.asarray(y) - model)
+    return lambda rng: draw(rng, sigma_i, phi_i)

@@ -294,51 +294,62 @@ class Problem:
 
     # -- fitting ---------------------------------------------------------------------------------------------
     def local(self, x0, free, search: bool = False, max_nfev: int | None = None, tol: float = 1e-10):
-        """Trust-region least squares over the parameters ``free`` from the full vector x0: (x, cost, success)."""
-        from scipy.optimize import least_squares
+        """Levenberg-Marquardt with bounds over the parameters ``free`` from the full vector x0 (``lm``)."""
+        return self.lm(x0, free, search, max_nfev or 100 * (len(free) + 1), tol)
 
-        x0 = np.array(x0, dtype=float)
-        if not free:
-            r, _ = self.evaluate(x0, free, search)
-            return x0, 0.5 * float(r @ r), True
-        lo, hi = self.bounds(free)
-        start = np.clip(x0[free], lo + 1e-10 * (1 + np.abs(lo)), hi - 1e-10 * (1 + np.abs(hi)))
-        r0, _ = self.evaluate(_put(x0, free, start), free, search)
-        if np.all(r0 == PENALTY):
-            return x0, math.inf, False
+    def damped(self, x0, free):
+        """The grid's inner fit (of a and b): a few Levenberg-Marquardt steps on the search subsample."""
+        return self.lm(x0, free, True, SEARCH_ITERS, 1e-6)
 
-        def fun(z):
-            return self.evaluate(_put(x0, free, z), free, search)[0]
-
-        def jac(z):
-            return self.evaluate(_put(x0, free, z), free, search)[1]
-
-        res = least_squares(fun, start, jac=jac, bounds=(lo, hi), method="trf", x_scale=1.0, ftol=tol, xtol=tol,
-                            gtol=tol, max_nfev=max_nfev or 100 * (len(free) + 1))
-        x = _put(x0, free, res.x)
-        return x, float(res.cost), bool(res.status > 0 and res.cost < 0.5 * PENALTY ** 2)
-
-    def damped(self, x0, free, iters: int = SEARCH_ITERS):
-        """A few Levenberg-Marquardt iterations over ``free`` on the search subsample (the grid's inner fit of a
-        and b): (x, cost, success)."""
+    def lm(self, x0, free, search: bool, max_nfev: int, tol: float):
+        """Levenberg-Marquardt (Marquardt's scaling by the diagonal of J'J) with bounds: a parameter at a bound
+        whose gradient points outward is held for the step (an active set), a step is clipped into the box.
+        Stops when a step lowers chi-square by less than ``tol`` relative and moves every parameter by less than
+        sqrt(tol) (relative, or absolute below 1), or after ``max_nfev`` evaluations. Returns (x, cost = chi2 / 2,
+        success)."""
         x = np.array(x0, dtype=float)
+        if not free:
+            r, _ = self.evaluate(x, free, search)
+            return x, 0.5 * float(r @ r), bool(np.all(r != PENALTY))
         lo, hi = self.bounds(free)
-        r, J = self.evaluate(x, free, search=True)
-        cost = float(r @ r)
+        z = np.clip(x[free], lo, hi)
+        x[free] = z
+        r, J = self.evaluate(x, free, search)
         if np.all(r == PENALTY):
             return x, math.inf, False
-        lam = 1e-3
-        for _ in range(iters):
+        cost, lam, used = float(r @ r), 1e-3, 1
+        while used < max_nfev:
+            g = J.T @ r
             A = J.T @ J
-            step = np.linalg.solve(A + lam * np.diag(np.diag(A) + 1e-12), -(J.T @ r))
-            trial = x.copy()
-            trial[free] = np.clip(x[free] + step, lo, hi)
-            rt, Jt = self.evaluate(trial, free, search=True)
-            ct = float(rt @ rt)
-            if ct < cost:
-                x, r, J, cost, lam = trial, rt, Jt, ct, lam / 3
+            out = ((z <= lo) & (g > 0)) | ((z >= hi) & (g < 0))
+            f = np.nonzero(~out)[0]
+            if not f.size:
+                break
+            Af = A[np.ix_(f, f)]
+            d = np.diag(Af).copy()
+            d[d <= 0] = 1e-12 * max(float(d.max()), 1e-300)
+            try:
+                step = np.linalg.solve(Af + lam * np.diag(d), -g[f])
+            except np.linalg.LinAlgError:
+                lam *= 10
+                continue
+            trial = z.copy()
+            trial[f] = np.clip(z[f] + step, lo[f], hi[f])
+            x_t = x.copy()
+            x_t[free] = trial
+            r_t, J_t = self.evaluate(x_t, free, search)
+            used += 1
+            c_t = float(r_t @ r_t)
+            if c_t < cost:
+                small = np.all(np.abs(trial - z) <= math.sqrt(tol) * np.maximum(1.0, np.abs(z)))
+                done = (cost - c_t) <= tol * cost and small
+                x, z, r, J, cost, lam = x_t, trial, r_t, J_t, c_t, max(lam / 3, 1e-12)
+                if done:
+                    break
             else:
-                lam *= 8
+                lam *= 4
+                if lam > 1e10:
+                    break
         return x, 0.5 * cost, True
 
     def search(self, n_starts: int) -> list[np.ndarray]:

@@ -27,7 +27,7 @@ from ..solve.quasistatic import UM
 from . import ar1
 from .fitresult import DatasetFit, FitResult, ParamResult, Stats
 from .fitstats import LIKELIHOOD_REASON
-from .goodness import SHARPEN_BELOW, combine, f_pvalue, goodness
+from .goodness import SHARPEN_BELOW, combine, f_pvalue, goodness, ljung_box
 from .identifiability import make_verdict
 
 #: A parameter within this distance of a bound (in its optimizer coordinate: a / 0.01, b / 0.01, ln Dc, ln k;
@@ -142,15 +142,12 @@ def build(problem, x, rounds, *, checks=True, errors=True, n_params=None, clock=
     law = problem.law
     v = problem.values(x)
     free = problem.free
-    pieces = [_piece(problem, s, v, x, free) for s in problem.series]
-    n_lin = [p["B"].shape[1] for p in pieces]
+    n_lin = [s.B.shape[1] for s in problem.series]
     n_cols = len(free) + sum(n_lin)
-    J = np.zeros((sum(s.n for s in problem.series), n_cols))
-    row, col = 0, len(free)
-    for p, q in zip(pieces, n_lin):
-        J[row:row + p["n"], :len(free)] = p["J"]
-        J[row:row + p["n"], col:col + q] = p["B"]
-        row += p["n"]
+    J = np.zeros((sum(s.n for s in problem.series), n_cols))  # the full prewhitened Jacobian, filled by _piece
+    pieces, col = [], len(free)
+    for s, q in zip(problem.series, n_lin):
+        pieces.append(_piece(problem, s, v, x, free, J, col))
         col += q
     at_bound = _at_bounds(problem, x)
     keep = [j for j in range(n_cols) if not (j < len(free) and problem.params[free[j]].name in at_bound)]
@@ -214,9 +211,10 @@ def build(problem, x, rounds, *, checks=True, errors=True, n_params=None, clock=
                      "variable projection)", notes=tuple(notes), goodness=combine(goods), velstep=report)
 
 
-def _piece(problem, s, v, x, free) -> dict:
-    """One dataset at the solution: model, residuals (plain, weighted, prewhitened), its rows of the full
-    Jacobian (nonlinear columns and linear columns, prewhitened), the linear coefficients and -2 ln L."""
+def _piece(problem, s, v, x, free, J, col: int) -> dict:
+    """One dataset at the solution: model, residuals (plain and prewhitened), the linear coefficients, -2 ln L; its
+    rows of the full prewhitened Jacobian J (the nonlinear columns, and its linear ones from column ``col``) are
+    written into J."""
     from ..solve import quasistatic
 
     sol = quasistatic.solve(problem.code, v["a"], v["b"], v["Dc"], v["k"][s.index], s.load, s.t, problem.rtol,
@@ -225,14 +223,15 @@ def _piece(problem, s, v, x, free) -> dict:
     model = s.offset(v["a"], v["b"]) + sol.m + s.B @ c
     r = model - s.y
     z = ar1.whiten(r / s.sigma, s.phi)
-    Jn = ar1.whiten(problem.columns(s, v, x, sol.S, free) / s.sigma[:, None], s.phi)
-    Bw = ar1.whiten(s.B / s.sigma[:, None], s.phi)
     start = sum(t.n for t in problem.series[:s.index])
+    rows = slice(start, start + s.n)
+    J[rows, :len(free)] = ar1.whiten(problem.columns(s, v, x, sol.S, free) / s.sigma[:, None], s.phi)
+    J[rows, col:col + s.B.shape[1]] = ar1.whiten(s.B / s.sigma[:, None], s.phi)
     ll = float(z @ z) + float(np.sum(np.log(2 * math.pi * s.sigma ** 2))) + ar1.log_det(s.phi)
     mu_ss = (c[0] if s.mu0 is None else s.mu0 + (v["a"] - v["b"]) * s.L1)
     trend = float(c[-1]) if s.trend else 0.0
-    return dict(n=s.n, model=model, r=r, z=z, J=Jn, B=Bw, c=c, rows=slice(start, start + s.n), ll=ll,
-                mu0=float(mu_ss - (v["a"] - v["b"]) * s.L1), mu_ss=float(mu_ss), trend=trend, kind=s.kind, sol=sol)
+    return dict(n=s.n, model=model, r=r, z=z, c=c, rows=rows, ll=ll, mu0=float(mu_ss - (v["a"] - v["b"]) * s.L1),
+                mu_ss=float(mu_ss), trend=trend, kind=s.kind)
 
 
 def _covariance(A) -> tuple[np.ndarray | None, int]:
@@ -275,8 +274,9 @@ def _goodness(s, p, k_each: int, J):
 
     z = p["z"]
     chi = float(z @ z)
+    white = ljung_box(z, s.refs.size) if s.ar1 else math.nan  # the AR(1) model says the prewhitened z are white
     if s.kind != "estimated":
-        return goodness(z, k_each, s.kind)
+        return goodness(z, k_each, s.kind, white_p=white)
     if s.ar1:
         df = ar1.pooled_df(s.noise_ests, s.labels)
         est = s.noise_ests[0] if len(s.noise_ests) == 1 else None
@@ -287,7 +287,7 @@ def _goodness(s, p, k_each: int, J):
     if J is not None and est is not None and chi_p >= SHARPEN_BELOW:
         sharp = ratio_pvalue_moments(est, chi, J)
         chi_p = chi_p if sharp is None else sharp
-    return goodness(z, k_each, "estimated", df, chi_p)
+    return goodness(z, k_each, "estimated", df, chi_p, white_p=white)
 
 
 def _params(problem, x, v, pieces, free, cov, at_bound, errors) -> tuple[dict, dict, dict]:

@@ -17,7 +17,7 @@ import numpy as np
 from ..core.display import fmt_time
 from ..inference.answers import group_of, unfitted
 from ..solve.solvers.series import slip_zero
-from . import figures
+from . import figures, velstep
 from .data_view import data_views, describe, spin_falls
 from .data_view import title as view_title
 from .doc import Section
@@ -197,6 +197,7 @@ def build(ctx) -> Section:
                  "The table shows what the comparison holds: the lowest AIC (a relative ranking, not a test that "
                  "the law fits), its reduced χ², and the discrimination test's verdict and noise threshold.")
         _fallback_table(sec, c, findings)
+    velstep.first_screen(sec, c)  # each measured velocity step: its parameters beside its figure
     story = [f for f in _pick(findings) if f.t_cross is not None and spin_falls(f.dataset)]
     if story:
         sec.fig("finding.png", "Spin (top) and slip u(t) (bottom) of the truncated series and the exact solution "
