@@ -152,8 +152,9 @@ def build(problem, x, rounds, *, checks=True, errors=True, n_params=None, clock=
     at_bound = _at_bounds(problem, x)
     keep = [j for j in range(n_cols) if not (j < len(free) and problem.params[free[j]].name in at_bound)]
     norms = np.linalg.norm(J, axis=0)
-    no_effect = [problem.params[free[j]].name for j in range(len(free)) if not norms[j] > 0]
-    keep = [j for j in keep if norms[j] > 0]
+    effect = norms > 1e-9 * max(float(norms.max()) if norms.size else 0.0, 1e-300)
+    no_effect = [problem.params[free[j]].name for j in range(len(free)) if not effect[j]]
+    keep = [j for j in keep if effect[j]]
     cov, rank = _covariance(J[:, keep] if errors else J[:, :0])
     full = np.full((n_cols, n_cols), np.nan)
     if cov is not None and errors:
@@ -192,6 +193,8 @@ def build(problem, x, rounds, *, checks=True, errors=True, n_params=None, clock=
                  "k_eff": k, "n_free": len(free) + sum(n_lin)}
     ident = make_verdict(structure, params, correl)
     meanings = {name: text for name, (_, _, text) in at_bound.items()}
+    meanings.update({name: NO_EFFECT.get(next(p.key for p in problem.params if p.name == name), "")
+                     for name in no_effect})
     ident = attrs.evolve(ident, warnings=tuple(_with_meaning(w, meanings) for w in ident.warnings))
     notes = []
     if rounds:
@@ -261,10 +264,18 @@ def _at_bounds(problem, x) -> dict:
     return out
 
 
+#: Why a parameter of the velocity-step fit has no effect on the prediction.
+NO_EFFECT = {"Dc": "b = 0, so the state does not enter the friction", "k": "no step moves the load point",
+             "a": "", "b": ""}
+
+
 def _with_meaning(warning: str, meanings: dict) -> str:
+    """A generic identifiability warning with what it means on velocity-step data."""
     for name, text in meanings.items():
         if warning.startswith(f"{name} is at"):
             return f"{warning}: {text}"
+        if text and warning.startswith(f"{name} has no effect"):
+            return f"{name} has no effect on the prediction near the best fit ({text})"
     return warning
 
 
@@ -298,11 +309,14 @@ def _params(problem, x, v, pieces, free, cov, at_bound, errors) -> tuple[dict, d
     n_cols = cov.shape[0]
     grads, entries = {}, []  # name -> gradient over the covariance's columns (SI value per column unit)
 
+    known = np.isfinite(np.diag(cov)) if n_cols else np.zeros(0, dtype=bool)  # columns in the covariance
+
     def add(name, key, kind, value, grad, unit, vary, initial, lower, upper, datasets, fixed_by=""):
         err = None
-        if errors and grad is not None and vary and name not in at_bound:
+        if errors and grad is not None and vary and name not in at_bound and np.any(known[grad != 0]):
+            grad = np.where(known, grad, 0.0)  # a parameter held at its bound (or without effect) adds nothing
             var = float(grad @ np.nan_to_num(cov) @ grad)
-            if np.isfinite(cov[np.ix_(grad != 0, grad != 0)]).all() and var >= 0:
+            if var >= 0:
                 err = math.sqrt(var)
         if grad is not None and err is not None:
             grads[name] = grad
@@ -499,10 +513,10 @@ def _strengthening(problem, x) -> str:
 
 def _missing(problem, x, pieces, goods, v, at_bound) -> list[str]:
     """What the data show that the law misses (module docstring), from the fit's residuals and refits."""
-    out = []
     text = _strengthening(problem, x)
-    if text:
-        out.append(f"{', '.join(s.target.name for s in problem.series)}: {text}")
+    if text:  # the first feature found; the others would be judged on a law the data reject
+        return [f"{', '.join(s.target.name for s in problem.series)}: {text}"]
+    out = []
     for s, pc, g in zip(problem.series, pieces, goods):
         if not s.trend:
             r = _refit(problem, x, s, trend=True)
