@@ -440,8 +440,10 @@ def fit(law, targets, *, fixed=None, free=None, initial=None, trend=None, stiffn
     if progress is not None:
         from .fitprogress import FitProgress
 
+        grid = GRID_DC * (GRID_K if any(p.key == "k" and p.vary for p in problem.params) else 1)
         problem.progress = FitProgress(progress, f"{law.name} on {', '.join(names)}", 1)
-        problem.progress.stage("velocity-step fit: global start", 1, total=1)
+        problem.progress.stage("velocity-step fit: grid start and local fits", grid * (SEARCH_ITERS + 1) + 100,
+                               total=grid * (SEARCH_ITERS + 1) + 100)
     try:
         x, cost, ok, rounds = _solve(problem, scan, n_starts, max_nfev)
     except FitTimeout:

@@ -62,12 +62,21 @@ class Quantity:
     low: float
     high: float
     unit: str
+    held: bool = False  # held by the caller or the dataset (no interval: not fitted)
 
-    def text(self, digits: int = 4) -> str:
+    @property
+    def digits(self) -> int:
+        """Significant digits that resolve the standard error (at least 4)."""
+        if not self.stderr or not self.value:
+            return 4
+        return max(4, min(10, math.ceil(math.log10(abs(self.value) / self.stderr)) + 2))
+
+    def text(self) -> str:
+        unit = f" {self.unit}" if self.unit else ""
         if self.stderr is None:
-            return f"{self.value:.{digits}g}{' ' + self.unit if self.unit else ''} (no interval)"
-        return (f"{self.value:.{digits}g} ± {self.stderr:.2g}{' ' + self.unit if self.unit else ''} "
-                f"[{self.low:.{digits}g}, {self.high:.{digits}g}]")
+            return f"{self.value:.4g}{unit} ({'held' if self.held else 'no interval'})"
+        d = self.digits
+        return f"{self.value:.{d}g} ± {self.stderr:.2g}{unit} [{self.low:.{d}g}, {self.high:.{d}g}]"
 
 
 @attrs.frozen
@@ -410,7 +419,9 @@ def law_unit(law, key: str) -> str:
 def _quantity(p: ParamResult, factor: float, unit: str, log: bool = False) -> Quantity:
     """A ParamResult in a display unit (factor from SI), with its 95% interval (log-normal for Dc and k)."""
     v = p.value * factor
-    if p.stderr is None or not p.vary and p.kind != "derived":
+    if not p.vary and p.kind != "derived":
+        return Quantity(v, None, math.nan, math.nan, unit, held=True)
+    if p.stderr is None:
         return Quantity(v, None, math.nan, math.nan, unit)
     e = p.stderr * factor
     if log and v > 0:

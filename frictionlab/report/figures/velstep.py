@@ -73,10 +73,11 @@ def _table_text(fit) -> str:
             continue
         unit = f" {q.unit.replace('um', 'µm')}" if q.unit else ""
         if q.stderr is None:
-            lines.append(f"{name:<6}{q.value:.4g}{unit}  (no interval)")
+            lines.append(f"{name:<6}{q.value:.4g}{unit}  ({'held' if q.held else 'no interval'})")
         else:
-            lines.append(f"{name:<6}{q.value:.4g} ± {q.stderr:.2g}{unit}")
-            lines.append(f"{'':<6}[{q.low:.4g}, {q.high:.4g}]")
+            d = q.digits
+            lines.append(f"{name:<6}{q.value:.{d}g} ± {q.stderr:.2g}{unit}")
+            lines.append(f"{'':<6}[{q.low:.{d}g}, {q.high:.{d}g}]")
     for label, phi in row.phi:
         lines.append(f"φ {label}: {phi:.3f}")
     lines.append("")
