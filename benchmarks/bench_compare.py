@@ -13,8 +13,8 @@ CPU seconds of the fits (sum over fits), the slowest fits, and
 
 where the reference is what a user writes without this library: the wear law on the paper's
 impact at 28 m/s (F = lam A u, A = A0 sin(pi t / t_c), spin), a plain Python right-hand side in
-SI units, the 51 sample times of impact-golf-v28, at rtol = atol = 1e-8 (the unit the target of 20 was
-set in, issue 22) and, for continuity, at rtol 1e-10, atol 1e-12 (the old unit, about 1.9x as costly).
+SI units, the 51 sample times of impact-golf-v28, at rtol = atol = 1e-8 (the unit the target of 20 is
+set in) and, for continuity, at rtol 1e-10, atol 1e-12 (the old unit, about 1.9x as costly).
 The reference loop runs right before and right after each compare run, and that run's ratio uses the
 mean of the two: on a shared or virtual machine the CPU's speed drifts by tens of percent over minutes,
 and the ratio is only meaningful between measurements taken in the same spell.
