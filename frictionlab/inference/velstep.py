@@ -464,14 +464,13 @@ def _solve(problem: Problem, scan: int, n_starts: int, max_nfev):
     rounds of the alternation)."""
     free = problem.free
     starts = problem.search(max(1, min(n_starts, 3))) if scan and free else [problem.x_start()]
-    best = None
-    for x0 in starts:
-        x, cost, ok = problem.local(x0, free, max_nfev=max_nfev)
-        if ok and (best is None or cost < best[1]):
-            best = (x, cost, ok)
-    if best is None:
+    if len(starts) > 1:  # each start fitted on the search's subsample; the best one then on every sample
+        found = [problem.local(x0, free, search=True, max_nfev=max_nfev) for x0 in starts]
+        found = [f for f in found if f[2]]
+        starts = [min(found, key=lambda f: f[1])[0]] if found else starts[:1]
+    x, cost, ok = problem.local(starts[0], free, max_nfev=max_nfev)
+    if not ok:
         return problem.x_start(), math.inf, False, 0
-    x, cost, ok = best
     rounds = 0
     if any(s.ar1 for s in problem.series):
         for rounds in range(1, AR1_ROUNDS + 1):

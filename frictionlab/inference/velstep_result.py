@@ -36,6 +36,7 @@ AT_BOUND = 1e-3
 #: Residual windows after a step beyond this many standard errors count as structure the law misses.
 MISSING_Z = 4.0
 CHI2_1_999 = 10.828  # the 0.1 % point of chi-square with one degree of freedom
+REFIT_EVALS = 40  # evaluations on every sample of a diagnostic refit (after it converged on the subsample)
 
 #: What a parameter at a bound means on velocity-step data: (key, 'lower' | 'upper') -> sentence.
 BOUND_MEANING = {
@@ -198,8 +199,8 @@ def build(problem, x, rounds, *, checks=True, errors=True, n_params=None, clock=
                                                              if n - k_lik - 1 > 0 else math.inf),
                   bic=ll + k_lik * math.log(n), likelihood=kind, neg2loglik=ll, k_lik=k_lik, likelihood_reason=reason)
     params, correl, quantities = _params(problem, x, v, pieces, free, full, at_bound, errors)
-    structure = {"at_bounds": tuple(at_bound), "ratios": (), "no_effect": tuple(no_effect),
-                 "k_eff": k, "n_free": len(free) + sum(n_lin)}
+    structure = {"at_bounds": tuple(at_bound), "sides": {name: side for name, (_, side, _) in at_bound.items()},
+                 "ratios": (), "no_effect": tuple(no_effect), "k_eff": k, "n_free": len(free) + sum(n_lin)}
     ident = make_verdict(structure, params, correl)
     meanings = {name: text for name, (_, _, text) in at_bound.items()}
     meanings.update({name: NO_EFFECT.get(next(p.key for p in problem.params if p.name == name), "")
@@ -281,8 +282,8 @@ NO_EFFECT = {"Dc": "b = 0, so the state does not enter the friction", "k": "no s
 def _with_meaning(warning: str, meanings: dict) -> str:
     """A generic identifiability warning with what it means on velocity-step data."""
     for name, text in meanings.items():
-        if warning.startswith(f"{name} is at"):
-            return f"{warning}: {text}"
+        if warning.startswith(f"{name} is at"):  # the generic sentence's head, then what it means here
+            return f"{warning.split(': ', 1)[0]}: {text}"
         if text and warning.startswith(f"{name} has no effect"):
             return f"{name} has no effect on the prediction near the best fit ({text})"
     return warning
@@ -481,7 +482,8 @@ def _refit(problem, x, s, trend: bool):
         s.B = s.B[:, :-1] if not trend else np.column_stack([s.B, s.x - s.x_ref])
         s._set_projection()
         problem._cache = None
-        xr, cost, ok = problem.local(x, problem.free)
+        xr, _, ok = problem.local(x, problem.free, search=True)  # on the subsample, then on every sample
+        xr, cost, ok = problem.local(xr if ok else x, problem.free, max_nfev=REFIT_EVALS)
         if not ok:
             return None
         v = problem.values(xr)
@@ -504,10 +506,11 @@ def _strengthening(problem, x) -> str:
     try:
         problem.params[ib] = attrs.evolve(p, lower=-p.upper)
         problem._cache = None
-        for x0 in [x] + problem.search(2)[1:]:  # from the fit, and from the best of a new grid
-            xr, cost, ok = problem.local(x0, problem.free)
-            if ok and (best is None or cost < best[1]):
-                best = (xr, cost)
+        tried = [problem.local(x0, problem.free, search=True) for x0 in [x] + problem.search(2)[1:]]
+        tried = [t for t in tried if t[2]]  # from the fit and from a new grid, on the subsample; the best on all
+        if tried:
+            xr, cost, ok = problem.local(min(tried, key=lambda t: t[1])[0], problem.free, max_nfev=REFIT_EVALS)
+            best = (xr, cost) if ok else None
     finally:
         problem.params[ib] = p
         problem._cache = None
