@@ -41,7 +41,7 @@ from ..core.errors import FrictionLabError, SolverError
 from ..solve import quasistatic
 from ..solve.quasistatic import UM, Load
 from . import ar1
-from .fitmodel import PENALTY, FitTimeout
+from .fitmodel import FitTimeout
 from .fitstats import noise_kind
 
 #: Samples per dataset the grid of starts is scored on (every sample when there are fewer).
@@ -223,8 +223,11 @@ class Problem:
 
     # -- evaluation -----------------------------------------------------------------------------------------
     def evaluate(self, x, free, search: bool = False, rtol: float | None = None):
-        """(weighted, prewhitened, projected residual, its Jacobian by the parameters ``free``) at the full vector
-        x; a model that cannot be solved there gives PENALTY residuals (and a zero Jacobian)."""
+        """(chi-square r'r, J'r, J'J, solved) of the weighted, prewhitened, projected residual r and its Jacobian J by
+        the parameters ``free`` at the full vector x (``velstep_kernel``: nothing per sample is kept); a model
+        that cannot be solved there gives (inf, 0, 0, False)."""
+        from .velstep_kernel import normal_equations
+
         key = (np.asarray(x).tobytes(), tuple(free), search, rtol)
         if self._cache is not None and self._cache[0] == key:
             return self._cache[1]
@@ -234,52 +237,52 @@ class Problem:
         if self.progress is not None:
             self.progress.tick()
         v = self.values(x)
-        parts, jacs = [], []
+        p = len(free)
+        cost, g, A = 0.0, np.zeros(p), np.zeros((p, p))
         try:
             for s in self.series:
-                r, J = self._one(s, v, x, free, search, rtol or (SEARCH_RTOL if search else self.rtol))
-                parts.append(r)
-                jacs.append(J)
-            out = (np.concatenate(parts), np.vstack(jacs))
+                idx = s.search if search else slice(None)
+                sol = quasistatic.solve(self.code, v["a"], v["b"], v["Dc"], v["k"][s.index], s.load, s.t[idx],
+                                        rtol or (SEARCH_RTOL if search else self.rtol), sensitivities=True)
+                cols, mult, const = self.column_spec(s, v, free)
+                phi = np.zeros(sol.m.size) if search else s.phi
+                ww, Cw, CC, Qw, QC = normal_equations(s.y[idx], s.offset(v["a"], v["b"]), sol.m, sol.S, s.sigma[idx],
+                                                      phi, cols, mult, const, s.Q_search if search else s.Q)
+                cost += ww - float(Qw @ Qw)
+                g += Cw - QC.T @ Qw
+                A += CC - QC.T @ QC
+            out = (cost, g, A, bool(np.isfinite(cost)))
         except SolverError as exc:
             self.failures += 1
             self.last_error = str(exc)
-            n = sum(s.search.size if search else s.n for s in self.series)
-            out = (np.full(n, PENALTY), np.zeros((n, len(free))))
+            out = (math.inf, g, A, False)
         self._cache = (key, out)
         return out
 
-    def _one(self, s: Series, v, x, free, search: bool, rtol: float):
-        idx = s.search if search else slice(None)
-        t, y, sigma = s.t[idx], s.y[idx], s.sigma[idx]
-        sol = quasistatic.solve(self.code, v["a"], v["b"], v["Dc"], v["k"][s.index], s.load, t, rtol,
-                                sensitivities=True)
-        model = s.offset(v["a"], v["b"]) + sol.m
-        cols = self.columns(s, v, x, sol.S, free)
-        if not search:
-            w = ar1.whiten((model - y) / sigma, s.phi)
-            Jw = ar1.whiten(cols / sigma[:, None], s.phi)
-            Q = s.Q
-        else:
-            w, Jw, Q = (model - y) / sigma, cols / sigma[:, None], s.Q_search
-        if Q.shape[1]:
-            w = w - Q @ (Q.T @ w)
-            Jw = Jw - Q @ (Q.T @ Jw)
-        return w, Jw
-
-    def columns(self, s: Series, v, x, S, free) -> np.ndarray:
-        """d(model)/d(x_j) for the parameters ``free`` on dataset s, from the sensitivities S = dm/d(a, b, Dc, k)."""
-        out = np.zeros((S.shape[0], len(free)))
+    def column_spec(self, s: Series, v, free):
+        """The columns d(model)/d(x_j) of the parameters ``free`` on dataset s as S[:, idx_j] mult_j + const_j from
+        the sensitivities S = dm/d(a, b, Dc, k) (idx_j = -1: another dataset's stiffness, a zero column)."""
+        held = s.L1 if s.mu0 is not None else 0.0  # a held mu0 at V0 puts (a - b) ln(V1 / V0) in the model
+        idx, mult, const = np.full(len(free), -1, dtype=np.int64), np.zeros(len(free)), np.zeros(len(free))
         for j, i in enumerate(free):
             p = self.params[i]
             if p.key == "a":
-                out[:, j] = (S[:, 0] + (s.L1 if s.mu0 is not None else 0.0)) * AB_SCALE
+                idx[j], mult[j], const[j] = 0, AB_SCALE, held * AB_SCALE
             elif p.key == "b":
-                out[:, j] = (S[:, 1] - (s.L1 if s.mu0 is not None else 0.0)) * AB_SCALE
+                idx[j], mult[j], const[j] = 1, AB_SCALE, -held * AB_SCALE
             elif p.key == "Dc":
-                out[:, j] = S[:, 2] * v["Dc"]
+                idx[j], mult[j] = 2, v["Dc"]
             elif p.target == s.index:  # this dataset's stiffness
-                out[:, j] = S[:, 3] * v["k"][s.index]
+                idx[j], mult[j] = 3, v["k"][s.index]
+        return idx, mult, const
+
+    def columns(self, s: Series, v, x, S, free) -> np.ndarray:
+        """d(model)/d(x_j) for the parameters ``free`` on dataset s, from the sensitivities S = dm/d(a, b, Dc, k)."""
+        idx, mult, const = self.column_spec(s, v, free)
+        out = np.zeros((S.shape[0], len(free)))
+        for j in range(len(free)):
+            if idx[j] >= 0:
+                out[:, j] = S[:, idx[j]] * mult[j] + const[j]
         return out
 
     def model(self, x) -> list[np.ndarray]:
@@ -309,18 +312,16 @@ class Problem:
         success)."""
         x = np.array(x0, dtype=float)
         if not free:
-            r, _ = self.evaluate(x, free, search)
-            return x, 0.5 * float(r @ r), bool(np.all(r != PENALTY))
+            cost, _, _, ok = self.evaluate(x, free, search)
+            return x, 0.5 * cost, ok
         lo, hi = self.bounds(free)
         z = np.clip(x[free], lo, hi)
         x[free] = z
-        r, J = self.evaluate(x, free, search)
-        if np.all(r == PENALTY):
+        cost, g, A, ok = self.evaluate(x, free, search)
+        if not ok:
             return x, math.inf, False
-        cost, lam, used = float(r @ r), 1e-3, 1
+        lam, used = 1e-3, 1
         while used < max_nfev:
-            g = J.T @ r
-            A = J.T @ J
             out = ((z <= lo) & (g > 0)) | ((z >= hi) & (g < 0))
             f = np.nonzero(~out)[0]
             if not f.size:
@@ -337,13 +338,12 @@ class Problem:
             trial[f] = np.clip(z[f] + step, lo[f], hi[f])
             x_t = x.copy()
             x_t[free] = trial
-            r_t, J_t = self.evaluate(x_t, free, search)
+            c_t, g_t, A_t, ok_t = self.evaluate(x_t, free, search)
             used += 1
-            c_t = float(r_t @ r_t)
-            if c_t < cost:
+            if ok_t and c_t < cost:
                 small = np.all(np.abs(trial - z) <= math.sqrt(tol) * np.maximum(1.0, np.abs(z)))
                 done = (cost - c_t) <= tol * cost and small
-                x, z, r, J, cost, lam = x_t, trial, r_t, J_t, c_t, max(lam / 3, 1e-12)
+                x, z, g, A, cost, lam = x_t, trial, g_t, A_t, c_t, max(lam / 3, 1e-12)
                 if done:
                     break
             else:

@@ -500,8 +500,7 @@ def _strengthening(problem, x) -> str:
     p = problem.params[ib]
     if not p.vary:
         return ""
-    r, _ = problem.evaluate(x, problem.free)
-    chi_now = float(r @ r)
+    chi_now = problem.evaluate(x, problem.free)[0]
     best = None
     try:
         problem.params[ib] = attrs.evolve(p, lower=-p.upper)
