@@ -277,3 +277,49 @@ def test_refits_of_a_velocity_step_fit_start_where_it_ended(small_step_fits):
     fast, _ = small_step_fits
     again = refit("rate-state-aging", refit_options(fast), fast.per_dataset[0].target)
     assert again.ok and again.velstep is None and again.stats.chisqr == pytest.approx(fast.stats.chisqr, rel=1e-6)
+
+
+def test_the_compiled_sums_equal_the_explicit_projected_jacobian(tmp_path):
+    """velstep_kernel.normal_equations (one pass, nothing per sample kept) against the prewhitened, projected
+    residual and Jacobian formed explicitly with numpy."""
+    from frictionlab.inference import ar1, velstep
+    from frictionlab.inference.velstep_kernel import normal_equations
+
+    ds, curve = _measured_like(tmp_path, "ar1")
+    y = curve + np.random.default_rng(6).normal(0.0, 4e-4, curve.size)
+    data = attrs.evolve(ds, columns=dict(ds.columns, mu=y), noise={"mu": 4e-4}, noise_correlation="ar1")
+    pb = velstep.make_problem(fl.get_law("rate-state-slip"), [Target(data, "mu", y, np.full(y.size, 4e-4))], {}, {},
+                              {}, True, True, 1e-8)
+    s = pb.series[0]
+    s.set_noise(np.random.default_rng(7).normal(0.0, 1.0, y.size))  # some phi and sigma
+    x = pb.x_start()
+    v = pb.values(x)
+    sol = quasistatic.solve(pb.code, v["a"], v["b"], v["Dc"], v["k"][0], s.load, s.t, 1e-8, sensitivities=True)
+    w = ar1.whiten((s.offset(v["a"], v["b"]) + sol.m - s.y) / s.sigma, s.phi)
+    J = ar1.whiten(pb.columns(s, v, x, sol.S, pb.free) / s.sigma[:, None], s.phi)
+    r, Jp = w - s.Q @ (s.Q.T @ w), J - s.Q @ (s.Q.T @ J)
+    cost, g, A, ok = pb.evaluate(x, pb.free)
+    assert ok and cost == pytest.approx(float(r @ r), rel=1e-10)
+    assert g == pytest.approx(Jp.T @ r, rel=1e-8, abs=1e-12 * np.abs(Jp.T @ r).max())
+    assert A == pytest.approx(Jp.T @ Jp, rel=1e-8, abs=1e-12 * np.abs(A).max())
+    ww, *_ = normal_equations(s.y, 0.0, sol.m, sol.S, s.sigma, np.zeros(s.n), *pb.column_spec(s, v, pb.free), s.Q[:, :0])
+    assert ww == pytest.approx(float(np.sum(((sol.m - s.y) / s.sigma) ** 2)), rel=1e-12)
+
+
+def test_the_equivalence_test_runs_on_ar1_velocity_steps(tmp_path):
+    """Both rate-and-state laws fitted to AR(1) data; the equivalence test draws AR(1) replicates and refits both
+    through the velocity-step path."""
+    from frictionlab.inference.ar1 import draw
+    from frictionlab.io.noise import estimate
+
+    ds, curve = _measured_like(tmp_path, "ar1")
+    n = curve.size
+    y = curve + draw(np.random.default_rng(1), np.full(n, 8e-4), np.r_[0.0, np.full(n - 1, 0.6)])
+    cols = dict(ds.columns, mu=y)
+    est = estimate(cols, "mu")
+    data = attrs.evolve(ds, columns=cols, noise={"mu": est.sigma}, noise_kind="estimated", noise_est={"mu": est},
+                        noise_df={"mu": est.df}, noise_correlation="ar1")
+    tg = Target(data, "mu", y, np.full(n, est.sigma))
+    fa, fb = fl.fit("rate-state-aging", tg), fl.fit("rate-state-slip", tg)
+    e = fl.analyze_equivalence(fa, fb, replicates=20, seed=1)
+    assert e.status == "ok" and 0.0 <= e.p <= 1.0 and e.failed == 0

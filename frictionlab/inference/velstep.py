@@ -135,9 +135,14 @@ class Series:
         return self.t.size
 
     def _set_projection(self):
+        """The orthonormal columns of the (prewhitened) linear parameters, and the data less a first guess of their
+        linear part (y_ref): the sums of ``velstep_kernel`` then add numbers of the size of the transient and the
+        noise, not of mu itself, and lose no precision; the projection removes any such part exactly."""
         self.Q = _basis(ar1.whiten(self.B / self.sigma[:, None], self.phi))
         s = self.search
         self.Q_search = _basis(self.B[s] / self.sigma[s, None])
+        self.y_ref = (self.y - self.B @ np.linalg.lstsq(self.B, self.y - (self.mu0 or 0.0), rcond=None)[0]
+                      if self.B.shape[1] else self.y)
 
     def set_noise(self, residual) -> float:
         """Profile phi from ``residual`` (model - data) and re-estimate sigma from the prewhitened data (estimated
@@ -246,7 +251,7 @@ class Problem:
                                         rtol or (SEARCH_RTOL if search else self.rtol), sensitivities=True)
                 cols, mult, const = self.column_spec(s, v, free)
                 phi = np.zeros(sol.m.size) if search else s.phi
-                ww, Cw, CC, Qw, QC = normal_equations(s.y[idx], s.offset(v["a"], v["b"]), sol.m, sol.S, s.sigma[idx],
+                ww, Cw, CC, Qw, QC = normal_equations(s.y_ref[idx], s.offset(v["a"], v["b"]), sol.m, sol.S, s.sigma[idx],
                                                       phi, cols, mult, const, s.Q_search if search else s.Q)
                 cost += ww - float(Qw @ Qw)
                 g += Cw - QC.T @ Qw
