@@ -30,6 +30,9 @@ from pathlib import Path
 import attrs
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import velstep_records  # noqa: E402
+
 TRUTH = {"mu0": 0.6, "a": 0.009, "b": 0.0095, "Dc": 7e-6}
 K_TRUE, TREND, SIGMA = 8e3, 3.0, 8e-4  # 1/m, 1/m (3e-6 /um), marginal noise
 LAW = "rate-state-aging"
@@ -50,32 +53,12 @@ def make_dataset(folder: Path, correlation: str, quick: bool):
     x = np.where(t < ts, v1 * t, v1 * ts + v2 * (t - ts))  # load-point displacement [um]
     name = f"calibration-{correlation}"
     (folder / f"{name}.csv").write_text("t,x,mu\n" + "\n".join(f"{a:.10g},{b:.10g},0.6" for a, b in zip(t, x)) + "\n")
-    (folder / f"{name}.toml").write_text(f'''name = "{name}"
-kind = "spring-slider"
-observable = "mu"
-[columns]
-t = "s"
-x = "um"
-mu = ""
-[noise]
-kind = "known"
-mu = {SIGMA}
-[scene]
-mass = "1 kg"
-[scene.normal]
-model = "constant"
-value = "1 N"
-[scene.spring]
-stiffness = "{K_TRUE * 1e-6} 1/um"
-times = ["0 s", "{ts} s"]
-velocities = ["{v1} um/s", "{v2} um/s"]
-[provenance]
-kind = "synthetic"
-source = "benchmarks/calibration_ar1.py"
-method = "the quasi-static slider (general ODE path) plus AR(1) noise of known coefficient"
-command = "python benchmarks/calibration_ar1.py"
-seed = 0
-''')
+    (folder / f"{name}.toml").write_text(velstep_records.toml_text(
+        name, "A synthetic velocity step for the AR(1) calibration. SYNTHETIC.", K_TRUE * 1e-6, ts, v1, v2,
+        f"kind = \"known\"\nmu = {SIGMA}",
+        'kind = "synthetic"\nsource = "benchmarks/calibration_ar1.py"\nmethod = "the quasi-static slider (general '
+        'ODE path) plus AR(1) noise of known coefficient"\ncommand = "python benchmarks/calibration_ar1.py"\n'
+        "seed = 0"))
     ds = fl.load_dataset(folder / f"{name}.toml")
     curve = fl.simulate(LAW, ds, TRUTH, solver="ode:LSODA", rtol=1e-10).load + TREND * 1e-6 * (x - v1 * ts)
     return ds, curve

@@ -94,35 +94,19 @@ def write(folder: Path, name: str, raw: Path) -> dict:
     t0 = float(t[0])
     (folder / f"{name}.csv").write_text("t,x,mu\n" + "\n".join(f"{a:.10g},{b:.10g},{c:.8g}" for a, b, c in zip(t, x, mu))
                                         + "\n")
-    (folder / f"{name}.toml").write_text(f'''name = "{name}"
-kind = "spring-slider"
-observable = "mu"
-description = "Every sample of {raw.name} (benchmark copy in a temporary folder). MEASURED."
-time_zero = "{t0:.10g} s"
-
-[columns]
-t = "s"
-x = "um"
-mu = ""
-
-[noise]
-kind = "estimated"
-correlation = "ar1"
-
-[scene]
-mass = "1 kg"
-
-[scene.normal]
-model = "constant"
-value = "1 N"
-
-[scene.spring]
-stiffness = "{k0:.4g} 1/um"
-times = ["0 s", "{ts - t0:.6f} s"]
-velocities = ["{v1:.6g} um/s", "{v2:.6g} um/s"]
-
-[provenance]
-kind = "measured"
-source = "pgiacomel/steadystate, {raw.name} (MIT)"
-''')
+    (folder / f"{name}.toml").write_text(toml_text(
+        name, f"Every sample of {raw.name} (benchmark copy in a temporary folder). MEASURED.", k0, ts - t0, v1, v2,
+        'kind = "estimated"\ncorrelation = "ar1"',
+        f'kind = "measured"\nsource = "pgiacomel/steadystate, {raw.name} (MIT)"', time_zero=t0))
     return {"t_step": ts, "v1": v1, "v2": v2, "k0": k0, "t0": t0, "n": t.size}
+
+
+def toml_text(name, description, k0, t_step, v1, v2, noise, provenance, time_zero=None) -> str:
+    """The TOML of a one-step spring-slider dataset with columns t [s], x [um], mu: stiffness k0 [1/um], the step
+    at t_step [s] from v1 to v2 [um/s]; ``noise`` and ``provenance`` are the lines of those tables."""
+    zero = f'time_zero = "{time_zero:.10g} s"\n' if time_zero is not None else ""
+    return (f'name = "{name}"\nkind = "spring-slider"\nobservable = "mu"\ndescription = "{description}"\n{zero}'
+            f'[columns]\nt = "s"\nx = "um"\nmu = ""\n[noise]\n{noise}\n[scene]\nmass = "1 kg"\n'
+            f'[scene.normal]\nmodel = "constant"\nvalue = "1 N"\n[scene.spring]\nstiffness = "{k0:.6g} 1/um"\n'
+            f'times = ["0 s", "{t_step:.6f} s"]\nvelocities = ["{v1:.6g} um/s", "{v2:.6g} um/s"]\n'
+            f'[provenance]\n{provenance}\n')
