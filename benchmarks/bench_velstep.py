@@ -39,8 +39,10 @@ from scipy.optimize import least_squares
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import velstep_records  # noqa: E402
 
-#: The reference's starts (a, b, Dc [um]); k starts at the record's loading estimate.
+#: The reference's starts (a, b, Dc [um]); k starts at the record's loading estimate; each start's budget of
+#: evaluations (a record whose slider is not steady before its step can send LSODA into very stiff corners).
 STARTS = ((0.01, 0.01, 3.0), (0.01, 0.01, 30.0), (0.01, 0.01, 300.0))
+MAX_NFEV = 60
 LAWS = {"aging": "rate-state-aging", "slip": "rate-state-slip"}
 
 
@@ -94,7 +96,8 @@ def plain_fit(t, x, mu, ts, V1, V2, k0, law):
     t0 = time.process_time()
     best = None
     for a, b, Dc in STARTS:
-        r = least_squares(res, [a, b, math.log(Dc), math.log(k0)], x_scale=[0.01, 0.01, 1.0, 1.0], method="trf")
+        r = least_squares(res, [a, b, math.log(Dc), math.log(k0)], x_scale=[0.01, 0.01, 1.0, 1.0], method="trf",
+                          max_nfev=MAX_NFEV)
         if best is None or r.cost < best.cost:
             best = r
     cpu = time.process_time() - t0
