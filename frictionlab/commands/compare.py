@@ -4,7 +4,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..core.errors import OutputError, ParameterError
+from ..core.errors import FitError, OutputError, ParameterError
 from ..core.progress import Progress
 from .fit import FIT_TIMEOUT, fit_timeout
 
@@ -61,6 +61,16 @@ def add_parser(sub):
     p.add_argument("--pairs", "--pair", action=ListAction, metavar="LAW:LAW",
                    help="the pairs of laws whose equivalence is tested, e.g. rate-state-aging:rate-state-slip "
                         "(default: wear:area-rate, wear:couette, coulomb:wear, where both laws are compared)")
+    from ..core.cluster import CONNECT_TIMEOUT, TASK_TIMEOUT, WAIT_WORKERS
+
+    p.add_argument("--connect-timeout", type=fit_timeout, default=CONNECT_TIMEOUT, metavar="SECONDS",
+                   help=f"with --scheduler: how long the scheduler has to answer (default {CONNECT_TIMEOUT:g})")
+    p.add_argument("--wait-workers", type=fit_timeout, default=WAIT_WORKERS, metavar="SECONDS",
+                   help="with --scheduler: how long to wait for a worker when the cluster has none, at the start or "
+                        f"after its last worker is lost (default {WAIT_WORKERS:g})")
+    p.add_argument("--task-timeout", type=fit_timeout, default=TASK_TIMEOUT, metavar="SECONDS",
+                   help="with --scheduler: how long one task (a dataset's fits, tests and bootstrap, or a batch of "
+                        f"figures) may run on a worker (default {TASK_TIMEOUT:g})")
     p.add_argument("--no-equivalence", action="store_true", help="skip the equivalence (discrimination) tests")
     p.add_argument("--replicates", type=int, default=REPLICATES, metavar="R",
                    help=f"the most replicate datasets per law in the equivalence test's sequential parametric bootstrap "
@@ -89,7 +99,7 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from ..core.cluster import connect
+    from ..core.cluster import Waits, close, connect, quiet_logs
     from ..io.dataset import builtin_names, load_dataset
     from .fit import parse_free
 
@@ -110,12 +120,25 @@ def run(args) -> int:
     free = parse_free(args.free)
     pairs = parse_pairs(args.pairs, args.laws or None) if args.pairs else None
     datasets = [load_dataset(d) for d in args.data or builtin_names()]  # read first: --out keeps clear of them
-    client = connect(args.scheduler) if args.scheduler else None
-    try:
-        return _run(args, free, pairs, datasets, client)
-    finally:
-        if client is not None:
-            client.close()
+    if args.scheduler is None:
+        return _run(args, free, pairs, datasets, None)
+    waits = Waits(connect=args.connect_timeout, workers=args.wait_workers, task=args.task_timeout,
+                  say=None if args.quiet else _say)
+    with quiet_logs(args.debug):  # distributed's own log is not the user's to read, unless --debug
+        client = connect(args.scheduler, waits)
+        try:
+            return _run(args, free, pairs, datasets, client)
+        finally:
+            close(client, waits)
+
+
+def _say(text: str) -> None:
+    """A wait on the cluster, said as a progress line."""
+    import sys
+
+    from ..core.progress import _stamp
+
+    print(f"{_stamp()} compare: {text}", file=sys.stderr, flush=True)
 
 
 def parse_pairs(items, laws) -> tuple[tuple[str, str], ...]:
@@ -157,6 +180,11 @@ def _run(args, free, pairs, datasets, client) -> int:
                              tolerance=TOLERANCE_RTOLS if args.tolerance else (), fit_timeout=args.fit_timeout,
                              replicates=args.replicates, transfer=args.transfer, client=client,
                              **({"pairs": pairs} if pairs else {}))
+        if not any(f.ok for f in result.fits):  # nothing to compare: an error, and no report of it
+            reasons = list(dict.fromkeys(f"{f.law} on {', '.join(f.datasets)}: {f.reason}" for f in result.fits
+                                         if f.status == "failed"))
+            raise FitError("compare: no fit succeeded: " + "; ".join(reasons[:3])
+                           + (f" (and {len(reasons) - 3} more)" if len(reasons) > 3 else ""))
         with Progress("report", quiet=args.quiet) as bar:
             out = write_report(result, args.out, force=args.force, progress=bar, jobs=args.jobs, client=client)
     ok = sum(f.ok for f in result.fits)

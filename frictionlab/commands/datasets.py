@@ -97,7 +97,7 @@ def _import(args) -> int:
     import shlex
 
     from ..core.errors import OutputError, ParameterError
-    from ..core.files import atomic_write_text
+    from ..core.files import write_files
     from ..core.names import check_name
     from ..core.units import to_si
     from ..io.dataset import load_dataset
@@ -127,8 +127,7 @@ def _import(args) -> int:
         (Path(tmp) / paths[0].name).write_text(toml)
         (Path(tmp) / paths[1].name).write_text(csv)
         load_dataset(Path(tmp) / paths[0].name)
-    atomic_write_text(paths[1], csv)
-    atomic_write_text(paths[0], toml)
+    write_files({paths[0]: toml, paths[1]: csv}, force=args.force)  # both or neither
     v = " -> ".join(f"{x * 1e6:g} um/s" for x in imp.velocities)
     print(f"wrote {paths[0]} and {paths[1]}: {len(imp.index)} samples, load point {v} (step at "
           f"{', '.join(f'{t:.6g} s' for t in imp.step_times)}), k = {imp.stiffness * 1e-6:.3g} 1/um "
@@ -233,7 +232,7 @@ def _to_file_unit(d, column: str) -> float:
 
 def _template(args) -> int:
     from ..core.errors import OutputError
-    from ..core.files import atomic_write_text
+    from ..core.files import write_files
     from ..core.names import check_name
     from ..io.template import template
 
@@ -245,8 +244,7 @@ def _template(args) -> int:
         if p.exists() and not args.force:
             raise OutputError(f"{p}: exists; choose another --name or --out, or pass --force")
     toml, csv = template(args.kind, args.name)
-    atomic_write_text(csv_path, csv)
-    atomic_write_text(toml_path, toml)
+    write_files({toml_path: toml, csv_path: csv}, force=args.force)  # both or neither
     print(f"wrote {toml_path} and {csv_path}: replace the example rows with your data, then "
           f"'frictionlab datasets show {toml_path}'")
     return 0

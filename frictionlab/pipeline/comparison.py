@@ -44,6 +44,7 @@ from .runner import Progress, Run, select
 from .runner import run_stages as run_stages_with
 from .settings import DEFAULT_LAWS, Settings, select_laws  # noqa: F401
 from .stages import STAGES
+from ..core.fpstate import with_own_errstate
 
 if TYPE_CHECKING:  # annotations only
     import pandas as pd
@@ -155,6 +156,7 @@ def versions() -> dict:
             "platform": platform.platform(), "cpus": os.cpu_count()}
 
 
+@with_own_errstate
 def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None, solvers: Sequence[str] | None = None,
             *, free: dict | None = None, equivalence: bool = True, jobs: int = 1,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
@@ -206,6 +208,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     return attrs.evolve(c, wall_time=time.perf_counter() - started)
 
 
+@with_own_errstate
 def run_stages(comparison: Comparison, stages: Sequence[str], *, progress: Progress | None = None,
                client: Client | None = None, **options: object) -> Comparison:
     """Run the named stages (``stages.STAGES``) on a comparison made by ``compare``, e.g.
@@ -229,8 +232,10 @@ def cluster_name(client) -> str:
     """How the report names a Dask cluster: its scheduler's address and number of workers ("" without one)."""
     if client is None:
         return ""
-    workers = len(client.scheduler_info().get("workers", {}))
-    return f"Dask cluster at {client.scheduler.address} ({workers} worker{'s' * (workers != 1)})"
+    from ..core.cluster import address_of, waits_of, worker_count
+
+    workers = worker_count(client, waits_of(client).connect)  # asked within the cluster's connect time
+    return f"Dask cluster at {address_of(client)} ({workers} worker{'s' * (workers != 1)})"
 
 
 def _make_run(settings: Settings, dss, progress, client=None) -> Run:

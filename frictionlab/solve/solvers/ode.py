@@ -153,7 +153,13 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
         T = float(t_out[-1])
         scale = phase_scales(plan, p, t0, T, y0, direction)
         f, event = _scaled_problem(plan, p, direction, T, scale, method)
-        return _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method, rtol, atol)
+        try:
+            return _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method, rtol, atol)
+        except SolverError as exc:  # name what in the scene makes it fail, where the plan knows
+            note = plan.stiffness_note(p, t0, y0) if method != "BDF" and method != "Radau" else ""
+            if note:
+                raise SolverError(f"{str(exc).rstrip('.')}; {note}") from None
+            raise
 
     return slide
 
