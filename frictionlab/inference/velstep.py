@@ -14,15 +14,17 @@ displacement (the dataset's x column, else the schedule's) and x_ref its value a
 
 * Nonlinear parameters: a, b and Dc shared by the datasets, and the machine stiffness k_i of each: fitted by
   default on measured data (a start: the dataset's stiffness), held at the dataset's value elsewhere, or as
-  ``free={'spring.stiffness': (lo, hi)}`` says. scipy's trust-region least squares with bounds (the laws' bounds
-  for a, b, Dc) sees a / 0.01, b / 0.01, ln Dc and ln k, and the Jacobian of the forward sensitivities.
+  ``free={'spring.stiffness': (lo, hi)}`` says. Levenberg-Marquardt with bounds (``Problem.lm``; the laws'
+  bounds for a, b, Dc) sees a / 0.01, b / 0.01, ln Dc and ln k, and the normal equations of the forward
+  sensitivities, summed in one compiled pass over the samples (``velstep_kernel``).
 * Linear parameters, by variable projection (Golub and Pereyra 1973): mu_ss,i and the trend s_i are solved by
   linear least squares inside every evaluation (the residual is projected off their columns; as those do
   not depend on the nonlinear parameters, the projected sensitivities are the exact Jacobian). The trend is
   fitted by default on measured data (``trend``: None, True or False). The reported covariance is the full one
   of every parameter fitted jointly; the law's mu0 (at V0 = 1 um/s) is mu_ss - (a - b) ln(V1 / V0).
 * Global start: a grid over ln Dc (and ln k where it is fitted), a, b fitted at each grid point on at most
-  SEARCH_POINTS samples, then full fits on every sample from the best distinct grid points; the lowest wins.
+  SEARCH_POINTS samples, full fits from the best distinct grid points on that subsample, and the lowest one
+  then fitted on every sample.
 * Noise: the dataset's sigma (known or estimated), or, where it declares ``correlation = "ar1"``, the AR(1)
   model of ``inference.ar1``: the fit and phi's profile alternate until phi settles.
 

@@ -154,14 +154,15 @@ def build(problem, x, rounds, *, checks=True, errors=True, n_params=None, clock=
     free = problem.free
     n_lin = [s.B.shape[1] for s in problem.series]
     n_cols = len(free) + sum(n_lin)
-    J = np.zeros((sum(s.n for s in problem.series), n_cols))  # the full prewhitened Jacobian, filled by _piece
+    # the full prewhitened Jacobian, filled by _piece (a replicate's refit, errors=False, needs none)
+    J = np.zeros((sum(s.n for s in problem.series), n_cols if errors else 0))
     pieces, col = [], len(free)
     for s, q in zip(problem.series, n_lin):
         pieces.append(_piece(problem, s, v, x, free, J, col))
         col += q
     at_bound = _at_bounds(problem, x)
     keep = [j for j in range(n_cols) if not (j < len(free) and problem.params[free[j]].name in at_bound)]
-    norms = np.linalg.norm(J, axis=0)
+    norms = np.linalg.norm(J, axis=0) if errors else np.ones(n_cols)
     effect = norms > 1e-9 * max(float(norms.max()) if norms.size else 0.0, 1e-300)
     no_effect = [problem.params[free[j]].name for j in range(len(free)) if not effect[j]]
     keep = [j for j in keep if effect[j]]
@@ -231,15 +232,16 @@ def _piece(problem, s, v, x, free, J, col: int) -> dict:
     from ..solve import quasistatic
 
     sol = quasistatic.solve(problem.code, v["a"], v["b"], v["Dc"], v["k"][s.index], s.load, s.t, problem.rtol,
-                            sensitivities=True)
+                            sensitivities=bool(J.shape[1]))
     c = s.linear(v["a"], v["b"], sol.m)
     model = s.offset(v["a"], v["b"]) + sol.m + s.B @ c
     r = model - s.y
     z = ar1.whiten(r / s.sigma, s.phi)
     start = sum(t.n for t in problem.series[:s.index])
     rows = slice(start, start + s.n)
-    J[rows, :len(free)] = ar1.whiten(problem.columns(s, v, x, sol.S, free) / s.sigma[:, None], s.phi)
-    J[rows, col:col + s.B.shape[1]] = ar1.whiten(s.B / s.sigma[:, None], s.phi)
+    if J.shape[1]:
+        J[rows, :len(free)] = ar1.whiten(problem.columns(s, v, x, sol.S, free) / s.sigma[:, None], s.phi)
+        J[rows, col:col + s.B.shape[1]] = ar1.whiten(s.B / s.sigma[:, None], s.phi)
     ll = float(z @ z) + float(np.sum(np.log(2 * math.pi * s.sigma ** 2))) + ar1.log_det(s.phi)
     mu_ss = (c[0] if s.mu0 is None else s.mu0 + (v["a"] - v["b"]) * s.L1)
     trend = float(c[-1]) if s.trend else 0.0

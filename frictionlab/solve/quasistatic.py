@@ -20,11 +20,12 @@ import attrs
 import numpy as np
 
 from ..core.errors import SolverError
-from ..physics.spring import runaway_cause
+from ..physics.spring import runaway_message
 
 #: Built-in laws served here, by name: the kernel's evolution-law code (``quasistatic_kernel.AGING``, ``SLIP``;
 #: the kernel, which imports numba, is loaded on the first solve).
 LAWS = {"rate-state-aging": 0, "rate-state-slip": 1}
+LAW_NAMES = {code: name for name, code in LAWS.items()}
 #: Reference slip rate V0 of the laws' mu0 [um/s] (laws/rate_state.py: 1e-6 m/s).
 V0_UM = 1.0
 #: A quasi-static slider has run away once its slip rate exceeds this multiple of the fastest load point
@@ -86,7 +87,7 @@ class Solution:
 
 
 def solve(law_code: int, a: float, b: float, Dc_um: float, k_um: float, load: Load, t, rtol: float = 1e-8,
-          sensitivities: bool = False) -> Solution:
+          sensitivities: bool = False, law: str = "") -> Solution:
     """Integrate the quasi-static slider (laboratory units: Dc [um], k [1/um]) from steady sliding at V1 and return
     m and psi at the sorted times t [s] >= 0. A slider that runs away or a failed integration raises SolverError."""
     from . import quasistatic_kernel as kernel
@@ -95,24 +96,23 @@ def solve(law_code: int, a: float, b: float, Dc_um: float, k_um: float, load: Lo
     n = t.size
     m, psi = np.empty(n), np.empty(n)
     S = np.empty((n, 4)) if sensitivities else np.empty((0, 4))
-    stats = np.zeros(4)
+    stats = np.zeros(5)
     vmax = RUNAWAY * float(np.max(load.velocities))
     status = kernel.integrate(law_code, float(a), float(b), float(Dc_um), float(k_um), load.V1, load.times,
                               load.velocities, t, float(rtol), float(rtol) * float(a), bool(sensitivities), vmax,
                               m, psi, S, stats)
     if status != kernel.OK:
-        raise SolverError(_failure(status, float(stats[3]), a, b, Dc_um, k_um, vmax))
+        raise SolverError(_failure(status, stats, a, b, Dc_um, k_um, load, law or LAW_NAMES[law_code]))
     return Solution(m, psi, S if sensitivities else None, int(stats[0]))
 
 
-def _failure(status: int, t: float, a, b, Dc_um, k_um, vmax) -> str:
+def _failure(status: int, stats, a, b, Dc_um, k_um, load: Load, law: str) -> str:
     from . import quasistatic_kernel as kernel
 
+    t = float(stats[3])
     if status == kernel.RUNAWAY:
-        cause = runaway_cause({"a": a, "b": b, "Dc": Dc_um * UM}, k_um / UM)
-        return (f"quasi-static slider: the slip rate passed {vmax * UM:.3g} m/s ({RUNAWAY:g} times the fastest load "
-                f"point) at t = {t:.6g} s: an unstable slider ({cause}); the quasi-static model cannot follow it: "
-                "give the slider a mass ([scene.spring] mass) to simulate the slip")
+        return runaway_message(law, float(stats[4]) * UM, t, load.velocities * UM,
+                               {"a": a, "b": b, "Dc": Dc_um * UM}, k_um / UM, RUNAWAY)
     if status == kernel.TOO_MANY_STEPS:
         return f"quasi-static slider: more than {kernel.MAX_STEPS} steps by t = {t:.6g} s"
     return f"quasi-static slider: the step size fell to round-off at t = {t:.6g} s (a, b, Dc, k = {a:g}, {b:g}, " \
@@ -133,7 +133,7 @@ def simulate(law, scene, p, t, rtol: float = 1e-10):
     t = np.asarray(t, dtype=float)
     load = Load.of(scene.spring)
     k_um = scene.spring.stiffness * UM
-    sol = solve(LAWS[law.name], p["a"], p["b"], p["Dc"] / UM, k_um, load, t, rtol)
+    sol = solve(LAWS[law.name], p["a"], p["b"], p["Dc"] / UM, k_um, load, t, rtol, law=law.name)
     V = load.V1 * np.exp((sol.m - p["b"] * sol.psi) / p["a"]) * UM
     mu = steady_friction(p, load.V1) + sol.m
     N = scene.normal(t)

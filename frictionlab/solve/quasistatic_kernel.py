@@ -112,9 +112,9 @@ def integrate(law, a, b, Dc, k, V1, seg_t, seg_v, t_out, rtol, atol_m, sens, vma
     velocities seg_v [um/s]) and write m, psi and (sens) dm/d(a, b, Dc, k) at the sorted times t_out [s].
 
     rtol: relative tolerance; atol_m: absolute tolerance of m (psi's is rtol). vmax: slip rate [um/s] beyond
-    which the slider has run away. stats[0:4] receive (accepted steps, rejected steps, Newton iterations, time
-    [s] reached; for a failure the time it happened). Returns a status code (OK, TOO_MANY_STEPS, RUNAWAY,
-    STEP_TOO_SMALL)."""
+    which the slider has run away. stats[0:5] receive (accepted steps, rejected steps, Newton iterations, time
+    [s] reached, and for a runaway the slip rate [um/s] then; for a failure the time it happened). Returns a
+    status code (OK, TOO_MANY_STEPS, RUNAWAY, STEP_TOO_SMALL)."""
     n = t_out.size
     y = np.zeros(2)
     S = np.zeros((2, 4))
@@ -226,7 +226,7 @@ def integrate(law, a, b, Dc, k, V1, seg_t, seg_v, t_out, rtol, atol_m, sens, vma
                 h *= max(0.2, 0.9 * err ** -0.25) if math.isfinite(err) else 0.2
                 continue
             if V > vmax:
-                stats[0], stats[1], stats[2], stats[3] = accepted, rejected, newton, t + h
+                stats[0], stats[1], stats[2], stats[3], stats[4] = accepted, rejected, newton, t + h, V
                 return RUNAWAY
             accepted += 1
             t_new = t1 if last else t + h
