@@ -323,3 +323,13 @@ def test_the_equivalence_test_runs_on_ar1_velocity_steps(tmp_path):
     fa, fb = fl.fit("rate-state-aging", tg), fl.fit("rate-state-slip", tg)
     e = fl.analyze_equivalence(fa, fb, replicates=20, seed=1)
     assert e.status == "ok" and 0.0 <= e.p <= 1.0 and e.failed == 0
+
+
+def test_held_law_parameters_stay_held_and_the_others_are_fitted():
+    """mu0 held (the model then carries mu0 + (a - b) ln(V1/V0) and its sensitivities) and Dc held: the others
+    recover the generating values within 3 standard errors."""
+    f = fl.fit("rate-state-aging", "spring-slider-aging", fixed={"mu0": 0.6, "Dc": 1e-5})
+    assert f.params["mu0"].vary is False and f.params["Dc"].vary is False and f.value("Dc") == 1e-5
+    assert f.params["mu0"].fixed_by == "held by the caller"
+    for name, true in (("a", 0.008), ("b", 0.012)):
+        assert abs(f.value(name) - true) < 3 * f.stderr(name), name
