@@ -19,7 +19,8 @@ def add_parser(sub):
   frictionlab fit wear impact-golf-v28 --solver series --json fit.json
   frictionlab fit area-rate impact-golf-v28 impact-golf-v61 --local mu       # a global fit, mu per dataset
   frictionlab fit couette incline-oil-a100 --fix eta='0.1 Pa s'
-  frictionlab fit wear my.toml --free u0='8 m/s:14 m/s'""")
+  frictionlab fit wear my.toml --free u0='8 m/s:14 m/s'
+  frictionlab fit rate-state-aging my-velocity-step.toml --trend none --stiffness hold""")
     p.add_argument("law", help="registered law name (see 'frictionlab laws')")
     p.add_argument("datasets", nargs="+", metavar="DATASET", help="built-in dataset name or TOML path")
     p.add_argument("--solver", default="auto", help="auto (exact where a closed form exists, else ode), exact, "
@@ -37,6 +38,12 @@ def add_parser(sub):
                    help=f"relative tolerance of every ODE solve in the fit (default {FIT_RTOL:g}, the library's "
                         "FIT_RTOL: a fit solves the model hundreds of times; 'simulate' defaults to 1e-10 for one "
                         "solve; closed forms and the series ignore it)")
+    p.add_argument("--trend", choices=("auto", "fit", "none"), default="auto",
+                   help="velocity-step fits (rate-and-state on spring-slider data): fit a linear friction-vs-"
+                        "displacement trend jointly with the law (auto: on measured data)")
+    p.add_argument("--stiffness", choices=("auto", "fit", "hold"), default="auto",
+                   help="velocity-step fits: fit the machine stiffness from the dataset's value (auto: on measured "
+                        "data, or where --free names spring.stiffness) or hold it")
     p.add_argument("--json", type=Path, metavar="FILE", help="also write the result as JSON")
     p.add_argument("--fit-timeout", type=fit_timeout, default=FIT_TIMEOUT, metavar="SECONDS",
                    help=f"time budget of the fit; past it the fit fails with that reason (default {FIT_TIMEOUT:g})")
@@ -111,6 +118,8 @@ def run(args) -> int:
         check_apart(args.json)  # never over a file the fit reads
     options = dict(solver=args.solver, free=parse_free(args.free), fixed=parse_fix(law, args.fix), local=args.local,
                    observable=args.observable, derive=args.derive, timeout=args.fit_timeout, rtol=args.rtol)
+    choice = {"fit": True, "none": False, "hold": False}
+    options.update({k: choice[v] for k, v in (("trend", args.trend), ("stiffness", args.stiffness)) if v != "auto"})
     from ..core.progress import Progress
     from ..physics.registry import is_third_party
 

@@ -147,6 +147,10 @@ def _resample(datasets, models, method, rng):
         if method == "case":
             idx = np.sort(rng.integers(0, len(ds), len(ds)))
             cols = {k: v[idx] for k, v in cols.items()}
+        elif method == "parametric" and getattr(ds, "noise_correlation", "none") == "ar1":  # AR(1) noise
+            from .ar1 import noise_drawer
+
+            cols[ds.observable] = model + noise_drawer(ds, ds.y, model, None)(rng)
         elif method == "parametric":
             cols[ds.observable] = model + rng.normal(0.0, ds.noise[ds.observable], model.shape)
         else:

@@ -430,7 +430,9 @@ def _sample(fit_a, fit_b, most, seed, obs, tol, executor, chunk, timeout):
 
     da, db = fit_a.per_dataset[0], fit_b.per_dataset[0]
     opts_a, opts_b = (refit_options(f) | {"timeout": timeout} for f in (fit_a, fit_b))
-    est = da.target.dataset.noise_est.get(da.target.observable) if fit_a.stats.likelihood == "estimated" else None
+    est = (da.target.dataset.noise_est.get(da.target.observable) if fit_a.stats.likelihood == "estimated"
+           and getattr(da.target.dataset, "noise_correlation", "none") == "none" else None)  # AR(1): each refit
+    # estimates its own sigma from its replicate, so no draw of sigma is added
     args = (fit_a.law, opts_a, fit_b.law, opts_b, da.target, da.model, db.model)
     df = float(est.df) if est is not None else math.inf
     ss = seed_sequence(seed, f"{fit_a.datasets[0]}|{fit_a.law}[{fit_a.solver}]|{fit_b.law}[{fit_b.solver}]")

@@ -136,6 +136,9 @@ class FitResult:
     #: lmfit's MinimizerResult of the best start, in SI (None when nothing was fitted); its parameter
     #: names are identifiers ('lam', 'scene_u0__0'); ``params`` holds the display names.
     minimizer_result: object = attrs.field(default=None, repr=False)
+    #: A velocity-step fit's parameters in laboratory units and what they say (``velstep_result.StepReport``);
+    #: None for other fits.
+    velstep: object = attrs.field(default=None, repr=False)
 
     @property
     def ok(self) -> bool:
@@ -232,5 +235,7 @@ class FitResult:
             lines.append(f"  warning: {w}")
         for n in self.notes:
             lines.append(f"  note: {n}")
+        if self.velstep is not None:
+            lines += self.velstep.lines()
         return "\n".join(lines)
 

@@ -58,7 +58,7 @@ from .fitstats import (
     neg2loglik,
 )
 from ..io.noise import ratio_pvalue
-from .goodness import combine, f_pvalue, goodness
+from .goodness import SHARPEN_BELOW, combine, f_pvalue, goodness
 from .identifiability import find_structure, jacobian, jacobian_errors, make_verdict
 from .plausibility import check_plausibility
 from .predict import (
@@ -84,7 +84,6 @@ if TYPE_CHECKING:  # annotations only
     from ..physics.law import FrictionLaw
     from .predict import DatasetLike
 
-SHARPEN_BELOW = 1e-3  # an F p-value (conservative) below this already rejects: no simulation needed
 _KEEP = (ODE_STARTS, PENALTY, LIKELIHOOD_REASON, neg2loglik)  # re-exported names other modules read from here
 
 
@@ -119,7 +118,8 @@ def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], s
         initial: Mapping[str, object] | None = None, observable: str | None = None, derive: str | None = None,
         scan: int = 125, n_starts: int = 3, max_nfev: int | None = None, rtol: float | None = None,
         timeout: float | None = None, checks: bool = True, errors: bool = True, n_params: int | None = None,
-        progress: Callable[[int, int, str], None] | None = None) -> FitResult:
+        progress: Callable[[int, int, str], None] | None = None, trend: bool | None = None,
+        stiffness: bool | None = None) -> FitResult:
     """Fit ``law`` to one dataset or a group of them (a global fit) and return a FitResult.
 
     law: name or FrictionLaw. datasets: a Dataset, name, path or Target, or a list of them.
@@ -146,6 +146,11 @@ def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], s
     None counts every free parameter.
     progress(done, total, label): told the stage (start scan, each Levenberg-Marquardt start, error
     analysis) and its count of model evaluations (core.progress.Progress takes it).
+    A built-in rate-and-state law on quasi-static spring-slider datasets (solver 'auto' or 'ode', no ``local``)
+    is fitted as the field fits velocity steps (``inference.velstep``: the slider in its own variables, mu0 and a
+    friction-vs-displacement trend by variable projection, the machine stiffness fitted, a global start, AR(1)
+    noise where the dataset declares it); there trend (None: fitted on measured data) and stiffness (None: fitted
+    on measured data or where ``free`` names spring.stiffness; True / False: fitted / held) apply.
     """
     import lmfit  # slow to import: only when fitting
 
@@ -176,6 +181,15 @@ def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], s
     if n_params is not None and (isinstance(n_params, bool) or not isinstance(n_params, int) or n_params < 0
                                  or errors):
         raise ParameterError(f"fit: n_params must be a whole number >= 0 given with errors=False, got {n_params!r}")
+    from . import velstep
+
+    if velstep.applies(law, targets, solver, local, free):
+        return velstep.fit(law, targets, fixed=fixed, free=free, initial=initial, trend=trend, stiffness=stiffness,
+                           scan=scan, n_starts=n_starts, max_nfev=max_nfev, rtol=rtol, timeout=timeout, checks=checks,
+                           errors=errors, n_params=n_params, progress=progress, names=names, clock=clock)
+    if trend is not None or stiffness is not None:
+        raise ParameterError("fit: trend and stiffness apply to the velocity-step fit only (a built-in rate-and-state "
+                             "law on quasi-static spring-slider datasets, solver 'auto' or 'ode')")
     solvers = _solvers(law, targets, solver, rtol)
     if isinstance(solvers, str):
         return give_up("skipped", solvers)

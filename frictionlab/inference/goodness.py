@@ -13,6 +13,11 @@ Two tests per fitted dataset, on the normalized residuals z = (model - data) / s
   The lag-1 autocorrelation r1 of z is reported beside it (one-sided p from r1 sqrt(n) ~ N(0, 1)),
   not used by the rule.
 
+* whiteness (AR(1) noise only, ``inference.ar1``): the Ljung-Box test of the prewhitened residuals'
+  autocorrelations at lags 1 to WHITE_LAGS (degrees of freedom WHITE_LAGS minus the fitted coefficients): the
+  noise model says they are white; a law that misses the data's shape, or noise that is not AR(1), leaves them
+  correlated. Then the three tests share the family-wise level, each at FITS_LEVEL / 3.
+
 Rule (``FITS_LEVEL`` = 0.01, family-wise over the two tests): a candidate fits a dataset when
 both p-values are at least ``TEST_LEVEL`` = 0.005 (Bonferroni over the two tests). The level keeps the false alarm rate of a true law low on the handful of
 built-in known-truth sets while a misfit of several sigma over tens of points fails by orders of
@@ -29,6 +34,8 @@ import numpy as np
 FITS_LEVEL = 0.01  # family-wise level of the fit tests (chi-square or F, and runs) on one dataset or group
 TEST_LEVEL = FITS_LEVEL / 2  # each of the two tests (Bonferroni)
 RUNS_MIN = 10
+WHITE_LAGS = 20  # lags of the whiteness test of prewhitened residuals
+SHARPEN_BELOW = 1e-3  # an F p-value (conservative) below this already rejects: no sharper p-value is needed
 
 
 @attrs.frozen
@@ -45,6 +52,7 @@ class Goodness:
     fits: bool | None  # None when no test could be made
     reason: str  # one phrase: why it fits or does not
     members: int = 1  # datasets combined (p-values Bonferroni-adjusted when more than one)
+    white_p: float = math.nan  # Ljung-Box p of prewhitened residuals (AR(1) noise only; NaN otherwise)
 
     def as_dict(self) -> dict:
         return attrs.asdict(self)
@@ -57,6 +65,8 @@ class Goodness:
             parts.append(f"chi2 p = {_p(self.chi2_p)}")
         if math.isfinite(self.runs_p):
             parts.append(f"runs p = {_p(self.runs_p)}")
+        if math.isfinite(self.white_p):
+            parts.append(f"whiteness p = {_p(self.white_p)}")
         if math.isfinite(self.lag1):
             parts.append(f"lag-1 r = {self.lag1:+.2f}")
         text = ", ".join(parts) or "no test possible"
@@ -65,7 +75,8 @@ class Goodness:
     @property
     def short(self) -> str:
         """'fits: chi2 p = 0.96' / 'fails: runs p = 8e-10': the verdict and the p-value closest to failing."""
-        ps = [(name, p) for name, p in (("χ²" if self.likelihood != "estimated" else "χ²/σ̂²", self.chi2_p), ("runs", self.runs_p)) if math.isfinite(p)]
+        ps = [(name, p) for name, p in (("χ²" if self.likelihood != "estimated" else "χ²/σ̂²", self.chi2_p), ("runs", self.runs_p),
+                                        ("whiteness", self.white_p)) if math.isfinite(p)]
         if self.fits is None or not ps:
             return "not testable"
         name, p = min(ps, key=lambda x: x[1])
@@ -136,10 +147,28 @@ def f_pvalue(chisqr: float, dof: int, df_sigma: float) -> float:
     return float(fdtrc(dof, df_sigma, chisqr / dof)) if dof > 0 and math.isfinite(chisqr) else math.nan
 
 
-def goodness(z: np.ndarray, k: int, likelihood: str, df_sigma: float = math.inf, chi_p: float | None = None) -> Goodness:
+def ljung_box(z: np.ndarray, fitted: int, lags: int = WHITE_LAGS) -> float:
+    """p of the Ljung-Box test that z is white: Q = n (n + 2) sum_k r_k^2 / (n - k), k = 1..lags, against
+    chi-square with lags - fitted degrees of freedom (``fitted``: coefficients of the noise model); NaN when too
+    short."""
+    z = np.asarray(z, dtype=float)
+    n = z.size
+    if n < 5 * lags or lags <= fitted:
+        return math.nan
+    d = z - z.mean()
+    den = float(d @ d)
+    if den <= 0:
+        return math.nan
+    q = sum(float(d[k:] @ d[:-k]) ** 2 / den ** 2 / (n - k) for k in range(1, lags + 1)) * n * (n + 2)
+    return chi2_pvalue(q, lags - fitted)
+
+
+def goodness(z: np.ndarray, k: int, likelihood: str, df_sigma: float = math.inf, chi_p: float | None = None,
+             white_p: float = math.nan) -> Goodness:
     """Goodness of one fitted dataset from its normalized residuals z, k fitted parameters and the
     degrees of freedom of its sigma (infinite when measured); chi_p: the fit test's p where the caller
-    has a sharper one (``noise.ratio_pvalue``)."""
+    has a sharper one (``noise.ratio_pvalue``); white_p: the whiteness test's p of prewhitened residuals
+    (AR(1) noise), which joins the rule."""
     z = np.asarray(z, dtype=float)
     if likelihood == "none":
         return Goodness("none", math.nan, math.nan, 0, math.nan, math.nan, math.nan, None,
@@ -148,23 +177,26 @@ def goodness(z: np.ndarray, k: int, likelihood: str, df_sigma: float = math.inf,
         chi_p = f_pvalue(float(z @ z), z.size - k, df_sigma if likelihood == "estimated" else math.inf)
     runs, expected, runs_p = runs_test(z)
     r1, r1_p = lag1(z)
-    return _decide(likelihood, chi_p, runs_p, runs, expected, r1, r1_p)
+    return _decide(likelihood, chi_p, runs_p, runs, expected, r1, r1_p, white_p)
 
 
-def _decide(likelihood, chi_p, runs_p, runs, expected, r1, r1_p) -> Goodness:
-    tests = [(name, p) for name, p in (("chi-square" if likelihood != "estimated" else "chi-square at estimated sigma", chi_p), ("runs test", runs_p)) if math.isfinite(p)]
+def _decide(likelihood, chi_p, runs_p, runs, expected, r1, r1_p, white_p=math.nan) -> Goodness:
+    tests = [(name, p) for name, p in (("chi-square" if likelihood != "estimated" else "chi-square at estimated sigma", chi_p), ("runs test", runs_p),
+                                       ("whiteness test of the prewhitened residuals", white_p)) if math.isfinite(p)]
+    level = TEST_LEVEL if not math.isfinite(white_p) else FITS_LEVEL / 3
+    done = dict(white_p=white_p)
     if not tests:
-        return Goodness(likelihood, chi_p, runs_p, runs, expected, r1, r1_p, None, "no test possible (too few points)")
-    failed = [f"{name} p = {_p(p)} < {TEST_LEVEL:g}" for name, p in tests if p < TEST_LEVEL]
+        return Goodness(likelihood, chi_p, runs_p, runs, expected, r1, r1_p, None, "no test possible (too few points)", **done)
+    failed = [f"{name} p = {_p(p)} < {level:.2g}" for name, p in tests if p < level]
     if failed:
         why = "; ".join(failed)
         if "runs" in why:
             why += f" ({runs} runs of residual signs where {expected:.0f} are expected: systematic misfit)"
-        return Goodness(likelihood, chi_p, runs_p, runs, expected, r1, r1_p, False, why)
-    why = " and ".join(f"{name} p >= {TEST_LEVEL:g}" for name, _ in tests)
+        return Goodness(likelihood, chi_p, runs_p, runs, expected, r1, r1_p, False, why, **done)
+    why = " and ".join(f"{name} p >= {level:.2g}" for name, _ in tests)
     if len(tests) > 1:
-        why += f" (each at {TEST_LEVEL:g}: {FITS_LEVEL:g} family-wise)"
-    return Goodness(likelihood, chi_p, runs_p, runs, expected, r1, r1_p, True, why)
+        why += f" (each at {level:.2g}: {FITS_LEVEL:g} family-wise)"
+    return Goodness(likelihood, chi_p, runs_p, runs, expected, r1, r1_p, True, why, **done)
 
 
 def combine(members: list[Goodness]) -> Goodness:
@@ -184,4 +216,5 @@ def combine(members: list[Goodness]) -> Goodness:
     r1, r1_p = max(lags) if lags else (math.nan, math.nan)
     return attrs.evolve(_decide(kinds.pop() if len(kinds) == 1 else "mixed", adjusted(g.chi2_p for g in members),
                    adjusted(g.runs_p for g in members), sum(g.runs for g in members),
-                   sum(g.runs_expected for g in members if math.isfinite(g.runs_expected)), r1, r1_p), members=m)
+                   sum(g.runs_expected for g in members if math.isfinite(g.runs_expected)), r1, r1_p,
+                   adjusted(g.white_p for g in members)), members=m)

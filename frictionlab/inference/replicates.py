@@ -82,10 +82,13 @@ def replicate_chunk(law_a, opts_a, law_b, opts_b, target, model_a, model_b, seed
     at its location under the replicate's own fit (``equivalence``, module docstring); D the RMS distance of
     the two refitted curves (``distance``). With an estimated sigma of ``df`` degrees of freedom each
     replicate's chi-squares are at its own estimate sigma^2 chi2_df / df. Runs in a worker."""
+    from .ar1 import noise_drawer
+
+    noise = noise_drawer(target.dataset, target.y, model_a, target.sigma)  # Gaussian, or AR(1) where declared
     out = []
     for ss in seeds:
         rng = np.random.default_rng(ss)
-        eps = rng.standard_normal(target.y.size) * target.sigma
+        eps = noise(rng)
         scale = df / rng.chisquare(df) if math.isfinite(df) else 1.0
         row = []
         for null, model in (("a", model_a), ("b", model_b)):

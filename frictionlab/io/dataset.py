@@ -67,6 +67,7 @@ class Dataset:
     noise_df: dict = attrs.field(factory=dict)  # column -> effective degrees of freedom of an estimated sigma
     noise_est: dict = attrs.field(factory=dict, repr=False)  # column -> noise.NoiseEstimate (estimated kind)
     noise_note: str = ""  # which noise is used, and why (one sentence, for the report and `datasets show`)
+    noise_correlation: str = "none"  # NOISE_CORRELATIONS: independent samples ('none') or AR(1) noise ('ar1')
     stated: dict = attrs.field(factory=dict)  # STATED name -> (value, precision) in SI ([stated])
     group: str = ""  # declared group (TOML 'group'); "": the dataset is its own group (nothing is inferred from names)
     time_zero: float = 0.0  # the file's time of t = 0 [s] (TOML 'time_zero'), already subtracted from columns['t']
@@ -233,8 +234,9 @@ def from_meta(meta: dict, path: Path, raw: dict | None = None) -> Dataset:
     columns = _columns(raw, units, path, csv)
     time_zero = _time_origin(meta, columns, raw, kind, path, csv)
     _check_series(columns, raw, kind, csv)
-    noise, noise_kind, noise_est, noise_note = noise_table(_table(meta, "noise", path, "[noise]"), path, observable,
-                                                           columns, _si_of)
+    noise_spec = dict(_table(meta, "noise", path, "[noise]"))
+    correlation = _correlation(noise_spec.pop("correlation", "none"), path)
+    noise, noise_kind, noise_est, noise_note = noise_table(noise_spec, path, observable, columns, _si_of)
     provenance = _provenance(meta.get("provenance"), path)
     scene = _scene(meta, path, kind, observable, columns, units, csv)
     fixed, fixed_units = _fixed(_table(meta, "fixed", path, "[fixed]"), path)
@@ -244,6 +246,7 @@ def from_meta(meta: dict, path: Path, raw: dict | None = None) -> Dataset:
                    description=meta.get("description", ""), reported=reported,
                    fixed_units=fixed_units, noise_kind=noise_kind, group=group, time_zero=time_zero,
                    noise_df={k: e.df for k, e in noise_est.items()}, noise_est=noise_est, noise_note=noise_note,
+                   noise_correlation=correlation,
                    stated=stated_table(_table(meta, "stated", path, "[stated]"), path, kind, noise_kind, _quantity))
 
 
@@ -339,6 +342,18 @@ def _check_series(columns, raw, kind, csv) -> None:
 def _si_of(col, value, where):
     """A declared noise value of column ``col`` in SI."""
     return _quantity(value, COLUMN_SI[col], where)
+
+
+#: ``[noise] correlation``: the samples' noise independent ('none', the default) or first-order autoregressive
+#: ('ar1': its coefficient profiled by each fit, inference/ar1.py).
+NOISE_CORRELATIONS = ("none", "ar1")
+
+
+def _correlation(value, path) -> str:
+    if not isinstance(value, str) or value not in NOISE_CORRELATIONS:
+        raise DatasetError(f"{path}: noise.correlation = {value!r}, expected one of {', '.join(NOISE_CORRELATIONS)} "
+                           "(none: independent samples; ar1: first-order autoregressive noise, phi fitted)")
+    return value
 
 
 def _scene(meta, path, kind, observable, columns, units, csv):

@@ -138,24 +138,98 @@ def estimate(columns: dict, col: str) -> NoiseEstimate | None:
 
 
 DRAWS = 4000  # noise draws of ``ratio_pvalue``
+#: Floats of one chunk of ``ratio_pvalue``'s draws (draws x points): its memory is bounded by this, not by DRAWS x n.
+CHUNK_FLOATS = 2_000_000
 
 
 def ratio_pvalue(est: NoiseEstimate, chisqr: float, J: np.ndarray, seed: int = 0) -> float:
     """P(chi2* / (n - k) >= chisqr / (n - k)) where chi2* is the fit's chi-square at sigma-hat on data of the
     fitted law plus noise, linearized at the fit: residuals e - P e (P the projection onto the columns
     of J, the weighted Jacobian of this dataset's points, n x k) over sigma-hat^2 of the same e.
-    chisqr is at sigma-hat. Monte Carlo with DRAWS draws: its floor is 1 / (DRAWS + 1)."""
+    chisqr is at sigma-hat. Monte Carlo with DRAWS draws, made in chunks of at most CHUNK_FLOATS numbers (the same
+    draws as one block): its floor is 1 / (DRAWS + 1)."""
     n = J.shape[0]
     rng = np.random.default_rng(seed)
-    E = rng.standard_normal((DRAWS, n))
-    if J.size:
-        U, s, _ = np.linalg.svd(J, full_matrices=False)
-        Qj = U[:, s > 1e-9 * s.max()] if s.size and s.max() > 0 else U[:, :0]
-        E_res = E - (E @ Qj) @ Qj.T
-    else:
-        E_res = E
-    ratio = np.sum(E_res * E_res, axis=1) / est.variance(E)
-    return (1.0 + float(np.sum(ratio >= chisqr))) / (DRAWS + 1.0)
+    Qj = _column_basis(J)
+    hits = 0
+    step = max(1, min(DRAWS, CHUNK_FLOATS // max(n, 1)))
+    for start in range(0, DRAWS, step):
+        E = rng.standard_normal((min(step, DRAWS - start), n))
+        E_res = E - (E @ Qj) @ Qj.T if Qj.shape[1] else E
+        ratio = np.sum(E_res * E_res, axis=1) / est.variance(E)
+        hits += int(np.sum(ratio >= chisqr))
+    return (1.0 + hits) / (DRAWS + 1.0)
+
+
+def _column_basis(J: np.ndarray) -> np.ndarray:
+    """An orthonormal basis of the columns of J that matter (singular values above 1e-9 of the largest)."""
+    if not J.size:
+        return np.zeros((J.shape[0], 0))
+    U, s, _ = np.linalg.svd(J, full_matrices=False)
+    return U[:, s > 1e-9 * s.max()] if s.size and s.max() > 0 else U[:, :0]
+
+
+def ratio_pvalue_moments(est: NoiseEstimate, chisqr: float, J: np.ndarray) -> float | None:
+    """``ratio_pvalue`` without simulation, for a GSJS estimate: with white noise e ~ N(0, I) the statistic exceeds
+    c = chisqr when Q = e' (I - P - c G) e >= 0, G = C'C / m the estimate's quadratic form (C: its m pseudo-residual
+    rows). Q's first three cumulants are traces (2^(j-1) (j-1)! tr(M^j)), computed in O(n k) time and memory from
+    the five diagonals of the band C C' and the columns of J; P(Q >= 0) follows from Pearson's three-moment
+    chi-square approximation (a shifted and scaled chi-square with Q's mean, variance and skewness). None for an
+    estimate from replicates."""
+    from scipy.special import chdtr, chdtrc, ndtr
+
+    if est.rows is None or est.weights is None:
+        return None
+    n = J.shape[0]
+    I, W = est.rows, est.weights  # noqa: E741 (the points each pseudo-residual combines, and its weights)
+    m = I.shape[0]
+    Qj = _column_basis(J)
+    p = Qj.shape[1]
+    tr_PG = tr_PG2 = 0.0
+    for c in range(p):  # C q and C'C q / m of each basis column q, one at a time
+        Cq = np.sum(W * Qj[I, c], axis=1)
+        tr_PG += float(Cq @ Cq) / m
+        Gq = np.bincount(I.ravel(), weights=(W * Cq[:, None]).ravel(), minlength=n) / m
+        tr_PG2 += float(Gq @ Gq)
+    band = {0: np.sum(W * W, axis=1)}  # K = C C': row j's overlap with row j + d, d = 0, 1, 2
+    for d in (1, 2):
+        dot = np.zeros(m)
+        for a in range(I.shape[1]):
+            for b in range(I.shape[1]):
+                dot[: m - d] += W[: m - d, a] * W[d:, b] * (I[: m - d, a] == I[d:, b])
+        band[d] = dot
+    tr_K2 = float(band[0] @ band[0]) + 2.0 * sum(float(band[d] @ band[d]) for d in (1, 2))
+
+    def diag(d):  # K(i, i + d) for i = 0 .. m - 1 (zero where i + d is outside)
+        if d >= 0:
+            return band[d]
+        out = np.zeros(m)
+        out[-d:] = band[-d][: m + d]
+        return out
+
+    tr_K3 = 0.0
+    for d1 in range(-2, 3):
+        for d2 in range(-2, 3):
+            d3 = -(d1 + d2)
+            if abs(d3) > 2:
+                continue
+            i = np.arange(max(0, -d1, -d1 - d2), min(m, m - d1, m - d1 - d2))
+            tr_K3 += float(np.sum(diag(d1)[i] * diag(d2)[i + d1] * diag(d3)[i + d1 + d2]))
+    tr_G2, tr_G3 = tr_K2 / m ** 2, tr_K3 / m ** 3
+    c = float(chisqr)
+    t1 = (n - p) - c
+    t2 = (n - p) - 2 * c * (1 - tr_PG) + c * c * tr_G2
+    t3 = (n - p) - 3 * c * (1 - tr_PG) + 3 * c * c * (tr_G2 - tr_PG2) - c ** 3 * tr_G3
+    mean, var, k3 = t1, 2 * t2, 8 * t3
+    if not var > 0:
+        return None
+    sd = math.sqrt(var)
+    skew = k3 / var ** 1.5
+    if abs(skew) < 1e-8:
+        return float(ndtr(mean / sd))
+    d = 8.0 / (skew * skew)
+    edge = max(d - math.copysign(1.0, skew) * mean * math.sqrt(2 * d) / sd, 0.0)  # chi-square lives on x >= 0
+    return float(chdtrc(d, edge)) if skew > 0 else float(chdtr(d, edge))
 
 
 # --- the [noise] and [stated] tables of a dataset TOML ----------------------------------------------
@@ -182,7 +256,6 @@ def noise_table(spec: dict, path, observable: str, columns: dict, si_of) -> tupl
     """(sigma by column, kind, NoiseEstimate by estimated column, note) from the [noise] table ``spec``;
     si_of(column, text, where) parses a declared value into SI."""
     spec = dict(spec)
-    spec.pop("correlation", None)  # the noise's correlation model: read by the fit where supported, not a column
     values = [k for k in spec if k != "kind"]
     if "kind" not in spec and values:  # a sigma whose use is not declared would be silently ignored
         raise DatasetError(f"{path}: [noise] gives {', '.join(values)} without kind: add kind = \"known\" (the "

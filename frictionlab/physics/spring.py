@@ -92,3 +92,12 @@ def runaway_cause(p, k: float) -> str:
     return (f"k = {k:.4g} /m is above the critical stiffness k_c = (b - a)/Dc = {k_c:.4g} /m, which is stable to small "
             "perturbations only: the slip law runs away after large velocity jumps above k_c (Gu, Rice, Ruina and "
             "Tse 1984)")
+
+
+def runaway_message(law: str, v: float, t: float, velocities, p, k: float, limit: float) -> str:
+    """The error of a quasi-static slider whose slip rate v [m/s] passed ``limit`` times the fastest load point at
+    time t [s] (load-point velocities [m/s]; law parameters p, SI; stiffness k [1/m])."""
+    return (f"law '{law}' on a spring-slider: the slip rate reached {v:.3g} m/s at t = {t:.6g} s, beyond {limit:g} "
+            f"times the fastest load-point velocity ([scene.spring] velocities, up to {max(velocities):.3g} m/s), as "
+            f"far as the quasi-static model follows a slider: an unstable slider ({runaway_cause(p, k)}); give the "
+            "slider a mass ([scene.spring] mass) to simulate the slip")

@@ -38,16 +38,16 @@ def spin_falls(d) -> bool:
     return float(np.max(w) - w[-1]) > 2.0 * float(d.noise.get("omega", 0.0))
 
 
-def group_views(c, findings, skip_kinds=()) -> list[DataView]:
+def group_views(c, findings, skip=frozenset()) -> list[DataView]:
     """One view per dataset group with a fitted law (in order of first appearance; groups whose datasets all have
-    a first-screen block of their own, ``skip_kinds``, are left to it): the group's first drawable dataset
+    a first-screen block of their own drew, ``skip`` (names), are left to it): the group's first drawable dataset
     (measured first, time series first) with the group's top-ranked candidates fitted to it."""
     from .figures.fits import angle_column
 
     by_ds = {f.dataset.name: f for f in findings}
     members: dict[str, list] = {}
     for d in c.fitted_datasets:
-        if d.kind not in skip_kinds and ("t" in d.columns or angle_column(d) is not None):
+        if d.name not in skip and ("t" in d.columns or angle_column(d) is not None):
             members.setdefault(group_of(d), []).append(d)
     out = []
     for label, dss in members.items():

@@ -10,7 +10,8 @@ candidates, and the slip of the truncated series against the exact solution wher
 
 Kinds of data with a first-screen block of their own plug in at one place, ``KIND_BLOCKS``: a dataset kind
 mapped to a function ``block(ctx, sec, datasets)`` that adds its paragraphs, tables and figures for the
-comparison's fitted datasets of that kind; those datasets are then left out of the generic figure.
+comparison's fitted datasets of that kind and returns the names of those it drew (None: all of them); those
+are then left out of the generic figure. Measured velocity steps (``velstep``) have one.
 """
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ from ..inference.accuracy import COMMAND as ACCURACY_COMMAND
 from ..inference.answers import group_of, unfitted
 from ..inference.equivalence import sentence
 from ..solve.solvers.series import slip_zero
-from . import figures
+from . import figures, velstep
 from .data_view import describe, group_views, spin_falls
 from .data_view import title as view_title
 from .doc import Section
@@ -44,9 +45,9 @@ NOTES = (("headline", ""), ("goodness", "Goodness"), ("equivalence", "λAu again
          ("equivalence_series", "The truncated series of λAu against μN + μη′dA/dt"),
          ("qualitative", "Shared features"), ("noise_threshold", "Noise threshold"),
          ("series_vs_exact", "Series vs exact"), ("accuracy", "What accuracy costs"), ("transfer", "Across conditions"))
-#: dataset kind -> block(ctx, sec, datasets): a first-screen block of its own for the fitted datasets of that kind
-#: (module docstring); the generic figure leaves those datasets out.
-KIND_BLOCKS: dict = {}
+#: dataset kind -> block(ctx, sec, datasets) -> names drawn or None (all): a first-screen block of its own for the
+#: fitted datasets of that kind (module docstring); the generic figure leaves the datasets it drew out.
+KIND_BLOCKS: dict = {"spring-slider": lambda ctx, sec, datasets: velstep.first_screen(sec, ctx.c, datasets)}
 
 
 @attrs.frozen
@@ -204,13 +205,15 @@ def build(ctx) -> Section:
                  "The table shows what the comparison holds: the lowest AIC (a relative ranking, not a test that "
                  "the law fits), its reduced χ², and the discrimination test's verdict and noise threshold.")
         _fallback_table(sec, c, findings)
-    own = {}
+    own: dict[str, list] = {}
     for d in c.fitted_datasets:
         if d.kind in KIND_BLOCKS:
             own.setdefault(d.kind, []).append(d)
+    drawn: set[str] = set()
     for kind, dss in own.items():
-        KIND_BLOCKS[kind](ctx, sec, dss)
-    views = group_views(c, findings, skip_kinds=tuple(own))
+        shown = KIND_BLOCKS[kind](ctx, sec, dss)
+        drawn |= {d.name for d in dss} if shown is None else set(shown)
+    views = group_views(c, findings, skip=drawn)
     if views:
         sec.fig("finding.png", "Per dataset group, one of its datasets with the group's top-ranked candidates (#rank)"
                 + ("; under a panel whose candidates include the truncated series, the slip u(t) of that series and "

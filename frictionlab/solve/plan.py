@@ -51,7 +51,7 @@ from ..physics.scene import (
     Scene,
     WeightNormal,
 )
-from ..physics.spring import runaway_cause
+from ..physics.spring import runaway_message
 from .patch import CompliantPatch
 
 #: A quasi-static spring-slider stops with an error once the slip rate exceeds this multiple of the fastest
@@ -265,12 +265,8 @@ class Plan(CompliantPatch):
         v = float(y[0])
         fastest = QUASI_STATIC_LIMIT * max(s.spring.velocities)
         if abs(v) > fastest:
-            raise SolverError(f"law '{self.law.name}' on a spring-slider: the slip rate reached {v:.3g} m/s at "
-                              f"t = {float(t):.6g} s, beyond {QUASI_STATIC_LIMIT:g} times the fastest load-point "
-                              f"velocity ([scene.spring] velocities, up to {max(s.spring.velocities):.3g} m/s), as far "
-                              f"as the quasi-static model follows a slider: an unstable slider "
-                              f"({runaway_cause(p, s.spring.stiffness)}); give the slider a mass ([scene.spring] mass) "
-                              "to simulate the slip")
+            raise SolverError(runaway_message(self.law.name, v, float(t), s.spring.velocities, p, s.spring.stiffness,
+                                              QUASI_STATIC_LIMIT))
         dF = self.slip_rate_partials(p, t, y)
         N = float(s.normal(t))
         return (s.spring.stiffness * N * (float(s.spring.velocity(t)) - v) - float(dF[1:] @ dy[1:])) / dF[0]

@@ -12,6 +12,7 @@ import numpy as np
 from ...core.errors import SceneError, SolverError
 from ...physics.registry import get_law
 from ...physics.scene import Scene, SceneSource
+from .. import quasistatic
 from ..plan import make_plan
 from . import exact, ode, segments, series
 from ...core.fpstate import with_own_errstate
@@ -47,7 +48,9 @@ def simulate(law: str | FrictionLaw, scene: Scene | SceneSource, params: Mapping
     law: a registered name or a FrictionLaw; scene: a Scene or a Dataset (its ``[fixed]``
     parameters apply and its time column is the default ``t``); params: values overriding the law's
     defaults, each an SI number, a quantity string or a pint Quantity; solver: 'exact', 'series', 'ode' (LSODA) or 'ode:METHOD'; t: sample times [s],
-    default n points over the scene's duration.
+    default n points over the scene's duration. 'ode' for a built-in rate-and-state law on a quasi-static
+    spring-slider integrates the slider in the field's variables (``solve.quasistatic``); 'ode:LSODA' and the
+    other methods take the general plan.
     """
     law = get_law(law)
     name = "scene"
@@ -72,6 +75,10 @@ def simulate(law: str | FrictionLaw, scene: Scene | SceneSource, params: Mapping
     t = np.asarray(t, dtype=float)
     if t.ndim != 1 or t.size == 0 or (np.diff(t) < 0).any() or t[0] < 0 or not np.isfinite(t).all():
         raise SolverError("simulate: t must be a non-empty, non-decreasing 1-D array of times >= 0")
+    if solver == "ode" and atol is None and not quasistatic.applies(law, scene):  # rate-and-state on a quasi-static slider
+        if isinstance(rtol, bool) or not isinstance(rtol, (int, float)) or not 0 < rtol < 1:
+            raise SolverError(f"rtol must be a number in (0, 1), got {rtol!r}")
+        return quasistatic.simulate(law, scene, p, t, rtol)
     plan = make_plan(scene, law, name)
     kind, method = parse_solver(solver)
     if kind == "series":

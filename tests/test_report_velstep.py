@@ -1,0 +1,52 @@
+"""The first screen's measured velocity steps (report.velstep): each step's a, b, a - b, Dc and k with intervals
+beside its figure (data, fit, residuals); nothing for synthetic or non-slider data."""
+import sys
+from pathlib import Path
+
+import attrs
+import numpy as np
+import pytest
+
+from frictionlab import compare
+from frictionlab.report import build, first_screen
+from frictionlab.report import velstep as report_velstep
+from frictionlab.report.figures import is_png
+from frictionlab.report.render import markdown
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+
+
+@pytest.fixture(scope="module")
+def comp(tmp_path_factory):
+    from calibration_ar1 import make_dataset
+
+    ds, curve = make_dataset(tmp_path_factory.mktemp("step"), "none", quick=True)
+    y = curve + np.random.default_rng(8).normal(0.0, 4e-4, curve.size)
+    measured = attrs.evolve(ds, name="lab-step", columns=dict(ds.columns, mu=y), noise={"mu": 4e-4},
+                            provenance=attrs.evolve(ds.provenance, kind="measured"))
+    return compare(laws=["rate-state-aging", "rate-state-slip"], datasets=[measured, "spring-slider-small-step"],
+                   equivalence=False, bootstrap=0)
+
+
+def test_each_measured_step_has_its_table_row_and_figure(comp):
+    steps = report_velstep.measured_steps(comp)
+    assert [d.name for d, _ in steps] == ["lab-step"]  # the synthetic set is not a measured step
+    sections, _ = build(comp, modules=[first_screen])
+    md = markdown("t", sections)
+    assert "**Measured velocity steps**" in md and "Dc [µm]" in md and "k [1/µm]" in md
+    f = steps[0][1][0]
+    row = next(line for line in md.splitlines() if line.startswith(f"| **lab-step** | {f.law[len('rate-state-'):]} |"))
+    q = f.velstep.rows[0].quantities
+    assert report_velstep.cell(q["a"]) in row and report_velstep.cell(q["Dc"]) in row and "±" in row
+    fig = next(b[1] for s in sections for b in s.blocks if b[0] == "fig" and b[1].name == "velstep-lab-step.png")
+    assert is_png(fig.draw())
+    assert "trend" in fig.side  # what the fit says about the sign of a - b, beside the figure
+
+
+def test_the_figure_table_gives_intervals_in_laboratory_units(comp):
+    from frictionlab.report.figures.velstep import _table_text
+
+    f = report_velstep.measured_steps(comp)[0][1][0]
+    text = _table_text(f)
+    q = f.velstep.rows[0].quantities
+    assert "µm" in text and "1/µm" in text and f"[{q['Dc'].low:.{q['Dc'].digits}g}" in text
