@@ -9,9 +9,10 @@ import math
 import numba
 import numpy as np
 
-from .memory_codes import (CALLS, COUPLED, DIRECTION, DRIVE, IL, ILOAD, INERTIA, ITH, IW, LAW, LUGRE, DAHL, MASS,
-                           MAXCALLS, NORMAL, NORMAL_HALF_SINE, NORMAL_PHI, NORMAL_TC, NORMAL_VALUE, RADIUS, RS_SLIP,
-                           SPIN, STIFFNESS, STOP_T, TINY, TSCALE, BAD, V0)
+from .memory_codes import (BAD, CALLS, COUPLED, DAHL, DAHL_SLID, DIRECTION, DRIVE, IL, ILOAD, INERTIA, ITH, IW, LAW,
+                           LUGRE, MASS, MAXCALLS, NORMAL, NORMAL_HALF_SINE, NORMAL_PHI, NORMAL_TC, NORMAL_VALUE,
+                           NOT_FINITE, RADIUS, RS_SLIP, S0, SENSE, SPIN, STRICT, STIFFNESS, STOP_T, TINY, TOO_MANY, TSCALE,
+                           TURNED, V0)
 
 jit = numba.njit(cache=True, fastmath=False, error_model="numpy")
 
@@ -22,9 +23,35 @@ def _sign(x):
 
 
 @jit
-def law(code, P, u, x):
+def dahl_slid(P, s0, X):
+    """Dahl's s = 1 - mu_d sign(u)/mu_c and ds/dX after a slip X [m] in one sense from s0: ds/dX = -(sigma/mu_c)
+    |s|^alpha sign(s) solved in closed form (for alpha < 1, s reaches 0 after a finite slip and stays)."""
+    mu_c, sigma, alpha = P[0], P[1], P[2]
+    k = sigma / mu_c
+    if s0 == 0.0:
+        return 0.0, 0.0
+    if alpha == 1.0:
+        s = s0 * math.exp(-k * X)
+        return s, -k * s
+    base = abs(s0) ** (1.0 - alpha) + (alpha - 1.0) * k * X
+    if base <= 0.0:  # alpha < 1: arrived
+        return 0.0, 0.0
+    s = _sign(s0) * base ** (1.0 / (1.0 - alpha))
+    return s, -k * abs(s) ** alpha * _sign(s0)
+
+
+@jit
+def law(code, P, C, u, x):
     """(mu, d mu/du, d mu/dx, rate, d rate/du, d rate/dx) of the law ``code`` per unit normal force at slip u
-    [m/s] and state x, parameters P in the law's order (laws/lugre.py, dahl.py, rate_state*.py)."""
+    [m/s] and state x, parameters P in the law's order (laws/lugre.py, dahl.py, rate_state*.py). DAHL_SLID is
+    Dahl with the slip X [m] since the phase began as its state (x), while the slip keeps the sense C[SENSE]:
+    mu_d = sense mu_c (1 - s(X)) from s(0) = C[S0] (``dahl_slid``), dX/dt = |u|: smooth where d mu_d/dt =
+    sigma u |s|^alpha sign(s) is not (alpha < 1 at s = 0). Where the slip turns, ``rhs`` stops with C[BAD] =
+    TURNED when C[STRICT]; otherwise it goes on with dX/dt = sense u (a stage past the turn, which an event ends)."""
+    if code == DAHL_SLID:
+        sense = C[SENSE]
+        s, ds = dahl_slid(P, C[S0], x)
+        return sense * P[0] * (1.0 - s), 0.0, -sense * P[0] * ds, u * sense, sense, 0.0
     if code == LUGRE:
         mu_c, mu_s, vs, s0, s1, s2 = P[0], P[1], P[2], P[3], P[4], P[5]
         q = u / vs
@@ -107,9 +134,9 @@ def rhs(s, z, P, C, scale, V):
     out = np.empty(n)
     C[CALLS] += 1.0
     if C[CALLS] > C[MAXCALLS]:
-        if C[BAD] != 2.0:
+        if C[BAD] != TOO_MANY:
             C[STOP_T] = s * C[TSCALE]
-        C[BAD] = 2.0
+        C[BAD] = TOO_MANY
         out[:] = np.nan
         return out
     tsc = C[TSCALE]
@@ -118,11 +145,16 @@ def rhs(s, z, P, C, scale, V):
     u, free = _slip(C, y)
     il = int(C[IL])
     N = _normal(C, t)
-    mu, _, _, rate, _, _ = law(int(C[LAW]), P, u, y[il])
+    code = int(C[LAW])
+    if code == DAHL_SLID and C[STRICT] and u * C[SENSE] < 0.0:
+        C[BAD] = TURNED
+        out[:] = np.nan
+        return out
+    mu, _, _, rate, _, _ = law(code, P, C, u, y[il])
     F = N * mu
     if not (math.isfinite(F) and math.isfinite(rate)):
         if C[BAD] == 0.0:
-            C[BAD] = 1.0
+            C[BAD] = NOT_FINITE
         out[:] = np.nan
         return out
     iload = int(C[ILOAD])
@@ -152,7 +184,7 @@ def jac(s, z, P, C, scale, V):
     u, free = _slip(C, y)
     il = int(C[IL])
     N = _normal(C, t)
-    _, dmu_du, dmu_dl, _, dr_du, dr_dl = law(int(C[LAW]), P, u, y[il])
+    _, dmu_du, dmu_dl, _, dr_du, dr_dl = law(int(C[LAW]), P, C, u, y[il])
     du = np.zeros(n)  # d u / d y
     iw = int(C[IW])
     if free:
@@ -177,3 +209,12 @@ def jac(s, z, P, C, scale, V):
         for j in range(n):
             J[i, j] = J[i, j] * (tsc * scale[j] / scale[i])
     return J
+
+
+@jit
+def dahl_mu(P, s0, sense, X):
+    """mu_d [-] after the slips X [m] (an array) of a DAHL_SLID phase (see ``law``)."""
+    out = np.empty(X.size)
+    for i in range(X.size):
+        out[i] = sense * P[0] * (1.0 - dahl_slid(P, s0, X[i])[0])
+    return out

@@ -24,9 +24,9 @@ import math
 import numpy as np
 
 from . import compiled
-from .memory_codes import (COUPLED, DIRECTION, DRIVE, IL, ILOAD, INERTIA, ITH, IW, LAW, MASS, MAXCALLS, NC, NORMAL,
-                           NORMAL_CONSTANT, NORMAL_HALF_SINE, NORMAL_PHI, NORMAL_TC, NORMAL_VALUE, RADIUS, SPIN,
-                           STIFFNESS, STOP_T, TINY, TSCALE, CALLS, BAD, DAHL, LUGRE, RS_AGING, RS_SLIP)
+from .memory_codes import (BAD, CALLS, COUPLED, DAHL, DAHL_SLID, DIRECTION, DRIVE, IL, ILOAD, INERTIA, ITH, IW, LAW,
+                           LUGRE, MASS, MAXCALLS, NC, NORMAL, NORMAL_CONSTANT, NORMAL_HALF_SINE, NORMAL_PHI, NORMAL_TC,
+                           NORMAL_VALUE, RADIUS, RS_AGING, RS_SLIP, S0, SENSE, SPIN, STIFFNESS, STOP_T, STRICT, TINY, TSCALE)
 
 #: The built-in laws with memory served here, by (module, class), with their code and parameter order.
 LAWS = {("frictionlab.laws.lugre", "LuGre"): (LUGRE, ("mu_c", "mu_s", "vs", "sigma0", "sigma1", "sigma2")),
@@ -47,28 +47,31 @@ def _normal(model):
     return None
 
 
+#: The most turns of the slip a Dahl phase follows in the slid form before it is integrated in mu_d instead.
+MAX_TURNS = 100
+
+
 class Phase:
     """The kernel's arguments for one sliding phase: ``f(s, z)`` and ``jac(s, z)`` call it from Python; ``args``
     are what ``rhs(s, z, *args)`` and ``jac(s, z, *args)`` take (ODEPACK's loop calls them directly).
-    ``C[CALLS]`` counts the calls; ``C[BAD]`` is 2 once they passed the cap (at ``stop_time``), 1 where a value
-    was not finite (the kernel then returns NaN, and the phase is not to be trusted)."""
+    ``C[CALLS]`` counts the calls; ``C[BAD]`` says why the phase is not to be trusted (memory_codes: a value not
+    finite, the calls past the cap at ``stop_time``, Dahl's slip turned). ``y0`` and ``scale``: the phase's
+    initial state and state scales as integrated (Dahl's slid form integrates the slip since the phase began in
+    place of mu_d); ``states(Y)`` gives back the plan's states."""
 
-    def __init__(self, P, C, scale, V):
+    def __init__(self, P, C, y0, scale, V):
         from . import memory_kernel
 
         self.kernel = memory_kernel
-        self.C = C
-        self.args = (P, C, np.ascontiguousarray(scale, dtype=float), V)
+        self.C, self.P = C, P
+        self.y0, self.scale = y0, np.ascontiguousarray(scale, dtype=float)
+        self.args = (P, C, self.scale, V)
 
     def f(self, s, z):
         return self.kernel.rhs(s, z, *self.args)
 
     def jac(self, s, z):
         return self.kernel.jac(s, z, *self.args)
-
-    @property
-    def calls(self) -> int:
-        return int(self.C[CALLS])
 
     @property
     def bad(self) -> int:
@@ -79,6 +82,16 @@ class Phase:
         """The time [s] at which the calls passed the cap."""
         return float(self.C[STOP_T])
 
+    def states(self, Y):
+        """The plan's states from the integrated ones (n_states, k) (a copy where they differ), or None for None."""
+        if Y is None or self.C[LAW] != DAHL_SLID:
+            return Y
+        Y = np.array(Y, dtype=float)
+        il = int(self.C[IL])
+        Y[il] = self.kernel.dahl_mu(self.P, self.C[S0], self.C[SENSE], np.ascontiguousarray(Y[il]).ravel()).reshape(
+            Y[il].shape)
+        return Y
+
 
 def served(plan) -> bool:
     """Whether ``phase`` serves this plan's law and scene (numba aside)."""
@@ -88,18 +101,22 @@ def served(plan) -> bool:
             and (s.spring is None or s.spring.inertial))
 
 
-def phase(plan, p, direction: float, vanishing: float, tscale: float, scale, max_calls: int) -> Phase | None:
-    """The compiled phase of ``plan`` for law parameters p (SI): slip direction (0: none) and the slip held while
-    a stage has not got its sign (``solvers.stick.vanishing_slip``), time scale [s] and state scales as
-    ``solvers.ode`` scales the problem, at most ``max_calls`` calls; None where it does not serve the plan."""
+def phase(plan, p, direction: float, vanishing: float, tscale: float, y0, scale, max_calls: int,
+          slid: bool = True, sense: float | None = None) -> Phase | None:
+    """The compiled phase of ``plan`` for law parameters p (SI) from the state y0: slip direction (0: none) and the
+    slip held while a stage has not got its sign (``solvers.stick.vanishing_slip``), time scale [s] and state
+    scales as ``solvers.ode`` scales the problem, at most ``max_calls`` calls; None where it does not serve the
+    plan. slid: Dahl in its slid form (``memory_kernel.law``) where the phase's slip has a sense; sense: that
+    sense, given (then the slip may turn: an event ends the phase there), or None: the initial slip's (or the
+    drive's), and the kernel stops where the slip turns."""
     if not served(plan) or not compiled.available():
         return None
     s, law = plan.scene, plan.law
     code, names = LAWS[(type(law).__module__, type(law).__name__)]
     P = np.array([float(p[k]) for k in names])
     C = np.zeros(NC)
-    C[LAW] = code
-    C[IL] = plan.index(plan.law_states[0])
+    il = plan.index(plan.law_states[0])
+    C[IL] = il
     spin = plan.has_spin
     if spin:
         C[IW], C[ITH] = plan.index("omega"), plan.index("theta")
@@ -117,4 +134,18 @@ def phase(plan, p, direction: float, vanishing: float, tscale: float, scale, max
         V = np.array([s.spring.times, s.spring.velocities], dtype=float)
     else:
         V = np.zeros((2, 1))
-    return Phase(P, C, scale, V)
+    y0 = np.array(y0, dtype=float)
+    scale = np.array(scale, dtype=float)
+    C[STRICT] = float(sense is None)
+    if sense is None:
+        u0 = float(plan.rigid_slip(y0))
+        sense = np.sign(u0) if u0 != 0.0 else (np.sign(plan.drive) if s.spring is None else 0.0)
+    if code == DAHL and slid and sense != 0.0:  # integrate the slip since the phase began in place of mu_d
+        code = DAHL_SLID
+        C[SENSE] = sense
+        C[S0] = 1.0 - y0[il] * sense / P[0]
+        y0[il] = 0.0
+        # the slip over which s relaxes, mu_c / sigma, or the distance slid where that is shorter
+        scale[il] = max(min(float(scale[0]) * float(tscale), P[0] / P[1]), 1e-300)
+    C[LAW] = code
+    return Phase(P, C, y0, scale, V)

@@ -17,6 +17,7 @@ import scipy.integrate
 from scipy.optimize import brentq
 
 from ...core.errors import FrictionLabError, SolverError
+from ..memory_codes import CALLS, SENSE, TOO_MANY, TURNED
 
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 
@@ -179,19 +180,60 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
         T = float(t_out[-1])
         scale = phase_scales(plan, p, t0, T, y0, direction)
         event = _zero_slip_event(plan, direction, scale)
-        fast = _memory_phase(plan, p, direction, T, scale)
-        if fast is not None:
+        for slid in (True, False):
+            fast = _memory_phase(plan, p, direction, T, y0, scale, slid)
+            if fast is None:
+                break
             try:
-                return _integrate_phase(plan, fast.f, event, t0, T, y0, direction, t_out, scale, method, rtol, atol,
-                                        fast.jac if method in IMPLICIT else None, fast)
+                Y, t_stop, y_stop, info = _integrate_phase(plan, fast.f, event, t0, T, fast.y0, direction, t_out,
+                                                           fast.scale, method, rtol, atol,
+                                                           fast.jac if method in IMPLICIT else None, fast)
+                return fast.states(Y), t_stop, fast.states(y_stop), info
             except SolverError:
-                if fast.bad == 2:
+                if fast.bad == TOO_MANY:
                     raise SolverError(f"ode:{method}: {_too_many(plan, fast.stop_time, method)}") from None
-                # anything else (a value not finite, a failed step) is the general path's to handle or to say
+                if fast.bad != TURNED:
+                    break  # a value not finite or a failed step: the general path's to handle or to say
+            try:  # Dahl's slip turned: slid phases from turn to turn
+                return _turns(plan, p, t0, T, y0, float(fast.C[SENSE]), t_out, scale, method, rtol, atol)
+            except SolverError:
+                if fast.bad == TOO_MANY:
+                    raise SolverError(f"ode:{method}: {_too_many(plan, fast.stop_time, method)}") from None
         f = _scaled_rates(plan, p, direction, T, scale, method)
         return _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method, rtol, atol)
 
     return slide
+
+
+def _turns(plan, p, t0, T, y0, sense, t_out, scale, method, rtol, atol):
+    """A Dahl phase in the slid form (``memoryrhs``) as a chain of phases of one slip sense each, the next one
+    begun where the slip turns (an event: slip past zero by SLIP_MARGIN of its scale), from the friction reached
+    there; SolverError past MAX_TURNS turns (then mu_d is integrated instead) or MAX_NFEV calls."""
+    from ..memoryrhs import MAX_TURNS, phase
+
+    t_out = np.asarray(t_out, dtype=float)
+    Y = np.empty((len(plan.states), t_out.size))
+    done, t, y, calls, stats = 0, t0, np.asarray(y0, dtype=float), 0, {"nfev": 0, "njev": 0, "nlu": 0}
+    iw = plan.index("omega") if plan.coupled else 0
+    r, sv = (plan.scene.radius if plan.coupled else 0.0), float(scale[0])
+    for _ in range(MAX_TURNS):
+        ph = phase(plan, p, 0.0, 0.0, T, y, scale, MAX_NFEV - calls, True, sense)
+        turn = (lambda s, z, sw=float(ph.scale[iw]), k=sense:
+                k * (z[0] * sv - r * (z[iw] * sw)) / sv + SLIP_MARGIN)
+        try:
+            Ys, t_stop, y_stop, info = _integrate_phase(plan, ph.f, turn, t, T, ph.y0, 1.0, t_out[done:], ph.scale,
+                                                        method, rtol, atol, ph.jac if method in IMPLICIT else None,
+                                                        ph)
+        finally:
+            calls += int(ph.C[CALLS])
+        Y[:, done:done + Ys.shape[1]] = ph.states(Ys)
+        done += Ys.shape[1]
+        for k in stats:
+            stats[k] += info[k]
+        if t_stop is None:
+            return Y, None, None, {**info, **stats}
+        t, y, sense = t_stop, ph.states(y_stop[:, None])[:, 0], -sense
+    raise SolverError(f"ode:{method}: Dahl's slip turned more than {MAX_TURNS} times")
 
 
 #: The methods that take a Jacobian.
@@ -233,7 +275,7 @@ def _zero_slip_event(plan, direction, scale):
     return zero_slip
 
 
-def _memory_phase(plan, p, direction, tscale, scale):
+def _memory_phase(plan, p, direction, tscale, y0, scale, slid=True):
     """``memoryrhs.phase``: the compiled right-hand side and Jacobian of a built-in law with memory on a scene
     written out there, for this phase; None where it does not serve."""
     if not plan.law_states:
@@ -241,8 +283,8 @@ def _memory_phase(plan, p, direction, tscale, scale):
     from ..memoryrhs import phase
     from .stick import vanishing_slip
 
-    return phase(plan, p, float(direction), float(vanishing_slip(plan)) if direction != 0 else 0.0, tscale, scale,
-                 MAX_NFEV)
+    return phase(plan, p, float(direction), float(vanishing_slip(plan)) if direction != 0 else 0.0, tscale, y0,
+                 scale, MAX_NFEV, slid)
 
 
 def _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method, rtol, atol, jac=None, compiled=None):
