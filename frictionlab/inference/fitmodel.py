@@ -247,10 +247,10 @@ def _si(params, slots) -> dict[str, float]:
     return {s.pname: params[s.pname].value * s.scale for s in slots}
 
 
-def _start_grid(slots, rng, limit: int) -> list[dict[str, float]]:
+def _start_grid(slots, rng, limit: int, decades: float = 1.5) -> list[dict[str, float]]:
     """Candidate starts in scaled units, the given start first: log-spaced multiples of the start
-    for positive quantities, steps of the scale around it for signed ones, the bounds' span for
-    scene quantities; clipped into the bounds. A full grid if it has at most ``limit`` points."""
+    for positive quantities (10^-decades to 10^decades), steps of the scale around it for signed ones, the
+    bounds' span for scene quantities; clipped into the bounds. A full grid if it has at most ``limit`` points."""
     levels = max(3, min(15, int(round(limit ** (1.0 / len(slots))))))
     axes = []
     for s in slots:
@@ -259,7 +259,7 @@ def _start_grid(slots, rng, limit: int) -> list[dict[str, float]]:
         if s.kind == "scene":
             c = np.linspace(lo, hi, levels)
         elif lo >= 0 and x0 > 0:
-            c = x0 * np.logspace(-1.5, 1.5, levels)
+            c = x0 * np.logspace(-decades, decades, levels)
         else:
             c = x0 + np.sinh(np.linspace(-4.0, 4.0, levels))  # dense near the start, out to +/- 27 scales
         axes.append(np.unique(np.clip(c, lo, hi)))
@@ -313,8 +313,10 @@ def lmfit_leastsq(lmfit, model: _Model, slots, params, scale_covar: bool, budget
     return mini.minimize(method="leastsq", epsfcn=epsfcn(model), ftol=FTOL, xtol=FTOL)
 
 
-#: How many times the given number of start points a compiled law with memory scores (``compiled_memory``).
+#: How many times the given number of start points a compiled law with memory scores (``compiled_memory``), and
+#: the decades either side of each positive parameter's start that the added points span.
 MEMORY_SCAN = 4
+MEMORY_DECADES = 1.5
 
 
 def compiled_memory(model: _Model) -> bool:
@@ -364,20 +366,26 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
     slow = any(x.startswith("ode") for x in solvers)
     wide = slow and compiled_memory(model)
     if wide:  # cheap solves of a law with memory: a wider scan, every start refined (see compiled_memory)
-        scan, slow = scan * MEMORY_SCAN, False
+        slow = False
     starts = [{s.pname: params[s.pname].value for s in varying}]
     if model.progress is not None:
         from .fitprogress import LM_EVALS
 
         lm = LM_EVALS * (len(varying) + 1)
-        model.progress.stage("scanning start points", scan, total=scan + n_starts * lm + 2 * len(varying) + 2)
+        k = scan * (MEMORY_SCAN if wide else 1)
+        model.progress.stage("scanning start points", k, total=k + n_starts * lm + 2 * len(varying) + 2)
     if scan:
         fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
         grid = _start_grid(varying, np.random.default_rng(0), scan)
+        given = len(grid)
+        if wide and MEMORY_SCAN > 1:  # the same grid, and MEMORY_SCAN - 1 times as many on a finer and wider one
+            grid += _start_grid(varying, np.random.default_rng(1), (MEMORY_SCAN - 1) * scan, MEMORY_DECADES)[1:]
         points = [{s.pname: vals[s.pname] * s.scale for s in slots} for vals in ({**fixed_part, **c} for c in grid)]
         scored = [(float(r @ r), i, c) for i, (r, c) in enumerate(zip(model.residuals(points), grid))]
         scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins
         starts = _distinct(scored, min(n_starts, ODE_STARTS) if slow else n_starts)
+        if wide:  # and the best of the given grid alone, as a fit of a law without memory starts
+            starts += [c for c in _distinct([x for x in scored if x[1] < given], n_starts) if c not in starts]
     best, notes = None, []
     for i, start in enumerate(starts):
         for k, v in start.items():  # every varying parameter; lmfit works on its own copy
