@@ -79,7 +79,7 @@ def main() -> None:
     import frictionlab as fl
 
     t0 = time.process_time()
-    fl.simulate("lugre", "incline-oil-a100", rtol=1e-6)
+    fl.simulate("lugre", fl.load_dataset("incline-oil-a100"), rtol=1e-6)
     print(f"cold start: the first compiled solve in this process {time.process_time() - t0:.2f} CPU s "
           "(numba's kernel loaded from its cache, or compiled once per machine)")
     print(f"\n{'law':17s} {'dataset':18s} {'chi2 frictionlab':>16s} {'chi2 plain':>12s} {'CPU fl [s]':>10s} "
