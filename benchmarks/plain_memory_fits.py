@@ -3,7 +3,8 @@
 
 Each fit: a float right-hand side with its analytic Jacobian, integrated by solve_ivp's LSODA at rtol 1e-8; a
 scan of 125 log-uniform random starts over wide ranges (seeded); ``least_squares`` (trust region, x_scale 'jac',
-2-point differences with a relative step of 1e-6) from the two best; the lower chi-square wins. Scenes:
+2-point differences with a relative step of 1e-6) from the two best; the lower chi-square wins. A solve that
+fails or takes more than 50,000 right-hand-side calls is penalized (residual 1e4 per point). Scenes:
   incline  m dv/dt = m g sin(alpha) - F, N = m g cos(alpha), from rest;
   impact   m dv/dt = -F, I domega/dt = F r, dtheta/dt = omega, N(t) half-sine of impulse m v_n (1 + e) over t_c;
            the observables are the paper's stated numbers read off a 401-point grid over the contact (peak spin
@@ -29,6 +30,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import least_squares
 
 G = 9.80665
+MAX_CALLS = 50_000  # right-hand-side calls a solve may take before it counts as failed (penalized)
 V0 = 1e-6
 UNITS = {"g": 1e-3, "kg": 1.0, "deg": math.pi / 180, "mm/s": 1e-3, "m/s": 1.0, "us": 1e-6, "s": 1.0, "mm": 1e-3,
          "rpm": 2 * math.pi / 60, "um": 1e-6}
@@ -125,8 +127,12 @@ def incline(meta, cols, make, rtol):
 
     def model(p):
         law, x0 = make(p)
+        calls = [0]
 
         def f(_, y):
+            calls[0] += 1
+            if calls[0] > MAX_CALLS:
+                raise ArithmeticError("too many calls")
             u = max(y[0], 1e-15) if stick else y[0]
             mu, _, _, rate, _, _ = law(u, y[1])
             return [drive - N * mu / m, rate]
@@ -170,8 +176,12 @@ def impact(meta, cols, make, rtol):
 
     def model(p):
         law, x0 = make(p)
+        calls = [0]
 
         def f(t, y):
+            calls[0] += 1
+            if calls[0] > MAX_CALLS:
+                raise ArithmeticError("too many calls")
             N = peak * math.sin(math.pi * t / tc) if t <= tc else 0.0
             mu, _, _, rate, _, _ = law(y[0], y[3])
             F = N * mu
