@@ -12,7 +12,7 @@ class Couette(FrictionLaw):
     citation = "Arakawa, Tribol. Int. (2016), PU rubber on oiled PMMA incline"
     params = (
         ParamSpec("eta", "Pa s", 0.1, 1e-6, 1e6, 0.1, "lubricant dynamic viscosity"),
-        ParamSpec("h", "m", 1e-6, 1e-12, 1.0, 1e-6, "lubricant film thickness"),
+        ParamSpec("h", "m", 1e-6, 1e-12, 1.0, 1e-6, "lubricant film thickness", display="um"),
     )
     requires = frozenset({"u", "A"})
     ratio_only = (("eta", "h"),)

@@ -36,7 +36,7 @@ class RateState(FrictionLaw):
         ParamSpec("mu0", "", 0.6, 0.0, 2.0, 0.1, "steady-state friction at V0 = 1 um/s"),
         ParamSpec("a", "", 0.01, 1e-5, 0.5, 0.01, "direct-effect parameter"),
         ParamSpec("b", "", 0.01, 0.0, 0.5, 0.01, "evolution-effect parameter"),
-        ParamSpec("Dc", "m", 1e-5, 1e-9, 1.0, 1e-5, "critical slip distance"),
+        ParamSpec("Dc", "m", 1e-5, 1e-9, 1.0, 1e-5, "critical slip distance", display="um"),
     )
     requires = frozenset({"u", "N"})
     states = (StateSpec("theta", "s", "steady", 1.0, "state variable (contact age)"),)

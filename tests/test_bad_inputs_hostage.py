@@ -1,4 +1,4 @@
-"""Plugins cannot take the process hostage (issue 23, class 4): a third-party law whose bare ``except:``
+"""Plugins cannot take the process hostage (the corpus's plugin class): a third-party law whose bare ``except:``
 swallows the in-process alarm is stopped from outside its code in every stage that calls it (the fit,
 the equivalence test's cross-fits, qualitative simulation and replicates, the transfer predictions and
 shared fit, the tolerance refits, the bootstrap replicates), with --jobs 1 and --jobs 2; a --load file

@@ -1,4 +1,4 @@
-"""Hardening (issue 13): plugins isolated, fits with a time budget, degenerate data skipped, outputs
+"""Hardening: plugins isolated, fits with a time budget, degenerate data skipped, outputs
 locked and written with the umask, every write error naming its path, worker pools that die with
 the run. The bad-input corpus (tests/bad_inputs/cases.toml) covers the one-line errors; these tests
 cover what a corpus case cannot: real signals and concurrent runs in subprocesses, a full disk, the

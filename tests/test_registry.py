@@ -12,7 +12,7 @@ from frictionlab.core.errors import LawError, RegistryError
 from frictionlab.physics import registry
 from frictionlab.physics.law import Contact
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+LAW_GUIDE = Path(__file__).resolve().parents[1] / "docs" / "guides" / "registering-a-law.md"
 
 
 def test_builtin_laws_come_from_entry_points():
@@ -166,9 +166,9 @@ def test_two_plugins_with_one_name_is_an_error_naming_both(tmp_path, monkeypatch
 
 
 def _readme_law_code() -> str:
-    text = README.read_text()
+    text = LAW_GUIDE.read_text()
     block = re.search(r"```python\n(import numpy as np\n\nfrom frictionlab import FrictionLaw.*?)```", text, re.S)
-    assert block, "README has no law example"
+    assert block, "the law guide has no law example"
     return block.group(1)
 
 

@@ -202,10 +202,10 @@ def _readme_stateful_code() -> str:
     import re
     from pathlib import Path
 
-    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    text = (Path(__file__).resolve().parents[1] / "docs" / "guides" / "registering-a-law.md").read_text()
     block = re.search(r"```python\n(import numpy as np\n\nfrom frictionlab import FrictionLaw, ParamSpec, StateSpec.*?)```",
                       text, re.S)
-    assert block, "README has no stateful law example"
+    assert block, "the law guide has no stateful law example"
     return block.group(1)
 
 

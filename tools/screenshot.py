@@ -1,10 +1,15 @@
 """Render a report's report.html in headless Chromium and save screenshots, to look at as a reader would.
 
     python tools/screenshot.py REPORT_FOLDER_OR_HTML [--out DIR] [--height 1000 --height 4000] [--open]
+    python tools/screenshot.py --readme
+    python tools/screenshot.py --site SITE_FOLDER --out DIR
 
 Writes DIR/screen-<height>.png (default DIR: the report folder) for a 1400 px wide window of each
-height: 1000 px is the first screen; --open opens every collapsible section first. Needs
-Debian's ``chromium`` (apt-get install chromium).
+height: 1000 px is the first screen; --open opens every collapsible section first.
+--readme runs ``frictionlab compare`` (the README's command 1) into a temporary folder and saves the first
+screen of its report as docs/images/first-screen.png, the README's picture.
+--site saves the first screen of each page of a built documentation site (``mkdocs build --site-dir
+SITE_FOLDER``) as DIR/<page>.png. Needs Debian's ``chromium`` (apt-get install chromium).
 """
 from __future__ import annotations
 
@@ -87,13 +92,52 @@ def first_screen_layout(html: Path, height: int = 1000, width: int = WIDTH, time
     return json.loads(_html.unescape(m.group(1)))
 
 
+ROOT = Path(__file__).resolve().parents[1]
+README_PICTURE = ROOT / "docs" / "images" / "first-screen.png"
+
+
+def readme_picture(png: Path = README_PICTURE) -> Path:
+    """Run the README's main job (``frictionlab compare``) in a temporary folder and save its report's first
+    screen (1400 x 1000 px) as ``png``."""
+    exe = Path(sys.executable).parent / "frictionlab"
+    with tempfile.TemporaryDirectory(prefix="frictionlab-readme-") as tmp:
+        subprocess.run([str(exe) if exe.exists() else "frictionlab", "compare", "--quiet", "--out", f"{tmp}/report"],
+                       check=True, cwd=tmp, stdout=subprocess.DEVNULL)
+        png.parent.mkdir(parents=True, exist_ok=True)
+        return screenshot(Path(tmp) / "report" / "report.html", png)
+
+
+def site_pictures(site: Path, out: Path, height: int = 1000) -> list[Path]:
+    """The first screen of every page of a built documentation site, as out/<page path with '-'>.png."""
+    out.mkdir(parents=True, exist_ok=True)
+    done = []
+    for page in sorted(site.rglob("index.html")):
+        rel = page.parent.relative_to(site)
+        if rel.parts and rel.parts[0] in ("search", "assets"):
+            continue
+        name = "-".join(rel.parts) or "home"
+        done.append(screenshot(page, out / f"{name}.png", height))
+    return done
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("report", type=Path, help="a report folder or its report.html")
+    ap.add_argument("report", type=Path, nargs="?", help="a report folder or its report.html")
+    ap.add_argument("--readme", action="store_true", help="make the README's picture, docs/images/first-screen.png")
+    ap.add_argument("--site", type=Path, help="a built documentation site: the first screen of each page")
     ap.add_argument("--out", type=Path, help="folder for the PNGs (default: the report folder)")
     ap.add_argument("--height", type=int, action="append", help="window height in px (repeatable; default 1000)")
     ap.add_argument("--open", action="store_true", help="open every collapsible section (screen-open-<height>.png)")
     args = ap.parse_args(argv)
+    if args.readme:
+        print(readme_picture())
+        return 0
+    if args.site:
+        for png in site_pictures(args.site, args.out or Path("site-screens"), (args.height or [1000])[0]):
+            print(png)
+        return 0
+    if args.report is None:
+        ap.error("give a report folder, --readme or --site")
     html = args.report / "report.html" if args.report.is_dir() else args.report
     out = args.out or html.parent
     out.mkdir(parents=True, exist_ok=True)

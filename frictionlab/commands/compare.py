@@ -17,7 +17,7 @@ REPLICATES = 400
 #: ODE tolerances at which ``--tolerance`` refits the ODE laws of one dataset for the report: a looser one
 #: and a tighter one than the fits' default (predict.FIT_RTOL, 1e-6), so the report shows the default converged.
 #: A robustness check beside the answer, run on demand: it changes no fit, ranking or verdict, and costs about a
-#: tenth of a default comparison (issue 22); the report says when it was not run and how to run it.
+#: tenth of a default comparison; the report says when it was not run and how to run it.
 TOLERANCE_RTOLS = (1e-3, 1e-10)
 MAX_JOBS = 64  # worker processes: more only forks processes that wait
 MAX_BOOTSTRAP = 100_000  # resamples: far past where percentile intervals stop moving
@@ -37,6 +37,8 @@ def add_parser(sub):
   frictionlab compare --laws wear,area-rate --data impact-golf-v28 --out golf
   frictionlab compare --data my.toml --data impact-golf-v61 --solver exact --solver series
   frictionlab compare --tolerance --out full    # also refit the ODE laws at other solver tolerances
+  frictionlab compare --laws rate-state-aging,rate-state-slip --data spring-slider-small-step \
+      --pairs rate-state-aging:rate-state-slip --bootstrap-all --out steps   # aging against slip
   frictionlab compare --bootstrap 0 --quiet --out quick   # fastest, no progress lines""")
     p.add_argument("--laws", "--law", action=ListAction, metavar="NAME", help="law names, or 'all' for every registered law "
                    "(default: coulomb, area-rate, wear, couette)")
@@ -56,6 +58,9 @@ def add_parser(sub):
                    help="run the fits, refits, tests, bootstrap and figures on the Dask cluster whose scheduler is "
                         "at ADDRESS (e.g. tcp://10.0.0.5:8786; needs pip install 'frictionlab[dask]'); --jobs is "
                         "then unused")
+    p.add_argument("--pairs", "--pair", action=ListAction, metavar="LAW:LAW",
+                   help="the pairs of laws whose equivalence is tested, e.g. rate-state-aging:rate-state-slip "
+                        "(default: wear:area-rate, wear:couette, coulomb:wear, where both laws are compared)")
     p.add_argument("--no-equivalence", action="store_true", help="skip the equivalence (discrimination) tests")
     p.add_argument("--replicates", type=int, default=REPLICATES, metavar="R",
                    help=f"the most replicate datasets per law in the equivalence test's sequential parametric bootstrap "
@@ -103,16 +108,41 @@ def run(args) -> int:
     if args.replicates < MIN_REPLICATES:
         raise ParameterError(f"--replicates must be at least {MIN_REPLICATES}, got {args.replicates}")
     free = parse_free(args.free)
+    pairs = parse_pairs(args.pairs, args.laws or None) if args.pairs else None
     datasets = [load_dataset(d) for d in args.data or builtin_names()]  # read first: --out keeps clear of them
     client = connect(args.scheduler) if args.scheduler else None
     try:
-        return _run(args, free, datasets, client)
+        return _run(args, free, pairs, datasets, client)
     finally:
         if client is not None:
             client.close()
 
 
-def _run(args, free, datasets, client) -> int:
+def parse_pairs(items, laws) -> tuple[tuple[str, str], ...]:
+    """--pairs 'wear:area-rate' ... -> (('wear', 'area-rate'), ...): registered names, two different laws, both
+    among the compared ``laws`` (None: the default set)."""
+    from ..physics.registry import get_law
+    from ..pipeline.settings import select_laws
+
+    compared = set(select_laws(laws))
+    pairs = []
+    for item in items:
+        a, sep, b = item.partition(":")
+        if not sep or not a.strip() or not b.strip() or ":" in b:
+            raise ParameterError(f"--pairs {item!r}: expected LAW:LAW, e.g. wear:area-rate")
+        a, b = get_law(a.strip()).name, get_law(b.strip()).name
+        if a == b:
+            raise ParameterError(f"--pairs {item!r}: a law is always equivalent to itself; name two different laws")
+        missing = [x for x in (a, b) if x not in compared]
+        if missing:
+            raise ParameterError(f"--pairs {item!r}: {', '.join(missing)} {'is' if len(missing) == 1 else 'are'} not "
+                                 f"among the compared laws ({', '.join(sorted(compared))}); add "
+                                 f"{'it' if len(missing) == 1 else 'them'} to --laws")
+        pairs.append((a, b))
+    return tuple(dict.fromkeys(pairs))
+
+
+def _run(args, free, pairs, datasets, client) -> int:
     from ..core.files import check_target, output_lock
     from ..core.workers import long_run_gc
     from ..pipeline.comparison import compare
@@ -125,7 +155,8 @@ def _run(args, free, datasets, client) -> int:
                              free=free, equivalence=not args.no_equivalence, jobs=args.jobs, progress=bar,
                              bootstrap=args.bootstrap, seed=args.seed, bootstrap_all=args.bootstrap_all,
                              tolerance=TOLERANCE_RTOLS if args.tolerance else (), fit_timeout=args.fit_timeout,
-                             replicates=args.replicates, transfer=args.transfer, client=client)
+                             replicates=args.replicates, transfer=args.transfer, client=client,
+                             **({"pairs": pairs} if pairs else {}))
         with Progress("report", quiet=args.quiet) as bar:
             out = write_report(result, args.out, force=args.force, progress=bar, jobs=args.jobs, client=client)
     ok = sum(f.ok for f in result.fits)

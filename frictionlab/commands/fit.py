@@ -51,24 +51,17 @@ def _split(text: str, what: str) -> tuple[str, str]:
 
 
 def parse_free(items) -> dict:
-    """'u0=8 m/s:14 m/s[:12 m/s]' -> {'u0': (8.0, 14.0[, 12.0])} in SI."""
-    from ..core.units import to_si
+    """'u0=8 m/s:14 m/s[:12 m/s]' -> {'u0': (8.0, 14.0[, 12.0])} in SI (``core.units.as_range``, as the API)."""
+    from ..core.units import as_range
 
     out = {}
     for item in items:
         name, rest = _split(item, "--free")
         if name not in SCENE_QUANTITIES:
             raise ParameterError(f"--free {name}: not a scene quantity; choose from {', '.join(SCENE_QUANTITIES)}")
-        parts = rest.split(":")
-        if len(parts) not in (2, 3):
+        if len(rest.split(":")) not in (2, 3):
             raise ParameterError(f"--free {item!r}: expected NAME=LOWER:UPPER or NAME=LOWER:UPPER:START")
-        out[name] = tuple(to_si(x.strip(), SCENE_QUANTITIES[name], f"--free {name}") for x in parts)
-        lo, hi = out[name][:2]
-        if not lo < hi:
-            raise ParameterError(f"--free {name}: lower bound {parts[0].strip()!r} must be below upper {parts[1].strip()!r}")
-        if len(parts) == 3 and not lo <= out[name][2] <= hi:
-            raise ParameterError(f"--free {name}: start {parts[2].strip()!r} is outside its bounds "
-                                 f"[{parts[0].strip()}, {parts[1].strip()}]")
+        out[name] = as_range(rest, SCENE_QUANTITIES[name], f"--free {name}")
     return out
 
 

@@ -1,6 +1,7 @@
 """Units at the edge: how SI values are shown in reports, tables and figures."""
 from __future__ import annotations
 
+import functools
 import math
 
 #: Display unit and factor (display = SI * factor) per observable / series.
@@ -82,44 +83,74 @@ def fmt(x, digits: int = 4) -> str:
     return f"{x:.{digits - 1}e}"
 
 
+def rounded(value: float, err: float | None) -> tuple[str, str]:
+    """(value, error) as text, the error to two significant figures and the value to the same decimal
+    place: (397.3, 11.2) -> ('397', '11'); (1.7851e6, 2.13e4) -> ('1.785e6', '0.021e6'). Without a finite,
+    positive error the value has four significant figures and the error is ''."""
+    if err is None or not (math.isfinite(err) and err > 0) or not math.isfinite(value):
+        return fmt(value), ""
+    last = math.floor(math.log10(err)) - 1  # the decimal place of the error's second significant figure
+    top = math.floor(math.log10(abs(value))) if value else last
+    if -3 <= max(top, last) < 5:  # plain decimals
+        d = max(0, -last)
+        return f"{round(value, -last):.{d}f}", f"{round(err, -last):.{d}f}"
+    e = max(top, last + 1)  # one power of ten for both
+    d = e - last
+    return f"{value / 10**e:.{d}f}e{e}", f"{err / 10**e:.{d}f}e{e}"
+
+
 def fmt_value(value: float, err: float | None, unit_: str) -> str:
-    """'1.234e+06 +/- 2.1e+04 Pa s/m' style."""
+    """'397 ± 11 µm': a value rounded to its standard error, with its unit."""
     u = f" {unit_}" if unit_ else ""
-    if err is None:
-        return f"{fmt(value)}{u}"
-    return f"{fmt(value)} ± {fmt(err, 2)}{u}"
+    v, e = rounded(value, err)
+    return f"{v} ± {e}{u}" if e else f"{v}{u}"
 
 
-#: SI unit -> (display unit, factor, threshold): shown in the display unit when |value| < threshold.
+#: How a unit string is written for people (pint reads the left, a reader the right).
+_PRETTY = {"um": "µm", "us": "µs", "1/um": "1/µm", "um/s": "µm/s"}
+
+
+@functools.cache
+def _shown(unit_: str, shown: str) -> tuple[str, float]:
+    """(unit as printed, factor: shown = SI * factor) of a quantity of SI unit ``unit_`` shown in ``shown``."""
+    if not shown or shown == unit_:
+        return unit_, 1.0
+    from .units import unit_factor
+
+    return _PRETTY.get(shown, shown), 1.0 / unit_factor(shown, unit_, f"display unit {shown!r}")
+
+
+def param_text(value: float, err: float | None, unit_: str, shown: str = "") -> str:
+    """A parameter with its error for a table, in its display unit ``shown`` (the law's or the scene
+    quantity's declared unit; '' keeps the SI unit): one unit per quantity, whatever the value's size."""
+    name, f = _shown(unit_, shown)
+    return fmt_value(value * f, None if err is None else err * f, name)
+
+
+def param_cells(value: float, err: float | None, unit_: str, shown: str = "") -> tuple[str, str, str]:
+    """(value, standard error, unit) as table cells, in the display unit ``param_text`` uses."""
+    name, f = _shown(unit_, shown)
+    v, e = rounded(value * f, None if err is None else err * f)
+    return v, e, name
+
+
+def interval_text(lo: float, hi: float, unit_: str, shown: str = "") -> str:
+    """'[lo, hi] unit', in the display unit that ``param_text`` uses."""
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        return ""
+    name, f = _shown(unit_, shown)
+    return f"[{fmt(lo * f)}, {fmt(hi * f)}]" + (f" {name}" if name else "")
+
+
+#: SI unit -> (display unit, factor, threshold): a scene value is shown in the display unit when |value| < threshold.
 _SMALL = {"m": ("µm", 1e6, 1e-3), "m^2": ("mm^2", 1e6, 1e-2), "s": ("µs", 1e6, 2e-3)}
 
 
 def _scale(value: float | None, unit_: str) -> tuple[str, float]:
-    """(display unit, factor) for a parameter of SI unit ``unit_`` and size ``value``."""
+    """(display unit, factor) for a scene value of SI unit ``unit_`` and size ``value``."""
     if unit_ in _SMALL and value is not None and math.isfinite(value) and abs(value) < _SMALL[unit_][2]:
         return _SMALL[unit_][:2]
     return unit_, 1.0
-
-
-def param_text(value: float, err: float | None, unit_: str) -> str:
-    """A parameter with its error for a table, small lengths, areas and times in um, mm^2, us."""
-    name, f = _scale(value, unit_)
-    return fmt_value(value * f, None if err is None else err * f, name)
-
-
-def param_cells(value: float, err: float | None, unit_: str) -> tuple[str, str, str]:
-    """(value, standard error, unit) as table cells, in the display unit ``param_text`` would use."""
-    name, f = _scale(value, unit_)
-    return fmt(value * f), ("" if err is None else fmt(err * f, 2)), name
-
-
-def interval_text(lo: float, hi: float, unit_: str, like: float | None = None) -> str:
-    """'[lo, hi] unit', in the display unit that ``param_text`` uses for a value ``like``."""
-    if not (math.isfinite(lo) and math.isfinite(hi)):
-        return ""
-    name, f = _scale(like if like is not None else hi, unit_)
-    return f"[{fmt(lo * f)}, {fmt(hi * f)}]" + (f" {name}" if name else "")
-
 
 
 #: SI unit of scene fields by name (for describing a scene in units a person reads).
@@ -196,3 +227,37 @@ def describe(obj, unit_: str = "") -> list[str]:
         lines.append(f"  {name}: {sub[0]}")
         lines += ["  " + x for x in sub[1:]]
     return lines
+
+
+# -- what a result draws in a notebook (the .plot() methods) ---------------------------------------------
+
+def figure_axes(ax=None, rows: int = 1, cols: int = 1, size: tuple[float, float] | None = None, **kw):
+    """(figure, axes) to draw on: ``ax`` and its figure when given, else a new figure of ``rows`` x ``cols``
+    axes (a single Axes, or an array squeezed as matplotlib does). The caller's pyplot backend is kept, so
+    a notebook shows the figure inline."""
+    if ax is not None:
+        first = ax if not hasattr(ax, "flat") else ax.flat[0]
+        return first.figure, ax
+    import matplotlib.pyplot as plt
+
+    size = size or (6.4 * cols, 2.6 + 1.9 * rows)
+    return plt.subplots(rows, cols, figsize=size, squeeze=rows * cols == 1, **kw)
+
+
+def display_unit(name: str, file_unit: str | None = None, si_unit: str = "") -> tuple[str, float]:
+    """(unit shown, factor: shown = SI * factor) for a series: the unit the dataset's file gives it where
+    known (so a spin written in rpm is shown in rpm), else the observable's display unit (``unit``)."""
+    if file_unit is not None and (file_unit or si_unit):
+        from .units import unit_factor
+
+        try:
+            return file_unit or "-", 1.0 / unit_factor(file_unit, si_unit, name)
+        except Exception:  # a unit the file gave but that does not convert: fall back, never fail a plot
+            pass
+    shown, factor = unit(name)
+    return ("-" if shown in ("", "-") else shown), factor
+
+
+def axis_label(name: str, shown: str) -> str:
+    """'spin omega [rpm]' for a series name and the unit it is shown in."""
+    return f"{NAMES.get(name, name)} [{shown}]"

@@ -9,7 +9,7 @@ import functools
 import math
 import re
 
-from .errors import UnitError
+from .errors import ParameterError, UnitError
 
 #: Limits checked on a quantity string before pint evaluates it (pint computes integer powers
 #: exactly, so "9**9**9 g" would never finish, and "10**400 g" overflows a float).
@@ -224,3 +224,63 @@ def check_time_scale(t_last: float, duration: float, unit: str, where: str, dura
                     + (f"; the values look like {guess}" if fits else "")
                     + f" (accepted: the last time within {TIME_SPAN_MIN:g} to {TIME_SPAN_MAX:g} times the "
                     "scene's duration)")
+
+
+#: What the Python API accepts wherever a value is given, for error messages.
+FORMS = "a number in SI, a quantity string such as '{example}' or a pint Quantity"
+
+
+def is_quantity(value) -> bool:
+    """True for a pint Quantity (of any unit registry), told by its interface, not its class."""
+    return hasattr(value, "magnitude") and hasattr(value, "units") and hasattr(value, "dimensionality")
+
+
+def as_si(value, si_unit: str, where: str) -> float:
+    """A value of the Python API in SI: an SI number as it is, a quantity string (``"1.5e6 Pa s/m"``) or a
+    pint Quantity converted from its unit (finite, within the accepted magnitudes); a boolean is a
+    ParameterError, anything else or a unit of the wrong dimension a UnitError, each naming ``where`` (the
+    parameter) and ``si_unit`` (the unit expected)."""
+    import numbers
+
+    example = f"1 {si_unit}" if si_unit else "0.3"
+    if isinstance(value, bool) or (hasattr(value, "dtype") and getattr(value.dtype, "kind", "") == "b"):
+        raise ParameterError(f"{where} = {value!r} is a boolean, not a number; expected "
+                             f"{FORMS.format(example=example)}")
+    if isinstance(value, numbers.Real):
+        return float(value)  # SI as given: the caller checks it against the parameter's bounds
+    if isinstance(value, str):
+        return to_si(value, si_unit, where)
+    if is_quantity(value):
+        try:
+            magnitude = float(value.magnitude)
+        except (TypeError, ValueError):
+            raise UnitError(f"{where}: {value!r}: expected one value, got {type(value.magnitude).__name__}") from None
+        unit = str(value.units)
+        if unit == "dimensionless":
+            unit = ""
+        factor = unit_factor(unit, si_unit, f"{where} ({value!r})")
+        return check_magnitude(magnitude * factor, value, where, si_unit)
+    raise UnitError(f"{where}: expected {FORMS.format(example=example)}, got {type(value).__name__} {value!r:.60}")
+
+
+def as_range(value, si_unit: str, where: str) -> tuple[float, ...]:
+    """Bounds (lower, upper) or (lower, upper, start) in SI from ``"low:high[:start]"`` (the command line's
+    form) or a tuple or list of two or three values, each in any form ``as_si`` reads; lower < upper and the
+    start within them, or a UnitError naming ``where``."""
+    if isinstance(value, str):
+        parts = [p.strip() for p in value.split(":")]
+        if len(parts) not in (2, 3) or not all(parts):
+            raise UnitError(f"{where}: {value!r}: expected 'LOWER:UPPER' or 'LOWER:UPPER:START', each with its "
+                            f"unit (like '1 {si_unit}:2 {si_unit}')")
+        items = parts
+    elif isinstance(value, (tuple, list)) and len(value) in (2, 3):
+        items = list(value)
+    else:
+        raise UnitError(f"{where}: expected bounds as 'LOWER:UPPER[:START]' or a tuple (lower, upper[, start]) of "
+                        f"{FORMS.format(example=f'1 {si_unit}' if si_unit else '0.3')}, got {value!r:.60}")
+    out = tuple(as_si(x, si_unit, where) for x in items)
+    if not out[0] < out[1]:
+        raise ParameterError(f"{where}: lower bound {items[0]!r} must be below upper {items[1]!r}")
+    if len(out) == 3 and not out[0] <= out[2] <= out[1]:
+        raise ParameterError(f"{where}: start {items[2]!r} is outside its bounds [{items[0]}, {items[1]}]")
+    return out

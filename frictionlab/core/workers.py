@@ -1,9 +1,10 @@
 """The process pool every parallel stage runs on (``compare``'s fits, tests and bootstrap; the report's figures).
 
 ``process_pool(jobs)`` is a context manager yielding a ``ProcessPoolExecutor`` of ``jobs`` forked
-workers, or None (run in this process) for one job or where fork is unavailable. Workers are
-forked, so they see everything the parent built before the pool's first task (a function that is
-not picklable can be reached through module state set before then).
+workers, or None (run in this process) for one job or where fork is unavailable (Windows; a warning
+says the run is serial). Workers are forked, so they see everything the parent built before the pool's
+first task (a function that is not picklable can be reached through module state set before then); a
+spawned worker would see none of it, which is why there is no spawned pool.
 """
 from __future__ import annotations
 
@@ -41,6 +42,8 @@ def long_run_gc(young: int = GC_YOUNG):
             gc.unfreeze()
 
 
+SERIAL = ("this platform cannot fork worker processes: the run is serial, in one process (--jobs has no effect; "
+          "on a cluster, --scheduler runs it in parallel)")
 LOST = "a worker process was lost (killed, out of memory, or a law plugin that ends its process)"
 
 
@@ -78,7 +81,10 @@ def process_pool(jobs: int, stage: str = "frictionlab"):
     """
     try:
         ctx = get_context("fork") if jobs > 1 else None
-    except ValueError:  # no fork on this platform: run serially
+    except ValueError:  # no fork on this platform: run serially, and say so
+        import warnings
+
+        warnings.warn(SERIAL, RuntimeWarning, stacklevel=3)
         ctx = None
     if ctx is None:
         try:

@@ -28,12 +28,19 @@ repeated. ``parameter_table`` and ``ranking_table`` turn the results into rows f
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping, Sequence
+from concurrent.futures import Executor
+from typing import TYPE_CHECKING
 
 import attrs
 import numpy as np
 
 from ..core.errors import FrictionLabError, ParameterError
+
+if TYPE_CHECKING:  # annotations only
+    from ..physics.law import FrictionLaw
+    from .fitresult import FitResult
+    from .predict import DatasetLike
 
 METHODS = ("parametric", "residual", "case")
 
@@ -75,7 +82,7 @@ class LawFit:
         return name if self.solver == "auto" else f"{name} [{self.solver}]"
 
 
-def law_fit(law, solver: str = "auto", **options) -> LawFit:
+def law_fit(law: str | FrictionLaw, solver: str = "auto", **options: object) -> LawFit:
     """``LawFit`` for a law name and ``fitting.fit`` keyword options (free, fixed, local, ...)."""
     name = law if isinstance(law, str) else law.name
     return LawFit(name, solver, tuple(sorted(options.items())))
@@ -262,8 +269,9 @@ def _check_n(n, seed):
 
 
 # --- public API -----------------------------------------------------------------------------------------
-def bootstrap(fit_fn, dataset, n: int = 200, seed: int = 0, executor=None, method: str = "residual",
-              chunk: int | None = None, base=None) -> BootstrapResult:
+def bootstrap(fit_fn: Callable[..., FitResult], dataset: DatasetLike | Sequence[DatasetLike], n: int = 200,
+              seed: int = 0, executor: Executor | None = None, method: str = "residual", chunk: int | None = None,
+              base: FitResult | None = None) -> BootstrapResult:
     """Refit ``n`` resampled copies of ``dataset`` (a Dataset, name or path, or a list fitted together).
 
     fit_fn(data) -> FitResult, e.g. ``law_fit('wear', solver='exact')`` (warm-started replicates) or

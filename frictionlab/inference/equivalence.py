@@ -48,6 +48,8 @@ reported beside them. Group verdicts (Holm across a group's members) are in ``eq
 """
 from __future__ import annotations
 
+from concurrent.futures import Executor
+
 import math
 
 import attrs
@@ -129,14 +131,17 @@ class EquivalenceResult:
 
     @property
     def ok(self) -> bool:
+        """True when the test was run (status 'ok')."""
         return self.status == "ok"
 
     @property
     def label(self) -> str:
+        """'law A [solver] vs law B [solver] on DATASET'."""
         return f"{self.law_a} [{self.solver_a}] vs {self.law_b} [{self.solver_b}]"
 
     @property
     def involves_series(self) -> bool:
+        """True when one side is the paper's truncated series."""
         return "series" in (self.solver_a, self.solver_b)
 
     def scale(self, d: float) -> float:
@@ -181,6 +186,7 @@ class EquivalenceResult:
                 f"by {rms} RMS")
 
     def as_dict(self) -> dict:
+        """The result as plain values, as results.json records it."""
         d = {k: v for k, v in attrs.asdict(self, recurse=False).items() if k != "decomposition"}
         d["t_a"], d["t_b"], d["s_a"], d["s_b"] = (self.t_a.tolist(), self.t_b.tolist(), self.s_a.tolist(),
                                                   self.s_b.tolist())
@@ -200,7 +206,8 @@ def _num(x: float) -> str:
 
 # --- the test -------------------------------------------------------------------------------------
 def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = REPLICATES, seed: int = 0,
-                        executor=None, chunk: int | None = None, timeout: float | None = None) -> EquivalenceResult:
+                        executor: Executor | None = None, chunk: int | None = None,
+                        timeout: float | None = None) -> EquivalenceResult:
     """Discrimination test of ``fit_a``'s law against ``fit_b``'s on their (common) dataset.
 
     replicates: the most replicates per null (sequential sampling stops earlier once the decision is

@@ -140,7 +140,7 @@ def fit_tolerance_study(laws, dataset, methods=("LSODA", "DOP853"), rtols=DEFAUL
                     if p0.stderr:
                         shift = (p.value - p0.value) / p0.stderr
                 rows.append({**base, "status": "ok", "parameter": name, "value": p.value, "stderr": p.stderr,
-                             "unit": p.unit, "shift_in_stderr": shift, "aic": f.stats.aic, "rank": ranks.get(law)})
+                             "unit": p.unit, "shown": p.shown, "shift_in_stderr": shift, "aic": f.stats.aic, "rank": ranks.get(law)})
     return rows
 
 

@@ -14,6 +14,7 @@ import attrs
 import numpy as np
 
 from ..core.errors import FrictionLabError, ParameterError, SolverError
+from ..physics.freeable import SCENE_SHOWN
 from . import levmar
 from .predict import (
     SCENE_QUANTITIES,
@@ -55,6 +56,7 @@ class _Slot:
     unit: str
     vary: bool
     fixed_by: str = ""
+    shown: str = ""  # the unit the value is shown in ("": unit)
 
 
 def _ident(text: str) -> str:
@@ -68,7 +70,8 @@ def _law_slots(law, targets, fixed, local, initial) -> list[_Slot]:
     for spec in law.params:
         n = spec.name
         start = float(initial.get(n, spec.default))
-        common = dict(kind="law", key=n, lower=spec.lower, upper=spec.upper, scale=spec.scale, unit=spec.unit)
+        common = dict(kind="law", key=n, lower=spec.lower, upper=spec.upper, scale=spec.scale, unit=spec.unit,
+                      shown=spec.display)
         if n in fixed:
             slots.append(_Slot(_ident(n), n, targets=tuple(range(len(targets))), value=float(fixed[n]), vary=False,
                                fixed_by="held by the caller", **common))
@@ -116,7 +119,7 @@ def _scene_slots(targets, free) -> list[_Slot]:
             disp = name if len(targets) == 1 else f"{name}[{tg.name}]"
             slots.append(_Slot(_ident(f"scene_{name}__{i}"), disp, "scene", name, (i,), start, lo, hi,
                                max(abs(start), abs(lo), abs(hi), 1e-300) if start == 0 else abs(start),
-                               SCENE_QUANTITIES[name], True))
+                               SCENE_QUANTITIES[name], True, shown=SCENE_SHOWN.get(name, "")))
     return slots
 
 

@@ -132,7 +132,7 @@ def _param_results(slots, best, targets, structure, jac) -> dict[str, ParamResul
         elif s.vary and (err is None or degenerate):
             err = jac["errors"].get(s.display)
         out[s.display] = ParamResult(s.display, s.key, s.kind, p.value * s.scale, err, s.unit, s.vary, s.value,
-                                     s.lower, s.upper, tuple(targets[i].name for i in s.targets), s.fixed_by)
+                                     s.lower, s.upper, tuple(targets[i].name for i in s.targets), s.fixed_by, s.shown)
     for name, (value, err, unit, slot) in jac["derived"].items():
         out[name] = ParamResult(name, name.split("[")[0], "derived", value, err, unit, False, value, 0.0, math.inf,
                                 tuple(targets[i].name for i in slot.targets),

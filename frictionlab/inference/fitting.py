@@ -32,13 +32,15 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
+from typing import TYPE_CHECKING
 
 import attrs
 import numpy as np
 
 from ..core.arguments import as_items, check_type
 from ..core.errors import DatasetError, FrictionLabError, ParameterError
+from ..core.units import as_range, as_si
 from ..core.workers import beat
 from ..physics.registry import get_law
 from . import levmar
@@ -75,26 +77,56 @@ from .predict import (
 )
 
 __all__ = ["DatasetFit", "FitResult", "ParamResult", "PREDICTORS", "SCENE_QUANTITIES", "SkipDataset", "Stats", "Target",
-           "applicable_solvers", "auto_solver", "fit", "get_scene_quantity", "make_target", "predict",
-           "register_predictor", "set_scene_quantity"]
+           "applicable_solvers", "auto_solver", "fit", "get_scene_quantity", "law_values", "make_target", "predict",
+           "register_predictor", "scene_ranges", "set_scene_quantity"]
+if TYPE_CHECKING:  # annotations only
+    from ..physics.law import FrictionLaw
+    from .predict import DatasetLike
+
 SHARPEN_BELOW = 1e-3  # an F p-value (conservative) below this already rejects: no simulation needed
 _KEEP = (ODE_STARTS, PENALTY, LIKELIHOOD_REASON, neg2loglik)  # re-exported names other modules read from here
 
 
-def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[float]] | None = None,
-        fixed: Mapping[str, float] | None = None, local: Sequence[str] = (),
-        initial: Mapping[str, float] | None = None, observable: str | None = None, derive: str | None = None,
+def law_values(law, values: Mapping[str, object] | None, where: str) -> dict[str, float]:
+    """Law parameter values by name in SI, each given as an SI number, a quantity string or a pint Quantity;
+    an unknown name or a wrong unit is an error naming ``where``, the parameter and the unit expected."""
+    if values is None:
+        return {}
+    if not isinstance(values, Mapping):
+        raise TypeError(f"{where}: expected a mapping of parameter names to values, got {type(values).__name__}")
+    return {name: as_si(v, law.spec(name).unit, f"{where}: {name}") for name, v in values.items()}
+
+
+def scene_ranges(free: Mapping[str, object] | None, where: str) -> dict[str, tuple[float, ...]]:
+    """Freed scene quantities by name as SI bounds (lower, upper[, start]); each is given as 'low:high[:start]'
+    with units, or a tuple of two or three values in any form (``core.units.as_range``)."""
+    if free is None:
+        return {}
+    if not isinstance(free, Mapping):
+        raise TypeError(f"{where}: expected a mapping of scene quantities to bounds, got {type(free).__name__}")
+    out = {}
+    for name, bounds in free.items():
+        if name not in SCENE_QUANTITIES:
+            raise ParameterError(f"{where}: {name!r} is not a scene quantity; choose from {', '.join(SCENE_QUANTITIES)}")
+        out[name] = as_range(bounds, SCENE_QUANTITIES[name], f"{where}: {name}")
+    return out
+
+
+def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], solver: str = "auto", *, free: Mapping[str, object] | None = None,
+        fixed: Mapping[str, object] | None = None, local: Sequence[str] = (),
+        initial: Mapping[str, object] | None = None, observable: str | None = None, derive: str | None = None,
         scan: int = 125, n_starts: int = 3, max_nfev: int | None = None, rtol: float | None = None,
         timeout: float | None = None, checks: bool = True, errors: bool = True, n_params: int | None = None,
-        progress=None) -> FitResult:
+        progress: Callable[[int, int, str], None] | None = None) -> FitResult:
     """Fit ``law`` to one dataset or a group of them (a global fit) and return a FitResult.
 
     law: name or FrictionLaw. datasets: a Dataset, name, path or Target, or a list of them.
     solver: 'auto' (exact where a closed form exists, else ode), 'exact', 'series', 'ode[:METHOD]'.
-    free: scene quantities to fit per dataset, name -> (lower, upper[, start]) in SI (see
-    SCENE_QUANTITIES). fixed: law parameters held for every dataset (SI), on top of each
-    dataset's [fixed]. local: law parameters fitted separately per dataset in a global fit.
-    initial: start values (SI). observable / derive: what to fit (see make_target).
+    free: scene quantities to fit per dataset, name -> bounds (see SCENE_QUANTITIES): 'low:high[:start]'
+    with units, or (lower, upper[, start]) of SI numbers, quantity strings or pint Quantities.
+    fixed: law parameters held for every dataset, on top of each dataset's [fixed]; initial: start values;
+    each value an SI number, a quantity string or a pint Quantity. local: law parameters fitted
+    separately per dataset in a global fit. observable / derive: what to fit (see make_target).
     scan: number of grid points scored before Levenberg-Marquardt (0: start from the defaults);
     n_starts: Levenberg-Marquardt runs from the best distinct grid points (the lowest chi2 wins);
     at most ODE_STARTS when a dataset is solved by 'ode' (deterministic, never timing-dependent).
@@ -136,6 +168,8 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     twice = sorted({n for n in names if names.count(n) > 1})
     if twice:  # its points would count twice and the error bars shrink by sqrt(2)
         raise DatasetError(f"fit: dataset '{twice[0]}' is given more than once; give each dataset once")
+    fixed, initial = law_values(law, fixed, "fit: fixed"), law_values(law, initial, "fit: initial")
+    free = scene_ranges(free, "fit: free")
     _check_arguments(law, fixed, local, initial, rtol, timeout)
     if n_params is not None and (isinstance(n_params, bool) or not isinstance(n_params, int) or n_params < 0
                                  or errors):
@@ -143,8 +177,8 @@ def fit(law, datasets, solver: str = "auto", *, free: Mapping[str, Sequence[floa
     solvers = _solvers(law, targets, solver, rtol)
     if isinstance(solvers, str):
         return give_up("skipped", solvers)
-    slots = _law_slots(law, targets, dict(fixed or {}), set(local), dict(initial or {}))
-    slots += _scene_slots(targets, dict(free or {}))
+    slots = _law_slots(law, targets, fixed, set(local), initial)
+    slots += _scene_slots(targets, free)
     model = _Model(law, targets, solvers, slots, rtol, None if timeout is None else time.monotonic() + timeout)
     if progress is not None:
         from .fitprogress import FitProgress

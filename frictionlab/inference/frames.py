@@ -137,19 +137,41 @@ def _table(df, caption: str) -> str:
 
 
 def fit_html(f) -> str:
-    """FitResult._repr_html_: a heading line and the parameter table."""
-    head = html.escape(repr(f).strip("<>"))
+    """FitResult._repr_html_: one row of statistics with whether the fit passes its goodness-of-fit tests
+    ("fits?"), then the parameters in their display units, rounded to their errors."""
+    from ..core.display import param_cells
+    from .plots import fits_text
+
+    e = html.escape
+    head = e(repr(f).strip("<>"))
     if not f.ok:
         return f"<p>{head}</p>"
     s = f.stats
-    return (f"<p><b>{html.escape(f.law)} [{html.escape(f.solver)}]</b> on {html.escape(', '.join(f.datasets))}: "
-            f"χ² = {s.chisqr:.4g}, reduced χ² = {s.redchi:.3g}, AIC = {s.aic:.4g}, n = {s.n_points}, "
-            f"k = {s.n_params}</p>" + _table(f.to_dataframe().drop(columns=["dataset", "law", "solver"]), "parameters"))
+    stats = ("<table><tr><th>law</th><th>solver</th><th>datasets</th><th>fits?</th><th>χ²</th><th>reduced χ²</th>"
+             "<th>AIC</th><th>n</th><th>k</th></tr>"
+             f"<tr><td>{e(f.law)}</td><td>{e(f.solver)}</td><td>{e(', '.join(f.datasets))}</td>"
+             f"<td>{e(fits_text(f.goodness))}</td><td>{s.chisqr:.4g}</td><td>{s.redchi:.3g}</td><td>{s.aic:.4g}</td>"
+             f"<td>{s.n_points}</td><td>{s.n_params}</td></tr></table>")
+    rows = []
+    for p in f.params.values():
+        value, err, unit = param_cells(p.value, p.stderr, p.unit, p.shown)
+        role = "fitted" if p.vary else (p.fixed_by or ("derived" if p.kind == "derived" else "held"))
+        rows.append(f"<tr><td>{e(p.name)}</td><td>{e(value)}</td><td>{e(err)}</td><td>{e(unit or '-')}</td><td>{e(role)}</td></tr>")
+    params = ("<table><tr><th>parameter</th><th>value</th><th>standard error</th><th>unit</th><th>role</th></tr>"
+              + "".join(rows) + "</table>")
+    flags = "".join(f"<p>implausible: {e(x)}</p>" for x in f.flags)
+    return f"<div><p><b>{head}</b></p>{stats}{flags}<b>parameters</b>{params}</div>"
 
 
 def comparison_html(c) -> str:
-    """Comparison._repr_html_: the first places per dataset and the ranking table."""
+    """Comparison._repr_html_: the ranking table per dataset, with whether each candidate fits ("fits?")."""
+    from .plots import fits_text
+
     df = ranking_frame(c)
-    cols = ["dataset", "candidate", "rank", "status", "rmse", "rmse_unit", "redchi", "delta_aic", "akaike_weight"]
+    df = df[df["rank"].notna()].copy()
+    goodness = {(r.dataset, r.law, r.solver): r.goodness for r in list(c.ranking) + list(c.groups)}
+    df["fits?"] = [fits_text(goodness.get((d, law, s))) for d, law, s in zip(df["dataset"], df["law"], df["solver"])]
+    cols = ["dataset", "candidate", "rank", "fits?", "status", "rmse", "rmse_unit", "redchi", "delta_aic",
+            "akaike_weight"]
     return (f"<p>{html.escape(repr(c).strip('<>'))}</p>"
-            + _table(df[df["rank"].notna()][cols], "ranking (SI units; group rows at the end)"))
+            + _table(df[cols], "ranking (SI units; a candidate is called best only if it fits; group rows at the end)"))

@@ -9,6 +9,8 @@ module state, so fits at different tolerances can run side by side.
 """
 from __future__ import annotations
 
+import os
+
 import functools
 import inspect
 import warnings
@@ -21,6 +23,7 @@ from ..core.errors import DatasetError, FrictionLabError, ParameterError
 from ..io.dataset import Dataset, load_dataset
 from ..physics.freeable import SCENE_QUANTITIES
 from ..physics.registry import get_law
+from ..physics.law import FrictionLaw
 from ..physics.scene import Scene
 from ..solve.outcome import OUTCOMES, predict_outcomes, predict_outcomes_many, rows_of
 
@@ -38,6 +41,9 @@ class SkipDataset(FrictionLabError):
     """A dataset this law or solver cannot predict (reported as 'skipped', not 'failed')."""
 
 
+#: What names a dataset: a loaded Dataset, a built-in name, or the path of its TOML (or CSV).
+DatasetLike = "Dataset | str | os.PathLike"
+
 # --- targets: what is fitted -------------------------------------------------------------
 @attrs.frozen(eq=False)
 class Target:
@@ -51,18 +57,21 @@ class Target:
 
     @property
     def name(self) -> str:
+        """The dataset's name."""
         return self.dataset.name
 
     @property
     def t(self) -> np.ndarray | None:
+        """The dataset's time column [s], None for one impact per row."""
         return self.dataset.columns.get("t")
 
     @property
     def label(self) -> str:
+        """'DATASET (observable)', with how it was derived where it was."""
         return f"{self.name} ({self.observable}{', ' + self.derivation if self.derivation else ''})"
 
 
-def make_target(dataset, observable: str | None = None, derive: str | None = None) -> Target:
+def make_target(dataset: DatasetLike, observable: str | None = None, derive: str | None = None) -> Target:
     """The series to fit from ``dataset``: its observable, another column, or omega derived from theta.
 
     derive: None, 'poly9' or 'spline' (then observable is omega, computed from the theta column).
@@ -177,7 +186,7 @@ def design(target: Target) -> tuple | None:
     return (ds.kind, target.observable, ds.stated) + tuple(v for k, v in ds.columns.items() if k != target.observable)
 
 
-def predict(law, target: Target, params: Mapping[str, float], solver: str = "exact",
+def predict(law: str | FrictionLaw, target: Target, params: Mapping[str, float], solver: str = "exact",
             scene: Scene | None = None, rtol: float | None = None) -> np.ndarray:
     """The law's prediction of ``target.y`` (SI) for law parameters ``params`` (SI), on ``scene``
     (default: the dataset's), solving any ODE to ``rtol`` (None: FIT_RTOL). Raises SkipDataset

@@ -80,9 +80,11 @@ class RankRow:
 
     @property
     def candidate(self) -> str:
+        """'law [solver]', the name the ranking shows."""
         return f"{self.law} [{self.solver}]"
 
     def as_dict(self) -> dict:
+        """The row as plain values, as ranking.csv and results.json record it."""
         out = {c: getattr(self, c) for c in COLUMNS}
         out["flags"] = "; ".join(self.flags)
         return out

@@ -105,7 +105,7 @@ def parameter_table(results, level: float = 0.95) -> list[dict]:
             lo, hi = b.interval(name, level)
             p = b.base.params[name]
             rows.append({"law": b.law, "solver": b.base.solver, "datasets": "+".join(b.datasets), "parameter": name,
-                         "unit": unit,
+                         "unit": unit, "shown": p.shown,
                          "value": p.value, "stderr": p.stderr, "boot_median": float(np.median(col)) if col.size else math.nan,
                          "boot_std": b.std(name), "ci_low": lo, "ci_high": hi, "level": level, "n_ok": int(col.size),
                          "n_failed": len(b.failures), "method": b.method, "seed": b.seed})

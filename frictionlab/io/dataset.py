@@ -19,6 +19,8 @@ from pathlib import Path
 import attrs
 import numpy as np
 
+from typing import TYPE_CHECKING
+
 from ..core.errors import DatasetError, FrictionLabError
 from ..core.files import read_toml
 from ..core.names import check_name
@@ -32,6 +34,10 @@ from .noise import NOISE_KINDS, STATED, noise_table, stated_table  # noqa: F401 
 DATA_KINDS = KINDS + ("contact-area",)
 
 #: SI unit of each well-known column; other columns must declare a unit of their own.
+if TYPE_CHECKING:  # annotations only
+    import pandas as pd
+    from matplotlib.axes import Axes
+
 COLUMN_SI = {
     "t": "s", "omega": "rad/s", "theta": "rad", "u": "m/s", "v": "m/s", "A": "m^2", "N": "N", "x": "m",
     "speed": "m/s", "incidence": "rad", "spin": "rad/s", "rebound_spin": "rad/s", "tangential_cor": "",
@@ -67,12 +73,14 @@ class Dataset:
 
     @property
     def t(self) -> np.ndarray:
+        """The time column [s]; a DatasetError for one impact per row (no time)."""
         if "t" not in self.columns:
             raise DatasetError(f"dataset '{self.name}' ({self.kind}) has no time column: one impact per row")
         return self.columns["t"]
 
     @property
     def y(self) -> np.ndarray:
+        """The fitted column (the observable), SI."""
         return self.columns[self.observable]
 
     @property
@@ -83,7 +91,7 @@ class Dataset:
     def __len__(self) -> int:
         return len(next(iter(self.columns.values())))
 
-    def to_dataframe(self):
+    def to_dataframe(self) -> pd.DataFrame:
         """The columns as a pandas DataFrame (SI; units by column in ``df.attrs['units']``, the file's own
         units in ``df.attrs['file_units']``, the noise in ``df.attrs['noise']``)."""
         import pandas as pd
@@ -95,6 +103,63 @@ class Dataset:
 
     def __repr__(self) -> str:
         return f"<Dataset {self.name}: {self.kind}, {len(self)} points of {self.observable}, {self.provenance.kind}>"
+
+    def shown(self, column: str) -> tuple[str, float]:
+        """(unit, factor) a column is shown in: the unit its file gives it (shown = SI * factor)."""
+        from ..core.display import display_unit
+
+        return display_unit(column, self.units.get(column), COLUMN_SI.get(column, ""))
+
+    def x_axis(self) -> tuple[str, str, float]:
+        """(column, unit shown, factor) of what the observable is drawn against: time, or for one impact
+        per row the incidence angle (else the row number, with column '')."""
+        for col in ("t", "incidence", "speed"):
+            if col in self.columns:
+                return (col, *self.shown(col))
+        return "", "", 1.0
+
+    def plot(self, y: str | None = None, ax: Axes | None = None, **style: object) -> Axes:
+        """Draw column ``y`` (default: the observable) against time, or against the incidence angle for one
+        impact per row, in the units of the dataset's file, with its noise as error bars where sigma is
+        known or estimated; returns the Axes (a new figure's if ``ax`` is None)."""
+        from ..core.display import axis_label, figure_axes
+
+        y = y or self.observable
+        if y not in self.columns:
+            raise DatasetError(f"dataset '{self.name}' has no column '{y}'; it has {', '.join(self.columns)}")
+        _, ax = figure_axes(ax)
+        xcol, xunit, xf = self.x_axis()
+        x = self.columns[xcol] * xf if xcol else np.arange(len(self))
+        shown, f = self.shown(y)
+        sigma = self.noise.get(y)
+        style = {"fmt": "o", "ms": 3, "color": "black", "ecolor": "0.7", "elinewidth": 0.8,
+                 "label": f"{self.name} ({self.provenance.kind})"} | style
+        ax.errorbar(x, self.columns[y] * f, yerr=None if sigma is None or not np.isfinite(sigma) else sigma * f,
+                    **style)
+        ax.set_xlabel(axis_label({"t": "time", "incidence": "incidence"}.get(xcol, xcol), xunit) if xcol else "row")
+        ax.set_ylabel(axis_label(y, shown))
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        return ax
+
+    def _repr_html_(self) -> str:
+        """A notebook's view: what the dataset is, where it comes from, its noise and columns in its units."""
+        import html
+
+        e = html.escape
+        rows = []
+        for col, values in self.columns.items():
+            shown, f = self.shown(col)
+            sigma = self.noise.get(col)
+            noise = "" if sigma is None or not np.isfinite(sigma) else f"{sigma * f:.3g}"
+            rows.append(f"<tr><td>{e(col)}{' (fitted)' if col == self.observable else ''}</td><td>{e(shown)}</td>"
+                        f"<td>{np.min(values) * f:.4g}</td><td>{np.max(values) * f:.4g}</td><td>{e(noise)}</td></tr>")
+        p = self.provenance
+        return (f"<p><b>Dataset {e(self.name)}</b>: {e(self.kind)}, {len(self)} rows, fitted column "
+                f"{e(self.observable)}; <b>{e(p.kind)}</b> ({e(getattr(p, 'source', '') or '')}); noise "
+                f"{e(self.noise_kind)}{': ' + e(self.noise_note) if self.noise_note else ''}</p>"
+                "<table><tr><th>column</th><th>unit</th><th>min</th><th>max</th><th>sigma</th></tr>"
+                + "".join(rows) + "</table>")
 
 
 def builtin_dir() -> Path:

@@ -4,8 +4,7 @@ Raw laboratory records under a third party's license are not committed. RECORDS 
 file, SHA-256, source, license, citation and import options); when the file is present in a raw-data
 folder with that checksum, the dataset is imported once into a cache folder and is then listed and
 loaded like any built-in dataset. Raw-data folders: the ``FRICTIONLAB_RAW_DATA`` environment variable
-(folders separated by ':'), else ``../shared/data`` beside the repository (``/work/shared/data`` for a
-checkout at ``/work/main``). Cache: ``$XDG_CACHE_HOME/frictionlab/external`` (default ``~/.cache``).
+(folders separated by ':'), else ``shared/data`` in the folder that holds the repository's folder. Cache: ``$XDG_CACHE_HOME/frictionlab/external`` (default ``~/.cache``).
 """
 from __future__ import annotations
 

@@ -76,7 +76,7 @@ def _spline_operators(t: np.ndarray, theta: np.ndarray):
     return S, spl.derivative()(t)
 
 
-def derive_omega(t, theta, method: str = "poly9", sigma_theta: float | None = None) -> Derived:
+def derive_omega(t: np.ndarray, theta: np.ndarray, method: str = "poly9", sigma_theta: float | None = None) -> Derived:
     """omega(t) [rad/s] from theta(t) [rad] by ``method`` (poly9 or spline).
 
     sigma_theta [rad] is the noise of theta; if None it is estimated from the smoother's

@@ -9,3 +9,8 @@ SCENE_QUANTITIES = {
     "compliance.stiffness": "N/m", "compliance.damping": "N*s/m",
     "spring.stiffness": "1/m",  # a spring-slider's machine stiffness per unit normal force (k of rate-and-state)
 }
+#: The unit each freed scene quantity is shown in (reports, summaries, notebook views); others in SI.
+SCENE_SHOWN = {
+    "omega0": "rpm", "mass": "g", "radius": "mm", "incline": "deg", "area.peak": "mm^2", "area.contact_time": "us",
+    "area.area": "mm^2", "area.initial": "mm^2", "normal.contact_time": "us", "spring.stiffness": "1/um",
+}

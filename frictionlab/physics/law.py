@@ -49,7 +49,9 @@ QUANTITIES = {
 
 @attrs.frozen
 class ParamSpec:
-    """One law parameter. ``unit`` is the SI unit of the value; ``scale`` its typical size."""
+    """One law parameter. ``unit`` is the SI unit of the value; ``scale`` its typical size; ``display`` the unit
+    the value is shown in everywhere (reports, summaries, notebook views), e.g. "um" for a slip distance in m;
+    "" shows it in ``unit``."""
 
     name: str
     unit: str
@@ -58,6 +60,7 @@ class ParamSpec:
     upper: float
     scale: float
     description: str
+    display: str = ""
 
     def __attrs_post_init__(self):
         if not (self.lower <= self.default <= self.upper):
@@ -186,35 +189,35 @@ class FrictionLaw:
     # -- helpers shared by every law --------------------------------------------------
     @property
     def param_names(self) -> tuple[str, ...]:
+        """The parameters' names, in declaration order."""
         return tuple(s.name for s in self.params)
 
     def spec(self, name: str) -> ParamSpec:
+        """The ParamSpec of parameter ``name``; an unknown name is a ParameterError listing the law's parameters."""
         for s in self.params:
             if s.name == name:
                 return s
         raise ParameterError(f"law '{self.name}' has no parameter '{name}' (it has: {', '.join(self.param_names)})")
 
     def defaults(self) -> dict[str, float]:
+        """Each parameter's default value (SI) by name."""
         return {s.name: s.default for s in self.params}
 
-    def resolve(self, values: Mapping[str, float] | None = None) -> dict[str, float]:
-        """Defaults overlaid with ``values``, each checked against its bounds. A value is an SI number or a
-        quantity string with its unit, as on the command line ('1.81e6 Pa s/m', '80 um', '0.3')."""
+    def resolve(self, values: Mapping[str, object] | None = None) -> dict[str, float]:
+        """Defaults overlaid with ``values``, each checked against its bounds. A value is an SI number, a
+        quantity string with its unit as on the command line ('1.81e6 Pa s/m', '80 um', '0.3') or a pint
+        Quantity; an error names the parameter and the unit it expected."""
         p = self.defaults()
         for name, value in (values or {}).items():
             s = self.spec(name)
             if isinstance(value, (bool, np.bool_)):  # True is not 1 m
                 raise ParameterError(f"law '{self.name}': {name} = {value!r} is a boolean, not a number "
                                      f"(SI value in {s.unit or 'plain units'})")
-            if isinstance(value, str):
-                from ..core.units import to_si
+            if not isinstance(value, (int, float, np.floating, np.integer)):
+                from ..core.units import as_si
 
-                value = to_si(value, s.unit, f"law '{self.name}': {name}")
-            try:
-                v = float(value)
-            except (TypeError, ValueError):
-                raise ParameterError(f"law '{self.name}': {name} = {value!r} is not a number "
-                                     f"(SI value in {s.unit or 'plain units'})") from None
+                value = as_si(value, s.unit, f"law '{self.name}': {name}")
+            v = float(value)
             if not (math.isfinite(v) and s.lower <= v <= s.upper):
                 raise ParameterError(
                     f"law '{self.name}': {name} = {value!r} {s.unit} is outside its bounds [{s.lower:g}, {s.upper:g}]"
@@ -243,6 +246,7 @@ class FrictionLaw:
 
     @property
     def state_names(self) -> tuple[str, ...]:
+        """The internal states' names (empty for a memoryless law)."""
         return tuple(s.name for s in self.states)
 
     def evaluate_rates(self, p: Mapping[str, float], c: Contact) -> dict[str, np.ndarray]:

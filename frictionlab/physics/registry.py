@@ -258,8 +258,9 @@ def _load() -> None:
     _loaded = True
 
 
-def register_law(obj=None, *, replace: bool = False):
-    """Register a law class or instance at run time; usable as a class decorator.
+def register_law(obj: type[FrictionLaw] | FrictionLaw | None = None, *, replace: bool = False) -> object:
+    """Register a law class or instance at run time; usable as a class decorator (then it returns the class,
+    else what it was given).
 
     ``replace=True`` swaps out a law of the same name registered earlier at run time. Registering the
     same class again (a notebook cell run twice) is a no-op with a warning; a class of the same module and

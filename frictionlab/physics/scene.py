@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from typing import Protocol
 
 import attrs
 import numpy as np
@@ -39,6 +40,15 @@ __all__ = ["AREA_KEYS", "NORMAL_KEYS", "EFFECTS", "G", "KINDS", "Compliance", "C
            "TableArea", "TableNormal", "WeightNormal", "read_effects", "spec_reader"]
 
 KINDS = ("impact", "incline", "impact-outcome", "spring-slider")
+
+
+class SceneSource(Protocol):
+    """What carries a scene to simulate: a loaded dataset (``io.dataset.Dataset``), told by its interface."""
+
+    name: str
+    kind: str
+    scene: Scene | None
+    fixed: Mapping[str, float]
 
 
 @attrs.frozen
@@ -81,6 +91,7 @@ class Scene:
 
     @property
     def inertia(self) -> float:
+        """The body's moment of inertia [kg m^2], inertia_factor m r^2."""
         if self.radius is None:
             raise SceneError("scene has no radius, so no moment of inertia")
         return self.inertia_factor * self.mass * self.radius**2
@@ -94,7 +105,8 @@ class Scene:
             q.add("N")
         return q
 
-    def with_(self, **changes) -> "Scene":
+    def with_(self, **changes: object) -> "Scene":
+        """A copy with the fields in ``changes`` replaced (SI values)."""
         return attrs.evolve(self, **changes)
 
     # -- construction from a TOML [scene] table -------------------------------------

@@ -1,8 +1,15 @@
 """The one result type of every solver."""
 from __future__ import annotations
 
+import os
+from typing import TYPE_CHECKING
+
 import attrs
 import numpy as np
+
+if TYPE_CHECKING:  # annotations only
+    import pandas as pd
+    from matplotlib.axes import Axes
 
 #: Columns written by ``Trajectory.to_csv``, SI units.
 CSV_UNITS = {"t": "s", "u": "m/s", "v": "m/s", "omega": "rad/s", "theta": "rad", "force": "N", "A": "m^2", "N": "N",
@@ -49,7 +56,7 @@ class Trajectory:
                     if np.shape(v) == np.shape(self.t)})
         return out
 
-    def to_dataframe(self):
+    def to_dataframe(self) -> pd.DataFrame:
         """The columns as a pandas DataFrame (SI; units by column in ``df.attrs['units']``)."""
         import pandas as pd
 
@@ -63,6 +70,40 @@ class Trajectory:
                 f"columns {', '.join(self.columns())}"
                 + (f"; stuck at {self.stick_time:.4g} s" if self.stick_time is not None else "") + ">")
 
+    def plot(self, y: str = "omega", ax: Axes | None = None, **style: object) -> Axes:
+        """Draw the series ``y`` (a column name: omega, theta, u, v, force, A, N, load, or a law state as
+        ``state_NAME``) against time on ``ax`` (a new figure if None), in display units; returns the Axes.
+        ``style`` goes to matplotlib's ``plot`` (color, ls, label ...)."""
+        from ..core.display import axis_label, figure_axes, time_unit, unit
+
+        cols = self.columns()
+        if y not in cols and not (y == "mu" and "load" in cols):
+            raise KeyError(f"trajectory has no series '{y}'; it has {', '.join(cols)}")
+        values = cols[y] if y in cols else cols["load"]
+        _, ax = figure_axes(ax)
+        tname, tf = time_unit(float(self.t[-1]) if len(self.t) else 0.0)
+        shown, factor = unit(y)
+        style.setdefault("label", f"{self.law} [{self.solver}]")
+        ax.plot(self.t * tf, values * factor, **style)
+        ax.set_xlabel(f"time [{tname}]")
+        ax.set_ylabel(axis_label(y, shown if shown not in ("", "SI") else ("-" if y in ("mu", "load") else "SI")))
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+        return ax
+
+    def _repr_html_(self) -> str:
+        """A notebook's view: law, solver, times and the columns with their units."""
+        import html
+
+        cols = self.columns()
+        rows = "".join(f"<tr><td>{html.escape(k)}</td><td>{html.escape(CSV_UNITS.get(k, 'SI') or '-')}</td>"
+                       f"<td>{np.min(v):.4g}</td><td>{np.max(v):.4g}</td></tr>" for k, v in cols.items())
+        end = float(self.t[-1]) if len(self.t) else 0.0
+        stuck = f"; stuck at {self.stick_time:.4g} s" if self.stick_time is not None else ""
+        return (f"<p><b>Trajectory</b> {html.escape(self.law or '?')} [{html.escape(self.solver or '?')}]: "
+                f"{len(self.t)} times from 0 to {end:.4g} s{html.escape(stuck)}</p>"
+                "<table><tr><th>column</th><th>unit (SI)</th><th>min</th><th>max</th></tr>" + rows + "</table>")
+
     def csv_text(self) -> str:
         """The columns (SI, units in CSV_UNITS) as CSV text, full precision."""
         cols = self.columns()
@@ -70,7 +111,7 @@ class Trajectory:
         lines = [",".join(cols)] + [",".join(f"{x:.17g}" for x in row) for row in rows]
         return "\n".join(lines) + "\n"
 
-    def to_csv(self, path) -> None:
+    def to_csv(self, path: str | os.PathLike) -> None:
         """Write the columns (SI) to ``path`` atomically."""
         from ..core.files import atomic_write_text
 

@@ -20,6 +20,7 @@ import os
 import platform
 import time
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import attrs
 import numpy as np
@@ -27,7 +28,7 @@ import numpy as np
 from ..core.arguments import as_items
 from ..core.errors import FrictionLabError
 from ..inference.equivalence import PAIRS, REPLICATES, EquivalenceResult
-from ..inference.fitting import FitResult
+from ..inference.fitting import FitResult, scene_ranges
 from ..inference.ranking import RankRow
 from ..inference.transfer import TransferResult
 from ..io.dataset import Dataset, builtin_names, load_dataset
@@ -43,6 +44,12 @@ from .runner import Progress, Run, select
 from .runner import run_stages as run_stages_with
 from .settings import DEFAULT_LAWS, Settings, select_laws  # noqa: F401
 from .stages import STAGES
+
+if TYPE_CHECKING:  # annotations only
+    import pandas as pd
+    from dask.distributed import Client
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 
 @attrs.frozen(eq=False)
@@ -68,29 +75,33 @@ class Comparison:
     options: Settings | None = None  # the settings as a record (``settings`` is the same as results.json writes it)
 
     def fit_for(self, dataset: str, law: str, solver: str | None = None) -> FitResult | None:
+        """The fit of ``law`` (with ``solver``, if given) to the single dataset ``dataset``, or None."""
         for f in self.fits:
             if f.datasets == (dataset,) and f.law == law and (solver is None or f.solver == solver):
                 return f
         return None
 
     def fits_on(self, dataset: str) -> list[FitResult]:
+        """Every single-dataset fit to ``dataset``."""
         return [f for f in self.fits if f.datasets == (dataset,)]
 
     def dataset(self, name: str) -> Dataset:
+        """The compared dataset called ``name``."""
         return next(d for d in self.datasets if d.name == name)
 
     @property
     def fitted_datasets(self) -> list[Dataset]:
+        """The datasets that were fitted (not left out with a reason)."""
         return [d for d in self.datasets if d.name not in self.skipped_datasets]
 
-    def to_dataframe(self):
+    def to_dataframe(self) -> pd.DataFrame:
         """The ranking as a tidy pandas DataFrame: one row per dataset and candidate (law, solver), with
         the observable and the units of rss and rmse; group rows (ALL, ALL[kind]) after them."""
         from ..inference.frames import ranking_frame
 
         return ranking_frame(self)
 
-    def parameters_dataframe(self):
+    def parameters_dataframe(self) -> pd.DataFrame:
         """Every fitted parameter as a tidy pandas DataFrame: dataset, law, solver, parameter, value,
         stderr, unit, kind, vary, fixed_by, lower, upper."""
         from ..inference.frames import parameters_frame
@@ -104,6 +115,27 @@ class Comparison:
         more = f"; ... {len(self.fitted_datasets) - 3} more" if len(self.fitted_datasets) > 3 else ""
         return (f"<Comparison of {len(self.laws)} laws on {len(self.fitted_datasets)} datasets: {ok} fits; "
                 f"lowest AIC: {best}{more}>")
+
+    def plot(self, ax: Axes | Sequence[Axes] | None = None, top: int = 3) -> Figure | Axes | Sequence[Axes]:
+        """What the report's first screen shows per dataset group, as one figure: for each group (its first
+        fitted dataset) the data with the ``top`` top-ranked candidates above and their residuals in units of
+        sigma below, each labelled with its rank and whether it passes its goodness-of-fit tests. Returns the matplotlib Figure; with ``ax``
+        (one Axes per group) the data and fits only, drawn there, and returns ``ax``."""
+        from ..inference.answers import group_of
+        from ..inference.plots import fits_text, plot_ranking
+
+        panels, seen = [], set()
+        for d in self.fitted_datasets:
+            group = group_of(d)
+            rows = sorted((r for r in self.ranking if r.dataset == d.name and r.rank is not None), key=lambda r: r.rank)
+            fits = [(self.fit_for(d.name, r.law, r.solver), r) for r in rows]
+            fits = [(f.per_dataset[0], f"{r.rank}. {r.candidate}: fits? {fits_text(r.goodness)}")
+                    for f, r in fits if f is not None and f.ok]
+            if group in seen or not fits:
+                continue
+            seen.add(group)
+            panels.append((group if group == d.name else f"{group}: {d.name}", fits))
+        return plot_ranking(panels, ax, top)
 
     def _repr_html_(self) -> str:
         from ..inference.frames import comparison_html
@@ -128,13 +160,14 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
             tolerance: Sequence[float] = (), fit_timeout: float | None = None, replicates: int = REPLICATES,
             pairs: Sequence = PAIRS, transfer: bool = True, stages: Sequence[str] | None = None,
-            client=None) -> Comparison:
+            client: Client | None = None) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
 
     laws: registered names, None for DEFAULT_LAWS, or "all" for every registered law; datasets: built-in names, TOML paths or Datasets
     (default every built-in); solvers: None for the default choice, or a list of 'exact',
-    'series', 'ode[:METHOD]', 'auto'; free: scene quantities fitted per dataset, name -> (lower,
-    upper) in SI (see fitting.SCENE_QUANTITIES); jobs: worker processes; progress(done, total, label).
+    'series', 'ode[:METHOD]', 'auto'; free: scene quantities fitted per dataset, name -> bounds,
+    'low:high' with units or a tuple of SI numbers, quantity strings or pint Quantities (see
+    fitting.SCENE_QUANTITIES); jobs: worker processes; progress(done, total, label).
     bootstrap: parametric replicates per dataset (0: none), drawn from ``seed``; datasets where a law
     needs the ODE, or without a time series, are bootstrapped only with bootstrap_all. tolerance: looser ODE tolerances at
     which the ODE laws of one dataset are refitted (empty: no tolerance check). fit_timeout: time
@@ -153,7 +186,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     """
     started = time.perf_counter()
     settings = Settings(laws=(), solvers=tuple(solvers) if solvers else None,
-                        free=dict(free or {}), equivalence=equivalence, jobs=jobs, bootstrap=bootstrap, seed=seed,
+                        free=scene_ranges(free, "compare: free"), equivalence=equivalence, jobs=jobs, bootstrap=bootstrap, seed=seed,
                         bootstrap_all=bootstrap_all, tolerance=tuple(tolerance), fit_timeout=fit_timeout,
                         replicates=replicates, pairs=tuple(pairs), transfer=transfer, cluster=cluster_name(client))
     settings = attrs.evolve(settings, laws=select_laws(laws))
@@ -173,8 +206,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     return attrs.evolve(c, wall_time=time.perf_counter() - started)
 
 
-def run_stages(comparison: Comparison, stages: Sequence[str], *, progress: Progress | None = None, client=None,
-               **options) -> Comparison:
+def run_stages(comparison: Comparison, stages: Sequence[str], *, progress: Progress | None = None,
+               client: Client | None = None, **options: object) -> Comparison:
     """Run the named stages (``stages.STAGES``) on a comparison made by ``compare``, e.g.
     ``run_stages(c, ["bootstrap", "answer"], bootstrap=150)``; ``options`` override the comparison's
     settings (the keyword arguments of ``compare``). Returns a new Comparison."""

@@ -33,7 +33,9 @@ import collections
 import json
 import os
 import threading
+from collections.abc import Callable
 from concurrent.futures import as_completed
+from typing import TYPE_CHECKING
 from pathlib import Path
 
 import attrs
@@ -62,6 +64,11 @@ from .doc import Section
 from .render import html_page, markdown
 from .results import SCHEMA, clean, fit_json, ranking_csv, results_json
 from .tolerance import tolerance_verdicts
+
+if TYPE_CHECKING:  # annotations only
+    from dask.distributed import Client
+
+    from ..pipeline.comparison import Comparison
 
 TITLE = "frictionlab: friction laws compared"
 
@@ -174,7 +181,9 @@ def _batches(items, n: int):
         yield first, batch
 
 
-def write_report(c, out, force: bool = False, progress=None, jobs: int = 1, client=None) -> Path:
+def write_report(c: Comparison, out: str | os.PathLike, force: bool = False,
+                 progress: Callable[[int, int, str], None] | None = None, jobs: int = 1,
+                 client: Client | None = None) -> Path:
     """Write the report folder ``out`` whole or not at all; an existing folder is replaced only with force=True.
 
     progress(done, total, label), if given, is called after each figure and file. jobs: worker

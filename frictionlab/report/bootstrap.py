@@ -72,9 +72,9 @@ def _parameters(sec: Section, c) -> None:
         for r in parameter_table(rb):
             width = (r["ci_high"] - r["ci_low"]) / (2 * 1.96 * r["stderr"]) if r["stderr"] else math.nan
             prow.append([r["datasets"], f"{r['law']} [{r['solver']}]", r["parameter"],
-                         param_text(r["value"], r["stderr"], r["unit"]),
-                         param_text(r["boot_median"], None, r["unit"]) if r["n_ok"] else "",
-                         interval_text(r["ci_low"], r["ci_high"], r["unit"], r["value"]), fmt(width, 2),
+                         param_text(r["value"], r["stderr"], r["unit"], r.get("shown", "")),
+                         param_text(r["boot_median"], None, r["unit"], r.get("shown", "")) if r["n_ok"] else "",
+                         interval_text(r["ci_low"], r["ci_high"], r["unit"], r.get("shown", "")), fmt(width, 2),
                          f"{r['n_ok']} of {r['n_ok'] + r['n_failed']}"])
         for b in rb.results.values():
             missing = b.base.identifiability.missing_stderr

@@ -34,8 +34,8 @@ def truth_check(d, c) -> str:
             except FrictionLabError:
                 continue
             dev = f" ({(p.value - value) / p.stderr:+.1f}σ)" if p.stderr else ""
-            found.append(f"{name}: true {param_text(value, None, p.unit)}, fitted "
-                         f"{param_text(p.value, p.stderr, p.unit)}{dev}")
+            found.append(f"{name}: true {param_text(value, None, p.unit, p.shown)}, fitted "
+                         f"{param_text(p.value, p.stderr, p.unit, p.shown)}{dev}")
         parts.append(f"{law} [{r.solver}] ranks #{r.rank}" + (f" ({r.status} with {', '.join(r.tied_with)})"
                                                               if r.tied_with else "")
                      + ("; " + "; ".join(found) if found else ""))
@@ -56,8 +56,8 @@ def reported_check(d, c) -> str:
                 value = to_si(text, get_law(f.law).spec(name).unit, f"{d.name}: reported.{name}")
             except FrictionLabError:
                 continue
-            parts.append(f"{name} reported {param_text(value, None, p.unit)}, fitted by {f.law} [{f.solver}] "
-                         f"{param_text(p.value, p.stderr, p.unit)}")
+            parts.append(f"{name} reported {param_text(value, None, p.unit, p.shown)}, fitted by {f.law} [{f.solver}] "
+                         f"{param_text(p.value, p.stderr, p.unit, p.shown)}")
     return ("**Reported by the source:** " + "; ".join(parts) + ".") if parts else ""
 
 
@@ -83,7 +83,7 @@ def param_rows(f) -> list[list[str]]:
         flagged = flags_on(f, p.name)
         if flagged:
             comment = "; ".join([comment] * bool(comment) + [f"implausible: {t}" for t in flagged])
-        value, err, unit = param_cells(p.value, p.stderr if p.vary or p.kind == "derived" else None, p.unit)
+        value, err, unit = param_cells(p.value, p.stderr if p.vary or p.kind == "derived" else None, p.unit, p.shown)
         rows.append([f"{f.law} [{f.solver}]", p.name, value, err, unit, role, comment])
     return rows
 

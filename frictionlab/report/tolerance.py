@@ -52,7 +52,7 @@ def build(ctx) -> Section:
             continue
         shifts = [abs(r["shift_in_stderr"]) for r in rs if math.isfinite(r["shift_in_stderr"])]
         table.append([law, rtol_text(rtol) + (" (default)" if rtol == FIT_RTOL else ""),
-                      "; ".join(f"{r['parameter']} = {param_text(r['value'], r['stderr'], r['unit'])}" for r in rs),
+                      "; ".join(f"{r['parameter']} = {param_text(r['value'], r['stderr'], r['unit'], r.get('shown', ''))}" for r in rs),
                       fmt(max(shifts), 2) if shifts else "", fmt(r0["fit_time_s"], 2), fmt(r0["aic"]),
                       r0["rank"], "yes" if r0["ranking_as_reference"] else "**no**"])
     sec.table(["law", "rtol", "parameters (value ± standard error)", "largest shift [σ]", "fit time [CPU s]", "AIC",

@@ -47,6 +47,8 @@ know takes the numpy engine.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING
 
 import attrs
 import numpy as np
@@ -60,6 +62,10 @@ from .batchrk import run_rk
 from .plan import make_plan
 from .scenebatch import SceneBatch, batch_params, take_params
 from .solvers import exact
+
+if TYPE_CHECKING:  # annotations only
+    from ..physics.law import FrictionLaw
+    from ..physics.scene import Scene
 
 __all__ = ["SOLVERS", "CHUNK", "SceneBatch", "BatchResult", "batch_params", "simulate_batch"]
 
@@ -99,7 +105,9 @@ class BatchResult:
                           solver=f"batch:{self.solver}", law=self.law, stick_time=None if math.isnan(st) else st)
 
 
-def simulate_batch(law, scenes, params=None, t=None, solver: str = "auto", rtol: float = 1e-8,
+def simulate_batch(law: str | FrictionLaw, scenes: Sequence[Scene] | SceneBatch,
+                   params: Mapping[str, object] | Sequence[Mapping[str, object]] | None = None,
+                   t: np.ndarray | None = None, solver: str = "auto", rtol: float = 1e-8,
                    atol: float | None = None, n: int = 201) -> BatchResult:
     """Simulate ``law`` on many scenes of one structure.
 

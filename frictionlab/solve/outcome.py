@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -62,6 +63,10 @@ from .outcomescene import (
     SpeedLaw,
     hertz_shape,
 )
+
+if TYPE_CHECKING:  # annotations only
+    from ..physics.scene import SceneSource
+    from ..physics.law import FrictionLaw
 
 __all__ = ["ANGLE_REFERENCES", "OUTCOMES", "HertzPulse", "Inbound", "OutcomeScene", "SpeedLaw", "hertz_shape",
            "mdr_solvers", "predict_outcomes", "rows_of"]
@@ -98,8 +103,10 @@ def _rows(law, dataset_or_scene, speed, incidence, spin):
                      f"got {type(dataset_or_scene).__name__}")
 
 
-def predict_outcomes(law, dataset_or_scene, params: Mapping[str, float] | None = None, solver: str = "ode", *,
-                     speed=None, incidence=None, spin=None, rtol: float = 1e-10) -> dict[str, np.ndarray]:
+def predict_outcomes(law: str | FrictionLaw, dataset_or_scene: SceneSource | OutcomeScene,
+                     params: Mapping[str, float] | None = None, solver: str = "ode", *,
+                     speed: np.ndarray | None = None, incidence: np.ndarray | None = None,
+                     spin: np.ndarray | None = None, rtol: float = 1e-10) -> dict[str, np.ndarray]:
     """Simulate every impact and return its outcomes (SI arrays, one entry per row).
 
     dataset_or_scene: an impact-outcome Dataset (its rows and ``[fixed]`` parameters) or an

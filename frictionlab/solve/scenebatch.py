@@ -7,6 +7,7 @@ import attrs
 import numpy as np
 
 from ..core.errors import ParameterError, SceneError
+from ..core.units import as_si, is_quantity, unit_factor
 from ..physics.scene import Scene
 
 _TOP = ("mass", "u0", "duration", "radius", "inertia_factor", "omega0", "incline")
@@ -124,7 +125,8 @@ class SceneBatch:
 def batch_params(law, params, n: int) -> dict:
     """Law parameters for n scenes: name -> float (shared) or (n,) array, checked against bounds.
 
-    ``params`` is None (defaults), a mapping of name -> scalar or (n,) array, or a sequence of n mappings.
+    ``params`` is None (defaults), a mapping of name -> scalar or (n,) array, or a sequence of n mappings; a
+    value is SI, or a quantity string, or a pint Quantity (scalar or array).
     """
     if params is None:
         params = {}
@@ -137,6 +139,10 @@ def batch_params(law, params, n: int) -> dict:
     out = {}
     for spec in law.params:
         v = params.get(spec.name, spec.default)
+        if isinstance(v, str) or is_quantity(v):  # a quantity string, or a pint Quantity (one value or an array)
+            where = f"law '{law.name}': {spec.name}"
+            v = as_si(v, spec.unit, where) if isinstance(v, str) or np.ndim(v.magnitude) == 0 else \
+                np.asarray(v.magnitude, dtype=float) * unit_factor(str(v.units), spec.unit, where)
         a = np.asarray(v, dtype=float)
         if a.ndim == 0:
             a = float(a)

@@ -18,7 +18,11 @@ BatchResult (k scenes) and must be a picklable, module-level function with an ex
 """
 from __future__ import annotations
 
+import os
+from collections.abc import Callable, Mapping, Sequence
+from concurrent.futures import Executor
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import attrs
 import numpy as np
@@ -26,6 +30,11 @@ import numpy as np
 from ..core.errors import OutputError, SolverError
 from ..physics.registry import get_law
 from .scenebatch import SceneBatch, batch_params, take_params
+
+if TYPE_CHECKING:  # annotations only
+    from ..physics.law import FrictionLaw
+    from ..physics.scene import Scene
+    from .batch import BatchResult
 
 FIELDS = ("u", "v", "omega", "theta", "force", "A", "N")
 
@@ -49,9 +58,13 @@ class Sweep:
         return pd.DataFrame(self.scenes).set_index("scene")
 
 
-def simulate_sweep(law, scenes, params=None, t=None, solver: str = "auto", rtol: float = 1e-8,
-                   atol: float | None = None, n: int = 201, executor=None, chunk: int = 5000, *, out=None,
-                   reduce=None, fields=None, force: bool = False):
+def simulate_sweep(law: str | FrictionLaw, scenes: Sequence[Scene] | SceneBatch,
+                   params: Mapping[str, object] | Sequence[Mapping[str, object]] | None = None,
+                   t: np.ndarray | None = None, solver: str = "auto", rtol: float = 1e-8, atol: float | None = None,
+                   n: int = 201, executor: Executor | None = None, chunk: int = 5000, *,
+                   out: str | os.PathLike | None = None,
+                   reduce: Callable[[BatchResult], Mapping[str, np.ndarray]] | None = None,
+                   fields: Sequence[str] | None = None, force: bool = False) -> Sweep:
     """``simulate_batch`` in chunks of ``chunk`` scenes, dispatched on ``executor`` (None runs here; a
     concurrent.futures executor or a dask.distributed Client spreads the chunks).
 

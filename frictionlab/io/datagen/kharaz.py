@@ -33,7 +33,7 @@ properties", friction "the same used in the MFIX documentation", i.e. MFIX DEM05
 Kharaz et al.'s data). Normal restitution 0.98: the YADE script of Chung and Ooi's Test 4
 (en = 0.98 for aluminium oxide at vn_ini = 3.9 m/s, mu = tan(atan(0.092))).
 
-Which anvil and which angle (checked for this round). The 2001 paper's abstract (as reproduced in a
+Which anvil and which angle. The 2001 paper's abstract (as reproduced in a
 public BibTeX entry of the paper) says: "5-mm aluminium oxide spheres impacting a thick soda-lime glass
 anvil, for impact angles from normal to very near glancing incidence", its measurements "show very close
 agreement with the numerical work of Maw et al. which takes into account the effects of sticking,

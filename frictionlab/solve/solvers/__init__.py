@@ -4,13 +4,20 @@ Every solver returns a ``Trajectory``; ``simulate`` is the one entry point.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ...core.errors import SceneError, SolverError
 from ...physics.registry import get_law
-from ...physics.scene import Scene
+from ...physics.scene import Scene, SceneSource
 from ..plan import make_plan
 from . import exact, ode, segments, series
+
+if TYPE_CHECKING:  # annotations only
+    from ...physics.law import FrictionLaw
+    from ...physics.trajectory import Trajectory
 
 SOLVERS = ("exact", "series", "ode")
 
@@ -30,13 +37,14 @@ def parse_solver(text: str) -> tuple[str, str | None]:
     return name, method or None
 
 
-def simulate(law, scene, params=None, solver: str = "ode", t=None, rtol: float = 1e-10, atol: float | None = None,
-             n: int = 201):
+def simulate(law: str | FrictionLaw, scene: Scene | SceneSource, params: Mapping[str, object] | None = None,
+             solver: str = "ode", t: np.ndarray | None = None, rtol: float = 1e-10, atol: float | None = None,
+             n: int = 201) -> Trajectory:
     """Simulate ``law`` on a scene (or a dataset's scene) and return a Trajectory.
 
     law: a registered name or a FrictionLaw; scene: a Scene or a Dataset (its ``[fixed]``
-    parameters apply and its time column is the default ``t``); params: SI values overriding
-    the law's defaults; solver: 'exact', 'series', 'ode' (LSODA) or 'ode:METHOD'; t: sample times [s],
+    parameters apply and its time column is the default ``t``); params: values overriding the law's
+    defaults, each an SI number, a quantity string or a pint Quantity; solver: 'exact', 'series', 'ode' (LSODA) or 'ode:METHOD'; t: sample times [s],
     default n points over the scene's duration.
     """
     law = get_law(law)

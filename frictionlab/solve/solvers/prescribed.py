@@ -6,6 +6,9 @@ law's own behaviour is examined: LuGre's steady-state curve, Dahl's hysteresis l
 """
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING
+
 import numpy as np
 from scipy.integrate import solve_ivp
 
@@ -13,8 +16,13 @@ from ...core.errors import SolverError
 from ...physics.law import Contact
 from ...physics.registry import get_law
 
+if TYPE_CHECKING:  # annotations only
+    from ...physics.law import FrictionLaw
 
-def respond(law, params, t, u, N: float = 1.0, A: float | None = None, rtol: float = 1e-10):
+
+def respond(law: str | FrictionLaw, params: Mapping[str, float], t: np.ndarray,
+            u: Callable[[np.ndarray], np.ndarray], N: float = 1.0, A: float | None = None,
+            rtol: float = 1e-10) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """Force [N] and internal states along the slip history u(t) [m/s] at times t [s] (t[0] is the start).
 
     The states start from their declared initial values (``steady`` ones at u(t[0])); N [N] and

@@ -1,11 +1,11 @@
-"""The third bad-input corpus, tests/bad_inputs/round3.toml and round3b.toml: cases by class (paths and links, names,
+"""The bad-input corpus by class, tests/bad_inputs/by_class.toml and by_class_more.toml: cases by class (paths and links, names,
 terminal and Markdown text, plugin numerics and time, API types, environment, signals), each with
 what the user sees.
 
 Every case, whatever its class: no traceback, and nothing a terminal would act on (ESC, BEL, other
 control characters) on stdout or stderr. A case with status 2 has exactly one error line matching
 ``error`` and leaves its folder byte for byte as it was. The fields are described at the top of
-round3.toml.
+by_class.toml.
 """
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ from frictionlab.core import errors
 
 from test_bad_inputs import ERROR_LINE, PROGRESS_LINE, clean_registry, prepare, snapshot  # noqa: F401 (a fixture)
 
-CASES = [case for name in ("round3.toml", "round3b.toml")
+CASES = [case for name in ("by_class.toml", "by_class_more.toml")
          for case in tomllib.loads((Path(__file__).parent / "bad_inputs" / name).read_text(encoding="utf-8"))["case"]]
 CLASSES = ("paths", "names", "text", "plugins", "api", "environment", "signals")
 FIELDS = {"id", "class", "sees", "base", "edit", "files", "argv", "python", "raises", "status", "error", "stdout",
@@ -130,7 +130,7 @@ def check(case, rc, out, err, before, tmp: Path):
         assert snapshot(tmp) == before, f"the case folder changed:\n{shown}"
 
 
-def test_round3_corpus_counts():
+def test_corpus_by_class_counts():
     """At least 80 cases, every class represented, ids unique."""
     ids = [c["id"] for c in CASES]
     assert len(ids) == len(set(ids)) and len(ids) >= 80
