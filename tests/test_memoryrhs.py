@@ -7,13 +7,12 @@ import pytest
 import frictionlab as fl
 from frictionlab.physics.registry import get_law
 from frictionlab.physics.scene import ConstantNormal, Scene, SpringLoad
-from frictionlab.solve import compiled
-from frictionlab.solve.memoryrhs import phase, served
+from frictionlab.solve.memoryrhs import available, phase, served
 from frictionlab.solve.plan import make_plan
 from frictionlab.solve.solvers import ode
 from frictionlab.solve.solvers.stick import vanishing_slip
 
-pytestmark = pytest.mark.skipif(not compiled.available(), reason="numba does not import here: no compiled path")
+pytestmark = pytest.mark.skipif(not available(), reason="numba does not import here: no compiled path")
 
 LAWS = {"lugre": dict(sigma1=0.01, sigma2=0.05), "dahl": dict(alpha=0.6), "rate-state-aging": {},
         "rate-state-slip": {}}

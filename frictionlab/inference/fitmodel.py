@@ -329,15 +329,14 @@ def compiled_memory(model: _Model) -> bool:
     Levenberg-Marquardt's difference quotients need steps of its size (``epsfcn``)."""
     cached = getattr(model, "_compiled_memory", None)
     if cached is None:
-        from ..solve import compiled
-        from ..solve.memoryrhs import served
+        from ..solve.memoryrhs import available, served
         from ..solve.plan import make_plan
 
         try:
             cached = (bool(model.law.states) and all(s in ("ode", "ode:LSODA") for s in model.solvers)
                       and all(tg.dataset.kind in ("impact", "incline", "spring-slider") for tg in model.targets)
                       and all(served(make_plan(tg.dataset.scene, model.law)) for tg in model.targets)
-                      and compiled.available())
+                      and available())
         except FrictionLabError:
             cached = False
         model._compiled_memory = cached

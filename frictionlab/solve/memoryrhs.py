@@ -23,7 +23,6 @@ import math
 
 import numpy as np
 
-from . import compiled
 from .memory_codes import (BAD, CALLS, COUPLED, DAHL, DAHL_SLID, DIRECTION, DRIVE, IL, ILOAD, INERTIA, ITH, IW, LAW,
                            LUGRE, MASS, MAXCALLS, NC, NORMAL, NORMAL_CONSTANT, NORMAL_HALF_SINE, NORMAL_PHI, NORMAL_TC,
                            NORMAL_VALUE, RADIUS, RS_AGING, RS_SLIP, S0, SENSE, SPIN, STIFFNESS, STOP_T, STRICT, TINY, TSCALE)
@@ -59,10 +58,8 @@ class Phase:
     initial state and state scales as integrated (Dahl's slid form integrates the slip since the phase began in
     place of mu_d); ``states(Y)`` gives back the plan's states."""
 
-    def __init__(self, P, C, y0, scale, V):
-        from . import memory_kernel
-
-        self.kernel = memory_kernel
+    def __init__(self, kernel, P, C, y0, scale, V):
+        self.kernel = kernel
         self.C, self.P = C, P
         self.y0, self.scale = y0, np.ascontiguousarray(scale, dtype=float)
         self.args = (P, C, self.scale, V)
@@ -93,6 +90,25 @@ class Phase:
         return Y
 
 
+_KERNEL: list = []  # [the kernel module, or None where numba does not import], once a process asked
+
+
+def _kernel():
+    """``memory_kernel`` (imports numba; compiles or loads the kernel on first use), or None where that fails."""
+    if not _KERNEL:
+        try:
+            from . import memory_kernel
+        except Exception:  # numba's import fails in many ways (solve.compiled warns of it); none may stop a solve
+            memory_kernel = None
+        _KERNEL.append(memory_kernel)
+    return _KERNEL[0]
+
+
+def available() -> bool:
+    """Whether the compiled path can run here (numba imports)."""
+    return _kernel() is not None
+
+
 def served(plan) -> bool:
     """Whether ``phase`` serves this plan's law and scene (numba aside)."""
     s = plan.scene
@@ -109,7 +125,8 @@ def phase(plan, p, direction: float, vanishing: float, tscale: float, y0, scale,
     plan. slid: Dahl in its slid form (``memory_kernel.law``) where the phase's slip has a sense; sense: that
     sense, given (then the slip may turn: an event ends the phase there), or None: the initial slip's (or the
     drive's), and the kernel stops where the slip turns."""
-    if not served(plan) or not compiled.available():
+    kernel = _kernel() if served(plan) else None
+    if kernel is None:
         return None
     s, law = plan.scene, plan.law
     code, names = LAWS[(type(law).__module__, type(law).__name__)]
@@ -148,4 +165,4 @@ def phase(plan, p, direction: float, vanishing: float, tscale: float, y0, scale,
         # the slip over which s relaxes, mu_c / sigma, or the distance slid where that is shorter
         scale[il] = max(min(float(scale[0]) * float(tscale), P[0] / P[1]), 1e-300)
     C[LAW] = code
-    return Phase(P, C, y0, scale, V)
+    return Phase(kernel, P, C, y0, scale, V)
