@@ -147,6 +147,13 @@ def _say_quietly(message: str) -> None:
         pass
 
 
+def _warn_quietly(message: str) -> None:
+    try:
+        print(f"warning: {message}", file=sys.stderr)
+    except (Exception, KeyboardInterrupt, Terminated):  # noqa: BLE001 (nothing more can be said)
+        pass
+
+
 def _say(message: str, status: int) -> int:
     print(f"frictionlab: {message}", file=sys.stderr)
     return status
@@ -154,6 +161,7 @@ def _say(message: str, status: int) -> int:
 
 def _run(args) -> int:
     """Run the parsed command; every way it can end becomes one line on stderr and an exit status."""
+    from .core.fpstate import own_errstate
     from .core.inputs import inputs_of_run
 
     formatwarning = warnings.formatwarning
@@ -163,9 +171,11 @@ def _run(args) -> int:
             warnings.simplefilter("default")
             warnings.simplefilter("ignore", ResourceWarning)  # e.g. an import cut short by a signal: not the user's
             warnings.formatwarning = lambda m, c, *a, **k: f"warning: {one_line(m)}\n"
-            for path in args.load:
-                load_file(path)
-            return int(args.func(args) or 0)
+            pin_paths(args)  # before any plugin runs: one that changes the working folder moves nothing
+            with own_errstate():  # numpy's error state of its own, whatever a plugin sets at import
+                for path in args.load:
+                    load_file(path)
+                return int(args.func(args) or 0)
     except FrictionLabError as exc:
         if args.debug:
             raise
@@ -190,6 +200,97 @@ def _run(args) -> int:
     finally:
         warnings.formatwarning = formatwarning
         restore()
+
+
+#: The options and arguments that name files or folders (a dataset argument only when it is a path).
+PATH_ARGS = ("out", "json", "plot", "raw", "load", "data", "datasets", "dataset", "name")
+
+
+def pin_paths(args) -> None:
+    """Make every path the command line names absolute against the folder the run starts in, spelled as given
+    ('sub/../d.csv' stays so, below that folder): a plugin that changes the working folder at import or in a call
+    cannot move the run's inputs or outputs. A dataset argument is a path when it ends in .toml or .csv or holds a
+    '/'; otherwise it is a built-in name."""
+    import os
+    from pathlib import Path
+
+    try:
+        here = os.getcwd()
+    except OSError:  # the folder was deleted: relative paths fail later, each naming itself
+        return
+
+    def pinned(v):
+        if isinstance(v, Path):
+            return v if v.is_absolute() else Path(here) / v
+        if isinstance(v, str) and v and not os.path.isabs(v) and (os.sep in v or v.endswith((".toml", ".csv", ".py"))):
+            return os.path.join(here, v)
+        return v
+
+    for key in PATH_ARGS:
+        if key == "name" and getattr(args, "action", None) != "show":  # elsewhere --name is a name
+            continue
+        value = getattr(args, key, None)
+        if isinstance(value, list):
+            setattr(args, key, [pinned(v) for v in value])
+        elif value is not None:
+            setattr(args, key, pinned(value))
+
+
+def entry() -> None:
+    """The ``frictionlab`` console script (and ``python -m frictionlab``): ``main()``, then the process ends as
+    soon as its work is done. What it wrote is flushed; a thread a plugin started (not a daemon) does not hold it,
+    nor do child processes a plugin forked and left running (they are ended, so that they hold neither the
+    process nor its output streams), each named in a warning."""
+    rc = main()
+    end_process(rc)
+
+
+def end_process(rc: int) -> None:
+    import os
+    import threading
+
+    threads = [t for t in threading.enumerate()
+               if t is not threading.main_thread() and not t.daemon and t.is_alive()]
+    children = _children()
+    for pid in children:
+        try:
+            os.kill(pid, 9)  # SIGKILL: a plugin's helper left behind
+        except OSError:
+            pass
+    if threads or children:
+        left = [f"thread {t.name!r}" for t in threads] + [f"process {pid}" for pid in children]
+        _warn_quietly(f"code loaded in this run left {', '.join(left)} running; not waiting for "
+                     f"{'it' if len(left) == 1 else 'them'}" + ("" if not children else " (the processes were ended)"))
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except Exception:  # noqa: BLE001 (a closed or broken stream: nothing more can be said)
+            pass
+    if threads or children:
+        os._exit(rc)
+    sys.exit(rc)
+
+
+def _children() -> list[int]:
+    """The process ids of this process's children still running (Linux /proc; [] elsewhere)."""
+    import os
+
+    me, found = os.getpid(), []
+    try:
+        names = os.listdir("/proc")
+    except OSError:
+        return []
+    for name in names:
+        if not name.isdigit():
+            continue
+        try:
+            with open(f"/proc/{name}/stat", "rb") as f:
+                fields = f.read().rsplit(b")", 1)[1].split()
+        except (OSError, IndexError):
+            continue
+        if len(fields) > 2 and int(fields[1]) == me and fields[0] != b"Z":
+            found.append(int(name))
+    return found
 
 
 def _cwd_gone() -> str:

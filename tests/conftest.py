@@ -15,6 +15,12 @@ if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
+@pytest.fixture(autouse=True, scope="session")
+def _record_cache(tmp_path_factory):
+    """The measured records' import cache of this test session, not the user's."""
+    os.environ["XDG_CACHE_HOME"] = str(tmp_path_factory.mktemp("cache"))
+
+
 @pytest.fixture
 def run_cli():
     """Run ``python -m frictionlab ARGS`` in a subprocess; returns CompletedProcess."""

@@ -122,7 +122,8 @@ def test_a_fit_that_does_not_converge_is_recorded_and_the_comparison_completes(m
 
 def test_failing_fit_on_the_command_line(bad_laws, tmp_path, run_cli):
     out = run_cli("--load", bad_laws, "fit", "nan-above-5", "impact-golf-v28", cwd=tmp_path)
-    assert out.returncode == 1, out.stdout + out.stderr  # not bad input: the fit ran and failed
+    assert out.returncode == 2, out.stdout + out.stderr  # the law given gives no fit: as bad input, exit 2
+    assert out.stderr.strip().splitlines()[-1].startswith("frictionlab: error: fit: nan-above-5 on impact-golf-v28 failed")
     assert "Traceback" not in out.stderr
     assert "nan-above-5" in out.stdout and "failed" in out.stdout and "NaN" in out.stdout
     rep = tmp_path / "rep"

@@ -1,6 +1,9 @@
 """Raw velocity-step records (time, displacement, friction, effective normal stress) imported as measured
-spring-slider datasets: the record here is made by the test itself, in the raw format, from a known law."""
+spring-slider datasets: the records here are made by the test itself, in the raw format, from a known law."""
 from __future__ import annotations
+
+import re
+import tomllib
 
 import numpy as np
 import pytest
@@ -9,84 +12,130 @@ import frictionlab as fl
 from frictionlab.cli import main
 from frictionlab.core.errors import DatasetError
 from frictionlab.io.dataset import load_dataset
-from frictionlab.io.velstep import read_raw, velstep_dataset
+from frictionlab.io.velstep import analyse, dataset_toml, read_raw
 from frictionlab.physics.scene import ConstantNormal, Scene, SpringLoad
 
 TRUTH = {"mu0": 0.55, "a": 0.010, "b": 0.014, "Dc": 50e-6}
 K = 0.01e6  # 0.01 1/um
 T_STEP, T_END, CLOCK = 400.0, 1400.0, 8105.381  # the record's clock starts at CLOCK s
 SIGMA = 2e-4
+HEADER = "Time(s)\tDispl(microns)\tFriction\tEffectiveNormalstress(MPa)"
 
 
-def _record(path, trend=0.0, header="Time(s)\tDispl(microns)\tFriction\tEffectiveNormalstress(MPa)"):
-    """Write a velocity step 0.2 -> 2 um/s sampled at 5 Hz, as the raw format has it; returns the slider's load."""
-    t = np.arange(0.0, T_END, 0.2)
-    scene = Scene(kind="spring-slider", mass=1.0, u0=2e-7, duration=T_END, normal=ConstantNormal(1.0),
-                  spring=SpringLoad(K, (0.0, T_STEP), (2e-7, 2e-6)))
+def _record(path, header=HEADER, times=(0.0, T_STEP), velocities=(2e-7, 2e-6), end=T_END, dt=0.2, seed=7):
+    """Write a velocity-step record (default 0.2 -> 2 um/s at T_STEP, 5 Hz) in the raw format; the friction is
+    the aging law's on a spring of stiffness K plus noise, the displacement the load point's plus 0.05 um noise."""
+    t = np.arange(0.0, end, dt)
+    scene = Scene(kind="spring-slider", mass=1.0, u0=velocities[0], duration=end, normal=ConstantNormal(1.0),
+                  spring=SpringLoad(K, times, velocities))
     mu = fl.simulate("rate-state-aging", scene, TRUTH, t=t).load
-    x = np.where(t < T_STEP, 2e-7 * t, 2e-7 * T_STEP + 2e-6 * (t - T_STEP))
-    rng = np.random.default_rng(7)
-    noisy = mu + trend * x + rng.normal(0.0, SIGMA, t.size)
-    rows = [header] + [f"{a + CLOCK:.6f}\t{(b + 1e-3) * 1e6:.6f}\t{c:.6f}\t{30 + rng.normal(0, 0.01):.6f}"
-                       for a, b, c in zip(t, x, noisy)]
+    edges = [*times[1:], np.inf]
+    x = sum(v * np.clip(t - a, 0.0, b - a) for a, b, v in zip(times, edges, velocities))
+    rng = np.random.default_rng(seed)
+    rows = [header] + [f"{a + CLOCK:.6f}\t{(b + 1e-3) * 1e6 + rng.normal(0, 0.05):.6f}\t{c:.6f}\t"
+                       f"{30 + rng.normal(0, 0.01):.6f}" for a, b, c in zip(t, x, mu + rng.normal(0.0, SIGMA, t.size))]
     path.write_text("\n".join(rows) + "\n")
     return mu
 
 
-def test_import_finds_the_step_the_velocities_and_the_stiffness(tmp_path):
+def test_import_finds_the_step_its_fitted_velocities_and_a_stiffness_start(tmp_path):
     _record(tmp_path / "raw.txt")
-    toml, csv, imp = velstep_dataset(tmp_path / "raw.txt", "vs", points=300, source="test", license="MIT",
-                                     citation="nobody")
-    assert imp.velocities == (2e-7, 2e-6)
-    assert imp.step_times[0] == pytest.approx(T_STEP, abs=0.2)
-    assert imp.time_zero == pytest.approx(CLOCK)
-    assert imp.stiffness == pytest.approx(K, rel=0.3)  # a starting value only: it is fitted afterwards
-    assert imp.sigma == pytest.approx(SIGMA, rel=0.1)
-    assert imp.trend == 0.0  # the record is kept as measured unless --detrend
-    assert 250 <= len(imp.index) <= 300
-    dense = np.diff(imp.index[(imp.index > T_STEP / 0.2) & (imp.index < T_STEP / 0.2 + 50)])
-    assert dense.size and dense.min() == 1  # every sample kept just after the step
-    (tmp_path / "vs.toml").write_text(toml)
-    (tmp_path / "vs.csv").write_text(csv)
-    d = load_dataset(tmp_path / "vs.toml")
-    assert d.provenance.kind == "measured" and d.provenance.license == "MIT" and d.provenance.citation == "nobody"
-    assert d.t[0] == 0.0 and d.time_zero == pytest.approx(CLOCK)
-    assert d.scene.spring.times == pytest.approx((0.0, T_STEP), abs=0.2)
+    imp = analyse(read_raw(tmp_path / "raw.txt"), "vs")
+    (st,), (w,) = imp.seg.steps, imp.windows
+    assert abs(st.time - (CLOCK + T_STEP)) < 4 * st.time_se and st.time_se < 0.05
+    assert imp.velocities == pytest.approx((2e-7, 2e-6), rel=1e-3)  # fitted, not rounded set points
+    assert imp.velocities != (2e-7, 2e-6)
+    assert (w.a, w.b) == (0, 7000) and w.times[1] == pytest.approx(T_STEP, abs=4 * st.time_se)
+    assert K / 2 < w.stiffness < 2 * K  # a start, fitted afterwards
 
 
-def test_a_trend_before_the_step_is_measured_and_removed(tmp_path):
-    mu = _record(tmp_path / "raw.txt", trend=-20.0)  # -2e-5 per um
-    _, _, imp = velstep_dataset(tmp_path / "raw.txt", "vs", points=300, detrend=True)
-    assert imp.trend == pytest.approx(-20.0, rel=0.1)
-    assert np.std(imp.mu - mu) < 2 * SIGMA
-    _, _, kept = velstep_dataset(tmp_path / "raw.txt", "vs", points=300)
-    assert kept.trend == 0.0 and np.std(kept.mu - mu) > 10 * SIGMA
+def test_the_dataset_keeps_the_contract_with_the_fit(tmp_path):
+    """CSV t,x,mu with every sample; TOML spring-slider, mu, [scene.spring] times exact to the microsecond,
+    fitted velocities, [noise] estimated with AR(1) correlation and no sigma, provenance measured."""
+    _record(tmp_path / "raw.txt")
+    out = tmp_path / "out"
+    out.mkdir()
+    assert main(["datasets", "import", "velstep", str(tmp_path / "raw.txt"), "--name", "vs", "--out", str(out),
+                 "--license", "MIT", "--citation", "nobody"]) == 0
+    meta = tomllib.loads((out / "vs.toml").read_text())
+    assert meta["kind"] == "spring-slider" and meta["observable"] == "mu"
+    assert meta["noise"] == {"kind": "estimated", "correlation": "ar1"}
+    assert "trend" not in (out / "vs.toml").read_text().split("[provenance]")[0]
+    spring = meta["scene"]["spring"]
+    assert spring["times"][0] == "0 s" and spring["stiffness"].endswith(" 1/um")
+    assert all(v.endswith(" um/s") for v in spring["velocities"])
+    imp = analyse(read_raw(tmp_path / "raw.txt"), "vs")
+    step = imp.seg.steps[0].time - imp.raw.t[0]
+    assert abs(float(spring["times"][1].split()[0]) - step) < 1e-6
+    assert meta["provenance"]["kind"] == "measured" and meta["provenance"]["license"] == "MIT"
+    assert {"source", "citation", "method", "command"} <= set(meta["provenance"])
+    lines = [x for x in (out / "vs.csv").read_text().splitlines() if not x.startswith("#")]
+    assert lines[0] == "t,x,mu" and len(lines) - 1 == 7000  # every sample
+    d = load_dataset(out / "vs.toml")
+    assert d.provenance.kind == "measured" and len(d) == 7000 and d.t[0] == 0.0
+    assert d.time_zero == pytest.approx(CLOCK) and d.scene.spring.times[1] == pytest.approx(step, abs=1e-6)
+
+
+def test_several_steps_and_a_hold_import_as_one_dataset_each_or_one_joint_dataset(tmp_path, capsys):
+    times, vs = (0.0, 300.0, 600.0, 700.0), (2e-6, 2e-7, 0.0, 2e-6)
+    _record(tmp_path / "raw.txt", times=times, velocities=vs, end=1000.0)
+    out = tmp_path / "out"
+    out.mkdir()
+    assert main(["datasets", "import", "velstep", str(tmp_path / "raw.txt"), "--name", "exp", "--out", str(out),
+                 "--steps", "3"]) == 0
+    text = capsys.readouterr().out
+    assert "3 velocity steps" in text and "hold from lines" in text
+    assert "step  line" in text and "V before [um/s]" in text  # the table
+    assert sorted(p.name for p in out.iterdir()) == [f"exp-step{i}.{e}" for i in (1, 2, 3) for e in ("csv", "toml")]
+    d2 = load_dataset(out / "exp-step2.toml")
+    assert d2.scene.spring.velocities == pytest.approx((2e-7, 0.0), abs=1e-9)
+    assert main(["datasets", "import", "velstep", str(tmp_path / "raw.txt"), "--name", "whole", "--out", str(out),
+                 "--joint"]) == 0
+    d = load_dataset(out / "whole.toml")
+    assert len(d) == 5000 and d.scene.spring.velocities == pytest.approx(vs, abs=1e-9)
+    assert d.scene.spring.times == pytest.approx(times, abs=0.05)
+
+
+def test_steps_expected_and_found_must_agree(tmp_path, capsys):
+    _record(tmp_path / "raw.txt")
+    assert main(["datasets", "import", "velstep", str(tmp_path / "raw.txt"), "--name", "vs", "--out", str(tmp_path),
+                 "--steps", "3"]) == 2
+    assert re.search(r"raw.txt: expected 3 velocity steps \(--steps\), found 1: line 200[23] \(t = 8505\.38",
+                     capsys.readouterr().err)
+
+
+def test_a_given_stiffness_is_the_start_and_a_bad_one_names_the_option(tmp_path, capsys):
+    _record(tmp_path / "raw.txt")
+    imp = analyse(read_raw(tmp_path / "raw.txt"), "vs", stiffness=2e3)
+    text = dataset_toml(imp, imp.windows[0])
+    assert 'stiffness = "0.002 1/um"   # given with --stiffness' in text
+    for bad in ("-0.01 1/um", "0 1/um", "nan 1/um"):
+        assert main(["datasets", "import", "velstep", str(tmp_path / "raw.txt"), "--name", "vs", "--out",
+                     str(tmp_path), f"--stiffness={bad}"]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("frictionlab: error: --stiffness") and ".toml" not in err, err
 
 
 @pytest.mark.slow
 def test_the_imported_step_is_fitted_back_with_free_stiffness(tmp_path):
     _record(tmp_path / "raw.txt")
-    toml, csv, _ = velstep_dataset(tmp_path / "raw.txt", "vs", points=200)
-    (tmp_path / "vs.toml").write_text(toml)
-    (tmp_path / "vs.csv").write_text(csv)
-    r = fl.fit("rate-state-aging", tmp_path / "vs.toml", free={"spring.stiffness": (1e3, 1e5)})
+    out = tmp_path / "out"
+    out.mkdir()
+    assert main(["datasets", "import", "velstep", str(tmp_path / "raw.txt"), "--name", "vs", "--out", str(out)]) == 0
+    r = fl.fit("rate-state-aging", out / "vs.toml", free={"spring.stiffness": (1e3, 1e5)})
     assert r.ok, r.reason
     for name in ("a", "b", "Dc"):
         p = r.params[name]
         assert abs(p.value - TRUTH[name]) < 4 * p.stderr, (name, p.value, p.stderr)
-    k = r.params["spring.stiffness"]
-    assert abs(k.value - K) < 4 * k.stderr
 
 
-def test_the_command_writes_a_pair_that_loads_and_refuses_bad_records(tmp_path, capsys):
+def test_the_command_refuses_bad_records_and_writes_nothing(tmp_path, capsys):
     _record(tmp_path / "raw.txt")
     out = tmp_path / "out"
     out.mkdir()
-    argv = ["datasets", "import", "velstep", str(tmp_path / "raw.txt"), "--name", "vs", "--out", str(out),
-            "--points", "200", "--license", "MIT"]
+    argv = ["datasets", "import", "velstep", str(tmp_path / "raw.txt"), "--name", "vs", "--out", str(out)]
     assert main(argv) == 0
-    assert "load point 0.2 um/s -> 2 um/s" in capsys.readouterr().out
-    assert load_dataset(out / "vs.toml").provenance.kind == "measured"
+    assert "load point" not in capsys.readouterr().err
     assert main(argv) == 2 and "exists" in capsys.readouterr().err
     (tmp_path / "bad.txt").write_text("t x mu sn\n1 2 3 4\n")
     assert main(["datasets", "import", "velstep", str(tmp_path / "bad.txt"), "--name", "b", "--out", str(out)]) == 2
@@ -100,6 +149,16 @@ def test_raw_reader_names_the_line_of_a_bad_row(tmp_path):
     lines[5] = "8106.0\t1000.0\tnan\t30.0"
     (tmp_path / "raw.txt").write_text("\n".join(lines) + "\n")
     with pytest.raises(DatasetError, match=r"raw.txt: line 6: expected four finite numbers"):
+        read_raw(tmp_path / "raw.txt")
+
+
+def test_blank_lines_keep_the_line_numbers_of_the_file(tmp_path):
+    _record(tmp_path / "raw.txt")
+    lines = (tmp_path / "raw.txt").read_text().splitlines()
+    lines[9:9] = ["", "  "]
+    lines[20] = "\t".join(lines[20].split("\t")[:3] + ["-30"])  # a negative normal stress on line 21
+    (tmp_path / "raw.txt").write_text("\n".join(lines) + "\n")
+    with pytest.raises(DatasetError, match=r"raw.txt: line 21: normal stress must be positive"):
         read_raw(tmp_path / "raw.txt")
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..core.errors import OutputError, ParameterError
+from ..core.errors import FitError, OutputError, ParameterError
 from ..core.progress import Progress
 from .fit import FIT_TIMEOUT, fit_timeout
 
@@ -27,13 +27,14 @@ def add_parser(sub):
     from ..cli import ListAction, subcommand
 
     p = subcommand(sub, "compare", help="compare laws on datasets and write a report folder",
-                   description="Fit every law to every dataset (default: the four mission laws, all "
-                               "built-in datasets), rank them, test the paper's equivalence claim, and write report.md, "
+                   description="Fit every law to every dataset (default: the laws of each dataset's kind, the "
+                               "four mission laws on impacts and inclines and rate-and-state aging and slip on "
+                               "spring-sliders, on every built-in dataset and measured record present), rank them, test the paper's equivalence claim, and write report.md, "
                                "report.html, figures/, ranking.csv and results.json. Two defaults differ from "
                                "the library's fl.compare(), which runs only what it is asked for: --bootstrap "
                                f"{BOOTSTRAP_N} (API bootstrap=0) and --fit-timeout {FIT_TIMEOUT:g} s (API "
                                "fit_timeout=None). The tolerance check runs only with --tolerance.",
-                   examples="""  frictionlab compare                          # the four mission laws on every built-in dataset into ./report
+                   examples="""  frictionlab compare                          # each kind's laws on every built-in dataset into ./report
   frictionlab compare --laws wear,area-rate --data impact-golf-v28 --out golf
   frictionlab compare --data my.toml --data impact-golf-v61 --solver exact --solver series
   frictionlab compare --tolerance --out full    # also refit the ODE laws at other solver tolerances
@@ -41,10 +42,11 @@ def add_parser(sub):
       --pairs rate-state-aging:rate-state-slip --bootstrap-all --out steps   # aging against slip
   frictionlab compare --bootstrap 0 --quiet --out quick   # fastest, no progress lines""")
     p.add_argument("--laws", "--law", action=ListAction, metavar="NAME", help="law names, or 'all' for every registered law "
-                   "(default: coulomb, area-rate, wear, couette)")
+                   "(default by dataset kind: coulomb, area-rate, wear, couette on impacts and inclines; "
+                   "rate-state-aging, rate-state-slip on spring-sliders)")
     p.add_argument("--data", action=ListAction, nargs="+", metavar="NAME_OR_TOML",
                    help="datasets, several after one --data (e.g. a shell glob), comma-separated or repeated "
-                        "(default: every built-in)")
+                        "(default: every built-in dataset and every measured record present)")
     p.add_argument("--solver", "--solvers", action=ListAction, metavar="SOLVER",
                    help="exact, series, ode[:METHOD] or auto (default: exact where a closed form exists else ode, "
                         "plus series where it applies)")
@@ -61,6 +63,16 @@ def add_parser(sub):
     p.add_argument("--pairs", "--pair", action=ListAction, metavar="LAW:LAW",
                    help="the pairs of laws whose equivalence is tested, e.g. rate-state-aging:rate-state-slip "
                         "(default: wear:area-rate, wear:couette, coulomb:wear, where both laws are compared)")
+    from ..core.cluster import CONNECT_TIMEOUT, TASK_TIMEOUT, WAIT_WORKERS
+
+    p.add_argument("--connect-timeout", type=fit_timeout, default=CONNECT_TIMEOUT, metavar="SECONDS",
+                   help=f"with --scheduler: how long the scheduler has to answer (default {CONNECT_TIMEOUT:g})")
+    p.add_argument("--wait-workers", type=fit_timeout, default=WAIT_WORKERS, metavar="SECONDS",
+                   help="with --scheduler: how long to wait for a worker when the cluster has none, at the start or "
+                        f"after its last worker is lost (default {WAIT_WORKERS:g})")
+    p.add_argument("--task-timeout", type=fit_timeout, default=TASK_TIMEOUT, metavar="SECONDS",
+                   help="with --scheduler: how long one task (a dataset's fits, tests and bootstrap, or a batch of "
+                        f"figures) may run on a worker (default {TASK_TIMEOUT:g})")
     p.add_argument("--no-equivalence", action="store_true", help="skip the equivalence (discrimination) tests")
     p.add_argument("--replicates", type=int, default=REPLICATES, metavar="R",
                    help=f"the most replicate datasets per law in the equivalence test's sequential parametric bootstrap "
@@ -89,8 +101,8 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from ..core.cluster import connect
-    from ..io.dataset import builtin_names, load_dataset
+    from ..core.cluster import Waits, close, connect, quiet_logs
+    from ..io.dataset import available_names, load_dataset
     from .fit import parse_free
 
     parent = args.out.parent if str(args.out.parent) else Path(".")
@@ -109,22 +121,38 @@ def run(args) -> int:
         raise ParameterError(f"--replicates must be at least {MIN_REPLICATES}, got {args.replicates}")
     free = parse_free(args.free)
     pairs = parse_pairs(args.pairs, args.laws or None) if args.pairs else None
-    datasets = [load_dataset(d) for d in args.data or builtin_names()]  # read first: --out keeps clear of them
-    client = connect(args.scheduler) if args.scheduler else None
-    try:
-        return _run(args, free, pairs, datasets, client)
-    finally:
-        if client is not None:
-            client.close()
+    datasets = [load_dataset(d) for d in args.data or available_names()]  # read first: --out keeps clear of them
+    if args.scheduler is None:
+        return _run(args, free, pairs, datasets, None)
+    waits = Waits(connect=args.connect_timeout, workers=args.wait_workers, task=args.task_timeout,
+                  say=None if args.quiet else _say)
+    with quiet_logs(args.debug):  # distributed's own log is not the user's to read, unless --debug
+        client = connect(args.scheduler, waits)
+        try:
+            return _run(args, free, pairs, datasets, client)
+        finally:
+            close(client, waits)
+
+
+def _say(text: str) -> None:
+    """A wait on the cluster, said as a progress line."""
+    import sys
+
+    from ..core.progress import _stamp
+
+    print(f"{_stamp()} compare: {text}", file=sys.stderr, flush=True)
 
 
 def parse_pairs(items, laws) -> tuple[tuple[str, str], ...]:
     """--pairs 'wear:area-rate' ... -> (('wear', 'area-rate'), ...): registered names, two different laws, both
-    among the compared ``laws`` (None: the default set)."""
+    among the compared ``laws`` (None: the default laws of every dataset kind)."""
     from ..physics.registry import get_law
-    from ..pipeline.settings import select_laws
+    from ..pipeline.settings import DEFAULT_LAWS_BY_KIND, select_laws
 
-    compared = set(select_laws(laws))
+    # the laws compared together: the named ones, or the default laws of each dataset kind (a pair of laws from
+    # two kinds' defaults is never fitted on one dataset)
+    groups = [set(select_laws(laws))] + ([{get_law(n).name for n in v} for v in DEFAULT_LAWS_BY_KIND.values()]
+                                         if laws is None else [])
     pairs = []
     for item in items:
         a, sep, b = item.partition(":")
@@ -133,8 +161,9 @@ def parse_pairs(items, laws) -> tuple[tuple[str, str], ...]:
         a, b = get_law(a.strip()).name, get_law(b.strip()).name
         if a == b:
             raise ParameterError(f"--pairs {item!r}: a law is always equivalent to itself; name two different laws")
-        missing = [x for x in (a, b) if x not in compared]
-        if missing:
+        if not any({a, b} <= g for g in groups):
+            compared = next((g for g in groups if b in g or a in g), groups[0])
+            missing = [x for x in (a, b) if x not in compared]
             raise ParameterError(f"--pairs {item!r}: {', '.join(missing)} {'is' if len(missing) == 1 else 'are'} not "
                                  f"among the compared laws ({', '.join(sorted(compared))}); add "
                                  f"{'it' if len(missing) == 1 else 'them'} to --laws")
@@ -157,6 +186,11 @@ def _run(args, free, pairs, datasets, client) -> int:
                              tolerance=TOLERANCE_RTOLS if args.tolerance else (), fit_timeout=args.fit_timeout,
                              replicates=args.replicates, transfer=args.transfer, client=client,
                              **({"pairs": pairs} if pairs else {}))
+        if not any(f.ok for f in result.fits):  # nothing to compare: an error, and no report of it
+            reasons = list(dict.fromkeys(f"{f.law} on {', '.join(f.datasets)}: {f.reason}" for f in result.fits
+                                         if f.status == "failed"))
+            raise FitError("compare: no fit succeeded: " + "; ".join(reasons[:3])
+                           + (f" (and {len(reasons) - 3} more)" if len(reasons) > 3 else ""))
         with Progress("report", quiet=args.quiet) as bar:
             out = write_report(result, args.out, force=args.force, progress=bar, jobs=args.jobs, client=client)
     ok = sum(f.ok for f in result.fits)
@@ -164,10 +198,20 @@ def _run(args, free, pairs, datasets, client) -> int:
     print(f"compared {n_laws} law{'s' * (n_laws != 1)} on {n_data} dataset{'s' * (n_data != 1)}: {ok} fits, "
           f"{sum(f.status == 'failed' for f in result.fits)} failed, {sum(f.status == 'skipped' for f in result.fits)} "
           f"skipped, {sum(e.ok for e in result.equivalence)} equivalence tests, in {result.wall_time:.1f} s")
-    for line in answer_lines(result):
+    for line in laws_lines(result) + answer_lines(result):
         print(line)
     print(f"report: {out / 'report.html'} (also report.md, ranking.csv, results.json, figures/)")
     return 0
+
+
+def laws_lines(c) -> list[str]:
+    """Which laws were fitted on which kind of dataset, when that was chosen by kind (the default laws)."""
+    from ..pipeline.settings import laws_groups
+
+    groups = laws_groups(c.options.by_kind if c.options is not None else {},
+                         {d.kind for d in c.datasets if d.kind != "contact-area"})
+    return ["laws by dataset kind (the default): " + "; ".join(f"{', '.join(laws)} on {', '.join(k)}"
+                                                               for laws, k in groups)] if groups else []
 
 
 def answer_lines(c) -> list[str]:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import filecmp
+import os
 import shutil
 import tempfile
 from pathlib import Path
@@ -65,27 +66,33 @@ def add_parser(sub):
 def _add_import(acts):
     from ..cli import subcommand
 
-    imp = subcommand(acts, "import", help="turn a raw laboratory record into a dataset (velocity steps)",
-                     description="Read a raw record and write NAME.toml and NAME.csv, a measured dataset. FORMAT "
+    imp = subcommand(acts, "import", help="turn a raw laboratory record into datasets, one per velocity step",
+                     description="Read a raw record and write measured datasets (NAME.toml + NAME.csv). FORMAT "
                                  "velstep: whitespace-separated Time(s) Displ(microns) Friction "
-                                 "EffectiveNormalstress(MPa), one velocity step per file (the sliced records of the "
-                                 "steadystate routine, Giacomel et al. 2024). The load-point velocities and step time "
-                                 "come from the displacement record; the machine stiffness is estimated from the "
-                                 "loading after the step unless given (fit it with --free spring.stiffness).",
-                     examples="""  frictionlab datasets import velstep velstep1.txt --name velstep1 --out data/ \\
-      --source 'pgiacomel/steadystate, velstep1_TR2_exp013_sepiolite.txt' --license MIT \\
-      --citation 'Giacomel et al., Geosphere (2024), doi:10.1130/GES02739.1'
-  frictionlab fit rate-state-aging data/velstep1.toml --free spring.stiffness='0.0005 1/um:1 1/um'""")
+                                 "EffectiveNormalstress(MPa) (the records of the steadystate routine, Giacomel et al. "
+                                 "2024), any number of velocity steps and holds. The displacement is segmented into "
+                                 "straight pieces (optimal partitioning: the data choose the number of steps); each "
+                                 "step's time is the kink of a continuous two-line fit, its velocities are fitted "
+                                 "values, and a table of both with their standard errors is printed. One dataset per "
+                                 "step (NAME-step1, NAME-step2, ...; NAME alone for one step) holds every sample from "
+                                 "the step before to the step after; --joint writes one dataset with every step, for "
+                                 "a joint fit across steps. A jump of displacement without a change of velocity (a "
+                                 "transducer reset) is stitched and reported. The machine stiffness is a start "
+                                 "estimated from friction's loading after each step unless given.",
+                     examples="""  frictionlab datasets import velstep experiment.txt --name exp13 --out data/ \\
+      --source 'my lab, run 13' --license CC-BY-4.0 --citation 'me et al. (2026)'
+  frictionlab datasets import velstep experiment.txt --name exp13 --joint --out data/
+  frictionlab fit rate-state-aging data/exp13-step1.toml""")
     imp.add_argument("format", choices=("velstep",), metavar="FORMAT", help="raw format: velstep")
     imp.add_argument("raw", type=Path, metavar="RAWFILE", help="the raw record")
-    imp.add_argument("--name", required=True, help="dataset and file name")
+    imp.add_argument("--name", required=True, help="dataset name, and file name: NAME-step1, ... for several steps")
     imp.add_argument("--out", type=Path, default=Path("."), help="folder to write into (default: here)")
-    imp.add_argument("--points", type=int, default=600, help="samples to keep (default 600)")
-    imp.add_argument("--steps", type=int, default=1, help="velocity steps in the record (default 1)")
-    imp.add_argument("--detrend", action="store_true", help="remove friction's slip trend, a straight line in "
-                     "displacement fitted before the step (default: keep the record as measured)")
-    imp.add_argument("--stiffness", help="machine stiffness per unit normal stress, e.g. '0.01 1/um' (default: "
-                                         "estimated from the loading after the step)")
+    imp.add_argument("--joint", action="store_true", help="one dataset holding every step of the record (a joint "
+                     "fit of a, b and Dc across steps) instead of one per step")
+    imp.add_argument("--steps", type=int, metavar="N", help="check: the number of velocity steps expected (an error "
+                                                           "names what was found when it differs)")
+    imp.add_argument("--stiffness", help="start for the machine stiffness per unit normal stress, e.g. '0.01 1/um' "
+                                         "(default: estimated from friction's loading after each step)")
     imp.add_argument("--source", default="", help="where the record comes from (default: its path)")
     imp.add_argument("--license", default="", help="the record's license, e.g. MIT")
     imp.add_argument("--citation", default="", help="what to cite")
@@ -94,66 +101,80 @@ def _add_import(acts):
 
 
 def _import(args) -> int:
+    import math
     import shlex
 
     from ..core.errors import OutputError, ParameterError
-    from ..core.files import atomic_write_text
+    from ..core.files import atomic_files
     from ..core.names import check_name
     from ..core.units import to_si
-    from ..io.dataset import load_dataset
-    from ..io.velstep import velstep_dataset
+    from ..io.dataset import from_meta
+    from ..io.velstep import analyse, dataset_toml, parts, read_raw, summary, write_csv
 
     check_name(args.name, "datasets import --name", OutputError)  # before any path is made of it
-    if not 10 <= args.points <= 100_000 or not 1 <= args.steps <= 50:
-        raise ParameterError("datasets import: --points must be 10 to 100000 and --steps 1 to 50")
+    if args.steps is not None and not 1 <= args.steps <= 10_000:
+        raise ParameterError(f"--steps: {args.steps} steps; expected a number from 1 to 10000")
+    k = to_si(args.stiffness, "1/m", "--stiffness") if args.stiffness is not None else None
+    if k is not None and not (k > 0 and math.isfinite(k)):
+        raise ParameterError(f"--stiffness: {args.stiffness!r} must be a positive stiffness per unit normal stress, "
+                             "e.g. '0.01 1/um'")
     if not args.out.is_dir():
         raise OutputError(f"{args.out}: folder does not exist")
-    paths = args.out / f"{args.name}.toml", args.out / f"{args.name}.csv"
-    if any(p.resolve() == args.raw.resolve() for p in paths):
-        raise OutputError(f"{args.raw}: the output would overwrite the raw record; choose another --name or --out")
-    for p in paths:
-        if p.exists() and not args.force:
-            raise OutputError(f"{p}: exists; choose another --name or --out, or pass --force")
-    k = to_si(args.stiffness, "1/m", "--stiffness") if args.stiffness else None
-    command = "frictionlab datasets import velstep " + " ".join(shlex.quote(a) for a in (
-        args.raw.name, "--name", args.name, "--points", str(args.points), "--steps", str(args.steps))) + (
-        " --detrend" if args.detrend else "") + (f" --stiffness {shlex.quote(args.stiffness)}" if k else "")
-    toml, csv, imp = velstep_dataset(args.raw, args.name, steps=args.steps, points=args.points,
-                                     detrend=args.detrend, stiffness=k, source=args.source,
-                                     license=args.license, citation=args.citation, command=command)
-    import tempfile
-
-    with tempfile.TemporaryDirectory() as tmp:  # the pair must load before it is written
-        (Path(tmp) / paths[0].name).write_text(toml)
-        (Path(tmp) / paths[1].name).write_text(csv)
-        load_dataset(Path(tmp) / paths[0].name)
-    atomic_write_text(paths[1], csv)
-    atomic_write_text(paths[0], toml)
-    v = " -> ".join(f"{x * 1e6:g} um/s" for x in imp.velocities)
-    print(f"wrote {paths[0]} and {paths[1]}: {len(imp.index)} samples, load point {v} (step at "
-          f"{', '.join(f'{t:.6g} s' for t in imp.step_times)}), k = {imp.stiffness * 1e-6:.3g} 1/um "
-          f"({'stated' if imp.stiffness_stated else 'estimated; fit it with --free spring.stiffness'})")
+    raw = read_raw(args.raw)
+    imp = analyse(raw, args.name, joint=args.joint, stiffness=k, steps=args.steps)
+    files, pairs = {}, []
+    for w in imp.windows:
+        paths = args.out / f"{w.name}.toml", args.out / f"{w.name}.csv"
+        for p in paths:
+            if p.resolve() == args.raw.resolve():
+                raise OutputError(f"{p}: would overwrite the raw record; choose another --name or --out")
+            if os.path.lexists(p) and not args.force:
+                raise OutputError(f"{p}: exists; choose another --name or --out, or pass --force")
+        command = "frictionlab datasets import velstep " + " ".join(shlex.quote(a) for a in (
+            args.raw.name, "--name", args.name)) + (" --joint" if args.joint else "") + (
+            f" --stiffness {shlex.quote(args.stiffness)}" if k else "")
+        toml = dataset_toml(imp, w, source=args.source, license=args.license, citation=args.citation,
+                            command=command)
+        meta, cols = parts(imp, w, toml, rows=20_000)
+        from_meta(meta, paths[0], raw=cols)  # the pair loads before it is written
+        files[paths[1]] = lambda fh, w=w: write_csv(fh, imp, w)
+        files[paths[0]] = lambda fh, toml=toml: fh.write(toml)
+        pairs.append((w, paths))
+    with atomic_files(list(files), force=args.force) as staged:  # every file of every step, or none
+        for write, tmp in zip(files.values(), staged):
+            with open(tmp, "w", encoding="utf-8", newline="\n") as fh:
+                write(fh)
+    for line in summary(imp):
+        print(line)
+    for w, (toml_path, csv_path) in pairs:
+        v = " -> ".join(f"{x * 1e6:.4g}" for x in w.velocities)
+        print(f"wrote {_shown(toml_path)} and {_shown(csv_path)}: lines {raw.line(w.a)} to {raw.line(w.b - 1)} ({w.b - w.a} samples), "
+              f"{v} um/s, k start {w.stiffness * 1e-6:.3g} 1/um ({w.stiffness_from}; fitted with the law)")
     return 0
+
+
+def _shown(path: Path) -> str:
+    """A path as the user would write it: relative to the current folder when it lies below it."""
+    rel = os.path.relpath(path)
+    return str(path) if rel.startswith("..") else rel
 
 
 def _list(args) -> int:
     from ..core.table import render
-    from ..io.dataset import builtin_dir, builtin_names, load_dataset
+    from ..io import external
+    from ..io.dataset import available_names, builtin_dir, load_dataset
 
     rows = []
-    for name in builtin_names():
+    for name in available_names():
         d = load_dataset(name)
         rows.append({"name": d.name, "kind": d.kind, "points": len(d), "observable": d.observable,
                      "provenance": d.provenance.kind, "source": _short(d.provenance.source)})
     print(render(rows))
-    print(f"\n{len(rows)} datasets in {builtin_dir()}; 'frictionlab datasets show NAME' for details, "
-          "'frictionlab datasets template KIND' to start your own.")
-    from ..io import external
-
     here = external.present()
-    missing = sorted(set(external.RECORDS) - set(here))
-    if here:
-        print(f"measured records present in {', '.join(map(str, external.raw_dirs()))}: {', '.join(here)}")
+    print(f"\n{len(rows)} datasets: {len(rows) - len(here)} in {builtin_dir()}"
+          + (f", {len(here)} measured records present in {', '.join(map(str, external.raw_dirs()))}" if here else "")
+          + "; 'frictionlab datasets show NAME' for details, 'frictionlab datasets template KIND' to start your own.")
+    missing = [n for n in external.RECORDS if n not in here]
     if missing:
         print(f"measured records not in the repository (license of their source; see 'datasets show NAME' for where "
               f"to place them): {', '.join(missing)}")
@@ -233,7 +254,7 @@ def _to_file_unit(d, column: str) -> float:
 
 def _template(args) -> int:
     from ..core.errors import OutputError
-    from ..core.files import atomic_write_text
+    from ..core.files import write_files
     from ..core.names import check_name
     from ..io.template import template
 
@@ -245,8 +266,7 @@ def _template(args) -> int:
         if p.exists() and not args.force:
             raise OutputError(f"{p}: exists; choose another --name or --out, or pass --force")
     toml, csv = template(args.kind, args.name)
-    atomic_write_text(csv_path, csv)
-    atomic_write_text(toml_path, toml)
+    write_files({toml_path: toml, csv_path: csv}, force=args.force)  # both or neither
     print(f"wrote {toml_path} and {csv_path}: replace the example rows with your data, then "
           f"'frictionlab datasets show {toml_path}'")
     return 0

@@ -126,4 +126,8 @@ def run(args) -> int:
         from ..report import clean as _clean
 
         atomic_write_text(args.json, json.dumps(_clean(_fit_json(result)), indent=1, allow_nan=False) + "\n")
-    return 0 if result.status != "failed" else 1
+    if result.status == "failed":  # caused by the law, the data or the budget given: exit 2, as bad input
+        from ..core.errors import FitError
+
+        raise FitError(f"fit: {result.law} on {', '.join(result.datasets)} failed: {result.reason}")
+    return 0

@@ -84,7 +84,7 @@ def parse_params(law, items) -> dict[str, float]:
 
 
 def run(args) -> int:
-    from ..core.files import atomic_write_bytes, atomic_write_text, check_writable
+    from ..core.files import check_writable, write_files
     from ..io.dataset import load_dataset
     from ..physics.registry import get_law
 
@@ -110,18 +110,9 @@ def run(args) -> int:
         else:
             text, summary, figure = _series(law, ds, params, args, bar)
         bar(1, 1, "done")
-    written = []
-    try:  # both outputs or neither
-        if args.plot is not None:
-            atomic_write_bytes(args.plot, figure)
-            written.append(args.plot)
-        if args.out is not None:
-            atomic_write_text(args.out, text)
-            written.append(args.out)
-    except Exception:
-        for p in written:
-            p.unlink(missing_ok=True)
-        raise
+    written = [p for p in (args.plot, args.out) if p is not None]
+    if written:  # both outputs or neither
+        write_files({p: figure if p is args.plot else text for p in written}, force=True)
     print(summary)
     for p in written:
         print(f"wrote {p}")

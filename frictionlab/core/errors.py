@@ -37,8 +37,18 @@ class SolverError(FrictionLabError):
     """An unknown solver, or a solver that does not apply to this law and scene."""
 
 
+class FitError(FrictionLabError):
+    """A fit that failed: past its time budget, not converged, or a model that cannot be solved at the data
+    (what the law, the data and the options given lead to; the reason says which)."""
+
+
 class OutputError(FrictionLabError):
     """An output path that exists or cannot be written."""
+
+
+class ClusterError(FrictionLabError):
+    """A Dask cluster that cannot run the work: no scheduler answering, no worker, a lost scheduler, a task past
+    its time limit (``compare --scheduler``)."""
 
 
 class WorkerLost(FrictionLabError):

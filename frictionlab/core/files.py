@@ -16,17 +16,25 @@ Rules (stated once):
   checked again just before the move. ``force`` replaces only a folder that holds the marker
   file ``MARKER`` (every folder written here gets one) or an empty folder; anything else,
   a regular file included, is refused.
+* Several files written by one command (a dataset's TOML and CSV, a simulation and its plot) are a set
+  (``atomic_files``, ``write_files``): written into a temporary folder beside their targets and moved into place
+  together at the end, or, on any failure, none of them (a target replaced with ``force`` is put back).
+* Every temporary file and folder, and every lock, carries its owner: the name of a temporary holds the
+  owner's process id and start time (``.NAME.PID-START.XXXX.tmp``), a lock file holds them as text. A run that
+  takes a lock removes what dead owners left beside that target (a run killed with SIGKILL); a lock whose
+  owner is dead is taken over even when a process the owner forked still holds its flock.
 * Every error names the path it concerns, "No space left on device" included.
 """
 from __future__ import annotations
 
 import errno
 import os
+import re
 import shutil
 import stat
 import tempfile
 import threading
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 
 from .errors import DatasetError, OutputError
@@ -178,6 +186,56 @@ def check_writable(path) -> Path:
     return path
 
 
+# --- owners --------------------------------------------------------------------------------
+def _start_time(pid: int) -> int:
+    """When process ``pid`` started, in clock ticks since boot (Linux /proc), or 0 where it cannot be read."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as f:
+            return int(f.read().rsplit(b")", 1)[1].split()[19])  # field 22: after the name, which may hold ')'
+    except (OSError, ValueError, IndexError):
+        return 0
+
+
+def owner() -> str:
+    """'PID-START' of this process: what it writes into its lock files and the names of its temporaries."""
+    pid = os.getpid()
+    return f"{pid}-{_start_time(pid)}"
+
+
+def _alive(pid: int, start: int) -> bool:
+    """True if process ``pid`` exists and, where start times can be read, is the one that started at ``start``
+    (not another process given the same id since)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        pass
+    now = _start_time(pid)
+    return not (start and now and now != start)
+
+
+def _tag(path: Path) -> str:
+    """The prefix of a temporary of this process beside ``path``: '.NAME.PID-START.'"""
+    return f".{path.name}.{owner()}."
+
+
+def clear_dead(path) -> None:
+    """Remove what runs that died (pid gone, or reused by another process) left beside the target ``path``:
+    their temporary files and folders ``.NAME.PID-START.XXXX.tmp`` and ``.old``. Links are removed, never followed."""
+    path = Path(path)
+    parent = path.parent if str(path.parent) else Path(".")
+    pattern = re.compile(rf"\.{re.escape(path.name)}\.(\d+)-(\d+)\.[^.]+\.(tmp|old)")
+    try:
+        names = os.listdir(parent)
+    except OSError:
+        return
+    for name in names:
+        m = pattern.fullmatch(name)
+        if m and not _alive(int(m[1]), int(m[2])):
+            _remove(os.path.join(parent, name))
+
+
 _leftovers: set[str] = set()  # temporary files and folders, and locks, of this process not yet removed
 
 
@@ -202,9 +260,10 @@ def remove_leftovers() -> None:
 def atomic_write_bytes(path, data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file in the same folder, then rename."""
     path = check_writable(path)
+    clear_dead(path)
     tmp = None
     try:
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=_tag(path), suffix=".tmp")
         _leftovers.add(tmp)
         os.fchmod(fd, 0o666 & ~_umask())
         with os.fdopen(fd, "wb") as fh:
@@ -285,17 +344,51 @@ def _take_lock(lock: Path, path: Path, parent: Path, busy: OutputError) -> int:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError as exc:
-            os.close(fd)
             if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                stale = _dead_owner(fd) and _same_file(fd, lock)
+                os.close(fd)
+                if stale:  # its owner died; a child it forked holds the flock: this file is free to replace
+                    _remove(str(lock))
+                    continue
                 raise busy from None
+            os.close(fd)
             raise _oserror(path, exc, "cannot lock") from None
         try:  # the holder before us may have removed the file after we opened it: lock the new one
             if os.fstat(fd).st_ino == os.lstat(lock).st_ino:
+                _claim(fd, path)
                 return fd
         except FileNotFoundError:
             pass
         os.close(fd)
     raise busy
+
+
+def _claim(fd: int, path: Path) -> None:
+    """A lock just taken: what dead runs left beside the target removed, and this process written in as owner."""
+    clear_dead(path)
+    try:
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{owner()}\n".encode(), 0)
+    except OSError:  # a full disk: the flock still guards; only a stale lock cannot be told by its owner then
+        pass
+
+
+def _dead_owner(fd: int) -> bool:
+    """True if the lock file open at ``fd`` names an owner 'PID-START' that is no longer running (its flock then
+    held only by a process the owner forked, e.g. a plugin's helper)."""
+    try:
+        text = os.pread(fd, 64, 0).decode("ascii", "replace").strip()
+        pid, start = (int(x) for x in text.split("-"))
+    except (OSError, ValueError):
+        return False
+    return pid != os.getpid() and not _alive(pid, start)
+
+
+def _same_file(fd: int, path: Path) -> bool:
+    try:
+        return os.fstat(fd).st_ino == os.lstat(path).st_ino
+    except OSError:
+        return False
 
 
 def _replaceable(path: Path) -> bool:
@@ -336,7 +429,7 @@ def atomic_dir(path, force: bool = False, marker: str = "frictionlab output\n"):
         check_target(path, force)
         parent = path.parent if str(path.parent) else Path(".")
         try:
-            tmp = Path(tempfile.mkdtemp(dir=parent, prefix=f".{path.name}.", suffix=".tmp"))
+            tmp = Path(tempfile.mkdtemp(dir=parent, prefix=_tag(path), suffix=".tmp"))
         except OSError as exc:
             raise _oserror(path, exc) from None
         _leftovers.add(str(tmp))
@@ -352,7 +445,7 @@ def atomic_dir(path, force: bool = False, marker: str = "frictionlab output\n"):
             old = None
             try:
                 if os.path.lexists(path):
-                    old = Path(tempfile.mkdtemp(dir=parent, prefix=f".{path.name}.", suffix=".old"))
+                    old = Path(tempfile.mkdtemp(dir=parent, prefix=_tag(path), suffix=".old"))
                     _leftovers.add(str(old))
                     os.replace(path, old / "x")
                 os.replace(tmp, path)
@@ -365,6 +458,88 @@ def atomic_dir(path, force: bool = False, marker: str = "frictionlab output\n"):
                     _remove(str(old))
         finally:
             _remove(str(tmp))
+
+
+@contextmanager
+def atomic_files(paths, force: bool = False):
+    """Yield one temporary path per target in ``paths`` (in their order) to write; when the block ends normally
+    every target is moved into place, else none is and what the block wrote is removed (see the module: a set).
+
+    Each target is locked (``output_lock``) throughout and must be writable (``check_writable``); an existing
+    one is refused unless ``force``, and then replaced (put back if a later move fails). The temporaries lie in
+    one temporary folder per target folder (``.NAME.PID-START.XXXX.tmp``, NAME the first target there), so each
+    move is a rename within one file system."""
+    targets = [Path(p) for p in paths]
+    if len({os.path.realpath(p) for p in targets}) != len(targets):
+        raise OutputError(f"{targets[0]}: the same file is named twice among the outputs {', '.join(map(str, targets))}")
+    with ExitStack() as stack:
+        for t in targets:
+            stack.enter_context(output_lock(t))
+        for t in targets:
+            check_writable(t)
+            if os.path.lexists(t) and not force:
+                raise OutputError(f"{t}: exists; choose another name or folder, or pass --force")
+        stages: dict[str, Path] = {}
+        staged = []
+        try:
+            for t in targets:
+                parent = t.parent if str(t.parent) else Path(".")
+                key = os.path.realpath(parent)
+                if key not in stages:
+                    try:
+                        stages[key] = Path(tempfile.mkdtemp(dir=parent, prefix=_tag(t), suffix=".tmp"))
+                    except OSError as exc:
+                        raise _oserror(t, exc) from None
+                    _leftovers.add(str(stages[key]))
+                staged.append(stages[key] / t.name)
+            try:
+                yield list(staged)
+            except OSError as exc:  # named by its target, never by the temporary written
+                which = [t for t, tmp in zip(targets, staged) if str(tmp) == str(getattr(exc, "filename", ""))]
+                raise OutputError(f"{(which or targets)[0]}: cannot write: {exc.strerror or exc}") from None
+            for t, tmp in zip(targets, staged):
+                if not tmp.is_file():
+                    raise OutputError(f"{t}: nothing was written for it")
+                os.chmod(tmp, 0o666 & ~_umask())
+            _move_all(targets, staged)
+        finally:
+            for folder in stages.values():
+                _remove(str(folder))
+
+
+def _move_all(targets: list[Path], staged: list[Path]) -> None:
+    """Move each staged file onto its target; on a failure, undo the moves made (old targets put back)."""
+    done = []  # (target, its old version moved aside, or None)
+    try:
+        for t, tmp in zip(targets, staged):
+            aside = None
+            if os.path.lexists(t):
+                aside = tmp.with_name(tmp.name + ".old")
+                os.replace(t, aside)
+            done.append((t, aside))
+            os.replace(tmp, t)
+    except OSError as exc:
+        for t, aside in reversed(done):
+            try:
+                if aside is not None:
+                    os.replace(aside, t)
+                elif os.path.lexists(t):
+                    os.unlink(t)
+            except OSError:
+                pass
+        raise _oserror(t, exc) from None
+
+
+def write_files(contents, force: bool = False) -> None:
+    """Write ``contents`` (target path -> text or bytes) as one set (``atomic_files``): all or none."""
+    paths = list(contents)
+    with atomic_files(paths, force=force) as staged:
+        for p, tmp in zip(paths, staged):
+            data = contents[p]
+            try:
+                tmp.write_bytes(data.encode("utf-8") if isinstance(data, str) else bytes(data))
+            except OSError as exc:
+                raise OutputError(f"{p}: cannot write: {exc.strerror or exc}") from None
 
 
 def _fix_modes(folder: Path) -> None:

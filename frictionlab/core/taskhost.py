@@ -22,11 +22,12 @@ from __future__ import annotations
 
 import os
 import pickle
+import select
 import subprocess
 import sys
 import threading
 
-from .errors import FrictionLabError, WorkerLost
+from .errors import ClusterError, FrictionLabError, WorkerLost
 
 #: the nanny's allocator setting that a child does not inherit (it also fixes glibc's mmap threshold at 128 KiB)
 NOT_INHERITED = ("MALLOC_TRIM_THRESHOLD_",)
@@ -65,14 +66,15 @@ def unpack(reply: bytes):
     raise value
 
 
-def relay(name: str, task: bytes) -> bytes:
+def relay(name: str, task: bytes, limit: float | None = None) -> bytes:
     """The packed ``task``'s packed reply: run in a child process when called in a Dask worker's task (the
-    worker passes the bytes on, unread), here otherwise. ``name`` names the task in a ``WorkerLost`` error."""
+    worker passes the bytes on, unread), here otherwise. ``name`` names the task in a ``WorkerLost`` error;
+    ``limit``: seconds the task may run in the child, which is ended past it (a ``ClusterError``)."""
     if os.name != "posix" or not _on_worker():  # (no pass_fds elsewhere: in the worker's thread, as Dask runs it)
         return _replied(task)
     host = _take()
     try:
-        return host.exchange(task, name)
+        return host.exchange(task, name, limit)
     finally:
         if host.alive():
             with _LOCK:
@@ -157,10 +159,17 @@ class Host:
         """``fn(*args, **kwargs)`` in the child: its value, or its exception raised here."""
         return unpack(self.exchange(pack(fn, args, kwargs), task_name(fn)))
 
-    def exchange(self, task: bytes, name: str) -> bytes:
-        """The packed ``task`` sent to the child, and its packed reply."""
+    def exchange(self, task: bytes, name: str, limit: float | None = None) -> bytes:
+        """The packed ``task`` sent to the child, and its packed reply; past ``limit`` seconds the child is ended
+        and ``ClusterError`` raised."""
         try:
             _send(self.outbox, task)
+            # (each reply is read whole, so nothing is left buffered for select to miss)
+            if limit is not None and not select.select([self.inbox], [], [], limit)[0]:
+                self.proc.kill()
+                self.proc.wait()
+                raise ClusterError(f"task {name} ran past the task time limit of {limit:g} s on a Dask worker "
+                                   "(--task-timeout); its process was ended")
             return _receive(self.inbox)
         except (EOFError, BrokenPipeError):
             self.proc.wait()

@@ -50,9 +50,14 @@ LOST = "a worker process was lost (killed, out of memory, or a law plugin that e
 def _worker_init(parent: int) -> None:
     """In a worker: ^C goes to the parent, which stops the pool; SIGTERM ends the worker at once;
     and (on Linux) the worker gets SIGKILL when the parent dies, even by SIGKILL, so no worker
-    outlives its run or keeps holding the output lock it inherited."""
+    outlives its run or keeps holding the output lock it inherited. It leads a process group of its own, which
+    is ended with it, so a process a plugin forks there cannot outlive the run either."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    try:  # a process group of its own: what a plugin's code forks in it is ended with it (``_end_groups``)
+        os.setpgid(0, 0)
+    except OSError:
+        pass
     if sys.platform.startswith("linux"):
         try:
             import ctypes
@@ -112,12 +117,23 @@ def process_pool(jobs: int, stage: str = "frictionlab"):
         raise
     else:
         if pool is not None:
+            workers = list(getattr(pool, "_processes", None) or ())
             pool.shutdown(wait=True)
+            _end_groups(workers)
     finally:
         if not frozen:
             gc.unfreeze()
         if handle:
             signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def _end_groups(pids) -> None:
+    """End what is left of the process groups the workers ``pids`` led (processes a plugin forked there)."""
+    for pid in pids:
+        try:
+            os.killpg(pid, signal.SIGKILL)
+        except OSError:  # nothing left of it
+            pass
 
 
 def _start(jobs: int, ctx) -> ProcessPoolExecutor | None:
@@ -147,6 +163,7 @@ def _stop(pool: ProcessPoolExecutor) -> None:
         if p.is_alive():
             p.kill()
             p.join()
+    _end_groups([p.pid for p in procs])
     # let the pool's manager thread finish closing its wake-up pipe now: otherwise the interpreter's
     # exit hook may race it and print "OSError: Bad file descriptor" after our one-line message
     if manager is not None:
@@ -154,7 +171,12 @@ def _stop(pool: ProcessPoolExecutor) -> None:
 
 
 class OverBudget(Exception):
-    """A call run by ``bounded`` ran past its limit; its process was ended."""
+    """A call run by ``bounded`` ran past its limit; its process was ended. ``doing``: what the call said it was
+    doing last (``doing``), "" if nothing."""
+
+    def __init__(self, text: str, doing: str = ""):
+        super().__init__(text)
+        self.doing = doing
 
 
 #: In a child of ``bounded``: the pipe to the parent, on which ``beat`` writes (None elsewhere).
@@ -169,10 +191,20 @@ def beat() -> None:
         os.write(_beat_fd, b"b")
 
 
+def doing(text: str) -> None:
+    """In a child of ``bounded``: what it does from now on (said by OverBudget if the limit passes meanwhile). A
+    no-op in any other process."""
+    if _beat_fd is not None:
+        data = text.encode("utf-8", "replace")[:60000]
+        os.write(_beat_fd, b"d" + len(data).to_bytes(2, "little") + data)
+
+
 def bounded(fn, limit: float, *args):
     """``fn(*args)`` run in a forked child process that is ended (SIGKILL) once it has run ``limit``
     seconds since it started or last called ``beat``: a time budget enforced from outside the code it
-    bounds (a plugin's ``except:`` cannot keep it). The result or the exception comes back pickled;
+    bounds (a plugin's ``except:`` cannot keep it). The result or the exception comes back pickled, framed
+    by its length, so a process the child forked (a plugin's helper, which inherits the pipe) cannot hold
+    the answer back; the child leads its own process group, which is ended with it, helpers included.
     OverBudget past the limit; BrokenProcessPool if the child died without a result. Runs here where
     there is no fork."""
     import pickle
@@ -206,7 +238,7 @@ def _child(read: int, write: int, fn, args) -> None:
     status = 0
     try:
         os.close(read)
-        _worker_init(os.getppid())
+        _worker_init(os.getppid())  # (a process group of its own: ended with it, helpers included, by _end)
         _beat_fd = write
         try:
             payload = pickle.dumps((True, fn(*args)))
@@ -214,7 +246,7 @@ def _child(read: int, write: int, fn, args) -> None:
             payload = _pickled_error(exc)
         os.write(write, b"r")
         with os.fdopen(write, "wb") as fh:
-            fh.write(payload)
+            fh.write(len(payload).to_bytes(8, "little") + payload)
     except BaseException:  # noqa: BLE001
         status = 1
     finally:
@@ -222,27 +254,33 @@ def _child(read: int, write: int, fn, args) -> None:
 
 
 def _receive(read: int, limit: float) -> bytes | None:
-    """What the child sends after b'r' (None if it ended first); each b'b' before it restarts the limit."""
+    """What the child sends after b'r': an 8-byte length and that many bytes (None if the pipe ends first);
+    each b'b' before it restarts the limit, each b'd' says what it does (``doing``). Returns once the answer is
+    whole, never waiting for the pipe to end."""
     import select
     import time
 
-    chunks, deadline, started = [], time.monotonic() + limit, False
+    got, deadline, started, now_doing = bytearray(), time.monotonic() + limit, False, ""
     while True:
+        while not started and got:  # the messages before the answer: b'b', b'd' + 2-byte length + text, b'r'
+            if got[:1] == b"b":
+                deadline, got = time.monotonic() + limit, got[1:]
+            elif got[:1] == b"d":
+                if len(got) < 3 or len(got) < 3 + int.from_bytes(got[1:3], "little"):
+                    break
+                n = int.from_bytes(got[1:3], "little")
+                now_doing, got = bytes(got[3:3 + n]).decode("utf-8", "replace"), got[3 + n:]
+            else:  # b'r'
+                started, got = True, got[1:]
+        if started and len(got) >= 8 and len(got) >= 8 + int.from_bytes(got[:8], "little"):
+            return bytes(got[8:8 + int.from_bytes(got[:8], "little")])
         left = deadline - time.monotonic()
         if left <= 0 or not select.select([read], [], [], left)[0]:
-            raise OverBudget(f"ran past {limit:g} s")
+            raise OverBudget(f"ran past {limit:g} s", now_doing)
         chunk = os.read(read, 1 << 16)
         if not chunk:
-            return b"".join(chunks) if started else None
-        if not started:
-            beats = len(chunk) - len(chunk.lstrip(b"b"))
-            if beats:
-                deadline = time.monotonic() + limit
-            chunk = chunk[beats:]
-            if chunk[:1] == b"r":
-                started, chunk = True, chunk[1:]
-        if started:
-            chunks.append(chunk)
+            return None
+        got += chunk
 
 
 def _pickled_error(exc: BaseException) -> bytes:
@@ -255,7 +293,11 @@ def _pickled_error(exc: BaseException) -> bytes:
 
 
 def _end(pid: int) -> None:
-    """Kill the child ``pid`` if it still runs, and reap it."""
+    """Kill the child ``pid`` and what is left of its process group (helpers its code forked), and reap it."""
+    try:
+        os.killpg(pid, signal.SIGKILL)
+    except OSError:  # the group is empty, or the child could not lead one
+        pass
     try:
         done, _ = os.waitpid(pid, os.WNOHANG)
         if not done:

@@ -62,6 +62,7 @@ from .fitting import FitResult
 from .qualitative import qualitative
 from .qualitative import text as qual_text
 from .replicates import centring, cross_chi2, one_family, refit_options, replicate_chunk
+from ..core.fpstate import with_own_errstate
 
 WEAR, AREA_RATE, COUETTE, COULOMB = "wear", "area-rate", "couette", "coulomb"
 #: The pairs ``compare`` tests by default: the paper's claim, the structural identity, and the simplest law against the paper's.
@@ -205,6 +206,7 @@ def _num(x: float) -> str:
 
 
 # --- the test -------------------------------------------------------------------------------------
+@with_own_errstate
 def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = REPLICATES, seed: int = 0,
                         executor: Executor | None = None, chunk: int | None = None,
                         timeout: float | None = None) -> EquivalenceResult:

@@ -64,6 +64,20 @@ def _ident(text: str) -> str:
     return s if re.match(r"[A-Za-z_]", s) else f"p_{s}"
 
 
+def held_value(law, name: str, dataset) -> float:
+    """The dataset's ``[fixed]`` value of the law's parameter ``name`` [SI], checked against the law's bounds
+    where it is used (the dataset's values may have been changed since they were read and checked)."""
+    spec, value = law.spec(name), dataset.fixed[name]
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        v = math.nan
+    if not (math.isfinite(v) and spec.lower <= v <= spec.upper):
+        raise ParameterError(f"dataset '{dataset.name}': [fixed] {name} = {value!r} {spec.unit} is outside the bounds "
+                             f"of law '{law.name}' [{spec.lower:g}, {spec.upper:g}] (changed after the dataset was read?)")
+    return v
+
+
 def _law_slots(law, targets, fixed, local, initial) -> list[_Slot]:
     slots = []
     multi = len(targets) > 1
@@ -76,7 +90,7 @@ def _law_slots(law, targets, fixed, local, initial) -> list[_Slot]:
             slots.append(_Slot(_ident(n), n, targets=tuple(range(len(targets))), value=float(fixed[n]), vary=False,
                                fixed_by="held by the caller", **common))
             continue
-        held = {i: float(t.dataset.fixed[n]) for i, t in enumerate(targets) if n in t.dataset.fixed}
+        held = {i: held_value(law, n, t.dataset) for i, t in enumerate(targets) if n in t.dataset.fixed}
         if not multi or (len(held) == len(targets) and len(set(held.values())) == 1):
             if held:
                 slots.append(_Slot(_ident(n), n, targets=tuple(range(len(targets))), value=next(iter(held.values())),

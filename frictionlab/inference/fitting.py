@@ -75,6 +75,7 @@ from .predict import (
     set_scene_quantity,
     takes_rtol,
 )
+from ..core.fpstate import with_own_errstate
 
 __all__ = ["DatasetFit", "FitResult", "ParamResult", "PREDICTORS", "SCENE_QUANTITIES", "SkipDataset", "Stats", "Target",
            "applicable_solvers", "auto_solver", "fit", "get_scene_quantity", "law_values", "make_target", "predict",
@@ -87,6 +88,7 @@ SHARPEN_BELOW = 1e-3  # an F p-value (conservative) below this already rejects: 
 _KEEP = (ODE_STARTS, PENALTY, LIKELIHOOD_REASON, neg2loglik)  # re-exported names other modules read from here
 
 
+@with_own_errstate
 def law_values(law, values: Mapping[str, object] | None, where: str) -> dict[str, float]:
     """Law parameter values by name in SI, each given as an SI number, a quantity string or a pint Quantity;
     an unknown name or a wrong unit is an error naming ``where``, the parameter and the unit expected."""

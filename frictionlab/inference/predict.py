@@ -97,7 +97,27 @@ def make_target(dataset: DatasetLike, observable: str | None = None, derive: str
         sigma = np.full(len(ds), ds.noise[obs])
     else:
         raise DatasetError(f"dataset '{ds.name}': [noise] gives no estimate for '{obs}'; add e.g. {obs} = '...'")
+    check_values(ds, obs, sigma)
     return Target(ds, obs, ds.columns[obs], sigma)
+
+
+def check_values(ds, obs: str, sigma) -> None:
+    """The values a fit uses, checked where it uses them (a Dataset's arrays and dicts may have been changed
+    since the dataset was read and checked): the fitted column and the times finite, the times in order, sigma
+    a positive number. A one-line DatasetError naming the dataset and the value otherwise."""
+    later = "(changed after the dataset was read?)"
+    for col in dict.fromkeys([obs] + (["t"] if "t" in ds.columns else [])):
+        bad = np.flatnonzero(~np.isfinite(np.asarray(ds.columns[col], dtype=float)))
+        if bad.size:
+            raise DatasetError(f"dataset '{ds.name}': column {col} holds a value that is not a finite number in row "
+                               f"{bad[0] + 1} {later}")
+    if "t" in ds.columns and np.any(np.diff(ds.columns["t"]) < 0):
+        raise DatasetError(f"dataset '{ds.name}': column t must not decrease (row "
+                           f"{int(np.flatnonzero(np.diff(ds.columns['t']) < 0)[0]) + 2}) {later}")
+    s = np.asarray(sigma, dtype=float)
+    if not (np.all(np.isfinite(s)) and np.all(s > 0)):
+        raise DatasetError(f"dataset '{ds.name}': [noise] {obs} = {ds.noise.get(obs)!r} must be a positive number "
+                           f"(SI) {later}")
 
 
 # --- predictions: one function per dataset kind -------------------------------------------

@@ -30,6 +30,8 @@ import attrs
 import numpy as np
 
 from ..core.errors import FrictionLabError
+from ..physics.registry import get_law
+from .fitmodel import held_value
 from .fitting import FitResult, fit, predict
 from .goodness import p_short
 
@@ -206,10 +208,11 @@ def predict_from(source: FitResult, target: FitResult) -> Prediction:
     d = target.per_dataset[0]
     tg = d.target
     params = _law_params(source)
-    params.update({k: v for k, v in tg.dataset.fixed.items() if k in params})
     base = dict(law=source.law, solver=source.solver, source=source.datasets[0], target=target.datasets[0],
                 params=params, own_chi2=float(d.chisqr))
     try:
+        law = get_law(source.law)
+        params.update({k: held_value(law, k, tg.dataset) for k in tg.dataset.fixed if k in params})
         m = predict(source.law, tg, params, d.solver, d.scene)
     except FrictionLabError as exc:
         return Prediction(**base, status="failed", reason=str(exc))

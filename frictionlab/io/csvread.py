@@ -10,14 +10,16 @@ from ..core.errors import DatasetError
 from ..core.files import MAX_CSV_BYTES, read_bytes, read_text
 
 
-def read_csv(csv: Path) -> dict[str, np.ndarray]:
+def read_csv(csv: Path, text: str | None = None) -> dict[str, np.ndarray]:
     """Read a numeric CSV with a header row into float arrays; one-line errors on bad content.
     '#' starts a comment (to the end of its line); blank lines are skipped; cells may be quoted and
-    padded with spaces. The CSV must lie in its folder once links are resolved (see io.read_bytes)."""
-    try:
-        text = read_bytes(csv, MAX_CSV_BYTES, within=Path(csv).parent).decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise DatasetError(f"{csv}: CSV does not parse: not UTF-8 text (byte {exc.start + 1})") from None
+    padded with spaces. The CSV must lie in its folder once links are resolved (see io.read_bytes).
+    ``text``: the file's content, already read (``csv`` then only names it)."""
+    if text is None:
+        try:
+            text = read_bytes(csv, MAX_CSV_BYTES, within=Path(csv).parent).decode("utf-8-sig")
+        except UnicodeDecodeError as exc:
+            raise DatasetError(f"{csv}: CSV does not parse: not UTF-8 text (byte {exc.start + 1})") from None
     rows = _rows(csv, text)
     if not rows:
         raise DatasetError(f"{csv}: file is empty")

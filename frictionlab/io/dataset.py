@@ -182,17 +182,27 @@ def resolve(name_or_path: str | Path) -> Path:
     candidate = builtin_dir() / f"{name_or_path}.toml"
     if candidate.exists():
         return candidate
-    from . import external
-
-    if str(name_or_path) in external.RECORDS:  # a measured record placed beside the repository, not in it
-        return external.dataset_toml(str(name_or_path))
     raise DatasetError(f"unknown dataset '{name_or_path}'; built-in: {', '.join(builtin_names())} (or give a .toml path)")
 
 
+def available_names() -> list[str]:
+    """The built-in datasets and the measured records present beside the repository (``external``)."""
+    from . import external
+
+    return builtin_names() + external.present()
+
+
 def load_dataset(name_or_path: str | Path) -> Dataset:
-    """Load and validate a dataset by built-in name or path to its TOML (or CSV)."""
+    """Load and validate a dataset by built-in name, name of a measured record (``external``), or path to
+    its TOML (or CSV)."""
     if isinstance(name_or_path, Dataset):
         return name_or_path
+    from . import external
+
+    if isinstance(name_or_path, str) and name_or_path in external.RECORDS \
+            and not (builtin_dir() / f"{name_or_path}.toml").exists():
+        meta, path, raw = external.load(name_or_path)  # a measured record placed beside the repository, not in it
+        return from_meta(meta, path, raw=raw)
     path = resolve(name_or_path)
     return from_meta(read_toml(path), path)
 
@@ -214,11 +224,12 @@ def _table(meta, key, path, where=None):
     return value
 
 
-def from_meta(meta: dict, path: Path) -> Dataset:
-    """Build a Dataset from a parsed TOML dict whose CSV sits beside ``path``."""
+def from_meta(meta: dict, path: Path, raw: dict | None = None) -> Dataset:
+    """Build a Dataset from a parsed TOML dict whose CSV sits beside ``path`` (``raw``: the CSV's columns,
+    already in memory, instead)."""
     name, group, kind, observable, units = _header(meta, path)
     csv = path.with_suffix(".csv")
-    raw = read_csv(csv)
+    raw = read_csv(csv) if raw is None else raw
     columns = _columns(raw, units, path, csv)
     time_zero = _time_origin(meta, columns, raw, kind, path, csv)
     _check_series(columns, raw, kind, csv)

@@ -182,6 +182,7 @@ def noise_table(spec: dict, path, observable: str, columns: dict, si_of) -> tupl
     """(sigma by column, kind, NoiseEstimate by estimated column, note) from the [noise] table ``spec``;
     si_of(column, text, where) parses a declared value into SI."""
     spec = dict(spec)
+    spec.pop("correlation", None)  # the noise's correlation model: read by the fit where supported, not a column
     kind = spec.pop("kind", "estimated")
     if not isinstance(kind, str):
         raise DatasetError(f"{path}: noise.kind must be a string, one of {', '.join(NOISE_KINDS)}")

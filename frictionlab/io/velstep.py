@@ -1,17 +1,21 @@
-"""Raw laboratory velocity-step records in, a spring-slider dataset (CSV + TOML) out.
+"""Raw laboratory velocity-step records in, measured spring-slider datasets (CSV + TOML) out.
 
-The raw format is the one of the steadystate routine's sliced records (Giacomel et al., Geosphere
-2024): a header line, then whitespace-separated rows of time [s], load-point displacement [um],
-friction [-] and (effective) normal stress [MPa], one velocity step per file. The importer finds the
-load-point velocities and the step time(s) from the displacement record (a piecewise straight-line
-fit), estimates the machine stiffness from the spring's loading right after the first step (to be
-fitted with ``--free spring.stiffness``), on request (``--detrend``) removes the slip trend of friction
-measured before the step (its uncertainty is not carried into the fit: the default keeps the record as
-measured), and keeps a subset of the samples: dense just after each step where friction
-changes fast, sparser later. Samples are picked, not averaged, so the noise stays that of the record.
+The raw format is the steadystate routine's (Giacomel et al., Geosphere 2024): a header line, then
+whitespace- (or comma-) separated rows of time [s], load-point displacement [um], friction [-] and
+(effective) normal stress [MPa]. A record may hold any number of velocity steps and holds. The importer
+
+* segments the displacement into straight pieces (``segment``): every step's time is the kink of a
+  continuous two-line fit, its velocities the fitted ones (not the machine's nominal set points), each with
+  its standard error; transducer resets (jumps without a change of slope) are stitched;
+* keeps every sample: one dataset per step, its window from the step before (or the record's start) to the
+  step after (or the record's end), or one dataset holding every step (``joint``);
+* estimates a start for the machine stiffness from friction's initial slope after each step, over a run of
+  samples chosen from the data (the shortest that gives the slope to 10 %), whatever the transient's length;
+* states the friction noise as estimated from the data with AR(1) correlation (no sigma is written).
 """
 from __future__ import annotations
 
+import io
 import math
 import re
 from pathlib import Path
@@ -20,241 +24,338 @@ import attrs
 import numpy as np
 
 from ..core.errors import DatasetError
-from ..core.files import MAX_CSV_BYTES, read_text
+from ..core.files import MAX_CSV_BYTES, read_bytes
 from ..core.names import check_name
+from .segment import MIN_PIECE, Segmentation, segment
 
 #: Header names accepted for the four raw columns (case-insensitive; '_' or nothing between words).
 RAW_HEADER = (r"time\(s\)", r"displ(acement)?\(microns\)", r"friction", r"(effective_?)?normal_?stress\(mpa\)")
-#: Fewest samples a constant-velocity segment may hold.
-MIN_SEGMENT = 20
+#: Smallest time increment of a record [s], and the largest magnitudes read (s, um, -, MPa).
+MIN_DT = 1e-9
+#: The stiffness start [1/m] (0.01 1/um, a typical laboratory value) where friction shows no loading after a step.
+DEFAULT_STIFFNESS = 1e4
+LIMITS = {"time": 1e12, "displacement": 1e12, "friction": 1e3, "normal stress": 1e6}
 
 
 @attrs.frozen(eq=False)
 class RawRecord:
-    """One raw record in SI units: time [s], displacement [m], friction [-], normal stress [Pa] (``stress``:
-    what the file's header calls it: effective normal stress, or normal stress where it does not say)."""
+    """One raw record: time [s], displacement [um, as recorded; ``x`` in m], friction [-], normal stress [Pa]
+    (``stress``: what the file's header calls it), and the line of the file each sample was read from."""
 
     path: Path
     t: np.ndarray
-    x: np.ndarray
+    x_um: np.ndarray
     mu: np.ndarray
     sn: np.ndarray
     stress: str = "effective normal stress"
+    first_line: int = 2  # line of the first sample when every line after the header holds one
+    lines: np.ndarray | None = None  # line of each sample otherwise
+
+    @property
+    def x(self) -> np.ndarray:
+        """Displacement [m]."""
+        return self.x_um * 1e-6
+
+    def line(self, i: int) -> int:
+        """The file's line (1-based) of sample i."""
+        return int(self.lines[i]) if self.lines is not None else self.first_line + int(i)
 
 
-def read_raw(path) -> RawRecord:
-    """Read a raw velocity-step record; one-line DatasetError naming the file and line on bad content."""
+def read_raw(path, data: bytes | None = None) -> RawRecord:
+    """Read a raw velocity-step record (``data``: its bytes, already read); a one-line DatasetError naming the
+    file and line on bad content (a bad number, fewer or more than four columns, time that does not increase
+    by at least MIN_DT, magnitudes beyond LIMITS, a normal stress that is not positive)."""
+    import pandas as pd
+
     path = Path(path)
-    lines = read_text(path, MAX_CSV_BYTES).splitlines()
-    rows = [(i + 1, line) for i, line in enumerate(lines) if line.strip()]
-    if not rows:
-        raise DatasetError(f"{path}: file is empty")
-    header = rows[0][1].split()
-    if len(header) != 4 or not all(re.fullmatch(p, h, re.IGNORECASE) for p, h in zip(RAW_HEADER, header)):
-        raise DatasetError(f"{path}: line {rows[0][0]}: header {rows[0][1].strip()!r}; expected four columns: "
-                           "Time(s) Displ(microns) Friction EffectiveNormalstress(MPa) (or NormalStress(MPa))")
-    data = np.empty((len(rows) - 1, 4))
-    for k, (no, line) in enumerate(rows[1:]):
-        parts = line.replace(",", " ").split()
+    data = read_bytes(path, MAX_CSV_BYTES) if data is None else data
+    if data.startswith(b"\xef\xbb\xbf"):
+        data = data[3:]
+    if not data.isascii():
         try:
-            values = [float(p) for p in parts]
+            data.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise DatasetError(f"{path}: not UTF-8 text (byte {exc.start + 1})") from None
+    head = re.match(rb"(?:[ \t\r\f\v]*\n)*([^\n]*)(?:\n|$)", data)
+    header_no = data.count(b"\n", 0, head.start(1)) + 1
+    header_text = head.group(1).decode("utf-8", "replace").strip()
+    header = header_text.split()
+    if not header:
+        raise DatasetError(f"{path}: file is empty")
+    if len(header) != 4 or not all(re.fullmatch(p, h, re.IGNORECASE) for p, h in zip(RAW_HEADER, header)):
+        raise DatasetError(f"{path}: line {header_no}: header {header_text[:80]!r}; expected four columns: "
+                           "Time(s) Displ(microns) Friction EffectiveNormalstress(MPa) (or NormalStress(MPa))")
+    if b"," in data:
+        data = data.replace(b",", b" ")
+    body = memoryview(data)[head.end():]
+    try:
+        table = pd.read_csv(io.BytesIO(body), sep=r"\s+", header=None, dtype=float, engine="c",
+                            skip_blank_lines=True).to_numpy()
+        ok = table.ndim == 2 and table.shape[1] == 4 and bool(np.isfinite(table).all())
+    except (ValueError, pd.errors.ParserError, pd.errors.EmptyDataError):
+        ok, table = False, None
+    blank = re.search(rb"(?:^|\n)[ \t\r\f\v]*(?:\n|$)", bytes(body).rstrip()) if b"\n\n" in data or b"\n " in data \
+        or b"\n\t" in data or b"\n\r" in data else None
+    lines = _lines(bytes(body).decode("utf-8", "replace"), header_no) if (blank or not ok) else None
+    if not ok:
+        _bad_row(path, bytes(body).decode("utf-8", "replace"), lines)
+    del body, data
+    first = header_no + 1
+    rec = RawRecord(path=path, t=table[:, 0].copy(), x_um=table[:, 1].copy(), mu=table[:, 2].copy(),
+                    sn=table[:, 3] * 1e6,
+                    stress="effective normal stress" if "effective" in header[3].lower() else "normal stress",
+                    first_line=first, lines=lines)
+    _check(rec, table)
+    return rec
+
+
+def _lines(body: str, header_no: int) -> np.ndarray:
+    """The line of each non-blank line of ``body`` (which starts on the line after ``header_no``)."""
+    return np.array([header_no + 1 + k for k, s in enumerate(body.split("\n")) if s.strip()], dtype=np.int64)
+
+
+def _bad_row(path: Path, body: str, lines) -> None:
+    """The one-line error for the first row that is not four finite numbers."""
+    rows = [s for s in body.split("\n") if s.strip()]
+    for no, row in zip(lines, rows):
+        try:
+            values = [float(p) for p in row.split()]
         except ValueError:
             values = []
         if len(values) != 4 or not all(math.isfinite(v) for v in values):
-            raise DatasetError(f"{path}: line {no}: expected four finite numbers, got {line.strip()[:60]!r}")
-        data[k] = values
-    if len(data) < 2 * MIN_SEGMENT:
-        raise DatasetError(f"{path}: {len(data)} data rows; a velocity step needs at least {2 * MIN_SEGMENT}")
-    t, x_um, mu, sn = data.T
-    bad = np.nonzero(np.diff(t) <= 0)[0]
+            raise DatasetError(f"{path}: line {no}: expected four finite numbers, got {row.strip()[:60]!r}")
+    raise DatasetError(f"{path}: no data rows after the header")
+
+
+def _check(rec: RawRecord, table: np.ndarray) -> None:
+    """Magnitudes, time increments and normal stress, each refused with the line of the first bad sample."""
+    n = len(table)
+    if n < 2 * MIN_PIECE:
+        raise DatasetError(f"{rec.path}: {n} data rows; a velocity step needs at least {MIN_PIECE} on either side")
+    for j, (what, limit) in enumerate(LIMITS.items()):
+        bad = np.flatnonzero(np.abs(table[:, j]) > limit)
+        if bad.size:
+            i = int(bad[0])
+            raise DatasetError(f"{rec.path}: line {rec.line(i)}: {what} {table[i, j]:g} is beyond {limit:g} in the "
+                               "record's units (s, um, -, MPa)")
+    dt = np.diff(rec.t)
+    bad = np.flatnonzero(~(dt >= MIN_DT))
     if bad.size:
-        raise DatasetError(f"{path}: line {rows[int(bad[0]) + 2][0]}: time does not increase")
-    if np.any(sn <= 0):
-        raise DatasetError(f"{path}: normal stress must be positive")
-    stress = "effective normal stress" if "effective" in header[3].lower() else "normal stress"
-    return RawRecord(path=path, t=t, x=x_um * 1e-6, mu=mu, sn=sn * 1e6, stress=stress)
+        i = int(bad[0]) + 1
+        what = "does not increase" if dt[i - 1] <= 0 else f"increases by {dt[i - 1]:.3g} s"
+        raise DatasetError(f"{rec.path}: line {rec.line(i)}: time {rec.t[i]:.10g} s {what} after line {rec.line(i - 1)} "
+                           f"({rec.t[i - 1]:.10g} s); time must increase by at least {MIN_DT:g} s a sample")
+    bad = np.flatnonzero(~(rec.sn > 0))
+    if bad.size:
+        raise DatasetError(f"{rec.path}: line {rec.line(int(bad[0]))}: normal stress must be positive, got "
+                           f"{table[int(bad[0]), 3]:g} MPa")
 
 
-def _line_fit_rss(t, x):
-    """For every split index j, the residual sum of squares of straight lines through x[:j] and x[j:]."""
-    n = len(t)
-
-    def rss_prefix(tt, xx):
-        k = np.arange(1, len(tt) + 1, dtype=float)
-        st, sx = np.cumsum(tt), np.cumsum(xx)
-        stt, sxx, stx = np.cumsum(tt * tt), np.cumsum(xx * xx), np.cumsum(tt * xx)
-        var_t = stt - st**2 / k
-        cov = stx - st * sx / k
-        var_x = sxx - sx**2 / k
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return var_x - np.where(var_t > 0, cov**2 / var_t, 0.0)
-
-    head = rss_prefix(t, x)  # head[j-1]: rss of the first j samples
-    tail = rss_prefix(t[::-1], x[::-1])[::-1]  # tail[j]: rss of samples j..n-1
-    j = np.arange(MIN_SEGMENT, n - MIN_SEGMENT + 1)
-    return j, head[j - 1] + tail[j]
-
-
-def find_steps(t, x, steps: int = 1) -> tuple[list[float], list[float]]:
-    """(times [s] at which the load-point velocity steps, velocities [m/s] of the segments) from the
-    displacement record: one breakpoint at a time, each splitting the segment whose two-line fit gains most."""
-    bounds = [0, len(t)]
-    for _ in range(steps):
-        best = None
-        for a, b in zip(bounds[:-1], bounds[1:]):
-            if b - a < 2 * MIN_SEGMENT:
-                continue
-            j, rss = _line_fit_rss(t[a:b], x[a:b])
-            k = int(np.argmin(rss))
-            gain = _line_fit_rss_one(t[a:b], x[a:b]) - rss[k]
-            if best is None or gain > best[0]:
-                best = (gain, a + int(j[k]))
-        if best is None:
-            raise DatasetError(f"too few samples to find {steps} velocity step(s)")
-        bounds = sorted(bounds + [best[1]])
-    lines = [np.polyfit(t[a:b], x[a:b], 1) for a, b in zip(bounds[:-1], bounds[1:])]
-    # each step where the two lines beside it cross (not at a sample: the step falls between samples)
-    times = [float(np.clip((c2 - c1) / (v1 - v2), t[j - 1], t[j])) if v1 != v2 else float(t[j])
-             for j, (v1, c1), (v2, c2) in zip(bounds[1:-1], lines[:-1], lines[1:])]
-    return times, [float(v) for v, _ in lines]
-
-
-def _line_fit_rss_one(t, x) -> float:
-    p = np.polyfit(t, x, 1)
-    return float(np.sum((x - np.polyval(p, t)) ** 2))
-
-
-def stiffness_guess(t, mu, t_step: float, v_before: float, v_after: float, span: float = 1.0) -> float | None:
-    """k [1/m] from d mu/dt = k (V_lp - v) just after a step, while the slider still slides at v_before:
-    the slope of mu over the first ``span`` seconds after the step over (v_after - v_before); None if unusable."""
-    sel = (t > t_step) & (t <= t_step + span)
-    if sel.sum() < 3 or v_after == v_before:
-        return None
-    k = float(np.polyfit(t[sel], mu[sel], 1)[0]) / (v_after - v_before)
-    return k if k > 0 and math.isfinite(k) else None
-
-
-def pick_samples(t, step_times, points: int) -> np.ndarray:
-    """Indices of about ``points`` samples: uniform in time before the first step, and after each step
-    at times growing geometrically from the sampling interval, where the transient is fast, to its end."""
-    dt = float(np.median(np.diff(t)))
-    edges = [t[0]] + list(step_times) + [t[-1]]
-    share = max(points // (len(edges) - 1), 4)
-    wanted = [np.linspace(edges[0], edges[1], share, endpoint=False)]
-    for a, b in zip(edges[1:-1], edges[2:]):
-        wanted.append(a + np.geomspace(dt, max(b - a, 2 * dt), share))
-    idx = np.searchsorted(t, np.concatenate(wanted))
-    return np.unique(np.clip(idx, 0, len(t) - 1))
-
-
-def rice_sigma(y) -> float:
-    """Difference-based noise estimate (Rice 1984): sigma^2 = sum (y_{i+1} - y_i)^2 / (2 (n - 1))."""
-    d = np.diff(np.asarray(y, dtype=float))
-    return float(math.sqrt(np.sum(d * d) / (2 * len(d))))
-
-
+# --- what the import finds --------------------------------------------------------------------------
 @attrs.frozen
+class Window:
+    """One dataset's samples [a, b) and its load-point schedule: times relative to the window's first sample
+    [s], velocities [m/s] (fitted), the stiffness start [1/m] and how it was obtained."""
+
+    name: str
+    a: int
+    b: int
+    times: tuple
+    velocities: tuple
+    stiffness: float
+    stiffness_note: str
+    steps: tuple  # indices of the Steps it holds
+
+    @property
+    def stiffness_from(self) -> str:
+        """'given', 'estimated' or 'a typical value' (the first word of how the start was obtained)."""
+        note = self.stiffness_note
+        return "given" if note.startswith("given") else "a typical value" if "typical" in note else "estimated"
+
+
+@attrs.frozen(eq=False)
 class Imported:
-    """What the importer found and chose, in SI units (for the TOML and for tests)."""
+    """What the importer found and chose, in SI units."""
 
-    time_zero: float
-    step_times: tuple  # relative to time_zero [s]
-    velocities: tuple  # [m/s]
-    stiffness: float  # [1/m]
-    stiffness_stated: bool
-    trend: float  # removed slope d mu / dx [1/m] (0: none)
-    sigma: float  # Rice estimate on the raw record [-]
-    normal_stress: float  # mean [Pa]
-    index: np.ndarray = attrs.field(eq=False)  # kept samples
-    mu: np.ndarray = attrs.field(eq=False)  # friction after the trend removal, all samples
+    raw: RawRecord
+    seg: Segmentation
+    windows: tuple  # Window per dataset
+    velocities: tuple  # each piece's load-point velocity as written [m/s] (a hold within its error: 0)
+    notes: tuple  # sentences for the user (jumps stitched, holds, starts in a hold)
 
-
-def analyse(raw: RawRecord, steps: int = 1, points: int = 600, detrend: bool = False,
-            stiffness: float | None = None) -> Imported:
-    """Find steps and velocities, the stiffness (given, or estimated), the trend, the noise and the samples."""
-    times, velocities = find_steps(raw.t, raw.x, steps)
-    velocities = [float(f"{v:.3g}") for v in velocities]  # the machine's set points, to 3 significant digits
-    if min(velocities) <= 0:
-        raise DatasetError(f"{raw.path}: a segment's load point does not advance ({min(velocities):.3g} m/s): "
-                           "not a velocity-step record")
-    mu, trend = raw.mu, 0.0
-    if detrend:
-        before = raw.t < times[0]
-        trend = float(np.polyfit(raw.x[before], raw.mu[before], 1)[0])
-        mu = raw.mu - trend * (raw.x - raw.x[0])
-    stated = stiffness is not None
-    if stiffness is None:
-        stiffness = stiffness_guess(raw.t, mu, times[0], velocities[0], velocities[1])
-        if stiffness is None:
-            raise DatasetError(f"{raw.path}: cannot estimate the machine stiffness from the loading after the step; "
-                               "give it with --stiffness (e.g. '0.01 1/um')")
-    return Imported(time_zero=float(raw.t[0]), step_times=tuple(tt - raw.t[0] for tt in times),
-                    velocities=tuple(velocities), stiffness=float(stiffness), stiffness_stated=stated, trend=trend,
-                    sigma=rice_sigma(raw.mu), normal_stress=float(np.mean(raw.sn)),
-                    index=pick_samples(raw.t, times, points), mu=mu)
+    @property
+    def x_um(self) -> np.ndarray:
+        """Load-point displacement [um], jumps stitched."""
+        return self.seg.x
 
 
-def velstep_dataset(raw_path, name: str, *, steps: int = 1, points: int = 600, detrend: bool = False,
-                    stiffness: float | None = None, source: str = "", license: str = "", citation: str = "",
-                    command: str = "") -> tuple[str, str, Imported]:
-    """(TOML text, CSV text, what was found) of a measured spring-slider dataset from one raw record."""
-    check_name(name, "datasets import: --name", DatasetError)
-    raw = read_raw(raw_path)
-    imp = analyse(raw, steps, points, detrend, stiffness)
-    toml = velstep_toml(name, raw, imp, source=source, license=license, citation=citation, command=command)
-    rows = [f"# Samples of {raw.path.name} kept by frictionlab datasets import velstep (picked, not averaged);",
-            "# t in the record's clock (time_zero in the TOML is t = 0), x load-point displacement, mu friction"
-            + (" after removing the slip trend measured before the step" if detrend else ""),
-            "t,x,mu"]
-    rows += [f"{raw.t[i]:.10g},{raw.x[i] * 1e6:.10g},{imp.mu[i]:.8g}" for i in imp.index]
-    return toml, "\n".join(rows) + "\n", imp
+def analyse(raw: RawRecord, name: str, *, joint: bool | None = False, stiffness: float | None = None,
+            steps: int | None = None) -> Imported:
+    """Segment the record, check it, and lay out its datasets: one per step (``name`` alone for a record of
+    one step, else name-step1, name-step2, ...), or one holding every step (``joint``; None: when there are
+    several). ``stiffness`` [1/m]: the start of every dataset instead of the estimate; ``steps``: the number of
+    steps expected (an error if another number is found)."""
+    where = str(raw.path)
+    seg = segment(raw.t, raw.x_um, where, raw.line, "um")  # in the record's units: um, um/s
+    m = len(seg.steps)
+    joint = m > 1 if joint is None else joint
+    if steps is not None and steps != m:
+        found = ", ".join(f"line {raw.line(s.index)} (t = {s.time:.6f} s)" for s in seg.steps)
+        raise DatasetError(f"{where}: expected {steps} velocity step{'s' * (steps != 1)} (--steps), found {m}: {found}")
+    velocities, notes = _velocities(raw, seg)
+    notes += [f"displacement jump of {j.size:.4g} ± {j.size_se:.2g} um at line {raw.line(j.index)} "
+              f"(t = {raw.t[j.index]:.10g} s) without a change of velocity: stitched (later samples shifted back)"
+              for j in seg.jumps]
+    b = seg.bounds
+    ks = [stiffness_start(raw.t, raw.mu, s, velocities[i], velocities[i + 1], b[i], b[i + 2])
+          for i, s in enumerate(seg.steps)]
+    if stiffness is None and all(k is None for k in ks):
+        notes.append(f"friction shows no loading after any step (no initial slope to 10 %): the stiffness start is "
+                     f"{DEFAULT_STIFFNESS * 1e-6:g} 1/um, a typical laboratory value, to be fitted with the law")
+
+    def start(i):
+        if stiffness is not None:
+            return stiffness, "given with --stiffness: a start, fitted with the law"
+        if ks[i]:
+            return ks[i][0], (f"start: friction's initial slope after the step, over the first {ks[i][1]:.3g} s (the "
+                              "shortest run that gives it to 10 %), over the load-point velocity change")
+        if any(ks):
+            return next(k for k in ks if k)[0], "start taken from another step of the record (this one's loading " \
+                                                "gives none)"
+        return DEFAULT_STIFFNESS, "start: a typical laboratory value (friction shows no loading after the step)"
+
+    windows = []
+    if joint:
+        k, note = start(0)
+        if stiffness is None and any(ks):
+            k = float(np.median([k[0] for k in ks if k]))
+            note = "start: the median over the steps of friction's initial slope after each step over the " \
+                   "load-point velocity change"
+        windows.append(Window(name, 0, len(raw.t), (0.0,) + tuple(float(s.time - raw.t[0]) for s in seg.steps),
+                              tuple(velocities), k, note, tuple(range(m))))
+    else:
+        for i, s in enumerate(seg.steps):
+            a, e = b[i], b[i + 2]
+            kv, note = start(i)
+            windows.append(Window(name if m == 1 else f"{name}-step{i + 1}", a, e, (0.0, float(s.time - raw.t[a])),
+                                  (velocities[i], velocities[i + 1]), kv, note, (i,)))
+            if velocities[i] == 0:
+                notes.append(f"{windows[-1].name} starts in a hold (V = 0): a fit that starts from steady state "
+                             "cannot start there; fit the record's joint dataset (--joint) instead")
+    for w in windows:
+        check_name(w.name, "datasets import: --name", DatasetError)
+    return Imported(raw=raw, seg=seg, windows=tuple(windows), velocities=tuple(velocities), notes=tuple(notes))
 
 
+def _velocities(raw: RawRecord, seg: Segmentation) -> tuple[list[float], list[str]]:
+    """The pieces' velocities as written [m/s]: fitted, a hold (within 3 standard errors of 0) as 0; a load
+    point that moves backwards is refused."""
+    out, notes = [], []
+    for k, (v, se) in enumerate(zip(np.array(seg.velocities) * 1e-6, np.array(seg.velocities_se) * 1e-6)):
+        a, b = seg.bounds[k], seg.bounds[k + 1]
+        span = f"lines {raw.line(a)} to {raw.line(b - 1)} (t = {raw.t[a]:.10g} to {raw.t[b - 1]:.10g} s)"
+        if abs(v) <= 3 * se:
+            out.append(0.0)
+            notes.append(f"hold from {span}: fitted {v * 1e6:.3g} ± {se * 1e6:.2g} um/s, written as 0")
+        elif v < 0:
+            raise DatasetError(f"{raw.path}: the load point moves backwards ({v * 1e6:.4g} um/s) from {span}; a "
+                               "velocity-step record's load point advances or holds")
+        else:
+            out.append(float(v))
+    return out, notes
+
+
+def stiffness_start(t, mu, step, v1: float, v2: float, a: int, b: int) -> tuple[float, float] | None:
+    """(k [1/m], duration [s]) from d mu/dt = k (V_lp - v) while the slider still slides at about v1: the
+    initial slope of friction after the step over (v2 - v1), fitted over the shortest run of samples from the
+    step (3, 4, 6, 8, ... up to the next step ``b``) that gives it to 10 % (the loading transient, whatever
+    its length and sampling); None when friction does not move towards the new velocity's level."""
+    i0 = step.index
+    if v2 == v1 or b - i0 < 3:
+        return None
+    sgn = 1.0 if v2 > v1 else -1.0
+    best, n = None, 3
+    while True:
+        u, y = t[i0:i0 + n] - t[i0], mu[i0:i0 + n]
+        slope, icpt = np.polyfit(u, y, 1)
+        resid = y - (slope * u + icpt)
+        se = math.sqrt(float(resid @ resid) / max(n - 2, 1) / float(np.sum((u - u.mean()) ** 2)))
+        if sgn * slope > 0 and (best is None or se / abs(slope) < best[2]):
+            best = (float(slope), float(u[-1]), se / abs(slope))
+        if (best is not None and best[2] <= 0.1) or i0 + n >= b:
+            break
+        n = min(max(n + 1, int(n * 1.41)), b - i0)
+    if best is None or best[2] > 0.1:
+        return None
+    k = best[0] / (v2 - v1)
+    return (k, best[1]) if k > 0 and math.isfinite(k) else None
+
+
+# --- the files ---------------------------------------------------------------------------------------
 def _q(text: str) -> str:
     """A TOML basic string."""
     return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
-def velstep_toml(name: str, raw: RawRecord, imp: Imported, *, source: str, license: str, citation: str,
-                 command: str) -> str:
-    """The TOML of an imported velocity-step record (provenance 'measured')."""
-    v_um = [f"{v * 1e6:g} um/s" for v in imp.velocities]
-    k_note = ("given with --stiffness: a start; fit it with --free spring.stiffness" if imp.stiffness_stated else
-              "estimated from d mu/dt = k (V_lp - v) over 1 s after the step: a start; fit it with --free "
-              "spring.stiffness")
-    trend = (f"friction's slip trend {imp.trend * 1e-6:.4g} per um, fitted to the samples before the step "
-             "(slope S1 of Giacomel et al. 2024), removed over the whole record" if imp.trend else "no trend removed")
-    method = (f"{len(imp.index)} of {len(raw.t)} samples of {raw.path.name} kept (picked, uniform before the step, "
-              f"geometric in time after it); load-point velocities {', '.join(v_um)} and the step time from a "
-              f"piecewise straight-line fit of displacement against time (3 significant digits); {trend}; "
-              f"noise: Rice (1984) difference estimate on the raw record")
+def _time(s: float) -> str:
+    """A time [s] to the nanosecond, trailing zeros dropped."""
+    return f"{s:.9f}".rstrip("0").rstrip(".") + " s"
+
+
+def _um(v: float) -> str:
+    return f"{v * 1e6:.7g} um/s"
+
+
+def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "", citation: str = "",
+                 command: str = "") -> str:
+    """The TOML of one imported window (provenance 'measured')."""
+    raw, seg = imp.raw, imp.seg
+    first, last = raw.line(w.a), raw.line(w.b - 1)
+    steps = [seg.steps[i] for i in w.steps]
+    v_text = " -> ".join(f"{v * 1e6:.4g}" for v in w.velocities)
+    stress = float(np.mean(raw.sn[w.a:w.b]))
+    fitted = "; ".join(f"step at {s.time - raw.t[w.a]:.6f} ± {s.time_se:.2g} s" for s in steps)
+    fitted_v = ", ".join(f"{v:.7g} ± {seg.velocities_se[k]:.2g}"
+                         for k, v in enumerate(seg.velocities) if k in _pieces(w))
+    jumps = [j for j in seg.jumps if w.a < j.index < w.b]
+    method = (f"every sample of lines {first} to {last} of {raw.path.name} ({w.b - w.a} samples); load-point "
+              f"velocities and step time{'s' * (len(steps) > 1)} from an exact piecewise-linear segmentation of the "
+              f"displacement (optimal partitioning, PELT, penalty 3 ln n = {seg.penalty:.1f}; "
+              f"{len(seg.steps)} step{'s' * (len(seg.steps) != 1)} in the record), each step at the kink of a "
+              "continuous two-line fit, velocities from one continuous fit through every kink (fitted values, not "
+              "set points)" + (f"; {len(jumps)} displacement jump{'s' * (len(jumps) != 1)} without a change of "
+                               "velocity stitched" if jumps else "") +
+              "; friction as measured (no trend removed); its noise estimated from the data, AR(1)")
+    description = (f"Velocity step{'s' * (len(steps) > 1)} {v_text} um/s at {stress / 1e6:.4g} MPa {raw.stress} "
+                   f"(record {raw.path.name}, lines {first} to {last}). MEASURED.")
     lines = [
         f"# Imported by `frictionlab datasets import velstep` from {raw.path.name}: measured data; do not edit by hand.",
-        f"name = {_q(name)}",
+        f"name = {_q(w.name)}",
         'kind = "spring-slider"',
         'observable = "mu"',
-        f"description = {_q(f'Velocity step {v_um[0]} -> {v_um[-1]} at {imp.normal_stress / 1e6:.4g} MPa {raw.stress} (record {raw.path.name}). MEASURED.')}",
-        f'time_zero = "{imp.time_zero:.10g} s"   # the record\'s clock at its first sample',
+        f"description = {_q(description)}",
+        f'time_zero = "{float(raw.t[w.a])!r} s"   # the record\'s clock at line {first}',
         "",
         "[columns]",
         't = "s"',
-        'x = "um"                   # load-point displacement',
+        'x = "um"                   # load-point displacement' + (" (jumps stitched)" if jumps else ""),
         'mu = ""',
         "",
-        "[noise]                    # Rice difference estimate on the raw record; kind = \"estimated\" when supported",
-        f"mu = {imp.sigma:.3g}",
+        "[noise]                    # friction's noise: estimated from the data, correlated (AR(1))",
+        'kind = "estimated"',
+        'correlation = "ar1"',
         "",
         "[scene]",
         'mass = "1 kg"              # not used by a quasi-static slider',
         "",
         f"[scene.normal]             # the mean {raw.stress} on a unit area: only a slider's inertia reads it",
         'model = "constant"',
-        f'value = "{imp.normal_stress:.6g} N"',
+        f'value = "{stress:.6g} N"',
         "",
         "[scene.spring]",
-        f'stiffness = "{imp.stiffness * 1e-6:.4g} 1/um"   # {k_note}',
-        "times = [" + ", ".join(f'"{tt:.6g} s"' for tt in (0.0,) + imp.step_times) + "]",
-        "velocities = [" + ", ".join(f'"{v}"' for v in v_um) + "]",
+        f'stiffness = "{w.stiffness * 1e-6:.4g} 1/um"   # {w.stiffness_note}',
+        "times = [" + ", ".join(f'"{_time(s)}"' for s in w.times) + f"]   # fitted: {fitted}",
+        "velocities = [" + ", ".join(f'"{_um(v)}"' for v in w.velocities) + f"]   # fitted: {fitted_v} um/s",
         "",
         "[provenance]",
         'kind = "measured"',
@@ -262,5 +363,71 @@ def velstep_toml(name: str, raw: RawRecord, imp: Imported, *, source: str, licen
     ]
     lines += [f"license = {_q(license)}"] if license else []
     lines += [f"citation = {_q(citation)}"] if citation else []
-    lines += [f"method = {_q(method)}", f"command = {_q(command)}"] if command else [f"method = {_q(method)}"]
+    lines += [f"method = {_q(method)}"] + ([f"command = {_q(command)}"] if command else [])
     return "\n".join(lines) + "\n"
+
+
+def _pieces(w: Window) -> range:
+    """The pieces (between steps) a window covers."""
+    return range(w.steps[0], w.steps[-1] + 2)
+
+
+CSV_HEADER = "t,x,mu"
+
+
+def write_csv(fh, imp: Imported, w: Window) -> None:
+    """Every sample of the window as t [s, the record's clock], x [um, jumps stitched, to 1e-9 um], mu, written
+    in chunks, each number as read (the shortest text that gives it back)."""
+    raw = imp.raw
+    fh.write(f"# Every sample of lines {raw.line(w.a)} to {raw.line(w.b - 1)} of {raw.path.name}, as recorded "
+             f"(x: load-point displacement{', jumps stitched' if any(w.a < j.index < w.b for j in imp.seg.jumps) else ''}"
+             "); t in the record's clock (time_zero in the TOML is t = 0)\n" + CSV_HEADER + "\n")
+    for lo in range(w.a, w.b, 100_000):
+        hi = min(lo + 100_000, w.b)
+        cols = (raw.t[lo:hi].tolist(), np.round(imp.x_um[lo:hi], 9).tolist(), raw.mu[lo:hi].tolist())
+        fh.write("\n".join(f"{a!r},{b!r},{c!r}" for a, b, c in zip(*cols)) + "\n")
+
+
+def columns(imp: Imported, w: Window, rows: int | None = None) -> dict:
+    """The CSV's columns as the dataset reader returns them (file units: s, um, -); ``rows``: at most that
+    many, evenly spread from the window's first sample to its last."""
+    idx = slice(w.a, w.b) if rows is None or w.b - w.a <= rows else \
+        np.unique(np.linspace(w.a, w.b - 1, rows).astype(np.int64))
+    return {"t": imp.raw.t[idx], "x": imp.x_um[idx], "mu": imp.raw.mu[idx]}
+
+
+def parts(imp: Imported, w: Window, toml_text: str, rows: int | None = None) -> tuple[dict, dict]:
+    """(TOML table, CSV columns) of one window, from its TOML text and the arrays in memory: what
+    ``dataset.from_meta`` builds the Dataset from once the pair is written (``rows``: a check on at most that
+    many samples, spread over the window)."""
+    import tomllib
+
+    return tomllib.loads(toml_text), columns(imp, w, rows)
+
+
+def summary(imp: Imported) -> list[str]:
+    """What the import found, as lines of text: the record, its noise and the table of steps."""
+    raw, seg = imp.raw, imp.seg
+    n, m = len(raw.t), len(seg.steps)
+    out = [f"{raw.path.name}: {n} samples, t = {raw.t[0]:.10g} to {raw.t[-1]:.10g} s; displacement noise "
+           f"{seg.noise:.3g} um; {m} velocity step{'s' * (m != 1)} (segmentation penalty 3 ln n = "
+           f"{seg.penalty:.1f}), {len(seg.jumps)} jump{'s' * (len(seg.jumps) != 1)} stitched"]
+    rows = [("step", "line", "time [s]", "V before [um/s]", "V after [um/s]", "samples before + after")]
+    for i, s in enumerate(seg.steps):
+        b = seg.bounds
+        rows.append((str(i + 1), str(raw.line(s.index)), _pm(s.time, s.time_se),
+                     _pm(imp.velocities[i] * 1e6, seg.velocities_se[i]),
+                     _pm(imp.velocities[i + 1] * 1e6, seg.velocities_se[i + 1]),
+                     f"{b[i + 1] - b[i]} + {b[i + 2] - b[i + 1]}"))
+    widths = [max(len(r[j]) for r in rows) for j in range(len(rows[0]))]
+    out += ["  " + "  ".join(c.ljust(wd) for c, wd in zip(r, widths)).rstrip() for r in rows]
+    out += [f"  note: {note}" for note in imp.notes]
+    return out
+
+
+def _pm(v: float, se: float) -> str:
+    """'v ± se' with se to two significant digits and v to the same decimal place."""
+    if not (se > 0 and math.isfinite(se)):
+        return f"{v:.7g}"
+    d = max(0, 1 - math.floor(math.log10(se)))
+    return f"{v:.{d}f} ± {se:.{d}f}"

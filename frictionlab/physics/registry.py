@@ -20,6 +20,7 @@ import attrs
 import numpy as np
 
 from ..core.errors import FrictionLabError, LawError, RegistryError
+from ..core.fpstate import own_errstate
 from ..core.inputs import note_input
 from ..core.names import check_name
 from ..core.signals import kept_signals
@@ -40,8 +41,6 @@ class PluginWarning(UserWarning):
     """A law plugin was skipped."""
 
 
-#: numpy's error state before any plugin ran: entry points are loaded and probed in it.
-_NUMPY_STATE = np.geterr()
 _laws: dict[str, FrictionLaw] = {}
 _sources: dict[str, str] = {}
 _runtime: list[tuple[FrictionLaw, str]] = []
@@ -78,8 +77,9 @@ def within_load_limit(fn, *args, what: str, error=RegistryError):
         limit = load_timeout()
         try:
             workers.bounded(_tried, limit, fn, *args)
-        except workers.OverBudget:
-            raise error(f"{what} ran past the load time limit of {limit:g} s (FRICTIONLAB_LOAD_TIMEOUT); "
+        except workers.OverBudget as exc:
+            during = f" during {exc.doing}" if exc.doing else ""
+            raise error(f"{what} ran past the load time limit of {limit:g} s (FRICTIONLAB_LOAD_TIMEOUT){during}; "
                         "its process was ended and nothing was loaded") from None
         except BrokenProcessPool:
             raise error(f"{what} ended its process; nothing was loaded") from None
@@ -104,8 +104,13 @@ def _as_law(obj, source: str) -> FrictionLaw:
     if type(law).__module__.startswith("frictionlab."):
         validate_law(law, source)
     else:  # a third-party law's check runs its code: within the load time limit
+        from ..core import workers
+
+        workers.doing(f"the check of law '{getattr(law, 'name', '?')}' at registration (its force, rates and form "
+                      "at its defaults)")
         within_load_limit(validate_law, law, source, what=f"law plugin {source}: its check at registration",
                           error=LawError)
+        workers.doing("the import")
     return law
 
 
@@ -229,7 +234,7 @@ def _load() -> None:
             seen.add(key)
             source = f"entry point '{ep.name} = {ep.value}' of {dist_name}"
             try:
-                with np.errstate(**_NUMPY_STATE):  # as before any plugin, whatever one set; restored after
+                with own_errstate():  # numpy's defaults, whatever a plugin or the caller set; restored after
                     try:
                         obj = (ep.load() if ep.value.startswith("frictionlab.")
                                else within_load_limit(ep.load, what="its import"))
@@ -374,6 +379,9 @@ def _import(spec, path) -> None:
     import importlib.util
     import sys
 
+    from ..core import workers
+
+    workers.doing("the import")
     module = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = module
     try:

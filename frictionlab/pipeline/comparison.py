@@ -31,7 +31,7 @@ from ..inference.equivalence import PAIRS, REPLICATES, EquivalenceResult
 from ..inference.fitting import FitResult, scene_ranges
 from ..inference.ranking import RankRow
 from ..inference.transfer import TransferResult
-from ..io.dataset import Dataset, builtin_names, load_dataset
+from ..io.dataset import Dataset, available_names, load_dataset
 from .planning import (  # noqa: F401
     candidates,
     equivalence_pairs,
@@ -42,8 +42,9 @@ from .planning import (  # noqa: F401
 from .perdataset import run_per_dataset
 from .runner import Progress, Run, select
 from .runner import run_stages as run_stages_with
-from .settings import DEFAULT_LAWS, Settings, select_laws  # noqa: F401
+from .settings import DEFAULT_LAWS, DEFAULT_LAWS_BY_KIND, Settings, default_laws_by_kind, select_laws  # noqa: F401
 from .stages import STAGES
+from ..core.fpstate import with_own_errstate
 
 if TYPE_CHECKING:  # annotations only
     import pandas as pd
@@ -155,6 +156,7 @@ def versions() -> dict:
             "platform": platform.platform(), "cpus": os.cpu_count()}
 
 
+@with_own_errstate
 def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None, solvers: Sequence[str] | None = None,
             *, free: dict | None = None, equivalence: bool = True, jobs: int = 1,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
@@ -163,11 +165,13 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             client: Client | None = None) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
 
-    laws: registered names, None for DEFAULT_LAWS, or "all" for every registered law; datasets: built-in names, TOML paths or Datasets
-    (default every built-in); solvers: None for the default choice, or a list of 'exact',
-    'series', 'ode[:METHOD]', 'auto'; free: scene quantities fitted per dataset, name -> bounds,
-    'low:high' with units or a tuple of SI numbers, quantity strings or pint Quantities (see
-    fitting.SCENE_QUANTITIES); jobs: worker processes; progress(done, total, label).
+    laws: registered names, None for the default laws of each dataset kind (DEFAULT_LAWS on impacts and
+    inclines, DEFAULT_LAWS_BY_KIND: rate-and-state aging and slip on spring-sliders), or "all" for every
+    registered law; datasets: built-in names, names of measured records, TOML paths or Datasets (default every
+    built-in dataset and every measured record present, ``available_names``); solvers: None for the default
+    choice, or a list of 'exact', 'series', 'ode[:METHOD]', 'auto'; free: scene quantities fitted per
+    dataset, name -> bounds, 'low:high' with units or a tuple of SI numbers, quantity strings or pint
+    Quantities (see fitting.SCENE_QUANTITIES); jobs: worker processes; progress(done, total, label).
     bootstrap: parametric replicates per dataset (0: none), drawn from ``seed``; datasets where a law
     needs the ODE, or without a time series, are bootstrapped only with bootstrap_all. tolerance: looser ODE tolerances at
     which the ODE laws of one dataset are refitted (empty: no tolerance check). fit_timeout: time
@@ -189,12 +193,17 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                         free=scene_ranges(free, "compare: free"), equivalence=equivalence, jobs=jobs, bootstrap=bootstrap, seed=seed,
                         bootstrap_all=bootstrap_all, tolerance=tuple(tolerance), fit_timeout=fit_timeout,
                         replicates=replicates, pairs=tuple(pairs), transfer=transfer, cluster=cluster_name(client))
-    settings = attrs.evolve(settings, laws=select_laws(laws))
     chosen = select(STAGES, stages)
     dss = unique_datasets(load_dataset(d) for d in (as_items(datasets, "compare: datasets") if datasets is not None
-                                                    else builtin_names()))
+                                                    else available_names()))
     if not dss:
         raise FrictionLabError("compare: no datasets to compare")
+    if laws is None:  # the default laws of each dataset kind
+        by_kind = default_laws_by_kind(d.kind for d in dss)
+        settings = attrs.evolve(settings, laws=tuple(dict.fromkeys(n for v in by_kind.values() for n in v)),
+                                by_kind=by_kind)
+    else:
+        settings = attrs.evolve(settings, laws=select_laws(laws))
     run = _make_run(settings, dss, progress, client)
     settings.check_replicates()
     c = Comparison(laws=settings.laws, datasets=dss, fits=run.plan.skipped_fits, ranking=(), groups=(),
@@ -206,6 +215,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     return attrs.evolve(c, wall_time=time.perf_counter() - started)
 
 
+@with_own_errstate
 def run_stages(comparison: Comparison, stages: Sequence[str], *, progress: Progress | None = None,
                client: Client | None = None, **options: object) -> Comparison:
     """Run the named stages (``stages.STAGES``) on a comparison made by ``compare``, e.g.
@@ -229,13 +239,15 @@ def cluster_name(client) -> str:
     """How the report names a Dask cluster: its scheduler's address and number of workers ("" without one)."""
     if client is None:
         return ""
-    workers = len(client.scheduler_info().get("workers", {}))
-    return f"Dask cluster at {client.scheduler.address} ({workers} worker{'s' * (workers != 1)})"
+    from ..core.cluster import address_of, waits_of, worker_count
+
+    workers = worker_count(client, waits_of(client).connect)  # asked within the cluster's connect time
+    return f"Dask cluster at {address_of(client)} ({workers} worker{'s' * (workers != 1)})"
 
 
 def _make_run(settings: Settings, dss, progress, client=None) -> Run:
     """The plan of the fits and tests (each stage counts its own items for the progress)."""
-    plan = plan_fits(settings.laws, dss, settings.solvers, settings.free)
+    plan = plan_fits(settings.laws, dss, settings.solvers, settings.free, settings.by_kind)
     eq_pairs = equivalence_pairs(settings.laws, plan.tasks, settings.pairs) if settings.equivalence else []
     return Run(settings=settings, plan=plan, eq_pairs=eq_pairs, progress=progress, client=client)
 

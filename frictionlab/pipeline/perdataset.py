@@ -42,6 +42,7 @@ def run_per_dataset(c, run: Run, chosen: list) -> tuple[object, list]:
         with executor(1, run.client, "compare", warm_worker) as ex:
             futures = {ex.submit(_one_dataset, *_part(c, run, name, ts, pairs.get(name, []), mine)): name
                        for name, ts in tasks.items()}
+            run.step(f"{len(futures)} dataset{'s' * (len(futures) != 1)} sent to the cluster", advance=False)
             for fut in as_completed(futures):
                 part, took = fut.result()
                 parts.append(part)

@@ -80,8 +80,9 @@ class FitPlan:
     no_law: frozenset  # datasets left out because no law compared applies (they get a not-fitted answer)
 
 
-def plan_fits(law_names: Sequence[str], dss: Sequence[Dataset], solvers, free) -> FitPlan:
-    """Every (law, solver) candidate on every dataset, or the reason a dataset or candidate is left out."""
+def plan_fits(law_names: Sequence[str], dss: Sequence[Dataset], solvers, free, by_kind=None) -> FitPlan:
+    """Every (law, solver) candidate on every dataset, or the reason a dataset or candidate is left out;
+    ``by_kind``: dataset kind -> the laws to fit on it (the default laws), instead of every law on every set."""
     skipped_ds, tasks, fits, no_law = {}, [], [], set()
     for name in free or {}:
         if not any(ds.scene is not None and has_scene_quantity(ds.scene, name) for ds in dss):
@@ -93,7 +94,8 @@ def plan_fits(law_names: Sequence[str], dss: Sequence[Dataset], solvers, free) -
         if ds.kind not in PREDICTORS:
             skipped_ds[ds.name] = f"no predictor for dataset kind '{ds.kind}' yet"
             continue
-        mine = [(law, solver, why) for law in law_names for solver, why in candidates(law, ds, solvers)]
+        names = by_kind.get(ds.kind, law_names) if by_kind else law_names
+        mine = [(law, solver, why) for law in names for solver, why in candidates(law, ds, solvers)]
         if mine and all(why for _, _, why in mine):  # nothing to fit: one reason for the dataset, not a row per law
             skipped_ds[ds.name] = no_law_applies(ds, mine, solvers)
             no_law.add(ds.name)

@@ -11,9 +11,11 @@ from ..core.errors import ParameterError
 from ..inference.equivalence import MIN_REPLICATES, PAIRS, REPLICATES
 from ..physics.registry import available_laws, get_law
 
-#: The laws ``compare`` fits by default: the four of the mission (the seed paper's question). Other
-#: registered laws (stribeck, lugre, dahl, rate-and-state, installed plugins) join when named or with "all".
+#: The laws ``compare`` fits by default on impacts and inclines: the four of the mission (the seed paper's
+#: question). Other registered laws (stribeck, lugre, dahl, installed plugins) join when named or with "all".
 DEFAULT_LAWS = ("coulomb", "area-rate", "wear", "couette")
+#: Dataset kinds whose default laws are others: rate-and-state friction on velocity steps of a spring-slider.
+DEFAULT_LAWS_BY_KIND = {"spring-slider": ("rate-state-aging", "rate-state-slip")}
 
 
 def select_laws(laws: Sequence[str] | None) -> tuple[str, ...]:
@@ -22,6 +24,20 @@ def select_laws(laws: Sequence[str] | None) -> tuple[str, ...]:
     if "all" in names:
         names = tuple(available_laws()) + tuple(n for n in names if n != "all")
     return tuple(dict.fromkeys(get_law(n).name for n in names))
+
+
+def laws_groups(by_kind: dict, kinds) -> list[tuple[tuple[str, ...], list[str]]]:
+    """(laws, the dataset kinds they were fitted on) for the kinds present, from a kind -> laws mapping."""
+    groups: dict[tuple, list[str]] = {}
+    for kind, laws in by_kind.items():
+        if kind in set(kinds):
+            groups.setdefault(tuple(laws), []).append(kind)
+    return list(groups.items())
+
+
+def default_laws_by_kind(kinds) -> dict[str, tuple[str, ...]]:
+    """The default laws of each dataset kind in ``kinds`` (DEFAULT_LAWS_BY_KIND, else DEFAULT_LAWS)."""
+    return {k: tuple(get_law(n).name for n in DEFAULT_LAWS_BY_KIND.get(k, DEFAULT_LAWS)) for k in dict.fromkeys(kinds)}
 
 
 @attrs.frozen
@@ -42,6 +58,7 @@ class Settings:
     pairs: tuple = PAIRS
     transfer: bool = True
     cluster: str = ""  # where the tasks ran when not on a local pool: "Dask cluster at ADDRESS (N workers)"
+    by_kind: dict = attrs.field(factory=dict)  # dataset kind -> the laws fitted on it ({}: every law on every dataset)
 
     def __attrs_post_init__(self):
         from ..solve.solvers import parse_solver
@@ -78,4 +95,5 @@ class Settings:
                 "bootstrap": int(self.bootstrap), "seed": int(self.seed), "bootstrap_all": bool(self.bootstrap_all),
                 "tolerance": [float(r) for r in self.tolerance], "fit_timeout": self.fit_timeout,
                 "replicates": int(self.replicates), "pairs": [list(p) for p in self.pairs],
-                "transfer": bool(self.transfer)} | ({"cluster": self.cluster} if self.cluster else {})
+                "transfer": bool(self.transfer)} | ({"cluster": self.cluster} if self.cluster else {}) | (
+                {"laws_by_kind": {k: list(v) for k, v in self.by_kind.items()}} if self.by_kind else {})

@@ -64,6 +64,7 @@ from .doc import Section
 from .render import html_page, markdown
 from .results import SCHEMA, clean, fit_json, ranking_csv, results_json
 from .tolerance import tolerance_verdicts
+from ..core.fpstate import with_own_errstate
 
 if TYPE_CHECKING:  # annotations only
     from dask.distributed import Client
@@ -181,6 +182,7 @@ def _batches(items, n: int):
         yield first, batch
 
 
+@with_own_errstate
 def write_report(c: Comparison, out: str | os.PathLike, force: bool = False,
                  progress: Callable[[int, int, str], None] | None = None, jobs: int = 1,
                  client: Client | None = None) -> Path:

@@ -42,8 +42,18 @@ def _how_it_ran(c) -> str:
             + (" (" + ", ".join(f"{k} {v:.1f} s" for k, v in c.timings.items()) + ", partly in parallel)"
                if len(c.timings) > 1 else "")
             + (f" on a {c.settings['cluster']}" if c.settings.get("cluster") else
-               f" on {jobs} worker process{'es' * (jobs != 1)}") + f". Laws: {', '.join(c.laws)}. "
+               f" on {jobs} worker process{'es' * (jobs != 1)}") + f". Laws: {_laws_text(c)}. "
             f"Datasets: {len(c.datasets)} ({len(c.fitted_datasets)} fitted).")
+
+
+def _laws_text(c) -> str:
+    """The laws compared, by dataset kind when they were chosen by kind (the default laws)."""
+    from ..pipeline.settings import laws_groups
+
+    groups = laws_groups(c.settings.get("laws_by_kind") or {}, {d.kind for d in c.datasets if d.kind != "contact-area"})
+    if not groups:
+        return ", ".join(c.laws)
+    return "; ".join(f"{', '.join(laws)} on {', '.join(k)} datasets" for laws, k in groups)
 
 
 def _provenance_warning(c) -> str:

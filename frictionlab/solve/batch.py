@@ -62,6 +62,7 @@ from .batchrk import run_rk
 from .plan import make_plan
 from .scenebatch import SceneBatch, batch_params, take_params
 from .solvers import exact
+from ..core.fpstate import with_own_errstate
 
 if TYPE_CHECKING:  # annotations only
     from ..physics.law import FrictionLaw
@@ -105,6 +106,7 @@ class BatchResult:
                           solver=f"batch:{self.solver}", law=self.law, stick_time=None if math.isnan(st) else st)
 
 
+@with_own_errstate
 def simulate_batch(law: str | FrictionLaw, scenes: Sequence[Scene] | SceneBatch,
                    params: Mapping[str, object] | Sequence[Mapping[str, object]] | None = None,
                    t: np.ndarray | None = None, solver: str = "auto", rtol: float = 1e-8,

@@ -63,6 +63,7 @@ from .outcomescene import (
     SpeedLaw,
     hertz_shape,
 )
+from ..core.fpstate import with_own_errstate
 
 if TYPE_CHECKING:  # annotations only
     from ..physics.scene import SceneSource
@@ -103,6 +104,7 @@ def _rows(law, dataset_or_scene, speed, incidence, spin):
                      f"got {type(dataset_or_scene).__name__}")
 
 
+@with_own_errstate
 def predict_outcomes(law: str | FrictionLaw, dataset_or_scene: SceneSource | OutcomeScene,
                      params: Mapping[str, float] | None = None, solver: str = "ode", *,
                      speed: np.ndarray | None = None, incidence: np.ndarray | None = None,

@@ -58,6 +58,14 @@ from .patch import CompliantPatch
 #: load-point velocity (a runaway, where inertia would matter: give the slider a mass to follow it).
 QUASI_STATIC_LIMIT = 1e3
 
+#: The smallest share of a spring-slider's motion its inertia may make, m k N / (dF/du)^2 at the start: below it the
+#: slider's velocity relaxes over a time that much shorter than its spring loads it, a stiffness the ODE solvers
+#: cannot follow (BDF and Radau integrate 1e-12 at rtol 1e-3 to 1e-10, and fail near 1e-16; LSODA fails from
+#: 1e-7 to 1e-10 depending on rtol), and the motion is the quasi-static slider's to that precision.
+INERTIA_FLOOR = 1e-12
+#: Below this share LSODA (the default ODE method) may fail on a slider with mass; BDF and Radau do not.
+LSODA_FLOOR = 1e-7
+
 #: Prefix of a law's internal states in the plan's state vector ("law:theta" cannot clash with the spin angle).
 LAW_PREFIX = "law:"
 
@@ -129,7 +137,43 @@ class Plan(CompliantPatch):
             y0 = y.reshape(y0.shape)
         if "load" in self.states:  # the spring starts at the friction of the initial state: no jolt at t = 0
             y0[self.index("load")] = float(self.force(p, np.zeros(1), y0[:, None], y0[:1])[0][0] / s.normal(0.0))
+            self._check_inertia(p, y0)
         return y0
+
+    def _inertia(self, p, t, y) -> tuple[float, float, float] | None:
+        """(m k N / (dF/du)^2, dF/du [N s/m], k N [N/m]) of a slider with mass at state y, or None where the
+        friction has no damping there."""
+        sp = self.scene.spring
+        c = float(self._partials(p, t, y)[0])  # the friction's damping dF/du
+        K = sp.stiffness * float(self.scene.normal(t))  # the spring
+        if not (c > 0 and K > 0 and math.isfinite(c)):
+            return None
+        return sp.mass * K / c**2, c, K
+
+    def stiffness_note(self, p, t, y) -> str:
+        """What in the scene makes an integration from state y at time t stiff, for its error ("" if nothing
+        known): a slider whose inertia is below LSODA_FLOOR of its motion."""
+        known = self._inertia(p, t, y) if "load" in self.states else None
+        if known is None or known[0] >= LSODA_FLOOR:
+            return ""
+        return (f"[scene.spring] mass = {self.scene.spring.mass:.3g} kg makes the slider's inertia {known[0]:.1g} of "
+                f"its motion, a stiff problem LSODA fails on from about {LSODA_FLOOR:g}: ode:BDF or ode:Radau integrate "
+                f"it down to {INERTIA_FLOOR:g}, or leave the mass out (the quasi-static slider)")
+
+    def _check_inertia(self, p, y0) -> None:
+        """Refuse a slider with mass so light that its inertia is below INERTIA_FLOOR of its motion, naming the
+        mass and the masses that work."""
+        sp = self.scene.spring
+        known = self._inertia(p, 0.0, y0)
+        if known is None:
+            return
+        share, c, K = known
+        if share < INERTIA_FLOOR:
+            raise SceneError(f"[scene.spring] mass = {sp.mass:.3g} kg: the slider's inertia is {share:.1g} of its motion "
+                             f"(m k N / (dF/du)^2 at the start, with dF/du = {c:.3g} N s/m at u = {float(y0[0]):.3g} "
+                             f"m/s), below the {INERTIA_FLOOR:g} the ODE solvers can integrate; leave the mass out "
+                             f"(the quasi-static slider, which this one is to that precision) or give at least "
+                             f"{INERTIA_FLOOR * c**2 / K:.2g} kg")
 
     # -- contact quantities ----------------------------------------------------------
     def rigid_slip(self, y: np.ndarray) -> np.ndarray:
@@ -222,9 +266,11 @@ class Plan(CompliantPatch):
         fastest = QUASI_STATIC_LIMIT * max(s.spring.velocities)
         if abs(v) > fastest:
             raise SolverError(f"law '{self.law.name}' on a spring-slider: the slip rate reached {v:.3g} m/s at "
-                              f"t = {float(t):.6g} s, beyond {QUASI_STATIC_LIMIT:g} times the fastest load point: an "
-                              f"unstable slider ({runaway_cause(p, s.spring.stiffness)}); the quasi-static model "
-                              "cannot follow it: give the slider a mass ([scene.spring] mass) to simulate the slip")
+                              f"t = {float(t):.6g} s, beyond {QUASI_STATIC_LIMIT:g} times the fastest load-point "
+                              f"velocity ([scene.spring] velocities, up to {max(s.spring.velocities):.3g} m/s), as far "
+                              f"as the quasi-static model follows a slider: an unstable slider "
+                              f"({runaway_cause(p, s.spring.stiffness)}); give the slider a mass ([scene.spring] mass) "
+                              "to simulate the slip")
         dF = self.slip_rate_partials(p, t, y)
         N = float(s.normal(t))
         return (s.spring.stiffness * N * (float(s.spring.velocity(t)) - v) - float(dF[1:] @ dy[1:])) / dF[0]
@@ -233,6 +279,17 @@ class Plan(CompliantPatch):
         """Partials of the friction force [N] of a spring-slider's one state vector y by its slip rate
         (first, N s/m) and by each law state, by central differences; error if dF/du is not positive
         (the quasi-static block then has no slip rate for the spring's load)."""
+        dF = self._partials(p, t, y)
+        if not dF[0] > 0:
+            s = self.scene
+            raise SceneError(f"law '{self.law.name}' on a spring-slider: its force does not grow with the slip rate "
+                             f"at fixed state (dF/du = {dF[0]:.3g} N s/m at u = {float(y[0]):.3g} m/s, t = "
+                             f"{float(t):.6g} s, load-point velocity {float(s.spring.velocity(t)):.3g} m/s), so the "
+                             "quasi-static block has no slip rate for the spring's load")
+        return dF
+
+    def _partials(self, p, t, y) -> np.ndarray:
+        """``slip_rate_partials`` without its check."""
         rows = [0] + [self.index(k) for k in self.law_states]  # the slip rate and the law's states
         n = len(rows)
         v = float(y[0])
@@ -243,12 +300,7 @@ class Plan(CompliantPatch):
             Y[i, 2 * j] += h
             Y[i, 2 * j + 1] -= h
         F, _ = self.force(p, np.full(2 * n, t), Y, Y[0])
-        dF = (F[0::2] - F[1::2]) / (2.0 * np.array(steps))
-        if not dF[0] > 0:
-            raise SceneError(f"law '{self.law.name}' on a spring-slider: its force does not grow with the slip rate "
-                             f"at fixed state (dF/du = {dF[0]:.3g} N s/m at u = {v:.3g} m/s), so the quasi-static "
-                             "block has no slip rate for the spring's load")
-        return dF
+        return (F[0::2] - F[1::2]) / (2.0 * np.array(steps))
 
     def _one_state(self, p, t, y, direction: float, normal=None) -> np.ndarray:
         """``derivatives`` for one state vector of a memoryless law without compliance (every scalar ODE

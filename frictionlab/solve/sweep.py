@@ -30,6 +30,7 @@ import numpy as np
 from ..core.errors import OutputError, SolverError
 from ..physics.registry import get_law
 from .scenebatch import SceneBatch, batch_params, take_params
+from ..core.fpstate import with_own_errstate
 
 if TYPE_CHECKING:  # annotations only
     from ..physics.law import FrictionLaw
@@ -58,6 +59,7 @@ class Sweep:
         return pd.DataFrame(self.scenes).set_index("scene")
 
 
+@with_own_errstate
 def simulate_sweep(law: str | FrictionLaw, scenes: Sequence[Scene] | SceneBatch,
                    params: Mapping[str, object] | Sequence[Mapping[str, object]] | None = None,
                    t: np.ndarray | None = None, solver: str = "auto", rtol: float = 1e-8, atol: float | None = None,

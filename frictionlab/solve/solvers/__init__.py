@@ -14,6 +14,7 @@ from ...physics.registry import get_law
 from ...physics.scene import Scene, SceneSource
 from ..plan import make_plan
 from . import exact, ode, segments, series
+from ...core.fpstate import with_own_errstate
 
 if TYPE_CHECKING:  # annotations only
     from ...physics.law import FrictionLaw
@@ -37,6 +38,7 @@ def parse_solver(text: str) -> tuple[str, str | None]:
     return name, method or None
 
 
+@with_own_errstate
 def simulate(law: str | FrictionLaw, scene: Scene | SceneSource, params: Mapping[str, object] | None = None,
              solver: str = "ode", t: np.ndarray | None = None, rtol: float = 1e-10, atol: float | None = None,
              n: int = 201) -> Trajectory:

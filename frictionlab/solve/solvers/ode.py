@@ -200,7 +200,13 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
                 if fast.bad == TOO_MANY:
                     raise SolverError(f"ode:{method}: {_too_many(plan, fast.stop_time, method)}") from None
         f = _scaled_rates(plan, p, direction, T, scale, method)
-        return _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method, rtol, atol)
+        try:
+            return _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method, rtol, atol)
+        except SolverError as exc:  # name what in the scene makes it fail, where the plan knows
+            note = plan.stiffness_note(p, t0, y0) if method not in ("BDF", "Radau") else ""
+            if note:
+                raise SolverError(f"{str(exc).rstrip('.')}; {note}") from None
+            raise
 
     return slide
 
