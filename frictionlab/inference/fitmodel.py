@@ -264,10 +264,10 @@ def _si(params, slots) -> dict[str, float]:
     return {s.pname: params[s.pname].value * s.scale for s in slots}
 
 
-def _start_grid(slots, rng, limit: int) -> list[dict[str, float]]:
+def _start_grid(slots, rng, limit: int, decades: float = 1.5) -> list[dict[str, float]]:
     """Candidate starts in scaled units, the given start first: log-spaced multiples of the start
-    for positive quantities, steps of the scale around it for signed ones, the bounds' span for
-    scene quantities; clipped into the bounds. A full grid if it has at most ``limit`` points."""
+    for positive quantities (10^-decades to 10^decades), steps of the scale around it for signed ones, the
+    bounds' span for scene quantities; clipped into the bounds. A full grid if it has at most ``limit`` points."""
     levels = max(3, min(15, int(round(limit ** (1.0 / len(slots))))))
     axes = []
     for s in slots:
@@ -276,7 +276,7 @@ def _start_grid(slots, rng, limit: int) -> list[dict[str, float]]:
         if s.kind == "scene":
             c = np.linspace(lo, hi, levels)
         elif lo >= 0 and x0 > 0:
-            c = x0 * np.logspace(-1.5, 1.5, levels)
+            c = x0 * np.logspace(-decades, decades, levels)
         else:
             c = x0 + np.sinh(np.linspace(-4.0, 4.0, levels))  # dense near the start, out to +/- 27 scales
         axes.append(np.unique(np.clip(c, lo, hi)))
@@ -327,7 +327,46 @@ def lmfit_leastsq(lmfit, model: _Model, slots, params, scale_covar: bool, budget
     evaluations: its MinimizerResult."""
     mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), params, scale_covar=scale_covar,
                            max_nfev=budget)
-    return mini.minimize(method="leastsq", epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
+    return mini.minimize(method="leastsq", epsfcn=epsfcn(model), ftol=FTOL, xtol=FTOL)
+
+
+#: How many times the given number of start points a compiled law with memory scores (``compiled_memory``), and
+#: the decades either side of each positive parameter's start that the added points span.
+MEMORY_SCAN = 4
+MEMORY_DECADES = 1.5
+
+
+def compiled_memory(model: _Model) -> bool:
+    """True when the model is a built-in law with memory that every target solves by the ODE solver's default
+    method on the compiled path (``solve.memoryrhs``): cheap enough for a wider search (MEMORY_SCAN times the
+    start points, every start refined, no early stop in a valley) and solved to a tolerance that makes
+    Levenberg-Marquardt's difference quotients need steps of its size (``epsfcn``)."""
+    cached = getattr(model, "_compiled_memory", None)
+    if cached is None:
+        from ..solve.memoryrhs import available, served
+        from ..solve.plan import make_plan
+
+        try:
+            cached = (bool(model.law.states) and all(s in ("ode", "ode:LSODA") for s in model.solvers)
+                      and all(tg.dataset.kind in ("impact", "incline", "spring-slider") for tg in model.targets)
+                      and all(served(make_plan(tg.dataset.scene, model.law)) for tg in model.targets)
+                      and available())
+        except FrictionLabError:
+            cached = False
+        model._compiled_memory = cached
+    return cached
+
+
+def epsfcn(model: _Model) -> float:
+    """Levenberg-Marquardt's relative squared step of its forward differences: 1e-10 (steps of 1e-5 of a scaled
+    parameter), or, for a compiled law with memory (``compiled_memory``), the fit's ODE tolerance: an adaptive
+    solve to rtol 1e-6 moves with the parameters by about that much, so steps of 1e-5 would measure the solver's
+    steps more than the law (LuGre's fit to incline-oil-a100 stalled at chi-square 2626 for it; 92 with these)."""
+    if not compiled_memory(model):
+        return 1e-10
+    from .predict import FIT_RTOL
+
+    return max(1e-10, FIT_RTOL if model.rtol is None else float(model.rtol))
 
 
 def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: int, max_nfev, scale_covar: bool = True,
@@ -341,19 +380,28 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
     if not varying:
         return params, True, "nothing to fit: every parameter is held", None, []
     slow = any(x.startswith("ode") for x in solvers)
+    wide = slow and compiled_memory(model)
+    if wide:  # cheap solves of a law with memory: a wider scan, every start refined (see compiled_memory)
+        slow = False
     starts = [{s.pname: params[s.pname].value for s in varying}]
     if model.progress is not None:
         from .fitprogress import LM_EVALS
 
         lm = LM_EVALS * (len(varying) + 1)
-        model.progress.stage("scanning start points", scan, total=scan + n_starts * lm + 2 * len(varying) + 2)
+        k = scan * (MEMORY_SCAN if wide else 1)
+        model.progress.stage("scanning start points", k, total=k + n_starts * lm + 2 * len(varying) + 2)
     if scan:
         fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
         grid = _start_grid(varying, np.random.default_rng(0), scan)
+        given = len(grid)
+        if wide and MEMORY_SCAN > 1:  # the same grid, and MEMORY_SCAN - 1 times as many on a finer and wider one
+            grid += _start_grid(varying, np.random.default_rng(1), (MEMORY_SCAN - 1) * scan, MEMORY_DECADES)[1:]
         points = [{s.pname: vals[s.pname] * s.scale for s in slots} for vals in ({**fixed_part, **c} for c in grid)]
         scored = [(float(r @ r), i, c) for i, (r, c) in enumerate(zip(model.residuals(points), grid))]
         scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins
         starts = _distinct(scored, min(n_starts, ODE_STARTS) if slow else n_starts)
+        if wide:  # and the best of the given grid alone, as a fit of a law without memory starts
+            starts += [c for c in _distinct([x for x in scored if x[1] < given], n_starts) if c not in starts]
     best, notes = None, []
     for i, start in enumerate(starts):
         for k, v in start.items():  # every varying parameter; lmfit works on its own copy
@@ -365,7 +413,7 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
         if direct:
             before = model.nfev, model.failures, model.last_error, model._last
             r = levmar.leastsq(lambda v: model.residual({s.pname: v[s.pname] * s.scale for s in slots}), params,
-                               scale_covar, budget, epsfcn=1e-10, ftol=FTOL, xtol=FTOL)
+                               scale_covar, budget, epsfcn=epsfcn(model), ftol=FTOL, xtol=FTOL)
             if r is None:  # lmfit takes another path here: run it, from the same state of the model
                 model.nfev, model.failures, model.last_error, model._last = before
         if r is None:

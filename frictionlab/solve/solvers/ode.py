@@ -17,6 +17,7 @@ import scipy.integrate
 from scipy.optimize import brentq
 
 from ...core.errors import FrictionLabError, SolverError
+from ..memory_codes import CALLS, SENSE, TOO_MANY, TURNED
 
 METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 
@@ -44,17 +45,22 @@ def watching(fn):
 
 
 def solve(f, s0: float, s1: float, z0, method: str, s_eval, rtol: float, atol: float, event=None,
-          event_direction: float = 0.0, label: str = "integration failed"):
+          event_direction: float = 0.0, label: str = "integration failed", jac=None, compiled=None):
     """Integrate z' = f(s, z) from s0 to s1 with scipy's ``method`` and return
     (Z at the times s_eval reached (n_states, k), s_event or None, z_event or None, the solver).
 
     s_eval: increasing times within [s0, s1]. event(s, z) -> float: a terminal event where it crosses
     zero in ``event_direction`` (as in solve_ivp: < 0 falling, > 0 rising, 0 either way), located by
     brentq on the step's dense output to 4 eps, exactly as solve_ivp does. A failed step raises
-    SolverError('{label}: {scipy's message}').
+    SolverError('{label}: {scipy's message}'). jac(s, z): the Jacobian df/dz for the implicit methods (None:
+    they difference f). LSODA with a compiled right-hand side (``compiled``, a ``memoryrhs.Phase``) and no event
+    runs its whole loop in ODEPACK (``_lsoda_loop``).
     """
+    if method == "LSODA" and compiled is not None and event is None and not _WATCHERS:
+        return _lsoda_loop(compiled, s0, s1, z0, s_eval, rtol, atol, label)
     eps = np.finfo(float).eps
-    solver = getattr(scipy.integrate, method)(f, s0, np.asarray(z0, dtype=float), s1, rtol=rtol, atol=atol)
+    kw = {"jac": jac} if jac is not None and method in ("Radau", "BDF", "LSODA") else {}
+    solver = getattr(scipy.integrate, method)(f, s0, np.asarray(z0, dtype=float), s1, rtol=rtol, atol=atol, **kw)
     s_eval = np.asarray(s_eval, dtype=float)
     eval_list = s_eval.tolist()  # bisect on floats: np.searchsorted's index, without its per-step dispatch
     outs, i = [], 0
@@ -83,6 +89,27 @@ def solve(f, s0: float, s1: float, z0, method: str, s_eval, rtol: float, atol: f
             break
     Z = np.hstack(outs) if outs else np.empty((len(z0), 0))
     return Z, s_event, z_event, solver
+
+
+def _lsoda_loop(compiled, s0, s1, z0, s_eval, rtol, atol, label):
+    """``solve`` for LSODA on a compiled phase without an event: scipy's ``odeint``, the same ODEPACK LSODA that
+    ``solve_ivp`` steps one call at a time, here with its stepping loop and output interpolation in Fortran (it
+    calls the kernel's right-hand side and Jacobian directly) and the end of the span as its critical time (no
+    step beyond it), as ``solve_ivp`` steps."""
+    import warnings
+    from types import SimpleNamespace
+
+    s_eval = np.asarray(s_eval, dtype=float)
+    times = np.concatenate([[s0], s_eval, [s1]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        Z, info = scipy.integrate.odeint(compiled.kernel.rhs, np.asarray(z0, dtype=float), times,
+                                         args=compiled.args, Dfun=compiled.kernel.jac, tfirst=True, rtol=rtol,
+                                         atol=atol, tcrit=[s1], full_output=True, mxstep=MAX_NFEV)
+    if info["message"] != "Integration successful.":
+        raise SolverError(f"{label}: {info['message']}")
+    used = {"nfev": int(info["nfe"][-1]), "njev": int(info["nje"][-1]), "nlu": int(info["nje"][-1])}
+    return Z[1:-1].T, None, None, SimpleNamespace(y=Z[-1].copy(), t=s1, **used)
 
 
 def state_scales(plan, T: float) -> np.ndarray:
@@ -152,11 +179,31 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
             return np.repeat(np.asarray(y0, dtype=float)[:, None], len(t_out), axis=1), None, None, {"nfev": 0}
         T = float(t_out[-1])
         scale = phase_scales(plan, p, t0, T, y0, direction)
-        f, event = _scaled_problem(plan, p, direction, T, scale, method)
+        event = _zero_slip_event(plan, direction, scale)
+        for slid in (True, False):
+            fast = _memory_phase(plan, p, direction, T, y0, scale, slid)
+            if fast is None:
+                break
+            try:
+                Y, t_stop, y_stop, info = _integrate_phase(plan, fast.f, event, t0, T, fast.y0, direction, t_out,
+                                                           fast.scale, method, rtol, atol,
+                                                           fast.jac if method in IMPLICIT else None, fast)
+                return fast.states(Y), t_stop, fast.states(y_stop), info
+            except SolverError:
+                if fast.bad == TOO_MANY:
+                    raise SolverError(f"ode:{method}: {_too_many(plan, fast.stop_time, method)}") from None
+                if fast.bad != TURNED:
+                    break  # a value not finite or a failed step: the general path's to handle or to say
+            try:  # Dahl's slip turned: slid phases from turn to turn
+                return _turns(plan, p, t0, T, y0, float(fast.C[SENSE]), t_out, scale, method, rtol, atol)
+            except SolverError:
+                if fast.bad == TOO_MANY:
+                    raise SolverError(f"ode:{method}: {_too_many(plan, fast.stop_time, method)}") from None
+        f = _scaled_rates(plan, p, direction, T, scale, method)
         try:
             return _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method, rtol, atol)
         except SolverError as exc:  # name what in the scene makes it fail, where the plan knows
-            note = plan.stiffness_note(p, t0, y0) if method != "BDF" and method != "Radau" else ""
+            note = plan.stiffness_note(p, t0, y0) if method not in ("BDF", "Radau") else ""
             if note:
                 raise SolverError(f"{str(exc).rstrip('.')}; {note}") from None
             raise
@@ -164,21 +211,65 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
     return slide
 
 
-def _scaled_problem(plan, p, direction, tscale, scale, method):
-    """(right-hand side, zero-slip event or None) of a sliding phase on the scaled problem (time / tscale,
-    states / scale); the right-hand side stops with a clear error beyond MAX_NFEV evaluations."""
+def _turns(plan, p, t0, T, y0, sense, t_out, scale, method, rtol, atol):
+    """A Dahl phase in the slid form (``memoryrhs``) as a chain of phases of one slip sense each, the next one
+    begun where the slip turns (an event: slip past zero by SLIP_MARGIN of its scale), from the friction reached
+    there; SolverError past MAX_TURNS turns (then mu_d is integrated instead) or MAX_NFEV calls."""
+    from ..memoryrhs import MAX_TURNS, phase
+
+    t_out = np.asarray(t_out, dtype=float)
+    Y = np.empty((len(plan.states), t_out.size))
+    done, t, y, calls, stats = 0, t0, np.asarray(y0, dtype=float), 0, {"nfev": 0, "njev": 0, "nlu": 0}
+    iw = plan.index("omega") if plan.coupled else 0
+    r, sv = (plan.scene.radius if plan.coupled else 0.0), float(scale[0])
+    for _ in range(MAX_TURNS):
+        ph = phase(plan, p, 0.0, 0.0, T, y, scale, MAX_NFEV - calls, True, sense)
+        turn = (lambda s, z, sw=float(ph.scale[iw]), k=sense:
+                k * (z[0] * sv - r * (z[iw] * sw)) / sv + SLIP_MARGIN)
+        try:
+            Ys, t_stop, y_stop, info = _integrate_phase(plan, ph.f, turn, t, T, ph.y0, 1.0, t_out[done:], ph.scale,
+                                                        method, rtol, atol, ph.jac if method in IMPLICIT else None,
+                                                        ph)
+        finally:
+            calls += int(ph.C[CALLS])
+        Y[:, done:done + Ys.shape[1]] = ph.states(Ys)
+        done += Ys.shape[1]
+        for k in stats:
+            stats[k] += info[k]
+        if t_stop is None:
+            return Y, None, None, {**info, **stats}
+        t, y, sense = t_stop, ph.states(y_stop[:, None])[:, 0], -sense
+    raise SolverError(f"ode:{method}: Dahl's slip turned more than {MAX_TURNS} times")
+
+
+#: The methods that take a Jacobian.
+IMPLICIT = ("Radau", "BDF", "LSODA")
+
+
+def _too_many(plan, t, method) -> str:
+    return (f"law '{plan.law.name}' needed more than {MAX_NFEV} right-hand-side evaluations (stopped at t = {t:.6g} s): "
+            f"too stiff for {method} here")
+
+
+def _scaled_rates(plan, p, direction, tscale, scale, method):
+    """The right-hand side of a sliding phase on the scaled problem (time / tscale, states / scale), through
+    ``Plan.bound``; it stops with a clear error beyond MAX_NFEV evaluations."""
     calls = [0]
     rates = plan.bound(p, direction)
 
     def f(s, z):
         calls[0] += 1
         if calls[0] > MAX_NFEV:
-            raise SolverError(f"ode:{method}: law '{plan.law.name}' needed more than {MAX_NFEV} right-hand-side "
-                              f"evaluations (stopped at t = {s * tscale:.6g} s): too stiff for {method} here")
+            raise SolverError(f"ode:{method}: {_too_many(plan, s * tscale, method)}")
         return rates(s * tscale, z * scale) * tscale / scale
 
+    return f
+
+
+def _zero_slip_event(plan, direction, scale):
+    """The zero-slip event of a sliding phase on the scaled problem, or None (no direction, or compliance)."""
     if "xi" in plan.states or direction == 0:
-        return f, None
+        return None
     r, iw = (plan.scene.radius, plan.index("omega")) if plan.coupled else (0.0, 0)
     sv, sw = float(scale[0]), float(scale[iw])
 
@@ -187,12 +278,25 @@ def _scaled_problem(plan, p, direction, tscale, scale, method):
         # hair (SLIP_MARGIN of its scale), so that round-off at a restart from rest is not a new stop
         return (z[0] * sv - r * (z[iw] * sw)) / sv + direction * SLIP_MARGIN
 
-    return f, zero_slip
+    return zero_slip
 
 
-def _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method, rtol, atol):
+def _memory_phase(plan, p, direction, tscale, y0, scale, slid=True):
+    """``memoryrhs.phase``: the compiled right-hand side and Jacobian of a built-in law with memory on a scene
+    written out there, for this phase; None where it does not serve."""
+    if not plan.law_states:
+        return None
+    from ..memoryrhs import phase
+    from .stick import vanishing_slip
+
+    return phase(plan, p, float(direction), float(vanishing_slip(plan)) if direction != 0 else 0.0, tscale, y0,
+                 scale, MAX_NFEV, slid)
+
+
+def _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method, rtol, atol, jac=None, compiled=None):
     """solve_ivp over [t0, T] (restarted at the plan's breaks when no event watches slip): (states at t_out
-    reached, stop time, state at the stop, counters)."""
+    reached, stop time, state at the stop, counters). jac: the Jacobian of f for the implicit methods;
+    compiled: the ``memoryrhs.Phase`` whose kernel f and jac call (ODEPACK's loop then calls the kernel itself)."""
     tscale = T
     s_eval = np.clip(np.asarray(t_out, dtype=float) / tscale, t0 / tscale, T / tscale)
     s_eval, back = np.unique(s_eval, return_inverse=True)  # repeated times (e.g. a resample) solved once
@@ -205,7 +309,8 @@ def _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method,
         for k, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
             last = k == len(edges) - 2
             inside = s_eval[(s_eval >= a) & ((s_eval <= b) if last else (s_eval < b))]
-            Z, s_stop, z_stop, solver = solve(f, a, b, z0, method, inside, rtol, atol, event, -direction, failed)
+            Z, s_stop, z_stop, solver = solve(f, a, b, z0, method, inside, rtol, atol, event, -direction, failed, jac,
+                                              compiled)
             parts.append(Z)
             for key in stats:
                 stats[key] += int(getattr(solver, key))
@@ -214,6 +319,8 @@ def _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method,
         raise
     except Exception as exc:  # a law raising inside the integrator
         raise SolverError(f"{failed}: {exc}") from exc
+    if compiled is not None and compiled.bad:
+        raise SolverError(f"{failed}: the compiled right-hand side was not finite or past its budget")
     Z = np.hstack(parts)
     Y = Z[:, back[back < Z.shape[1]]] * scale[:, None]  # a stop ends the samples reached
     t_stop = y_stop = None
