@@ -69,6 +69,7 @@ def _general(monkeypatch):
     ("lugre", "impact-golf-v28", {}),
     ("dahl", "incline-oil-a100", dict(mu_c=0.6, sigma=30.0, alpha=2.0)),  # the block stops: the slip turns
     ("dahl", "impact-golf-v28", dict(mu_c=0.5, sigma=3e4, alpha=1.0)),  # the slip turns during the contact
+    ("dahl", "incline-dry-d10", dict(mu_c=0.8, sigma=300.0, alpha=1.5)),  # more turns than MAX_TURNS: then mu_d
     ("rate-state-aging", "incline-oil-a100", dict(mu0=0.2)),  # stick events
     ("rate-state-slip", "impact-golf-v28", dict(mu0=0.2)),
 ])
@@ -118,3 +119,18 @@ def test_lugre_fit_reaches_the_careful_minimum():
     """The fit that stalled at chi-square 2626 ('does not fit') on the general path's search reaches < 93."""
     r = fl.fit("lugre", "incline-oil-a100")
     assert r.ok and r.stats.chisqr < 93.0
+
+
+def test_a_dahl_oscillation_past_max_turns_is_integrated_in_mu_d(monkeypatch):
+    from frictionlab.solve import memoryrhs
+
+    d = fl.load_dataset("incline-dry-d10")
+    p = dict(mu_c=0.8, sigma=300.0, alpha=1.5)  # the block stops and rocks: the slip turns about 18 times
+    turns = []
+    real = ode._turns
+    monkeypatch.setattr(ode, "_turns", lambda *a, **k: turns.append(1) or real(*a, **k))
+    few = fl.simulate("dahl", d.scene, p, t=d.t, rtol=1e-8)
+    assert turns  # the slid form followed the turns, then gave up: mu_d's own rate from the phase's start
+    monkeypatch.setattr(memoryrhs, "MAX_TURNS", 100)
+    many = fl.simulate("dahl", d.scene, p, t=d.t, rtol=1e-8)  # every turn followed in the slid form
+    assert np.abs(few.v - many.v).max() < 1e-5 * np.abs(many.v).max()

@@ -46,8 +46,11 @@ def _normal(model):
     return None
 
 
-#: The most turns of the slip a Dahl phase follows in the slid form before it is integrated in mu_d instead.
-MAX_TURNS = 100
+#: The most turns of the slip a Dahl phase follows in the slid form before it is integrated in mu_d instead. The
+#: slid form pays where the slip keeps its sense (mu_d near +-mu_c, where |s|^alpha is not smooth); a slip that
+#: keeps turning is an oscillation about rest, mu_d well inside the bounds, where mu_d's own rate is smooth and
+#: one phase in ODEPACK costs less than a chain of phases stepped one turn at a time.
+MAX_TURNS = 8
 
 
 class Phase:
