@@ -134,3 +134,35 @@ def test_a_dahl_oscillation_past_max_turns_is_integrated_in_mu_d(monkeypatch):
     monkeypatch.setattr(memoryrhs, "MAX_TURNS", 100)
     many = fl.simulate("dahl", d.scene, p, t=d.t, rtol=1e-8)  # every turn followed in the slid form
     assert np.abs(few.v - many.v).max() < 1e-5 * np.abs(many.v).max()
+
+
+@pytest.mark.parametrize("law", ["rate-state-aging", "rate-state-slip"])
+def test_chatter_is_seen_early_with_the_same_error(monkeypatch, law):
+    from frictionlab.core.errors import SolverError
+    from frictionlab.solve.solvers import segments
+
+    d = fl.load_dataset("incline-oil-a100")
+    p = dict(mu0=0.3, a=0.01, b=0.012, Dc=1e-5)  # breaks away at once and sticks again within nanoseconds
+    seen = []
+    real = segments._chattering
+    monkeypatch.setattr(segments, "_chattering", lambda *a: seen.append(real(*a)) or seen[-1])
+    with pytest.raises(SolverError, match="chatter") as early:
+        fl.simulate(law, d.scene, p, t=d.t, rtol=1e-6)
+    assert any(seen) and len(seen) < segments.MAX_SEGMENTS / 4  # stopped long before the segment limit
+    monkeypatch.setattr(segments, "_chattering", lambda *a: False)  # the general rule: MAX_SEGMENTS segments
+    with pytest.raises(SolverError, match="chatter") as late:
+        fl.simulate(law, d.scene, p, t=d.t, rtol=1e-6)
+    assert str(early.value) == str(late.value)
+
+
+def test_a_short_stick_slip_burst_is_not_chatter():
+    from frictionlab.solve.solvers.segments import _chattering
+
+    y = np.array([0.0, 1.0])
+    fast = [(k * 1e-9, y) for k in range(10)]
+    assert _chattering(fast, 1.0, 180)
+    assert not _chattering(fast[:-2], 1.0, 180)  # too few cycles yet
+    moving = [(k * 1e-9, y * (1 + 1e-3 * k)) for k in range(10)]
+    assert not _chattering(moving, 1.0, 180)  # the state changes from cycle to cycle: it may break free
+    slow = [(k * 1e-3, y) for k in range(10)]
+    assert not _chattering(slow, 1.0, 180)  # at this pace the segments left might reach the end

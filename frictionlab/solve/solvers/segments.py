@@ -20,6 +20,11 @@ from ...physics.trajectory import Trajectory
 from . import stick
 
 MAX_SEGMENTS = 200
+#: Chatter seen early: CHATTER_CYCLES slides in a row, each begun by a stuck phase that broke away at once, that
+#: left the states as they were (to CHATTER_RTOL) and covered so little time that the segments left could not
+#: reach the end at CHATTER_MARGIN times that pace: the cycle repeats itself and the solve would end in the
+#: chatter error after MAX_SEGMENTS segments anyway, only later.
+CHATTER_CYCLES, CHATTER_RTOL, CHATTER_MARGIN = 8, 1e-6, 1e3
 COUNTERS = ("nfev", "njev", "nlu")  # solver statistics summed over segments
 
 
@@ -55,9 +60,10 @@ def _phases(plan, p, t_eval, slide, solver_name):
     stick_time = None
     phase, direction = _start(plan, p, T, y0)
     last_direction = direction or 1.0
+    cycles: list = []  # (time, state) where each slide began after a stuck phase that broke away at once
     while True:
         info["segments"] += 1
-        if info["segments"] > MAX_SEGMENTS:
+        if info["segments"] > MAX_SEGMENTS or _chattering(cycles, T, MAX_SEGMENTS - info["segments"]):
             raise SolverError(f"{solver_name}: slip changed between sliding and sticking more than "
                               f"{MAX_SEGMENTS} times (chatter); the law is not suited to this scene")
         todo = (~done) & (t_eval >= t0)
@@ -85,12 +91,23 @@ def _phases(plan, p, t_eval, slide, solver_name):
             if tb is None:
                 break
             ys, _ = stick.stuck_states(plan, np.array([tb]), t0, y0)
+            cycles = (cycles + [(tb, ys[:, 0])])[-CHATTER_CYCLES - 1:] if tb == t0 else []
             t0, y0 = tb, ys[:, 0]
             direction = stick.hold_direction(plan, last_direction)
             phase = "slide"
     if not done.all():
         raise SolverError(f"{solver_name}: solution ended at t = {t0:g} s before the last requested time {T:g} s")
     return Y, F, sliding, dirs, info, stick_time
+
+
+def _chattering(cycles, T: float, segments_left: int) -> bool:
+    """Whether the last CHATTER_CYCLES stick-slip cycles (``_phases``) repeat themselves too fast to reach T."""
+    if len(cycles) <= CHATTER_CYCLES:
+        return False
+    (t_old, y_old), (t_now, y_now) = cycles[-CHATTER_CYCLES - 1], cycles[-1]
+    pace = (t_now - t_old) / CHATTER_CYCLES  # time a cycle (two segments) covers
+    return (CHATTER_MARGIN * pace * max(segments_left, 0) / 2 < T - t_now
+            and bool(np.all(np.abs(y_now - y_old) <= CHATTER_RTOL * np.abs(y_old))))
 
 
 def _trajectory(plan, p, t_eval, Y, F, sliding, dirs, info, stick_time, solver_name):
