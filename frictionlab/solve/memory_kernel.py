@@ -129,7 +129,9 @@ def _slip(C, y):
 @jit
 def rhs(s, z, P, C, scale, V):
     """dz/ds of the scaled phase (time s = t / TSCALE, states z = y / scale) at one state vector; counts calls in
-    C[CALLS]: past C[MAXCALLS], or where a value is not finite, sets C[BAD] and returns NaN (the solver stops)."""
+    C[CALLS]: past C[MAXCALLS], where a value is not finite, or where a strict slid phase's slip turns, sets C[BAD]
+    and raises FloatingPointError, which stops the solver at once (ODEPACK steps on through NaN, accepting steps
+    whose error it cannot measure, to the end of the span)."""
     n = z.size
     out = np.empty(n)
     C[CALLS] += 1.0
@@ -137,8 +139,7 @@ def rhs(s, z, P, C, scale, V):
         if C[BAD] != TOO_MANY:
             C[STOP_T] = s * C[TSCALE]
         C[BAD] = TOO_MANY
-        out[:] = np.nan
-        return out
+        raise FloatingPointError("stopped: see C[BAD]")
     tsc = C[TSCALE]
     t = s * tsc
     y = z * scale
@@ -148,15 +149,13 @@ def rhs(s, z, P, C, scale, V):
     code = int(C[LAW])
     if code == DAHL_SLID and C[STRICT] and u * C[SENSE] < 0.0:
         C[BAD] = TURNED
-        out[:] = np.nan
-        return out
+        raise FloatingPointError("stopped: see C[BAD]")
     mu, _, _, rate, _, _ = law(code, P, C, u, y[il])
     F = N * mu
     if not (math.isfinite(F) and math.isfinite(rate)):
         if C[BAD] == 0.0:
             C[BAD] = NOT_FINITE
-        out[:] = np.nan
-        return out
+        raise FloatingPointError("stopped: see C[BAD]")
     iload = int(C[ILOAD])
     if iload >= 0:
         out[0] = (N * y[iload] - F) / C[MASS]

@@ -103,9 +103,12 @@ def _lsoda_loop(compiled, s0, s1, z0, s_eval, rtol, atol, label):
     times = np.concatenate([[s0], s_eval, [s1]])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        Z, info = scipy.integrate.odeint(compiled.kernel.rhs, np.asarray(z0, dtype=float), times,
-                                         args=compiled.args, Dfun=compiled.kernel.jac, tfirst=True, rtol=rtol,
-                                         atol=atol, tcrit=[s1], full_output=True, mxstep=MAX_NFEV)
+        try:
+            Z, info = scipy.integrate.odeint(compiled.kernel.rhs, np.asarray(z0, dtype=float), times,
+                                             args=compiled.args, Dfun=compiled.kernel.jac, tfirst=True, rtol=rtol,
+                                             atol=atol, tcrit=[s1], full_output=True, mxstep=MAX_NFEV)
+        except FloatingPointError:  # the kernel stopped (compiled.bad says why)
+            raise SolverError(f"{label}: the compiled right-hand side stopped") from None
     if info["message"] != "Integration successful.":
         raise SolverError(f"{label}: {info['message']}")
     used = {"nfev": int(info["nfe"][-1]), "njev": int(info["nje"][-1]), "nlu": int(info["nje"][-1])}
