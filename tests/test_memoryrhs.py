@@ -115,10 +115,13 @@ def test_a_law_error_still_comes_from_the_general_path():
 
 
 @pytest.mark.slow
-def test_lugre_fit_reaches_the_careful_minimum():
-    """The fit that stalled at chi-square 2626 ('does not fit') on the general path's search reaches < 93."""
-    r = fl.fit("lugre", "incline-oil-a100")
-    assert r.ok and r.stats.chisqr < 93.0
+@pytest.mark.parametrize("ds, careful", [("incline-oil-a100", 93.0), ("incline-oil-a400", 82.63)])
+def test_lugre_fit_reaches_the_careful_minimum(ds, careful):
+    """The fit that stalled at chi-square 2626 ('does not fit') on the general path's search reaches < 93; on
+    incline-oil-a400 the careful plain fit's minimum (82.63, benchmarks/plain_memory_fits.py) has bristles 3.3 decades
+    softer than the start, which only the widest grid of starts reaches."""
+    r = fl.fit("lugre", ds)
+    assert r.ok and r.stats.chisqr < careful
 
 
 def test_a_dahl_oscillation_past_max_turns_is_integrated_in_mu_d(monkeypatch):

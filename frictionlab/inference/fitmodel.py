@@ -330,10 +330,11 @@ def lmfit_leastsq(lmfit, model: _Model, slots, params, scale_covar: bool, budget
     return mini.minimize(method="leastsq", epsfcn=epsfcn(model), ftol=FTOL, xtol=FTOL)
 
 
-#: How many times the given number of start points a compiled law with memory scores (``compiled_memory``), and
-#: the decades either side of each positive parameter's start that the added points span.
+#: How many times the given number of start points a compiled law with memory scores on a finer and wider grid
+#: (``compiled_memory``; as many again on the widest), and the decades either side of each positive parameter's
+#: start that those grids span.
 MEMORY_SCAN = 4
-MEMORY_DECADES = 1.5
+MEMORY_DECADES = (1.5, 3.0)
 
 
 def compiled_memory(model: _Model) -> bool:
@@ -388,20 +389,24 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
         from .fitprogress import LM_EVALS
 
         lm = LM_EVALS * (len(varying) + 1)
-        k = scan * (MEMORY_SCAN if wide else 1)
+        k = scan * (MEMORY_SCAN + 1 if wide else 1)
         model.progress.stage("scanning start points", k, total=k + n_starts * lm + 2 * len(varying) + 2)
     if scan:
         fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
         grid = _start_grid(varying, np.random.default_rng(0), scan)
-        given = len(grid)
-        if wide and MEMORY_SCAN > 1:  # the same grid, and MEMORY_SCAN - 1 times as many on a finer and wider one
-            grid += _start_grid(varying, np.random.default_rng(1), (MEMORY_SCAN - 1) * scan, MEMORY_DECADES)[1:]
+        given = fine = len(grid)
+        if wide and MEMORY_SCAN > 1:  # the same grid, MEMORY_SCAN - 1 times as many on a finer and wider one, and
+            # as many as given on the widest (a start 3 decades off: LuGre's soft bristles on incline-oil-a400)
+            grid += _start_grid(varying, np.random.default_rng(1), (MEMORY_SCAN - 1) * scan, MEMORY_DECADES[0])[1:]
+            fine = len(grid)
+            grid += _start_grid(varying, np.random.default_rng(2), scan, MEMORY_DECADES[1])[1:]
         points = [{s.pname: vals[s.pname] * s.scale for s in slots} for vals in ({**fixed_part, **c} for c in grid)]
         scored = [(float(r @ r), i, c) for i, (r, c) in enumerate(zip(model.residuals(points), grid))]
         scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins
-        starts = _distinct(scored, min(n_starts, ODE_STARTS) if slow else n_starts)
-        if wide:  # and the best of the given grid alone, as a fit of a law without memory starts
+        starts = _distinct([x for x in scored if x[1] < fine], min(n_starts, ODE_STARTS) if slow else n_starts)
+        if wide:  # the best of the given grid alone, as a fit of a law without memory starts, and of the widest
             starts += [c for c in _distinct([x for x in scored if x[1] < given], n_starts) if c not in starts]
+            starts += [c for c in _distinct([x for x in scored if x[1] >= fine], n_starts) if c not in starts]
     best, notes = None, []
     for i, start in enumerate(starts):
         for k, v in start.items():  # every varying parameter; lmfit works on its own copy
