@@ -38,7 +38,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-
 import refunit
 
 SEED = 2033
@@ -148,6 +147,7 @@ def dask(args, folder: Path) -> None:
     files = make(args.dask, folder / "dask")
     print(f"\n{args.dask} datasets on a Dask LocalCluster (compare --scheduler; {args.repeat} repeats, order alternating):")
     walls: dict[int, list[float]] = {1: [], 2: []}
+    cpus: dict[int, list[list[float]]] = {1: [], 2: []}  # per run, each worker's CPU seconds
     for r in range(args.repeat):
         for w in ((1, 2) if r % 2 == 0 else (2, 1)):
             with distributed.LocalCluster(n_workers=w, threads_per_worker=1, processes=True,
@@ -159,6 +159,7 @@ def dask(args, folder: Path) -> None:
                 c1 = client.run(worker_cpu)
             per = [c1[k] - c0[k] for k in sorted(c0)]
             walls[w].append(wall)
+            cpus[w].append(per)
             print(f"  repeat {r + 1}, {w} worker{'s' * (w > 1)}: wall {wall:6.1f} s; CPU of the client {own:5.1f} s, of "
                   f"the workers {' + '.join(f'{x:.1f}' for x in per)} s; load average {os.getloadavg()[0]:.1f}",
                   flush=True)
@@ -167,6 +168,9 @@ def dask(args, folder: Path) -> None:
     print(f"RATIO wall 1 worker / 2 workers: median {statistics.median(ratios):.2f}x (repeats "
           f"{', '.join(f'{x:.2f}' for x in ratios)}; spread {spread}); target >= 1.6: "
           f"{'met' if statistics.median(ratios) >= 1.6 else 'not met'}; {refunit.load()}")
+    bound = [sum(a) / max(b) for a, b in zip(cpus[1], cpus[2])]
+    print(f"CPU: the 1-worker run's worker CPU over the busier of the 2 workers' (the wall ratio 2 free cores would "
+          f"give, the client aside): median {statistics.median(bound):.2f}x (repeats {', '.join(f'{x:.2f}' for x in bound)})")
 
 
 def main(argv=None) -> None:

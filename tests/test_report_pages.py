@@ -46,7 +46,7 @@ def test_restrict_keeps_one_group(comparison):
 
 
 def test_a_figure_on_several_pages_is_drawn_once(comparison, tmp_path, monkeypatch):
-    import frictionlab.report as report
+    from frictionlab import report
 
     drawn = []
 
