@@ -75,10 +75,11 @@ def stages(r: dict) -> dict:
     return out
 
 
-def measured_share(res: dict) -> tuple[float, float]:
-    """(CPU seconds of the fits on measured datasets, of all fits)."""
-    kinds = {d["name"]: (d.get("provenance") or {}).get("kind") for d in res.get("datasets", [])}
-    cpu = [(f.get("cpu_time_s") or 0.0, kinds.get(f["dataset"]) == "measured") for f in res["fits"]]
+def measured_share(res: dict, kinds=None) -> tuple[float, float]:
+    """(CPU seconds of the fits on measured datasets (of the dataset ``kinds``; None: any), of all fits)."""
+    mine = {d["name"] for d in res.get("datasets", []) if (d.get("provenance") or {}).get("kind") == "measured"
+            and (kinds is None or d.get("kind") in kinds)}
+    cpu = [(f.get("cpu_time_s") or 0.0, f["dataset"] in mine) for f in res["fits"]]
     return sum(c for c, m in cpu if m), sum(c for c, _ in cpu)
 
 
@@ -112,11 +113,13 @@ def main() -> None:
     print("  figures by kind (last run): " + ", ".join(f"{k} {last['figures'][k]:.2f} s ({last['figure counts'][k]})"
                                                       for k in kinds))
     res = runs[-1]["results"]
-    measured = [d["name"] for d in res.get("datasets", []) if (d.get("provenance") or {}).get("kind") == "measured"]
-    rec, _ = measured_share(res)
-    figs = sum(v for name, v in last["figure by name"].items() if any(m in name for m in measured))
-    print(f"  the measured records ({', '.join(measured) or 'none'}): their fits {rec:.2f} CPU s and the figures named "
-          f"after them {figs:.2f} s, {100 * (rec + figs) / last['total'] if last['total'] else 0:.1f}% of the run's CPU")
+    for what, kinds in (("the measured datasets", None), ("the measured velocity-step records", ("spring-slider",))):
+        measured = [d["name"] for d in res.get("datasets", []) if (d.get("provenance") or {}).get("kind") == "measured"
+                    and (kinds is None or d.get("kind") in kinds)]
+        rec, _ = measured_share(res, kinds)
+        figs = sum(v for name, v in last["figure by name"].items() if any(m in name for m in measured))
+        print(f"  {what} ({', '.join(measured) or 'none'}): their fits {rec:.2f} CPU s and the figures named after "
+              f"them {figs:.2f} s, {100 * (rec + figs) / last['total'] if last['total'] else 0:.1f}% of the run's CPU")
     print()
     print("where the time goes (wall s of each stage; with --jobs 1 on an idle machine wall is CPU):")
     names = list(dict.fromkeys(k for r in runs for k in stages(r)))
