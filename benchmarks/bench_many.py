@@ -15,7 +15,8 @@ they are not data.
 1. Per size: ``frictionlab compare --data FILES --out DIR --jobs 1`` in a fresh process (the default
    comparison: the four default laws, equivalence tests, transfer, what accuracy costs, bootstrap 150,
    the report), its CPU seconds (user + system, with its children) over the number of datasets, and that
-   over the unit (``refunit.unit()``, 1000 plain solve_ivp solves) measured right before and after.
+   over the unit (``refunit.unit()``, 1000 plain solve_ivp solves) measured right before and after, and
+   where it went a dataset at a time (``stage_cpu.py``: imports, each stage, figures, the rest).
    Target: at most 1 CPU s a dataset.
 2. With ``--dask N``: the same comparison of N of them on a LocalCluster of 1 and of 2 worker processes
    (``compare --scheduler ADDRESS``; the cluster started and its workers prepared before the clock starts,
@@ -102,13 +103,25 @@ def children_cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def run_compare(files, out: Path, extra=()) -> tuple[float, float]:
-    """(wall, CPU seconds with children) of one ``frictionlab compare`` in a fresh process."""
+def run_compare(files, out: Path, extra=(), parts: Path | None = None) -> tuple[float, float]:
+    """(wall, CPU seconds with children) of one ``frictionlab compare`` in a fresh process; with ``parts``, run
+    through ``stage_cpu.py``, which writes there where the CPU went."""
     exe = shutil.which("frictionlab", path=os.path.dirname(sys.executable)) or "frictionlab"
+    head = [exe] if parts is None else [sys.executable, str(Path(__file__).with_name("stage_cpu.py")), str(parts)]
     c0, w0 = children_cpu(), time.perf_counter()
-    subprocess.run([exe, "compare", "--data", *map(str, files), "--out", str(out), "--force", "--quiet", *extra],
+    subprocess.run([*head, "compare", "--data", *map(str, files), "--out", str(out), "--force", "--quiet", *extra],
                    check=True, stdout=subprocess.DEVNULL)
     return time.perf_counter() - w0, children_cpu() - c0
+
+
+def said(parts_file: Path, n: int) -> str:
+    """Where one run's CPU went, a dataset at a time (``stage_cpu.py``'s parts)."""
+    import json
+
+    p = json.loads(parts_file.read_text())
+    rows = {"imports": p["imports"], **p["stages"], "figures": sum(p["figures"].values())}
+    rows["the rest"] = p["total"] - sum(rows.values())
+    return ", ".join(f"{k} {v / n:.2f}" for k, v in rows.items() if v / n >= 0.005)
 
 
 def sizes(args, folder: Path) -> None:
@@ -116,12 +129,13 @@ def sizes(args, folder: Path) -> None:
     for n in args.sizes:
         files = make(n, folder / f"data{n}")
         before = refunit.unit()
-        wall, cpu = run_compare(files, folder / f"report{n}", ["--jobs", "1"])
+        wall, cpu = run_compare(files, folder / f"report{n}", ["--jobs", "1"], folder / f"parts{n}.json")
         after = refunit.unit()
         unit = 0.5 * (before + after)
         print(f"  {n:4d} datasets: CPU {cpu:7.1f} s, {cpu / n:5.2f} CPU s a dataset ({cpu / n / unit:5.2f} units; "
               f"unit {before:.2f} before, {after:.2f} after); wall {wall:6.1f} s; target <= 1 CPU s a dataset: "
               f"{'met' if cpu / n <= 1.0 else 'not met'}; {refunit.load()}", flush=True)
+        print(f"        CPU s a dataset by part: {said(folder / f'parts{n}.json', n)}", flush=True)
         if args.keep and n == args.sizes[-1]:
             shutil.copytree(folder / f"report{n}", args.keep, dirs_exist_ok=True)
 
