@@ -48,6 +48,8 @@ from pathlib import Path
 import attrs
 import numpy as np
 
+from frictionlab.inference.ranking_bootstrap import wilson  # 95% Wilson score interval
+
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 TRUTH = {"wear": {"lam": 1.2e6}, "area-rate": {"mu": 0.12, "eta_prime": 8000.0}}
@@ -205,15 +207,6 @@ def _refits_exact(truth: str, sigma: float) -> float:
                 full = fit(law, tg, checks=False, errors=False).stats.chisqr
                 worst = max(worst, abs(warm - full))
     return worst
-
-
-def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
-    if n == 0:
-        return math.nan, math.nan
-    p = k / n
-    c = (p + z * z / (2 * n)) / (1 + z * z / n)
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return c - h, c + h
 
 
 def _pct(row: dict, key: str) -> str:

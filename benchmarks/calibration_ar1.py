@@ -30,6 +30,8 @@ from pathlib import Path
 import attrs
 import numpy as np
 
+from frictionlab.inference.ranking_bootstrap import wilson  # 95% Wilson score interval
+
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import velstep_records  # noqa: E402
 
@@ -96,16 +98,6 @@ def replicate(ds, curve, correlation: str, phi: float, seed: int):
         covered[name] = p.stderr is not None and abs(p.value - value) <= 1.959964 * p.stderr
     phis = [p.value for p in f.params.values() if p.kind == "noise"]
     return covered, f.goodness.fits, phis[0] if phis else math.nan
-
-
-def wilson(k: int, n: int) -> tuple[float, float]:
-    if n == 0:
-        return math.nan, math.nan
-    z = 1.959964
-    p = k / n
-    c = (p + z * z / (2 * n)) / (1 + z * z / n)
-    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return c - h, c + h
 
 
 def run(n: int, phis, seed: int = 0, quick: bool = False, models=("ar1", "none")) -> list[dict]:

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from _fit_helpers import TC, TRUTH, impact_scene, incline_scene, synthetic
 
-from frictionlab import analyze_equivalence, fit
+from frictionlab import analyze_equivalence, compare, fit
 from frictionlab.inference.equivalence import BOTH_FAIL, CANNOT, CRITICAL, DIFFERENT, WITHIN, decomposition
 
 R = 100  # the most replicates per law (sequential: clear cases stop at 20 or 60)
@@ -264,3 +264,13 @@ def test_a_report_adjusts_every_hypothesis_as_one_family(coulomb_data):
     assert "adjusted p = 0.096" in out[2].explanation
     per_group = adjust_family([e, same, borderline], "group", {e.dataset: "g1", same.dataset: "g1", "other": "g2"})
     assert per_group[2].verdict == DIFFERENT and "per-group rule" in per_group[0].family
+
+
+def test_the_golf_coulomb_against_exact_wear_pair_gets_no_p_value():
+    """On the paper's golf impact both Coulomb and exact wear miss the four stated numbers: the pair is not
+    tested (no p-value, no replicates), its misfits are compared."""
+    c = compare(laws=["coulomb", "wear"], datasets=["impact-golf-v28"], pairs=[("coulomb", "wear")], bootstrap=0,
+                transfer=False, replicates=40)
+    (e,) = c.equivalence
+    assert e.verdict == BOTH_FAIL and not e.tested and math.isnan(e.p)
+    assert e.explanation.startswith("No test: coulomb [exact] and wear [exact] both fail their own fit tests")

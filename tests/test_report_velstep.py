@@ -43,6 +43,18 @@ def test_each_measured_step_has_its_table_row_and_figure(comp):
     assert "trend" in fig.side  # what the fit says about the sign of a - b, beside the figure
 
 
+def test_a_velocity_step_first_screen_speaks_of_its_own_data(comp):
+    sections, _ = build(comp, modules=[first_screen])
+    md = markdown("t", sections)
+    assert "λAu" not in md and "paper" not in md and "series" not in md  # no word of the impact paper's questions
+    # the measured step has its block; the synthetic one is left to the generic figure, which draws it alone
+    from frictionlab.report.data_view import group_views
+
+    views = group_views(comp, first_screen.series_findings(comp), skip={"lab-step"})
+    assert [v.dataset.name for v in views] == ["spring-slider-small-step"]
+    assert any(b[0] == "fig" and b[1].name == "finding.png" for s in sections for b in s.blocks)
+
+
 def test_the_figure_table_gives_intervals_in_laboratory_units(comp):
     from frictionlab.report.figures.velstep import _table_text
 

@@ -62,7 +62,9 @@ class SolverCost:
 
 
 def _timed(law, target, params, solver, scene, rtol) -> tuple[np.ndarray, float]:
-    """(prediction, CPU seconds per prediction) over at least MIN_TIME seconds of repeats."""
+    """(prediction, CPU seconds per prediction) over at least MIN_TIME seconds of repeats, after one untimed
+    prediction (a first call may compile a kernel or fill a cache: a one-time cost, not the solver's)."""
+    predict(law, target, params, solver, scene=scene, rtol=rtol)
     start, n = time.thread_time(), 0
     while True:
         y = predict(law, target, params, solver, scene=scene, rtol=rtol)

@@ -64,6 +64,7 @@ class Quantity:
     high: float
     unit: str
     held: bool = False  # held by the caller or the dataset (no interval: not fitted)
+    bound: str = ""  # 'lower' | 'upper' where the fit ended at that bound (no interval: the bound's value)
 
     @property
     def digits(self) -> int:
@@ -72,10 +73,15 @@ class Quantity:
             return 4
         return max(4, min(10, math.ceil(math.log10(abs(self.value) / self.stderr)) + 2))
 
+    @property
+    def missing(self) -> str:
+        """Why there is no interval: 'held', 'at its lower bound', 'at its upper bound' or 'no interval'."""
+        return "held" if self.held else f"at its {self.bound} bound" if self.bound else "no interval"
+
     def text(self) -> str:
         unit = f" {self.unit}" if self.unit else ""
         if self.stderr is None:
-            return f"{self.value:.4g}{unit} ({'held' if self.held else 'no interval'})"
+            return f"{self.value:.4g}{unit} ({self.missing})"
         d = self.digits
         return f"{self.value:.{d}g} ± {self.stderr:.2g}{unit} [{self.low:.{d}g}, {self.high:.{d}g}]"
 
@@ -284,8 +290,8 @@ NO_EFFECT = {"Dc": "b = 0, so the state does not enter the friction", "k": "no s
 def _with_meaning(warning: str, meanings: dict) -> str:
     """A generic identifiability warning with what it means on velocity-step data."""
     for name, text in meanings.items():
-        if warning.startswith(f"{name} is at"):  # the generic sentence's head, then what it means here
-            return f"{warning.split(': ', 1)[0]}: {text}"
+        if warning.startswith(f"{name} is at"):  # what it means here, naming the bound once
+            return text if text.startswith(f"{name} at") else f"{warning.split(': ', 1)[0]}: {text}"
         if text and warning.startswith(f"{name} has no effect"):
             return f"{name} has no effect on the prediction near the best fit ({text})"
     return warning
@@ -403,15 +409,13 @@ def _params(problem, x, v, pieces, free, cov, at_bound, errors) -> tuple[dict, d
     for s in problem.series:
         suffix = f"[{s.target.name}]" if multi else ""
         q = quantities[s.target.name]
-        q["a"] = _quantity(params["a"], 1.0, "")
-        q["b"] = _quantity(params["b"], 1.0, "")
-        q["a-b"] = _quantity(params["a-b"], 1.0, "")
-        q["Dc"] = _quantity(params["Dc"], 1 / UM, "um", log=True)
         kname = next(p.name for p in problem.params if p.key == "k" and p.target == s.index)
-        q["k"] = _quantity(params[kname], UM, "1/um", log=True)
-        q["mu0"] = _quantity(params["mu0" + suffix], 1.0, "")
-        if s.trend:
-            q["trend"] = _quantity(params["trend" + suffix], UM, "1/um")
+        for key, name, factor, unit in (("a", "a", 1.0, ""), ("b", "b", 1.0, ""), ("a-b", "a-b", 1.0, ""),
+                                        ("Dc", "Dc", 1 / UM, "um"), ("k", kname, UM, "1/um"),
+                                        ("mu0", "mu0" + suffix, 1.0, ""), ("trend", "trend" + suffix, UM, "1/um")):
+            if key != "trend" or s.trend:
+                q[key] = _quantity(params[name], factor, unit, log=key in ("Dc", "k"),
+                                   bound=at_bound[name][1] if name in at_bound else "")
     return params, correl, quantities
 
 
@@ -419,13 +423,14 @@ def law_unit(law, key: str) -> str:
     return law.spec(key).unit
 
 
-def _quantity(p: ParamResult, factor: float, unit: str, log: bool = False) -> Quantity:
-    """A ParamResult in a display unit (factor from SI), with its 95% interval (log-normal for Dc and k)."""
+def _quantity(p: ParamResult, factor: float, unit: str, log: bool = False, bound: str = "") -> Quantity:
+    """A ParamResult in a display unit (factor from SI), with its 95% interval (log-normal for Dc and k);
+    ``bound``: the side of the bound the fit ended at, if any."""
     v = p.value * factor
     if not p.vary and p.kind != "derived":
         return Quantity(v, None, math.nan, math.nan, unit, held=True)
-    if p.stderr is None:
-        return Quantity(v, None, math.nan, math.nan, unit)
+    if p.stderr is None or bound:
+        return Quantity(v, None, math.nan, math.nan, unit, bound=bound)
     e = p.stderr * factor
     if log and v > 0:
         f = math.exp(1.959964 * e / v)

@@ -23,7 +23,7 @@ import numpy as np
 from ..core.display import fmt_time
 from ..inference.accuracy import COMMAND as ACCURACY_COMMAND
 from ..inference.answers import group_of, unfitted
-from ..inference.equivalence import sentence
+from ..inference.equivalence import AREA_RATE, COULOMB, COUETTE, WEAR, sentence
 from ..solve.solvers.series import slip_zero
 from . import figures, velstep
 from .data_view import describe, group_views, spin_falls
@@ -94,8 +94,9 @@ ABSENT = {"best": "a best law", "goodness": "a goodness-of-fit test",
           "transfer": "one parameter set across conditions (no group of two or more datasets)"}
 
 
-def _answer_table(sec: Section, answers):
-    """The verdict table: groups without a fitted law fold into one line under it, columns without data go."""
+def _answer_table(sec: Section, answers, laws=()):
+    """The verdict table: groups without a fitted law fold into one line under it, columns without data go
+    (named in one line where they could apply to ``laws``, the laws compared)."""
     shown = [a for a in answers if a.best is not None]
     cols = [(key, head) for key, head in COLUMNS if any(a.cell(key) not in ("", "not tested") for a in shown)]
     rows, notes = [], []
@@ -109,9 +110,19 @@ def _answer_table(sec: Section, answers):
     if rows:
         sec.table(["dataset group"] + [h for _, h in cols], rows)
         sec.more("Each verdict in full (datasets, tests, p-values, thresholds per dataset)", notes)
-    absent = [ABSENT[key] for key, _ in COLUMNS if key not in dict(cols)]
+    absent = [ABSENT[key] for key, _ in COLUMNS if key not in dict(cols) and _could_apply(key, laws)]
     if shown and absent:
         sec.p("Not in this comparison: " + "; ".join(absent) + ".")
+
+
+def _could_apply(key: str, laws) -> bool:
+    """Whether a column absent from the verdict table is worth naming: the paper's pair and the truncated series
+    only where the paper's laws were compared."""
+    if key in ("equivalence", "threshold"):
+        return {WEAR, AREA_RATE} <= set(laws)
+    if key == "series":
+        return bool({WEAR, AREA_RATE, COULOMB, COUETTE} & set(laws))
+    return True
 
 
 def _unfitted(sec: Section, answers):
@@ -198,7 +209,7 @@ def build(ctx) -> Section:
     if c.answers:
         if note:
             sec.warn(note)
-        _answer_table(sec, c.answers)
+        _answer_table(sec, c.answers, {f.law for f in c.fits})
     else:
         sec.warn(note + "The verdict layer gave no answers for this comparison (`Comparison.answers` is empty): no "
                  "law is declared to fit, and no goodness-of-fit test is shown. "

@@ -29,7 +29,7 @@ def cell(q) -> str:
     if q is None:
         return "—"
     if q.stderr is None:
-        return f"{q.value:.3g} ({'held' if q.held else 'no interval'})"
+        return f"{q.value:.3g} ({q.missing})"
     return f"{q.value:.{q.digits - 1}g} ± {q.stderr:.2g}"
 
 

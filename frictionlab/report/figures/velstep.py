@@ -73,7 +73,7 @@ def _table_text(fit) -> str:
             continue
         unit = f" {q.unit.replace('um', 'µm')}" if q.unit else ""
         if q.stderr is None:
-            lines.append(f"{name:<6}{q.value:.4g}{unit}  ({'held' if q.held else 'no interval'})")
+            lines.append(f"{name:<6}{q.value:.4g}{unit}  ({q.missing})")
         else:
             d = q.digits
             lines.append(f"{name:<6}{q.value:.{d}g} ± {q.stderr:.2g}{unit}")
