@@ -129,7 +129,7 @@ def main() -> None:
         print(f"  {k:22s} {statistics.median(vals):7.2f} s  ({100 * statistics.median(vals) / total:4.1f}% of the wall "
               f"time; runs: {', '.join(f'{v:.2f}' for v in vals)})")
     rec, fits_cpu = measured_share(runs[-1]["results"])
-    print(f"  fits on measured datasets (the records): {rec:.2f} CPU s of the fits' {fits_cpu:.2f} "
+    print(f"  fits on measured datasets: {rec:.2f} CPU s of the fits' {fits_cpu:.2f} "
           f"({100 * rec / fits_cpu if fits_cpu else 0:.1f}%)")
     print()
     for i, r in enumerate(runs):
