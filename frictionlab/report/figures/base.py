@@ -184,9 +184,10 @@ THIN_BINS = 1000
 def thinned(t, *series) -> np.ndarray:
     """Indices of the points of a long series that a figure needs to look as the whole does: all of them up to
     THIN_AT points; beyond, in each of THIN_BINS equal spans of ``t`` (sorted), the first and last point and
-    those where each of ``series`` (arrays over ``t``) is lowest and highest. Lines through these points
-    cover the same pixels as through every point (M4: Jugel et al., PVLDB 7, 2014); markers and error bars
-    at each column's extremes reach where the whole cloud does."""
+    those where each of ``series`` (arrays over ``t``) is lowest and highest (M4: Jugel et al., PVLDB 7,
+    2014). With more columns than pixels, lines through these points cover the pixels that lines through every
+    point do, to within a pixel; markers and error bars at each column's extremes reach where the whole cloud
+    does."""
     n = len(t)
     if n <= THIN_AT:
         return np.arange(n)
