@@ -26,10 +26,17 @@ def test_size_of_the_equivalence_test_is_at_most_8_percent(truth, noise):
 @pytest.mark.parametrize("noise", ["known", "estimated"])
 @pytest.mark.parametrize("margin", [1.0, 0.25])
 def test_equivalent_within_the_margin_is_rarely_said_where_the_curves_differ_by_the_margin(truth, noise, margin):
-    """At the boundary of its null (the curves' distance equal to the margin) 'equivalent within delta', and the
-    distance's bound below delta alone, are said in at most 8% of 200 datasets (nominally at most 5%)."""
+    """At the boundary of its null (the curves' distance equal to the margin) 'equivalent within delta' is said in
+    at most 8% of 200 datasets (nominally at most 5%); at the default margin the distance's bound alone too. Below
+    MIN_MARGIN the bound is not calibrated (it was below delta in about 20% there) and the claim is withheld."""
     import calibration
+
+    from frictionlab.inference.equivalence import MIN_MARGIN
 
     (row,) = calibration.run(200, [truth], [noise], ["boundary"], jobs=2, seed=2, margin=margin)
     assert row["d_delta"] == pytest.approx(1.0)
-    assert row["eq"] <= 0.08 and row["bound"] <= 0.08, row
+    assert row["eq"] <= 0.08, row
+    if margin >= MIN_MARGIN:
+        assert row["bound"] <= 0.08, row
+    else:
+        assert row["eq"] == 0.0, row

@@ -80,6 +80,8 @@ def test_verdict_follows_the_noise_and_the_margin(coulomb_data):
     assert f.verdict == WITHIN and f.upper < f.margin, f.explanation
     assert max(f.power_a, f.power_b) < 0.5
     assert f.threshold == pytest.approx(e.threshold, rel=0.05)  # a property of the two curves, not of sigma
+    below = analyze_equivalence(fa, fb, replicates=R, margin=0.5)  # tighter than MIN_MARGIN: not calibrated
+    assert below.upper < below.margin and below.verdict == CANNOT and "not calibrated" in below.explanation
     tight = analyze_equivalence(fa, fb, replicates=R, margin=0.01)
     assert tight.verdict == CANNOT and tight.upper > tight.margin and tight.p_within >= 0.05, tight.explanation
     rpm = 2 * math.pi / 60
