@@ -3,8 +3,10 @@
     python benchmarks/bench_compare.py [--repeat R] [--jobs J] [--keep DIR]
 
 Runs README command 1 as a user does: ``frictionlab compare --out DIR --force`` in a fresh process (every
-default law on every built-in dataset, the equivalence tests, the bootstrap, the report written). Its first
-output is where the time went, stage by stage: each stage's wall time as ``results.json`` records it (fits,
+default law on every built-in dataset, the equivalence tests, the bootstrap, the report written), through
+``stage_cpu.py``, which counts the process's CPU time by part. Its first output is where the CPU went: the
+start-up imports, each stage, the report's figures (by kind) and the rest, with the measured records' share
+(their fits and the figures named after them); then each stage's wall time as ``results.json`` records it (fits,
 rank, equivalence, transfer, bootstrap, answer; with ``--jobs 1`` wall time is CPU time), the report and
 start-up (the rest of the process's wall time), and the share of the fits on measured datasets (the
 records). Then the run's wall and CPU time (the process and its workers, user + system), the slowest fits, and
@@ -40,13 +42,29 @@ def children_cpu() -> float:
 
 
 def run_compare(out: Path, jobs: int | None = None) -> dict:
-    exe = shutil.which("frictionlab", path=os.path.dirname(sys.executable)) or "frictionlab"
+    """One ``frictionlab compare`` in a fresh process (``stage_cpu.py``: the command line, its CPU counted by part)."""
+    fd, name = tempfile.mkstemp(suffix=".json", prefix="cpu-parts-")
+    os.close(fd)
+    parts_file = Path(name)
     c0, w0 = children_cpu(), time.perf_counter()
-    subprocess.run([exe, "compare", "--out", str(out), "--force"] + (["--jobs", str(jobs)] if jobs else []),
-                   check=True, stdout=subprocess.DEVNULL)
+    subprocess.run([sys.executable, str(Path(__file__).with_name("stage_cpu.py")), str(parts_file), "compare", "--out",
+                    str(out), "--force"] + (["--jobs", str(jobs)] if jobs else []), check=True, stdout=subprocess.DEVNULL)
     wall, cpu = time.perf_counter() - w0, children_cpu() - c0
     res = json.loads((out / "results.json").read_text())
-    return {"wall": wall, "cpu": cpu, "results": res}
+    parts = json.loads(parts_file.read_text())
+    parts_file.unlink()
+    return {"wall": wall, "cpu": cpu, "results": res, "parts": parts}
+
+
+def cpu_parts(r: dict) -> dict:
+    """CPU seconds of each part of one run (with --jobs 1 every part ran in the one process): imports, each
+    stage, the figures, and the rest (reading the datasets, planning, the report's text)."""
+    p = r["parts"]
+    out = {"start-up imports": p["imports"]}
+    out.update({f"stage {k}": v for k, v in p["stages"].items()})
+    out["report figures"] = sum(p["figures"].values())
+    out["datasets, planning, report text"] = p["total"] - sum(out.values())
+    return out
 
 
 def stages(r: dict) -> dict:
@@ -57,10 +75,11 @@ def stages(r: dict) -> dict:
     return out
 
 
-def measured_share(res: dict) -> tuple[float, float]:
-    """(CPU seconds of the fits on measured datasets, of all fits)."""
-    kinds = {d["name"]: (d.get("provenance") or {}).get("kind") for d in res.get("datasets", [])}
-    cpu = [(f.get("cpu_time_s") or 0.0, kinds.get(f["dataset"]) == "measured") for f in res["fits"]]
+def measured_share(res: dict, kinds=None) -> tuple[float, float]:
+    """(CPU seconds of the fits on measured datasets (of the dataset ``kinds``; None: any), of all fits)."""
+    mine = {d["name"] for d in res.get("datasets", []) if (d.get("provenance") or {}).get("kind") == "measured"
+            and (kinds is None or d.get("kind") in kinds)}
+    cpu = [(f.get("cpu_time_s") or 0.0, f["dataset"] in mine) for f in res["fits"]]
     return sum(c for c, m in cpu if m), sum(c for c, _ in cpu)
 
 
@@ -83,7 +102,26 @@ def main() -> None:
         after = refunit.unit()
         r.update(before=before, after=after, unit=0.5 * (before + after), load=refunit.load())
         runs.append(r)
-    print("where the time goes (wall s of each stage; with --jobs 1 wall is CPU):")
+    print("where the CPU goes (CPU s of this process, user + system; with --jobs 1 that is all of it):")
+    for k in dict.fromkeys(k for r in runs for k in cpu_parts(r)):
+        vals = [cpu_parts(r).get(k, 0.0) for r in runs]
+        total = statistics.median([r["parts"]["total"] for r in runs])
+        print(f"  {k:34s} {statistics.median(vals):7.2f} s  ({100 * statistics.median(vals) / total:4.1f}%; runs: "
+              f"{', '.join(f'{v:.2f}' for v in vals)})")
+    last = runs[-1]["parts"]
+    kinds = sorted(last["figures"], key=lambda k: -last["figures"][k])
+    print("  figures by kind (last run): " + ", ".join(f"{k} {last['figures'][k]:.2f} s ({last['figure counts'][k]})"
+                                                      for k in kinds))
+    res = runs[-1]["results"]
+    for what, kinds in (("the measured datasets", None), ("the measured velocity-step records", ("spring-slider",))):
+        measured = [d["name"] for d in res.get("datasets", []) if (d.get("provenance") or {}).get("kind") == "measured"
+                    and (kinds is None or d.get("kind") in kinds)]
+        rec, _ = measured_share(res, kinds)
+        figs = sum(v for name, v in last["figure by name"].items() if any(m in name for m in measured))
+        print(f"  {what} ({', '.join(measured) or 'none'}): their fits {rec:.2f} CPU s and the figures named after "
+              f"them {figs:.2f} s, {100 * (rec + figs) / last['total'] if last['total'] else 0:.1f}% of the run's CPU")
+    print()
+    print("where the time goes (wall s of each stage; with --jobs 1 on an idle machine wall is CPU):")
     names = list(dict.fromkeys(k for r in runs for k in stages(r)))
     for k in names:
         vals = [stages(r).get(k, 0.0) for r in runs]
@@ -91,7 +129,7 @@ def main() -> None:
         print(f"  {k:22s} {statistics.median(vals):7.2f} s  ({100 * statistics.median(vals) / total:4.1f}% of the wall "
               f"time; runs: {', '.join(f'{v:.2f}' for v in vals)})")
     rec, fits_cpu = measured_share(runs[-1]["results"])
-    print(f"  fits on measured datasets (the records): {rec:.2f} CPU s of the fits' {fits_cpu:.2f} "
+    print(f"  fits on measured datasets: {rec:.2f} CPU s of the fits' {fits_cpu:.2f} "
           f"({100 * rec / fits_cpu if fits_cpu else 0:.1f}%)")
     print()
     for i, r in enumerate(runs):

@@ -43,3 +43,35 @@ def test_restrict_keeps_one_group(comparison):
     assert [d.name for d in r.datasets] == ["impact-golf-v28"]
     assert {f.datasets for f in r.fits} == {("impact-golf-v28",)} and {a.group for a in r.answers} == {"impact-golf"}
     assert all(e.dataset == "impact-golf-v28" for e in r.equivalence)
+
+
+def test_a_figure_on_several_pages_is_drawn_once(comparison, tmp_path, monkeypatch):
+    from frictionlab import report
+
+    drawn = []
+
+    def draw():
+        import io
+
+        import matplotlib.figure
+
+        drawn.append(1)
+        buf = io.BytesIO()
+        matplotlib.figure.Figure(figsize=(1, 1)).savefig(buf, format="png")
+        return buf.getvalue()
+
+    pages_of = report._pages
+
+    def with_shared(c, extra):  # every page shows one picture (one key), as the index and a group page can
+        for path, sections, figdir in pages_of(c, extra):
+            sections[0].fig("shared.png", "one picture on every page", draw, key=("shared", 1))
+            yield path, sections, figdir
+
+    monkeypatch.setattr(pages, "GROUP_PAGES_AT", 2)
+    monkeypatch.setattr(report, "_pages", with_shared)
+    out = write_report(comparison, tmp_path / "r")
+    assert len(drawn) == 1
+    folders = ["figures"] + [f"figures/{g}" for g in pages.groups_of(comparison)]
+    assert all((out / f / "shared.png").read_bytes() == (out / "figures" / "shared.png").read_bytes() for f in folders)
+    for html in [out / "report.html", *(out / "groups").glob("*.html")]:
+        assert "one picture on every page" in html.read_text()

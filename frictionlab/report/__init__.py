@@ -206,27 +206,36 @@ def write_report(c: Comparison, out: str | os.PathLike, force: bool = False,
     # full collection would walk the comparison too (about 0.2 of the default report's 4 CPU s)
     with atomic_dir(out, force=force) as tmp, long_run_gc():
         built, figs, extra = [], [], {}
+        same: dict = {}  # a figure's key -> the index in figs of the first figure drawn with it
+        copies = collections.defaultdict(list)  # index in figs -> (page, figure) of the others with its key
 
         def figures():  # page by page as each is built: a cluster draws a page's figures while the next is built
             for page in _pages(c, extra):
                 built.append(page)
                 for sec in page[1]:
                     for f in sec.figures:
+                        if f.key is not None and f.key in same:  # drawn once for every page that shows it
+                            copies[same[f.key]].append((len(built) - 1, f))
+                            continue
+                        if f.key is not None:
+                            same[f.key] = len(figs)
                         figs.append((len(built) - 1, f))
                         yield f
             missing.update(k for k, _ in figs)
+            missing.update(k for more in copies.values() for k, _ in more)
             _write_texts(tmp, c, built, extra)  # every page built: while a pool or cluster draws the last figures
 
         images, missing = {}, collections.Counter()  # missing: per page, how many of its figures are still to come
         for done, (i, png) in enumerate(_drawn(figures(), jobs, client), 1):  # every page is built by now
-            k, f = figs[i]
-            figdir = built[k][2]
-            images[(figdir, f.name)] = png
-            (tmp / figdir).mkdir(parents=True, exist_ok=True)
-            (tmp / figdir / f.name).write_bytes(png)
-            missing[k] -= 1
-            if not missing[k]:  # the page's last figure: its HTML now, while the others are drawn
-                _write_html(tmp, built[k], images)
+            for k, f in [figs[i]] + copies[i]:
+                figdir = built[k][2]
+                images[(figdir, f.name)] = png
+                (tmp / figdir).mkdir(parents=True, exist_ok=True)
+                (tmp / figdir / f.name).write_bytes(png)
+                missing[k] -= 1
+                if not missing[k]:  # the page's last figure: its HTML now, while the others are drawn
+                    _write_html(tmp, built[k], images)
+            f = figs[i][1]
             if progress:
                 progress(done, len(figs) + 1, f"figure {f.name}")
         (tmp / "figures").mkdir(exist_ok=True)

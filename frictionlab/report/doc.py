@@ -49,6 +49,7 @@ class Figure:
     caption: str
     draw: Callable[[], bytes]
     side: str = ""  # text shown beside the figure in HTML (before it in Markdown)
+    key: object = None  # figures of one report with one (hashable) key are the same picture: drawn once
 
 
 @attrs.define
@@ -100,10 +101,11 @@ class Section:
         if items:
             self.blocks.append(("links", items))
 
-    def fig(self, name: str, caption: str, draw: Callable[[], bytes], side: str = ""):
+    def fig(self, name: str, caption: str, draw: Callable[[], bytes], side: str = "", key: object = None):
         """A figure file ``name`` (characters other than letters, digits, '.', '-' and '_' become '_'),
-        optionally with a text ``side`` shown beside it."""
-        self.blocks.append(("fig", Figure(re.sub(r"[^A-Za-z0-9._-]", "_", name), caption, draw, side)))
+        optionally with a text ``side`` shown beside it; ``key``: one picture on several pages of a report
+        (the same key) is drawn once."""
+        self.blocks.append(("fig", Figure(re.sub(r"[^A-Za-z0-9._-]", "_", name), caption, draw, side, key)))
 
     @property
     def figures(self) -> list[Figure]:

@@ -52,5 +52,5 @@ def first_screen(sec, c, datasets=None) -> list[str]:
         said = [s for f in fits[:1] for s in (f.velstep.sign + f.velstep.bounds + f.velstep.noise + f.velstep.missing)]
         sec.fig(f"velstep-{d.name}.png", f"{d.name} (measured): the data with the {best.law} fit, the step close up, "
                 "the residuals (fit − data) and the fitted parameters.", lambda f=best: velstep_figure(f),
-                side=" ".join(f"{s}." for s in said))
+                side=" ".join(f"{s}." for s in said), key=("velstep", id(best)))  # the index's and its group's
     return [d.name for d, _ in steps]

@@ -174,6 +174,37 @@ def draw_fit(ax, f, obs: str, t, tf: float, uf: float, label: str, **style):
         ax.plot(t * tf, d.model * uf, label=label, zorder=3, **style)
 
 
+#: Points of a series beyond which a figure draws a thinned copy (``thinned``): at the report's figure widths
+#: (about 800 pixels) a longer series puts several points on each pixel column.
+THIN_AT = 4000
+#: Columns of ``thinned``: more than the pixels across a panel.
+THIN_BINS = 1000
+
+
+def thinned(t, *series) -> np.ndarray:
+    """Indices of the points of a long series that a figure needs to look as the whole does: all of them up to
+    THIN_AT points; beyond, in each of THIN_BINS equal spans of ``t`` (sorted), the first and last point and
+    those where each of ``series`` (arrays over ``t``) is lowest and highest (M4: Jugel et al., PVLDB 7,
+    2014). With more columns than pixels, lines through these points cover the pixels that lines through every
+    point do, to within a pixel; markers and error bars at each column's extremes reach where the whole cloud
+    does."""
+    n = len(t)
+    if n <= THIN_AT:
+        return np.arange(n)
+    t = np.asarray(t, dtype=float)
+    cut = np.searchsorted(t, np.linspace(t[0], t[-1], THIN_BINS + 1)[1:-1])
+    starts = np.unique(np.concatenate([[0], cut]))
+    keep = [starts, np.append(starts[1:] - 1, n - 1)]
+    for y in series:
+        y = np.asarray(y, dtype=float)
+        for pick in (np.minimum, np.maximum):
+            best = pick.reduceat(y, starts)
+            # the first index of each span where y takes its extreme: spans are consecutive, so a running count
+            hit = np.flatnonzero(y == np.repeat(best, np.diff(np.append(starts, n))))
+            keep.append(hit[np.unique(np.searchsorted(starts, hit, side="right") - 1, return_index=True)[1]])
+    return np.unique(np.concatenate(keep))
+
+
 def same_curve(a, b) -> bool:
     """Whether two fits of one dataset with one solver predict the same curve at every data point (within
     SAME_CURVE sigma), or are the ranking's one candidate (laws spanning one closed-form family, fitted to one

@@ -154,7 +154,9 @@ def _against_time(ax, d, target, curves) -> str:
                 label=f"{d.provenance.kind} curve (figure only, not fitted)", zorder=1)
     else:
         uname, uf = unit(obs)
-        ax.errorbar(target.t * tf, target.y * uf, yerr=target.sigma * uf, fmt="o", ms=3, color="black",
+        y, sigma = target.y, np.broadcast_to(target.sigma, target.y.shape)
+        k = base.thinned(target.t, y, y - sigma, y + sigma)  # a long record: what its pixels show
+        ax.errorbar(target.t[k] * tf, y[k] * uf, yerr=sigma[k] * uf, fmt="o", ms=3, color="black",
                     ecolor="0.75", elinewidth=0.7, label=f"data ({d.provenance.kind})", zorder=1)
     for f, label, style in curves:
         base.draw_fit(ax, f, obs, d.t, tf, uf, label, **style)

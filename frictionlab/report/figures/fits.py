@@ -29,14 +29,17 @@ def fit_figure(dataset, fits, rows) -> bytes:
     y = target.y if curves else dataset.columns[obs]
     sigma = target.sigma if curves else np.full(t.shape, dataset.noise.get(obs, np.nan))
     kind = dataset.provenance.kind
-    ax.errorbar(t * tf, y * uf, yerr=sigma * uf, fmt="o", ms=3.2, color="black", ecolor="0.7", elinewidth=0.8,
+    visible = base.visible_curves(curves, float(np.ptp(y)))
+    sigma = np.broadcast_to(sigma, t.shape)
+    k = base.thinned(t, y, y - sigma, y + sigma, *(f.per_dataset[0].residual for f, _, _ in visible))  # a long record
+    ax.errorbar(t[k] * tf, y[k] * uf, yerr=sigma[k] * uf, fmt="o", ms=3.2, color="black", ecolor="0.7", elinewidth=0.8,
                 label=f"data ({kind})" + (f", {target.derivation}" if curves and target.derivation else ""), zorder=1)
-    for i, (f, laws, hidden) in enumerate(base.visible_curves(curves, float(np.ptp(y)))):
+    for i, (f, laws, hidden) in enumerate(visible):
         d = f.per_dataset[0]
         style = base._style(f.law, f.solver, i)
         base.draw_fit(ax, f, obs, t, tf, uf, base._label(f, rows, laws, hidden), **style)
-        axr.plot(t * tf, d.residual * uf, marker=".", ms=3, **style)
-    axr.fill_between(t * tf, -sigma * uf, sigma * uf, color="0.85", label="±1σ noise", zorder=0)
+        axr.plot(t[k] * tf, d.residual[k] * uf, marker=".", ms=3, **style)
+    axr.fill_between(t[k] * tf, -sigma[k] * uf, sigma[k] * uf, color="0.85", label="±1σ noise", zorder=0)
     axr.axhline(0, color="0.3", lw=0.8)
     ax.set_ylabel(f"{NAMES.get(obs, obs)} [{uname}]")
     axr.set_ylabel(f"model − data [{uname}]")
