@@ -127,6 +127,15 @@ def _slip(C, y):
 
 
 @jit
+def _point(s, z, C, scale):
+    """(t, unscaled states y, slip u, whether it slides, the law state's index, normal force N) at scaled (s, z)."""
+    t = s * C[TSCALE]
+    y = z * scale
+    u, free = _slip(C, y)
+    return t, y, u, free, int(C[IL]), _normal(C, t)
+
+
+@jit
 def rhs(s, z, P, C, scale, V):
     """dz/ds of the scaled phase (time s = t / TSCALE, states z = y / scale) at one state vector; counts calls in
     C[CALLS]: past C[MAXCALLS], where a value is not finite, or where a strict slid phase's slip turns, sets C[BAD]
@@ -141,11 +150,7 @@ def rhs(s, z, P, C, scale, V):
         C[BAD] = TOO_MANY
         raise FloatingPointError("stopped: see C[BAD]")
     tsc = C[TSCALE]
-    t = s * tsc
-    y = z * scale
-    u, free = _slip(C, y)
-    il = int(C[IL])
-    N = _normal(C, t)
+    t, y, u, free, il, N = _point(s, z, C, scale)
     code = int(C[LAW])
     if code == DAHL_SLID and C[STRICT] and u * C[SENSE] < 0.0:
         C[BAD] = TURNED
@@ -178,11 +183,7 @@ def jac(s, z, P, C, scale, V):
     n = z.size
     J = np.zeros((n, n))
     tsc = C[TSCALE]
-    t = s * tsc
-    y = z * scale
-    u, free = _slip(C, y)
-    il = int(C[IL])
-    N = _normal(C, t)
+    _, y, u, free, il, N = _point(s, z, C, scale)
     _, dmu_du, dmu_dl, _, dr_du, dr_dl = law(int(C[LAW]), P, C, u, y[il])
     du = np.zeros(n)  # d u / d y
     iw = int(C[IW])
