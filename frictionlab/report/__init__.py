@@ -140,11 +140,15 @@ def _drawn(figs, jobs: int, client=None):
     figs = list(figs)
     if jobs <= 1 or len(figs) <= 1:
         from ..core.signals import kept_signals
+        from .figures.base import release
 
-        for i, f in enumerate(figs):
-            with kept_signals():  # a law plugin drawn here does not keep SIGINT, SIGTERM or SIGHUP
-                png = f.draw()
-            yield i, png
+        try:
+            for i, f in enumerate(figs):
+                with kept_signals():  # a law plugin drawn here does not keep SIGINT, SIGTERM or SIGHUP
+                    png = f.draw()
+                yield i, png
+        finally:
+            release()  # the canvases kept for the next figure of a kind (figures.base.subplots)
         return
     from .figures import _plt
 

@@ -3,6 +3,7 @@ legend labels, and which fits are one curve. Display units: rpm, deg, us/ms/s, N
 from __future__ import annotations
 
 import io
+import threading
 
 import numpy as np
 
@@ -31,6 +32,67 @@ def _png(fig) -> bytes:
     fig.savefig(buf, format="png", dpi=DPI, pil_kwargs={"compress_level": COMPRESS})
     _plt().close(fig)
     return buf.getvalue()
+
+
+#: Per thread, the figure each kind of figure last drew on, by layout (``subplots``); at most KEEP of them.
+_KEPT = threading.local()
+KEEP = 12
+
+
+def subplots(kind: str, nrows: int = 1, ncols: int = 1, figsize: tuple[float, float] = (6.4, 4.8), **kw):
+    """(figure, 2-d array of its axes) as ``plt.subplots(nrows, ncols, figsize=figsize, squeeze=False, **kw)`` gives
+    them, built outside pyplot and kept: the next figure of ``kind`` with the same layout is drawn on the same
+    canvas, emptied (``_emptied``), which spares building the axes, their ticks and the renderer (and its
+    measured text) once per dataset. Besides what ``_emptied`` resets, a kind of figure sets whatever it changes
+    (tick locators, fonts, limits) on every figure it draws, so that each figure looks as on a fresh canvas."""
+    kept = _KEPT.__dict__.setdefault("figures", {})
+    key = (kind, nrows, ncols, tuple(figsize), repr(sorted(kw.items())))
+    if key in kept:
+        fig, axes = kept[key]
+        _emptied(fig)
+        return fig, axes
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    _plt()  # rcParams as every report figure has them (mathtext off)
+    fig = Figure(figsize=figsize)
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(nrows, ncols, squeeze=False, **kw)
+    if len(kept) >= KEEP:
+        kept.pop(next(iter(kept)))
+    kept[key] = fig, axes
+    return fig, axes
+
+
+def _emptied(fig) -> None:
+    """``fig`` with what ``subplots`` gave first, as far as its kinds of figure change it: no artists, legends,
+    titles, axis labels or figure texts; every axes visible, its axis on, its limits following the data and its
+    colour cycle from the start."""
+    for ax in fig.axes:
+        for c in list(ax.containers):
+            c.remove()
+        for a in (*ax.lines, *ax.collections, *ax.patches, *ax.texts, *ax.images, *ax.artists, *ax.tables):
+            a.remove()
+        if ax.legend_ is not None:
+            ax.legend_.remove()
+        for loc in ("left", "center", "right"):
+            ax.set_title("", loc=loc)
+        ax.set_xlabel("")
+        ax.set_ylabel("")
+        ax.set_visible(True)
+        ax.set_axis_on()
+        ax.set_prop_cycle(None)
+        ax.relim()
+        ax.set_autoscale_on(True)
+    for t in fig.texts:
+        t.set_text("")
+    for leg in list(fig.legends):
+        leg.remove()
+
+
+def release() -> None:
+    """Let go of this thread's kept figures (``subplots``)."""
+    _KEPT.__dict__.pop("figures", None)
 
 
 #: Inches: the blank border of the canvas; below an axes, its x tick labels and label (XTICKS: the labels

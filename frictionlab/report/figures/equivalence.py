@@ -11,12 +11,11 @@ def equivalence_figure(dataset, fw_list, fa, decomps) -> bytes:
     """The paper's two-term decomposition of each wear fit (a panel per fit in ``fw_list``, each with its
     decomposition in ``decomps``) with its projection onto mu N + mu eta' dA/dt, over the friction force
     of that wear fit and the area-rate fit ``fa``. Forces in N, time in the display unit."""
-    plt = base._plt()
     s = fa.per_dataset[0].scene
     t_end = float(dataset.t[-1])
     tname, tf = time_unit(t_end)
     t = np.linspace(0.0, t_end, 400)
-    fig, axes = plt.subplots(1, max(1, len(fw_list)), figsize=(5.4 * max(1, len(fw_list)), 4.7), squeeze=False)
+    fig, axes = base.subplots("equivalence", 1, max(1, len(fw_list)), figsize=(5.4 * max(1, len(fw_list)), 4.7))
     Fa = fa.per_dataset[0].trajectory(fa.law, t).force
     A, dA = s.area(t)
     A = np.where(t <= s.area.contact_time, A, 0.0)
@@ -54,10 +53,10 @@ def discrimination_figure(dataset: str, results) -> bytes:
     get no panel, only a line under the title."""
     from matplotlib.ticker import MaxNLocator
 
-    plt = base._plt()
     drawn = [e for e in results if not one_curve(e)]
     same = [e for e in results if one_curve(e)]
-    fig, axes = plt.subplots(1, max(1, len(drawn)), figsize=(4.6 * max(1, len(drawn)), 3.4), squeeze=False)
+    fig, axes = base.subplots("discrimination", 1, max(1, len(drawn)),
+                              figsize=(4.6 * max(1, len(drawn)), 3.4))
     for ax, e in zip(axes[0], drawn):
         both = np.concatenate([e.t_a, e.t_b, [e.t_obs]])
         span = float(np.ptp(both))

@@ -19,13 +19,13 @@ def fit_figure(dataset, fits, rows) -> bytes:
         from .stated import stated_figure
 
         return stated_figure(dataset, curves, rows)
-    plt = base._plt()
     target = curves[0][0].per_dataset[0].target if curves else None
     obs = target.observable if curves else dataset.observable
     uname, uf = unit(obs)
     t = dataset.t
     tname, tf = time_unit(float(t[-1]))
-    fig, (ax, axr) = plt.subplots(2, 1, figsize=(7.6, 6.0), sharex=True, gridspec_kw={"height_ratios": [3, 1.6]})
+    fig, ((ax,), (axr,)) = base.subplots("fit", 2, 1, figsize=(7.6, 6.0), sharex=True,
+                                         gridspec_kw={"height_ratios": [3, 1.6]})
     y = target.y if curves else dataset.columns[obs]
     sigma = target.sigma if curves else np.full(t.shape, dataset.noise.get(obs, np.nan))
     kind = dataset.provenance.kind
@@ -73,7 +73,6 @@ def outcome_figure(dataset, fits, rows) -> bytes:
     """Impact-outcome rows: each distinct fit's prediction against the observation (left) and the
     observation against impact angle (right; one line per group of the other inputs, e.g. speed,
     never joining different groups), in the dataset's own units."""
-    plt = base._plt()
     obs = dataset.observable
     uname, uf = column_unit(dataset, obs)
     ylab = f"{obs.replace('_', ' ')}" + (f" [{uname}]" if uname else "")
@@ -81,7 +80,8 @@ def outcome_figure(dataset, fits, rows) -> bytes:
     curves = base.visible_curves(base.distinct_curves(fits), float(np.ptp(dataset.columns[obs])))
     sigma = dataset.noise.get(obs, 0.0) * uf
     angle = angle_column(dataset)
-    fig, (axp, axa) = plt.subplots(1, 2, figsize=(11.0, 5.2), gridspec_kw={"width_ratios": [1, 1.35]})
+    fig, ((axp, axa),) = base.subplots("outcome", 1, 2, figsize=(11.0, 5.2),
+                                       gridspec_kw={"width_ratios": [1, 1.35]})
     lo, hi = float(np.min(y)), float(np.max(y))
     for i, (f, laws, hidden) in enumerate(curves):
         st = base._style(f.law, f.solver, i)
@@ -156,13 +156,12 @@ def _residual_limits(ax, residuals, sigma):
 
 def force_figure(dataset, fits, rows=()) -> bytes:
     """The friction force history of every law's best fit."""
-    plt = base._plt()
     curves = [(f, laws) for f, laws in base.distinct_curves(fits) if f.per_dataset[0].target.t is not None]
     span = float(np.ptp(curves[0][0].per_dataset[0].target.y)) if curves else 1.0
     curves = base.visible_curves(curves, span)  # a force history under another's: named in its entry
     t_end = float(dataset.t[-1])
     tname, tf = time_unit(t_end)
-    fig, ax = plt.subplots(figsize=(7.6, 3.8))
+    fig, ((ax,),) = base.subplots("force", figsize=(7.6, 3.8))
     drawn = 0
     for i, (f, laws, hidden) in enumerate(curves):
         try:

@@ -14,12 +14,12 @@ def stated_figure(dataset, curves, rows) -> bytes:
     """A reconstruction fitted on its stated numbers: the noise-free spin curve (grey, drawn for the figure
     only) with the stated peak and end-of-contact spin as crosses of their stated precision and each
     distinct fit's spin (top); each stated number's miss (model − stated) / precision (bottom)."""
-    plt = base._plt()
     t = dataset.t
     tname, tf = time_unit(float(t[-1]))
     uname, uf = unit("omega")
     st = dataset.stated
-    fig, (ax, axr) = plt.subplots(2, 1, figsize=(7.6, 6.0), gridspec_kw={"height_ratios": [3, 1.6]})
+    fig, ((ax,), (axr,)) = base.subplots("stated", 2, 1, figsize=(7.6, 6.0),
+                                         gridspec_kw={"height_ratios": [3, 1.6]})
     if "omega" in dataset.columns:
         ax.plot(t * tf, dataset.columns["omega"] * uf, color="0.6", lw=3, alpha=0.6,
                 label=f"{dataset.provenance.kind} curve (figure only, not fitted)")
