@@ -27,10 +27,19 @@ COMPRESS = 3
 
 def _png(fig) -> bytes:
     """The figure as PNG bytes at DPI, drawn once: the report's figures are placed by ``margins`` (a layout
-    engine, or bbox_inches="tight", would draw the whole figure once more to measure it)."""
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=DPI, pil_kwargs={"compress_level": COMPRESS})
+    engine, or bbox_inches="tight", would draw the whole figure once more to measure it). RGB: on the figures'
+    opaque background the alpha channel is 255 everywhere, and without it the encoding takes about a quarter
+    less CPU and the file a tenth fewer bytes."""
+    from PIL import Image
+
+    fig.set_dpi(DPI)
+    raw = io.BytesIO()
+    fig.savefig(raw, format="rgba", dpi=DPI)
+    size = fig.canvas.get_width_height()
     _plt().close(fig)
+    rgba = Image.frombuffer("RGBA", size, raw.getbuffer(), "raw", "RGBA", 0, 1)
+    buf = io.BytesIO()
+    rgba.convert("RGB").save(buf, format="png", compress_level=COMPRESS, dpi=(DPI, DPI))
     return buf.getvalue()
 
 
