@@ -310,3 +310,38 @@ def get_scene_quantity(scene: Scene, name: str) -> float:
     if not isinstance(obj, (int, float)):
         raise ParameterError(f"scene quantity '{name}' is not a number on this scene")
     return float(obj)
+
+
+#: The observables ``predict_array`` reads off a batch of trajectories.
+ARRAY_SERIES = ("omega", "theta", "v", "u")
+
+
+def predict_array(law, target: Target, params: Mapping[str, np.ndarray], solver: str) -> np.ndarray | None:
+    """``predict`` at m parameter sets at once: ``params`` maps every law parameter to an (m,) array [SI]; returns
+    the (m, n) predictions of ``target.y``, or None where no batched route serves (then ``predict`` one set at a
+    time). Served: a built-in series predictor of an impact or incline on its dataset's scene, solved by the
+    closed forms over a batch of parameter sets (``solve.batch``, equal to ``simulate(..., 'exact')`` to
+    round-off; tests/test_batchfit.py) or by the paper's series. Raises FrictionLabError where the batch cannot
+    be solved (a value outside its bounds)."""
+    from ..solve.batch import simulate_batch
+    from ..solve.plan import make_plan
+    from ..solve.scenebatch import SceneBatch, batch_params, take_params
+    from ..solve.solvers import series
+
+    law = get_law(law)
+    ds = target.dataset
+    if (ds.kind not in ("impact", "incline") or PREDICTORS.get(ds.kind) is not _predict_series or ds.scene is None
+            or target.observable not in ARRAY_SERIES or solver not in ("exact", "series")):
+        return None
+    m = len(next(iter(params.values())))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        if solver == "series":
+            plan = make_plan(ds.scene, law)
+            p = take_params(batch_params(law, params, m), slice(None), column=True)
+            form = series.check(plan, p)
+            out = series.curves(plan, form.k, np.asarray(target.t, dtype=float))[target.observable]
+        else:
+            res = simulate_batch(law, SceneBatch(ds.scene, {}, m), params, t=target.t, solver="exact")
+            out = getattr(res, SERIES[target.observable])
+    return np.array(np.broadcast_to(out, (m, target.y.size)), dtype=float)

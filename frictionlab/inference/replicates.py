@@ -81,34 +81,67 @@ def replicate_chunk(law_a, opts_a, law_b, opts_b, target, model_a, model_b, seed
     S_A = T + (B refitted to A's refitted curve), S_B = T - (A refitted to B's refitted curve): T centred
     at its location under the replicate's own fit (``equivalence``, module docstring); D the RMS distance of
     the two refitted curves (``distance``). With an estimated sigma of ``df`` degrees of freedom each
-    replicate's chi-squares are at its own estimate sigma^2 chi2_df / df. Runs in a worker."""
+    replicate's chi-squares are at its own estimate sigma^2 chi2_df / df. The refits of every seed are made
+    together where a batched route serves (``batchfit``), else one at a time. Runs in a worker."""
     from .ar1 import noise_drawer
 
     noise = noise_drawer(target.dataset, target.y, model_a, target.sigma)  # Gaussian, or AR(1) where declared
-    out = []
+    eps, scale = [], []
     for ss in seeds:
         rng = np.random.default_rng(ss)
-        eps = noise(rng)
-        scale = df / rng.chisquare(df) if math.isfinite(df) else 1.0
-        row = []
-        for null, model in (("a", model_a), ("b", model_b)):
-            tg = with_y(target, model + eps, "parametric bootstrap replicate")
-            try:
-                ra, rb = refit(law_a, opts_a, tg), refit(law_b, opts_b, tg)
-            except FrictionLabError:
-                row += [math.nan] * 3
-                continue
-            if not (ra.ok and rb.ok):
-                row += [math.nan] * 3
-                continue
-            t = ra.stats.chisqr - rb.stats.chisqr
-            if null == "a":
-                s = t + centring(law_b, opts_b, rb, target, ra.per_dataset[0].model)
+        eps.append(noise(rng))
+        scale.append(df / rng.chisquare(df) if math.isfinite(df) else 1.0)
+    laws = ((law_a, opts_a), (law_b, opts_b))
+    cols = [_null_rows(laws, target, null, model, eps) for null, model in (("a", model_a), ("b", model_b))]
+    return [tuple(x * c for x, c in zip(ra + rb, (sc, sc, 1.0) * 2)) + (1.0 / math.sqrt(sc),)
+            for ra, rb, sc in zip(cols[0], cols[1], scale)]
+
+
+def _null_rows(laws, target, null: str, model: np.ndarray, eps: list) -> list[list[float]]:
+    """(T, S, D) per replicate ``model + eps[i]`` under ``null`` ('a' or 'b'; ``replicate_chunk``), before the
+    sigma draw's scale: every replicate's refits in one batch where ``batchfit`` serves, the rest one at a time."""
+    from . import batchfit
+
+    (law_a, opts_a), (law_b, opts_b) = laws
+    if not eps:
+        return []
+    Y = model + np.asarray(eps)
+    pa, pb = batchfit.problem(law_a, opts_a, target), batchfit.problem(law_b, opts_b, target)
+    rows: list = [None] * len(eps)
+    if pa is not None and pb is not None:
+        ra, rb = batchfit.refit_many(law_a, opts_a, target, Y, pr=pa), batchfit.refit_many(law_b, opts_b, target, Y, pr=pb)
+        if ra is not None and rb is not None:
+            if null == "a":  # B refitted to A's refitted curve, from B's refit
+                rc, sign = batchfit.refit_many(law_b, opts_b, target, ra.models, starts=rb.values, pr=pb), 1.0
             else:
-                s = t - centring(law_a, opts_a, ra, target, rb.per_dataset[0].model)
-            row += [scale * t, scale * s, distance(target, ra.per_dataset[0].model, rb.per_dataset[0].model)]
-        out.append(tuple(row) + (1.0 / math.sqrt(scale),))
-    return out
+                rc, sign = batchfit.refit_many(law_a, opts_a, target, rb.models, starts=ra.values, pr=pa), -1.0
+            if rc is not None:
+                t = ra.chisqr - rb.chisqr
+                for i in np.nonzero(ra.ok & rb.ok & rc.ok)[0]:
+                    rows[i] = [float(t[i]), float(t[i] + sign * rc.chisqr[i]),
+                               distance(target, ra.models[i], rb.models[i])]
+    for i, row in enumerate(rows):
+        if row is None:
+            rows[i] = _null_row(laws, target, null, Y[i])
+    return rows
+
+
+def _null_row(laws, target, null: str, y: np.ndarray) -> list[float]:
+    """(T, S, D) of one replicate y under ``null``, its refits made one at a time (``_null_rows``)."""
+    (law_a, opts_a), (law_b, opts_b) = laws
+    tg = with_y(target, y, "parametric bootstrap replicate")
+    try:
+        ra, rb = refit(law_a, opts_a, tg), refit(law_b, opts_b, tg)
+    except FrictionLabError:
+        return [math.nan] * 3
+    if not (ra.ok and rb.ok):
+        return [math.nan] * 3
+    t = ra.stats.chisqr - rb.stats.chisqr
+    if null == "a":
+        s = t + centring(law_b, opts_b, rb, target, ra.per_dataset[0].model)
+    else:
+        s = t - centring(law_a, opts_a, ra, target, rb.per_dataset[0].model)
+    return [t, s, distance(target, ra.per_dataset[0].model, rb.per_dataset[0].model)]
 
 
 def one_family(fit_a: FitResult, fit_b: FitResult) -> bool:

@@ -1,0 +1,225 @@
+"""Many refits of one law to one dataset's points at once: the replicates of the equivalence test and the bootstrap.
+
+A replicate refit is a small least-squares problem (one or two law parameters, tens of points) solved thousands of
+times a comparison; one at a time, each Levenberg-Marquardt step is one closed-form solve through the general phase
+driver, and the Python around it is most of the cost. ``refit_many(law, opts, target, Y, starts)`` fits every row of
+Y (r, n) together instead: one Levenberg-Marquardt run per row, all rows stepping at once, each step one batched
+prediction (``predict.predict_array``: the closed forms over a batch of parameter sets, or the paper's series) of
+every row's trial point and its forward-difference neighbours.
+
+The problem is the one ``fitting.fit`` poses for the refit (``replicates.refit``): the same parameter slots, scales
+and bounds (``fitmodel._law_slots``), lmfit's bounded coordinates (MINUIT's transformation, as ``levmar``), lmfit's
+forward-difference steps (relative sqrt(1e-10)), the chi-square at the dataset's sigma. Each row stops where the
+Gauss-Newton step predicts a fall in chi-square below ``FTOL`` of it, or where a step is refused and its promise
+is below ``RESOLVED`` of it, or no damped step lowers it (at the minimum to round-off): a tighter stop than the single refit's (its relative tolerance is ``fitmodel.FTOL``), so
+the two agree to well within that tolerance (tests/test_batchfit.py). A row that is not finite, or not converged
+in ``MAX_STEPS`` steps, comes back not ok and the caller refits it alone. None where no batched route serves (a
+third-party law, a freed scene quantity, an ODE solver, correlated noise): then every row is refitted alone.
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+import attrs
+import numpy as np
+
+from ..core.errors import FrictionLabError
+from ..physics.registry import get_law, is_third_party
+from .fitmodel import _law_slots, _lmfit_bound
+from .fitting import law_values
+from .levmar import TINY
+from .predict import predict_array
+
+FTOL = 1e-10  # relative fall in chi-square a Gauss-Newton step may still promise at a row's minimum
+MAX_STEPS = 100  # Levenberg-Marquardt steps per row before it is handed back (not ok)
+STEP = math.sqrt(1e-10)  # lmfit's relative forward-difference step (epsfcn 1e-10)
+LAMBDA0, LAMBDA_MAX = 1e-3, 1e12  # Marquardt's damping at the start; past this no step lowers chi-square
+RESOLVED = 1e-8  # a rejected step whose Gauss-Newton promise is below this fraction of chi-square ends the row: the
+# promise is then within what forward differences of relative step STEP resolve (a hundredth of fitmodel.FTOL)
+
+
+@attrs.frozen(eq=False)
+class Refits:
+    """Rows of ``refit_many``: chisqr (r,), values law parameter -> (r,) [SI] (held ones included), models (r, n)
+    [SI], ok (r,) (False: refit that row alone)."""
+
+    chisqr: np.ndarray
+    values: dict
+    models: np.ndarray
+    ok: np.ndarray
+
+    def row(self, i: int) -> dict[str, float]:
+        """Row i's law parameter values [SI]."""
+        return {k: float(v[i]) for k, v in self.values.items()}
+
+
+class _Problem:
+    """One law on one target with ``opts`` (``replicates.refit_options``): its varying slots in lmfit's bounded
+    coordinates and the batched prediction."""
+
+    def __init__(self, law, opts: Mapping, target):
+        self.law, self.target, self.solver = law, target, opts["solver"]
+        fixed = law_values(law, opts.get("fixed") or {}, "fit: fixed")
+        initial = law_values(law, opts.get("initial") or {}, "fit: initial")
+        slots = _law_slots(law, [target], fixed, set(), initial)
+        self.held = {s.key: s.value for s in slots if not s.vary}
+        self.slots = [s for s in slots if s.vary]
+        self.scale = np.array([s.scale for s in self.slots])
+        self.lo = np.array([_lmfit_bound(s.lower, s) / s.scale for s in self.slots])
+        self.hi = np.array([_lmfit_bound(s.upper, s) / s.scale for s in self.slots])
+        self.start = np.array([s.value / s.scale for s in self.slots])
+        self.sigma = np.asarray(target.sigma, dtype=float)
+
+    def values(self, X: np.ndarray) -> dict[str, np.ndarray]:
+        """Law parameters [SI] for scaled external values X (m, k)."""
+        m = X.shape[0]
+        out = {s.key: X[:, j] * s.scale for j, s in enumerate(self.slots)}
+        return out | {k: np.full(m, v) for k, v in self.held.items()}
+
+    def predict(self, X: np.ndarray) -> np.ndarray | None:
+        return predict_array(self.law, self.target, self.values(X), self.solver)
+
+    def internal(self, X: np.ndarray) -> np.ndarray:
+        """lmfit's ``setup_bounds`` per column (``levmar.Param.internal``), values clipped into the bounds first."""
+        lo, hi = self.lo, self.hi
+        X = np.clip(X, lo, hi)
+        both, upper_only, lower_only = (np.isfinite(lo) & np.isfinite(hi)), np.isinf(lo) & np.isfinite(hi), \
+            np.isfinite(lo) & np.isinf(hi)
+        with np.errstate(all="ignore"):
+            U = np.where(lower_only, np.sqrt((X - lo + 1.0) ** 2 - 1), X)
+            U = np.where(upper_only, np.sqrt((hi - X + 1.0) ** 2 - 1), U)
+            U = np.where(both, np.arcsin(2 * (X - lo) / np.where(both, hi - lo, 1.0) - 1), U)
+        return np.where(np.abs(U) < TINY, 0.0, U)
+
+    def external(self, U: np.ndarray) -> np.ndarray:
+        """lmfit's ``from_internal`` per column (``levmar.Param.external``)."""
+        lo, hi = self.lo, self.hi
+        both, upper_only, lower_only = (np.isfinite(lo) & np.isfinite(hi)), np.isinf(lo) & np.isfinite(hi), \
+            np.isfinite(lo) & np.isinf(hi)
+        with np.errstate(all="ignore"):
+            X = np.where(lower_only, lo - 1.0 + np.sqrt(U * U + 1), U)
+            X = np.where(upper_only, hi + 1 - np.sqrt(U * U + 1), X)
+            return np.where(both, lo + (np.sin(U) + 1) * (hi - lo) / 2.0, X)
+
+
+def problem(law, opts: Mapping, target) -> _Problem | None:
+    """The batched refit problem of ``law`` on ``target`` with ``opts``, or None where no batched route serves."""
+    law = get_law(law)
+    if (is_third_party(law) or opts.get("free") or opts.get("solver") not in ("exact", "series")
+            or getattr(target, "derivation", None) or getattr(target.dataset, "noise_correlation", "none") != "none"
+            or target.observable == "stated"):
+        return None
+    try:
+        pr = _Problem(law, opts, target)
+        if not pr.slots or pr.predict(pr.start[None, :]) is None:
+            return None
+    except FrictionLabError:
+        return None
+    return pr
+
+
+def refit_many(law, opts: Mapping, target, Y: np.ndarray, starts: Mapping[str, np.ndarray] | None = None,
+               pr: _Problem | None = None) -> Refits | None:
+    """``law`` refitted to every row of Y (r, n) [SI] on ``target``'s points and sigma, each warm-started at
+    ``opts``' values or, per row, at ``starts`` (law parameter -> (r,) [SI]); None where no batched route serves
+    (module docstring)."""
+    pr = pr or problem(law, opts, target)
+    if pr is None:
+        return None
+    Y = np.atleast_2d(np.asarray(Y, dtype=float))
+    r = Y.shape[0]
+    X0 = np.tile(pr.start, (r, 1))
+    for j, s in enumerate(pr.slots):
+        if starts is not None and s.key in starts:
+            X0[:, j] = np.asarray(starts[s.key], dtype=float) / s.scale
+    try:
+        U, chisqr, models, ok = _levenberg_marquardt(pr, Y, pr.internal(X0))
+    except FrictionLabError:
+        return None
+    return Refits(chisqr=chisqr, values=pr.values(pr.external(U)), models=models, ok=ok)
+
+
+def _residuals(pr: _Problem, U: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(models (m, n), weighted residuals (m, n)) at internal values U (m, k) against rows Y (m, n)."""
+    M = pr.predict(pr.external(U))
+    if M is None:
+        raise FrictionLabError("batch prediction refused")
+    return M, (M - Y) / pr.sigma
+
+
+def _levenberg_marquardt(pr: _Problem, Y: np.ndarray, U: np.ndarray):
+    """Every row's Levenberg-Marquardt run, stepped together; returns (U, chisqr, models, ok) per row. Each
+    step predicts, in one batch, the trial point of every running row and the forward-difference neighbours
+    it needs if accepted, so an accepted step comes with its Jacobian."""
+    r, k = U.shape
+    U = U.copy()
+    models, res = _residuals(pr, U, Y)
+    J = _jacobian(pr, U, res, Y)
+    chisqr = np.einsum("ij,ij->i", res, res)
+    ok = np.isfinite(chisqr) & np.isfinite(J).all(axis=(1, 2))
+    lam = np.full(r, LAMBDA0)
+    running = ok.copy()
+    for _ in range(MAX_STEPS):
+        idx = np.nonzero(running)[0]
+        g, A = np.einsum("rnk,rn->rk", J[idx], res[idx]), np.einsum("rnk,rnl->rkl", J[idx], J[idx])
+        gain = _gauss_newton_gain(g, A)
+        at_min = gain <= FTOL * np.maximum(chisqr[idx], 1e-300)
+        running[idx[at_min]] = False
+        idx, g, A, gain = idx[~at_min], g[~at_min], A[~at_min], gain[~at_min]
+        if not idx.size:
+            break
+        D = np.einsum("rkk->rk", A)
+        D = np.maximum(D, 1e-12 * np.max(D, axis=1, keepdims=True) + 1e-300)
+        step = -np.linalg.solve(A + lam[idx, None, None] * _diag(D), g[..., None])[..., 0]
+        trial = U[idx] + step
+        h = _steps(trial)
+        pts = np.concatenate([trial[:, None, :], trial[:, None, :] + h[:, :, None] * np.eye(k)], axis=1)
+        Yrep = np.repeat(Y[idx], k + 1, axis=0)
+        m_all, r_all = _residuals(pr, pts.reshape(-1, k), Yrep)
+        m_all, r_all = m_all.reshape(idx.size, k + 1, -1), r_all.reshape(idx.size, k + 1, -1)
+        c_new = np.einsum("ij,ij->i", r_all[:, 0], r_all[:, 0])
+        J_new = np.transpose((r_all[:, 1:] - r_all[:, :1]) / h[:, :, None], (0, 2, 1))
+        better = np.isfinite(c_new) & (c_new < chisqr[idx]) & np.isfinite(J_new).all(axis=(1, 2))
+        go = idx[better]
+        U[go], chisqr[go], models[go], res[go], J[go] = trial[better], c_new[better], m_all[better, 0], \
+            r_all[better, 0], J_new[better]
+        lam[go] = np.maximum(lam[go] / 10.0, 1e-15)
+        stay = idx[~better]
+        lam[stay] *= 10.0
+        # no damped step lowers chi-square, or none where what a step promises is below the forward differences'
+        # resolution: at the minimum
+        running[stay[(lam[stay] > LAMBDA_MAX) | (gain[~better] <= RESOLVED * chisqr[stay])]] = False
+    else:
+        ok &= ~running  # still going after MAX_STEPS: not converged
+    ok &= np.isfinite(chisqr) & np.isfinite(models).all(axis=1)
+    return U, chisqr, models, ok
+
+
+def _diag(D: np.ndarray) -> np.ndarray:
+    out = np.zeros(D.shape + (D.shape[-1],))
+    idx = np.arange(D.shape[-1])
+    out[:, idx, idx] = D
+    return out
+
+
+def _steps(U: np.ndarray) -> np.ndarray:
+    """lmfit's (MINPACK's) forward-difference steps: STEP |u|, or STEP where u is 0."""
+    h = STEP * np.abs(U)
+    return np.where(h == 0.0, STEP, h)
+
+
+def _jacobian(pr: _Problem, U: np.ndarray, res: np.ndarray, Y: np.ndarray) -> np.ndarray:
+    """Forward-difference Jacobians (r, n, k) of the weighted residuals at U (r, k)."""
+    r, k = U.shape
+    h = _steps(U)
+    pts = (U[:, None, :] + h[:, :, None] * np.eye(k)).reshape(-1, k)
+    rp = _residuals(pr, pts, np.repeat(Y, k, axis=0))[1].reshape(r, k, -1)
+    return np.transpose((rp - res[:, None, :]) / h[:, :, None], (0, 2, 1))
+
+
+def _gauss_newton_gain(g: np.ndarray, A: np.ndarray) -> np.ndarray:
+    """The fall in chi-square a full Gauss-Newton step promises, g^T A^+ g per row (nan rows: inf)."""
+    with np.errstate(all="ignore"):
+        gain = np.einsum("rk,rk->r", g, np.einsum("rkl,rl->rk", np.linalg.pinv(A), g))
+    return np.where(np.isfinite(gain), gain, np.inf)
