@@ -11,7 +11,8 @@ The problem is the one ``fitting.fit`` poses for the refit (``replicates.refit``
 and bounds (``fitmodel._law_slots``), lmfit's bounded coordinates (MINUIT's transformation, as ``levmar``), lmfit's
 forward-difference steps (relative sqrt(1e-10)), the chi-square at the dataset's sigma. Each row stops where the
 Gauss-Newton step predicts a fall in chi-square below ``FTOL`` of it, or where a step is refused and its promise
-is below ``RESOLVED`` of it, or no damped step lowers it (at the minimum to round-off): a tighter stop than the single refit's (its relative tolerance is ``fitmodel.FTOL``), so
+is below ``RESOLVED`` of it, or its step is below ``XTOL`` of its values, or no damped step lowers it (at the
+minimum to round-off): a tighter stop than the single refit's (its relative tolerance is ``fitmodel.FTOL``), so
 the two agree to well within that tolerance (tests/test_batchfit.py). A row that is not finite, or not converged
 in ``MAX_STEPS`` steps, comes back not ok and the caller refits it alone. None where no batched route serves (a
 third-party law, a freed scene quantity, an ODE solver, correlated noise): then every row is refitted alone.
@@ -31,11 +32,14 @@ from .fitting import law_values
 from .levmar import TINY
 from .predict import predict_array
 
-FTOL = 1e-10  # relative fall in chi-square a Gauss-Newton step may still promise at a row's minimum
-MAX_STEPS = 100  # Levenberg-Marquardt steps per row before it is handed back (not ok)
+FTOL = 1e-9  # relative fall in chi-square a Gauss-Newton step may still promise at a row's minimum
+MAX_STEPS = 100  # Levenberg-Marquardt steps per row before it is handed back (not ok). Most rows end in 2 to 4; one
+# zigzagging across a kink of chi-square (a stick time crossing a sample time) may take 30, which in a batch of its
+# own still costs less than a refit alone (an area-rate refit with stick and breakaway: 0.1 s)
 STEP = math.sqrt(1e-10)  # lmfit's relative forward-difference step (epsfcn 1e-10)
 LAMBDA0, LAMBDA_MAX = 1e-3, 1e12  # Marquardt's damping at the start; past this no step lowers chi-square
-RESOLVED = 1e-8  # a rejected step whose Gauss-Newton promise is below this fraction of chi-square ends the row: the
+XTOL = 1e-10  # relative step of the internal values below which a row stops
+RESOLVED = 1e-8  # a refused step whose Gauss-Newton promise is below this fraction of chi-square ends the row: the
 # promise is then within what forward differences of relative step STEP resolve (a hundredth of fitmodel.FTOL)
 
 
@@ -154,8 +158,7 @@ def _levenberg_marquardt(pr: _Problem, Y: np.ndarray, U: np.ndarray):
     it needs if accepted, so an accepted step comes with its Jacobian."""
     r, k = U.shape
     U = U.copy()
-    models, res = _residuals(pr, U, Y)
-    J = _jacobian(pr, U, res, Y)
+    models, res, J = _with_jacobian(pr, U, Y)
     chisqr = np.einsum("ij,ij->i", res, res)
     ok = np.isfinite(chisqr) & np.isfinite(J).all(axis=(1, 2))
     lam = np.full(r, LAMBDA0)
@@ -173,23 +176,21 @@ def _levenberg_marquardt(pr: _Problem, Y: np.ndarray, U: np.ndarray):
         D = np.maximum(D, 1e-12 * np.max(D, axis=1, keepdims=True) + 1e-300)
         step = -np.linalg.solve(A + lam[idx, None, None] * _diag(D), g[..., None])[..., 0]
         trial = U[idx] + step
-        h = _steps(trial)
-        pts = np.concatenate([trial[:, None, :], trial[:, None, :] + h[:, :, None] * np.eye(k)], axis=1)
-        Yrep = np.repeat(Y[idx], k + 1, axis=0)
-        m_all, r_all = _residuals(pr, pts.reshape(-1, k), Yrep)
-        m_all, r_all = m_all.reshape(idx.size, k + 1, -1), r_all.reshape(idx.size, k + 1, -1)
-        c_new = np.einsum("ij,ij->i", r_all[:, 0], r_all[:, 0])
-        J_new = np.transpose((r_all[:, 1:] - r_all[:, :1]) / h[:, :, None], (0, 2, 1))
+        m_new, r_new, J_new = _with_jacobian(pr, trial, Y[idx])
+        c_new = np.einsum("ij,ij->i", r_new, r_new)
         better = np.isfinite(c_new) & (c_new < chisqr[idx]) & np.isfinite(J_new).all(axis=(1, 2))
         go = idx[better]
-        U[go], chisqr[go], models[go], res[go], J[go] = trial[better], c_new[better], m_all[better, 0], \
-            r_all[better, 0], J_new[better]
+        U[go], chisqr[go], models[go], res[go], J[go] = trial[better], c_new[better], m_new[better], r_new[better], \
+            J_new[better]
         lam[go] = np.maximum(lam[go] / 10.0, 1e-15)
         stay = idx[~better]
         lam[stay] *= 10.0
         # no damped step lowers chi-square, or none where what a step promises is below the forward differences'
         # resolution: at the minimum
         running[stay[(lam[stay] > LAMBDA_MAX) | (gain[~better] <= RESOLVED * chisqr[stay])]] = False
+        # a step below XTOL of the values (MINPACK's xtol): at the minimum, or at a kink of chi-square (a stick time
+        # crossing a sample time) that smaller steps do not resolve
+        running[idx[np.all(np.abs(step) <= XTOL * (np.abs(U[idx]) + XTOL), axis=1)]] = False
     else:
         ok &= ~running  # still going after MAX_STEPS: not converged
     ok &= np.isfinite(chisqr) & np.isfinite(models).all(axis=1)
@@ -209,13 +210,15 @@ def _steps(U: np.ndarray) -> np.ndarray:
     return np.where(h == 0.0, STEP, h)
 
 
-def _jacobian(pr: _Problem, U: np.ndarray, res: np.ndarray, Y: np.ndarray) -> np.ndarray:
-    """Forward-difference Jacobians (r, n, k) of the weighted residuals at U (r, k)."""
+def _with_jacobian(pr: _Problem, U: np.ndarray, Y: np.ndarray):
+    """(models (r, n), weighted residuals (r, n), their forward-difference Jacobians (r, n, k)) at internal values
+    U (r, k) against rows Y (r, n): every point and its k neighbours in one batched prediction."""
     r, k = U.shape
     h = _steps(U)
-    pts = (U[:, None, :] + h[:, :, None] * np.eye(k)).reshape(-1, k)
-    rp = _residuals(pr, pts, np.repeat(Y, k, axis=0))[1].reshape(r, k, -1)
-    return np.transpose((rp - res[:, None, :]) / h[:, :, None], (0, 2, 1))
+    pts = np.concatenate([U[:, None, :], U[:, None, :] + h[:, :, None] * np.eye(k)], axis=1)
+    M, R = _residuals(pr, pts.reshape(-1, k), np.repeat(Y, k + 1, axis=0))
+    M, R = M.reshape(r, k + 1, -1), R.reshape(r, k + 1, -1)
+    return M[:, 0], R[:, 0], np.transpose((R[:, 1:] - R[:, :1]) / h[:, :, None], (0, 2, 1))
 
 
 def _gauss_newton_gain(g: np.ndarray, A: np.ndarray) -> np.ndarray:
