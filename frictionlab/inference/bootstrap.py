@@ -248,14 +248,11 @@ def _guarded_chunk(fit_fns, datasets, models, method, seeds):
                          fit_fns, datasets, models, method, seeds, over=over)
 
 
-#: Chunks of a bootstrap run here (no executor): few, so that each chunk's refits are one batch (``_batched``).
-LOCAL_CHUNKS = 4
-
-
 def _dispatch(executor, fit_fns, datasets, models, method, seed, n, chunk, progress=None):
     """Rows of _run_chunk over n resamples in batches of ``chunk``; progress(done, n) after each batch."""
     seeds = np.random.SeedSequence(seed).spawn(n)
-    chunk = max(1, int(chunk or math.ceil(n / (16 if executor is not None else LOCAL_CHUNKS))))
+    # run here, the replicates are one chunk, so that a law's refits of them are one batch (``_batched``)
+    chunk = max(1, int(chunk or (math.ceil(n / 16) if executor is not None else n)))
     groups = [seeds[i:i + chunk] for i in range(0, n, chunk)]
     parts, done = [], 0
     futures = None if executor is None else [executor.submit(_guarded_chunk, fit_fns, datasets, models, method, g)
@@ -327,7 +324,7 @@ def bootstrap(fit_fn: Callable[..., FitResult], dataset: DatasetLike | Sequence[
     """Refit ``n`` resampled copies of ``dataset`` (a Dataset, name or path, or a list fitted together).
 
     fit_fn(data) -> FitResult, e.g. ``law_fit('wear', solver='exact')`` (warm-started replicates) or
-    any picklable callable. chunk: replicates per submitted task (default: n / 16 with an executor, n / 4 without; at least 1).
+    any picklable callable. chunk: replicates per submitted task (default: n / 16 with an executor, n without; at least 1).
     base: fit_fn's FitResult on the original data, if already made (else it is fitted here).
     """
     _check_n(n, seed)

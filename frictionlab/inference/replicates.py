@@ -92,42 +92,49 @@ def replicate_chunk(law_a, opts_a, law_b, opts_b, target, model_a, model_b, seed
         eps.append(noise(rng))
         scale.append(df / rng.chisquare(df) if math.isfinite(df) else 1.0)
     laws = ((law_a, opts_a), (law_b, opts_b))
-    cols = [_null_rows(laws, target, null, model, eps) for null, model in (("a", model_a), ("b", model_b))]
-    return [tuple(x * c for x, c in zip(ra + rb, (sc, sc, 1.0) * 2)) + (1.0 / math.sqrt(sc),)
-            for ra, rb, sc in zip(cols[0], cols[1], scale)]
-
-
-def _null_rows(laws, target, null: str, model: np.ndarray, eps: list) -> list[list[float]]:
-    """(T, S, D) per replicate ``model + eps[i]`` under ``null`` ('a' or 'b'; ``replicate_chunk``), before the
-    sigma draw's scale: every replicate's refits in one batch where ``batchfit`` serves, the rest one at a time."""
-    from . import batchfit
-
-    (law_a, opts_a), (law_b, opts_b) = laws
-    if not eps:
-        return []
-    Y = model + np.asarray(eps)
-    pa, pb = batchfit.problem(law_a, opts_a, target), batchfit.problem(law_b, opts_b, target)
-    rows: list = [None] * len(eps)
-    if pa is not None and pb is not None:
-        ra, rb = batchfit.refit_many(law_a, opts_a, target, Y, pr=pa), batchfit.refit_many(law_b, opts_b, target, Y, pr=pb)
-        if ra is not None and rb is not None:
-            if null == "a":  # B refitted to A's refitted curve, from B's refit
-                rc, sign = batchfit.refit_many(law_b, opts_b, target, ra.models, starts=rb.values, pr=pb), 1.0
-            else:
-                rc, sign = batchfit.refit_many(law_a, opts_a, target, rb.models, starts=ra.values, pr=pa), -1.0
-            if rc is not None:
-                t = ra.chisqr - rb.chisqr
-                for i in np.nonzero(ra.ok & rb.ok & rc.ok)[0]:
-                    rows[i] = [float(t[i]), float(t[i] + sign * rc.chisqr[i]),
-                               distance(target, ra.models[i], rb.models[i])]
-    for i, row in enumerate(rows):
-        if row is None:
-            rows[i] = _null_row(laws, target, null, Y[i])
+    got = _batched_rows(laws, target, model_a, model_b, eps)
+    rows = []
+    for i, sc in enumerate(scale):
+        ra = got[0][i] or _null_row(laws, target, "a", model_a + eps[i])
+        rb = got[1][i] or _null_row(laws, target, "b", model_b + eps[i])
+        rows.append((sc * ra[0], sc * ra[1], ra[2], sc * rb[0], sc * rb[1], rb[2], 1.0 / math.sqrt(sc)))
     return rows
 
 
+def _batched_rows(laws, target, model_a, model_b, eps: list) -> tuple[list, list]:
+    """(T, S, D) per replicate under null A and under null B (``replicate_chunk``, before the sigma draw's scale),
+    each replicate's refits made in batches (``batchfit``: both laws on the replicates of both nulls, then each
+    null's centring refit); None for a replicate the batches did not serve, every one where none serves."""
+    from . import batchfit
+
+    (law_a, opts_a), (law_b, opts_b) = laws
+    r = len(eps)
+    none = ([None] * r, [None] * r)
+    pa, pb = batchfit.problem(law_a, opts_a, target), batchfit.problem(law_b, opts_b, target)
+    if not r or pa is None or pb is None:
+        return none
+    E = np.asarray(eps)
+    Y = np.concatenate([model_a + E, model_b + E])  # the replicates of null A, then those of null B
+    ra, rb = batchfit.refit_many(law_a, opts_a, target, Y, pr=pa), batchfit.refit_many(law_b, opts_b, target, Y, pr=pb)
+    if ra is None or rb is None:
+        return none
+    head, tail = slice(0, r), slice(r, 2 * r)
+    # under A: B refitted to A's refitted curve, from B's refit; under B: A to B's curve, from A's refit
+    cb = batchfit.refit_many(law_b, opts_b, target, ra.models[head], starts={k: v[head] for k, v in rb.values.items()},
+                             pr=pb)
+    ca = batchfit.refit_many(law_a, opts_a, target, rb.models[tail], starts={k: v[tail] for k, v in ra.values.items()},
+                             pr=pa)
+    t = ra.chisqr - rb.chisqr
+    out = []
+    for part, centre, sign in ((head, cb, 1.0), (tail, ca, -1.0)):
+        ok = ra.ok[part] & rb.ok[part] & (centre.ok if centre is not None else False)
+        out.append([[float(t[part][i]), float(t[part][i] + sign * centre.chisqr[i]),
+                     distance(target, ra.models[part][i], rb.models[part][i])] if ok[i] else None for i in range(r)])
+    return out[0], out[1]
+
+
 def _null_row(laws, target, null: str, y: np.ndarray) -> list[float]:
-    """(T, S, D) of one replicate y under ``null``, its refits made one at a time (``_null_rows``)."""
+    """(T, S, D) of one replicate y under ``null``, its refits made one at a time (``replicate_chunk``)."""
     (law_a, opts_a), (law_b, opts_b) = laws
     tg = with_y(target, y, "parametric bootstrap replicate")
     try:
