@@ -14,7 +14,8 @@ Gauss-Newton step predicts a fall in chi-square below ``FTOL`` of it, or where a
 is below ``RESOLVED`` of it, or its step is below ``XTOL`` of its values, or no damped step lowers it (at the
 minimum to round-off): a tighter stop than the single refit's (its relative tolerance is ``fitmodel.FTOL``), so
 the two agree to well within that tolerance (tests/test_batchfit.py). A row that is not finite, or not converged
-in ``MAX_STEPS`` steps, comes back not ok and the caller refits it alone. None where no batched route serves (a
+in ``MAX_STEPS`` steps, or whose step the law refuses (a value beyond its bounds), comes back not ok and the caller
+refits it alone. None where no batched route serves (a
 third-party law, a freed scene quantity, an ODE solver, correlated noise): then every row is refitted alone.
 """
 from __future__ import annotations
@@ -82,7 +83,21 @@ class _Problem:
         return out | {k: np.full(m, v) for k, v in self.held.items()}
 
     def predict(self, X: np.ndarray) -> np.ndarray | None:
-        return predict_array(self.law, self.target, self.values(X), self.solver)
+        """Predictions (m, n) at scaled values X (m, k); NaN rows where a value is outside its law bounds (lmfit
+        passes bounds far beyond a parameter's scale as infinite, so a step may cross them: the law refuses it)."""
+        values = self.values(X)
+        inside = np.ones(X.shape[0], dtype=bool)
+        for spec in self.law.params:
+            inside &= (values[spec.name] >= spec.lower) & (values[spec.name] <= spec.upper)
+        if inside.all():
+            return predict_array(self.law, self.target, values, self.solver)
+        out = np.full((X.shape[0], self.target.y.size), np.nan)
+        if inside.any():
+            got = predict_array(self.law, self.target, {k: v[inside] for k, v in values.items()}, self.solver)
+            if got is None:
+                return None
+            out[inside] = got
+        return out
 
     def internal(self, X: np.ndarray) -> np.ndarray:
         """lmfit's ``setup_bounds`` per column (``levmar.Param.internal``), values clipped into the bounds first."""
@@ -161,7 +176,7 @@ def _levenberg_marquardt(pr: _Problem, Y: np.ndarray, U: np.ndarray):
     models, res, J = _with_jacobian(pr, U, Y)
     chisqr = np.einsum("ij,ij->i", res, res)
     ok = np.isfinite(chisqr) & np.isfinite(J).all(axis=(1, 2))
-    lam = np.full(r, LAMBDA0)
+    lam, nu = np.full(r, LAMBDA0), np.full(r, 2.0)
     running = ok.copy()
     for _ in range(MAX_STEPS):
         idx = np.nonzero(running)[0]
@@ -178,19 +193,30 @@ def _levenberg_marquardt(pr: _Problem, Y: np.ndarray, U: np.ndarray):
         trial = U[idx] + step
         m_new, r_new, J_new = _with_jacobian(pr, trial, Y[idx])
         c_new = np.einsum("ij,ij->i", r_new, r_new)
-        better = np.isfinite(c_new) & (c_new < chisqr[idx]) & np.isfinite(J_new).all(axis=(1, 2))
+        finite = np.isfinite(c_new) & np.isfinite(J_new).all(axis=(1, 2))
+        lost = idx[~finite]  # a step or its neighbours the law refuses: handed back, refitted alone
+        ok[lost], running[lost] = False, False
+        better = finite & (c_new < chisqr[idx])
+        # Nielsen's damping: after a step, by how well the quadratic model predicted its fall in chi-square (a
+        # large-residual fit, such as the series far from its range, overshoots with Gauss-Newton steps)
+        pred = -2.0 * np.einsum("rk,rk->r", step, g) - np.einsum("rk,rkl,rl->r", step, A, step)
+        with np.errstate(all="ignore"):
+            rho = (chisqr[idx] - c_new) / pred  # read for accepted steps only, whose fall and promise are > 0
         go = idx[better]
         U[go], chisqr[go], models[go], res[go], J[go] = trial[better], c_new[better], m_new[better], r_new[better], \
             J_new[better]
-        lam[go] = np.maximum(lam[go] / 10.0, 1e-15)
-        stay = idx[~better]
-        lam[stay] *= 10.0
+        lam[go] *= np.maximum(1.0 / 3.0, 1.0 - (2.0 * rho[better] - 1.0) ** 3)
+        lam[go] = np.maximum(lam[go], 1e-15)
+        nu[go] = 2.0
+        stay = idx[~better & finite]
+        lam[stay] *= nu[stay]
+        nu[stay] *= 2.0
         # no damped step lowers chi-square, or none where what a step promises is below the forward differences'
         # resolution: at the minimum
-        running[stay[(lam[stay] > LAMBDA_MAX) | (gain[~better] <= RESOLVED * chisqr[stay])]] = False
+        running[stay[(lam[stay] > LAMBDA_MAX) | (gain[~better & finite] <= RESOLVED * chisqr[stay])]] = False
         # a step below XTOL of the values (MINPACK's xtol): at the minimum, or at a kink of chi-square (a stick time
         # crossing a sample time) that smaller steps do not resolve
-        running[idx[np.all(np.abs(step) <= XTOL * (np.abs(U[idx]) + XTOL), axis=1)]] = False
+        running[idx[finite & np.all(np.abs(step) <= XTOL * (np.abs(U[idx]) + XTOL), axis=1)]] = False
     else:
         ok &= ~running  # still going after MAX_STEPS: not converged
     ok &= np.isfinite(chisqr) & np.isfinite(models).all(axis=1)
