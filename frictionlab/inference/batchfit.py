@@ -60,14 +60,11 @@ class Refits:
 
 
 class _Problem:
-    """One law on one target with ``opts`` (``replicates.refit_options``): its varying slots in lmfit's bounded
-    coordinates and the batched prediction."""
+    """One law on one target: its varying parameter slots (``fitmodel._Slot``) in lmfit's bounded coordinates, the
+    held ones' values, and the batched prediction."""
 
-    def __init__(self, law, opts: Mapping, target):
-        self.law, self.target, self.solver = law, target, opts["solver"]
-        fixed = law_values(law, opts.get("fixed") or {}, "fit: fixed")
-        initial = law_values(law, opts.get("initial") or {}, "fit: initial")
-        slots = _law_slots(law, [target], fixed, set(), initial)
+    def __init__(self, law, target, solver: str, slots):
+        self.law, self.target, self.solver = law, target, solver
         self.held = {s.key: s.value for s in slots if not s.vary}
         self.slots = [s for s in slots if s.vary]
         self.scale = np.array([s.scale for s in self.slots])
@@ -123,19 +120,51 @@ class _Problem:
 
 
 def problem(law, opts: Mapping, target) -> _Problem | None:
-    """The batched refit problem of ``law`` on ``target`` with ``opts``, or None where no batched route serves."""
+    """The batched refit problem of ``law`` on ``target`` with ``opts`` (``replicates.refit_options``: solver,
+    initial, fixed, free), or None where no batched route serves."""
     law = get_law(law)
-    if (is_third_party(law) or opts.get("free") or opts.get("solver") not in ("exact", "series")
-            or getattr(target, "derivation", None) or getattr(target.dataset, "noise_correlation", "none") != "none"
-            or target.observable == "stated"):
+    if opts.get("free"):
         return None
     try:
-        pr = _Problem(law, opts, target)
-        if not pr.slots or pr.predict(pr.start[None, :]) is None:
-            return None
+        fixed = law_values(law, opts.get("fixed") or {}, "fit: fixed")
+        initial = law_values(law, opts.get("initial") or {}, "fit: initial")
+        return _served(_Problem(law, target, opts.get("solver"), _law_slots(law, [target], fixed, set(), initial)))
     except FrictionLabError:
         return None
-    return pr
+
+
+def _served(pr: _Problem) -> _Problem | None:
+    """``pr`` where a batched route serves it (module docstring), else None."""
+    tg = pr.target
+    if (is_third_party(pr.law) or pr.solver not in ("exact", "series") or getattr(tg, "derivation", None)
+            or getattr(tg.dataset, "noise_correlation", "none") != "none" or tg.observable == "stated" or not pr.slots
+            or tg.y.size < len(pr.slots) + 1):
+        return None
+    try:
+        return pr if pr.predict(pr.start[None, :]) is not None else None
+    except FrictionLabError:
+        return None
+
+
+def best_start(model, starts: list[dict[str, float]]) -> dict[str, float] | None:
+    """Of a fit's Levenberg-Marquardt ``starts`` (scaled values of the varying slots by lmfit name), the one whose
+    batched run ends lowest, moved to where it ended; None where no batched route serves ``model``
+    (``fitmodel._Model``: one target, law slots only). The fit then runs its own Levenberg-Marquardt from there
+    alone, instead of from every start (``fitmodel._search``)."""
+    if len(model.targets) != 1 or any(s.kind != "law" for s in model.slots):
+        return None
+    pr = _served(_Problem(model.law, model.targets[0], model.solvers[0], model.slots))
+    if pr is None:
+        return None
+    X0 = np.array([[st[s.pname] for s in pr.slots] for st in starts])
+    try:
+        U, chisqr, _, ok = _levenberg_marquardt(pr, np.tile(pr.target.y, (len(starts), 1)), pr.internal(X0))
+    except FrictionLabError:
+        return None
+    if not ok.any():
+        return None
+    i = int(np.argmin(np.where(ok, chisqr, np.inf)))
+    return {s.pname: float(x) for s, x in zip(pr.slots, pr.external(U[i:i + 1])[0])}
 
 
 def refit_many(law, opts: Mapping, target, Y: np.ndarray, starts: Mapping[str, np.ndarray] | None = None,

@@ -407,6 +407,11 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
         if wide:  # the best of the given grid alone, as a fit of a law without memory starts, and of the widest
             starts += [c for c in _distinct([x for x in scored if x[1] < given], n_starts) if c not in starts]
             starts += [c for c in _distinct([x for x in scored if x[1] >= fine], n_starts) if c not in starts]
+    if len(starts) > 1 and not slow:  # closed forms: every start's run in one batch, then lmfit's from the best end
+        from .batchfit import best_start
+
+        moved = best_start(model, starts)
+        starts = [moved] if moved is not None else starts
     best, notes = None, []
     for i, start in enumerate(starts):
         for k, v in start.items():  # every varying parameter; lmfit works on its own copy
