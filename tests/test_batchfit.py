@@ -20,6 +20,12 @@ def _data(truth: str, where: str):
     return synthetic(truth, TRUTH[truth], scene, n=26 if where == "impact" else 41, name=f"{where}-{truth}")
 
 
+def _one_at_a_time(monkeypatch):
+    """Every refit one at a time through lmfit's Levenberg-Marquardt (levmar), no batch anywhere."""
+    monkeypatch.setattr(batchfit, "problem", lambda *a, **k: None)
+    monkeypatch.setattr(batchfit, "best_start", lambda *a, **k: None)
+
+
 def _replicates(f, n: int, seed: int = 3):
     tg = f.per_dataset[0].target
     return tg, f.per_dataset[0].model + np.random.default_rng(seed).normal(0.0, tg.sigma, (n, tg.y.size))
@@ -40,7 +46,7 @@ def test_the_batched_prediction_is_the_single_one_to_round_off(law, solver, wher
 
 @pytest.mark.parametrize("law, solver, where", CASES)
 @pytest.mark.parametrize("truth", ["coulomb", "area-rate"])
-def test_batched_refits_reach_the_single_refits_minimum(law, solver, where, truth):
+def test_batched_refits_reach_the_single_refits_minimum(law, solver, where, truth, monkeypatch):
     """Every row converges; its chi-square is the single refit's within that refit's own tolerance (relative
     1e-6), or lower; its values within 0.01 of the base fit's standard error where it is not lower."""
     f = fit(law, _data(truth, where), solver=solver)
@@ -49,6 +55,9 @@ def test_batched_refits_reach_the_single_refits_minimum(law, solver, where, trut
     tg, Y = _replicates(f, 12)
     got = batchfit.refit_many(law, opts, tg, Y)
     assert got is not None and got.ok.all()
+    via_fit = [refit(law, opts, with_y(tg, Y[i], "replicate")) for i in range(len(Y))]  # the batched starts' answer
+    assert np.allclose([r.stats.chisqr for r in via_fit], got.chisqr, rtol=1e-9)
+    _one_at_a_time(monkeypatch)
     for i in range(len(Y)):
         one = refit(law, opts, with_y(tg, Y[i], "replicate"))
         assert one.ok
@@ -98,7 +107,7 @@ def test_the_equivalence_replicates_are_those_of_the_single_refits(monkeypatch):
     args = ("wear", refit_options(fa), "area-rate", refit_options(fb), fa.per_dataset[0].target,
             fa.per_dataset[0].model, fb.per_dataset[0].model, seed_sequence(0, "test").spawn(6))
     batched = np.array(replicate_chunk(*args))
-    monkeypatch.setattr(batchfit, "problem", lambda *a, **k: None)
+    _one_at_a_time(monkeypatch)
     single = np.array(replicate_chunk(*args))
     assert batched.shape == single.shape == (6, 7)
     scale = max(1.0, float(np.max(np.abs(single[:, [0, 1, 3, 4]]))))
@@ -110,7 +119,7 @@ def test_the_bootstrap_replicates_are_those_of_the_single_refits(monkeypatch):
     boot = lambda: bootstrap.bootstrap(bootstrap.law_fit("area-rate", "exact"), data, n=24, seed=5,  # noqa: E731
                                        method="parametric")
     batched = boot()
-    monkeypatch.setattr(batchfit, "problem", lambda *a, **k: None)
+    _one_at_a_time(monkeypatch)
     single = boot()
     assert batched.n_ok == single.n_ok == 24
     for name in batched.names:

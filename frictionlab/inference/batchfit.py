@@ -136,7 +136,7 @@ def problem(law, opts: Mapping, target) -> _Problem | None:
 def _served(pr: _Problem) -> _Problem | None:
     """``pr`` where a batched route serves it (module docstring), else None."""
     tg = pr.target
-    if (is_third_party(pr.law) or pr.solver not in ("exact", "series") or getattr(tg, "derivation", None)
+    if (is_third_party(pr.law) or pr.solver not in ("exact", "series")
             or getattr(tg.dataset, "noise_correlation", "none") != "none" or tg.observable == "stated" or not pr.slots
             or tg.y.size < len(pr.slots) + 1):
         return None
@@ -146,11 +146,12 @@ def _served(pr: _Problem) -> _Problem | None:
         return None
 
 
-def best_start(model, starts: list[dict[str, float]]) -> dict[str, float] | None:
+def best_start(model, starts: list[dict[str, float]]) -> tuple[dict[str, float], float] | None:
     """Of a fit's Levenberg-Marquardt ``starts`` (scaled values of the varying slots by lmfit name), the one whose
-    batched run ends lowest, moved to where it ended; None where no batched route serves ``model``
-    (``fitmodel._Model``: one target, law slots only). The fit then runs its own Levenberg-Marquardt from there
-    alone, instead of from every start (``fitmodel._search``)."""
+    batched run ends lowest, moved to where it ended, and its chi-square; None where no batched route serves
+    ``model`` (``fitmodel._Model``: one target, law slots only) or no run converged. A refit takes that end as its
+    answer; a fit runs lmfit's Levenberg-Marquardt from there alone, instead of from every start
+    (``fitmodel._search``)."""
     if len(model.targets) != 1 or any(s.kind != "law" for s in model.slots):
         return None
     pr = _served(_Problem(model.law, model.targets[0], model.solvers[0], model.slots))
@@ -164,7 +165,7 @@ def best_start(model, starts: list[dict[str, float]]) -> dict[str, float] | None
     if not ok.any():
         return None
     i = int(np.argmin(np.where(ok, chisqr, np.inf)))
-    return {s.pname: float(x) for s, x in zip(pr.slots, pr.external(U[i:i + 1])[0])}
+    return {s.pname: float(x) for s, x in zip(pr.slots, pr.external(U[i:i + 1])[0])}, float(chisqr[i])
 
 
 def refit_many(law, opts: Mapping, target, Y: np.ndarray, starts: Mapping[str, np.ndarray] | None = None,
