@@ -72,6 +72,7 @@ class _Problem:
         self.hi = np.array([_lmfit_bound(s.upper, s) / s.scale for s in self.slots])
         self.start = np.array([s.value / s.scale for s in self.slots])
         self.sigma = np.asarray(target.sigma, dtype=float)
+        self.evaluations = 0  # parameter sets predicted so far (each row of each batch)
 
     def values(self, X: np.ndarray) -> dict[str, np.ndarray]:
         """Law parameters [SI] for scaled external values X (m, k)."""
@@ -83,6 +84,7 @@ class _Problem:
         """Predictions (m, n) at scaled values X (m, k); NaN rows where a value is outside its law bounds (lmfit
         passes bounds far beyond a parameter's scale as infinite, so a step may cross them: the law refuses it)."""
         values = self.values(X)
+        self.evaluations += X.shape[0]
         inside = np.ones(X.shape[0], dtype=bool)
         for spec in self.law.params:
             inside &= (values[spec.name] >= spec.lower) & (values[spec.name] <= spec.upper)
@@ -162,6 +164,8 @@ def best_start(model, starts: list[dict[str, float]]) -> tuple[dict[str, float],
         U, chisqr, _, ok = _levenberg_marquardt(pr, np.tile(pr.target.y, (len(starts), 1)), pr.internal(X0))
     except FrictionLabError:
         return None
+    finally:
+        model.nfev += pr.evaluations  # the fit's count of model evaluations includes the batched ones
     if not ok.any():
         return None
     i = int(np.argmin(np.where(ok, chisqr, np.inf)))
