@@ -1,22 +1,24 @@
-"""Many refits of one law to one dataset's points at once: the replicates of the equivalence test and the bootstrap.
+"""Many refits of one law to one dataset's points at once: the equivalence test's and the bootstrap's replicates,
+their cross fits, and a fit's start points.
 
 A replicate refit is a small least-squares problem (one or two law parameters, tens of points) solved thousands of
 times a comparison; one at a time, each Levenberg-Marquardt step is one closed-form solve through the general phase
 driver, and the Python around it is most of the cost. ``refit_many(law, opts, target, Y, starts)`` fits every row of
 Y (r, n) together instead: one Levenberg-Marquardt run per row, all rows stepping at once, each step one batched
 prediction (``predict.predict_array``: the closed forms over a batch of parameter sets, or the paper's series) of
-every row's trial point and its forward-difference neighbours.
+every running row's trial point and its forward-difference neighbours. ``best_start(model, starts)`` runs a fit's
+starts the same way (``fitmodel._search``).
 
-The problem is the one ``fitting.fit`` poses for the refit (``replicates.refit``): the same parameter slots, scales
-and bounds (``fitmodel._law_slots``), lmfit's bounded coordinates (MINUIT's transformation, as ``levmar``), lmfit's
-forward-difference steps (relative sqrt(1e-10)), the chi-square at the dataset's sigma. Each row stops where the
-Gauss-Newton step predicts a fall in chi-square below ``FTOL`` of it, or where a step is refused and its promise
-is below ``RESOLVED`` of it, or its step is below ``XTOL`` of its values, or no damped step lowers it (at the
-minimum to round-off): a tighter stop than the single refit's (its relative tolerance is ``fitmodel.FTOL``), so
-the two agree to well within that tolerance (tests/test_batchfit.py). A row that is not finite, or not converged
-in ``MAX_STEPS`` steps, or whose step the law refuses (a value beyond its bounds), comes back not ok and the caller
-refits it alone. None where no batched route serves (a
-third-party law, a freed scene quantity, an ODE solver, correlated noise): then every row is refitted alone.
+The problem is the one ``fitting.fit`` poses (``replicates.refit``): the same parameter slots, scales and bounds
+(``fitmodel._law_slots``), lmfit's bounded coordinates (MINUIT's transformation, as ``levmar``), lmfit's
+forward-difference steps (relative sqrt(1e-10)), the chi-square at the dataset's sigma; Nielsen's damping. Each row
+stops where the Gauss-Newton step promises a fall in chi-square below ``FTOL`` of it, or a step is refused whose
+promise is below ``RESOLVED`` of it, or its step is below ``XTOL`` of its values, or no damped step lowers it:
+a tighter stop than the single refit's (relative tolerance ``fitmodel.FTOL``), so the two agree well within that
+tolerance or the batch's minimum lies lower (tests/test_batchfit.py). A row that is not finite, not converged in
+``MAX_STEPS`` steps, or whose step the law refuses (a value beyond its bounds) comes back not ok and the caller
+refits it alone. None where no batched route serves (a third-party law, a freed scene quantity, an ODE solver,
+correlated noise, stated numbers): then every row is refitted alone.
 """
 from __future__ import annotations
 
