@@ -190,7 +190,9 @@ def test_command_line_defaults_agree_with_the_library():
 
 
 def test_replicate_refits_without_error_analysis_give_the_same_statistic(coulomb_data, monkeypatch):
-    """The replicates' refits skip the Jacobian (fit(errors=False)): T on every replicate is what full fits give."""
+    """The replicates' refits skip the Jacobian (fit(errors=False)): T on every replicate is what full fits give
+    (a refit that reads values only ends where the batched starts end, a full fit polishes that end with lmfit's
+    own run: the cross refits' chi-squares agree far within the fits' tolerance)."""
     from frictionlab.inference import fitting
 
     _, fc, fw, e = coulomb_data
@@ -199,7 +201,8 @@ def test_replicate_refits_without_error_analysis_give_the_same_statistic(coulomb
     monkeypatch.setattr(replicates, "fit", lambda *a, errors=True, **k: fitting.fit(*a, **k))
     full = analyze_equivalence(fc, fw, replicates=R)
     assert np.array_equal(full.t_a, e.t_a) and np.array_equal(full.t_b, e.t_b)
-    assert (full.d_ab, full.d_ba, full.verdict, full.p_within) == (e.d_ab, e.d_ba, e.verdict, e.p_within)
+    assert (full.verdict, full.p_within) == (e.verdict, e.p_within)
+    assert full.d_ab == pytest.approx(e.d_ab, rel=1e-9) and full.d_ba == pytest.approx(e.d_ba, rel=1e-9)
 
 
 def test_a_kept_law_whose_own_p_is_below_half_alpha_is_rejected_too(coulomb_data):

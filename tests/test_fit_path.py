@@ -294,8 +294,9 @@ def _numbers(r):
 def test_refits_run_levenberg_marquardt_directly_with_lmfits_numbers(law, options, monkeypatch):
     """fit(checks=False) runs lmfit's Levenberg-Marquardt through levmar.leastsq: values, error bars,
     correlations, chi-square, messages and evaluation counts are those of lmfit itself, bit for bit."""
-    from frictionlab.inference import levmar
+    from frictionlab.inference import batchfit, levmar
 
+    monkeypatch.setattr(batchfit, "best_start", lambda *a: None)  # the batched starts aside (tests/test_batchfit.py)
     data = synthetic(law, TRUTH[law], n=21, name=f"direct-{law}", rel_noise=0.03)
     calls = []
     direct_run = levmar.leastsq
@@ -374,8 +375,10 @@ def test_refits_of_resampled_data_share_the_evaluations_the_data_do_not_change(m
     import numpy as np
 
     from frictionlab import get_law
-    from frictionlab.inference import fitmodel, predict as predict_module
+    from frictionlab.inference import batchfit, fitmodel, predict as predict_module
     from frictionlab.inference.replicates import refit, refit_options, with_y
+
+    monkeypatch.setattr(batchfit, "best_start", lambda *a: None)  # the one-at-a-time path (an ODE's, a plugin's)
 
     data = synthetic("area-rate", TRUTH["area-rate"], n=21, name="shared-evals", rel_noise=0.03)
     base = fit("area-rate", data, solver="exact")

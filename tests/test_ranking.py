@@ -124,3 +124,20 @@ def test_one_curve_of_an_unflagged_and_a_flagged_law_is_one_row_with_both_flags(
     assert set(status) == {"coulomb = area-rate [exact]", "wear [exact]"}
     assert status["coulomb = area-rate [exact]"] == \
         "same curve; FLAG (area-rate only): slip reaches 7e6 times the starting speed"
+
+
+def test_one_family_is_represented_by_its_simplest_member_where_they_reach_one_minimum():
+    """Wear and Couette fitted to one dataset reach one minimum; which lands a round-off lower decides nothing."""
+    from _fit_helpers import impact_scene
+
+    from frictionlab import fit
+    from frictionlab.inference.ranking import merge_identical
+
+    data = synthetic("wear", TRUTH["wear"], impact_scene(), name="one-family")
+    w, c = fit("wear", data, solver="exact"), fit("couette", data, solver="exact")
+    for pair in ((w, c), (c, w)):
+        ((best, members, _),) = merge_identical(list(pair))
+        assert best.law == "wear" and members == ("wear", "couette")
+    worse = attrs.evolve(w, stats=attrs.evolve(w.stats, aic=w.stats.aic + 1.0, chisqr=w.stats.chisqr + 1.0))
+    ((best, _, _),) = merge_identical([worse, c])
+    assert best.law == "couette"  # a member clearly lower stands for the family

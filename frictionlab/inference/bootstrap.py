@@ -175,21 +175,65 @@ def _aic(result):
 
 def _run_chunk(fit_fns, datasets, models, method, seeds):
     """Fit every function in fit_fns to the replicates of seeds; returns, per seed, per function,
-    (values or None, aic, failure reason)."""
+    (values or None, aic, failure reason). A warm-started law's refits of every seed are made together where a
+    batched route serves (``_batched``), the others one at a time."""
     single = len(datasets) == 1
+    data = [_resample(datasets, models, method, np.random.default_rng(seed)) for seed in seeds]
+    cols = [_batched(fn, names, datasets, method, data) if single else None for fn, names in fit_fns]
     out = []
-    for seed in seeds:
-        rng = np.random.default_rng(seed)
-        data = _resample(datasets, models, method, rng)
+    for r, replicate in enumerate(data):
         row = []
-        for fn, names in fit_fns:
+        for (fn, names), col in zip(fit_fns, cols):
+            if col is not None and col[r] is not None:
+                row.append(col[r])
+                continue
             try:
-                r = fn(data[0] if single else data)
-                vals = _values(r, names)
-                row.append((vals, _aic(r), "" if vals is not None else (getattr(r, "reason", "") or "fit failed")))
+                res = fn(replicate[0] if single else replicate)
+                vals = _values(res, names)
+                row.append((vals, _aic(res), "" if vals is not None else (getattr(res, "reason", "") or "fit failed")))
             except FrictionLabError as exc:
                 row.append((None, math.nan, str(exc)))
         out.append(row)
+    return out
+
+
+#: LawFit options a batched refit reproduces (``_batched``); any other keeps the refits one at a time.
+BATCHED_OPTIONS = frozenset({"fixed", "initial", "timeout", "rtol", "max_nfev"})
+
+
+def _batched(fn, names, datasets, method, data) -> list | None:
+    """Per replicate of ``data`` (one dataset each) ``fn``'s row (values, aic, '') from one batched refit
+    (``batchfit.refit_many``), None for a replicate it did not serve; None where no batched route serves: a
+    parametric bootstrap of a warm-started law (``LawFit.warm``) with options the batch reproduces."""
+    from . import batchfit
+    from .fitstats import neg2loglik, noise_kind
+    from .predict import auto_solver, make_target
+
+    if not (isinstance(fn, LawFit) and fn.start and method == "parametric" and set(dict(fn.options)) <= BATCHED_OPTIONS):
+        return None
+    ds, opts = datasets[0], dict(fn.options)
+    try:
+        target = make_target(ds, None, None)
+        solver = auto_solver(fn.law, ds.scene) if fn.solver == "auto" else fn.solver
+    except FrictionLabError:
+        return None
+    refit = {"solver": solver, "fixed": opts.get("fixed") or {},
+             "initial": {**dict(opts.get("initial") or {}), **dict(fn.start)}}
+    pr = batchfit.problem(fn.law, refit, target)
+    if pr is None or target.y.size < len(pr.slots) + 1:
+        return None
+    got = batchfit.refit_many(fn.law, refit, target, np.array([d[0].y for d in data]), pr=pr)
+    if got is None:
+        return None
+    k = len(pr.slots) if fn.n_params is None else int(fn.n_params)
+    kind = noise_kind(target)
+    out = []
+    for i in range(len(data)):
+        if not got.ok[i]:
+            out.append(None)
+            continue
+        vals = [float(got.values[n][i]) if n in got.values else math.nan for n in names]
+        out.append((vals, neg2loglik(float(got.chisqr[i]), target.y.size, target.sigma, kind) + 2 * k, ""))
     return out
 
 
@@ -207,7 +251,8 @@ def _guarded_chunk(fit_fns, datasets, models, method, seeds):
 def _dispatch(executor, fit_fns, datasets, models, method, seed, n, chunk, progress=None):
     """Rows of _run_chunk over n resamples in batches of ``chunk``; progress(done, n) after each batch."""
     seeds = np.random.SeedSequence(seed).spawn(n)
-    chunk = max(1, int(chunk or math.ceil(n / 16)))
+    # run here, the replicates are one chunk, so that a law's refits of them are one batch (``_batched``)
+    chunk = max(1, int(chunk or (math.ceil(n / 16) if executor is not None else n)))
     groups = [seeds[i:i + chunk] for i in range(0, n, chunk)]
     parts, done = [], 0
     futures = None if executor is None else [executor.submit(_guarded_chunk, fit_fns, datasets, models, method, g)
@@ -279,7 +324,7 @@ def bootstrap(fit_fn: Callable[..., FitResult], dataset: DatasetLike | Sequence[
     """Refit ``n`` resampled copies of ``dataset`` (a Dataset, name or path, or a list fitted together).
 
     fit_fn(data) -> FitResult, e.g. ``law_fit('wear', solver='exact')`` (warm-started replicates) or
-    any picklable callable. chunk: replicates per submitted task (default: n / 16, at least 1).
+    any picklable callable. chunk: replicates per submitted task (default: n / 16 with an executor, n without; at least 1).
     base: fit_fn's FitResult on the original data, if already made (else it is fitted here).
     """
     _check_n(n, seed)

@@ -371,12 +371,14 @@ def epsfcn(model: _Model) -> float:
 
 
 def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: int, max_nfev, scale_covar: bool = True,
-            direct: bool = False):
+            direct: bool = False, values_only: bool = False):
     """Score a grid of starts, refine the best distinct ones with Levenberg-Marquardt, keep the lowest
     chi-square. Returns (parameters, success, message, lmfit MinimizerResult or None, notes). scale_covar:
     scale lmfit's error bars by sqrt(reduced chi2) (only when sigma is not known). direct: run lmfit's
     Levenberg-Marquardt through ``levmar.leastsq`` (the same numbers without lmfit's bookkeeping; its
-    result is not a MinimizerResult), lmfit itself where that declines."""
+    result is not a MinimizerResult), lmfit itself where that declines. Closed forms run every start in one batch
+    (``batchfit.best_start``) and Levenberg-Marquardt from the lowest end only; with values_only (direct, and the
+    caller reads values and chi-square only: a replicate refit) that end is the answer."""
     varying = [s for s in slots if s.vary]
     if not varying:
         return params, True, "nothing to fit: every parameter is held", None, []
@@ -407,6 +409,16 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
         if wide:  # the best of the given grid alone, as a fit of a law without memory starts, and of the widest
             starts += [c for c in _distinct([x for x in scored if x[1] < given], n_starts) if c not in starts]
             starts += [c for c in _distinct([x for x in scored if x[1] >= fine], n_starts) if c not in starts]
+    if not slow and (values_only or len(starts) > 1):  # closed forms: every start's run in one batch
+        from .batchfit import best_start
+
+        moved = best_start(model, starts)
+        if moved is not None and values_only and direct:
+            for k, v in moved[0].items():
+                params[k].set(value=v)
+            return params, True, "Fit succeeded.", levmar.Result(params, True, "Fit succeeded.", moved[1]), []
+        if moved is not None:  # lmfit's own run from the lowest end, for its error analysis
+            starts = [moved[0]]
     best, notes = None, []
     for i, start in enumerate(starts):
         for k, v in start.items():  # every varying parameter; lmfit works on its own copy

@@ -207,7 +207,8 @@ def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], s
         return give_up("skipped", f"{', '.join(names)}: {n_points} data point{'s' * (n_points != 1)} for {len(varying)} free parameter"
                                   f"{'s' * (len(varying) != 1)}: a fit needs at least {len(varying) + 1}")
     likelihood = _likelihood(targets)
-    found = _run_search(lmfit, model, params, slots, solvers, (scan, n_starts, max_nfev), likelihood, checks, timeout)
+    found = _run_search(lmfit, model, params, slots, solvers, (scan, n_starts, max_nfev), likelihood, checks, timeout,
+                        values_only=not (checks or errors))
     if len(found) == 3:  # (status, reason, extra): failed or skipped
         return give_up(*found[:2], **found[2])
     known = None
@@ -264,15 +265,16 @@ def _polished(lmfit, law, model, slots, found, scale_covar: bool, timeout):
             (J, find_structure(law, slots, values, J)))
 
 
-def _run_search(lmfit, model, params, slots, solvers, budget, likelihood, checks, timeout):
+def _run_search(lmfit, model, params, slots, solvers, budget, likelihood, checks, timeout, values_only=False):
     """The search under the time budget: (SI values, models, parameters, lmfit result, (success, message,
-    notes)), or (status, reason, extra) of a fit that failed or is skipped. budget: (scan, n_starts, max_nfev)."""
+    notes)), or (status, reason, extra) of a fit that failed or is skipped. budget: (scan, n_starts, max_nfev);
+    values_only: the caller reads values and chi-square only (``fitmodel._search``)."""
     success, message = True, ""
     try:
         with _alarm(timeout):
             best_params, success, message, best, notes = _search(lmfit, model, params, slots, solvers, *budget,
                                                                  scale_covar=likelihood not in AS_GIVEN,
-                                                                 direct=not checks)
+                                                                 direct=not checks, values_only=values_only)
             values = _si(best_params, slots)
             models = model.models(values)
         model.deadline = None  # the error analysis after it is bounded work

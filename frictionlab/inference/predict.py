@@ -225,9 +225,19 @@ def predict(law: str | FrictionLaw, target: Target, params: Mapping[str, float],
 
 def predict_many(law, target: Target, params_list, solver: str, scene: Scene | None = None) -> list | None:
     """``predict`` at each parameter set of ``params_list`` (SI) in one vectorized call where the kind offers one
-    (the closed forms of impact outcomes, each set's rows on the batch engine at once); None where it does not,
-    or refuses, and ``predict`` one set at a time gives each answer or error."""
+    (an impact's or incline's series by ``predict_array``; the closed forms of impact outcomes, each set's rows on
+    the batch engine at once); None where it does not, or refuses, and ``predict`` one set at a time gives each
+    answer or error."""
     law = get_law(law)
+    if scene is None or scene is target.dataset.scene:  # a series on the dataset's own scene: the batch of closed forms
+        names = set().union(*params_list) if params_list else set()
+        try:
+            got = predict_array(law, target, {k: np.array([p.get(k, law.spec(k).default) for p in params_list],
+                                                           dtype=float) for k in names}, solver) if names else None
+        except FrictionLabError:
+            got = None
+        if got is not None:
+            return list(got)
     if (solver != "exact" or target.dataset.kind != "impact-outcome" or target.observable not in OUTCOMES
             or target.observable in ("psi1", "psi2") or PREDICTORS.get("impact-outcome") is not outcome_predictor):
         return None
@@ -310,3 +320,40 @@ def get_scene_quantity(scene: Scene, name: str) -> float:
     if not isinstance(obj, (int, float)):
         raise ParameterError(f"scene quantity '{name}' is not a number on this scene")
     return float(obj)
+
+
+#: The observables ``predict_array`` reads off a batch of trajectories.
+ARRAY_SERIES = ("omega", "theta", "v", "u")
+
+
+def predict_array(law, target: Target, params: Mapping[str, np.ndarray], solver: str) -> np.ndarray | None:
+    """``predict`` at m parameter sets at once: ``params`` maps every law parameter to an (m,) array [SI]; returns
+    the (m, n) predictions of ``target.y``, or None where no batched route serves (then ``predict`` one set at a
+    time). Served: a built-in law (a third party's force need not broadcast over parameter sets) with the built-in
+    series predictor of an impact or incline on its dataset's scene, solved by the closed forms over a batch of
+    parameter sets (``solve.batch``, equal to ``simulate(..., 'exact')`` to round-off; tests/test_batchfit.py)
+    or by the paper's series. Raises FrictionLabError where the batch cannot be solved (a value outside its
+    bounds)."""
+    from ..physics.registry import is_third_party
+    from ..solve.batch import simulate_batch
+    from ..solve.plan import make_plan
+    from ..solve.scenebatch import SceneBatch, batch_params, take_params
+    from ..solve.solvers import series
+
+    law = get_law(law)
+    ds = target.dataset
+    if (is_third_party(law) or ds.kind not in ("impact", "incline") or PREDICTORS.get(ds.kind) is not _predict_series
+            or ds.scene is None or target.observable not in ARRAY_SERIES or solver not in ("exact", "series")):
+        return None
+    m = len(next(iter(params.values())))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        if solver == "series":
+            plan = make_plan(ds.scene, law)
+            p = take_params(batch_params(law, params, m), slice(None), column=True)
+            form = series.check(plan, p)
+            out = series.curves(plan, form.k, np.asarray(target.t, dtype=float))[target.observable]
+        else:
+            res = simulate_batch(law, SceneBatch(ds.scene, {}, m), params, t=target.t, solver="exact")
+            out = getattr(res, SERIES[target.observable])
+    return np.array(np.broadcast_to(out, (m, target.y.size)), dtype=float)

@@ -35,6 +35,7 @@ from collections import defaultdict
 import attrs
 import numpy as np
 
+from .fitmodel import FTOL
 from .fitting import FitResult
 
 #: Candidates whose AIC differ by at most this much share a rank (the same fitted curve).
@@ -206,8 +207,10 @@ def _parameterization(f: FitResult) -> str:
 
 
 def merge_identical(fits: list[FitResult]) -> list[tuple[FitResult, tuple[str, ...], str]]:
-    """Single-dataset fits with structurally identical laws merged: (representative: the lowest AIC,
-    member laws, their parameterizations and the shared form), in order of first appearance."""
+    """Single-dataset fits with structurally identical laws merged: (representative, member laws, their
+    parameterizations and the shared form), in order of first appearance. The representative is the simplest
+    member (fewest parameters) of those at the lowest AIC within the fits' relative tolerance (``fitmodel.FTOL``
+    of chi-square): the members reach one minimum, and which of them lands a round-off lower decides nothing."""
     from ..physics.registry import get_law
 
     groups: dict = {}
@@ -225,8 +228,10 @@ def merge_identical(fits: list[FitResult]) -> list[tuple[FitResult, tuple[str, .
         if len(members) == 1:
             out.append((members[0], (members[0].law,), ""))
             continue
-        best = min(members, key=lambda f: f.stats.aic)
         members = sorted(members, key=lambda f: (len(get_law(f.law).params), f.law))  # 'wear = couette': simplest first
+        score = {id(f): f.stats.aic if math.isfinite(f.stats.aic) else f.stats.chisqr for f in members}
+        low = min(score.values())  # one minimum, reached by each within the fits' own tolerance: the simplest stands
+        best = next((f for f in members if score[id(f)] <= low + FTOL * max(1.0, f.stats.chisqr)), members[0])
         form_cls = key[1][0]
         what = (form_cls.__doc__ or form_cls.__name__).split(".")[0]
         text = (f"one closed-form family ({what}): " + "; ".join(_parameterization(f) for f in members))

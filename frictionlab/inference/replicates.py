@@ -81,34 +81,74 @@ def replicate_chunk(law_a, opts_a, law_b, opts_b, target, model_a, model_b, seed
     S_A = T + (B refitted to A's refitted curve), S_B = T - (A refitted to B's refitted curve): T centred
     at its location under the replicate's own fit (``equivalence``, module docstring); D the RMS distance of
     the two refitted curves (``distance``). With an estimated sigma of ``df`` degrees of freedom each
-    replicate's chi-squares are at its own estimate sigma^2 chi2_df / df. Runs in a worker."""
+    replicate's chi-squares are at its own estimate sigma^2 chi2_df / df. The refits of every seed are made
+    together where a batched route serves (``batchfit``), else one at a time. Runs in a worker."""
     from .ar1 import noise_drawer
 
     noise = noise_drawer(target.dataset, target.y, model_a, target.sigma)  # Gaussian, or AR(1) where declared
-    out = []
+    eps, scale = [], []
     for ss in seeds:
         rng = np.random.default_rng(ss)
-        eps = noise(rng)
-        scale = df / rng.chisquare(df) if math.isfinite(df) else 1.0
-        row = []
-        for null, model in (("a", model_a), ("b", model_b)):
-            tg = with_y(target, model + eps, "parametric bootstrap replicate")
-            try:
-                ra, rb = refit(law_a, opts_a, tg), refit(law_b, opts_b, tg)
-            except FrictionLabError:
-                row += [math.nan] * 3
-                continue
-            if not (ra.ok and rb.ok):
-                row += [math.nan] * 3
-                continue
-            t = ra.stats.chisqr - rb.stats.chisqr
-            if null == "a":
-                s = t + centring(law_b, opts_b, rb, target, ra.per_dataset[0].model)
-            else:
-                s = t - centring(law_a, opts_a, ra, target, rb.per_dataset[0].model)
-            row += [scale * t, scale * s, distance(target, ra.per_dataset[0].model, rb.per_dataset[0].model)]
-        out.append(tuple(row) + (1.0 / math.sqrt(scale),))
-    return out
+        eps.append(noise(rng))
+        scale.append(df / rng.chisquare(df) if math.isfinite(df) else 1.0)
+    laws = ((law_a, opts_a), (law_b, opts_b))
+    got = _batched_rows(laws, target, model_a, model_b, eps)
+    rows = []
+    for i, sc in enumerate(scale):
+        ra = got[0][i] or _null_row(laws, target, "a", model_a + eps[i])
+        rb = got[1][i] or _null_row(laws, target, "b", model_b + eps[i])
+        rows.append((sc * ra[0], sc * ra[1], ra[2], sc * rb[0], sc * rb[1], rb[2], 1.0 / math.sqrt(sc)))
+    return rows
+
+
+def _batched_rows(laws, target, model_a, model_b, eps: list) -> tuple[list, list]:
+    """(T, S, D) per replicate under null A and under null B (``replicate_chunk``, before the sigma draw's scale),
+    each replicate's refits made in batches (``batchfit``: both laws on the replicates of both nulls, then each
+    null's centring refit); None for a replicate the batches did not serve, every one where none serves."""
+    from . import batchfit
+
+    (law_a, opts_a), (law_b, opts_b) = laws
+    r = len(eps)
+    none = ([None] * r, [None] * r)
+    pa, pb = batchfit.problem(law_a, opts_a, target), batchfit.problem(law_b, opts_b, target)
+    if not r or pa is None or pb is None:
+        return none
+    E = np.asarray(eps)
+    Y = np.concatenate([model_a + E, model_b + E])  # the replicates of null A, then those of null B
+    ra, rb = batchfit.refit_many(law_a, opts_a, target, Y, pr=pa), batchfit.refit_many(law_b, opts_b, target, Y, pr=pb)
+    if ra is None or rb is None:
+        return none
+    head, tail = slice(0, r), slice(r, 2 * r)
+    # under A: B refitted to A's refitted curve, from B's refit; under B: A to B's curve, from A's refit
+    cb = batchfit.refit_many(law_b, opts_b, target, ra.models[head], starts={k: v[head] for k, v in rb.values.items()},
+                             pr=pb)
+    ca = batchfit.refit_many(law_a, opts_a, target, rb.models[tail], starts={k: v[tail] for k, v in ra.values.items()},
+                             pr=pa)
+    t = ra.chisqr - rb.chisqr
+    out = []
+    for part, centre, sign in ((head, cb, 1.0), (tail, ca, -1.0)):
+        ok = ra.ok[part] & rb.ok[part] & (centre.ok if centre is not None else False)
+        out.append([[float(t[part][i]), float(t[part][i] + sign * centre.chisqr[i]),
+                     distance(target, ra.models[part][i], rb.models[part][i])] if ok[i] else None for i in range(r)])
+    return out[0], out[1]
+
+
+def _null_row(laws, target, null: str, y: np.ndarray) -> list[float]:
+    """(T, S, D) of one replicate y under ``null``, its refits made one at a time (``replicate_chunk``)."""
+    (law_a, opts_a), (law_b, opts_b) = laws
+    tg = with_y(target, y, "parametric bootstrap replicate")
+    try:
+        ra, rb = refit(law_a, opts_a, tg), refit(law_b, opts_b, tg)
+    except FrictionLabError:
+        return [math.nan] * 3
+    if not (ra.ok and rb.ok):
+        return [math.nan] * 3
+    t = ra.stats.chisqr - rb.stats.chisqr
+    if null == "a":
+        s = t + centring(law_b, opts_b, rb, target, ra.per_dataset[0].model)
+    else:
+        s = t - centring(law_a, opts_a, ra, target, rb.per_dataset[0].model)
+    return [t, s, distance(target, ra.per_dataset[0].model, rb.per_dataset[0].model)]
 
 
 def one_family(fit_a: FitResult, fit_b: FitResult) -> bool:

@@ -61,28 +61,36 @@ def b_parameter(plan, p) -> float:
 
 def solve(plan, p, t) -> Trajectory:
     form = check(plan, p)
-    s = plan.scene
-    t = np.asarray(t, dtype=float)
-    tc = s.area.contact_time
-    phi = math.pi / tc
     b = b_parameter(plan, p)
     if b > B_ACCURATE:
         warnings.warn(f"series: b = {b:.3g} exceeds {B_ACCURATE}; the first-order series (eq 7) is accurate only "
                       f"for b << 1 (its slip at t_c is off by about 2 b^2 u0 = {2 * b * b:.2g} u0)",
                       SeriesAccuracyWarning, stacklevel=3)
+    t = np.asarray(t, dtype=float)
+    out = curves(plan, form.k, t)
+    return Trajectory(t=t, **out, solver="series", law=plan.law.name, info={"b": b})
+
+
+def curves(plan, k, t: np.ndarray) -> dict[str, np.ndarray]:
+    """u, v, omega, theta, force [SI] and A (where the plan needs it) on times t [s] for F = k A u; k [Pa s/m]
+    a number, or an (m, 1) column of m parameter sets (then each curve is (m, len(t)): ``predict.predict_array``)."""
+    s = plan.scene
+    tc = s.area.contact_time
+    phi = math.pi / tc
+    b = k * s.area.peak * tc / (s.mass * math.pi)
     u0 = s.u0
     tau = np.minimum(t, tc)
     c, sn = np.cos(phi * tau), np.sin(phi * tau)
     u = u0 * (1.0 - b + b * c)
     A, _ = s.area(t)
-    force = form.k * A * u
-    J = form.k * s.area.peak * u0 / phi * ((1.0 - b) * (1.0 - c) + b * sn * sn / 2.0)
-    K = form.k * s.area.peak * u0 / phi * ((1.0 - b) * (tau - sn / phi) + b / 2.0 * (tau / 2.0 - np.sin(2 * phi * tau) / (4 * phi)))
-    J_end = form.k * s.area.peak * u0 / phi * 2.0 * (1.0 - b)
+    force = k * A * u
+    J = k * s.area.peak * u0 / phi * ((1.0 - b) * (1.0 - c) + b * sn * sn / 2.0)
+    K = k * s.area.peak * u0 / phi * ((1.0 - b) * (tau - sn / phi) + b / 2.0 * (tau / 2.0 - np.sin(2 * phi * tau) / (4 * phi)))
+    J_end = k * s.area.peak * u0 / phi * 2.0 * (1.0 - b)
     K = K + J_end * np.maximum(t - tc, 0.0)
-    omega = theta = np.zeros_like(t)
+    omega = theta = np.zeros_like(u)
     if plan.has_spin:
         omega = s.omega0 + s.radius * J / s.inertia
         theta = s.omega0 * t + s.radius * K / s.inertia
-    return Trajectory(t=t, u=u, v=u.copy(), omega=omega, theta=theta, force=force, A=A if plan.needs_area else None,
-                      solver="series", law=plan.law.name, info={"b": b})
+    return {"u": u, "v": u.copy(), "omega": omega, "theta": theta, "force": force,
+            "A": (A if A.shape == u.shape else np.broadcast_to(A, u.shape)) if plan.needs_area else None}
