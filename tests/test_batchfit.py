@@ -8,7 +8,9 @@ from _fit_helpers import TRUTH, impact_scene, incline_scene, synthetic
 from frictionlab import fit
 from frictionlab.inference import batchfit, bootstrap
 from frictionlab.inference.predict import predict, predict_array
-from frictionlab.inference.replicates import refit, refit_options, replicate_chunk, seed_sequence, with_y
+from frictionlab.inference import replicates
+from frictionlab.inference.replicates import (batch_problem, refit, refit_options, replicate_chunk, seed_sequence,
+                                               with_y)
 
 CASES = [("coulomb", "exact", "impact"), ("wear", "exact", "impact"), ("wear", "series", "impact"),
          ("area-rate", "exact", "impact"), ("couette", "exact", "impact"), ("coulomb", "exact", "incline"),
@@ -22,7 +24,7 @@ def _data(truth: str, where: str):
 
 def _one_at_a_time(monkeypatch):
     """Every refit one at a time through lmfit's Levenberg-Marquardt (levmar), no batch anywhere."""
-    monkeypatch.setattr(batchfit, "problem", lambda *a, **k: None)
+    monkeypatch.setattr(replicates, "batch_problem", lambda *a, **k: None)
     monkeypatch.setattr(batchfit, "best_start", lambda *a, **k: None)
 
 
@@ -53,7 +55,7 @@ def test_batched_refits_reach_the_single_refits_minimum(law, solver, where, trut
     assert f.ok
     opts = refit_options(f)
     tg, Y = _replicates(f, 12)
-    got = batchfit.refit_many(law, opts, tg, Y)
+    got = batchfit.refit_many(batch_problem(law, opts, tg), Y)
     assert got is not None and got.ok.all()
     via_fit = [refit(law, opts, with_y(tg, Y[i], "replicate")) for i in range(len(Y))]  # the batched starts' answer
     assert np.allclose([r.stats.chisqr for r in via_fit], got.chisqr, rtol=1e-9)
@@ -73,10 +75,11 @@ def test_rows_start_where_they_are_told():
     f = fit("coulomb", _data("coulomb", "impact"), solver="exact")
     opts, (tg, Y) = refit_options(f), _replicates(f, 3)
     far = {"mu": np.full(3, 3.0 * f.value("mu"))}
-    near = batchfit.refit_many("coulomb", opts, tg, Y)
-    from_far = batchfit.refit_many("coulomb", opts, tg, Y, starts=far)
+    pr = batch_problem("coulomb", opts, tg)
+    near = batchfit.refit_many(pr, Y)
+    from_far = batchfit.refit_many(pr, Y, starts=far)
     assert np.allclose(from_far.chisqr, near.chisqr, rtol=1e-8)
-    assert (batchfit.refit_many("coulomb", opts, tg, Y, starts={"mu": np.full(3, f.value("mu"))}).chisqr
+    assert (batchfit.refit_many(pr, Y, starts={"mu": np.full(3, f.value("mu"))}).chisqr
             == near.chisqr).all()
 
 
@@ -85,9 +88,9 @@ def test_no_batched_route_where_the_single_refit_must_serve():
     f = fit("wear", data, solver="exact")
     tg = f.per_dataset[0].target
     opts = refit_options(f)
-    assert batchfit.problem("wear", opts, tg) is not None
-    assert batchfit.problem("wear", opts | {"solver": "ode"}, tg) is None  # an ODE solve is not batched
-    assert batchfit.problem("wear", opts | {"free": {"u0": (10.0, 14.0, 12.0)}}, tg) is None  # a freed scene value
+    assert batch_problem("wear", opts, tg) is not None
+    assert batch_problem("wear", opts | {"solver": "ode"}, tg) is None  # an ODE solve is not batched
+    assert batch_problem("wear", opts | {"free": {"u0": (10.0, 14.0, 12.0)}}, tg) is None  # a freed scene value
     import frictionlab as fl
 
     cls = type("MyWear", (fl.FrictionLaw,), {  # a third-party law: its refits keep their time budget, one at a time
@@ -96,7 +99,7 @@ def test_no_batched_route_where_the_single_refit_must_serve():
         "requires": frozenset({"u"}), "force": lambda self, p, c: p["c"] * c.u})
     fl.register_law(cls)
     try:
-        assert batchfit.problem("my-wear-batchfit", {"solver": "exact", "initial": {"c": 1.0}, "fixed": {}}, tg) is None
+        assert batch_problem("my-wear-batchfit", {"solver": "exact", "initial": {"c": 1.0}, "fixed": {}}, tg) is None
     finally:
         fl.unregister_law("my-wear-batchfit")
 

@@ -31,6 +31,15 @@ def numbers(c):
     return strip(json.loads(json.dumps(results_json(c, {}))))
 
 
+def _differences(a, b, path="") -> list[str]:
+    """Where two JSON-like values differ: paths with both values, for the failure message."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        return [d for k in a.keys() | b.keys() for d in _differences(a.get(k), b.get(k), f"{path}/{k}")]
+    if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+        return [d for i, (x, y) in enumerate(zip(a, b)) for d in _differences(x, y, f"{path}[{i}]")]
+    return [] if a == b else [f"{path}: {a!r:.80} != {b!r:.80}"]
+
+
 @pytest.fixture(scope="module")
 def local():
     from frictionlab.pipeline.comparison import compare
@@ -47,7 +56,8 @@ def test_cluster_gives_the_local_numbers(local, workers, tmp_path):
                                   dashboard_address=None) as cluster, distributed.Client(cluster) as client:
         c = compare(client=client, **OPTIONS)
         assert f"({workers} worker" in c.settings["cluster"]
-        assert numbers(c) == numbers(local)
+        got, want = numbers(c), numbers(local)
+        assert got == want, f"differs at {_differences(got, want)[:5]}"
         if workers == 2:  # the figures drawn on the workers (several a task) are the local ones, byte for byte
             out = write_report(c, tmp_path / "r", client=client)
             figs = [f for s in build(c)[0] for f in s.figures]

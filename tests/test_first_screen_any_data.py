@@ -148,3 +148,27 @@ def test_margin_and_family_are_options_of_the_command_and_the_library(tmp_path):
     assert main(["compare", "--data", "impact-golf-v28", "--margin", "100 rpm", "--out", str(tmp_path / "x"),
                  "-q"]) == 2 and not (tmp_path / "x").exists()
     assert not math.isnan(e.p_within)
+
+
+def test_a_comparison_of_many_groups_draws_the_first_of_them_and_says_so(monkeypatch):
+    """The first screen's figure and the ranking heat map have a bounded size: past MAX_PANELS groups (MAX_COLUMNS
+    datasets) they draw the first ones and their captions say how many of how many, and where the rest are."""
+    from frictionlab.report import ranking as ranking_section
+
+    c = compare(laws=["wear", "area-rate"], datasets=["impact-golf-v28", "impact-golf-v61", "incline-oil-a100"],
+                equivalence=False, transfer=False, bootstrap=0)
+    drawn = {}
+    monkeypatch.setattr(first_screen, "MAX_PANELS", 1)
+    monkeypatch.setattr(ranking_section, "MAX_COLUMNS", 2)
+    monkeypatch.setattr(first_screen.figures, "group_figure", lambda views, title: drawn.setdefault("views", views))
+    monkeypatch.setattr(ranking_section.figures, "ranking_figure", lambda rows, alias: drawn.setdefault("rows", rows))
+    sections = build(c, modules=[first_screen, ranking_section])[0]
+    md = markdown("t", sections)
+    for s in sections:
+        for f in s.figures:
+            f.draw()
+    assert [v.group for v in drawn["views"]] == ["impact-golf"]
+    assert {r.dataset for r in drawn["rows"]} == {"impact-golf-v28", "impact-golf-v61"}
+    assert "The first 1 of 2 groups; each group's page (under 'Dataset groups') draws its own." in md
+    assert "The first 2 of 3 datasets; the tables below and ranking.csv hold every one." in md
+    assert "### incline-oil-a100" in md.split("The first 2 of 3 datasets")[-1]  # the ranking's tables: every dataset

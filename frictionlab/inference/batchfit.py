@@ -3,11 +3,11 @@ their cross fits, and a fit's start points.
 
 A replicate refit is a small least-squares problem (one or two law parameters, tens of points) solved thousands of
 times a comparison; one at a time, each Levenberg-Marquardt step is one closed-form solve through the general phase
-driver, and the Python around it is most of the cost. ``refit_many(law, opts, target, Y, starts)`` fits every row of
-Y (r, n) together instead: one Levenberg-Marquardt run per row, all rows stepping at once, each step one batched
-prediction (``predict.predict_array``: the closed forms over a batch of parameter sets, or the paper's series) of
-every running row's trial point and its forward-difference neighbours. ``best_start(model, starts)`` runs a fit's
-starts the same way (``fitmodel._search``).
+driver, and the Python around it is most of the cost. ``refit_many(problem, Y, starts)`` fits every row of Y (r, n)
+together instead (``replicates.batch_problem`` poses a refit's problem): one Levenberg-Marquardt run per row, all
+rows stepping at once, each step one batched prediction (``predict.predict_array``: the closed forms over a batch of
+parameter sets, or the paper's series) of every running row's trial point and its forward-difference neighbours.
+``best_start(model, starts)`` runs a fit's starts the same way (``fitmodel._search``).
 
 The problem is the one ``fitting.fit`` poses (``replicates.refit``): the same parameter slots, scales and bounds
 (``fitmodel._law_slots``), lmfit's bounded coordinates (MINUIT's transformation, as ``levmar``), lmfit's
@@ -29,10 +29,8 @@ import attrs
 import numpy as np
 
 from ..core.errors import FrictionLabError
-from ..physics.registry import get_law, is_third_party
-from .fitmodel import _law_slots, _lmfit_bound
-from .fitting import law_values
-from .levmar import TINY
+from ..physics.registry import is_third_party
+from .levmar import TINY, lmfit_bound
 from .predict import predict_array
 
 FTOL = 1e-9  # relative fall in chi-square a Gauss-Newton step may still promise at a row's minimum
@@ -61,7 +59,7 @@ class Refits:
         return {k: float(v[i]) for k, v in self.values.items()}
 
 
-class _Problem:
+class Problem:
     """One law on one target: its varying parameter slots (``fitmodel._Slot``) in lmfit's bounded coordinates, the
     held ones' values, and the batched prediction."""
 
@@ -70,8 +68,8 @@ class _Problem:
         self.held = {s.key: s.value for s in slots if not s.vary}
         self.slots = [s for s in slots if s.vary]
         self.scale = np.array([s.scale for s in self.slots])
-        self.lo = np.array([_lmfit_bound(s.lower, s) / s.scale for s in self.slots])
-        self.hi = np.array([_lmfit_bound(s.upper, s) / s.scale for s in self.slots])
+        self.lo = np.array([lmfit_bound(s.lower, s) / s.scale for s in self.slots])
+        self.hi = np.array([lmfit_bound(s.upper, s) / s.scale for s in self.slots])
         self.start = np.array([s.value / s.scale for s in self.slots])
         self.sigma = np.asarray(target.sigma, dtype=float)
         self.evaluations = 0  # parameter sets predicted so far (each row of each batch)
@@ -123,21 +121,7 @@ class _Problem:
             return np.where(both, lo + (np.sin(U) + 1) * (hi - lo) / 2.0, X)
 
 
-def problem(law, opts: Mapping, target) -> _Problem | None:
-    """The batched refit problem of ``law`` on ``target`` with ``opts`` (``replicates.refit_options``: solver,
-    initial, fixed, free), or None where no batched route serves."""
-    law = get_law(law)
-    if opts.get("free"):
-        return None
-    try:
-        fixed = law_values(law, opts.get("fixed") or {}, "fit: fixed")
-        initial = law_values(law, opts.get("initial") or {}, "fit: initial")
-        return _served(_Problem(law, target, opts.get("solver"), _law_slots(law, [target], fixed, set(), initial)))
-    except FrictionLabError:
-        return None
-
-
-def _served(pr: _Problem) -> _Problem | None:
+def served(pr: Problem) -> Problem | None:
     """``pr`` where a batched route serves it (module docstring), else None."""
     tg = pr.target
     if (is_third_party(pr.law) or pr.solver not in ("exact", "series")
@@ -158,7 +142,7 @@ def best_start(model, starts: list[dict[str, float]]) -> tuple[dict[str, float],
     (``fitmodel._search``)."""
     if len(model.targets) != 1 or any(s.kind != "law" for s in model.slots):
         return None
-    pr = _served(_Problem(model.law, model.targets[0], model.solvers[0], model.slots))
+    pr = served(Problem(model.law, model.targets[0], model.solvers[0], model.slots))
     if pr is None:
         return None
     X0 = np.array([[st[s.pname] for s in pr.slots] for st in starts])
@@ -174,14 +158,10 @@ def best_start(model, starts: list[dict[str, float]]) -> tuple[dict[str, float],
     return {s.pname: float(x) for s, x in zip(pr.slots, pr.external(U[i:i + 1])[0])}, float(chisqr[i])
 
 
-def refit_many(law, opts: Mapping, target, Y: np.ndarray, starts: Mapping[str, np.ndarray] | None = None,
-               pr: _Problem | None = None) -> Refits | None:
-    """``law`` refitted to every row of Y (r, n) [SI] on ``target``'s points and sigma, each warm-started at
-    ``opts``' values or, per row, at ``starts`` (law parameter -> (r,) [SI]); None where no batched route serves
-    (module docstring)."""
-    pr = pr or problem(law, opts, target)
-    if pr is None:
-        return None
+def refit_many(pr: Problem, Y: np.ndarray, starts: Mapping[str, np.ndarray] | None = None) -> Refits | None:
+    """``pr``'s law refitted to every row of Y (r, n) [SI] on its target's points and sigma, each warm-started at
+    the slots' values or, per row, at ``starts`` (law parameter -> (r,) [SI]); None where the batch cannot be
+    solved (module docstring)."""
     Y = np.atleast_2d(np.asarray(Y, dtype=float))
     r = Y.shape[0]
     X0 = np.tile(pr.start, (r, 1))
@@ -195,7 +175,7 @@ def refit_many(law, opts: Mapping, target, Y: np.ndarray, starts: Mapping[str, n
     return Refits(chisqr=chisqr, values=pr.values(pr.external(U)), models=models, ok=ok)
 
 
-def _residuals(pr: _Problem, U: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _residuals(pr: Problem, U: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(models (m, n), weighted residuals (m, n)) at internal values U (m, k) against rows Y (m, n)."""
     M = pr.predict(pr.external(U))
     if M is None:
@@ -203,7 +183,7 @@ def _residuals(pr: _Problem, U: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, 
     return M, (M - Y) / pr.sigma
 
 
-def _levenberg_marquardt(pr: _Problem, Y: np.ndarray, U: np.ndarray):
+def _levenberg_marquardt(pr: Problem, Y: np.ndarray, U: np.ndarray):
     """Every row's Levenberg-Marquardt run, stepped together; returns (U, chisqr, models, ok) per row. Each
     step predicts, in one batch, the trial point of every running row and the forward-difference neighbours
     it needs if accepted, so an accepted step comes with its Jacobian."""
@@ -272,7 +252,7 @@ def _steps(U: np.ndarray) -> np.ndarray:
     return np.where(h == 0.0, STEP, h)
 
 
-def _with_jacobian(pr: _Problem, U: np.ndarray, Y: np.ndarray):
+def _with_jacobian(pr: Problem, U: np.ndarray, Y: np.ndarray):
     """(models (r, n), weighted residuals (r, n), their forward-difference Jacobians (r, n, k)) at internal values
     U (r, k) against rows Y (r, n): every point and its k neighbours in one batched prediction."""
     r, k = U.shape

@@ -208,6 +208,7 @@ def _batched(fn, names, datasets, method, data) -> list | None:
     from . import batchfit
     from .fitstats import neg2loglik, noise_kind
     from .predict import auto_solver, make_target
+    from .replicates import batch_problem
 
     if not (isinstance(fn, LawFit) and fn.start and method == "parametric" and set(dict(fn.options)) <= BATCHED_OPTIONS):
         return None
@@ -219,10 +220,10 @@ def _batched(fn, names, datasets, method, data) -> list | None:
         return None
     refit = {"solver": solver, "fixed": opts.get("fixed") or {},
              "initial": {**dict(opts.get("initial") or {}), **dict(fn.start)}}
-    pr = batchfit.problem(fn.law, refit, target)
-    if pr is None or target.y.size < len(pr.slots) + 1:
+    pr = batch_problem(fn.law, refit, target)
+    if pr is None:
         return None
-    got = batchfit.refit_many(fn.law, refit, target, np.array([d[0].y for d in data]), pr=pr)
+    got = batchfit.refit_many(pr, np.array([d[0].y for d in data]))
     if got is None:
         return None
     k = len(pr.slots) if fn.n_params is None else int(fn.n_params)

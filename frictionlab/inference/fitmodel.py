@@ -137,11 +137,6 @@ def _scene_slots(targets, free) -> list[_Slot]:
     return slots
 
 
-def _lmfit_bound(b: float, slot: _Slot) -> float:
-    """Bounds far outside the parameter's scale are passed as infinite (the law still checks them)."""
-    return b if abs(b) <= 1e4 * slot.scale else math.copysign(math.inf, b)
-
-
 class FitTimeout(BaseException):
     """A fit ran past its time budget (a BaseException, so that no handler of a law's errors keeps it)."""
 

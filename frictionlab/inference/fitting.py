@@ -44,7 +44,7 @@ from ..core.units import as_range, as_si
 from ..core.workers import beat
 from ..physics.registry import get_law
 from . import levmar
-from .fitmodel import (FTOL, ODE_STARTS, PENALTY, FitTimeout, _alarm, _law_slots, _lmfit_bound, _Model, _scene_slots,
+from .fitmodel import (FTOL, ODE_STARTS, PENALTY, FitTimeout, _alarm, _law_slots, _Model, _scene_slots,
                        _search, _si, lmfit_leastsq)
 from .fitresult import DatasetFit, FitResult, ParamResult, Stats
 from .fitstats import (
@@ -330,7 +330,7 @@ def _solvers(law, targets, solver: str, rtol) -> list[str] | str:
 def _parameters(lmfit, slots, checks: bool):
     """The optimizer's parameters (values / scale): levmar's light ones for replicate refits, lmfit's
     own (and its error where the bounds are no interval) otherwise."""
-    bounds = [(_lmfit_bound(s.lower, s) / s.scale, _lmfit_bound(s.upper, s) / s.scale) for s in slots]
+    bounds = [(levmar.lmfit_bound(s.lower, s) / s.scale, levmar.lmfit_bound(s.upper, s) / s.scale) for s in slots]
     if not checks and all(lo < hi and (math.isinf(lo) or math.isinf(hi) or hi - lo > 1e-13 + 1e-13 * abs(hi))
                           for lo, hi in bounds):  # an interval lmfit accepts
         return {s.pname: levmar.Param(s.pname, s.value / s.scale, lo, hi, s.vary) for s, (lo, hi) in zip(slots, bounds)}

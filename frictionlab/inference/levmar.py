@@ -12,11 +12,19 @@ residual that is not finite, the evaluation budget reached) it returns None and 
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import scipy.optimize
 from numpy import arcsin, cos, inf, sin, sqrt
 
 TINY = 1.0e-15  # lmfit.lineshapes.tiny: an internal start closer to 0 than this is 0
+
+
+def lmfit_bound(b: float, slot) -> float:
+    """The bound b handed to lmfit for a parameter slot (``fitmodel._Slot``: its scale): infinite where it is far
+    outside the parameter's scale (the law still checks it)."""
+    return b if abs(b) <= 1e4 * slot.scale else math.copysign(inf, b)
 
 
 class Param:

@@ -7,6 +7,7 @@ import zlib
 import numpy as np
 
 from ..core.errors import FrictionLabError
+from ..physics.registry import get_law
 from .fitting import FitResult, Target, fit
 
 
@@ -19,6 +20,25 @@ def refit_options(f: FitResult) -> dict:
              if p.kind == "law" and (p.fixed_by == "held by the caller" or (p.vary and p.name in held))}
     free = {p.key: (p.lower, p.upper, p.value) for p in f.params.values() if p.kind == "scene" and p.vary}
     return {"solver": f.per_dataset[0].solver, "initial": initial, "fixed": fixed, "free": free}
+
+
+def batch_problem(law, opts: dict, target: Target):
+    """The batched refit problem (``batchfit.Problem``) of ``law`` on ``target`` with ``opts`` (``refit_options``:
+    solver, initial, fixed, free), or None where no batched route serves: then ``refit`` one at a time."""
+    from . import batchfit
+    from .fitmodel import _law_slots
+    from .fitting import law_values
+
+    law = get_law(law)
+    if opts.get("free"):
+        return None
+    try:
+        fixed = law_values(law, opts.get("fixed") or {}, "fit: fixed")
+        initial = law_values(law, opts.get("initial") or {}, "fit: initial")
+        slots = _law_slots(law, [target], fixed, set(), initial)
+    except FrictionLabError:
+        return None
+    return batchfit.served(batchfit.Problem(law, target, opts.get("solver"), slots))
 
 
 def refit(law: str, opts: dict, target: Target, scan: int = 0, n_starts: int = 1) -> FitResult:
@@ -110,20 +130,18 @@ def _batched_rows(laws, target, model_a, model_b, eps: list) -> tuple[list, list
     (law_a, opts_a), (law_b, opts_b) = laws
     r = len(eps)
     none = ([None] * r, [None] * r)
-    pa, pb = batchfit.problem(law_a, opts_a, target), batchfit.problem(law_b, opts_b, target)
+    pa, pb = batch_problem(law_a, opts_a, target), batch_problem(law_b, opts_b, target)
     if not r or pa is None or pb is None:
         return none
     E = np.asarray(eps)
     Y = np.concatenate([model_a + E, model_b + E])  # the replicates of null A, then those of null B
-    ra, rb = batchfit.refit_many(law_a, opts_a, target, Y, pr=pa), batchfit.refit_many(law_b, opts_b, target, Y, pr=pb)
+    ra, rb = batchfit.refit_many(pa, Y), batchfit.refit_many(pb, Y)
     if ra is None or rb is None:
         return none
     head, tail = slice(0, r), slice(r, 2 * r)
     # under A: B refitted to A's refitted curve, from B's refit; under B: A to B's curve, from A's refit
-    cb = batchfit.refit_many(law_b, opts_b, target, ra.models[head], starts={k: v[head] for k, v in rb.values.items()},
-                             pr=pb)
-    ca = batchfit.refit_many(law_a, opts_a, target, rb.models[tail], starts={k: v[tail] for k, v in ra.values.items()},
-                             pr=pa)
+    cb = batchfit.refit_many(pb, ra.models[head], starts={k: v[head] for k, v in rb.values.items()})
+    ca = batchfit.refit_many(pa, rb.models[tail], starts={k: v[tail] for k, v in ra.values.items()})
     t = ra.chisqr - rb.chisqr
     out = []
     for part, centre, sign in ((head, cb, 1.0), (tail, ca, -1.0)):

@@ -226,15 +226,23 @@ def build(ctx) -> Section:
         drawn |= {d.name for d in dss} if shown is None else set(shown)
     views = group_views(c, findings, skip=drawn)
     if views:
+        shown = views[:MAX_PANELS]
         sec.fig("finding.png", "Per dataset group, one of its datasets with the group's top-ranked candidates (#rank)"
                 + ("; under a panel whose candidates include the truncated series, the slip u(t) of that series and "
                    "of the exact solution of the same law (dotted: where the series' slip crosses zero)"
-                   if any(v.series for v in views) else "") + ".",
-                lambda: figures.group_figure(views, view_title(views)))
+                   if any(v.series for v in shown) else "") + "."
+                + (f" The first {len(shown)} of {len(views)} groups; each group's page (under 'Dataset groups') "
+                   "draws its own." if len(shown) < len(views) else ""),
+                lambda: figures.group_figure(shown, view_title(shown)))
         sec.p(_side(views))
     _unfitted(sec, c.answers)
     _accuracy_table(sec, c)
     return sec
+
+
+#: Panels the first screen's figure draws at most (three rows of five): a comparison of many groups shows the first
+#: of them there, and each group's page draws its own.
+MAX_PANELS = 15
 
 
 def _side(views) -> str:

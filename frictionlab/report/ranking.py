@@ -105,6 +105,10 @@ def group_table(rows) -> tuple[list[str], list[list]]:
             r.status + (f": {r.reason}" if r.reason else "") + _flags(r, limit=1)] for r in rows]
     return headers, out
 
+#: Datasets the ranking heat map draws at most (a column each, about 1.25 inches): past them the tables hold the rest.
+MAX_COLUMNS = 30
+
+
 def build(ctx) -> Section:
     c = ctx.c
     sec = Section(TITLE)
@@ -117,8 +121,12 @@ def build(ctx) -> Section:
           "row, their weights summed.")
     ranking, alias = list(c.ranking), law_aliases(c)
     if ranking:  # a page of a group none of whose datasets was fitted has no ranking to draw
+        names = list(dict.fromkeys(r.dataset for r in ranking))
+        drawn = [r for r in ranking if r.dataset in set(names[:MAX_COLUMNS])]
         sec.fig("ranking.png", "Rank and ΔAIC of every law [solver] on every dataset (grey: not fitted); laws whose "
-                "fits are the same curve on every dataset share a row.", lambda: figures.ranking_figure(ranking, alias))
+                "fits are the same curve on every dataset share a row."
+                + (f" The first {MAX_COLUMNS} of {len(names)} datasets; the tables below and ranking.csv hold every "
+                   "one." if len(names) > MAX_COLUMNS else ""), lambda: figures.ranking_figure(drawn, alias))
     sec.h3("Over groups of datasets")
     sec.p("−2 ln L and k add over the per-dataset fits (independent, so log-likelihoods add); AIC, AICc and BIC "
           "use the group's n and k; goodness p-values are Bonferroni-adjusted over the members. 'exact' and 'ode' solve the "
