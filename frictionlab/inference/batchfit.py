@@ -198,7 +198,7 @@ def _levenberg_marquardt(pr: Problem, Y: np.ndarray, U: np.ndarray):
         idx = np.nonzero(running)[0]
         g, A = np.einsum("rnk,rn->rk", J[idx], res[idx]), np.einsum("rnk,rnl->rkl", J[idx], J[idx])
         gain = _gauss_newton_gain(g, A)
-        at_min = gain <= FTOL * np.maximum(chisqr[idx], 1e-300)
+        at_min = gain <= FTOL * np.maximum(chisqr[idx], 1.0)  # chi-square is in sigma^2: below 1, absolute
         running[idx[at_min]] = False
         idx, g, A, gain = idx[~at_min], g[~at_min], A[~at_min], gain[~at_min]
         if not idx.size:
@@ -229,7 +229,8 @@ def _levenberg_marquardt(pr: Problem, Y: np.ndarray, U: np.ndarray):
         nu[stay] *= 2.0
         # no damped step lowers chi-square, or none where what a step promises is below the forward differences'
         # resolution: at the minimum
-        running[stay[(lam[stay] > LAMBDA_MAX) | (gain[~better & finite] <= RESOLVED * chisqr[stay])]] = False
+        resolved = gain[~better & finite] <= RESOLVED * np.maximum(chisqr[stay], 1.0)
+        running[stay[(lam[stay] > LAMBDA_MAX) | resolved]] = False
         # a step below XTOL of the values (MINPACK's xtol): at the minimum, or at a kink of chi-square (a stick time
         # crossing a sample time) that smaller steps do not resolve
         running[idx[finite & np.all(np.abs(step) <= XTOL * (np.abs(U[idx]) + XTOL), axis=1)]] = False

@@ -120,8 +120,8 @@ def build(ctx) -> Section:
           "is visible. Laws whose best fits are the same curve (wear and Couette share the form F = k A u) are one "
           "row, their weights summed.")
     ranking, alias = list(c.ranking), law_aliases(c)
-    if ranking:  # a page of a group none of whose datasets was fitted has no ranking to draw
-        names = list(dict.fromkeys(r.dataset for r in ranking))
+    names = list(dict.fromkeys(r.dataset for r in ranking))
+    if len(names) > 1:  # across datasets (of one, the table below says it all; none fitted: nothing to draw)
         drawn = [r for r in ranking if r.dataset in set(names[:MAX_COLUMNS])]
         sec.fig("ranking.png", "Rank and ΔAIC of every law [solver] on every dataset (grey: not fitted); laws whose "
                 "fits are the same curve on every dataset share a row."
