@@ -1,7 +1,7 @@
 """``compare`` on a Dask cluster in coarse tasks: one task per dataset.
 
-A dataset's fits, its equivalence tests and its bootstrap need nothing but that dataset's own fits, so one
-task on one worker runs those stages for it (``--jobs 1`` there) and sends back only their results (fit
+A dataset's fits, its equivalence tests, what accuracy costs on it and its bootstrap need nothing but that
+dataset's own fits, so one task on one worker runs those stages for it (``--jobs 1`` there) and sends back only their results (fit
 rows, test and bootstrap records: tens of kB). The stages across datasets (rank, transfer, tolerance,
 answer) then run as they do locally. Compared with one task per fit, test and bootstrap batch: one round
 trip per dataset, no barrier between one dataset's fits and another's tests (a worker never waits for the
@@ -17,12 +17,13 @@ from concurrent.futures import as_completed
 import attrs
 
 from ..core.cluster import executor
+from ..inference.accuracy import study_fits
 from ..inference.ranking_bootstrap import bootstrap_fits
 from .runner import Run, run_stages, warm_worker
 from .stages import check_some_fit, equivalence_order, family_adjusted, fit_order
 
 #: The stages one dataset's task runs (in this order); the others run after the parts are merged.
-PER_DATASET = ("fit", "equivalence", "bootstrap")
+PER_DATASET = ("fit", "equivalence", "accuracy", "bootstrap")
 
 
 def run_per_dataset(c, run: Run, chosen: list) -> tuple[object, list]:
@@ -73,8 +74,8 @@ def _one_dataset(c, settings, plan, pairs: list, names: tuple) -> tuple[dict, di
     started = time.perf_counter()
     run = Run(settings=settings, plan=plan, eq_pairs=pairs, part=True)
     done = run_stages(c, run, [s for s in STAGES if s.name in names], forced=True)
-    fields = {"fits": done.fits, "equivalence": done.equivalence, "bootstrap": done.bootstrap,
-              "bootstrap_skipped": done.bootstrap_skipped}
+    fields = {"fits": done.fits, "equivalence": done.equivalence, "accuracy": done.accuracy,
+              "bootstrap": done.bootstrap, "bootstrap_skipped": done.bootstrap_skipped}
     return fields, done.timings or {"per dataset": time.perf_counter() - started}
 
 
@@ -90,6 +91,10 @@ def _merge(c, run: Run, parts: list, sent: set, names: set) -> dict:
         found = [e for p in parts for e in p["equivalence"]]
         fields["equivalence"] = family_adjusted(c, sorted(found, key=equivalence_order(c, run.settings.pairs)),
                                                 run.settings)
+    if "accuracy" in names:  # in the order of the local run: its study's fits (accuracy.study_fits), rows kept together
+        rank = {(f.datasets[0], f.law): i for i, f in enumerate(study_fits(fields.get("fits", c.fits)))}
+        rows = [r for p in parts for r in p["accuracy"]]
+        fields["accuracy"] = tuple(sorted(rows, key=lambda r: rank.get((r.dataset, r.law), len(rank))))
     if "bootstrap" in names:
         s = run.settings
         rest = [f for f in fields.get("fits", c.fits) if f.datasets[0] not in sent]  # nothing fitted there

@@ -148,7 +148,8 @@ def tolerance(c, run: Run) -> dict:
 
 def accuracy(c, run: Run) -> dict:
     """In this process: a few predictions per law and dataset (1.3 CPU s on the built-in data) cost less than
-    sending the fits to the workers."""
+    sending the fits to the workers. On a cluster it runs in each dataset's task, beside its fits
+    (``pipeline.perdataset``)."""
     fits = study_fits(c.fits)
     full = bool(run.settings.tolerance)  # --tolerance asks for the whole study, the costly rows too
     run.tally().total = max(len(fits), 1)
