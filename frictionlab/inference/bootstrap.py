@@ -210,7 +210,8 @@ def _batched(fn, names, datasets, method, data) -> list | None:
     from .predict import auto_solver, make_target
     from .replicates import batch_problem
 
-    if not (isinstance(fn, LawFit) and fn.start and method == "parametric" and set(dict(fn.options)) <= BATCHED_OPTIONS):
+    if not (isinstance(fn, LawFit) and fn.start and method == "parametric"
+            and set(dict(fn.options)) <= BATCHED_OPTIONS):
         return None
     ds, opts = datasets[0], dict(fn.options)
     try:
@@ -325,7 +326,8 @@ def bootstrap(fit_fn: Callable[..., FitResult], dataset: DatasetLike | Sequence[
     """Refit ``n`` resampled copies of ``dataset`` (a Dataset, name or path, or a list fitted together).
 
     fit_fn(data) -> FitResult, e.g. ``law_fit('wear', solver='exact')`` (warm-started replicates) or
-    any picklable callable. chunk: replicates per submitted task (default: n / 16 with an executor, n without; at least 1).
+    any picklable callable. chunk: replicates per submitted task (default: n / 16 with an executor, n without;
+    at least 1).
     base: fit_fn's FitResult on the original data, if already made (else it is fitted here).
     """
     _check_n(n, seed)
