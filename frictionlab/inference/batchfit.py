@@ -84,18 +84,16 @@ class Problem:
         """Predictions (m, n) at scaled values X (m, k); NaN rows where a value is outside its law bounds (lmfit
         passes bounds far beyond a parameter's scale as infinite, so a step may cross them: the law refuses it)."""
         values = self.values(X)
-        self.evaluations += X.shape[0]
         inside = np.ones(X.shape[0], dtype=bool)
         for spec in self.law.params:
             inside &= (values[spec.name] >= spec.lower) & (values[spec.name] <= spec.upper)
-        if inside.all():
-            return predict_array(self.law, self.target, values, self.solver)
         out = np.full((X.shape[0], self.target.y.size), np.nan)
         if inside.any():
             got = predict_array(self.law, self.target, {k: v[inside] for k, v in values.items()}, self.solver)
             if got is None:
                 return None
             out[inside] = got
+            self.evaluations += int(inside.sum())
         return out
 
     def internal(self, X: np.ndarray) -> np.ndarray:
@@ -122,16 +120,14 @@ class Problem:
 
 
 def served(pr: Problem) -> Problem | None:
-    """``pr`` where a batched route serves it (module docstring), else None."""
+    """``pr`` where a batched route may serve it (module docstring), else None; whether ``predict_array`` takes
+    its target is known at its first prediction (a refusal there ends the batch: the caller refits alone)."""
     tg = pr.target
     if (is_third_party(pr.law) or pr.solver not in ("exact", "series")
             or getattr(tg.dataset, "noise_correlation", "none") != "none" or tg.observable == "stated" or not pr.slots
             or tg.y.size < len(pr.slots) + 1):
         return None
-    try:
-        return pr if pr.predict(pr.start[None, :]) is not None else None
-    except FrictionLabError:
-        return None
+    return pr
 
 
 def best_start(model, starts: list[dict[str, float]]) -> tuple[dict[str, float], float] | None:

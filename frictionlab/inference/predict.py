@@ -229,11 +229,9 @@ def predict_many(law, target: Target, params_list, solver: str, scene: Scene | N
     the batch engine at once); None where it does not, or refuses, and ``predict`` one set at a time gives each
     answer or error."""
     law = get_law(law)
-    if scene is None or scene is target.dataset.scene:  # a series on the dataset's own scene: the batch of closed forms
-        names = set().union(*params_list) if params_list else set()
+    if params_list and (scene is None or scene is target.dataset.scene):  # a series on the dataset's own scene
         try:
-            got = predict_array(law, target, {k: np.array([p.get(k, law.spec(k).default) for p in params_list],
-                                                           dtype=float) for k in names}, solver) if names else None
+            got = predict_array(law, target, params_list, solver)
         except FrictionLabError:
             got = None
         if got is not None:
@@ -326,9 +324,10 @@ def get_scene_quantity(scene: Scene, name: str) -> float:
 ARRAY_SERIES = ("omega", "theta", "v", "u")
 
 
-def predict_array(law, target: Target, params: Mapping[str, np.ndarray], solver: str) -> np.ndarray | None:
-    """``predict`` at m parameter sets at once: ``params`` maps every law parameter to an (m,) array [SI]; returns
-    the (m, n) predictions of ``target.y``, or None where no batched route serves (then ``predict`` one set at a
+def predict_array(law, target: Target, params, solver: str) -> np.ndarray | None:
+    """``predict`` at m parameter sets at once: ``params`` maps law parameters to (m,) arrays [SI], or is a sequence
+    of m mappings (``solve.scenebatch.batch_params``; defaults fill the rest); returns the (m, n) predictions of
+    ``target.y``, or None where no batched route serves (then ``predict`` one set at a
     time). Served: a built-in law (a third party's force need not broadcast over parameter sets) with the built-in
     series predictor of an impact or incline on its dataset's scene, solved by the closed forms over a batch of
     parameter sets (``solve.batch``, equal to ``simulate(..., 'exact')`` to round-off; tests/test_batchfit.py)
@@ -345,12 +344,13 @@ def predict_array(law, target: Target, params: Mapping[str, np.ndarray], solver:
     if (is_third_party(law) or ds.kind not in ("impact", "incline") or PREDICTORS.get(ds.kind) is not _predict_series
             or ds.scene is None or target.observable not in ARRAY_SERIES or solver not in ("exact", "series")):
         return None
-    m = len(next(iter(params.values())))
+    m = len(next(iter(params.values()))) if isinstance(params, Mapping) else len(params)
+    params = batch_params(law, params, m)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         if solver == "series":
             plan = make_plan(ds.scene, law)
-            p = take_params(batch_params(law, params, m), slice(None), column=True)
+            p = take_params(params, slice(None), column=True)
             form = series.check(plan, p)
             out = series.curves(plan, form.k, np.asarray(target.t, dtype=float))[target.observable]
         else:
