@@ -7,6 +7,8 @@ import threading
 
 import numpy as np
 
+from ...core.errors import FrictionLabError
+
 LAW_COLORS = {"coulomb": "#7f7f7f", "area-rate": "#d95f02", "wear": "#1b9e77", "couette": "#7570b3"}
 EXTRA_COLORS = ["#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#1f78b4"]
 DPI = 110
@@ -54,11 +56,19 @@ def subplots(kind: str, nrows: int = 1, ncols: int = 1, figsize: tuple[float, fl
     canvas, emptied (``_emptied``), which spares building the axes, their ticks and the renderer (and its
     measured text) once per dataset. Besides what ``_emptied`` resets, a kind of figure sets whatever it changes
     (tick locators, fonts, limits) on every figure it draws, so that each figure looks as on a fresh canvas."""
+    return canvas((kind, nrows, ncols, tuple(figsize), repr(sorted(kw.items()))), figsize,
+                  lambda fig: fig.subplots(nrows, ncols, squeeze=False, **kw))
+
+
+def canvas(key, figsize: tuple[float, float], build):
+    """(figure, what ``build(figure)`` returned: its axes) for the layout ``key`` (hashable, naming the kind of
+    figure first), kept as ``subplots`` keeps its figures: the figure of a layout drawn before is handed back
+    emptied (``_emptied``) and sized ``figsize`` again, with the axes its ``build`` made."""
     kept = _KEPT.__dict__.setdefault("figures", {})
-    key = (kind, nrows, ncols, tuple(figsize), repr(sorted(kw.items())))
     if key in kept:
         fig, axes = kept[key]
         _emptied(fig)
+        fig.set_size_inches(figsize)
         return fig, axes
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -66,7 +76,7 @@ def subplots(kind: str, nrows: int = 1, ncols: int = 1, figsize: tuple[float, fl
     _plt()  # rcParams as every report figure has them (mathtext off)
     fig = Figure(figsize=figsize)
     FigureCanvasAgg(fig)
-    axes = fig.subplots(nrows, ncols, squeeze=False, **kw)
+    axes = build(fig)
     if len(kept) >= KEEP:
         kept.pop(next(iter(kept)))
     kept[key] = fig, axes
@@ -100,8 +110,9 @@ def _emptied(fig) -> None:
 
 
 def release() -> None:
-    """Let go of this thread's kept figures (``subplots``)."""
+    """Let go of this thread's kept figures (``subplots``, ``canvas``) and trajectories (``trajectory``)."""
     _KEPT.__dict__.pop("figures", None)
+    _KEPT.__dict__.pop("trajectories", None)
 
 
 #: Inches: the blank border of the canvas; below an axes, its x tick labels and label (XTICKS: the labels
@@ -232,14 +243,36 @@ def visible_curves(curves, span: float) -> list[tuple[object, list[str], list[st
     return out
 
 
+#: Trajectories ``trajectory`` keeps per thread at most (a long-lived worker drawing many reports lets go of them).
+MEMO = 256
+
+
+def trajectory(d, law: str, t):
+    """``d.trajectory(law, t)`` (a DatasetFit's best-fit trajectory on the times ``t``, s), computed once per
+    thread for the figures of one report (the fit, force and first-screen figures draw the same curves); a
+    FrictionLabError (the solver's budget exceeded) is raised again on each call. Let go by ``release``."""
+    memo = _KEPT.__dict__.setdefault("trajectories", {})
+    if len(memo) >= MEMO:
+        memo.clear()
+    t = np.asarray(t, dtype=float)
+    key = (id(d), law, t.shape, t.tobytes())
+    hit = memo.get(key)
+    if hit is None or hit[0] is not d:  # the fit itself kept beside its result: an id is never taken for another's
+        try:
+            hit = memo[key] = (d, d.trajectory(law, t), None)
+        except FrictionLabError as e:
+            hit = memo[key] = (d, None, e)
+    if hit[2] is not None:
+        raise hit[2]
+    return hit[1]
+
+
 def draw_fit(ax, f, obs: str, t, tf: float, uf: float, label: str, **style):
     """The fit ``f``'s ``obs`` as a dense curve over the span of the data times ``t`` (s), scaled by tf and uf;
     a stiff law whose dense curve exceeds the solver's budget draws its fitted points instead."""
-    from ...core.errors import FrictionLabError
-
     d = f.per_dataset[0]
     try:
-        tr = d.trajectory(f.law, np.linspace(float(t[0]), float(t[-1]), 300))
+        tr = trajectory(d, f.law, np.linspace(float(t[0]), float(t[-1]), 300))
         ax.plot(tr.t * tf, tr[obs] * uf, label=label, zorder=3, **style)
     except FrictionLabError:
         ax.plot(t * tf, d.model * uf, label=label, zorder=3, **style)

@@ -20,26 +20,27 @@ def group_figure(views, title: str) -> bytes:
     each column as wide as its tick labels need, each row as tall as its titles, legends and axes need."""
     from .fits import against_angle, angle_column
 
-    plt = base._plt()
     n = len(views)
     cols = min(n, PER_ROW)
     grid = [views[k:k + cols] for k in range(0, n, cols)]
     axw = {1: 4.7, 2: 3.7}.get(cols, 2.4)  # inches: few panels are drawn larger, five fill the page's width
     axh, slip_h, under = 1.55 + 0.25 * (axw - 2.4), 0.85, 0.15  # slip panel, and its gap under the data panel
     cell_w, cell_h = axw + 2.0, axh + under + slip_h + 2.0  # provisional: each axes at its final size, apart
-    fig = plt.figure(figsize=(cols * cell_w, len(grid) * cell_h))
+    slip = tuple(v.series is not None for v in views)  # the panels with a slip panel under them
+    fig, axes = base.canvas(("finding", cols, slip), (cols * cell_w, len(grid) * cell_h),
+                            lambda fig: [(fig.add_axes((0, 0, 1, 1)), fig.add_axes((0, 0, 1, 1)) if s else None)
+                                         for s in slip])
     fig.set_dpi(base.DPI)
     title = base.wrapped(title, cols * (axw + 0.8), 10)
     fig.suptitle(title, fontsize=10)
     panels = []  # (row, column, data axes, slip axes or None)
-    for r, row in enumerate(grid):
-        slips = any(v.series for v in row)
-        for j, v in enumerate(row):
-            ax = fig.add_axes(_box(fig, 1.0 + j * cell_w, 1.0 + r * cell_h, axw, axh))
-            ax_s = (fig.add_axes(_box(fig, 1.0 + j * cell_w, 1.0 + r * cell_h + axh + under, axw, slip_h))
-                    if slips and v.series is not None else None)
-            panels.append((r, j, ax, ax_s))
-            _group_panel(ax, ax_s, v, axw, against_angle, angle_column)
+    for k, (v, (ax, ax_s)) in enumerate(zip(views, axes)):
+        r, j = divmod(k, cols)
+        ax.set_position(_box(fig, 1.0 + j * cell_w, 1.0 + r * cell_h, axw, axh))
+        if ax_s is not None:
+            ax_s.set_position(_box(fig, 1.0 + j * cell_w, 1.0 + r * cell_h + axh + under, axw, slip_h))
+        panels.append((r, j, ax, ax_s))
+        _group_panel(ax, ax_s, v, axw, against_angle, angle_column)
     _place(fig, panels, axw, axh, slip_h, under, title)
     return base._png(fig)
 
@@ -170,7 +171,7 @@ def _slip_panel(ax, s, xlabel: str):
     tname, tf = time_unit(float(s.dataset.t[-1]))
     t = np.linspace(0.0, float(s.dataset.t[-1]), 300)
     for i, fit in enumerate((s.full, s.series)):  # styled as in the panel above: the series dashed
-        tr = fit.per_dataset[0].trajectory(fit.law, t)
+        tr = base.trajectory(fit.per_dataset[0], fit.law, t)
         ax.plot(t * tf, tr["u"], label=f"{fit.law} [{fit.solver}]", **base._style(fit.law, fit.solver, i))
     ax.axhline(0, color="0.3", lw=0.8)
     if s.t_cross is not None:

@@ -165,7 +165,7 @@ def force_figure(dataset, fits, rows=()) -> bytes:
     drawn = 0
     for i, (f, laws, hidden) in enumerate(curves):
         try:
-            tr = f.per_dataset[0].trajectory(f.law, np.linspace(0.0, t_end, 300))
+            tr = base.trajectory(f.per_dataset[0], f.law, np.linspace(0.0, t_end, 300))
         except FrictionLabError:  # a stiff law whose dense curve exceeds the solver's budget: left out
             continue
         ax.plot(tr.t * tf, tr.force, label=base._label(f, rows, laws, hidden), **base._style(f.law, f.solver, i))

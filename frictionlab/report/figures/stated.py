@@ -34,7 +34,7 @@ def stated_figure(dataset, curves, rows) -> bytes:
     for i, (f, laws) in enumerate(curves):
         d = f.per_dataset[0]
         style = base._style(f.law, f.solver, i)
-        tr = d.trajectory(f.law, tt)
+        tr = base.trajectory(d, f.law, tt)
         ax.plot(tr.t * tf, tr["omega"] * uf, label=base._label(f, rows, laws), zorder=3, **style)
         axr.bar(np.arange(len(names)) + (i - (len(curves) - 1) / 2) * width, d.residual / d.target.sigma, width,
                 color=style.get("color"))

@@ -13,16 +13,11 @@ ROWS = (("a", "a"), ("b", "b"), ("a-b", "a − b"), ("Dc", "Dc"), ("k", "k"), ("
 def velstep_figure(fit) -> bytes:
     """Data and fit (left: the record; middle: the first step close up), residuals below, and the parameter table
     (value ± standard error, 95% interval) on the right, for a velocity-step fit of one dataset."""
-    plt = base._plt()
     d = fit.per_dataset[0]
     t, y, model = d.target.t, d.target.y, d.model
     steps = d.scene.spring.times[1:]
     t0 = steps[0] if steps else 0.0
-    fig = plt.figure(figsize=(11.0, 4.2))
-    grid = fig.add_gridspec(2, 3, width_ratios=[1.5, 1.0, 1.05], height_ratios=[2.2, 1.0], wspace=0.28, hspace=0.08)
-    ax, axz, axr = fig.add_subplot(grid[0, 0]), fig.add_subplot(grid[0, 1]), fig.add_subplot(grid[1, 0])
-    axrz = fig.add_subplot(grid[1, 1], sharex=axz)
-    axt = fig.add_subplot(grid[:, 2])
+    fig, (ax, axz, axr, axrz, axt) = base.canvas(("velstep",), (11.0, 4.2), _panels)
     every = max(1, t.size // 4000)  # at most about 4000 points drawn per panel
     color = base.EXTRA_COLORS[4]
     for a, ar, sel in ((ax, axr, slice(None, None, every)), (axz, axrz, _close_up(t, steps, fit))):
@@ -47,6 +42,13 @@ def velstep_figure(fit) -> bytes:
              transform=axt.transAxes)
     fig.subplots_adjust(left=0.085, right=0.99, top=0.9, bottom=0.13)
     return base._png(fig)
+
+
+def _panels(fig) -> tuple:
+    """The figure's axes: the record and the close up (top), their residuals (under them), the table (right)."""
+    grid = fig.add_gridspec(2, 3, width_ratios=[1.5, 1.0, 1.05], height_ratios=[2.2, 1.0], wspace=0.28, hspace=0.08)
+    ax, axz, axr = fig.add_subplot(grid[0, 0]), fig.add_subplot(grid[0, 1]), fig.add_subplot(grid[1, 0])
+    return ax, axz, axr, fig.add_subplot(grid[1, 1], sharex=axz), fig.add_subplot(grid[:, 2])
 
 
 def _close_up(t, steps, fit) -> np.ndarray:
