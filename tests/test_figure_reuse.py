@@ -15,13 +15,18 @@ def _figures(c):
 
 
 @pytest.fixture(scope="module")
-def figures():
+def comparisons():
     series = [synthetic("area-rate", TRUTH["area-rate"], seed=3, name="a"),
               synthetic("coulomb", TRUTH["coulomb"], seed=4, rel_noise=0.05, name="b-" + "long-name-" * 6),
               synthetic("wear", TRUTH["wear"], seed=5, rel_noise=0.002, name="c")]
     outcome = load_dataset("impact-outcome-synthetic")
-    return (_figures(compare(laws=["coulomb", "wear", "area-rate"], datasets=series))
-            + _figures(compare(laws=["coulomb", "wear"], datasets=[outcome, attrs.evolve(outcome, name="other")])))
+    return (compare(laws=["coulomb", "wear", "area-rate"], datasets=series),
+            compare(laws=["coulomb", "wear"], datasets=[outcome, attrs.evolve(outcome, name="other")]))
+
+
+@pytest.fixture(scope="module")
+def figures(comparisons):
+    return [f for c in comparisons for f in _figures(c)]
 
 
 def test_each_figure_on_a_kept_canvas_is_the_figure_a_fresh_canvas_gives(figures, monkeypatch):
@@ -36,6 +41,32 @@ def test_each_figure_on_a_kept_canvas_is_the_figure_a_fresh_canvas_gives(figures
         fresh.append(f.draw())
     base.release()
     kinds = {f.name.split("-")[0] for f in figures}
-    assert {"fit", "force", "discrimination", "equivalence"} <= kinds
-    assert len(emptied) >= 6  # the canvases were drawn on again
+    assert {"fit", "force", "discrimination", "equivalence", "derive", "finding.png"} <= kinds
+    assert len(emptied) >= 8  # the canvases were drawn on again
+    again = [fig._suptitle.get_text() for fig in emptied if fig._suptitle is not None]  # as the last figure left it
+    assert any("spin derived from rotation angle" in t for t in again)
     assert [f.name for f, a, b in zip(figures, kept, fresh) if a != b] == []
+
+
+def test_the_first_screens_figure_on_a_kept_canvas_is_the_figure_a_fresh_canvas_gives(comparisons, monkeypatch):
+    """A report of many groups draws one first-screen figure per group's page, mostly of one panel: each on the
+    canvas the last one of its layout (panels, slip panels under them) used."""
+    from frictionlab.report.data_view import group_views, title
+    from frictionlab.report.figures import group_figure
+    from frictionlab.report.first_screen import series_findings
+
+    views = [v for c in comparisons for v in group_views(c, series_findings(c))]
+    layouts = [v.series is not None for v in views]
+    assert len(views) > len(set(layouts))  # two panels of one layout at least: a canvas drawn on again
+    emptied = []
+    empty = base._emptied
+    monkeypatch.setattr(base, "_emptied", lambda fig: (emptied.append(fig), empty(fig)))
+    base.release()
+    kept = [group_figure([v], title([v])) for v in views]
+    fresh = []
+    for v in views:
+        base.release()
+        fresh.append(group_figure([v], title([v])))
+    base.release()
+    assert len(emptied) >= len(views) - len(set(layouts))
+    assert [v.dataset.name for v, a, b in zip(views, kept, fresh) if a != b] == []

@@ -62,3 +62,21 @@ def test_the_figure_table_gives_intervals_in_laboratory_units(comp):
     text = _table_text(f)
     q = f.velstep.rows[0].quantities
     assert "µm" in text and "1/µm" in text and f"[{q['Dc'].low:.{q['Dc'].digits}g}" in text
+
+
+def test_a_velocity_step_figure_on_a_kept_canvas_is_the_figure_a_fresh_canvas_gives(comp):
+    """The figures of the measured steps are drawn on one kept canvas (figures.base.canvas), emptied: each comes out
+    as on a fresh canvas, byte for byte, whatever the figure before it showed."""
+    from frictionlab.report.figures import base
+    from frictionlab.report.figures.velstep import velstep_figure
+
+    fits = [f for f in comp.fits if f.ok and getattr(f, "velstep", None) is not None]
+    assert len(fits) >= 2
+    base.release()
+    kept = [velstep_figure(f) for f in fits + fits[:1]]
+    fresh = []
+    for f in fits + fits[:1]:
+        base.release()
+        fresh.append(velstep_figure(f))
+    base.release()
+    assert kept == fresh and kept[0] != kept[1]

@@ -94,6 +94,12 @@ class HertzPulse:
         """(y, dy/ds) at times t [s]; zero outside the contact."""
         s_end, dense = _hertz_solution()
         s = np.asarray(t, dtype=float) / self.time_scale
+        if s.ndim == 0 and dense.ascending:  # one time (an ODE's right-hand side): the step's interpolant, as dense()
+            if not 0.0 <= s <= s_end:        # picks it for an array, without the array's sorting (same numbers)
+                return np.asarray(0.0), np.asarray(0.0)
+            k = min(max(int(np.searchsorted(dense.ts_sorted, s)) - 1, 0), dense.n_segments - 1)
+            y, dy = dense.interpolants[k](float(s))
+            return np.asarray(np.maximum(y, 0.0)), np.asarray(dy)
         inside = (s >= 0) & (s <= s_end)
         sc = np.clip(s, 0.0, s_end)
         y, dy = dense(sc.ravel())  # both rows of one evaluation of the interpolant

@@ -35,13 +35,12 @@ def _png(fig) -> bytes:
     from PIL import Image
 
     fig.set_dpi(DPI)
-    raw = io.BytesIO()
-    fig.savefig(raw, format="rgba", dpi=DPI)
-    size = fig.canvas.get_width_height()
+    fig.canvas.draw()  # what savefig(format="rgba") draws, without its copy of the pixels and its settings' round trip
+    rgb = Image.frombuffer("RGBA", fig.canvas.get_width_height(), fig.canvas.buffer_rgba(), "raw", "RGBA", 0,
+                           1).convert("RGB")
     _plt().close(fig)
-    rgba = Image.frombuffer("RGBA", size, raw.getbuffer(), "raw", "RGBA", 0, 1)
     buf = io.BytesIO()
-    rgba.convert("RGB").save(buf, format="png", compress_level=COMPRESS, dpi=(DPI, DPI))
+    rgb.save(buf, format="png", compress_level=COMPRESS, dpi=(DPI, DPI))
     return buf.getvalue()
 
 
