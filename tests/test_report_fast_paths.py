@@ -70,3 +70,28 @@ def test_the_hertz_pulse_at_one_time_is_the_pulse_at_an_array_of_times():
         assert (one[0], one[1]) == (many[0][k], many[1][k]) or (np.isnan(t) and one == (0.0, 0.0)), t
     inside = (ts >= 0) & (ts <= s_end * pulse.time_scale)
     assert inside.sum() > 3000 and np.all(many[0][~inside] == 0.0)
+
+
+@pytest.mark.parametrize("n, nan", [(5000, False), (7, False), (40, True)])
+def test_error_bars_from_plain_arrays_are_matplotlibs_error_bars(n, nan):
+    """base.errorbar against Axes.errorbar: the same PNG bytes (bars, markers, legend entry, axis limits) and
+    the same artists; a NaN takes matplotlib's own way."""
+    rng = np.random.default_rng(n)
+    x = np.sort(rng.uniform(0.0, 3.0, n))
+    y, err = np.sin(x) + rng.normal(0.0, 0.1, n), rng.uniform(0.01, 0.2, n)
+    if nan:
+        y[3] = np.nan
+    pngs, kinds = [], []
+    for way in ("matplotlib", "plain"):
+        base.release()
+        fig, ((ax,),) = base.subplots("errorbar-test", figsize=(7.6, 3.8))
+        style = dict(fmt="o", ms=3.2, color="black", ecolor="0.7", elinewidth=0.8, label="data", zorder=1)
+        c = ax.errorbar(x, y, yerr=err, **style) if way == "matplotlib" else base.errorbar(ax, x, y, err, **style)
+        ax.legend()
+        kinds.append([type(a).__name__ for a in ax.get_children()][:4] + [len(c.lines[2][0].get_segments())])
+        assert "vlines" not in vars(ax)  # the axes is left as it was
+        base.margins(fig, top=0.1, bottom=0.5)
+        pngs.append(base._png(fig))
+    base.release()
+    assert kinds[0] == kinds[1] and kinds[0][-1] == n
+    assert pngs[0] == pngs[1]

@@ -35,12 +35,13 @@ def _png(fig) -> bytes:
     from PIL import Image
 
     fig.set_dpi(DPI)
-    fig.canvas.draw()  # what savefig(format="rgba") draws, without its copy of the pixels and its settings' round trip
-    rgb = Image.frombuffer("RGBA", fig.canvas.get_width_height(), fig.canvas.buffer_rgba(), "raw", "RGBA", 0,
-                           1).convert("RGB")
+    raw = io.BytesIO()
+    fig.savefig(raw, format="rgba", dpi=DPI)
+    size = fig.canvas.get_width_height()
     _plt().close(fig)
+    rgba = Image.frombuffer("RGBA", size, raw.getbuffer(), "raw", "RGBA", 0, 1)
     buf = io.BytesIO()
-    rgb.save(buf, format="png", compress_level=COMPRESS, dpi=(DPI, DPI))
+    rgba.convert("RGB").save(buf, format="png", compress_level=COMPRESS, dpi=(DPI, DPI))
     return buf.getvalue()
 
 
@@ -275,6 +276,42 @@ def draw_fit(ax, f, obs: str, t, tf: float, uf: float, label: str, **style):
         ax.plot(tr.t * tf, tr[obs] * uf, label=label, zorder=3, **style)
     except FrictionLabError:
         ax.plot(t * tf, d.model * uf, label=label, zorder=3, **style)
+
+
+def errorbar(ax, x, y, yerr, **kw):
+    """``ax.errorbar(x, y, yerr=yerr, **kw)``, its error bars built from plain arrays: matplotlib's ``vlines``
+    combines its inputs into masked arrays and makes each bar's path from a masked row, which costs more than
+    drawing it; for finite floats on rectilinear axes ``_vlines`` makes the same collection (the same paths, style
+    and data limits) from the plain rows. Anything else takes matplotlib's own way."""
+    x, y, yerr = (np.asarray(a, dtype=float) for a in (x, y, yerr))
+    plain = ax.name == "rectilinear" and all(np.all(np.isfinite(a)) for a in (x, y, yerr))
+    if plain:
+        ax.vlines = lambda *a, **k: _vlines(ax, *a, **k)  # what errorbar calls for its bars, on this axes only
+    try:
+        return ax.errorbar(x, y, yerr=yerr, **kw)
+    finally:
+        if plain:
+            del ax.vlines
+
+
+def _vlines(ax, x, ymin, ymax, colors=None, linestyles="solid", label="", **kw):
+    """``Axes.vlines`` for finite float arrays on rectilinear axes (what ``errorbar`` passes it), without its
+    masked arrays: one LineCollection of the segments (x, ymin)-(x, ymax), the axes' data limits taken from it."""
+    from matplotlib.collections import LineCollection
+
+    x, ymin, ymax = (np.ravel(np.asarray(a, dtype=float)) for a in (x, ymin, ymax))
+    verts = np.empty((len(x), 2, 2))
+    verts[:, 0, 0], verts[:, 0, 1], verts[:, 1, 0], verts[:, 1, 1] = x, ymin, x, ymax
+    lines = LineCollection(verts, colors=colors, linestyles=linestyles, label=label)
+    ax.add_collection(lines, autolim=False)
+    lines._internal_update(kw)
+    if len(x):
+        lim = lines.get_datalim(ax.transData)
+        updatex, updatey = lines.get_transform().contains_branch_separately(ax.transData)
+        ax.update_datalim(((np.nanmin(lim.xmin), np.nanmin(lim.ymin)), (np.nanmax(lim.xmax), np.nanmax(lim.ymax))),
+                          updatex, updatey)
+        ax._request_autoscale_view()
+    return lines
 
 
 #: Points of a series beyond which a figure draws a thinned copy (``thinned``): at the report's figure widths
