@@ -82,12 +82,14 @@ def gsjs(x: np.ndarray, y: np.ndarray, segments: np.ndarray | None = None) -> No
     # tr(Q) and tr(Q^2) of Q = C'C / m (C: the m x n pseudo-residual weights; each row has unit norm, so
     # tr(Q) = 1); tr(Q^2) = |C C'|_F^2 / m^2, and rows r, s of C overlap only when their triples do.
     tr2 = 0.0
+    Wt, It = np.ascontiguousarray(W.T), np.ascontiguousarray(I.T)
     for d in range(3):
-        r, s = np.arange(m - d), np.arange(d, m)
-        dot = np.zeros(r.size)
+        dot = np.zeros(m - d)
         for p in range(3):
             for q in range(3):
-                dot += W[r, p] * W[s, q] * (I[r, p] == I[s, q])
+                same = It[p, :m - d] == It[q, d:]
+                if same.any():
+                    dot += np.where(same, Wt[p, :m - d] * Wt[q, d:], 0.0)
         tr2 += (1 if d == 0 else 2) * float(dot @ dot)
     return NoiseEstimate(math.sqrt(float(e @ e) / m), m * m / tr2 if tr2 > 0 else 0.0, "GSJS", rows=I, weights=W)
 
@@ -192,20 +194,24 @@ def ratio_pvalue_moments(est: NoiseEstimate, chisqr: float, J: np.ndarray) -> fl
         Gq = np.bincount(I.ravel(), weights=(W * Cq[:, None]).ravel(), minlength=n) / m
         tr_PG2 += float(Gq @ Gq)
     band = {0: np.sum(W * W, axis=1)}  # K = C C': row j's overlap with row j + d, d = 0, 1, 2
+    Wt, It = np.ascontiguousarray(W.T), np.ascontiguousarray(I.T)
     for d in (1, 2):
         dot = np.zeros(m)
         for a in range(I.shape[1]):
             for b in range(I.shape[1]):
-                dot[: m - d] += W[: m - d, a] * W[d:, b] * (I[: m - d, a] == I[d:, b])
+                same = It[a, : m - d] == It[b, d:]
+                if same.any():
+                    dot[: m - d] += np.where(same, Wt[a, : m - d] * Wt[b, d:], 0.0)
         band[d] = dot
     tr_K2 = float(band[0] @ band[0]) + 2.0 * sum(float(band[d] @ band[d]) for d in (1, 2))
 
-    def diag(d):  # K(i, i + d) for i = 0 .. m - 1 (zero where i + d is outside)
+    diag = {}  # d -> K(i, i + d) for i = 0 .. m - 1 (zero where i + d is outside)
+    for d in range(-2, 3):
         if d >= 0:
-            return band[d]
-        out = np.zeros(m)
-        out[-d:] = band[-d][: m + d]
-        return out
+            diag[d] = band[d]
+        else:
+            diag[d] = np.zeros(m)
+            diag[d][-d:] = band[-d][: m + d]
 
     tr_K3 = 0.0
     for d1 in range(-2, 3):
@@ -213,8 +219,9 @@ def ratio_pvalue_moments(est: NoiseEstimate, chisqr: float, J: np.ndarray) -> fl
             d3 = -(d1 + d2)
             if abs(d3) > 2:
                 continue
-            i = np.arange(max(0, -d1, -d1 - d2), min(m, m - d1, m - d1 - d2))
-            tr_K3 += float(np.sum(diag(d1)[i] * diag(d2)[i + d1] * diag(d3)[i + d1 + d2]))
+            lo, hi = max(0, -d1, -d1 - d2), min(m, m - d1, m - d1 - d2)
+            if hi > lo:
+                tr_K3 += float(np.dot(diag[d1][lo:hi] * diag[d2][lo + d1:hi + d1], diag[d3][lo + d1 + d2:hi + d1 + d2]))
     tr_G2, tr_G3 = tr_K2 / m ** 2, tr_K3 / m ** 3
     c = float(chisqr)
     t1 = (n - p) - c
