@@ -85,7 +85,8 @@ def test_error_bars_from_plain_arrays_are_matplotlibs_error_bars(n, nan):
     for way in ("matplotlib", "plain"):
         base.release()
         fig, ((ax,),) = base.subplots("errorbar-test", figsize=(7.6, 3.8))
-        style = dict(fmt="o", ms=3.2, color="black", ecolor="0.7", elinewidth=0.8, label="data", zorder=1)
+        style = {"fmt": "o", "ms": 3.2, "color": "black", "ecolor": "0.7", "elinewidth": 0.8, "label": "data",
+                 "zorder": 1}
         c = ax.errorbar(x, y, yerr=err, **style) if way == "matplotlib" else base.errorbar(ax, x, y, err, **style)
         ax.legend()
         kinds.append([type(a).__name__ for a in ax.get_children()][:4] + [len(c.lines[2][0].get_segments())])

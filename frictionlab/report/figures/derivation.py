@@ -17,8 +17,8 @@ def derivation_figure(dataset, derived: dict, noisy: dict, sigma_theta: float, s
     views = [("theta column as given", derived)]
     if sigma_theta > 0:  # a noise-free column (no stated sigma): the noisy twin would repeat it
         views.append((f"with simulated noise σθ = {sigma_theta * af:.2g} {au} (seed {seed})", noisy))
-    fig, axes = base.subplots("derive", 2, len(views), figsize=(5.25 * len(views) + (0 if sigma_theta > 0 else 1.0), 6.6),
-                              sharex=True)
+    width = 5.25 * len(views) + (0 if sigma_theta > 0 else 1.0)
+    fig, axes = base.subplots("derive", 2, len(views), figsize=(width, 6.6), sharex=True)
     colors = {"poly9": "#d95f02", "spline": "#1b9e77"}
     for col, (title, res) in enumerate(views):
         ax, axw = axes[0, col], axes[1, col]

@@ -158,7 +158,7 @@ def _against_time(ax, d, target, curves) -> str:
         y, sigma = target.y, np.broadcast_to(target.sigma, target.y.shape)
         k = base.thinned(target.t, y, y - sigma, y + sigma)  # a long record: what its pixels show
         base.errorbar(ax, target.t[k] * tf, y[k] * uf, sigma[k] * uf, fmt="o", ms=3, color="black",
-                    ecolor="0.75", elinewidth=0.7, label=f"data ({d.provenance.kind})", zorder=1)
+                      ecolor="0.75", elinewidth=0.7, label=f"data ({d.provenance.kind})", zorder=1)
     for f, label, style in curves:
         base.draw_fit(ax, f, obs, d.t, tf, uf, label, **style)
     name = NAMES.get(obs, obs.replace("_", " ")).split(" (")[0]  # the short name: the panel is small
