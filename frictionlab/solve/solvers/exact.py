@@ -303,7 +303,7 @@ def _area_integrals(area, t, second=True):
     if area is None:
         return np.zeros_like(t), (np.zeros_like(t) if second else None)
     if isinstance(area, ConstantArea):
-        return np.full_like(t, area.area), (area.area * t if second else None)
+        return area.area + np.zeros_like(t), (area.area * t if second else None)  # a batch's areas: a column
     tc = area.contact_time
     phi = math.pi / tc
     tau = np.minimum(t, tc)
