@@ -15,8 +15,7 @@ Solvers:
             vectorized bracketed root finding (``vecrk.root_bracketed``). Scenes that break away after sticking
             (the area-rate law with eta' > 0 on an unloading contact) go on phase by phase, sliding from
             rest in closed form and perhaps sticking again, with the scenes still going in each round
-            (``batchexact.exact_phases``); a scene at rest at first contact (an incline from rest) starts there,
-            stuck until its breakaway (at once where the law cannot hold it), as the scalar solver starts it.
+            (``batchexact.exact_phases``); only a scene that starts at zero slip is re-run alone with the scalar solver.
   'RK45', 'DOP853'  scipy's tableaus, per-scene adaptive steps, dense output, zero slip located per
             scene (``frictionlab.solve.vecrk``, or ``frictionlab.solve.compiled`` where it serves: see Engines); stuck
             phases and breakaway handled per scene.

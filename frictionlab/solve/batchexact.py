@@ -1,7 +1,5 @@
 """The batch engine's closed forms: the sliding families of ``solvers.exact`` over the whole batch, stick
-located per scene by bracketed roots (in closed form where slip is a line, a relaxation or the impact's cosine),
-later phases from breakaway in closed form; a scene at rest at first contact begins stuck, as in
-``solvers.segments``."""
+located per scene by bracketed roots, later phases from breakaway in closed form."""
 from __future__ import annotations
 
 import numpy as np
@@ -26,6 +24,7 @@ def run_exact(law, batch, p, T, into=None):
     y0 = np.broadcast_to(plan.initial_state().reshape(d, -1, 1), (d, nsc, 1))
     stick_time = np.full(nsc, np.nan)
     stuck_mask = np.zeros((nsc, m), dtype=bool)
+    fallback = np.zeros(nsc, dtype=bool)
     dirs, info = None, {}
     if isinstance(form, exact.AreaSlipForm):
         J, K = exact._area_slip(plan, form.k, 0.0, y0, T)
@@ -33,47 +32,36 @@ def run_exact(law, batch, p, T, into=None):
     else:
         u_s = np.broadcast_to(plan.rigid_slip(y0), (nsc, 1))
         sgn = np.sign(u_s)
-        rest = sgn[:, 0] == 0  # at rest at first contact: stuck from t = 0 until the law lets go (segments._start)
+        fallback |= sgn[:, 0] == 0
         sgn = np.where(sgn == 0, 1.0, sgn)
-        ts = np.full(nsc, np.nan)
-        if rest.all():
-            pass
-        elif not rest.any():
-            ts = exact_stop(law, batch, p, None, plan, form, 0.0, y0, u_s[:, 0], sgn[:, 0], T[:, -1])
-        else:
-            go = np.nonzero(~rest)[0]
-            ts[go] = exact_stop(law, batch, p, go, plan_of(law, batch.view(go, column=True)),
-                                law.form(take_params(p, go, column=True)), 0.0, y0[:, go], u_s[go, 0], sgn[go, 0],
-                                T[go, -1])
-        hit = ~np.isnan(ts)
+        ts = exact_stop(law, batch, p, None, plan, form, 0.0, y0, u_s[:, 0], sgn[:, 0], T[:, -1])
+        hit = ~np.isnan(ts) & ~fallback
         segs, tb_first = np.where(hit, 2, 1), np.full(nsc, np.nan)  # phases per scene, first breakaway time [s]
         info = {"segments_per_scene": segs, "breakaway_time": tb_first}
-        tcol = np.where(hit, ts, np.where(rest, 0.0, np.inf))[:, None]
+        tcol = np.where(hit, ts, np.inf)[:, None]
         # the sliding closed form at min(t, stick time): frozen at the stick, where the stuck phase continues
-        tt = np.minimum(T, tcol) if (hit | rest).any() else T
+        tt = np.minimum(T, tcol) if hit.any() else T
         Y = sliding_states(plan, form, sgn, 0.0, y0, tt, out=None if into is None else into["states"])
-        if (hit | rest).any():
+        if hit.any():
             stick_time[hit] = ts[hit]
-            ids = np.nonzero(hit | rest)[0]
+            ids = np.nonzero(hit)[0]
             ys = zero_slip(plan_of(law, batch.view(ids)), Y[:, ids, -1])  # the state at the stick, slip exactly zero
-            stuck_mask = (T > tcol) | rest[:, None]
+            stuck_mask = T > tcol
             v_stick = np.zeros((nsc, 1))
             v_stick[ids, 0] = ys[0]
             np.copyto(Y[0], v_stick, where=stuck_mask)  # zero slip exactly while stuck, as the stick state has it
             stick.stuck_states(plan, T, tt, Y, out=Y)  # dt = 0 before the stick: those states stay
-            dirs = exact_phases(law, batch, p, T, Y, stuck_mask, ids, np.where(rest, 0.0, ts)[ids], ys, sgn[ids, 0],
-                                segs, tb_first, stick_time)
-            at_once = rest & (tb_first == 0.0)  # let go at first contact: no stuck phase, the first sample slides
-            if at_once.any():
-                segs[at_once] -= 1
-                stuck_mask[at_once] &= T[at_once] > 0.0
+            dirs = exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts[ids], ys, sgn[ids, 0], segs, tb_first)
     need = stick.needed_force(plan)
-    out = finish(law, batch, p, T, Y, ~stuck_mask, need, into, dirs)
+    out = finish(law, batch, p, T, np.nan_to_num(Y, copy=into is None) if fallback.any() else Y, ~stuck_mask, need, into,
+                  dirs)
+    for i in np.nonzero(fallback)[0]:
+        scalar_into(out, stick_time, law, batch, p, T, i, info)
     out["stick_time"] = stick_time
-    return out, info | {"nfev": 0}
+    return out, info | {"nfev": 0, "scalar_fallback": int(fallback.sum())}
 
 
-def exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts, ys, last_dir, segs, tb_first, stick_time):
+def exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts, ys, last_dir, segs, tb_first):
     """After the first stick of scenes ``ids`` (at ts [s] in state ys (d, k), slip before of sign last_dir):
     breakaway, a sliding phase in closed form from there, perhaps a stick again, and so on, as
     ``solvers.segments.run`` sequences them, with only the scenes still going in each round. A phase owns
@@ -119,8 +107,6 @@ def exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts, ys, last_dir, segs, t
             dirs = np.zeros(T.shape)
         dirs[ids] = np.where(after & slide, h, dirs[ids])
         segs[ids[~stops]] -= 1  # slid to the end: no stuck phase after it
-        first = stops & np.isnan(stick_time[ids])  # the first stop of a scene that began at rest
-        stick_time[ids[first]] = t_stop[first]
         ids, ts, ys, last_dir = ids[stops], t_stop[stops], y_stop[:, stops, 0], hold[stops]
     return dirs
 
@@ -228,3 +214,17 @@ def _scan_bracket(g, plan, t0, t0c, t_end, restart, noise):
     lo, hi = grid[rows, ihi - 1], grid[rows, ihi]
     glo, ghi = gg[rows, ihi - 1] + offset[rows], gg[rows, ihi] + offset[rows]  # fn at the bracket, from the scan
     return rows, lo, hi, glo, ghi, offset, noise
+
+
+def scalar_into(out, stick_time, law, batch, p, T, i, info):
+    """Re-run scene i with the scalar exact solver (it starts at zero slip)."""
+    from .solvers import simulate
+
+    pi = {k: v if isinstance(v, float) else float(v[i]) for k, v in p.items()}
+    tr = simulate(law, batch.scene(i), pi, solver="exact", t=T[i])
+    for k in ("u", "v", "omega", "theta", "force", "A", "N"):
+        if out.get(k) is not None and getattr(tr, k) is not None:
+            out[k][i] = getattr(tr, k)
+    stick_time[i] = np.nan if tr.stick_time is None else tr.stick_time
+    if "segments_per_scene" in info:
+        info["segments_per_scene"][i] = tr.info["segments"]
