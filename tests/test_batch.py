@@ -168,6 +168,34 @@ def test_exact_breakaway_phases_vectorized_match_scalar(rng):
     assert seen == {1, 2, 3, 4}  # never sticks, sticks for good, breaks away, breaks away and sticks again
 
 
+def test_a_start_from_rest_is_solved_in_the_batch_as_one_at_a_time(rng):
+    """Scenes at rest at t = 0 (the incline datasets' u0 = 0): stuck for good, sliding at once, or held until the
+    contact unloads and then sliding and perhaps sticking again, all in the batch's closed forms (no scalar
+    fallback), equal to the scalar exact solver to 1e-10 of each output's scale, with the same number of phases
+    and the same first stop."""
+    steep = [incline(0.0, alpha=a, area=ConstantArea(1e-4)) for a in (0.2, 0.35, 0.5, 0.7)]
+    sp = [{"mu": m, "eta_prime": 0.0} for m in (0.1, 0.5, 0.3, 1.2)]
+    unloading = [unloading_incline(0.0, rng.uniform(0.05, 0.1)) for _ in range(5)] + [unloading_incline(0.0, 0.08)]
+    up = [{"mu": rng.uniform(0.3, 0.7), "eta_prime": rng.uniform(0.0, 300.0)} for _ in range(5)] + [{"mu": 0.5, "eta_prime": 30.0}]
+    seen = set()
+    for scenes, params in ((steep, sp), (unloading, up)):
+        br = simulate_batch("area-rate", scenes, params, solver="exact", n=301)
+        assert br.info["scalar_fallback"] == 0
+        for i, s in enumerate(scenes):
+            tr = fl.simulate("area-rate", s, params[i], solver="exact", t=br.t)
+            V = max(float(np.max(np.abs(tr.u))), 1e-3)
+            for name, scale in (("u", V), ("v", V), ("force", max(np.max(np.abs(tr.force)), 1e-12))):
+                err = np.max(np.abs(getattr(br, name)[i] - getattr(tr, name)))
+                assert err <= 1e-10 * scale, (i, name, err / scale)
+            assert int(br.info["segments_per_scene"][i]) == tr.info["segments"]
+            seen.add(tr.info["segments"])
+            if tr.stick_time is None:
+                assert math.isnan(br.stick_time[i])
+            else:
+                assert br.stick_time[i] == pytest.approx(tr.stick_time, rel=1e-10)
+    assert {1, 2, 3} <= seen  # stuck for good or sliding throughout, held then sliding, sliding then stuck again
+
+
 def test_lubricated_and_dry_inclines_match_ode(rng):
     lub = [incline(rng.uniform(0, 0.05), alpha=rng.uniform(0.2, 0.6), area=ConstantArea(rng.uniform(1e-4, 4e-4)))
            for _ in range(5)]

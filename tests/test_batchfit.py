@@ -130,3 +130,33 @@ def test_the_bootstrap_replicates_are_those_of_the_single_refits(monkeypatch):
         assert np.max(np.abs(batched.samples - single.samples)[:, batched.names.index(name)]) <= 0.01 * se
     assert np.allclose(batched.aic, single.aic, rtol=0, atol=1e-4)
     assert math.isclose(batched.std("mu"), single.std("mu"), rel_tol=1e-3)
+
+
+@pytest.mark.parametrize("law, solver", [("coulomb", "exact"), ("area-rate", "exact"), ("wear", "exact"),
+                                         ("wear", "series"), ("couette", "exact")])
+def test_stated_numbers_are_read_off_a_batch_as_off_one_trajectory(law, solver, monkeypatch):
+    """A reconstruction's stated numbers (peak spin and its time, end spin, largest angle): the batched
+    prediction equals the single one, and the batched refits of replicates of them reach the single refits'
+    minimum (values within 0.01 SE where the minimum is the same)."""
+    f = fit(law, "impact-golf-v28", solver=solver)
+    tg = f.per_dataset[0].target
+    assert tg.observable == "stated" and f.ok
+    rng = np.random.default_rng(1)
+    sets = [{k: p.value * float(rng.uniform(0.6, 1.4)) for k, p in f.params.items() if p.kind == "law"}
+            for _ in range(6)]
+    got = predict_array(law, tg, sets, solver)
+    want = np.array([predict(law, tg, s, solver) for s in sets])
+    assert got.shape == want.shape == (6, 4)
+    assert np.max(np.abs(got - want) / np.abs(want)) <= 1e-12
+    opts = refit_options(f)
+    _, Y = _replicates(f, 8)
+    many = batchfit.refit_many(batch_problem(law, opts, tg), Y)
+    assert many is not None and many.ok.all()
+    _one_at_a_time(monkeypatch)
+    for i in np.nonzero(many.ok)[0]:
+        one = refit(law, opts, with_y(tg, Y[i], "replicate"))
+        assert one.ok
+        assert many.chisqr[i] <= one.stats.chisqr * (1 + 1e-6) + 1e-9
+        if many.chisqr[i] >= one.stats.chisqr * (1 - 1e-6):
+            for k in opts["initial"]:
+                assert abs(many.values[k][i] - one.params[k].value) <= 0.01 * (f.params[k].stderr or abs(f.params[k].value)), k

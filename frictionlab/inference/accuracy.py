@@ -31,7 +31,7 @@ REFERENCE_RTOL = 1e-12
 #: the fit's own solver (tight ODE tolerances cost several evaluations each, and each solver is timed repeatedly)
 BUDGET = 2.0
 COST_FACTOR = 60
-MIN_TIME = 0.004  # seconds of repeats a timing covers at least (thread CPU clock: microsecond resolution)
+MIN_TIME = 0.001  # seconds of repeats a timing covers at least (thread CPU clock: microsecond resolution)
 MAX_REPEATS = 50
 COMMAND = "frictionlab compare --tolerance"
 

@@ -6,7 +6,8 @@ times a comparison; one at a time, each Levenberg-Marquardt step is one closed-f
 driver, and the Python around it is most of the cost. ``refit_many(problem, Y, starts)`` fits every row of Y (r, n)
 together instead (``replicates.batch_problem`` poses a refit's problem): one Levenberg-Marquardt run per row, all
 rows stepping at once, each step one batched prediction (``predict.predict_array``: the closed forms over a batch of
-parameter sets, or the paper's series) of every running row's trial point and its forward-difference neighbours.
+parameter sets, or the paper's series; stated numbers read off each row's curves) of every running row's trial point
+and its forward-difference neighbours.
 ``best_start(model, starts)`` runs a fit's starts the same way (``fitmodel._search``).
 
 The problem is the one ``fitting.fit`` poses (``replicates.refit``): the same parameter slots, scales and bounds
@@ -18,7 +19,7 @@ a tighter stop than the single refit's (relative tolerance ``fitmodel.FTOL``), s
 tolerance or the batch's minimum lies lower (tests/test_batchfit.py). A row that is not finite, not converged in
 ``MAX_STEPS`` steps, or whose step the law refuses (a value beyond its bounds) comes back not ok and the caller
 refits it alone. None where no batched route serves (a third-party law, a freed scene quantity, an ODE solver,
-correlated noise, stated numbers): then every row is refitted alone.
+correlated noise): then every row is refitted alone.
 """
 from __future__ import annotations
 
@@ -124,7 +125,7 @@ def served(pr: Problem) -> Problem | None:
     its target is known at its first prediction (a refusal there ends the batch: the caller refits alone)."""
     tg = pr.target
     if (is_third_party(pr.law) or pr.solver not in ("exact", "series")
-            or getattr(tg.dataset, "noise_correlation", "none") != "none" or tg.observable == "stated" or not pr.slots
+            or getattr(tg.dataset, "noise_correlation", "none") != "none" or not pr.slots
             or tg.y.size < len(pr.slots) + 1):
         return None
     return pr

@@ -149,16 +149,26 @@ STATED_GRID = 401
 def stated_numbers(tr, contact_time: float) -> dict[str, float]:
     """The numbers a paper states about an impact's spin, read off a trajectory on [0, t_c]: peak spin
     and its time (a parabola through the grid's three highest points), spin at t_c, the largest angle."""
-    t, w = np.asarray(tr.t), np.asarray(tr["omega"])
-    i = int(np.clip(np.argmax(w), 1, w.size - 2))
-    y0, y1, y2 = w[i - 1], w[i], w[i + 1]
+    got = stated_rows(np.asarray(tr.t), np.asarray(tr["omega"])[None], np.asarray(tr["theta"])[None])
+    return {k: float(v[0]) for k, v in got.items()}
+
+
+def stated_rows(t: np.ndarray, omega: np.ndarray, theta: np.ndarray) -> dict[str, np.ndarray]:
+    """``stated_numbers`` of each row of ``omega`` and ``theta`` (m, n) [rad/s, rad] on the grid ``t`` (n,) [s]:
+    each number an (m,) array."""
+    m = omega.shape[0]
+    rows = np.arange(m)
+    top = np.argmax(omega, axis=1)
+    i = np.clip(top, 1, omega.shape[1] - 2)
+    y0, y1, y2 = omega[rows, i - 1], omega[rows, i], omega[rows, i + 1]
     den = y0 - 2 * y1 + y2
-    shift = 0.5 * (y0 - y2) / den if den < 0 else 0.0
-    shift = float(np.clip(shift, -1.0, 1.0))
+    curved = den < 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        shift = np.clip(np.where(curved, 0.5 * (y0 - y2) / den, 0.0), -1.0, 1.0)
     h = t[1] - t[0]
-    return {"omega_peak": float(y1 - 0.25 * (y0 - y2) * shift) if den < 0 else float(np.max(w)),
-            "t_peak": float(t[i] + shift * h) if den < 0 else float(t[np.argmax(w)]),
-            "omega_end": float(w[-1]), "theta_max": float(np.max(np.asarray(tr["theta"])))}
+    return {"omega_peak": np.where(curved, y1 - 0.25 * (y0 - y2) * shift, omega[rows, top]),
+            "t_peak": np.where(curved, t[i] + shift * h, t[top]),
+            "omega_end": omega[:, -1].copy(), "theta_max": np.max(theta, axis=1)}
 
 
 def _predict_series(law, target, scene, params, solver, rtol=FIT_RTOL):
@@ -329,7 +339,8 @@ def predict_array(law, target: Target, params, solver: str) -> np.ndarray | None
     of m mappings (``solve.scenebatch.batch_params``; defaults fill the rest); returns the (m, n) predictions of
     ``target.y``, or None where no batched route serves (then ``predict`` one set at a
     time). Served: a built-in law (a third party's force need not broadcast over parameter sets) with the built-in
-    series predictor of an impact or incline on its dataset's scene, solved by the closed forms over a batch of
+    series predictor of an impact or incline on its dataset's scene (a series, or a reconstruction's stated numbers
+    read off each row as ``stated_numbers`` reads them), solved by the closed forms over a batch of
     parameter sets (``solve.batch``, equal to ``simulate(..., 'exact')`` to round-off; tests/test_batchfit.py)
     or by the paper's series. Raises FrictionLabError where the batch cannot be solved (a value outside its
     bounds)."""
@@ -341,19 +352,27 @@ def predict_array(law, target: Target, params, solver: str) -> np.ndarray | None
 
     law = get_law(law)
     ds = target.dataset
+    stated = target.observable == "stated"
     if (is_third_party(law) or ds.kind not in ("impact", "incline") or PREDICTORS.get(ds.kind) is not _predict_series
-            or ds.scene is None or target.observable not in ARRAY_SERIES or solver not in ("exact", "series")):
+            or ds.scene is None or not (target.observable in ARRAY_SERIES or stated)
+            or solver not in ("exact", "series")):
         return None
     m = len(next(iter(params.values()))) if isinstance(params, Mapping) else len(params)
     params = batch_params(law, params, m)
+    t = np.linspace(0.0, ds.scene.area.contact_time, STATED_GRID) if stated else np.asarray(target.t, dtype=float)
+    names = ("omega", "theta") if stated else (SERIES[target.observable],)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         if solver == "series":
             plan = make_plan(ds.scene, law)
             p = take_params(params, slice(None), column=True)
             form = series.check(plan, p)
-            out = series.curves(plan, form.k, np.asarray(target.t, dtype=float))[target.observable]
+            got = series.curves(plan, form.k, t)
         else:
-            res = simulate_batch(law, SceneBatch(ds.scene, {}, m), params, t=target.t, solver="exact")
-            out = getattr(res, SERIES[target.observable])
-    return np.array(np.broadcast_to(out, (m, target.y.size)), dtype=float)
+            res = simulate_batch(law, SceneBatch(ds.scene, {}, m), params, t=t, solver="exact")
+            got = {k: getattr(res, k) for k in names}
+        curves = [np.broadcast_to(got[k], (m, t.size)) for k in names]
+    if stated:  # a reconstruction's stated numbers, read off each row as ``_predict_series`` reads them
+        numbers = stated_rows(t, *curves)
+        return np.column_stack([numbers[k] for k in ds.stated]).astype(float)
+    return np.array(curves[0], dtype=float)

@@ -82,12 +82,14 @@ def gsjs(x: np.ndarray, y: np.ndarray, segments: np.ndarray | None = None) -> No
     # tr(Q) and tr(Q^2) of Q = C'C / m (C: the m x n pseudo-residual weights; each row has unit norm, so
     # tr(Q) = 1); tr(Q^2) = |C C'|_F^2 / m^2, and rows r, s of C overlap only when their triples do.
     tr2 = 0.0
+    Wt, It = np.ascontiguousarray(W.T), np.ascontiguousarray(I.T)
     for d in range(3):
-        r, s = np.arange(m - d), np.arange(d, m)
-        dot = np.zeros(r.size)
+        dot = np.zeros(m - d)
         for p in range(3):
             for q in range(3):
-                dot += W[r, p] * W[s, q] * (I[r, p] == I[s, q])
+                same = It[p, :m - d] == It[q, d:]
+                if same.any():
+                    dot += np.where(same, Wt[p, :m - d] * Wt[q, d:], 0.0)
         tr2 += (1 if d == 0 else 2) * float(dot @ dot)
     return NoiseEstimate(math.sqrt(float(e @ e) / m), m * m / tr2 if tr2 > 0 else 0.0, "GSJS", rows=I, weights=W)
 

@@ -32,10 +32,13 @@ def run_exact(law, batch, p, T, into=None):
     else:
         u_s = np.broadcast_to(plan.rigid_slip(y0), (nsc, 1))
         sgn = np.sign(u_s)
-        fallback |= sgn[:, 0] == 0
+        rest = sgn[:, 0] == 0  # at rest at first: a stuck phase from t = 0 (``segments._start``), then as after a stick
+        if plan.continuous or "xi" in plan.states:
+            fallback |= rest
+            rest[:] = False
         sgn = np.where(sgn == 0, 1.0, sgn)
         ts = exact_stop(law, batch, p, None, plan, form, 0.0, y0, u_s[:, 0], sgn[:, 0], T[:, -1])
-        hit = ~np.isnan(ts) & ~fallback
+        hit = ~np.isnan(ts) & ~fallback & ~rest
         segs, tb_first = np.where(hit, 2, 1), np.full(nsc, np.nan)  # phases per scene, first breakaway time [s]
         info = {"segments_per_scene": segs, "breakaway_time": tb_first}
         tcol = np.where(hit, ts, np.inf)[:, None]
@@ -51,7 +54,21 @@ def run_exact(law, batch, p, T, into=None):
             v_stick[ids, 0] = ys[0]
             np.copyto(Y[0], v_stick, where=stuck_mask)  # zero slip exactly while stuck, as the stick state has it
             stick.stuck_states(plan, T, tt, Y, out=Y)  # dt = 0 before the stick: those states stay
-            dirs = exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts[ids], ys, sgn[ids, 0], segs, tb_first)
+        else:
+            ids, ys = np.zeros(0, dtype=int), np.zeros((d, 0))
+        if rest.any():  # stuck from t = 0 in the initial state, slip before it of no sign
+            still = np.nonzero(rest)[0]
+            y_rest = np.ascontiguousarray(y0[:, still, 0])
+            Y[:, still] = stick.stuck_states(plan_of(law, batch.view(still, column=True)), T[still], 0.0,
+                                             y_rest[:, :, None])[0]
+            stuck_mask[still] = True
+        else:
+            still, y_rest = ids[:0], ys[:, :0]
+        if ids.size or still.size:
+            dirs = exact_phases(law, batch, p, T, Y, stuck_mask, np.concatenate([ids, still]),
+                                np.concatenate([ts[ids], np.zeros(still.size)]), np.concatenate([ys, y_rest], axis=1),
+                                np.concatenate([sgn[ids, 0], np.zeros(still.size)]), segs, tb_first, stick_time)
+            segs[still[tb_first[still] == 0.0]] -= 1  # broke away at once: it slid from the start, no stuck phase
     need = stick.needed_force(plan)
     out = finish(law, batch, p, T, np.nan_to_num(Y, copy=into is None) if fallback.any() else Y, ~stuck_mask, need, into,
                   dirs)
@@ -61,13 +78,14 @@ def run_exact(law, batch, p, T, into=None):
     return out, info | {"nfev": 0, "scalar_fallback": int(fallback.sum())}
 
 
-def exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts, ys, last_dir, segs, tb_first):
-    """After the first stick of scenes ``ids`` (at ts [s] in state ys (d, k), slip before of sign last_dir):
-    breakaway, a sliding phase in closed form from there, perhaps a stick again, and so on, as
-    ``solvers.segments.run`` sequences them, with only the scenes still going in each round. A phase owns
-    its outputs in (start, end]; they are written into Y and stuck_mask, each scene's number of phases into
-    segs and its first breakaway time into tb_first. Returns the slip direction of the outputs of the
-    later sliding phases ((n, m), 0 elsewhere; None if no scene broke away)."""
+def exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts, ys, last_dir, segs, tb_first, stick_time):
+    """After the first stick of scenes ``ids`` (at ts [s] in state ys (d, k), slip before of sign last_dir; 0 for
+    a scene at rest from the start): breakaway, a sliding phase in closed form from there, perhaps a stick again,
+    and so on, as ``solvers.segments.run`` sequences them, with only the scenes still going in each round. A phase
+    owns its outputs in (start, end]; they are written into Y and stuck_mask, each scene's number of phases into
+    segs, its first breakaway time into tb_first and the first stop of its sliding phases into stick_time where
+    that is still NaN. Returns the slip direction of the outputs of the later sliding phases ((n, m), 0
+    elsewhere; None if no scene broke away)."""
     dirs = None
     while ids.size:
         t_end = T[ids, -1]
@@ -75,6 +93,7 @@ def exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts, ys, last_dir, segs, t
         go = ~np.isnan(tb) & (tb < t_end)
         if not go.any():
             break
+        at_once = (last_dir[go] == 0) & (tb[go] == ts[go])  # at rest from the start, sliding at once: it owns t = 0
         ids, ts, ys, tb, hold, t_end = ids[go], ts[go], ys[:, go], tb[go], hold[go], t_end[go]
         tb_first[ids] = np.where(np.isnan(tb_first[ids]), tb, tb_first[ids])
         segs[ids] += 2
@@ -98,7 +117,7 @@ def exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts, ys, last_dir, segs, t
         Ys = states(np.clip(Tr, t0, end))
         te = np.where(stops, t_stop, tb)[:, None]
         y_stop = zero_slip(plan, states(te))  # the state at the stop, slip exactly zero (d, k, 1)
-        after, slide = Tr > t0, Tr <= end
+        after, slide = (Tr > t0) | (at_once[:, None] & (Tr == t0)), Tr <= end
         if stops.any():
             Ys = np.where(slide, Ys, stick.stuck_states(plan, Tr, te, y_stop)[0])
         Y[:, ids] = np.where(after, Ys, Y[:, ids])
@@ -107,6 +126,8 @@ def exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts, ys, last_dir, segs, t
             dirs = np.zeros(T.shape)
         dirs[ids] = np.where(after & slide, h, dirs[ids])
         segs[ids[~stops]] -= 1  # slid to the end: no stuck phase after it
+        first = stops & np.isnan(stick_time[ids])
+        stick_time[ids[first]] = t_stop[first]
         ids, ts, ys, last_dir = ids[stops], t_stop[stops], y_stop[:, stops, 0], hold[stops]
     return dirs
 
