@@ -122,7 +122,23 @@ def test_batch_matches_the_scalar_solver():
             assert _rel(getattr(br, name)[i], getattr(tr, name)) <= 1e-12 or not np.any(getattr(tr, name)), (i, name)
         assert (math.isnan(br.stick_time[i]) if tr.stick_time is None
                 else br.stick_time[i] == pytest.approx(tr.stick_time, rel=1e-12))
-    assert {1, 2, 3} <= segs  # slides throughout, sticks for good, breaks away after a stop
+        assert br.info["segments_per_scene"][i] == tr.info["segments"]
+    assert {1, 2, 3} <= segs  # slides throughout (or held from rest), sticks for good, breaks away after a stop
+
+
+def test_batch_of_constant_areas_each_its_own():
+    """A batch whose scenes differ in their constant area (a column of areas) against the scalar solver."""
+    from frictionlab.physics.scene import ConstantArea
+
+    rng = np.random.default_rng(3)
+    scenes = [worn_incline(rng.uniform(10, 40), u0=rng.uniform(-1, 1)).with_(area=ConstantArea(rng.uniform(1e-5, 1e-4)))
+              for _ in range(8)]
+    params = [{"mu": rng.uniform(0.1, 0.6), "eta_prime": rng.uniform(-1e3, 1e6)} for _ in range(8)]
+    br = simulate_batch("area-rate", scenes, params, solver="exact", n=201)
+    for i, (s, p) in enumerate(zip(scenes, params)):
+        tr = simulate("area-rate", s, p, solver="exact", n=201)
+        for name in ("u", "v", "force"):
+            assert _rel(getattr(br, name)[i], getattr(tr, name)) <= 1e-12, (i, name)
 
 
 def test_the_comparison_fits_the_worn_inclines_in_closed_form():
