@@ -160,3 +160,34 @@ def test_stated_numbers_are_read_off_a_batch_as_off_one_trajectory(law, solver, 
         if many.chisqr[i] >= one.stats.chisqr * (1 - 1e-6):
             for k in opts["initial"]:
                 assert abs(many.values[k][i] - one.params[k].value) <= 0.01 * (f.params[k].stderr or abs(f.params[k].value)), k
+
+
+@pytest.mark.parametrize("law, dataset", [("coulomb", "impact-outcome-synthetic"), ("area-rate", "kharaz2001-spin"),
+                                          ("wear", "impact-outcome-synthetic")])
+def test_impact_outcomes_are_predicted_and_refitted_in_batches(law, dataset, monkeypatch):
+    """Every parameter set's impacts in one batch of closed forms: the batched prediction equals the one-at-a-time
+    one, and the batched refits of replicates reach the single refits' minimum (values within 0.01 SE where it is
+    the same minimum)."""
+    f = fit(law, dataset, solver="exact")
+    tg = f.per_dataset[0].target
+    assert tg.dataset.kind == "impact-outcome" and f.ok
+    rng = np.random.default_rng(2)
+    sets = [{k: p.value * float(rng.uniform(0.7, 1.3)) for k, p in f.params.items() if p.kind == "law"}
+            for _ in range(5)]
+    got = predict_array(law, tg, sets, "exact")
+    want = np.array([predict(law, tg, s, "exact") for s in sets])
+    assert got.shape == want.shape == (5, tg.y.size)
+    assert np.max(np.abs(got - want)) <= 1e-12 * np.max(np.abs(want))
+    assert predict_array(law, tg, sets, "ode") is None  # only the closed forms are batched
+    opts = refit_options(f)
+    _, Y = _replicates(f, 6)
+    many = batchfit.refit_many(batch_problem(law, opts, tg), Y)
+    assert many is not None and many.ok.all()
+    _one_at_a_time(monkeypatch)
+    for i in range(len(Y)):
+        one = refit(law, opts, with_y(tg, Y[i], "replicate"))
+        assert one.ok
+        assert many.chisqr[i] <= one.stats.chisqr * (1 + 1e-6) + 1e-9
+        if many.chisqr[i] >= one.stats.chisqr * (1 - 1e-6):
+            for k in opts["initial"]:
+                assert abs(many.values[k][i] - one.params[k].value) <= 0.01 * (f.params[k].stderr or abs(f.params[k].value)), k

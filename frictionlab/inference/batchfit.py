@@ -6,8 +6,8 @@ times a comparison; one at a time, each Levenberg-Marquardt step is one closed-f
 driver, and the Python around it is most of the cost. ``refit_many(problem, Y, starts)`` fits every row of Y (r, n)
 together instead (``replicates.batch_problem`` poses a refit's problem): one Levenberg-Marquardt run per row, all
 rows stepping at once, each step one batched prediction (``predict.predict_array``: the closed forms over a batch of
-parameter sets, or the paper's series; stated numbers read off each row's curves) of every running row's trial point
-and its forward-difference neighbours.
+parameter sets, or the paper's series; stated numbers read off each row's curves; impact outcomes, every row's
+impacts in one batch) of every running row's trial point and its forward-difference neighbours.
 ``best_start(model, starts)`` runs a fit's starts the same way (``fitmodel._search``).
 
 The problem is the one ``fitting.fit`` poses (``replicates.refit``): the same parameter slots, scales and bounds

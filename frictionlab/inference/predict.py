@@ -235,26 +235,16 @@ def predict(law: str | FrictionLaw, target: Target, params: Mapping[str, float],
 
 def predict_many(law, target: Target, params_list, solver: str, scene: Scene | None = None) -> list | None:
     """``predict`` at each parameter set of ``params_list`` (SI) in one vectorized call where the kind offers one
-    (an impact's or incline's series by ``predict_array``; the closed forms of impact outcomes, each set's rows on
-    the batch engine at once); None where it does not, or refuses, and ``predict`` one set at a time gives each
-    answer or error."""
+    (``predict_array``); None where it does not, or refuses, and ``predict`` one set at a time gives each answer
+    or error."""
     law = get_law(law)
-    if params_list and (scene is None or scene is target.dataset.scene):  # a series on the dataset's own scene
-        try:
-            got = predict_array(law, target, params_list, solver)
-        except FrictionLabError:
-            got = None
-        if got is not None:
-            return list(got)
-    if (solver != "exact" or target.dataset.kind != "impact-outcome" or target.observable not in OUTCOMES
-            or target.observable in ("psi1", "psi2") or PREDICTORS.get("impact-outcome") is not outcome_predictor):
+    if not params_list or (scene is not None and scene is not target.dataset.scene):  # the dataset's own scene only
         return None
-    rows = rows_of(target.dataset)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        out = predict_outcomes_many(law, scene or target.dataset.scene, params_list, speed=rows["speed"],
-                                    incidence=rows["incidence"], spin=rows["spin"])
-    return None if out is None else [np.asarray(o[target.observable], dtype=float) for o in out]
+    try:
+        got = predict_array(law, target, params_list, solver)
+    except FrictionLabError:
+        return None
+    return None if got is None else list(got)
 
 
 def applicable_solvers(law, scene: Scene) -> dict[str, str | None]:
@@ -340,7 +330,8 @@ def predict_array(law, target: Target, params, solver: str) -> np.ndarray | None
     ``target.y``, or None where no batched route serves (then ``predict`` one set at a
     time). Served: a built-in law (a third party's force need not broadcast over parameter sets) with the built-in
     series predictor of an impact or incline on its dataset's scene (a series, or a reconstruction's stated numbers
-    read off each row as ``stated_numbers`` reads them), solved by the closed forms over a batch of
+    read off each row as ``stated_numbers`` reads them) or an impact-outcome dataset's outcomes (every set's impacts
+    in one batch, ``_outcomes_array``), solved by the closed forms over a batch of
     parameter sets (``solve.batch``, equal to ``simulate(..., 'exact')`` to round-off; tests/test_batchfit.py)
     or by the paper's series. Raises FrictionLabError where the batch cannot be solved (a value outside its
     bounds)."""
@@ -352,6 +343,8 @@ def predict_array(law, target: Target, params, solver: str) -> np.ndarray | None
 
     law = get_law(law)
     ds = target.dataset
+    if ds.kind == "impact-outcome":
+        return _outcomes_array(law, target, params, solver)
     stated = target.observable == "stated"
     if (is_third_party(law) or ds.kind not in ("impact", "incline") or PREDICTORS.get(ds.kind) is not _predict_series
             or ds.scene is None or not (target.observable in ARRAY_SERIES or stated)
@@ -376,3 +369,21 @@ def predict_array(law, target: Target, params, solver: str) -> np.ndarray | None
         numbers = stated_rows(t, *curves)
         return np.column_stack([numbers[k] for k in ds.stated]).astype(float)
     return np.array(curves[0], dtype=float)
+
+
+def _outcomes_array(law, target: Target, params, solver: str) -> np.ndarray | None:
+    """``predict_array`` of an impact-outcome target: every parameter set's impacts in the closed forms of one
+    batch (``outcome.predict_outcomes_many``); None where that route does not serve (a solver but 'exact', psi1
+    and psi2, a third party's predictor, one impact, a refusal)."""
+    if (solver != "exact" or target.observable not in OUTCOMES or target.observable in ("psi1", "psi2")
+            or PREDICTORS.get("impact-outcome") is not outcome_predictor):
+        return None
+    m = len(next(iter(params.values()))) if isinstance(params, Mapping) else len(params)
+    if isinstance(params, Mapping):
+        params = [{k: float(np.broadcast_to(v, (m,))[i]) for k, v in params.items()} for i in range(m)]
+    rows = rows_of(target.dataset)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        out = predict_outcomes_many(law, target.dataset.scene, list(params), speed=rows["speed"],
+                                    incidence=rows["incidence"], spin=rows["spin"])
+    return None if out is None else np.array([np.asarray(o[target.observable], dtype=float) for o in out])

@@ -194,20 +194,24 @@ def ratio_pvalue_moments(est: NoiseEstimate, chisqr: float, J: np.ndarray) -> fl
         Gq = np.bincount(I.ravel(), weights=(W * Cq[:, None]).ravel(), minlength=n) / m
         tr_PG2 += float(Gq @ Gq)
     band = {0: np.sum(W * W, axis=1)}  # K = C C': row j's overlap with row j + d, d = 0, 1, 2
+    Wt, It = np.ascontiguousarray(W.T), np.ascontiguousarray(I.T)
     for d in (1, 2):
         dot = np.zeros(m)
         for a in range(I.shape[1]):
             for b in range(I.shape[1]):
-                dot[: m - d] += W[: m - d, a] * W[d:, b] * (I[: m - d, a] == I[d:, b])
+                same = It[a, : m - d] == It[b, d:]
+                if same.any():
+                    dot[: m - d] += np.where(same, Wt[a, : m - d] * Wt[b, d:], 0.0)
         band[d] = dot
     tr_K2 = float(band[0] @ band[0]) + 2.0 * sum(float(band[d] @ band[d]) for d in (1, 2))
 
-    def diag(d):  # K(i, i + d) for i = 0 .. m - 1 (zero where i + d is outside)
+    diag = {}  # d -> K(i, i + d) for i = 0 .. m - 1 (zero where i + d is outside)
+    for d in range(-2, 3):
         if d >= 0:
-            return band[d]
-        out = np.zeros(m)
-        out[-d:] = band[-d][: m + d]
-        return out
+            diag[d] = band[d]
+        else:
+            diag[d] = np.zeros(m)
+            diag[d][-d:] = band[-d][: m + d]
 
     tr_K3 = 0.0
     for d1 in range(-2, 3):
@@ -215,8 +219,9 @@ def ratio_pvalue_moments(est: NoiseEstimate, chisqr: float, J: np.ndarray) -> fl
             d3 = -(d1 + d2)
             if abs(d3) > 2:
                 continue
-            i = np.arange(max(0, -d1, -d1 - d2), min(m, m - d1, m - d1 - d2))
-            tr_K3 += float(np.sum(diag(d1)[i] * diag(d2)[i + d1] * diag(d3)[i + d1 + d2]))
+            lo, hi = max(0, -d1, -d1 - d2), min(m, m - d1, m - d1 - d2)
+            if hi > lo:
+                tr_K3 += float(np.dot(diag[d1][lo:hi] * diag[d2][lo + d1:hi + d1], diag[d3][lo + d1 + d2:hi + d1 + d2]))
     tr_G2, tr_G3 = tr_K2 / m ** 2, tr_K3 / m ** 3
     c = float(chisqr)
     t1 = (n - p) - c
