@@ -11,7 +11,7 @@ NormalAreaRateForm, F = s (a N + c dA/dt) while slip keeps its sign s:
   for half-sine or constant (weight) N and half-sine or constant A; slip reaching zero is
   located by root finding and handed to the stick logic.
   growth area A = A0 + rate x (x the sliding length, dA/dt = rate |u|) and constant (weight) N, the
-  incline: F = s a N + c rate u, so slip relaxes linearly, u' = b - lam u with lam = kappa c rate
+  incline: F = s a N + c rate u, so slip obeys a linear equation, u' = b - lam u with lam = kappa c rate
   [1/s] and b = drive - kappa s a N [m/s^2]:  u = u_s exp(-lam dt) + b dt (1 - exp(-lam dt)) / (lam dt)
   (lam < 0, eta' < 0, lets slip grow); the stop, where s u falls to zero, is in closed form too.
 In every case the friction impulse J(t) = int F dt and its integral K(t) give the states:
@@ -215,9 +215,9 @@ def _area_slip(plan, k, t0, y0, t):
 
 
 def _relax(u0, b, lam, dt):
-    """u and int_0^dt u [m/s, m] of u' = b - lam u from u(0) = u0: u0 exp(-x) + b dt g1(x), x = lam dt, for either
-    sign of lam [1/s] (x -> 0: the straight line); g1 = (1 - exp(-x)) / x and g2 = int_0^1 of g1's integrand
-    ((x - 1 + exp(-x)) / x^2) are written to stay exact for tiny |x|. Elementwise (a batch's columns)."""
+    """u and int_0^dt u [m/s, m] of u' = b - lam u from u(0) = u0, for either sign of lam [1/s] (x = lam dt -> 0:
+    the straight line): u = u0 exp(-x) + b dt g1, int u = u0 dt g1 + b dt^2 g2 with g1 = (1 - exp(-x)) / x and
+    g2 = (x - 1 + exp(-x)) / x^2, written to stay exact for tiny |x|. Elementwise (a batch's columns)."""
     x = lam * dt
     ax = np.abs(x)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
@@ -392,6 +392,12 @@ def pulse_stop(C0, B, S, phi, t_end, margin):
     return np.where(passes, (x_pass - (a_level - a_zero)) / phi, np.inf)
 
 
+def _slip_margin(plan, T: float) -> float:
+    """SLIP_MARGIN of the slip's scale over a phase ending at T [s]: the initial slip, the drive's, the spin's."""
+    s = plan.scene
+    return SLIP_MARGIN * max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * (s.radius or 0.0), 1e-300)
+
+
 def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     """Friction impulse J and its integral K from t0 at times t (and, with find_stop, the stop).
 
@@ -405,8 +411,7 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
         if not find_stop or t.size == 0:
             return J, K, None
         T = float(t[-1])
-        margin = SLIP_MARGIN * max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * (s.radius or 0.0), 1e-300)
-        t_stop = float(relax_stop(*relaxing, t0, T, margin))
+        t_stop = float(relax_stop(*relaxing, t0, T, _slip_margin(plan, T)))
         return J, K, (t_stop if t_stop <= T else None)
     area = s.area if (np.asarray(form.c) != 0.0).any() else None
     t0_ = np.atleast_1d(np.asarray(t0, dtype=float))  # (1,) for a float: broadcasts against t as before
@@ -444,8 +449,7 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     T = float(t[-1])
     # slip must pass zero by a hair (as in the ode solver's event): at a restart from rest,
     # round-off in the slip an ulp after t0 is not a new stop
-    s = plan.scene
-    margin = SLIP_MARGIN * max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * (s.radius or 0.0), 1e-300)
+    margin = _slip_margin(plan, T)
     if closed_stop_applies(plan, form, t0):  # slip falls monotonically: a stop iff it has passed zero at T
         if sgn * slip(T)[0] + margin > 0.0:
             return J, K, None
