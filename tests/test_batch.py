@@ -132,6 +132,25 @@ def unloading_incline(u0, tc, mu_alpha=0.3, mass=0.02, A0=1e-4, duration=0.2):
                  normal=WeightNormal(mass * G * math.cos(mu_alpha)), effects=frozenset({"gravity"}))
 
 
+def _one_at_a_time(br, i, s, p, V):
+    """The scalar exact solve of batch row i (scene s, area-rate parameters p), checked against the row: every
+    output within 1e-10 of its scale (slip and velocity: the larger of V and the slip's largest), the same
+    number of phases and the same first stop."""
+    tr = fl.simulate("area-rate", s, p, solver="exact", t=br.t)
+    V = max(V, float(np.max(np.abs(tr.u))))
+    r = s.radius or 1.0
+    for name, scale in (("u", V), ("v", V), ("omega", V / r), ("theta", V * s.duration / r),
+                        ("force", max(np.max(np.abs(tr.force)), 1e-12))):
+        err = np.max(np.abs(getattr(br, name)[i] - getattr(tr, name)))
+        assert err <= 1e-10 * scale, (i, name, err / scale)
+    assert int(br.info["segments_per_scene"][i]) == tr.info["segments"]
+    if tr.stick_time is None:
+        assert math.isnan(br.stick_time[i])
+    else:
+        assert br.stick_time[i] == pytest.approx(tr.stick_time, rel=1e-10)
+    return tr
+
+
 def test_exact_breakaway_phases_vectorized_match_scalar(rng):
     """Closed forms after a breakaway run vectorized (no scalar fallback) and equal the scalar exact solver to
     1e-10 of each output's scale, with the same stick and breakaway times and number of phases: a mixture
@@ -145,20 +164,11 @@ def test_exact_breakaway_phases_vectorized_match_scalar(rng):
         br = simulate_batch("area-rate", scenes, params, solver="exact", n=301)
         assert br.info["scalar_fallback"] == 0
         for i, s in enumerate(scenes):
-            tr = fl.simulate("area-rate", s, params[i], solver="exact", t=br.t)
-            V = max(abs(s.u0), 1e-3)
-            r = s.radius or 1.0
-            for name, scale in (("u", V), ("v", V), ("omega", V / r), ("theta", V * s.duration / r),
-                                ("force", np.max(np.abs(tr.force)))):
-                err = np.max(np.abs(getattr(br, name)[i] - getattr(tr, name)))
-                assert err <= 1e-10 * scale, (i, name, err / scale)
-            segs = int(br.info["segments_per_scene"][i])
-            assert segs == tr.info["segments"]
+            tr = _one_at_a_time(br, i, s, params[i], max(abs(s.u0), 1e-3))
+            segs = tr.info["segments"]
             seen.add(segs)
             if tr.stick_time is None:
-                assert math.isnan(br.stick_time[i])
                 continue
-            assert br.stick_time[i] == pytest.approx(tr.stick_time, rel=1e-10)
             tb = br.info["breakaway_time"][i]
             assert math.isnan(tb) == (segs == 2)
             if segs > 2:  # the scalar solver's breakaway from its own stick (capacity reads t only, not the state)
@@ -182,17 +192,7 @@ def test_a_start_from_rest_is_solved_in_the_batch_as_one_at_a_time(rng):
         br = simulate_batch("area-rate", scenes, params, solver="exact", n=301)
         assert br.info["scalar_fallback"] == 0
         for i, s in enumerate(scenes):
-            tr = fl.simulate("area-rate", s, params[i], solver="exact", t=br.t)
-            V = max(float(np.max(np.abs(tr.u))), 1e-3)
-            for name, scale in (("u", V), ("v", V), ("force", max(np.max(np.abs(tr.force)), 1e-12))):
-                err = np.max(np.abs(getattr(br, name)[i] - getattr(tr, name)))
-                assert err <= 1e-10 * scale, (i, name, err / scale)
-            assert int(br.info["segments_per_scene"][i]) == tr.info["segments"]
-            seen.add(tr.info["segments"])
-            if tr.stick_time is None:
-                assert math.isnan(br.stick_time[i])
-            else:
-                assert br.stick_time[i] == pytest.approx(tr.stick_time, rel=1e-10)
+            seen.add(_one_at_a_time(br, i, s, params[i], 1e-3).info["segments"])
     assert {1, 2, 3} <= seen  # stuck for good or sliding throughout, held then sliding, sliding then stuck again
 
 

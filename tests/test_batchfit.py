@@ -33,6 +33,25 @@ def _replicates(f, n: int, seed: int = 3):
     return tg, f.per_dataset[0].model + np.random.default_rng(seed).normal(0.0, tg.sigma, (n, tg.y.size))
 
 
+def _batched_reaches_the_single_minimum(f, n: int, monkeypatch):
+    """n replicates of fit ``f``'s curve, refitted in one batch: every row converges to the one-at-a-time refit's
+    chi-square (within its tolerance) or lower, its values within 0.01 SE of that refit's where the minimum is
+    the same."""
+    law, tg, opts = f.law, f.per_dataset[0].target, refit_options(f)
+    _, Y = _replicates(f, n)
+    many = batchfit.refit_many(batch_problem(law, opts, tg), Y)
+    assert many is not None and many.ok.all()
+    _one_at_a_time(monkeypatch)
+    for i in range(n):
+        one = refit(law, opts, with_y(tg, Y[i], "replicate"))
+        assert one.ok
+        assert many.chisqr[i] <= one.stats.chisqr * (1 + 1e-6) + 1e-9
+        if many.chisqr[i] >= one.stats.chisqr * (1 - 1e-6):
+            for k in opts["initial"]:
+                se = f.params[k].stderr or abs(f.params[k].value)
+                assert abs(many.values[k][i] - one.params[k].value) <= 0.01 * se, k
+
+
 @pytest.mark.parametrize("law, solver, where", CASES)
 def test_the_batched_prediction_is_the_single_one_to_round_off(law, solver, where):
     f = fit(law, _data(law, where), solver=solver)
@@ -148,18 +167,7 @@ def test_stated_numbers_are_read_off_a_batch_as_off_one_trajectory(law, solver, 
     want = np.array([predict(law, tg, s, solver) for s in sets])
     assert got.shape == want.shape == (6, 4)
     assert np.max(np.abs(got - want) / np.abs(want)) <= 1e-12
-    opts = refit_options(f)
-    _, Y = _replicates(f, 8)
-    many = batchfit.refit_many(batch_problem(law, opts, tg), Y)
-    assert many is not None and many.ok.all()
-    _one_at_a_time(monkeypatch)
-    for i in np.nonzero(many.ok)[0]:
-        one = refit(law, opts, with_y(tg, Y[i], "replicate"))
-        assert one.ok
-        assert many.chisqr[i] <= one.stats.chisqr * (1 + 1e-6) + 1e-9
-        if many.chisqr[i] >= one.stats.chisqr * (1 - 1e-6):
-            for k in opts["initial"]:
-                assert abs(many.values[k][i] - one.params[k].value) <= 0.01 * (f.params[k].stderr or abs(f.params[k].value)), k
+    _batched_reaches_the_single_minimum(f, 8, monkeypatch)
 
 
 @pytest.mark.parametrize("law, dataset", [("coulomb", "impact-outcome-synthetic"), ("area-rate", "kharaz2001-spin"),
@@ -179,15 +187,4 @@ def test_impact_outcomes_are_predicted_and_refitted_in_batches(law, dataset, mon
     assert got.shape == want.shape == (5, tg.y.size)
     assert np.max(np.abs(got - want)) <= 1e-12 * np.max(np.abs(want))
     assert predict_array(law, tg, sets, "ode") is None  # only the closed forms are batched
-    opts = refit_options(f)
-    _, Y = _replicates(f, 6)
-    many = batchfit.refit_many(batch_problem(law, opts, tg), Y)
-    assert many is not None and many.ok.all()
-    _one_at_a_time(monkeypatch)
-    for i in range(len(Y)):
-        one = refit(law, opts, with_y(tg, Y[i], "replicate"))
-        assert one.ok
-        assert many.chisqr[i] <= one.stats.chisqr * (1 + 1e-6) + 1e-9
-        if many.chisqr[i] >= one.stats.chisqr * (1 - 1e-6):
-            for k in opts["initial"]:
-                assert abs(many.values[k][i] - one.params[k].value) <= 0.01 * (f.params[k].stderr or abs(f.params[k].value)), k
+    _batched_reaches_the_single_minimum(f, 6, monkeypatch)

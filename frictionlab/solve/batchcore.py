@@ -46,7 +46,7 @@ def finish(law, batch, p, T, Y, sliding, need, into=None, dirs=None):
     elif not F.flags.writeable or np.shares_memory(F, u):
         F = F.copy()
     np.copyto(F, np.broadcast_to(need, F.shape), where=stuck)
-    A = c.A if c.A is not None else (view.area(T, None, u)[0] if plan.needs_area else None)
+    A = c.A if c.A is not None else (plan.area(T, Y, u)[0] if plan.needs_area else None)  # a growth area reads x
     N = c.N
     for name, arr in (("states", Y), ("force", F)):
         if not all_finite(arr):

@@ -44,9 +44,7 @@ def run_exact(law, batch, p, T, into=None):
         tcol = np.where(hit, ts, np.inf)[:, None]
         # the sliding closed form at min(t, stick time): frozen at the stick, where the stuck phase continues
         tt = np.minimum(T, tcol) if hit.any() else T
-        signed = exact.NormalAreaRateForm(a=sgn * form.a, c=sgn * form.c)  # the slip's sign in the form: no pass
-        J1, K1, _ = exact._normal_area_rate(plan, signed, 0.0, y0, 1.0, tt, find_stop=False)
-        Y = exact._states(plan, 0.0, y0, tt, J1, K1, out=None if into is None else into["states"])
+        Y = sliding_states(plan, form, sgn, 0.0, y0, tt, out=None if into is None else into["states"])
         if hit.any():
             stick_time[hit] = ts[hit]
             ids = np.nonzero(hit)[0]
@@ -111,11 +109,9 @@ def exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts, ys, last_dir, segs, t
         t_stop = exact_stop(law, batch, p, ids, plan, form, tb, y0, u_s, hold, t_end)
         stops = ~np.isnan(t_stop)
         end = np.where(stops, t_stop, np.inf)[:, None]
-        signed = exact.NormalAreaRateForm(a=h * form.a, c=h * form.c)
 
         def states(tt):
-            J, K, _ = exact._normal_area_rate(plan, signed, t0, y0, 1.0, tt, find_stop=False)
-            return exact._states(plan, t0, y0, tt, J, K)
+            return sliding_states(plan, form, h, t0, y0, tt)
 
         Tr = T[ids]
         Ys = states(np.clip(Tr, t0, end))
@@ -134,6 +130,18 @@ def exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts, ys, last_dir, segs, t
         stick_time[ids[first]] = t_stop[first]
         ids, ts, ys, last_dir = ids[stops], t_stop[stops], y_stop[:, stops, 0], hold[stops]
     return dirs
+
+
+def sliding_states(plan, form, sgn, t0, y0, tt, out=None):
+    """States at times tt (k, q) of sliding phases under F = s (a N + c dA/dt) from t0 in states y0, slip of sign
+    sgn (k, 1). The slip's sign goes into the form (no pass over the grid), except on a growth area, where the
+    area term c rate u does not carry it."""
+    if exact.growth_slip(plan, form, sgn, 0.0) is not None:
+        J, K, _ = exact._normal_area_rate(plan, form, t0, y0, sgn, tt, find_stop=False)
+    else:
+        signed = exact.NormalAreaRateForm(a=sgn * form.a, c=sgn * form.c)
+        J, K, _ = exact._normal_area_rate(plan, signed, t0, y0, 1.0, tt, find_stop=False)
+    return exact._states(plan, t0, y0, tt, J, K, out=out, direction=sgn)
 
 
 def exact_stop(law, batch, p, ids, plan, form, t0, y0, u_s, sgn, t_end):
@@ -159,6 +167,14 @@ def exact_stop(law, batch, p, ids, plan, form, t0, y0, u_s, sgn, t_end):
 
         return g
 
+    relaxing = exact.growth_slip(plan, form, sgn[:, None], u_s[:, None])
+    if relaxing is not None:  # in closed form (exact.relax_stop), by the scalar solver's rule and margin
+        sc = plan.scene
+        terms = (sc.u0, plan.drive * t_end[:, None], sc.omega0 * (0.0 if sc.radius is None else sc.radius))
+        scale = np.maximum.reduce([np.broadcast_to(np.abs(np.asarray(x, dtype=float)), (k, 1)) for x in terms])
+        ts = exact.relax_stop(*relaxing, t0c, t_end[:, None], exact.SLIP_MARGIN * np.maximum(scale, 1e-300))
+        ts = np.broadcast_to(ts, (k, 1))[:, 0]
+        return np.where(ts < t_end, ts, np.nan)
     noise = 8 * np.finfo(float).eps * np.abs(u_s)  # slip is u_s minus terms of its size
     c_zero = exact.form_branch(form)[0]
     monotone = not restart and c_zero and (isinstance(batch.template.normal, exact.WeightNormal)

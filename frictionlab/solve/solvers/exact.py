@@ -10,8 +10,13 @@ NormalAreaRateForm, F = s (a N + c dA/dt) while slip keeps its sign s:
   u = u_s + drive (t - t_s) - kappa s [a (IN(t) - IN(t_s)) + c (A(t) - A(t_s))], IN = int N dt,
   for half-sine or constant (weight) N and half-sine or constant A; slip reaching zero is
   located by root finding and handed to the stick logic.
+  growth area A = A0 + rate x (x the sliding length, dA/dt = rate |u|) and constant (weight) N, the
+  incline: F = s a N + c rate u, so slip obeys a linear equation, u' = b - lam u with lam = kappa c rate
+  [1/s] and b = drive - kappa s a N [m/s^2]:  u = u_s exp(-lam dt) + b dt (1 - exp(-lam dt)) / (lam dt)
+  (lam < 0, eta' < 0, lets slip grow); the stop, where s u falls to zero, is in closed form too.
 In every case the friction impulse J(t) = int F dt and its integral K(t) give the states:
-  v = v_s + drive dt - J/m,  omega = omega_s + r J / I,  theta = theta_s + omega_s dt + r K / I.
+  v = v_s + drive dt - J/m,  omega = omega_s + r J / I,  theta = theta_s + omega_s dt + r K / I,
+  and the sliding length, where the plan carries it, x = x_s + s (u_s dt + drive dt^2 / 2 - kappa K).
 """
 from __future__ import annotations
 
@@ -23,7 +28,7 @@ from scipy.special import ive
 
 from ...core.errors import SolverError
 from ...physics.law import AreaSlipForm, NormalAreaRateForm
-from ...physics.scene import ConstantArea, HalfSineArea, HalfSineNormal, WeightNormal
+from ...physics.scene import ConstantArea, GrowthArea, HalfSineArea, HalfSineNormal, WeightNormal
 
 SCAN = 4096  # grid points scanned for the first zero of slip
 SLIP_MARGIN = 1e-12  # slip, relative to its scale, by which a stop must pass zero (as in ode.zero_slip)
@@ -56,8 +61,14 @@ def _form_and_reason(plan, p):
         if not isinstance(s.normal, (HalfSineNormal, WeightNormal)):
             raise SolverError(f"exact: {name} needs a half-sine or weight normal force; this scene has "
                               f"{type(s.normal).__name__}")
+        if form.c != 0.0 and isinstance(s.area, GrowthArea):
+            if not isinstance(s.normal, WeightNormal):
+                raise SolverError(f"exact: {name} on a growth area needs a weight normal force (an incline); this "
+                                  f"scene has {type(s.normal).__name__}")
+            return form
         if form.c != 0.0 and not isinstance(s.area, (HalfSineArea, ConstantArea)):
-            raise SolverError(f"exact: {name} needs a half-sine or constant area; this scene has {type(s.area).__name__}")
+            raise SolverError(f"exact: {name} needs a half-sine, constant or growth area; this scene has "
+                              f"{type(s.area).__name__}")
         return form
     raise SolverError(f"exact: {name} returned an unknown form {form!r}")
 
@@ -71,19 +82,20 @@ def make_slide():
         else:
             J, K, t_stop = _normal_area_rate(plan, form, t0, y0, direction, t_out)
         keep = t_out <= t_stop if t_stop is not None else np.ones(t_out.shape, dtype=bool)
-        Y = _states(plan, t0, y0, t_out[keep], J[keep], K[keep])
+        Y = _states(plan, t0, y0, t_out[keep], J[keep], K[keep], direction=direction)
         y_stop = None
         if t_stop is not None:
             Js, Ks = _normal_area_rate(plan, form, t0, y0, direction, np.array([t_stop]), find_stop=False)[:2]
-            y_stop = _states(plan, t0, y0, np.array([t_stop]), Js, Ks)[:, 0]
+            y_stop = _states(plan, t0, y0, np.array([t_stop]), Js, Ks, direction=direction)[:, 0]
         return Y, t_stop, y_stop, {"nfev": 0}
 
     return slide
 
 
-def _states(plan, t0, y0, t, J, K, out=None):
+def _states(plan, t0, y0, t, J, K, out=None, direction=1.0):
     """States at times t from the friction impulse J and its integral K (terms that vanish skipped: a batch
-    evaluates this on large grids)."""
+    evaluates this on large grids); the sliding length x, where the plan carries it, grows by the integral of
+    slip times the phase's slip ``direction`` (+1, -1; a column on a batch)."""
     s = plan.scene
     dt = t - t0
     if out is None:
@@ -103,6 +115,9 @@ def _states(plan, t0, y0, t, J, K, out=None):
             w0 = y0[plan.index("omega")]
             if np.asarray(w0).any():
                 out[i] += w0 * dt
+        elif name == "x":  # int u = u_s dt + drive dt^2 / 2 - kappa K over the phase, of the phase's sign
+            slid = plan.rigid_slip(y0) * dt + plan.drive * dt * dt / 2.0 - plan.kappa * K
+            out[i] = y0[i] + np.where(np.asarray(direction) < 0, -1.0, 1.0) * slid
         else:  # pragma: no cover - guarded by check()
             raise SolverError(f"exact: state '{name}' has no closed form")
     return out
@@ -183,19 +198,7 @@ def _area_slip(plan, k, t0, y0, t):
     u0 = plan.rigid_slip(y0)
     kappa = plan.kappa
     if isinstance(s.area, ConstantArea):
-        rate = kappa * k * s.area.area
-        dt = t - t0
-        x = rate * dt
-        # e1 = (1 - exp(-x)) / rate and e2 = int_0^dt e1, written to stay exact for tiny x
-        with np.errstate(divide="ignore", invalid="ignore"):
-            g1 = np.where(x > 1e-8, -np.expm1(-x) / np.where(x > 0, x, 1.0), 1.0 - x / 2.0 + x * x / 6.0)
-            g2 = np.where(x > 1e-5, (x + np.expm1(-x)) / np.where(x > 0, x * x, 1.0), 0.5 - x / 6.0 + x * x / 24.0)
-        a = plan.drive
-        u = u0 * np.exp(-x) + a * dt * g1
-        int_u = u0 * dt * g1 + a * dt * dt * g2
-        J = (a * dt - (u - u0)) / kappa
-        K = (a * dt * dt / 2.0 - (int_u - u0 * dt)) / kappa
-        return J, K
+        return _relaxing(plan, u0, plan.drive, kappa * k * s.area.area, t - t0)
     if t0 != 0.0:
         raise SolverError("exact: the half-sine closed form starts at first contact only")
     tc = s.area.contact_time
@@ -209,6 +212,59 @@ def _area_slip(plan, k, t0, y0, t):
     J = (u0 - u) / kappa
     K = (u0 * t - int_u) / kappa
     return J, K
+
+
+def _relax(u0, b, lam, dt):
+    """u and int_0^dt u [m/s, m] of u' = b - lam u from u(0) = u0, for either sign of lam [1/s] (x = lam dt -> 0:
+    the straight line): u = u0 exp(-x) + b dt g1, int u = u0 dt g1 + b dt^2 g2 with g1 = (1 - exp(-x)) / x and
+    g2 = (x - 1 + exp(-x)) / x^2, written to stay exact for tiny |x|. Elementwise (a batch's columns)."""
+    x = lam * dt
+    ax = np.abs(x)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        g1 = np.where(ax > 1e-8, -np.expm1(-x) / np.where(x != 0, x, 1.0), 1.0 - x / 2.0 + x * x / 6.0)
+        g2 = np.where(ax > 1e-5, (x + np.expm1(-x)) / np.where(x != 0, x * x, 1.0), 0.5 - x / 6.0 + x * x / 24.0)
+        u = u0 * np.exp(-x) + b * dt * g1
+    int_u = u0 * dt * g1 + b * dt * dt * g2
+    return u, int_u
+
+
+def _relaxing(plan, u0, b, lam, dt):
+    """Impulse J and its integral K [N s, N s^2] over dt [s] of a phase whose slip relaxes, u' = b - lam u."""
+    u, int_u = _relax(u0, b, lam, dt)
+    a, kappa = plan.drive, plan.kappa
+    return (a * dt - (u - u0)) / kappa, (a * dt * dt / 2.0 - (int_u - u0 * dt)) / kappa
+
+
+def growth_slip(plan, form, sgn, u_s):
+    """(sgn slip at the phase's start, b = sgn u' at zero slip [m/s^2], lam [1/s]) when sgn slip relaxes as
+    g' = b - lam g: F = s (a N + c rate |u|) on a growth area under a weight (constant) normal force, with an
+    area term (c != 0 somewhere); else None. Arrays broadcast (a batch's columns)."""
+    s = plan.scene
+    if not isinstance(s.area, GrowthArea) or not isinstance(s.normal, WeightNormal) or not np.any(np.asarray(form.c)):
+        return None
+    return sgn * u_s, sgn * plan.drive - plan.kappa * form.a * s.normal.value, plan.kappa * form.c * s.area.rate
+
+
+def _time_to_zero(g0, b, lam):
+    """Time [s] for g' = b - lam g to fall from g0 >= 0 to zero, inf where it never does: only with b < 0, and
+    with lam < 0 only below the unstable rest g = b / lam. dt = log1p(z) / lam, z = -g0 lam / b, written
+    (g0 / -b) log1p(z) / z to stay exact as lam -> 0 (the straight line, g0 / -b). Arrays broadcast."""
+    g0, b, lam = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (g0, b, lam)))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        z = -g0 * lam / b
+        h = np.where(np.abs(z) > 1e-8, np.log1p(np.maximum(z, -1.0)) / np.where(z != 0, z, 1.0),
+                     1.0 - z / 2.0 + z * z / 3.0)
+        dt = np.maximum(g0, 0.0) / -b * h
+    return np.where((b < 0.0) & (z > -1.0), dt, np.inf)
+
+
+def relax_stop(g0, b, lam, t0, T, margin):
+    """Stop [s] of sgn slip g (``growth_slip``) from g0 at t0 by the rule of the scan (as ``_line_stop``): g must pass
+    -margin by T; the stop is its zero when it started ahead (g0 > 0), else the time it passed; inf where not by T.
+    g + margin obeys the same equation with b + lam margin. Arrays broadcast (a batch)."""
+    passed = t0 + _time_to_zero(g0 + margin, b + lam * margin, lam)
+    stop = np.where(g0 > 0.0, t0 + _time_to_zero(g0, b, lam), passed)
+    return np.where(passed <= T, stop, np.inf)
 
 
 # --- F = s (a N + c dA/dt) --------------------------------------------------------------
@@ -247,7 +303,7 @@ def _area_integrals(area, t, second=True):
     if area is None:
         return np.zeros_like(t), (np.zeros_like(t) if second else None)
     if isinstance(area, ConstantArea):
-        return np.full_like(t, area.area), (area.area * t if second else None)
+        return area.area + np.zeros_like(t), (area.area * t if second else None)  # a batch's areas: a column
     tc = area.contact_time
     phi = math.pi / tc
     tau = np.minimum(t, tc)
@@ -336,6 +392,12 @@ def pulse_stop(C0, B, S, phi, t_end, margin):
     return np.where(passes, (x_pass - (a_level - a_zero)) / phi, np.inf)
 
 
+def _slip_margin(plan, T: float) -> float:
+    """SLIP_MARGIN of the slip's scale over a phase ending at T [s]: the initial slip, the drive's, the spin's."""
+    s = plan.scene
+    return SLIP_MARGIN * max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * (s.radius or 0.0), 1e-300)
+
+
 def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     """Friction impulse J and its integral K from t0 at times t (and, with find_stop, the stop).
 
@@ -343,6 +405,14 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     broadcasting against t (k, q): a batch restarts its scenes' sliding phases at their own times."""
     s = plan.scene
     sgn = np.where(np.asarray(direction) != 0, direction, 1.0)
+    relaxing = growth_slip(plan, form, sgn, plan.rigid_slip(y0))
+    if relaxing is not None:  # a growth area: sgn u relaxes (F = s a N + c rate u)
+        J, K = _relaxing(plan, plan.rigid_slip(y0), sgn * relaxing[1], relaxing[2], t - t0)
+        if not find_stop or t.size == 0:
+            return J, K, None
+        T = float(t[-1])
+        t_stop = float(relax_stop(*relaxing, t0, T, _slip_margin(plan, T)))
+        return J, K, (t_stop if t_stop <= T else None)
     area = s.area if (np.asarray(form.c) != 0.0).any() else None
     t0_ = np.atleast_1d(np.asarray(t0, dtype=float))  # (1,) for a float: broadcasts against t as before
 
@@ -379,8 +449,7 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     T = float(t[-1])
     # slip must pass zero by a hair (as in the ode solver's event): at a restart from rest,
     # round-off in the slip an ulp after t0 is not a new stop
-    s = plan.scene
-    margin = SLIP_MARGIN * max(abs(s.u0), abs(plan.drive) * T, abs(s.omega0) * (s.radius or 0.0), 1e-300)
+    margin = _slip_margin(plan, T)
     if closed_stop_applies(plan, form, t0):  # slip falls monotonically: a stop iff it has passed zero at T
         if sgn * slip(T)[0] + margin > 0.0:
             return J, K, None
