@@ -80,18 +80,32 @@ def gsjs(x: np.ndarray, y: np.ndarray, segments: np.ndarray | None = None) -> No
     e = np.sum(W * y[I], axis=1)
     m = i.size
     # tr(Q) and tr(Q^2) of Q = C'C / m (C: the m x n pseudo-residual weights; each row has unit norm, so
-    # tr(Q) = 1); tr(Q^2) = |C C'|_F^2 / m^2, and rows r, s of C overlap only when their triples do.
-    tr2 = 0.0
-    Wt, It = np.ascontiguousarray(W.T), np.ascontiguousarray(I.T)
-    for d in range(3):
-        dot = np.zeros(m - d)
-        for p in range(3):
-            for q in range(3):
-                same = It[p, :m - d] == It[q, d:]
-                if same.any():
-                    dot += np.where(same, Wt[p, :m - d] * Wt[q, d:], 0.0)
-        tr2 += (1 if d == 0 else 2) * float(dot @ dot)
+    # tr(Q) = 1); tr(Q^2) = |C C'|_F^2 / m^2
+    tr2 = _frobenius2(_band(W, I))
     return NoiseEstimate(math.sqrt(float(e @ e) / m), m * m / tr2 if tr2 > 0 else 0.0, "GSJS", rows=I, weights=W)
+
+
+def _band(W: np.ndarray, I: np.ndarray) -> dict[int, np.ndarray]:  # noqa: E741
+    """K = C C' of pseudo-residual rows (weights W on the points I, each m x 3) as its diagonals: d -> K(j, j + d)
+    for j = 0 .. m - 1, d = 0, 1, 2 (zero where j + d is outside; rows overlap only where their triples share a
+    point, so K is a band)."""
+    m = I.shape[0]
+    band = {0: np.sum(W * W, axis=1)}
+    Wt, It = np.ascontiguousarray(W.T), np.ascontiguousarray(I.T)
+    for d in (1, 2):
+        dot = np.zeros(m)
+        for a in range(I.shape[1]):
+            for b in range(I.shape[1]):
+                same = It[a, : m - d] == It[b, d:]
+                if same.any():
+                    dot[: m - d] += np.where(same, Wt[a, : m - d] * Wt[b, d:], 0.0)
+        band[d] = dot
+    return band
+
+
+def _frobenius2(band: dict[int, np.ndarray]) -> float:
+    """tr(K^2) = |K|_F^2 of the symmetric band ``band`` (``_band``)."""
+    return float(band[0] @ band[0]) + 2.0 * sum(float(band[d] @ band[d]) for d in (1, 2))
 
 
 def replicate_spread(keys: list, y: np.ndarray) -> NoiseEstimate | None:
@@ -193,17 +207,8 @@ def ratio_pvalue_moments(est: NoiseEstimate, chisqr: float, J: np.ndarray) -> fl
         tr_PG += float(Cq @ Cq) / m
         Gq = np.bincount(I.ravel(), weights=(W * Cq[:, None]).ravel(), minlength=n) / m
         tr_PG2 += float(Gq @ Gq)
-    band = {0: np.sum(W * W, axis=1)}  # K = C C': row j's overlap with row j + d, d = 0, 1, 2
-    Wt, It = np.ascontiguousarray(W.T), np.ascontiguousarray(I.T)
-    for d in (1, 2):
-        dot = np.zeros(m)
-        for a in range(I.shape[1]):
-            for b in range(I.shape[1]):
-                same = It[a, : m - d] == It[b, d:]
-                if same.any():
-                    dot[: m - d] += np.where(same, Wt[a, : m - d] * Wt[b, d:], 0.0)
-        band[d] = dot
-    tr_K2 = float(band[0] @ band[0]) + 2.0 * sum(float(band[d] @ band[d]) for d in (1, 2))
+    band = _band(W, I)  # K = C C'
+    tr_K2 = _frobenius2(band)
 
     diag = {}  # d -> K(i, i + d) for i = 0 .. m - 1 (zero where i + d is outside)
     for d in range(-2, 3):
