@@ -45,6 +45,7 @@ def run_exact(law, batch, p, T, into=None):
         # the sliding closed form at min(t, stick time): frozen at the stick, where the stuck phase continues
         tt = np.minimum(T, tcol) if hit.any() else T
         Y = sliding_states(plan, form, sgn, 0.0, y0, tt, out=None if into is None else into["states"])
+        stuck = []  # (scenes, stick time, state there, slip's sign before): each goes on by ``exact_phases``
         if hit.any():
             stick_time[hit] = ts[hit]
             ids = np.nonzero(hit)[0]
@@ -54,20 +55,17 @@ def run_exact(law, batch, p, T, into=None):
             v_stick[ids, 0] = ys[0]
             np.copyto(Y[0], v_stick, where=stuck_mask)  # zero slip exactly while stuck, as the stick state has it
             stick.stuck_states(plan, T, tt, Y, out=Y)  # dt = 0 before the stick: those states stay
-        else:
-            ids, ys = np.zeros(0, dtype=int), np.zeros((d, 0))
-        if rest.any():  # stuck from t = 0 in the initial state, slip before it of no sign
-            still = np.nonzero(rest)[0]
+            stuck.append((ids, ts[ids], ys, sgn[ids, 0]))
+        still = np.nonzero(rest)[0]
+        if still.size:  # stuck from t = 0 in the initial state, slip before it of no sign
             y_rest = np.ascontiguousarray(y0[:, still, 0])
             Y[:, still] = stick.stuck_states(plan_of(law, batch.view(still, column=True)), T[still], 0.0,
                                              y_rest[:, :, None])[0]
             stuck_mask[still] = True
-        else:
-            still, y_rest = ids[:0], ys[:, :0]
-        if ids.size or still.size:
-            dirs = exact_phases(law, batch, p, T, Y, stuck_mask, np.concatenate([ids, still]),
-                                np.concatenate([ts[ids], np.zeros(still.size)]), np.concatenate([ys, y_rest], axis=1),
-                                np.concatenate([sgn[ids, 0], np.zeros(still.size)]), segs, tb_first, stick_time)
+            stuck.append((still, np.zeros(still.size), y_rest, np.zeros(still.size)))
+        if stuck:
+            ids, ts0, ys, last = (np.concatenate(part, axis=-1) for part in zip(*stuck))
+            dirs = exact_phases(law, batch, p, T, Y, stuck_mask, ids, ts0, ys, last, segs, tb_first, stick_time)
             segs[still[tb_first[still] == 0.0]] -= 1  # broke away at once: it slid from the start, no stuck phase
     need = stick.needed_force(plan)
     out = finish(law, batch, p, T, np.nan_to_num(Y, copy=into is None) if fallback.any() else Y, ~stuck_mask, need, into,
@@ -169,10 +167,8 @@ def exact_stop(law, batch, p, ids, plan, form, t0, y0, u_s, sgn, t_end):
 
     relaxing = exact.growth_slip(plan, form, sgn[:, None], u_s[:, None])
     if relaxing is not None:  # in closed form (exact.relax_stop), by the scalar solver's rule and margin
-        sc = plan.scene
-        terms = (sc.u0, plan.drive * t_end[:, None], sc.omega0 * (0.0 if sc.radius is None else sc.radius))
-        scale = np.maximum.reduce([np.broadcast_to(np.abs(np.asarray(x, dtype=float)), (k, 1)) for x in terms])
-        ts = exact.relax_stop(*relaxing, t0c, t_end[:, None], exact.SLIP_MARGIN * np.maximum(scale, 1e-300))
+        margin = exact.SLIP_MARGIN * np.maximum(_slip_scale(plan, t_end), 1e-300)[:, None]
+        ts = exact.relax_stop(*relaxing, t0c, t_end[:, None], margin)
         ts = np.broadcast_to(ts, (k, 1))[:, 0]
         return np.where(ts < t_end, ts, np.nan)
     noise = 8 * np.finfo(float).eps * np.abs(u_s)  # slip is u_s minus terms of its size
@@ -208,6 +204,15 @@ def exact_stop(law, batch, p, ids, plan, form, t0, y0, u_s, sgn, t_end):
     return ts
 
 
+def _slip_scale(plan, t_end):
+    """Per scene (k,), the slip's scale over a phase ending at t_end (k,) [s]: the largest of the initial slip, the
+    drive's and the spin's (``exact._slip_margin`` of one scene)."""
+    sc = plan.scene
+    k = t_end.shape[0]
+    terms = (sc.u0, plan.drive * t_end[:, None], sc.omega0 * (0.0 if sc.radius is None else sc.radius))
+    return np.maximum.reduce([np.broadcast_to(np.abs(np.asarray(x, dtype=float)), (k, 1))[:, 0] for x in terms])
+
+
 def _scan_bracket(g, plan, t0, t0c, t_end, restart, noise):
     """Brackets of the first zero of slip ``g`` (sgn * slip at times (k, q)) from SCAN points over each
     row's phase: (rows with a zero, lo, hi, g at lo and hi, offset of g per scene, noise per scene)."""
@@ -217,9 +222,7 @@ def _scan_bracket(g, plan, t0, t0c, t_end, restart, noise):
     grid = t0c + (t_end - t0)[:, None] * frac if restart else t_end[:, None] * frac
     gg = g(grid)
     if restart:
-        sc = plan.scene
-        terms = (sc.u0, plan.drive * t_end[:, None], sc.omega0 * (0.0 if sc.radius is None else sc.radius))
-        scale = np.maximum.reduce([np.broadcast_to(np.abs(np.asarray(x, dtype=float)), (k, 1))[:, 0] for x in terms])
+        scale = _slip_scale(plan, t_end)
         margin = exact.SLIP_MARGIN * np.maximum(scale, 1e-300)
         noise = 8 * np.finfo(float).eps * scale
     else:

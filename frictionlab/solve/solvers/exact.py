@@ -405,9 +405,10 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     broadcasting against t (k, q): a batch restarts its scenes' sliding phases at their own times."""
     s = plan.scene
     sgn = np.where(np.asarray(direction) != 0, direction, 1.0)
-    relaxing = growth_slip(plan, form, sgn, plan.rigid_slip(y0))
+    u_s = plan.rigid_slip(y0)
+    relaxing = growth_slip(plan, form, sgn, u_s)
     if relaxing is not None:  # a growth area: sgn u relaxes (F = s a N + c rate u)
-        J, K = _relaxing(plan, plan.rigid_slip(y0), sgn * relaxing[1], relaxing[2], t - t0)
+        J, K = _relaxing(plan, u_s, sgn * relaxing[1], relaxing[2], t - t0)
         if not find_stop or t.size == 0:
             return J, K, None
         T = float(t[-1])
