@@ -343,14 +343,14 @@ def predict_array(law, target: Target, params, solver: str) -> np.ndarray | None
 
     law = get_law(law)
     ds = target.dataset
+    m = len(next(iter(params.values()))) if isinstance(params, Mapping) else len(params)
     if ds.kind == "impact-outcome":
-        return _outcomes_array(law, target, params, solver)
+        return _outcomes_array(law, target, params, m, solver)
     stated = target.observable == "stated"
     if (is_third_party(law) or ds.kind not in ("impact", "incline") or PREDICTORS.get(ds.kind) is not _predict_series
             or ds.scene is None or not (target.observable in ARRAY_SERIES or stated)
             or solver not in ("exact", "series")):
         return None
-    m = len(next(iter(params.values()))) if isinstance(params, Mapping) else len(params)
     params = batch_params(law, params, m)
     t = np.linspace(0.0, ds.scene.area.contact_time, STATED_GRID) if stated else np.asarray(target.t, dtype=float)
     names = ("omega", "theta") if stated else (SERIES[target.observable],)
@@ -371,14 +371,13 @@ def predict_array(law, target: Target, params, solver: str) -> np.ndarray | None
     return np.array(curves[0], dtype=float)
 
 
-def _outcomes_array(law, target: Target, params, solver: str) -> np.ndarray | None:
-    """``predict_array`` of an impact-outcome target: every parameter set's impacts in the closed forms of one
-    batch (``outcome.predict_outcomes_many``); None where that route does not serve (a solver but 'exact', psi1
-    and psi2, a third party's predictor, one impact, a refusal)."""
+def _outcomes_array(law, target: Target, params, m: int, solver: str) -> np.ndarray | None:
+    """``predict_array`` of an impact-outcome target at m parameter sets: every set's impacts in the closed forms
+    of one batch (``outcome.predict_outcomes_many``); None where that route does not serve (a solver but 'exact',
+    psi1 and psi2, a third party's predictor, one impact, a refusal)."""
     if (solver != "exact" or target.observable not in OUTCOMES or target.observable in ("psi1", "psi2")
             or PREDICTORS.get("impact-outcome") is not outcome_predictor):
         return None
-    m = len(next(iter(params.values()))) if isinstance(params, Mapping) else len(params)
     if isinstance(params, Mapping):
         params = [{k: float(np.broadcast_to(v, (m,))[i]) for k, v in params.items()} for i in range(m)]
     rows = rows_of(target.dataset)

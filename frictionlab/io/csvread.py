@@ -39,10 +39,7 @@ def read_csv(csv: Path, text: str | None = None) -> dict[str, np.ndarray]:
     out = {}
     for j, name in enumerate(header):
         cells = [c[j] if j < len(c) else "" for _, c in rows[1:]]
-        try:  # numpy parses decimal text as float() does; a cell it refuses is found cell by cell
-            values = np.array(cells, dtype=float)
-        except ValueError:
-            values = np.array([_number(x) for x in cells], dtype=float)
+        values = np.array([_number(x) for x in cells], dtype=float)
         bad = np.nonzero(~np.isfinite(values))[0]
         if bad.size:
             i = int(bad[0])
