@@ -70,12 +70,13 @@ def canvas(key, figsize: tuple[float, float], build):
         _emptied(fig)
         fig.set_size_inches(figsize)
         return fig, axes
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     _plt()  # rcParams as every report figure has them (mathtext off)
+    from .agg import Canvas
+
     fig = Figure(figsize=figsize)
-    FigureCanvasAgg(fig)
+    Canvas(fig)
     axes = build(fig)
     if len(kept) >= KEEP:
         kept.pop(next(iter(kept)))
@@ -110,7 +111,11 @@ def _emptied(fig) -> None:
 
 
 def release() -> None:
-    """Let go of this thread's kept figures (``subplots``, ``canvas``) and trajectories (``trajectory``)."""
+    """Let go of this thread's kept figures (``subplots``, ``canvas``), their text measures (``agg``) and
+    trajectories (``trajectory``)."""
+    from . import agg
+
+    agg.release()
     _KEPT.__dict__.pop("figures", None)
     _KEPT.__dict__.pop("trajectories", None)
 

@@ -1,0 +1,101 @@
+"""The Agg canvas of the report's kept figures (``base.canvas``): its renderer keeps, for this thread until
+``release``, what matplotlib's Agg renderer works out anew for each renderer (a new one at each figure size) or
+each draw of a text: a string's size, its glyphs' layout and a font's line metrics. They depend only on the
+string, the font properties, the DPI and the hinting, so the PNG bytes are those matplotlib draws."""
+from __future__ import annotations
+
+import threading
+
+from matplotlib import rcParams
+from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg, get_hinting_flag
+from matplotlib.ft2font import FT2Font
+
+_KEPT = threading.local()
+#: matplotlib lays out a string's glyphs with FT2Font._layout (3.11 on); before, RendererAgg draws as it does
+_LAYOUT = hasattr(FT2Font, "_layout")
+
+
+def release() -> None:
+    """Let go of this thread's kept text measures."""
+    _KEPT.__dict__.clear()
+
+
+def _kept() -> tuple[dict, dict, dict]:
+    k = _KEPT.__dict__
+    if "sizes" not in k:
+        k["sizes"], k["layouts"], k["lines"] = {}, {}, {}
+    return k["sizes"], k["layouts"], k["lines"]
+
+
+def _font(prop) -> tuple:
+    """What FontProperties compares (its ``__eq__`` is its hash's tuple): a key that does not change with it."""
+    return (tuple(prop.get_family()), prop.get_slant(), prop.get_variant(), prop.get_weight(), prop.get_stretch(),
+            prop.get_size(), prop.get_file(), prop.get_math_fontfamily())
+
+
+def _hinting() -> tuple:
+    return rcParams["text.hinting"], rcParams["text.hinting_factor"], rcParams["text.kerning_factor"]
+
+
+class Renderer(RendererAgg):
+    """RendererAgg with this thread's kept text measures (plain text; mathtext and TeX as RendererAgg has them)."""
+
+    def get_text_width_height_descent(self, s, prop, ismath):
+        if ismath:
+            return super().get_text_width_height_descent(s, prop, ismath)
+        sizes = _kept()[0]
+        key = (s, _font(prop), self.dpi, _hinting())
+        got = sizes.get(key)
+        if got is None:
+            got = sizes[key] = super().get_text_width_height_descent(s, prop, ismath)
+        return got
+
+    def draw_text(self, gc, x, y, s, prop, angle, ismath=False, mtext=None):
+        if ismath or not _LAYOUT:
+            return super().draw_text(gc, x, y, s, prop, angle, ismath, mtext)
+        features = mtext.get_fontfeatures() if mtext is not None else None
+        language = mtext.get_language() if mtext is not None else None
+        layouts = _kept()[1]
+        key = (s, _font(prop), self.dpi, _hinting(), features, language)
+        items = layouts.get(key)
+        if items is None:  # RendererAgg.draw_text's layout of the string's glyphs
+            font = self._prepare_font(prop)
+            items = layouts[key] = [(i.ft_object, i.glyph_index, i.x, i.y) for i in font._layout(
+                s, flags=get_hinting_flag(), features=features, language=language)]
+        size = prop.get_size_in_points()
+        self._draw_text_glyphs_and_boxes(gc, x, y, angle, ((f, size, g, 0, 1, dx, dy) for f, g, dx, dy in items), [])
+
+    def _get_font_height_metrics(self, prop):
+        """(ascent, descent, line gap) in pixels of the font of ``prop`` from its tables, as ``Text`` works them
+        out without this method (at its figure's DPI: the renderer's); (None, None, None) without the tables."""
+        lines = _kept()[2]
+        key = (_font(prop), self.dpi, _hinting())
+        got = lines.get(key)
+        if got is None:
+            got = lines[key] = _line_metrics(prop, self.dpi)
+        return got
+
+
+def _line_metrics(prop, dpi: float) -> tuple:
+    from matplotlib.font_manager import fontManager, get_font
+
+    font = get_font(fontManager._find_fonts_by_props(prop))
+    for table_name, gap, ascent, descent in (("OS/2", "sTypoLineGap", "sTypoAscender", "sTypoDescender"),
+                                             ("hhea", "lineGap", "ascent", "descent")):
+        table = font.get_sfnt_table(table_name)
+        if table is not None:
+            scale = 1 / font.get_sfnt_table("head")["unitsPerEm"] * prop.get_size_in_points() * dpi / 72
+            return table[ascent] * scale, -table[descent] * scale, table[gap] * scale
+    return None, None, None
+
+
+class Canvas(FigureCanvasAgg):
+    """FigureCanvasAgg drawing with ``Renderer``."""
+
+    def get_renderer(self):
+        w, h = self.get_width_height(physical=True)
+        key = w, h, self.figure.dpi
+        if self._lastKey != key:
+            self.renderer = Renderer(w, h, self.figure.dpi)
+            self._lastKey = key
+        return self.renderer
