@@ -4,11 +4,13 @@ each draw of a text: a string's size, its glyphs' layout and a font's line metri
 string, the font properties, the DPI and the hinting, so the PNG bytes are those matplotlib draws."""
 from __future__ import annotations
 
+import math
 import threading
 
+import numpy as np
 from matplotlib import rcParams
 from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg, get_hinting_flag
-from matplotlib.ft2font import FT2Font
+from matplotlib.ft2font import FT2Font, RenderMode
 
 _KEPT = threading.local()
 #: matplotlib lays out a string's glyphs with FT2Font._layout (3.11 on); before, RendererAgg draws as it does
@@ -20,11 +22,11 @@ def release() -> None:
     _KEPT.__dict__.clear()
 
 
-def _kept() -> tuple[dict, dict, dict]:
+def _kept() -> tuple[dict, dict, dict, dict]:
     k = _KEPT.__dict__
     if "sizes" not in k:
-        k["sizes"], k["layouts"], k["lines"] = {}, {}, {}
-    return k["sizes"], k["layouts"], k["lines"]
+        k["sizes"], k["layouts"], k["lines"], k["glyphs"] = {}, {}, {}, {}
+    return k["sizes"], k["layouts"], k["lines"], k["glyphs"]
 
 
 def _font(prop) -> tuple:
@@ -55,6 +57,8 @@ class Renderer(RendererAgg):
             return super().draw_text(gc, x, y, s, prop, angle, ismath, mtext)
         features = mtext.get_fontfeatures() if mtext is not None else None
         language = mtext.get_language() if mtext is not None else None
+        if not isinstance(features, (tuple, type(None))) or not isinstance(language, (str, type(None))):
+            return super().draw_text(gc, x, y, s, prop, angle, ismath, mtext)
         layouts = _kept()[1]
         key = (s, _font(prop), self.dpi, _hinting(), features, language)
         items = layouts.get(key)
@@ -62,8 +66,33 @@ class Renderer(RendererAgg):
             font = self._prepare_font(prop)
             items = layouts[key] = [(i.ft_object, i.glyph_index, i.x, i.y) for i in font._layout(
                 s, flags=get_hinting_flag(), features=features, language=language)]
-        size = prop.get_size_in_points()
-        self._draw_text_glyphs_and_boxes(gc, x, y, angle, ((f, size, g, 0, 1, dx, dy) for f, g, dx, dy in items), [])
+        self._glyphs(gc, x, y, angle, prop.get_size_in_points(), items)
+
+    def _glyphs(self, gc, x, y, angle, size, items) -> None:
+        """RendererAgg._draw_text_glyphs_and_boxes for the glyphs ``items`` of plain text (no slant, no stretch),
+        each glyph's bitmap rendered once for each 1/64 pixel phase of its origin: moved by whole pixels, FreeType
+        renders the same bitmap moved by as many pixels."""
+        glyphs = _kept()[3]
+        cos, sin = math.cos(math.radians(angle)), math.sin(math.radians(angle))
+        matrix = (0x10000 * np.array([[cos, -sin], [sin, cos]]) @ [[1, 0], [0, 1]]).round().astype(int)
+        flags, aa = get_hinting_flag(), gc.get_antialiased()
+        turn = (*matrix.ravel().tolist(), self.dpi, flags, aa, size)
+        height = self.height
+        for font, index, dx, dy in items:  # dy is upwards; FreeType's y is upwards, the renderer's downwards
+            ox, oy = round(0x40 * (x + dx * cos - dy * sin)), round(0x40 * (height - y + dx * sin + dy * cos))
+            key = (font, index, turn, ox & 0x3f, oy & 0x3f)
+            got = glyphs.get(key)
+            if got is None:
+                font.set_size(size, self.dpi)
+                font._set_transform(matrix, [ox, oy])
+                bitmap = font._render_glyph(index, flags, RenderMode.NORMAL if aa else RenderMode.MONO)
+                buffer = bitmap.buffer
+                if not aa:
+                    buffer *= 0xff
+                got = glyphs[key] = (buffer, bitmap.left - (ox >> 6), bitmap.top - (oy >> 6))
+            buffer, left, top = got
+            self._renderer.draw_text_image(buffer, left + (ox >> 6), int(height) - top - (oy >> 6) + buffer.shape[0],
+                                           0, gc)
 
     def _get_font_height_metrics(self, prop):
         """(ascent, descent, line gap) in pixels of the font of ``prop`` from its tables, as ``Text`` works them

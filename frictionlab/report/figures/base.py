@@ -34,9 +34,12 @@ def _png(fig) -> bytes:
     less CPU and the file a tenth fewer bytes."""
     from PIL import Image
 
+    from .ticks import same
+
     fig.set_dpi(DPI)
     raw = io.BytesIO()
-    fig.savefig(raw, format="rgba", dpi=DPI)
+    with same(fig):
+        fig.savefig(raw, format="rgba", dpi=DPI)
     size = fig.canvas.get_width_height()
     _plt().close(fig)
     rgba = Image.frombuffer("RGBA", size, raw.getbuffer(), "raw", "RGBA", 0, 1)
@@ -70,6 +73,16 @@ def canvas(key, figsize: tuple[float, float], build):
         _emptied(fig)
         fig.set_size_inches(figsize)
         return fig, axes
+    fig = figure(figsize)
+    axes = build(fig)
+    if len(kept) >= KEEP:
+        kept.pop(next(iter(kept)))
+    kept[key] = fig, axes
+    return fig, axes
+
+
+def figure(figsize: tuple[float, float]):
+    """A new matplotlib Figure of ``figsize`` inches, outside pyplot, drawn by ``agg.Canvas`` (not kept)."""
     from matplotlib.figure import Figure
 
     _plt()  # rcParams as every report figure has them (mathtext off)
@@ -77,11 +90,7 @@ def canvas(key, figsize: tuple[float, float], build):
 
     fig = Figure(figsize=figsize)
     Canvas(fig)
-    axes = build(fig)
-    if len(kept) >= KEEP:
-        kept.pop(next(iter(kept)))
-    kept[key] = fig, axes
-    return fig, axes
+    return fig
 
 
 def _emptied(fig) -> None:
@@ -191,14 +200,17 @@ def _spacing(gap: float, n: int, span: float) -> float:
 def yaxes_in(fig) -> list[tuple[int, float, float]]:
     """(grid row, inches left of its axes, inches above it) the y axis of each of ``fig``'s visible grid axes
     takes (ticks, tick labels and label; above, an offset text such as '1e8')."""
+    from .ticks import same
+
     renderer = fig.canvas.get_renderer()
     out = []
-    for ax in fig.axes:
-        if ax.get_visible() and ax.axison and ax.get_subplotspec() is not None:
-            box, axes = ax.yaxis.get_tightbbox(renderer), ax.get_window_extent(renderer)
-            if box is not None:
-                out.append((ax.get_subplotspec().rowspan.start, max(0.0, axes.x0 - box.x0) / fig.dpi,
-                            max(0.0, box.y1 - axes.y1) / fig.dpi))
+    with same(fig):
+        for ax in fig.axes:
+            if ax.get_visible() and ax.axison and ax.get_subplotspec() is not None:
+                box, axes = ax.yaxis.get_tightbbox(renderer), ax.get_window_extent(renderer)
+                if box is not None:
+                    out.append((ax.get_subplotspec().rowspan.start, max(0.0, axes.x0 - box.x0) / fig.dpi,
+                                max(0.0, box.y1 - axes.y1) / fig.dpi))
     return out
 
 

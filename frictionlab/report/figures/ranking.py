@@ -5,6 +5,7 @@ import numpy as np
 
 from ...core.display import plain_log
 from . import base
+from .ticks import same
 
 
 def ranking_figure(rows, alias: dict | None = None) -> bytes:
@@ -27,7 +28,8 @@ def ranking_figure(rows, alias: dict | None = None) -> bytes:
         else:
             text[i][j] = r.status
     heat = (1.25 * len(datasets) + 0.8, 0.55 * len(cands) + 0.5)  # inches: the heat map; the figure grows around it
-    fig, ax = plt.subplots(figsize=(heat[0] + 3.2, heat[1] + 1.3))
+    fig = base.figure((heat[0] + 3.2, heat[1] + 1.3))
+    ax = fig.subplots()
     cmap = plt.get_cmap("viridis_r").with_extremes(bad="0.9")
     im = ax.imshow(np.where(np.isnan(M), np.nan, M + 1.0), cmap=cmap, aspect="auto",
                    norm=LogNorm(vmin=1.0, vmax=max(10.0, np.nanmax(M + 1.0) if np.isfinite(M).any() else 10.0)))
@@ -55,8 +57,9 @@ def _place(fig, ax, cax, heat: tuple[float, float], top: float) -> None:
     measure: the candidates left, the slanted dataset names below (and left of the first), the colour bar right."""
     for _ in range(2):  # measured where placed: the slanted names' reach to the left depends on the cell width
         r = fig.canvas.get_renderer()
-        box, names, bar = ax.get_window_extent(r), ax.xaxis.get_tightbbox(r), cax.yaxis.get_tightbbox(r)
-        left = max([(box.x0 - names.x0) / fig.dpi] + [side for _, side, _ in base.yaxes_in(fig)]) + base.EDGE
+        with same(fig):
+            box, names, bar = ax.get_window_extent(r), ax.xaxis.get_tightbbox(r), cax.yaxis.get_tightbbox(r)
+            left = max([(box.x0 - names.x0) / fig.dpi] + [side for _, side, _ in base.yaxes_in(fig)]) + base.EDGE
         bottom = (box.y0 - names.y0) / fig.dpi + base.EDGE
         right = CBAR + (bar.x1 - cax.get_window_extent(r).x1) / fig.dpi + base.EDGE
         fig.set_size_inches(left + heat[0] + right, top + heat[1] + bottom)

@@ -1,0 +1,49 @@
+"""Each axis' ticks worked out once while a figure does not change. matplotlib works out an axis' ticks
+(``Axis._update_ticks``: locations, label texts, which are in view) and their labels' boxes
+(``Axis._get_ticklabel_bboxes``) anew each time it draws or measures the axis, the axis label, the spine or an
+axes title: three to six times for one axis in one draw. Inside ``same(fig)`` (nothing changes the figure's
+limits, sizes, ticks or texts meanwhile: one draw, one measurement) each axis of ``fig`` computes them once."""
+from __future__ import annotations
+
+import contextlib
+import threading
+import types
+
+_KEPT = threading.local()
+
+
+@contextlib.contextmanager
+def same(fig):
+    """Within: each axis of ``fig``'s axes works out its ticks and tick-label boxes once (for each renderer)."""
+    for ax in fig.axes:
+        for axis in ax._axis_map.values():
+            if "_update_ticks" not in vars(axis):
+                axis._update_ticks = types.MethodType(_update_ticks, axis)
+                axis._get_ticklabel_bboxes = types.MethodType(_get_ticklabel_bboxes, axis)
+    outer = getattr(_KEPT, "memo", None)
+    _KEPT.memo = {}
+    try:
+        yield
+    finally:
+        _KEPT.memo = outer
+
+
+def _update_ticks(axis):
+    memo = getattr(_KEPT, "memo", None)
+    if memo is None:
+        return type(axis)._update_ticks(axis)
+    key = ("ticks", axis)
+    if key not in memo:
+        memo[key] = type(axis)._update_ticks(axis)
+    return list(memo[key])
+
+
+def _get_ticklabel_bboxes(axis, ticks, renderer):
+    memo = getattr(_KEPT, "memo", None)
+    if memo is None or renderer is None:
+        return type(axis)._get_ticklabel_bboxes(axis, ticks, renderer)
+    key = ("boxes", axis, renderer, *ticks)
+    if key not in memo:
+        memo[key] = type(axis)._get_ticklabel_bboxes(axis, ticks, renderer)
+    one, two = memo[key]
+    return list(one), list(two)
