@@ -96,3 +96,129 @@ def test_error_bars_from_plain_arrays_are_matplotlibs_error_bars(n, nan):
     base.release()
     assert kinds[0] == kinds[1] and kinds[0][-1] == n
     assert pngs[0] == pngs[1]
+
+
+def _texts(canvas):
+    """A figure of ``canvas`` (a FigureCanvasAgg class) with texts at many sub-pixel places: repeated strings,
+    sizes, angles, several lines, glyphs from a fallback font, and text drawn without antialiasing."""
+    from matplotlib.figure import Figure
+
+    base._plt()
+    fig = Figure(figsize=(5.0, 4.0), dpi=base.DPI)
+    canvas(fig)
+    rng = np.random.default_rng(7)
+    words = ["0.5", "1e+08", "ΔAIC 1.2 (hides #3 wear [exact])", "Ψ2 against Ψ1, μ = 0.092\nsecond line", "g y p ∡"]
+    for k in range(80):
+        fig.text(rng.uniform(0.0, 0.8), rng.uniform(0.0, 0.9), words[k % 5], fontsize=(6.5, 7, 8, 12)[k % 4],
+                 rotation=(0, 35, 90)[k % 3], antialiased=k % 7 != 0)
+    return fig
+
+
+def test_text_drawn_with_the_kept_measures_is_matplotlibs_text():
+    """agg.Renderer (each string measured and laid out once, each glyph rendered once per 1/64-pixel phase) against
+    matplotlib's RendererAgg: the same boxes, line metrics and PNG bytes, on a first draw and on one that takes
+    everything from what was kept."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from frictionlab.report.figures import agg
+
+    base.release()
+    plain = _texts(FigureCanvasAgg)
+    kept = _texts(agg.Canvas)
+    r0, r1 = plain.canvas.get_renderer(), kept.canvas.get_renderer()
+    assert type(r1) is agg.Renderer and type(r0) is not agg.Renderer
+    for a, b in zip(plain.texts, kept.texts):
+        for s in a.get_text().split("\n"):
+            prop = a.get_fontproperties()
+            assert r0.get_text_width_height_descent(s, prop, False) == r1.get_text_width_height_descent(s, prop, False)
+        assert a.get_window_extent(r0).bounds == b.get_window_extent(r1).bounds
+    png = base._png(plain)
+    first = base._png(kept)
+    glyphs = len(agg._KEPT.glyphs)
+    assert 0 < glyphs < sum(len(t.get_text()) for t in kept.texts)  # a glyph at one phase is rendered once
+    again = _texts(agg.Canvas)
+    assert base._png(again) == first == png
+    assert len(agg._KEPT.glyphs) == glyphs  # the second figure took every glyph from the first
+    base.release()
+    assert not vars(agg._KEPT)
+
+
+def _two_panels(fig):
+    """A fit figure's layout: data over residuals sharing x, a title, y labels and an offset text (1e8)."""
+    (ax,), (axr,) = fig.subplots(2, 1, squeeze=False, sharex=True)
+    t = np.linspace(0.0, 2.0, 50)
+    ax.plot(t, 3e8 + 1e6 * np.sin(t), label="data")
+    axr.plot(t, 1e-3 * np.cos(t))
+    ax.set_title("a title over the data, long enough to reach the offset text above the y axis")
+    ax.set_ylabel("spin [rpm]")
+    axr.set_ylabel("model − data")
+    axr.set_xlabel("time [ms]")
+    ax.legend()
+    base.margins(fig, top=0.5, bottom=0.5, hspace=base.GAP)
+
+
+def test_an_axis_works_out_its_ticks_once_in_a_draw(monkeypatch):
+    """Inside ticks.same, each axis works out its ticks once in a draw (matplotlib: three to six times), and the
+    figure is the one matplotlib draws without it."""
+    import contextlib
+
+    from matplotlib.axis import Axis
+
+    from frictionlab.report.figures import ticks
+
+    computed = []
+    own = Axis._update_ticks
+    monkeypatch.setattr(Axis, "_update_ticks", lambda self: (computed.append(self), own(self))[1])
+    pngs, counts = [], []
+    for window in (ticks.same, lambda fig: contextlib.nullcontext()):
+        monkeypatch.setattr(ticks, "same", window)
+        base.release()
+        fig = base.figure((6.0, 5.0))
+        _two_panels(fig)
+        del computed[:]
+        pngs.append(base._png(fig))
+        counts.append(len(computed))
+    base.release()
+    assert counts[0] == 4 and counts[1] > 8  # 2 axes of 2 panels
+    assert pngs[0] == pngs[1]
+    assert b"1e8" not in pngs[0]  # drawn, not written: the offset text is pixels
+
+
+@pytest.fixture(scope="module")
+def small_comparisons():
+    from frictionlab import compare
+    from frictionlab.io.dataset import load_dataset
+
+    series = [synthetic("area-rate", TRUTH["area-rate"], seed=3, name="a"),
+              synthetic("wear", TRUTH["wear"], seed=5, rel_noise=0.002, name="c-" + "long-name-" * 4)]
+    return (compare(laws=["coulomb", "wear", "area-rate"], datasets=series),
+            compare(laws=["coulomb", "wear"], datasets=[load_dataset("impact-outcome-synthetic")]))
+
+
+@pytest.mark.parametrize("scale", [1.0, 1e5])
+def test_the_reports_figures_are_the_ones_matplotlib_draws_without_the_fast_paths(small_comparisons, scale,
+                                                                                   monkeypatch):
+    """Every figure of two reports (fits, force, ranking, discrimination, equivalence, first screen, outcomes;
+    spin also in a unit 1e5 times rpm: offset texts above the axes) drawn with agg.Canvas and ticks.same, and
+    with matplotlib's FigureCanvasAgg and no tick window: the same PNG bytes."""
+    import contextlib
+
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from frictionlab import report
+    from frictionlab.core import display
+    from frictionlab.report.figures import agg, ticks
+
+    name, factor = display.OBSERVABLE_UNITS["omega"]
+    monkeypatch.setitem(display.OBSERVABLE_UNITS, "omega", (name, factor * scale))
+    figures = [f for c in small_comparisons for page in report._pages(c, {}) for sec in page[1] for f in sec.figures]
+    assert {"fit", "force", "ranking", "discrimination", "finding"} <= {f.name.split("-")[0].split(".")[0]
+                                                                       for f in figures}
+    base.release()
+    fast = [f.draw() for f in figures]
+    monkeypatch.setattr(agg, "Canvas", FigureCanvasAgg)
+    monkeypatch.setattr(ticks, "same", lambda fig: contextlib.nullcontext())
+    base.release()
+    plain = [f.draw() for f in figures]
+    base.release()
+    assert [f.name for f, a, b in zip(figures, fast, plain) if a != b] == []

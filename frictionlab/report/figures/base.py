@@ -8,6 +8,7 @@ import threading
 import numpy as np
 
 from ...core.errors import FrictionLabError
+from . import ticks
 
 LAW_COLORS = {"coulomb": "#7f7f7f", "area-rate": "#d95f02", "wear": "#1b9e77", "couette": "#7570b3"}
 EXTRA_COLORS = ["#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#1f78b4"]
@@ -34,11 +35,9 @@ def _png(fig) -> bytes:
     less CPU and the file a tenth fewer bytes."""
     from PIL import Image
 
-    from .ticks import same
-
     fig.set_dpi(DPI)
     raw = io.BytesIO()
-    with same(fig):
+    with ticks.same(fig):
         fig.savefig(raw, format="rgba", dpi=DPI)
     size = fig.canvas.get_width_height()
     _plt().close(fig)
@@ -200,11 +199,9 @@ def _spacing(gap: float, n: int, span: float) -> float:
 def yaxes_in(fig) -> list[tuple[int, float, float]]:
     """(grid row, inches left of its axes, inches above it) the y axis of each of ``fig``'s visible grid axes
     takes (ticks, tick labels and label; above, an offset text such as '1e8')."""
-    from .ticks import same
-
     renderer = fig.canvas.get_renderer()
     out = []
-    with same(fig):
+    with ticks.same(fig):
         for ax in fig.axes:
             if ax.get_visible() and ax.axison and ax.get_subplotspec() is not None:
                 box, axes = ax.yaxis.get_tightbbox(renderer), ax.get_window_extent(renderer)

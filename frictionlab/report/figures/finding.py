@@ -5,8 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...core.display import NAMES, time_unit, unit
-from . import base
-from .ticks import same
+from . import base, ticks
 
 
 #: panels side by side in one row of the first screen's figure (five fill the page's width)
@@ -90,7 +89,7 @@ def _place(fig, panels, axw, axh, slip_h, under, title) -> None:
         return (max(0.0, box.x0 - tight.x0) / dpi, max(0.0, tight.x1 - box.x1) / dpi,
                 max(0.0, tight.y1 - box.y1) / dpi, max(0.0, box.y0 - tight.y0) / dpi)
 
-    with same(fig):
+    with ticks.same(fig):
         rooms = {id(a): room(a) for _, _, ax, ax_s in panels for a in (ax, ax_s) if a is not None and a.axison}
     zero = (0.0, 0.0, 0.0, 0.0)
     ncols, nrows = max(j for _, j, _, _ in panels) + 1, max(r for r, _, _, _ in panels) + 1
