@@ -1,7 +1,8 @@
-"""The Agg canvas of the report's kept figures (``base.canvas``): its renderer keeps, for this thread until
-``release``, what matplotlib's Agg renderer works out anew for each renderer (a new one at each figure size) or
-each draw of a text: a string's size, its glyphs' layout and a font's line metrics. They depend only on the
-string, the font properties, the DPI and the hinting, so the PNG bytes are those matplotlib draws."""
+"""The Agg canvas of the report's figures (``base.figure``): its renderer keeps, for this thread until ``release``,
+what matplotlib's Agg renderer works out anew for each renderer (a new one at each figure size) or each draw of a
+text: a string's size and glyph layout, a font's line metrics, and each glyph's bitmap at each 1/64-pixel phase of
+its origin. They depend only on the string, the font properties, the DPI, the angle and the hinting, so the PNG
+bytes are those matplotlib draws."""
 from __future__ import annotations
 
 import math
@@ -22,9 +23,14 @@ def release() -> None:
     _KEPT.__dict__.clear()
 
 
+#: Entries of each kind kept at most (a report keeps about 10000 glyphs); beyond, all are let go.
+MEMO = 1 << 16
+
+
 def _kept() -> tuple[dict, dict, dict, dict]:
+    """(text sizes, glyph layouts, line metrics, glyph bitmaps) of this thread."""
     k = _KEPT.__dict__
-    if "sizes" not in k:
+    if "sizes" not in k or any(len(d) > MEMO for d in k.values()):
         k["sizes"], k["layouts"], k["lines"], k["glyphs"] = {}, {}, {}, {}
     return k["sizes"], k["layouts"], k["lines"], k["glyphs"]
 
@@ -74,7 +80,7 @@ class Renderer(RendererAgg):
         renders the same bitmap moved by as many pixels."""
         glyphs = _kept()[3]
         cos, sin = math.cos(math.radians(angle)), math.sin(math.radians(angle))
-        matrix = (0x10000 * np.array([[cos, -sin], [sin, cos]]) @ [[1, 0], [0, 1]]).round().astype(int)
+        matrix = (0x10000 * np.array([[cos, -sin], [sin, cos]])).round().astype(int)
         flags, aa = get_hinting_flag(), gc.get_antialiased()
         turn = (*matrix.ravel().tolist(), self.dpi, flags, aa, size)
         height = self.height
