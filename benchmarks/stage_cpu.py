@@ -23,6 +23,9 @@ def cpu() -> float:
 def main() -> int:
     out, argv = sys.argv[1], sys.argv[2:]
     start = cpu()
+    from frictionlab.cli import blas_one_thread
+
+    blas_one_thread()  # as the console script does, before numpy is imported
     import lmfit  # noqa: F401  (imported by every comparison anyway; counted here as start-up)
     import matplotlib.pyplot  # noqa: F401
     import scipy.integrate  # noqa: F401

@@ -3,8 +3,12 @@ import signal
 import subprocess
 import sys
 
-import matplotlib
-import pytest
+from frictionlab.cli import blas_one_thread
+
+blas_one_thread()  # the suite computes with BLAS as the command line does (set before numpy is imported)
+
+import matplotlib  # noqa: E402
+import pytest  # noqa: E402
 
 matplotlib.use("Agg")
 

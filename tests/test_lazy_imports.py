@@ -44,3 +44,26 @@ def test_predict_stays_the_function_after_its_module_is_imported():
 def test_unknown_name_is_an_attribute_error():
     with pytest.raises(AttributeError, match="no attribute 'nonsense'"):
         fl.nonsense  # noqa: B018
+
+
+def _blas_env_seen(tmp_path, env: dict) -> dict:
+    """The BLAS thread variables as a plugin loaded by ``python -m frictionlab --load`` sees them."""
+    import json
+    import os
+
+    plugin = tmp_path / "probe.py"
+    plugin.write_text("import json, os\nfrom frictionlab.cli import BLAS_THREADS\n"
+                      "print(json.dumps({k: os.environ.get(k) for k in BLAS_THREADS}))\n")
+    full = {k: v for k, v in os.environ.items() if k not in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
+                                                                "OMP_NUM_THREADS")} | env
+    out = subprocess.run([sys.executable, "-m", "frictionlab", "--load", str(plugin), "laws"], capture_output=True,
+                         text=True, check=True, env=full)
+    return json.loads(out.stdout.splitlines()[0])
+
+
+def test_the_command_line_runs_blas_on_one_thread_unless_told(tmp_path):
+    # the entry point sets them before numpy is first imported (the help test above: importing the CLI loads none)
+    assert _blas_env_seen(tmp_path, {}) == {"OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
+                                             "OMP_NUM_THREADS": "1"}
+    seen = _blas_env_seen(tmp_path, {"OPENBLAS_NUM_THREADS": "2"})
+    assert seen["OPENBLAS_NUM_THREADS"] == "2" and seen["MKL_NUM_THREADS"] == "1"
