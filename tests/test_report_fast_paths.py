@@ -135,7 +135,8 @@ def test_text_drawn_with_the_kept_measures_is_matplotlibs_text():
     png = base._png(plain)
     first = base._png(kept)
     glyphs = len(agg._KEPT.glyphs)
-    assert 0 < glyphs < sum(len(t.get_text()) for t in kept.texts)  # a glyph at one phase is rendered once
+    if agg._LAYOUT:  # matplotlib 3.11 on: glyphs drawn one at a time (before, RendererAgg draws them)
+        assert 0 < glyphs < sum(len(t.get_text()) for t in kept.texts)  # a glyph at one phase is rendered once
     again = _texts(agg.Canvas)
     assert base._png(again) == first == png
     assert len(agg._KEPT.glyphs) == glyphs  # the second figure took every glyph from the first

@@ -11,11 +11,15 @@ import threading
 import numpy as np
 from matplotlib import rcParams
 from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg, get_hinting_flag
-from matplotlib.ft2font import FT2Font, RenderMode
+from matplotlib.ft2font import FT2Font
 
 _KEPT = threading.local()
 #: matplotlib lays out a string's glyphs with FT2Font._layout (3.11 on); before, RendererAgg draws as it does
 _LAYOUT = hasattr(FT2Font, "_layout")
+if _LAYOUT:
+    from matplotlib.ft2font import RenderMode
+
+    _MODES = {True: RenderMode.NORMAL, False: RenderMode.MONO}
 
 
 def release() -> None:
@@ -91,7 +95,7 @@ class Renderer(RendererAgg):
             if got is None:
                 font.set_size(size, self.dpi)
                 font._set_transform(matrix, [ox, oy])
-                bitmap = font._render_glyph(index, flags, RenderMode.NORMAL if aa else RenderMode.MONO)
+                bitmap = font._render_glyph(index, flags, _MODES[aa])
                 buffer = bitmap.buffer
                 if not aa:
                     buffer *= 0xff
