@@ -224,3 +224,11 @@ def test_the_reports_figures_are_the_ones_matplotlib_draws_without_the_fast_path
     plain = [f.draw() for f in figures]
     base.release()
     assert [f.name for f, a, b in zip(figures, fast, plain) if a != b] == []
+    # with a matplotlib these paths do not follow: agg.Canvas draws text as RendererAgg does, no tick window
+    monkeypatch.undo()
+    monkeypatch.setitem(display.OBSERVABLE_UNITS, "omega", (name, factor * scale))
+    monkeypatch.setattr(agg, "_LAYOUT", False)
+    monkeypatch.setattr(ticks, "SUPPORTED", False)
+    gated = [f.draw() for f in figures]
+    base.release()
+    assert [f.name for f, a, b in zip(figures, fast, gated) if a != b] == []

@@ -8,14 +8,16 @@ from __future__ import annotations
 import math
 import threading
 
+import matplotlib
 import numpy as np
 from matplotlib import rcParams
 from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg, get_hinting_flag
 from matplotlib.ft2font import FT2Font
 
 _KEPT = threading.local()
-#: matplotlib lays out a string's glyphs with FT2Font._layout (3.11 on); before, RendererAgg draws as it does
-_LAYOUT = hasattr(FT2Font, "_layout")
+#: glyphs drawn here as matplotlib 3.11 draws them (it lays out a string with FT2Font._layout); with another
+#: matplotlib, RendererAgg draws them as it does
+_LAYOUT = hasattr(FT2Font, "_layout") and tuple(matplotlib.__version_info__[:2]) == (3, 11)
 if _LAYOUT:
     from matplotlib.ft2font import RenderMode
 

@@ -321,7 +321,8 @@ def _vlines(ax, x, ymin, ymax, colors=None, linestyles="solid", label="", **kw):
     lines._internal_update(kw)
     if len(x):
         lim = lines.get_datalim(ax.transData)
-        updatex, updatey = lines.get_transform().contains_branch_separately(ax.transData)
+        t = lines.get_transform()  # the method's name before matplotlib 3.11: contains_branch_seperately
+        updatex, updatey = (getattr(t, "contains_branch_separately", None) or t.contains_branch_seperately)(ax.transData)
         ax.update_datalim(((np.nanmin(lim.xmin), np.nanmin(lim.ymin)), (np.nanmax(lim.xmax), np.nanmax(lim.ymax))),
                           updatex, updatey)
         ax._request_autoscale_view()

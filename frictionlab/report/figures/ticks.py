@@ -9,12 +9,20 @@ import contextlib
 import threading
 import types
 
+import matplotlib
+
 _KEPT = threading.local()
+#: the matplotlib versions whose Axis._update_ticks and _get_ticklabel_bboxes this follows
+SUPPORTED = (3, 7) <= tuple(matplotlib.__version_info__[:2]) <= (3, 11)
 
 
 @contextlib.contextmanager
 def same(fig):
-    """Within: each axis of ``fig``'s axes works out its ticks and tick-label boxes once (for each renderer)."""
+    """Within: each axis of ``fig``'s axes works out its ticks and tick-label boxes once (for each renderer); with a
+    matplotlib other than the ones whose Axis methods this follows (3.7 to 3.11), as matplotlib does."""
+    if not SUPPORTED:
+        yield
+        return
     for ax in fig.axes:
         for axis in ax._axis_map.values():
             if "_update_ticks" not in vars(axis):
