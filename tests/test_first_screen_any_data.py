@@ -172,3 +172,20 @@ def test_a_comparison_of_many_groups_draws_the_first_of_them_and_says_so(monkeyp
     assert "The first 1 of 2 groups; each group's page (under 'Dataset groups') draws its own." in md
     assert "The first 2 of 3 datasets; the tables below and ranking.csv hold every one." in md
     assert "### incline-oil-a100" in md.split("The first 2 of 3 datasets")[-1]  # the ranking's tables: every dataset
+
+
+def test_each_kind_of_solver_is_warmed_once_before_it_is_timed(users_impact, monkeypatch):
+    """The reference, the series and the first ODE tolerance get one untimed call first (a kernel compiled, a
+    cache filled); a later ODE tolerance shares the first one's, so its first call is timed."""
+    from frictionlab.inference import accuracy
+
+    warmed = []
+    real = accuracy._timed
+    monkeypatch.setattr(accuracy, "_timed", lambda law, tg, p, solver, scene, rtol, warm=False: (
+        warmed.append((solver, rtol, warm)), real(law, tg, p, solver, scene, rtol, warm))[1])
+    f = next(f for f in users_impact.fits if f.ok and f.law == "wear" and f.solver == "exact")
+    rows = solver_costs(f, full=True)
+    assert [(s, w) for s, _, w in warmed] == [("exact", False), ("series", False), ("ode", False), ("ode", True),
+                                              ("ode", True)]
+    assert [r for _, r, _ in warmed if r is not None] == list(RTOLS)
+    assert all(r.status == "ok" and r.time_s > 0 for r in rows)

@@ -6,7 +6,8 @@ quantities included), predicts the fitted observable with every solver that appl
 every fit, among them). The most accurate solver is the reference: the closed form where one exists, else the
 ODE at REFERENCE_RTOL. Per solver: the RMS difference from the reference in the observable's unit (stated
 numbers: in stated precisions) and in units of the data's noise sigma, and the CPU seconds of one prediction
-(the thread's CPU time over at least MIN_TIME seconds of repeats), with its ratio to the reference's.
+(the thread's CPU time over at least MIN_TIME seconds of repeats, after one untimed prediction of the reference
+and of each other kind of solver), with its ratio to the reference's.
 
 It runs by default where it is cheap: a prediction with the fit's own solver costs the fit's CPU time over its
 model evaluations; where that, times the solves the study needs (COST_FACTOR), exceeds BUDGET CPU seconds,
@@ -61,10 +62,13 @@ class SolverCost:
         return attrs.asdict(self) | {"label": self.label}
 
 
-def _timed(law, target, params, solver, scene, rtol) -> tuple[np.ndarray, float]:
+def _timed(law, target, params, solver, scene, rtol, warm: bool = False) -> tuple[np.ndarray, float]:
     """(prediction, CPU seconds per prediction) over at least MIN_TIME seconds of repeats, after one untimed
-    prediction (a first call may compile a kernel or fill a cache: a one-time cost, not the solver's)."""
-    predict(law, target, params, solver, scene=scene, rtol=rtol)
+    prediction unless ``warm`` (a first call may compile a kernel or fill a cache: a one-time cost, not the
+    solver's; the ODE at a later tolerance shares the first one's kernel and caches, so ``solver_costs`` warms the
+    reference and each other kind of solver once)."""
+    if not warm:
+        predict(law, target, params, solver, scene=scene, rtol=rtol)
     start, n = time.thread_time(), 0
     while True:
         y = predict(law, target, params, solver, scene=scene, rtol=rtol)
@@ -99,11 +103,13 @@ def solver_costs(fit, full: bool = False) -> tuple[SolverCost, ...]:
         return (SolverCost(**base, solver=ref[0], status="failed", reason=str(exc)),)
     out = [SolverCost(**base, solver=ref[0], rtol=ref[1] if ref[1] else math.nan, reference=True, error=0.0,
                       error_sigma=0.0, time_s=t_ref, time_ratio=1.0)]
+    warmed: set = set()  # the kinds of solver called here: an ODE tolerance after the first shares its kernel
     for solver, rtol in todo:
         if (solver, rtol) == ref:
             continue
         try:
-            y, t = _timed(law, target, d.params, solver, scene, rtol)
+            y, t = _timed(law, target, d.params, solver, scene, rtol, warm=solver in warmed)
+            warmed.add(solver)
         except FrictionLabError as exc:
             out.append(SolverCost(**base, solver=solver, rtol=rtol or math.nan, status="failed", reason=str(exc)))
             continue
