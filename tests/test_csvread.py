@@ -54,3 +54,10 @@ def test_plain_files_take_the_one_call_path_and_others_do_not():
     assert csvread._plain("# c\nt,v\n0,1  # c\n1,2\n") is not None
     for text in ('"t",v\n0,1\n', "t,v\n0\n", "t,v\n0,x\n", "t,v\n0,inf\n", "t,v\n"):
         assert csvread._plain(text) is None
+
+
+@pytest.mark.parametrize("text, line", [('t,omega,theta\n"\r"', 2), ('t,a\n1,"2\n3",4\n5,6', 2), ('t,"a\n1",2\n3,4', 1)])
+def test_a_quoted_cell_left_open_at_the_end_of_its_line_is_named(text, line):
+    """A line ending (\\n, \\r) inside quotes would let one row take the next line; it is refused at its line."""
+    with pytest.raises(DatasetError, match=f"data.csv: CSV does not parse: line {line}: a quoted cell is not closed"):
+        csvread.read_csv("data.csv", text=text)

@@ -1,6 +1,8 @@
 """What the report's figures compute once and share, against computing it each time: a best-fit trajectory drawn
 by several figures (figures.base.trajectory) and the Hertz pulse at one time (an ODE's right-hand side) against
 the same pulse at an array of times."""
+import os
+
 import numpy as np
 import pytest
 from _fit_helpers import TRUTH, synthetic
@@ -232,3 +234,32 @@ def test_the_reports_figures_are_the_ones_matplotlib_draws_without_the_fast_path
     gated = [f.draw() for f in figures]
     base.release()
     assert [f.name for f, a, b in zip(figures, fast, gated) if a != b] == []
+
+
+def _kept_in_a_forked_child(queue):
+    from frictionlab.report.figures import agg
+
+    queue.put(sorted(k for k, v in agg._KEPT.__dict__.items() if v))
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="no fork on this platform")
+def test_a_forked_worker_starts_without_the_parents_kept_glyphs():
+    """The kept layouts and glyphs hold fonts that read their files through descriptors a fork shares: a worker
+    process forked from a report drawer lets go of them, as matplotlib's font cache does."""
+    import multiprocessing
+
+    from frictionlab.report.figures import agg
+
+    base.release()
+    fig = base.figure((2.0, 1.0))
+    fig.text(0.1, 0.5, "kept glyphs")
+    base._png(fig)
+    assert agg._KEPT.__dict__.get("glyphs")
+    ctx = multiprocessing.get_context("fork")
+    queue = ctx.Queue()
+    child = ctx.Process(target=_kept_in_a_forked_child, args=(queue,))
+    child.start()
+    seen = queue.get(timeout=60)
+    child.join(60)
+    assert seen == [] and agg._KEPT.__dict__.get("glyphs")
+    base.release()

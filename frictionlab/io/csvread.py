@@ -91,11 +91,13 @@ def _rows(csv: Path, text: str) -> list[tuple[int, list[str]]]:
     kept = [(n, line) for n, line in kept if line.strip()]
     out = []
     reader = csvmod.reader((line for _, line in kept), skipinitialspace=True, strict=True)  # one reader: a line each
-    for n, _ in kept:
+    for i, (n, _) in enumerate(kept):
         try:
             cells = next(reader)
         except csvmod.Error as exc:
             raise DatasetError(f"{csv}: CSV does not parse: line {n}: {exc}") from None
+        if reader.line_num != i + 1:  # a quoted cell ran on into the next line (which this row then took)
+            raise DatasetError(f"{csv}: CSV does not parse: line {n}: a quoted cell is not closed on its line")
         out.append((n, [c.strip() for c in cells]))
     return out
 

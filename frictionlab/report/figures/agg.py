@@ -6,6 +6,7 @@ bytes are those matplotlib draws."""
 from __future__ import annotations
 
 import math
+import os
 import threading
 
 import matplotlib
@@ -27,6 +28,12 @@ if _LAYOUT:
 def release() -> None:
     """Let go of this thread's kept text measures."""
     _KEPT.__dict__.clear()
+
+
+# A forked worker lets go of them too: the kept layouts and glyphs hold the parent's fonts, which read their files
+# through descriptors the processes share (matplotlib's own font cache is cleared at a fork for the same reason).
+if hasattr(os, "register_at_fork"):  # (not on Windows, which does not fork)
+    os.register_at_fork(after_in_child=release)
 
 
 #: Entries of each kind kept at most (a report keeps about 10000 glyphs); beyond, all are let go.
