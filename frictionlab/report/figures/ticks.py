@@ -19,7 +19,8 @@ SUPPORTED = (3, 7) <= tuple(matplotlib.__version_info__[:2]) <= (3, 11)
 @contextlib.contextmanager
 def same(fig):
     """Within: each axis of ``fig``'s axes works out its ticks and tick-label boxes once (for each renderer); with a
-    matplotlib other than the ones whose Axis methods this follows (3.7 to 3.11), as matplotlib does."""
+    matplotlib other than the ones whose Axis methods this follows (3.7 to 3.11), as matplotlib does. A window
+    opened inside another keeps the outer one's results: nothing changes meanwhile there either."""
     if not SUPPORTED:
         yield
         return
@@ -29,7 +30,8 @@ def same(fig):
                 axis._update_ticks = types.MethodType(_update_ticks, axis)
                 axis._get_ticklabel_bboxes = types.MethodType(_get_ticklabel_bboxes, axis)
     outer = getattr(_KEPT, "memo", None)
-    _KEPT.memo = {}
+    if outer is None:
+        _KEPT.memo = {}
     try:
         yield
     finally:
