@@ -208,6 +208,8 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
                     raise SolverError(f"ode:{method}: {_too_many(plan, fast.stop_time, method)}") from None
         f = _scaled_rates(plan, p, direction, T, scale, method)
         odepack = method == "LSODA" and event is not None and slip_keeps_sign(plan, p, direction)
+        if odepack:
+            f = _counted(_lean_slip_rates(plan, p, direction, T, scale, f) or f, plan, T, method)
         try:
             return _integrate_phase(plan, f, None if odepack else event, t0, T, y0, direction, t_out, scale, method,
                                     rtol, atol, odepack=odepack)
@@ -273,6 +275,27 @@ def _scaled_rates(plan, p, direction, tscale, scale, method):
         return rates(s * tscale, z * scale) * tscale / scale
 
     return f
+
+
+def _lean_slip_rates(plan, p, direction, tscale, scale, general):
+    """``fastrhs.scaled_slip_rhs`` for a phase of ``slip_keeps_sign``, or None."""
+    from ..fastrhs import scaled_slip_rhs
+    from .stick import vanishing_slip
+
+    return scaled_slip_rhs(plan, p, direction, float(vanishing_slip(plan)), tscale, scale, general)
+
+
+def _counted(f, plan, tscale, method):
+    """f stopped with a clear error beyond MAX_NFEV evaluations (as ``_scaled_rates``)."""
+    calls = [0]
+
+    def counted(s, z):
+        calls[0] += 1
+        if calls[0] > MAX_NFEV:
+            raise SolverError(f"ode:{method}: {_too_many(plan, s * tscale, method)}")
+        return f(s, z)
+
+    return counted
 
 
 def slip_keeps_sign(plan, p, direction) -> bool:
