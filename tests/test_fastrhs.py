@@ -72,16 +72,20 @@ def test_unknown_models_and_plugins_take_the_general_path():
 
 @pytest.mark.parametrize("law", ["area-rate", "wear", "couette", "coulomb"])
 def test_ode_fits_with_and_without_it_agree(law, monkeypatch):
+    """The same fit: each determined parameter within 1e-4 of its standard error, the same chi-square and the same
+    curve to 1e-4 of the noise (couette's eta and h are determined only as eta / h: each alone may end anywhere
+    along that valley, with no standard error)."""
     ds = load_dataset("incline-dry-d10")
     fast = fit(law, ds, solver="ode")
     monkeypatch.setattr(fastrhs, "scalar_rhs", lambda *a: None)
     slow = fit(law, ds, solver="ode")
     assert fast.status == slow.status
+    assert fast.stats.chisqr == pytest.approx(slow.stats.chisqr, rel=1e-7)
     for name, pr in slow.params.items():
         if pr.stderr:
             assert abs(fast.params[name].value - pr.value) <= 1e-4 * pr.stderr
-        else:
-            assert fast.params[name].value == pytest.approx(pr.value, rel=1e-9)
+    f, s = fast.per_dataset[0], slow.per_dataset[0]
+    assert np.max(np.abs(f.model - s.model)) <= 1e-4 * float(np.min(s.target.sigma))
 
 
 def test_ode_solve_with_and_without_it_agree(monkeypatch):
