@@ -358,8 +358,8 @@ MEMORY_SAMPLED, MEMORY_SAMPLED_STARTS = 1, 3
 def compiled_memory(model: _Model) -> bool:
     """True when the model is a built-in law with memory that every target solves by the ODE solver's default
     method on the compiled path (``solve.memoryrhs``): cheap enough for a wider search (MEMORY_SCAN times the
-    start points and MEMORY_SAMPLED times them sampled, every start refined, no early stop in a valley, the lowest
-    ends refined again at a tighter tolerance: ``_tighter``) and solved to a tolerance that makes
+    start points and MEMORY_SAMPLED times them sampled, every start refined, no early stop in a valley, the best
+    end refined again at a tighter tolerance: ``_tighter``) and solved to a tolerance that makes
     Levenberg-Marquardt's difference quotients need steps of its size (``epsfcn``)."""
     cached = getattr(model, "_compiled_memory", None)
     if cached is None:
@@ -443,7 +443,7 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
             return params, True, "Fit succeeded.", levmar.Result(params, True, "Fit succeeded.", moved[1]), []
         if moved is not None:  # lmfit's own run from the lowest end, for its error analysis
             starts = [moved[0]]
-    best, notes, ends = None, [], []
+    best, notes = None, []
     for i, start in enumerate(starts):
         for k, v in start.items():  # every varying parameter; lmfit works on its own copy
             params[k].set(value=v)
@@ -461,35 +461,32 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
             r = lmfit_leastsq(lmfit, model, slots, levmar.lmfit_parameters(params), scale_covar, budget)
         if best is None or (r.success, -r.chisqr) > (best.success, -best.chisqr):
             best = r
-        ends.append(r)
         why = _valley(r) if slow and r.success and i + 1 < len(starts) else ""
         if why:
             notes.append(f"one Levenberg-Marquardt start of {len(starts)}: the first ended where the data do not "
                          f"determine the parameters ({why}), where another start ends too")
             break
-    if wide and scan and not direct:
-        ends = sorted((r for r in ends if math.isfinite(r.chisqr)), key=lambda r: r.chisqr)
+    if wide and scan and not direct:  # a main fit's search (replicate refits start at its values)
         if model.progress is not None:
-            model.progress.stage("refining the lowest ends at a tighter tolerance", min(len(ends), TIGHTER_ENDS) * lm)
-        for r in ends[:TIGHTER_ENDS]:
-            best = _tighter(lmfit, model, slots, r, best, scale_covar, max_nfev or 200 * (len(varying) + 1))
+            model.progress.stage("refining the best end at a tighter tolerance", lm)
+        best = _tighter(lmfit, model, slots, best, scale_covar, max_nfev or 200 * (len(varying) + 1))
     return best.params, bool(best.success), str(best.message), best, notes
 
 
-#: The ODE tolerance, relative to the fit's, at which a compiled law with memory refines its search's lowest
-#: TIGHTER_ENDS ends (``_tighter``).
-TIGHTER, TIGHTER_ENDS = 1e-2, 3
+#: The ODE tolerance, relative to the fit's, at which a compiled law with memory refines its search's best end
+#: (``_tighter``).
+TIGHTER = 1e-2
 
 
-def _tighter(lmfit, model: _Model, slots, end, best, scale_covar: bool, budget: int):
-    """One end of the search refined, and the better of it and ``best`` (lmfit results). An adaptive solve to the
+def _tighter(lmfit, model: _Model, slots, best, scale_covar: bool, budget: int):
+    """The search's best end (an lmfit result) refined, or itself where that is no better. An adaptive solve to the
     fit's rtol changes in jumps with the parameters: rate-state-slip on incline-oil-a200 jumps by +-3 in chi-square
     between points 0.1% apart in Dc at rtol 1e-6, where the trend is 0.03 a step, so Levenberg-Marquardt's
     difference quotients see no slope and its run ends where it stands; and lmfit's bound transformation makes a
-    parameter near a bound of 0 (mu0 and b there) move the least where it must move to the bound. From ``end``,
-    scipy's bounded trust region (``least_squares``: the bounds as they are, steps relative to each parameter,
-    sqrt(epsfcn) of it) runs with the ODEs solved TIGHTER times the fit's rtol, where the jumps are that much
-    smaller; then lmfit's Levenberg-Marquardt at the fit's own rtol from where it ended, for the fit's result and
+    parameter near a bound of 0 (mu0 and b there) move the least where it must move to the bound. From there,
+    scipy's bounded trust region (``least_squares``: the bounds as they are, difference steps of sqrt(epsfcn)
+    of each scaled parameter) runs with the ODEs solved to TIGHTER times the fit's rtol, where the jumps are that
+    much smaller; then lmfit's Levenberg-Marquardt at the fit's own rtol from where it ended, for the fit's result and
     its error analysis (that run only lowers chi-square)."""
     from scipy.optimize import least_squares
 
@@ -497,7 +494,7 @@ def _tighter(lmfit, model: _Model, slots, end, best, scale_covar: bool, budget: 
 
     varying = [s for s in slots if s.vary]
     fixed = {s.pname: s.value for s in slots if not s.vary}
-    x0 = np.array([end.params[s.pname].value for s in varying])
+    x0 = np.array([best.params[s.pname].value for s in varying])
     lo = np.array([s.lower / s.scale for s in varying])
     hi = np.array([s.upper / s.scale for s in varying])
 
@@ -510,9 +507,11 @@ def _tighter(lmfit, model: _Model, slots, end, best, scale_covar: bool, budget: 
         with np.errstate(all="ignore"):
             x = least_squares(residual, np.clip(x0, lo, hi), bounds=(lo, hi), x_scale="jac", diff_step=step,
                               ftol=FTOL, xtol=FTOL, max_nfev=budget).x
+    except ValueError:  # scipy refuses the problem (bounds that leave a parameter no room): the search's end stands
+        return best
     finally:
         model.rtol, model._last = rtol, None
-    params = levmar.lmfit_parameters(end.params).copy()
+    params = levmar.lmfit_parameters(best.params).copy()
     for s, v in zip(varying, x):
         params[s.pname].set(value=v)
     r = lmfit_leastsq(lmfit, model, slots, params, scale_covar, budget)
