@@ -91,3 +91,29 @@ def test_ode_solve_with_and_without_it_agree(monkeypatch):
     slow = simulate("area-rate", scene, PARAMS["area-rate"], solver="ode")
     np.testing.assert_allclose(fast.omega, slow.omega, rtol=1e-9, atol=1e-9 * np.max(np.abs(slow.omega)))
     assert (fast.stick_time is None) == (slow.stick_time is None)
+
+
+@pytest.mark.parametrize("law", ["wear", "couette"])
+def test_the_scaled_float_rhs_of_a_slip_that_keeps_its_sign_equals_the_general_one(law):
+    """``scaled_slip_rhs`` (the ODE solver's right-hand side where the slip keeps its sign) against the scaled
+    general right-hand side, on the incline scenes driven down their slope."""
+    from frictionlab.solve.solvers import ode
+    from frictionlab.solve.solvers.stick import vanishing_slip
+
+    rng = np.random.default_rng(7)
+    lw = get_law(law)
+    p = lw.resolve(PARAMS[law])
+    checked = 0
+    for scene in scenes():
+        plan = make_plan(scene, lw)
+        if not ode.slip_keeps_sign(plan, p, 1.0):
+            continue
+        T, scale = scene.duration, rng.uniform(0.5, 2.0, len(plan.states))
+        general = ode._scaled_rates(plan, p, 1.0, T, scale, "LSODA")
+        lean = fastrhs.scaled_slip_rhs(plan, p, 1.0, float(vanishing_slip(plan)), T, scale, general)
+        assert lean is not None, plan.states
+        for _ in range(30):
+            s, z = rng.uniform(0.0, 1.0), rng.uniform(-0.2, 2.0, len(plan.states))
+            np.testing.assert_allclose(lean(s, z), general(s, z), rtol=1e-13, atol=1e-13 * np.max(np.abs(general(s, z))))
+            checked += 1
+    assert checked >= 90

@@ -224,3 +224,47 @@ def test_unknown_solver_is_an_error():
         simulate("wear", paper_impact(28), {"lam": 1e6}, solver="ode:Euler")
     with pytest.raises(SolverError, match="closed form only with a half-sine area"):
         simulate("wear", paper_impact(28).with_(area=GrowthArea(1e-6, 1e-4)), {"lam": 1e6}, solver="exact")
+
+
+def test_a_slip_that_keeps_its_sign_is_integrated_without_the_zero_slip_event():
+    """F = k A u on a block driven down its slope cannot bring the slip to zero: LSODA then runs its loop in
+    ODEPACK without the event, to the same accuracy as solve_ivp's loop watching it; driven against the slip, or
+    with another form of law, or with spin, the event stays, and a block sent up the slope still stops."""
+    import math
+
+    from frictionlab import simulate
+    from frictionlab.physics.registry import get_law
+    from frictionlab.physics.scene import G, GrowthArea, HalfSineArea, HalfSineNormal, Scene, WeightNormal
+    from frictionlab.solve.plan import make_plan
+    from frictionlab.solve.solvers import ode
+
+    a = 0.3
+
+    def block(u0):
+        return Scene(kind="incline", mass=0.02, u0=u0, duration=1.0, incline=a, area=GrowthArea(1e-5, 2e-5),
+                     normal=WeightNormal(0.02 * G * math.cos(a)), effects=frozenset({"gravity"}))
+
+    wear, coulomb = get_law("wear"), get_law("coulomb")
+    p = wear.resolve({"lam": 1.5e6})
+    down = make_plan(block(0.1), wear)
+    assert ode.slip_keeps_sign(down, p, 1.0)
+    assert not ode.slip_keeps_sign(down, p, -1.0) and not ode.slip_keeps_sign(down, p, 0.0)
+    assert not ode.slip_keeps_sign(make_plan(block(0.1), coulomb), coulomb.resolve({"mu": 0.3}), 1.0)
+    golf = Scene(kind="impact", mass=0.046, u0=20.0, duration=500e-6, radius=0.0213, normal=HalfSineNormal(2.0, 450e-6),
+                 area=HalfSineArea(150e-6, 450e-6), effects=frozenset({"slip-coupling", "spin"}))
+    assert not ode.slip_keeps_sign(make_plan(golf, wear), p, 1.0)
+
+    t = np.linspace(0.0, 1.0, 200)
+    ref = simulate(wear, block(0.1), p, solver="ode:Radau", t=t, rtol=1e-12)
+    fast = simulate(wear, block(0.1), p, solver="ode", t=t, rtol=1e-8)
+    keep = ode.slip_keeps_sign
+    try:
+        ode.slip_keeps_sign = lambda *args: False
+        watched = simulate(wear, block(0.1), p, solver="ode", t=t, rtol=1e-8)
+    finally:
+        ode.slip_keeps_sign = keep
+    scale = float(np.max(np.abs(ref.v)))
+    err_fast, err_watched = (float(np.max(np.abs(x.v - ref.v))) / scale for x in (fast, watched))
+    assert fast.stick_time is None and err_fast < 1e-6 and err_fast < 10 * err_watched
+    up = simulate(wear, block(-3.0), p, solver="ode", t=t, rtol=1e-8)  # sent up the slope: stops, then slides down
+    assert up.stick_time is not None and 0.0 < up.stick_time < 1.0

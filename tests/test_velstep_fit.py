@@ -230,6 +230,31 @@ def test_a_strengthening_evolution_ends_at_b_0_and_says_so(tmp_path):
     assert found and "b = -0.004" in found[0]
 
 
+def test_the_strengthening_refit_starts_where_the_bound_held_b(tmp_path):
+    """The search keeps its grid points whose a, b fit ended with b held at 0, best first and distinct; a fit that
+    ends with b inside its range and no such grid point runs no refit (from there the bound did not act)."""
+    from frictionlab.inference import velstep, velstep_result
+
+    ds, _ = _measured_like(tmp_path)
+    load = quasistatic.Load.of(ds.scene.spring)
+    y = 0.6 + quasistatic.solve(0, 0.01, -0.004, 10.0, 0.008, load, ds.t, 1e-10).m
+    y = y + np.random.default_rng(3).normal(0.0, 2e-4, y.size)
+    data = attrs.evolve(ds, columns=dict(ds.columns, mu=y), noise={"mu": 2e-4})
+    law = fl.get_law("rate-state-aging")
+    problem = velstep.make_problem(law, [Target(data, "mu", y, np.full(y.size, 2e-4))], {}, {}, {}, None, None, 1e-8)
+    starts = problem.search(3)
+    ib = next(i for i, p in enumerate(problem.params) if p.key == "b")
+    assert problem.b_held and all(x[ib] == problem.params[ib].bounds_x[0] for x in problem.b_held)
+    costs = [problem.evaluate(x, problem.free, search=True)[0] for x in problem.b_held]
+    assert costs == sorted(costs)
+    assert any(np.array_equal(starts[1], x) for x in problem.b_held)  # the data's best grid point holds b at 0
+    problem.b_held = []
+    x = starts[0].copy()
+    x[ib] = problem.params[ib].to_x(0.01)  # b inside its range: nothing to refit from
+    before = problem.nfev
+    assert velstep_result._strengthening(problem, x) == "" and problem.nfev == before
+
+
 def test_bound_meanings_name_what_each_bound_says():
     from frictionlab.inference.velstep_result import BOUND_MEANING
 

@@ -1,6 +1,7 @@
 """Units at the edges: quantity strings such as "46 g" or "500 us" become SI floats.
 
-pint is imported lazily, only when a string has to be parsed. Inside frictionlab every
+pint is imported lazily, only when a string has to be parsed in a unit outside ``KNOWN`` (the units
+laboratory files and scenes write most, whose factors are pint's own). Inside frictionlab every
 number is a plain float in SI units (angles in radians, spin in rad/s).
 """
 from __future__ import annotations
@@ -38,6 +39,31 @@ SI = {
     "force": "N",
     "dimensionless": "",
 }
+
+
+#: For each SI unit the project reads, the factor of each common unit to it, exactly as pint converts it (a
+#: value v in one of them is v * factor in SI, to the last bit: tests/test_units.py checks every pair against pint).
+#: Reading these needs no unit registry: importing pint and building its registry costs about a third of a CPU
+#: second a process. Every other unit is pint's to read, and to refuse.
+KNOWN = {
+    "kg": {"kg": 1.0, "g": 1e-3, "mg": 1e-6},
+    "m": {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "nm": 1e-9},
+    "s": {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9},
+    "m/s": {"m/s": 1.0, "mm/s": 1e-3, "um/s": 1e-6, "nm/s": 1e-9},
+    "m^2": {"m^2": 1.0, "cm^2": 1e-4, "mm^2": 1e-6, "um^2": 1e-12},
+    "rad": {"rad": 1.0, "deg": math.pi / 180},
+    "rad/s": {"rad/s": 1.0, "rpm": math.pi / 30, "deg/s": math.pi / 180},
+    "N": {"N": 1.0, "kN": 1e3, "mN": 1e-3},
+    "Pa": {"Pa": 1.0, "kPa": 1e3, "MPa": 1e6, "GPa": 1e9},
+    "Pa s": {"Pa s": 1.0, "mPa s": 1e-3},
+    "Pa s/m": {"Pa s/m": 1.0},
+    "1/m": {"1/m": 1.0, "1/mm": 1e3, "1/um": 1e6},
+    "m^2/m": {"m^2/m": 1.0, "mm^2/m": 1e-6},
+    "s/m": {"s/m": 1.0},
+    "": {"": 1.0},
+}
+#: A quantity string of one number and a unit: the number as Python reads it, then the unit.
+_QUANTITY = re.compile(r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*)")
 
 
 @functools.cache
@@ -108,8 +134,11 @@ def check_magnitude(value: float, shown, where: str, si_unit: str = "") -> float
 
 def unit_factor(unit: str, si_unit: str, where: str) -> float:
     """Factor that converts a value in ``unit`` to ``si_unit``; ``where`` names the field."""
-    ureg = _registry()
     unit = check_text(unit, where)
+    known = KNOWN.get(si_unit, {}).get(unit)
+    if known is not None:
+        return known
+    ureg = _registry()
     try:
         q = ureg.Quantity(1.0, unit) if unit else ureg.Quantity(1.0)
     except Exception:
@@ -147,8 +176,12 @@ def to_si(value, si_unit: str, where: str) -> float:
         except OverflowError:
             out = math.inf
     elif isinstance(value, str):
-        ureg = _registry()
         text = check_text(value, where)
+        m = _QUANTITY.fullmatch(text)
+        known = KNOWN.get(si_unit, {}).get(m[2]) if m else None
+        if known is not None:
+            return check_magnitude(float(m[1]) * known, value, where, si_unit)
+        ureg = _registry()
         try:
             q = ureg.Quantity(text)
             if not hasattr(q, "dimensionality"):  # pint returns a plain number for "30"

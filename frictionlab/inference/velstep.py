@@ -209,6 +209,9 @@ class Problem:
         self.failures = 0
         self.last_error = ""
         self._cache = None
+        #: The grid points of the last ``search`` whose a, b fit ended with b held at its lower bound (best first):
+        #: where a refit that lets b go lower starts (``velstep_result``).
+        self.b_held: list[np.ndarray] = []
 
     # -- parameters -----------------------------------------------------------------------------------------
     def x_start(self) -> np.ndarray:
@@ -381,15 +384,23 @@ class Problem:
                 if ok:
                     scored.append((cost, a_i, b_i, x))
         scored.sort(key=lambda c: c[0])
-        starts = [x0]
-        taken = []
-        for cost, a_i, b_i, x in scored:
-            if all(abs(a_i - a) >= 2 or abs(b_i - b) >= 2 for a, b in taken):
-                starts.append(x)
-                taken.append((a_i, b_i))
-            if len(taken) >= n_starts:
-                break
-        return starts
+        b_low = self.params[by_key["b"]].bounds_x[0]
+        self.b_held = (_distinct([c for c in scored if c[3][by_key["b"]] <= b_low], n_starts)
+                       if self.params[by_key["b"]].vary else [])
+        return [x0] + _distinct(scored, n_starts)
+
+
+def _distinct(scored, n: int) -> list[np.ndarray]:
+    """The best ``n`` of the scored grid points (cost, Dc index, k index, x; sorted by cost), each at least two grid
+    steps from those taken before it along Dc or k."""
+    out, taken = [], []
+    for _, a_i, b_i, x in scored:
+        if len(taken) >= n:
+            break
+        if all(abs(a_i - a) >= 2 or abs(b_i - b) >= 2 for a, b in taken):
+            out.append(x)
+            taken.append((a_i, b_i))
+    return out
 
 
 def _slip_after_step(target) -> float:

@@ -11,7 +11,8 @@ units (``StepReport``).
   without the trend gives a - b of the other sign.
 * What the data show that the law misses, where it does not fit: a trend it was not given (a refit with one
   lowers chi-square beyond the 0.1 % point of chi-square with one degree of freedom), a strengthening evolution
-  (b pressed to 0), and residual structure after a step (runs of same-sign mean residual in windows of slip,
+  (b pressed to 0: a refit that lets b go below 0, from the fit and the search's grid points where the bound held
+  b at 0), and residual structure after a step (runs of same-sign mean residual in windows of slip,
   each beyond MISSING_Z standard errors of a mean of correlated noise): slower than the fitted evolution, a
   second state variable.
 """
@@ -501,19 +502,22 @@ def _refit(problem, x, s, trend: bool):
 
 
 def _strengthening(problem, x) -> str:
-    """A refit with b free to go below 0: the sentence when it finds b < 0 and lowers chi-square beyond
+    """A refit with b free to go below 0 from where the bound held b at 0: the fit, if it ends there, and the best
+    grid points of the search whose a, b fit ended there (``Problem.b_held``); from anywhere else the bound did not
+    act, and a local refit returns where it started. The sentence when it finds b < 0 and lowers chi-square beyond
     CHI2_1_999 ('' otherwise)."""
     ib = next(i for i, p in enumerate(problem.params) if p.key == "b")
     p = problem.params[ib]
-    if not p.vary:
+    starts = ([x] if x[ib] <= p.bounds_x[0] + AT_BOUND else []) + problem.b_held[:2]
+    if not p.vary or not starts:
         return ""
     chi_now = problem.evaluate(x, problem.free)[0]
     best = None
     try:
         problem.params[ib] = attrs.evolve(p, lower=-p.upper)
         problem._cache = None
-        tried = [problem.local(x0, problem.free, search=True) for x0 in [x] + problem.search(2)[1:]]
-        tried = [t for t in tried if t[2]]  # from the fit and from a new grid, on the subsample; the best on all
+        tried = [problem.local(x0, problem.free, search=True) for x0 in starts]
+        tried = [t for t in tried if t[2]]  # on the subsample; the best one then on every sample
         if tried:
             xr, cost, ok = problem.local(min(tried, key=lambda t: t[1])[0], problem.free, max_nfev=REFIT_EVALS)
             best = (xr, cost) if ok else None

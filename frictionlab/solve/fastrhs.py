@@ -111,3 +111,39 @@ def scalar_rhs(plan, p, direction: float, vanishing: float = 0.0):
         return np.array([rate[k] for k in names])
 
     return rhs
+
+
+def scaled_slip_rhs(plan, p, direction: float, vanishing: float, tscale: float, scale, general):
+    """``scalar_rhs`` of a law of the form F = k A u on a block without spin (states v, or v and x) on the scaled
+    problem of a phase (time / tscale, states / scale), with floats throughout: f(s, z) -> (dz/ds), the phases of
+    ``solvers.ode.slip_keeps_sign``, whose right-hand side is called tens of thousands of times a fit from
+    ODEPACK's loop. None where ``scalar_rhs`` would not serve; ``general(s, z)``, the scaled general right-hand
+    side, answers where the force is not finite (with the law's one-line error)."""
+    if scalar_rhs(plan, p, direction, vanishing) is None or plan.states not in (("v",), ("v", "x")):
+        return None
+    form, area = plan.law.form(p), _area(plan.scene.area)
+    if not isinstance(form, AreaSlipForm) or area is None:
+        return None
+    k, m, drive, tiny = float(form.k), float(plan.scene.mass), float(plan.drive), direction * vanishing
+    sv = float(scale[0])
+    cv = tscale / sv
+    if len(plan.states) == 1:
+        def f(s, z):
+            u = float(z[0]) * sv
+            if not direction * u > 0:
+                u = tiny
+            F = k * area(s * tscale, 0.0, u)[0] * u
+            return ((drive - F / m) * cv,) if math.isfinite(F) else general(s, z)
+
+        return f
+    sx = float(scale[1])
+    cx = tscale / sx
+
+    def f(s, z):
+        u = float(z[0]) * sv
+        if not direction * u > 0:
+            u = tiny
+        F = k * area(s * tscale, float(z[1]) * sx, u)[0] * u
+        return ((drive - F / m) * cv, abs(u) * cx) if math.isfinite(F) else general(s, z)
+
+    return f

@@ -45,7 +45,8 @@ def watching(fn):
 
 
 def solve(f, s0: float, s1: float, z0, method: str, s_eval, rtol: float, atol: float, event=None,
-          event_direction: float = 0.0, label: str = "integration failed", jac=None, compiled=None):
+          event_direction: float = 0.0, label: str = "integration failed", jac=None, compiled=None,
+          odepack: bool = False):
     """Integrate z' = f(s, z) from s0 to s1 with scipy's ``method`` and return
     (Z at the times s_eval reached (n_states, k), s_event or None, z_event or None, the solver).
 
@@ -53,11 +54,14 @@ def solve(f, s0: float, s1: float, z0, method: str, s_eval, rtol: float, atol: f
     zero in ``event_direction`` (as in solve_ivp: < 0 falling, > 0 rising, 0 either way), located by
     brentq on the step's dense output to 4 eps, exactly as solve_ivp does. A failed step raises
     SolverError('{label}: {scipy's message}'). jac(s, z): the Jacobian df/dz for the implicit methods (None:
-    they difference f). LSODA with a compiled right-hand side (``compiled``, a ``memoryrhs.Phase``) and no event
-    runs its whole loop in ODEPACK (``_lsoda_loop``).
+    they difference f). LSODA with no event runs its whole loop in ODEPACK (``_lsoda_loop``) on a compiled
+    right-hand side (``compiled``, a ``memoryrhs.Phase``), or on f where ``odepack`` says so (``slip_keeps_sign``).
     """
-    if method == "LSODA" and compiled is not None and event is None and not _WATCHERS:
-        return _lsoda_loop(compiled, s0, s1, z0, s_eval, rtol, atol, label)
+    if method == "LSODA" and event is None and not _WATCHERS and (compiled is not None or odepack):
+        if compiled is not None:
+            return _lsoda_loop(compiled.kernel.rhs, compiled.kernel.jac, compiled.args, s0, s1, z0, s_eval, rtol,
+                               atol, label)
+        return _lsoda_loop(f, jac, (), s0, s1, z0, s_eval, rtol, atol, label)
     eps = np.finfo(float).eps
     kw = {"jac": jac} if jac is not None and method in ("Radau", "BDF", "LSODA") else {}
     solver = getattr(scipy.integrate, method)(f, s0, np.asarray(z0, dtype=float), s1, rtol=rtol, atol=atol, **kw)
@@ -91,11 +95,11 @@ def solve(f, s0: float, s1: float, z0, method: str, s_eval, rtol: float, atol: f
     return Z, s_event, z_event, solver
 
 
-def _lsoda_loop(compiled, s0, s1, z0, s_eval, rtol, atol, label):
-    """``solve`` for LSODA on a compiled phase without an event: scipy's ``odeint``, the same ODEPACK LSODA that
-    ``solve_ivp`` steps one call at a time, here with its stepping loop and output interpolation in Fortran (it
-    calls the kernel's right-hand side and Jacobian directly) and the end of the span as its critical time (no
-    step beyond it), as ``solve_ivp`` steps."""
+def _lsoda_loop(rhs, jac, args, s0, s1, z0, s_eval, rtol, atol, label):
+    """``solve`` for LSODA without an event: scipy's ``odeint``, the same ODEPACK LSODA that ``solve_ivp`` steps
+    one call at a time, here with its stepping loop and output interpolation in Fortran (it calls rhs(s, z, *args)
+    and jac, a compiled kernel's or None for differences, directly) and the end of the span as its critical time
+    (no step beyond it), as ``solve_ivp`` steps."""
     import warnings
     from types import SimpleNamespace
 
@@ -104,10 +108,10 @@ def _lsoda_loop(compiled, s0, s1, z0, s_eval, rtol, atol, label):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            Z, info = scipy.integrate.odeint(compiled.kernel.rhs, np.asarray(z0, dtype=float), times,
-                                             args=compiled.args, Dfun=compiled.kernel.jac, tfirst=True, rtol=rtol,
-                                             atol=atol, tcrit=[s1], full_output=True, mxstep=MAX_NFEV)
-        except FloatingPointError:  # the kernel stopped (compiled.bad says why)
+            Z, info = scipy.integrate.odeint(rhs, np.asarray(z0, dtype=float), times, args=args, Dfun=jac,
+                                             tfirst=True, rtol=rtol, atol=atol, tcrit=[s1], full_output=True,
+                                             mxstep=MAX_NFEV)
+        except FloatingPointError:  # a compiled kernel stopped (its phase's ``bad`` says why)
             raise SolverError(f"{label}: the compiled right-hand side stopped") from None
     if info["message"] != "Integration successful.":
         raise SolverError(f"{label}: {info['message']}")
@@ -203,8 +207,12 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
                 if fast.bad == TOO_MANY:
                     raise SolverError(f"ode:{method}: {_too_many(plan, fast.stop_time, method)}") from None
         f = _scaled_rates(plan, p, direction, T, scale, method)
+        odepack = method == "LSODA" and event is not None and slip_keeps_sign(plan, p, direction)
+        if odepack:
+            f = _counted(_lean_slip_rates(plan, p, direction, T, scale, f) or f, plan, T, method)
         try:
-            return _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method, rtol, atol)
+            return _integrate_phase(plan, f, None if odepack else event, t0, T, y0, direction, t_out, scale, method,
+                                    rtol, atol, odepack=odepack)
         except SolverError as exc:  # name what in the scene makes it fail, where the plan knows
             note = plan.stiffness_note(p, t0, y0) if method not in ("BDF", "Radau") else ""
             if note:
@@ -269,6 +277,43 @@ def _scaled_rates(plan, p, direction, tscale, scale, method):
     return f
 
 
+def _lean_slip_rates(plan, p, direction, tscale, scale, general):
+    """``fastrhs.scaled_slip_rhs`` for a phase of ``slip_keeps_sign``, or None."""
+    from ..fastrhs import scaled_slip_rhs
+    from .stick import vanishing_slip
+
+    return scaled_slip_rhs(plan, p, direction, float(vanishing_slip(plan)), tscale, scale, general)
+
+
+def _counted(f, plan, tscale, method):
+    """f stopped with a clear error beyond MAX_NFEV evaluations (as ``_scaled_rates``)."""
+    calls = [0]
+
+    def counted(s, z):
+        calls[0] += 1
+        if calls[0] > MAX_NFEV:
+            raise SolverError(f"ode:{method}: {_too_many(plan, s * tscale, method)}")
+        return f(s, z)
+
+    return counted
+
+
+def slip_keeps_sign(plan, p, direction) -> bool:
+    """Whether the slip of a sliding phase cannot reach zero, so that no zero-slip event is watched: a law of the
+    form F = k A u (``AreaSlipForm``) on a body without spin, driven in the slip's direction. At u = 0 its force
+    vanishes whatever the area, so du/dt = the drive, of the slip's sign: the slip tends to a speed the drive
+    holds, never through zero (an inclined block with lubricated or wear friction)."""
+    from ...physics.law import AreaSlipForm
+
+    if direction == 0 or plan.coupled or plan.has_spin or plan.scene.spring is not None or plan.law_states:
+        return False
+    try:
+        form = plan.law.form(p)
+    except Exception:  # a plugin's form that fails: the event stays
+        return False
+    return isinstance(form, AreaSlipForm) and direction * plan.drive > 0
+
+
 def _zero_slip_event(plan, direction, scale):
     """The zero-slip event of a sliding phase on the scaled problem, or None (no direction, or compliance)."""
     if "xi" in plan.states or direction == 0:
@@ -296,10 +341,12 @@ def _memory_phase(plan, p, direction, tscale, y0, scale, slid=True):
                  scale, MAX_NFEV, slid)
 
 
-def _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method, rtol, atol, jac=None, compiled=None):
+def _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method, rtol, atol, jac=None, compiled=None,
+                     odepack: bool = False):
     """solve_ivp over [t0, T] (restarted at the plan's breaks when no event watches slip): (states at t_out
     reached, stop time, state at the stop, counters). jac: the Jacobian of f for the implicit methods;
-    compiled: the ``memoryrhs.Phase`` whose kernel f and jac call (ODEPACK's loop then calls the kernel itself)."""
+    compiled: the ``memoryrhs.Phase`` whose kernel f and jac call (ODEPACK's loop then calls the kernel itself);
+    odepack: LSODA's loop in ODEPACK on f (``solve``)."""
     tscale = T
     s_eval = np.clip(np.asarray(t_out, dtype=float) / tscale, t0 / tscale, T / tscale)
     s_eval, back = np.unique(s_eval, return_inverse=True)  # repeated times (e.g. a resample) solved once
@@ -313,7 +360,7 @@ def _integrate_phase(plan, f, event, t0, T, y0, direction, t_out, scale, method,
             last = k == len(edges) - 2
             inside = s_eval[(s_eval >= a) & ((s_eval <= b) if last else (s_eval < b))]
             Z, s_stop, z_stop, solver = solve(f, a, b, z0, method, inside, rtol, atol, event, -direction, failed, jac,
-                                              compiled)
+                                              compiled, odepack)
             parts.append(Z)
             for key in stats:
                 stats[key] += int(getattr(solver, key))
