@@ -356,12 +356,12 @@ def _valley(result) -> str:
     return ""
 
 
-def lmfit_leastsq(lmfit, model: _Model, slots, params, scale_covar: bool, budget: int, eps: float | None = None):
+def lmfit_leastsq(lmfit, model: _Model, slots, params, scale_covar: bool, budget: int):
     """lmfit's Levenberg-Marquardt on ``model`` from lmfit ``params`` (values / scale), at most ``budget``
-    evaluations, with forward-difference steps ``epsfcn(model)`` unless eps is given: its MinimizerResult."""
+    evaluations: its MinimizerResult."""
     mini = lmfit.Minimizer(lambda ps: model.residual(_si(ps, slots)), params, scale_covar=scale_covar,
                            max_nfev=budget)
-    return mini.minimize(method="leastsq", epsfcn=epsfcn(model) if eps is None else eps, ftol=FTOL, xtol=FTOL)
+    return mini.minimize(method="leastsq", epsfcn=epsfcn(model), ftol=FTOL, xtol=FTOL)
 
 
 #: How many times the given number of start points a compiled law with memory scores on a finer and wider grid
