@@ -209,7 +209,8 @@ def make_slide(method: str = "LSODA", rtol: float = 1e-10, atol: float | None = 
         f = _scaled_rates(plan, p, direction, T, scale, method)
         odepack = method == "LSODA" and event is not None and slip_keeps_sign(plan, p, direction)
         if odepack:
-            f = _counted(_lean_slip_rates(plan, p, direction, T, scale, f) or f, plan, T, method)
+            lean = _lean_slip_rates(plan, p, direction, T, scale, f)
+            f = f if lean is None else _counted(lean, plan, T, method)
         try:
             return _integrate_phase(plan, f, None if odepack else event, t0, T, y0, direction, t_out, scale, method,
                                     rtol, atol, odepack=odepack)
@@ -264,17 +265,9 @@ def _too_many(plan, t, method) -> str:
 
 def _scaled_rates(plan, p, direction, tscale, scale, method):
     """The right-hand side of a sliding phase on the scaled problem (time / tscale, states / scale), through
-    ``Plan.bound``; it stops with a clear error beyond MAX_NFEV evaluations."""
-    calls = [0]
+    ``Plan.bound``; it stops with a clear error beyond MAX_NFEV evaluations (``_counted``)."""
     rates = plan.bound(p, direction)
-
-    def f(s, z):
-        calls[0] += 1
-        if calls[0] > MAX_NFEV:
-            raise SolverError(f"ode:{method}: {_too_many(plan, s * tscale, method)}")
-        return rates(s * tscale, z * scale) * tscale / scale
-
-    return f
+    return _counted(lambda s, z: rates(s * tscale, z * scale) * tscale / scale, plan, tscale, method)
 
 
 def _lean_slip_rates(plan, p, direction, tscale, scale, general):
@@ -286,7 +279,7 @@ def _lean_slip_rates(plan, p, direction, tscale, scale, general):
 
 
 def _counted(f, plan, tscale, method):
-    """f stopped with a clear error beyond MAX_NFEV evaluations (as ``_scaled_rates``)."""
+    """f(s, z) of a phase's scaled problem, stopped with a clear error beyond MAX_NFEV evaluations."""
     calls = [0]
 
     def counted(s, z):
