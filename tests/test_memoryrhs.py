@@ -169,3 +169,31 @@ def test_a_short_stick_slip_burst_is_not_chatter():
     assert not _chattering(moving, 1.0, 180)  # the state changes from cycle to cycle: it may break free
     slow = [(k * 1e-3, y) for k in range(10)]
     assert not _chattering(slow, 1.0, 180)  # at this pace the segments left might reach the end
+
+
+def test_rate_state_slip_fit_reaches_the_careful_minimum():
+    """The careful plain fit (benchmarks/plain_memory_fits.py) reaches chi-square 14029.6 with mu0 and b at 0; the
+    search stopped at 14065.2 (b = 0.0087, Dc = 0.021 um), where chi-square jumps by +-3 with the solver's steps at
+    rtol 1e-6, until it also drew starts between its grid's levels and refined its lowest ends at rtol 1e-8."""
+    r = fl.fit("rate-state-slip", "incline-oil-a200")
+    assert r.ok and r.stats.chisqr < 14031
+
+
+def test_sampled_starts_fill_every_axis_between_the_grid_levels():
+    """``_start_grid(sampled=True)``: the given start first, then a Latin hypercube over the same spans (one point in
+    each of ``limit`` equal slices of every axis, in log for positive parameters), inside the bounds."""
+    from frictionlab.inference.fitmodel import _law_slots, _start_grid
+
+    law = get_law("rate-state-slip")
+    tg = fl.make_target(fl.load_dataset("incline-oil-a200"))
+    slots = _law_slots(law, [tg], {}, set(), {})
+    levels = _start_grid(slots, np.random.default_rng(1), 375, 1.5)
+    grid = _start_grid(slots, np.random.default_rng(3), 125, 1.5, sampled=True)
+    assert len(grid) == 126 and grid[0] == {s.pname: s.value / s.scale for s in slots}
+    for s in slots:
+        x = np.array([g[s.pname] for g in grid[1:]])
+        assert np.all((x >= s.lower / s.scale) & (x <= s.upper / s.scale))
+        assert len({g[s.pname] for g in levels[1:]}) <= 4  # the grid's levels
+        if s.key != "mu0":  # mu0's span reaches past its upper bound 2, where points are clipped
+            u = (np.log10(x / (s.value / s.scale)) + 1.5) / 3.0
+            assert sorted(np.floor(u * 125).astype(int)) == list(range(125))

@@ -279,10 +279,30 @@ def _si(params, slots) -> dict[str, float]:
     return {s.pname: params[s.pname].value * s.scale for s in slots}
 
 
-def _start_grid(slots, rng, limit: int, decades: float = 1.5) -> list[dict[str, float]]:
+def _start_grid(slots, rng, limit: int, decades: float = 1.5, sampled: bool = False) -> list[dict[str, float]]:
     """Candidate starts in scaled units, the given start first: log-spaced multiples of the start
     for positive quantities (10^-decades to 10^decades), steps of the scale around it for signed ones, the
-    bounds' span for scene quantities; clipped into the bounds. A full grid if it has at most ``limit`` points."""
+    bounds' span for scene quantities; clipped into the bounds. A full grid if it has at most ``limit`` points,
+    else ``limit`` points of it drawn at random; sampled: ``limit`` points of a Latin hypercube over the same
+    spans instead, every axis continuous (rate-and-state's a and b trade off: where the data want b near 0, the
+    levels hold no a that matches them, and the grid's best starts all have b large)."""
+    start = [s.value / s.scale for s in slots]
+    if sampled:
+        from scipy.stats import qmc
+
+        u = qmc.LatinHypercube(d=len(slots), seed=rng).random(limit)
+        axes = []
+        for s, w in zip(slots, u.T):
+            x0, lo, hi = s.value / s.scale, s.lower / s.scale, s.upper / s.scale
+            if s.kind == "scene":
+                c = lo + (hi - lo) * w
+            elif lo >= 0 and x0 > 0:
+                c = x0 * 10.0 ** (decades * (2.0 * w - 1.0))
+            else:
+                c = x0 + np.sinh(8.0 * w - 4.0)
+            axes.append(np.clip(c, lo, hi))
+        grid = np.vstack([start, np.array(axes).T])
+        return [dict(zip((s.pname for s in slots), row)) for row in grid]
     levels = max(3, min(15, int(round(limit ** (1.0 / len(slots))))))
     axes = []
     for s in slots:
@@ -295,7 +315,6 @@ def _start_grid(slots, rng, limit: int, decades: float = 1.5) -> list[dict[str, 
         else:
             c = x0 + np.sinh(np.linspace(-4.0, 4.0, levels))  # dense near the start, out to +/- 27 scales
         axes.append(np.unique(np.clip(c, lo, hi)))
-    start = [s.value / s.scale for s in slots]
     total = math.prod(len(a) for a in axes)
     if total <= limit:
         grid = np.array(np.meshgrid(*axes, indexing="ij")).reshape(len(axes), -1).T
@@ -350,12 +369,17 @@ def lmfit_leastsq(lmfit, model: _Model, slots, params, scale_covar: bool, budget
 #: start that those grids span.
 MEMORY_SCAN = 4
 MEMORY_DECADES = (1.5, 3.0)
+#: How many times the given number of start points a compiled law with memory also draws from a Latin hypercube
+#: over the finer grid's spans (``_start_grid``, sampled: coordinates between the grid's levels), and how many of
+#: the best of those it refines.
+MEMORY_SAMPLED, MEMORY_SAMPLED_STARTS = 1, 2
 
 
 def compiled_memory(model: _Model) -> bool:
     """True when the model is a built-in law with memory that every target solves by the ODE solver's default
     method on the compiled path (``solve.memoryrhs``): cheap enough for a wider search (MEMORY_SCAN times the
-    start points, every start refined, no early stop in a valley) and solved to a tolerance that makes
+    start points and MEMORY_SAMPLED times them sampled, every start refined, no early stop in a valley, the best
+    end refined again at a tighter tolerance: ``_tighter``) and solved to a tolerance that makes
     Levenberg-Marquardt's difference quotients need steps of its size (``epsfcn``)."""
     cached = getattr(model, "_compiled_memory", None)
     if cached is None:
@@ -406,24 +430,29 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
         from .fitprogress import LM_EVALS
 
         lm = LM_EVALS * (len(varying) + 1)
-        k = scan * (MEMORY_SCAN + 1 if wide else 1)
+        k = scan * (MEMORY_SCAN + 1 + MEMORY_SAMPLED if wide else 1)
         model.progress.stage("scanning start points", k, total=k + n_starts * lm + 2 * len(varying) + 2)
     if scan:
         fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
         grid = _start_grid(varying, np.random.default_rng(0), scan)
-        given = fine = len(grid)
+        given = fine = widest = len(grid)
         if wide and MEMORY_SCAN > 1:  # the same grid, MEMORY_SCAN - 1 times as many on a finer and wider one, and
             # as many as given on the widest (a start 3 decades off: LuGre's soft bristles on incline-oil-a400)
             grid += _start_grid(varying, np.random.default_rng(1), (MEMORY_SCAN - 1) * scan, MEMORY_DECADES[0])[1:]
             fine = len(grid)
             grid += _start_grid(varying, np.random.default_rng(2), scan, MEMORY_DECADES[1])[1:]
+            widest = len(grid)  # and as many again sampled over the finer grid's spans, every axis continuous
+            grid += _start_grid(varying, np.random.default_rng(3), MEMORY_SAMPLED * scan, MEMORY_DECADES[0],
+                                sampled=True)[1:]
         points = [{s.pname: vals[s.pname] * s.scale for s in slots} for vals in ({**fixed_part, **c} for c in grid)]
         scored = [(float(r @ r), i, c) for i, (r, c) in enumerate(zip(model.residuals(points), grid))]
         scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins
         starts = _distinct([x for x in scored if x[1] < fine], min(n_starts, ODE_STARTS) if slow else n_starts)
         if wide:  # the best of the given grid alone, as a fit of a law without memory starts, and of the widest
             starts += [c for c in _distinct([x for x in scored if x[1] < given], n_starts) if c not in starts]
-            starts += [c for c in _distinct([x for x in scored if x[1] >= fine], n_starts) if c not in starts]
+            starts += [c for c in _distinct([x for x in scored if fine <= x[1] < widest], n_starts) if c not in starts]
+            starts += [c for c in _distinct([x for x in scored if x[1] >= widest], MEMORY_SAMPLED_STARTS)
+                       if c not in starts]
     if not slow and (values_only or len(starts) > 1):  # closed forms: every start's run in one batch
         from .batchfit import best_start
 
@@ -457,5 +486,53 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
             notes.append(f"one Levenberg-Marquardt start of {len(starts)}: the first ended where the data do not "
                          f"determine the parameters ({why}), where another start ends too")
             break
+    if wide and scan and not direct:  # a main fit's search (replicate refits start at its values)
+        if model.progress is not None:
+            model.progress.stage("refining the best end at a tighter tolerance", lm)
+        best = _tighter(lmfit, model, slots, best, scale_covar, max_nfev or 200 * (len(varying) + 1))
     return best.params, bool(best.success), str(best.message), best, notes
 
+
+#: The ODE tolerance, relative to the fit's, at which a compiled law with memory refines its search's best end
+#: (``_tighter``).
+TIGHTER = 1e-2
+
+
+def _tighter(lmfit, model: _Model, slots, best, scale_covar: bool, budget: int):
+    """The search's best end (an lmfit result) refined, or itself where that is no better. An adaptive solve to the
+    fit's rtol changes in jumps with the parameters: rate-state-slip on incline-oil-a200 jumps by +-3 in chi-square
+    between points 0.1% apart in Dc at rtol 1e-6, where the trend is 0.03 a step, so Levenberg-Marquardt's
+    difference quotients see no slope and its run ends where it stands; and lmfit's bound transformation makes a
+    parameter near a bound of 0 (mu0 and b there) move the least where it must move to the bound. From there,
+    scipy's bounded trust region (``least_squares``: the bounds as they are, difference steps of sqrt(epsfcn)
+    of each scaled parameter) runs with the ODEs solved to TIGHTER times the fit's rtol, where the jumps are that
+    much smaller; then lmfit's Levenberg-Marquardt at the fit's own rtol from where it ended, for the fit's result and
+    its error analysis (that run only lowers chi-square)."""
+    from scipy.optimize import least_squares
+
+    from .predict import FIT_RTOL
+
+    varying = [s for s in slots if s.vary]
+    fixed = {s.pname: s.value for s in slots if not s.vary}
+    x0 = np.array([best.params[s.pname].value for s in varying])
+    lo = np.array([s.lower / s.scale for s in varying])
+    hi = np.array([s.upper / s.scale for s in varying])
+
+    def residual(x):
+        return model.residual({**fixed, **{s.pname: v * s.scale for s, v in zip(varying, x)}})
+
+    rtol, step = model.rtol, math.sqrt(epsfcn(model))
+    model.rtol, model._last = TIGHTER * (FIT_RTOL if rtol is None else rtol), None
+    try:
+        with np.errstate(all="ignore"):
+            x = least_squares(residual, np.clip(x0, lo, hi), bounds=(lo, hi), x_scale="jac", diff_step=step,
+                              ftol=FTOL, xtol=FTOL, max_nfev=budget).x
+    except ValueError:  # scipy refuses the problem (bounds that leave a parameter no room): the search's end stands
+        return best
+    finally:
+        model.rtol, model._last = rtol, None
+    params = levmar.lmfit_parameters(best.params).copy()
+    for s, v in zip(varying, x):
+        params[s.pname].set(value=v)
+    r = lmfit_leastsq(lmfit, model, slots, params, scale_covar, budget)
+    return r if (r.success, -r.chisqr) > (best.success, -best.chisqr) else best
