@@ -89,12 +89,24 @@ def test_what_accuracy_costs_is_answered_for_every_law_and_dataset(users_impact)
     assert c.timings["accuracy"] < 30  # cheap: a few predictions per law and dataset
 
 
-def test_where_it_is_not_cheap_it_says_how_to_run_it(users_impact):
+def test_where_it_is_not_cheap_it_says_how_to_run_it(users_impact, monkeypatch):
+    from frictionlab.inference import accuracy
+
     f = next(f for f in users_impact.fits if f.ok and f.solver == "exact")
     slow = attrs.evolve(f, cpu_time=BUDGET * f.nfev)  # as if one evaluation took BUDGET seconds
+    monkeypatch.setattr(accuracy, "BUDGET", 1e-12)  # and a timed prediction also costs more than the budget
     (row,) = solver_costs(slow)
     assert row.status == "not run" and COMMAND in row.reason and "CPU s" in row.reason
     assert solver_costs(slow, full=True)[0].reference  # the full study runs it anyway
+
+
+def test_a_fit_slowed_by_a_one_time_cost_still_gets_its_study(users_impact):
+    """A fit's CPU time may hold a kernel compiled once per machine (a fresh install's first fit): where the fit's
+    time per evaluation says the study is dear, one timed prediction decides."""
+    f = next(f for f in users_impact.fits if f.ok and f.solver == "exact")
+    slow = attrs.evolve(f, cpu_time=BUDGET * f.nfev)  # as if one evaluation took BUDGET seconds
+    rows = solver_costs(slow)
+    assert rows[0].reference and rows[0].status == "ok" and len(rows) > 1
     assert len(study_fits(users_impact.fits)) == len({(g.datasets[0], g.law) for g in users_impact.fits if g.ok})
 
 
