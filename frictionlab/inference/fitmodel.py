@@ -279,30 +279,11 @@ def _si(params, slots) -> dict[str, float]:
     return {s.pname: params[s.pname].value * s.scale for s in slots}
 
 
-def _start_grid(slots, rng, limit: int, decades: float = 1.5, sampled: bool = False) -> list[dict[str, float]]:
+def _start_grid(slots, rng, limit: int, decades: float = 1.5) -> list[dict[str, float]]:
     """Candidate starts in scaled units, the given start first: log-spaced multiples of the start
     for positive quantities (10^-decades to 10^decades), steps of the scale around it for signed ones, the
     bounds' span for scene quantities; clipped into the bounds. A full grid if it has at most ``limit`` points,
-    else ``limit`` points of it drawn at random; sampled: ``limit`` points of a Latin hypercube over the same
-    spans instead, every axis continuous (rate-and-state's a and b trade off: where the data want b near 0, the
-    levels hold no a that matches them, and the grid's best starts all have b large)."""
-    start = [s.value / s.scale for s in slots]
-    if sampled:
-        from scipy.stats import qmc
-
-        u = qmc.LatinHypercube(d=len(slots), seed=rng).random(limit)
-        axes = []
-        for s, w in zip(slots, u.T):
-            x0, lo, hi = s.value / s.scale, s.lower / s.scale, s.upper / s.scale
-            if s.kind == "scene":
-                c = lo + (hi - lo) * w
-            elif lo >= 0 and x0 > 0:
-                c = x0 * 10.0 ** (decades * (2.0 * w - 1.0))
-            else:
-                c = x0 + np.sinh(8.0 * w - 4.0)
-            axes.append(np.clip(c, lo, hi))
-        grid = np.vstack([start, np.array(axes).T])
-        return [dict(zip((s.pname for s in slots), row)) for row in grid]
+    else ``limit`` points of it drawn at random."""
     levels = max(3, min(15, int(round(limit ** (1.0 / len(slots))))))
     axes = []
     for s in slots:
@@ -320,7 +301,32 @@ def _start_grid(slots, rng, limit: int, decades: float = 1.5, sampled: bool = Fa
         grid = np.array(np.meshgrid(*axes, indexing="ij")).reshape(len(axes), -1).T
     else:
         grid = np.array([[rng.choice(a) for a in axes] for _ in range(limit)])
-    grid = np.vstack([start, grid])
+    return _starts(slots, grid)
+
+
+def _sampled_starts(slots, rng, limit: int, decades: float = 1.5) -> list[dict[str, float]]:
+    """As ``_start_grid``, ``limit`` points of a Latin hypercube over the same spans instead of a grid's levels,
+    every axis continuous (rate-and-state's a and b trade off: where the data want b near 0, the levels hold no a
+    that matches them, and the grid's best starts all have b large)."""
+    from scipy.stats import qmc
+
+    u = qmc.LatinHypercube(d=len(slots), seed=rng).random(limit)
+    axes = []
+    for s, w in zip(slots, u.T):
+        x0, lo, hi = s.value / s.scale, s.lower / s.scale, s.upper / s.scale
+        if s.kind == "scene":
+            c = lo + (hi - lo) * w
+        elif lo >= 0 and x0 > 0:
+            c = x0 * 10.0 ** (decades * (2.0 * w - 1.0))
+        else:
+            c = x0 + np.sinh(8.0 * w - 4.0)
+        axes.append(np.clip(c, lo, hi))
+    return _starts(slots, np.array(axes).T)
+
+
+def _starts(slots, grid) -> list[dict[str, float]]:
+    """The given start (scaled), then each row of ``grid``, as {parameter name: scaled value}."""
+    grid = np.vstack([[s.value / s.scale for s in slots], grid])
     return [dict(zip((s.pname for s in slots), row)) for row in grid]
 
 
@@ -370,7 +376,7 @@ def lmfit_leastsq(lmfit, model: _Model, slots, params, scale_covar: bool, budget
 MEMORY_SCAN = 4
 MEMORY_DECADES = (1.5, 3.0)
 #: How many times the given number of start points a compiled law with memory also draws from a Latin hypercube
-#: over the finer grid's spans (``_start_grid``, sampled: coordinates between the grid's levels), and how many of
+#: over the finer grid's spans (``_sampled_starts``: coordinates between the grid's levels), and how many of
 #: the best of those it refines.
 MEMORY_SAMPLED, MEMORY_SAMPLED_STARTS = 1, 2
 
@@ -442,8 +448,7 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
             fine = len(grid)
             grid += _start_grid(varying, np.random.default_rng(2), scan, MEMORY_DECADES[1])[1:]
             widest = len(grid)  # and as many again sampled over the finer grid's spans, every axis continuous
-            grid += _start_grid(varying, np.random.default_rng(3), MEMORY_SAMPLED * scan, MEMORY_DECADES[0],
-                                sampled=True)[1:]
+            grid += _sampled_starts(varying, np.random.default_rng(3), MEMORY_SAMPLED * scan, MEMORY_DECADES[0])[1:]
         points = [{s.pname: vals[s.pname] * s.scale for s in slots} for vals in ({**fixed_part, **c} for c in grid)]
         scored = [(float(r @ r), i, c) for i, (r, c) in enumerate(zip(model.residuals(points), grid))]
         scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins

@@ -125,25 +125,18 @@ def scaled_slip_rhs(plan, p, direction: float, vanishing: float, tscale: float, 
     if not isinstance(form, AreaSlipForm) or area is None:
         return None
     k, m, drive, tiny = float(form.k), float(plan.scene.mass), float(plan.drive), direction * vanishing
-    sv = float(scale[0])
-    cv = tscale / sv
-    if len(plan.states) == 1:
-        def f(s, z):
-            u = float(z[0]) * sv
-            if not direction * u > 0:
-                u = tiny
-            F = k * area(s * tscale, 0.0, u)[0] * u
-            return ((drive - F / m) * cv,) if math.isfinite(F) else general(s, z)
-
-        return f
-    sx = float(scale[1])
+    sv, cv = float(scale[0]), tscale / float(scale[0])
+    slid = len(plan.states) == 2  # x, the slip so far, is a state: the area may depend on it
+    sx = float(scale[1]) if slid else 1.0
     cx = tscale / sx
 
     def f(s, z):
         u = float(z[0]) * sv
         if not direction * u > 0:
             u = tiny
-        F = k * area(s * tscale, float(z[1]) * sx, u)[0] * u
-        return ((drive - F / m) * cv, abs(u) * cx) if math.isfinite(F) else general(s, z)
+        F = k * area(s * tscale, float(z[1]) * sx if slid else 0.0, u)[0] * u
+        if not math.isfinite(F):
+            return general(s, z)
+        return ((drive - F / m) * cv, abs(u) * cx) if slid else ((drive - F / m) * cv,)
 
     return f
