@@ -305,10 +305,10 @@ def test_refits_of_a_velocity_step_fit_start_where_it_ended(small_step_fits):
 
 
 def test_the_compiled_sums_equal_the_explicit_projected_jacobian(tmp_path):
-    """velstep_kernel.normal_equations (one pass, nothing per sample kept) against the prewhitened, projected
+    """velstep_kernel.basis_sums (one pass, nothing per sample kept) against the prewhitened, projected
     residual and Jacobian formed explicitly with numpy."""
     from frictionlab.inference import ar1, velstep
-    from frictionlab.inference.velstep_kernel import normal_equations
+    from frictionlab.inference.velstep_kernel import basis_sums
 
     ds, curve = _measured_like(tmp_path, "ar1")
     y = curve + np.random.default_rng(6).normal(0.0, 4e-4, curve.size)
@@ -327,8 +327,11 @@ def test_the_compiled_sums_equal_the_explicit_projected_jacobian(tmp_path):
     assert ok and cost == pytest.approx(float(r @ r), rel=1e-10)
     assert g == pytest.approx(Jp.T @ r, rel=1e-8, abs=1e-12 * np.abs(Jp.T @ r).max())
     assert A == pytest.approx(Jp.T @ Jp, rel=1e-8, abs=1e-12 * np.abs(A).max())
-    ww, *_ = normal_equations(s.y, 0.0, sol.m, sol.S, s.sigma, np.zeros(s.n), *pb.column_spec(s, v, pb.free), s.Q[:, :0])
+    ww, Bw, BB, Qw, QB = basis_sums(s.y, 0.0, sol.m, sol.S, 1 / s.sigma, np.zeros(s.n), np.ones(s.n), s.Q[:, :0])
+    B = np.column_stack([sol.S, np.ones(s.n)]) / s.sigma[:, None]
     assert ww == pytest.approx(float(np.sum(((sol.m - s.y) / s.sigma) ** 2)), rel=1e-12)
+    assert Bw == pytest.approx(B.T @ ((sol.m - s.y) / s.sigma), rel=1e-10, abs=1e-12 * np.abs(B.T @ B).max())
+    assert BB == pytest.approx(B.T @ B, rel=1e-10) and Qw.shape == (0,) and QB.shape == (0, 5)
 
 
 def test_the_equivalence_test_runs_on_ar1_velocity_steps(tmp_path):

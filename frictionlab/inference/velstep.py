@@ -61,6 +61,8 @@ SEARCH_RTOL, FIT_RTOL = 1e-5, 1e-8
 AR1_ROUNDS, AR1_TOL = 8, 1e-3
 #: Optimizer scale of a and b (the laws' typical size).
 AB_SCALE = 0.01
+#: Columns every Jacobian column combines (``velstep_kernel``): the sensitivities to a, b, Dc and k, and a constant.
+NBASIS = 5
 
 
 def applies(law, targets, solver: str, local, free) -> bool:
@@ -130,11 +132,18 @@ class Series:
         self.phi_groups = np.zeros(self.refs.size)
         self.noise_ests: list = []
         self.search = _search_index(self.t, self.load.times)
+        self.no_phi = np.zeros(self.search.size)  # the search's subsample is fitted as white noise
+        self._set_weights()
         self._set_projection()
 
     @property
     def n(self) -> int:
         return self.t.size
+
+    def _set_weights(self):
+        """What the compiled sums read of sigma and phi: 1 / sigma and the prewhitening gain 1 / sqrt(1 - phi^2)."""
+        self.inv_sigma = 1.0 / self.sigma
+        self.gain = 1.0 / np.sqrt(1.0 - self.phi ** 2)
 
     def _set_projection(self):
         """The orthonormal columns of the (prewhitened) linear parameters, and the data less a first guess of their
@@ -158,6 +167,7 @@ class Series:
             if not np.all(np.isfinite(self.sigma) & (self.sigma > 0)):
                 raise FrictionLabError(f"dataset '{self.target.name}': the noise of the prewhitened data cannot be "
                                        "estimated")
+        self._set_weights()
         self._set_projection()
         return change
 
@@ -236,7 +246,7 @@ class Problem:
         """(chi-square r'r, J'r, J'J, solved) of the weighted, prewhitened, projected residual r and its Jacobian J by
         the parameters ``free`` at the full vector x (``velstep_kernel``: nothing per sample is kept); a model
         that cannot be solved there gives (inf, 0, 0, False)."""
-        from .velstep_kernel import normal_equations
+        from .velstep_kernel import basis_sums
 
         key = (np.asarray(x).tobytes(), tuple(free), search, rtol)
         if self._cache is not None and self._cache[0] == key:
@@ -254,13 +264,18 @@ class Problem:
                 idx = s.search if search else slice(None)
                 sol = quasistatic.solve(self.code, v["a"], v["b"], v["Dc"], v["k"][s.index], s.load, s.t[idx],
                                         rtol or (SEARCH_RTOL if search else self.rtol), sensitivities=True)
-                cols, mult, const = self.column_spec(s, v, free)
-                phi = np.zeros(sol.m.size) if search else s.phi
-                ww, Cw, CC, Qw, QC = normal_equations(s.y_ref[idx], s.offset(v["a"], v["b"]), sol.m, sol.S, s.sigma[idx],
-                                                      phi, cols, mult, const, s.Q_search if search else s.Q)
+                M = self.combination(s, v, free)
+                if search:  # white noise on the subsample
+                    sums = basis_sums(s.y_ref[idx], s.offset(v["a"], v["b"]), sol.m, sol.S, s.inv_sigma[idx],
+                                      s.no_phi, s.no_phi, s.Q_search)
+                else:
+                    sums = basis_sums(s.y_ref, s.offset(v["a"], v["b"]), sol.m, sol.S, s.inv_sigma, s.phi, s.gain,
+                                      s.Q)
+                ww, Bw, BB, Qw, QB = sums
+                QC = QB @ M
                 cost += ww - float(Qw @ Qw)
-                g += Cw - QC.T @ Qw
-                A += CC - QC.T @ QC
+                g += M.T @ Bw - QC.T @ Qw
+                A += M.T @ BB @ M - QC.T @ QC
             out = (cost, g, A, bool(np.isfinite(cost)))
         except SolverError as exc:
             self.failures += 1
@@ -269,31 +284,26 @@ class Problem:
         self._cache = (key, out)
         return out
 
-    def column_spec(self, s: Series, v, free):
-        """The columns d(model)/d(x_j) of the parameters ``free`` on dataset s as S[:, idx_j] mult_j + const_j from
-        the sensitivities S = dm/d(a, b, Dc, k) (idx_j = -1: another dataset's stiffness, a zero column)."""
+    def combination(self, s: Series, v, free) -> np.ndarray:
+        """M (5 x len(free)): the columns d(model)/d(x_j) of the parameters ``free`` on dataset s are [S, 1] M, with
+        S = dm/d(a, b, Dc, k) the sensitivities (a zero column for another dataset's stiffness)."""
         held = s.L1 if s.mu0 is not None else 0.0  # a held mu0 at V0 puts (a - b) ln(V1 / V0) in the model
-        idx, mult, const = np.full(len(free), -1, dtype=np.int64), np.zeros(len(free)), np.zeros(len(free))
+        M = np.zeros((NBASIS, len(free)))
         for j, i in enumerate(free):
             p = self.params[i]
             if p.key == "a":
-                idx[j], mult[j], const[j] = 0, AB_SCALE, held * AB_SCALE
+                M[0, j], M[4, j] = AB_SCALE, held * AB_SCALE
             elif p.key == "b":
-                idx[j], mult[j], const[j] = 1, AB_SCALE, -held * AB_SCALE
+                M[1, j], M[4, j] = AB_SCALE, -held * AB_SCALE
             elif p.key == "Dc":
-                idx[j], mult[j] = 2, v["Dc"]
+                M[2, j] = v["Dc"]
             elif p.target == s.index:  # this dataset's stiffness
-                idx[j], mult[j] = 3, v["k"][s.index]
-        return idx, mult, const
+                M[3, j] = v["k"][s.index]
+        return M
 
     def columns(self, s: Series, v, x, S, free) -> np.ndarray:
         """d(model)/d(x_j) for the parameters ``free`` on dataset s, from the sensitivities S = dm/d(a, b, Dc, k)."""
-        idx, mult, const = self.column_spec(s, v, free)
-        out = np.zeros((S.shape[0], len(free)))
-        for j in range(len(free)):
-            if idx[j] >= 0:
-                out[:, j] = S[:, idx[j]] * mult[j] + const[j]
-        return out
+        return np.column_stack([S, np.ones(S.shape[0])]) @ self.combination(s, v, free)
 
     def model(self, x) -> list[np.ndarray]:
         """Each dataset's model of mu (linear parameters solved) at the full vector x, every sample."""

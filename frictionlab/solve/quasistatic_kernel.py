@@ -244,24 +244,34 @@ def integrate(law, a, b, Dc, k, V1, seg_t, seg_v, t_out, rtol, atol_m, sens, vma
                 for c in range(4):
                     S1[0, c] = baseS[0, c] + h * G * KS[4, 0, c]
                     S1[1, c] = baseS[1, c] + h * G * KS[4, 1, c]
-            # dense output on (t, t_new]: cubic Hermite of m, psi (and of the sensitivities of m)
-            while i_out < n and (t_out[i_out] <= t_new or (last and j == nseg - 1 and t_out[i_out] <= t_end)):
-                th = (t_out[i_out] - t) / (t_new - t)
+            # dense output on (t, t_new]: cubic Hermite of m, psi (and of the sensitivities of m); the step's
+            # values held in scalars (an output array might alias the small arrays: they would be read again)
+            dt = t_new - t
+            m0, m1, dm0, dm1 = y[0], Y[0], f0[0], K[4, 0]
+            q0, q1, dq0, dq1 = y[1], Y[1], f0[1], K[4, 1]
+            sa0, sb0, sc0_, sd0 = S[0, 0], S[0, 1], S[0, 2], S[0, 3]
+            sa1, sb1, sc1_, sd1 = S1[0, 0], S1[0, 1], S1[0, 2], S1[0, 3]
+            da0, db0, dc0, dd0 = KS0[0, 0], KS0[0, 1], KS0[0, 2], KS0[0, 3]
+            da1, db1, dc1, dd1 = KS[4, 0, 0], KS[4, 0, 1], KS[4, 0, 2], KS[4, 0, 3]
+            final = last and j == nseg - 1
+            while i_out < n and (t_out[i_out] <= t_new or (final and t_out[i_out] <= t_end)):
+                th = (t_out[i_out] - t) / dt
                 if th < 0.0:
                     th = 0.0
                 elif th > 1.0:
                     th = 1.0
-                h00 = (1.0 + 2.0 * th) * (1.0 - th) ** 2
-                h10 = th * (1.0 - th) ** 2
+                u2 = (1.0 - th) * (1.0 - th)
+                h00 = (1.0 + 2.0 * th) * u2
+                h10 = th * u2 * dt
                 h01 = th * th * (3.0 - 2.0 * th)
-                h11 = th * th * (th - 1.0)
-                dt = t_new - t
-                out_m[i_out] = h00 * y[0] + h10 * dt * f0[0] + h01 * Y[0] + h11 * dt * K[4, 0]
-                out_psi[i_out] = h00 * y[1] + h10 * dt * f0[1] + h01 * Y[1] + h11 * dt * K[4, 1]
+                h11 = th * th * (th - 1.0) * dt
+                out_m[i_out] = h00 * m0 + h10 * dm0 + h01 * m1 + h11 * dm1
+                out_psi[i_out] = h00 * q0 + h10 * dq0 + h01 * q1 + h11 * dq1
                 if sens:
-                    for c in range(4):
-                        out_S[i_out, c] = (h00 * S[0, c] + h10 * dt * KS0[0, c] + h01 * S1[0, c]
-                                           + h11 * dt * KS[4, 0, c])
+                    out_S[i_out, 0] = h00 * sa0 + h10 * da0 + h01 * sa1 + h11 * da1
+                    out_S[i_out, 1] = h00 * sb0 + h10 * db0 + h01 * sb1 + h11 * db1
+                    out_S[i_out, 2] = h00 * sc0_ + h10 * dc0 + h01 * sc1_ + h11 * dc1
+                    out_S[i_out, 3] = h00 * sd0 + h10 * dd0 + h01 * sd1 + h11 * dd1
                 i_out += 1
             if sens:
                 for c in range(4):
