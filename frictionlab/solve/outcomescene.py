@@ -3,6 +3,7 @@ inbound impact as an ordinary Scene: normal-force and area models per row (half-
 Hertz pulse), their speed dependence, compliance and materials (see ``frictionlab.solve.outcome``)."""
 from __future__ import annotations
 
+import bisect
 import functools
 import math
 from collections.abc import Mapping
@@ -93,18 +94,40 @@ class HertzPulse:
     def shape(self, t):
         """(y, dy/ds) at times t [s]; zero outside the contact."""
         s_end, dense = _hertz_solution()
+        if isinstance(t, (float, np.floating)) or np.ndim(t) == 0:  # one time (an ODE's right-hand side)
+            s = float(t) / self.time_scale
+            if not 0.0 <= s <= s_end:
+                return np.float64(0.0), np.float64(0.0)
+            y, dy = _hertz_at(s)
+            return np.float64(max(y, 0.0)), np.float64(dy)
         s = np.asarray(t, dtype=float) / self.time_scale
-        if s.ndim == 0 and dense.ascending:  # one time (an ODE's right-hand side): the step's interpolant, as dense()
-            if not 0.0 <= s <= s_end:        # picks it for an array, without the array's sorting (same numbers)
-                return np.asarray(0.0), np.asarray(0.0)
-            k = min(max(int(np.searchsorted(dense.ts_sorted, s)) - 1, 0), dense.n_segments - 1)
-            y, dy = dense.interpolants[k](float(s))
-            return np.asarray(np.maximum(y, 0.0)), np.asarray(dy)
         inside = (s >= 0) & (s <= s_end)
         sc = np.clip(s, 0.0, s_end)
         y, dy = dense(sc.ravel())  # both rows of one evaluation of the interpolant
         return (np.where(inside, np.maximum(y, 0.0).reshape(sc.shape), 0.0),
                 np.where(inside, dy.reshape(sc.shape), 0.0))
+
+
+@functools.cache
+def _hertz_steps() -> tuple[list, list]:
+    """(the solution's step times, each step's interpolant as (t_old, h, y_old, its coefficients last first))."""
+    _, dense = _hertz_solution()
+    steps = [(f.t_old, f.h, tuple(f.y_old.tolist()), [tuple(row) for row in reversed(f.F.tolist())])
+             for f in dense.interpolants]
+    return dense.ts_sorted.tolist(), steps
+
+
+def _hertz_at(s: float) -> tuple[float, float]:
+    """(y, y') of the dimensionless Hertz impact at one s: the DOP853 interpolant of s's step, as scipy's
+    OdeSolution evaluates it (the same operations on floats, so the same numbers), without its array calls."""
+    times, steps = _hertz_steps()
+    t_old, h, (y0, dy0), coefs = steps[min(max(bisect.bisect_left(times, s) - 1, 0), len(steps) - 1)]
+    x = (s - t_old) / h
+    y = dy = 0.0
+    for i, (f0, f1) in enumerate(coefs):
+        w = x if i % 2 == 0 else 1 - x
+        y, dy = (y + f0) * w, (dy + f1) * w
+    return y + y0, dy + dy0
 
 
 @attrs.frozen
