@@ -102,25 +102,26 @@ class HertzPulse:
             return np.float64(max(y, 0.0)), np.float64(dy)
         s = np.asarray(t, dtype=float) / self.time_scale
         inside = (s >= 0) & (s <= s_end)
-        sc = np.clip(s, 0.0, s_end)
-        y, dy = dense(sc.ravel())  # both rows of one evaluation of the interpolant
-        return (np.where(inside, np.maximum(y, 0.0).reshape(sc.shape), 0.0),
-                np.where(inside, dy.reshape(sc.shape), 0.0))
+        y, dy = _hertz_many(np.clip(s, 0.0, s_end))
+        return np.where(inside, np.maximum(y, 0.0), 0.0), np.where(inside, dy, 0.0)
 
 
 @functools.cache
-def _hertz_steps() -> tuple[list, list]:
-    """(the solution's step times, each step's interpolant as (t_old, h, y_old, its coefficients last first))."""
+def _hertz_steps() -> tuple[list, list, tuple]:
+    """The solution's step times, each step's interpolant as (t_old, h, y_old, its coefficients last first), and
+    the same as arrays (t_old, h, y_old (steps, 2), coefficients last first (steps, 7, 2))."""
     _, dense = _hertz_solution()
     steps = [(f.t_old, f.h, tuple(f.y_old.tolist()), [tuple(row) for row in reversed(f.F.tolist())])
              for f in dense.interpolants]
-    return dense.ts_sorted.tolist(), steps
+    arrays = (np.array([f.t_old for f in dense.interpolants]), np.array([f.h for f in dense.interpolants]),
+              np.array([f.y_old for f in dense.interpolants]), np.array([f.F[::-1] for f in dense.interpolants]))
+    return dense.ts_sorted.tolist(), steps, arrays
 
 
 def _hertz_at(s: float) -> tuple[float, float]:
     """(y, y') of the dimensionless Hertz impact at one s: the DOP853 interpolant of s's step, as scipy's
     OdeSolution evaluates it (the same operations on floats, so the same numbers), without its array calls."""
-    times, steps = _hertz_steps()
+    times, steps, _ = _hertz_steps()
     t_old, h, (y0, dy0), coefs = steps[min(max(bisect.bisect_left(times, s) - 1, 0), len(steps) - 1)]
     x = (s - t_old) / h
     y = dy = 0.0
@@ -128,6 +129,23 @@ def _hertz_at(s: float) -> tuple[float, float]:
         w = x if i % 2 == 0 else 1 - x
         y, dy = (y + f0) * w, (dy + f1) * w
     return y + y0, dy + dy0
+
+
+def _hertz_many(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``_hertz_at`` at every s of an array (any shape): each point's step found at once and every step's
+    interpolant evaluated together, the same operations elementwise (the same numbers as scipy's OdeSolution)."""
+    times, _, (t_old, h, y_old, coefs) = _hertz_steps()
+    k = np.clip(np.searchsorted(times, s, side="left") - 1, 0, t_old.size - 1)
+    x = (s - t_old[k]) / h[k]
+    y, dy = np.zeros(s.shape), np.zeros(s.shape)
+    c = coefs[k]
+    for i in range(c.shape[-2]):
+        w = x if i % 2 == 0 else 1 - x
+        y += c[..., i, 0]
+        y *= w
+        dy += c[..., i, 1]
+        dy *= w
+    return y + y_old[k, 0], dy + y_old[k, 1]
 
 
 @attrs.frozen
