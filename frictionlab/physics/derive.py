@@ -96,7 +96,7 @@ def _gcv_spline(t: np.ndarray, theta: np.ndarray, lams: np.ndarray):
 def _spline_operators(t: np.ndarray, theta: np.ndarray):
     """Smoother S and derivative D [1/s] of the cubic smoothing spline whose penalty minimizes GCV.
 
-    The penalty is chosen among (t[-1] - t[0])^3 * 10^-14 ... 10^1 s^3 (61 values, log-spaced).
+    The penalty [s^3] is chosen among (t[-1] - t[0])^3 * 10^k, k = -14 ... 1 in 60 equal log steps.
     """
     n = t.size
     if n < 5:
