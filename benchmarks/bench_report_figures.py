@@ -3,8 +3,8 @@
 of its origin; ``report.figures.ticks``: each axis' ticks worked out once per draw or measurement) against
 matplotlib's (``FigureCanvasAgg``, ticks worked out each time they are asked for) and against the report's with
 glyph origins on matplotlib's 1/64-pixel grid (``agg.STEP = 1``), in turns in one process: the minimum over the
-rounds, by kind (the file name up to its first '-' or '.'), and whether the PNG bytes of the latter two are the
-same.
+rounds, by kind (the file name up to its first '-' or '.'), the glyph bitmaps FreeType rendered for the report's
+renderer, and whether the PNG bytes of the latter two are the same.
 
     python benchmarks/bench_report_figures.py [ROUNDS]      (default 3)
 
@@ -43,7 +43,7 @@ def main(rounds: int = 3) -> None:
         f.draw()
     base.release()
     gc.freeze()
-    cpu, pngs = {w: [] for w in ways}, {}
+    cpu, pngs, rendered = {w: [] for w in ways}, {}, {}
     try:
         for _ in range(rounds):
             for way, (canvas, window, step) in ways.items():
@@ -54,6 +54,7 @@ def main(rounds: int = 3) -> None:
                     c0 = time.process_time()
                     drawn.append(f.draw())
                     t[f.name.replace(".", "-").split("-")[0]] += time.process_time() - c0
+                rendered[way] = len(vars(agg._KEPT).get("glyphs", ()))
                 base.release()
                 cpu[way].append(t)
                 pngs[way] = drawn
@@ -64,7 +65,8 @@ def main(rounds: int = 3) -> None:
     for way, t in best.items():
         print(f"  {way} renderer and ticks: {sum(t.values()):.2f} (" +
               ", ".join(f"{k} {v:.2f}" for k, v in sorted(t.items(), key=lambda kv: -kv[1])) + ")")
-        print("    rounds: " + ", ".join(f"{sum(t.values()):.2f}" for t in cpu[way]))
+        print("    rounds: " + ", ".join(f"{sum(t.values()):.2f}" for t in cpu[way]) +
+              (f"; glyph bitmaps rendered: {rendered[way]}" if rendered[way] else ""))
     plain, fast, fine = (sum(best[w].values()) for w in ways)
     print(f"matplotlib's / the report's: {plain / fast:.2f}; "
           f"the report's at 1/64 pixel / at 1/4 pixel: {fine / fast:.2f}")
