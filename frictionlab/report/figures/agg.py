@@ -1,8 +1,12 @@
 """The Agg canvas of the report's figures (``base.figure``): its renderer keeps, for this thread until ``release``,
 what matplotlib's Agg renderer works out anew for each renderer (a new one at each figure size) or each draw of a
-text: a string's size and glyph layout, a font's line metrics, and each glyph's bitmap at each 1/64-pixel phase of
-its origin. They depend only on the string, the font properties, the DPI, the angle and the hinting, so the PNG
-bytes are those matplotlib draws."""
+text: a string's size and glyph layout, a font's line metrics, and each glyph's bitmap at each phase of its origin.
+They depend only on the string, the font properties, the DPI, the angle and the hinting.
+
+Plain text is drawn glyph by glyph as matplotlib 3.11 draws it, except that each glyph's origin (matplotlib's, in
+1/64 pixel) is rounded to a multiple of ``STEP`` = 16, a quarter pixel (halves up): each glyph sits at most 1/8 pixel
+from matplotlib's place in x and in y, drawn as FreeType renders it there. All else (mathtext, TeX, text with another
+matplotlib, everything but text) has matplotlib's own pixels."""
 from __future__ import annotations
 
 import math
@@ -36,7 +40,10 @@ if hasattr(os, "register_at_fork"):  # (not on Windows, which does not fork)
     os.register_at_fork(after_in_child=release)
 
 
-#: Entries of each kind kept at most (a report keeps about 10000 glyphs); beyond, all are let go.
+#: Grid of glyph origins in 1/64 pixel (a quarter pixel): 4 x 4 phases of a glyph's bitmap, not 64 x 64
+STEP = 16
+
+#: Entries of each kind kept at most (a report keeps a few thousand glyphs); beyond, all are let go.
 MEMO = 1 << 16
 
 
@@ -89,16 +96,18 @@ class Renderer(RendererAgg):
 
     def _glyphs(self, gc, x, y, angle, size, items) -> None:
         """RendererAgg._draw_text_glyphs_and_boxes for the glyphs ``items`` of plain text (no slant, no stretch),
-        each glyph's bitmap rendered once for each 1/64 pixel phase of its origin: moved by whole pixels, FreeType
-        renders the same bitmap moved by as many pixels."""
+        each glyph's origin rounded to a multiple of ``STEP`` and its bitmap rendered once for each phase: moved by
+        whole pixels, FreeType renders the same bitmap moved by as many pixels."""
         glyphs = _kept()[3]
         cos, sin = math.cos(math.radians(angle)), math.sin(math.radians(angle))
         matrix = (0x10000 * np.array([[cos, -sin], [sin, cos]])).round().astype(int)
         flags, aa = get_hinting_flag(), gc.get_antialiased()
         turn = (*matrix.ravel().tolist(), self.dpi, flags, aa, size)
         height = self.height
+        half = STEP // 2
         for font, index, dx, dy in items:  # dy is upwards; FreeType's y is upwards, the renderer's downwards
-            ox, oy = round(0x40 * (x + dx * cos - dy * sin)), round(0x40 * (height - y + dx * sin + dy * cos))
+            ox = (round(0x40 * (x + dx * cos - dy * sin)) + half) // STEP * STEP
+            oy = (round(0x40 * (height - y + dx * sin + dy * cos)) + half) // STEP * STEP
             key = (font, index, turn, ox & 0x3f, oy & 0x3f)
             got = glyphs.get(key)
             if got is None:
