@@ -75,3 +75,23 @@ def test_a_figure_on_several_pages_is_drawn_once(comparison, tmp_path, monkeypat
     assert all((out / f / "shared.png").read_bytes() == (out / "figures" / "shared.png").read_bytes() for f in folders)
     for html in [out / "report.html", *(out / "groups").glob("*.html")]:
         assert "one picture on every page" in html.read_text()
+
+
+def test_a_group_page_opens_on_its_dataset_fits_drawn_once(comparison, tmp_path, monkeypatch):
+    """A group's page (no series finding) shows the fit figure of its dataset on its first screen: the picture its
+    'Fits' section shows too, drawn once for both; the index keeps the panel of every group."""
+    from frictionlab.report import figures
+
+    calls = []
+    real = figures.fit_figure
+    monkeypatch.setattr(figures, "fit_figure", lambda d, *a: calls.append(d.name) or real(d, *a))
+    monkeypatch.setattr(pages, "GROUP_PAGES_AT", 2)
+    out = write_report(comparison, tmp_path / "r")
+    md = (out / "groups" / "kharaz2001.md").read_text()
+    first, details = md.split("## Summary", 1)
+    assert "fit-kharaz2001-spin.png" in first and "finding.png" not in first
+    assert "fit-kharaz2001-spin.png" in details
+    assert sorted(calls) == sorted(set(calls))  # each dataset's fit figure drawn once
+    assert (out / "figures" / "finding.png").exists() and not (out / "figures" / "kharaz2001" / "finding.png").exists()
+    golf = (out / "groups" / "impact-golf.md").read_text()
+    assert "finding.png" in golf  # the series' slip panel is the golf group's own figure

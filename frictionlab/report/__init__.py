@@ -86,15 +86,17 @@ __all__ = ["SCHEMA", "SECTIONS", "Context", "Section", "build", "clean", "fit_js
 
 @attrs.define
 class Context:
-    """What a section's ``build`` gets: the Comparison, and a dict for numbers results.json carries."""
+    """What a section's ``build`` gets: the Comparison, a dict for numbers results.json carries, and whether the
+    page is one group's page of a report in pages (``report.pages``)."""
 
     c: object
     json: dict = attrs.field(factory=dict)
+    group_page: bool = False
 
 
-def build(c, modules=SECTIONS) -> tuple[list[Section], dict]:
+def build(c, modules=SECTIONS, group_page: bool = False) -> tuple[list[Section], dict]:
     """The sections of the report (figures not drawn yet) and the extra numbers for results.json."""
-    ctx = Context(c)
+    ctx = Context(c, group_page=group_page)
     out: list[Section] = []
     for m in modules:
         got = m.build(ctx)
@@ -285,7 +287,7 @@ def _pages(c, extra: dict):
         yield "report", sections, "figures"
         return
     for path, cc, modules, figdir, groups in pages.pages(c, SECTIONS, INDEX_SECTIONS):
-        sections, more = build(cc, modules)
+        sections, more = build(cc, modules, group_page=not groups)
         if groups:
             sections.insert(len(sections) - 1, pages.index_section(groups))
         elif sections:  # a group's page: the way back to the index first

@@ -225,7 +225,15 @@ def build(ctx) -> Section:
         shown = KIND_BLOCKS[kind](ctx, sec, dss)
         drawn |= {d.name for d in dss} if shown is None else set(shown)
     views = group_views(c, findings, skip=drawn)
-    if views:
+    if ctx.group_page and len(views) == 1 and views[0].series is None:  # its dataset's fits, as drawn among them
+        from .fits import fit_figure
+
+        d = views[0].dataset
+        fit_figure(sec, d, c.fits_on(d.name), [r for r in c.ranking if r.dataset == d.name],
+                   f"{d.name}: the data ({d.provenance.kind}) with each law's best fit (ΔAIC from the lowest) and the "
+                   "residuals under them.")
+        sec.p(_side(views))
+    elif views:
         shown = views[:MAX_PANELS]
         sec.fig("finding.png", "Per dataset group, one of its datasets with the group's top-ranked candidates (#rank)"
                 + ("; under a panel whose candidates include the truncated series, the slip u(t) of that series and "

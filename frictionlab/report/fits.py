@@ -92,6 +92,13 @@ def param_rows(f) -> list[list[str]]:
     return rows
 
 
+def fit_figure(sec: Section, d, fits, rows, caption: str) -> None:
+    """The figure of every law's fit to dataset d with its residuals, in ``sec``: one picture wherever a page shows
+    it (a group's page shows it on its first screen and among its fits)."""
+    sec.fig(f"fit-{d.name}.png", caption, lambda: figures.fit_figure(d, fits, rows),
+            key=("fit", id(d), tuple(id(f) for f in fits)))
+
+
 def build(ctx) -> Section:
     c = ctx.c
     sec = Section(TITLE)
@@ -106,8 +113,7 @@ def build(ctx) -> Section:
             if check:
                 sec.p(check)
         if any(f.ok for f in fits):
-            sec.fig(f"fit-{d.name}.png", f"{d.name}: data ({d.provenance.kind}) with each law's best fit, and residuals.",
-                    lambda d=d, fits=fits, rows=rows: figures.fit_figure(d, fits, rows))
+            fit_figure(sec, d, fits, rows, f"{d.name}: data ({d.provenance.kind}) with each law's best fit, and residuals.")
             if "t" in d.columns and d.kind != "spring-slider":  # a slider's friction is mu N: the fit figure shows it
                 sec.fig(f"force-{d.name}.png", f"{d.name}: friction force of each best fit.",
                         lambda d=d, fits=fits, rows=rows: figures.force_figure(d, fits, rows))
