@@ -101,19 +101,11 @@ def impacts(t, N, A, mu: float, shear: float, mass: float, radius: float, inerti
     amax = a.max(axis=1)
     if not np.all(amax > 0):
         raise ValueError("an impact row has no contact area: the Mindlin-Deresiewicz springs need A(t) > 0")
+    from .mdr_kernel import impacts_loop
+
     x = grid(springs)[None, :] * amax[:, None]
     k = 8.0 * shear * amax / springs  # per-spring stiffness [N/m], per row
     v = np.array(v0, dtype=float).reshape(-1)
     omega = np.array(omega0, dtype=float).reshape(-1)
-    f = np.zeros(x.shape)
-    F = np.zeros(len(v))
-    for i in range(t.shape[1] - 1):
-        dt = t[:, i + 1] - t[:, i]
-        v -= 0.5 * dt * F / mass
-        omega += 0.5 * dt * F * radius / inertia
-        dw = (v - radius * omega) * dt
-        f = step(f, (k * dw)[:, None], a[:, i + 1], limits(a[:, i + 1], N[:, i + 1], mu, x), x)
-        F = f.sum(axis=1)
-        v -= 0.5 * dt * F / mass
-        omega += 0.5 * dt * F * radius / inertia
+    impacts_loop(t, N, a, float(mu), np.ascontiguousarray(x), k, float(mass), float(radius), float(inertia), v, omega)
     return v, omega
