@@ -20,7 +20,8 @@ class HalfSineArea:
         t = np.asarray(t, dtype=float)
         phi = math.pi / self.contact_time
         inside = (t >= 0) & (t <= self.contact_time)
-        return np.where(inside, self.peak * np.sin(phi * t), 0.0), np.where(inside, self.peak * phi * np.cos(phi * t), 0.0)
+        x = phi * t
+        return np.where(inside, self.peak * np.sin(x), 0.0), np.where(inside, self.peak * phi * np.cos(x), 0.0)
 
     def value(self, t):
         """A(t) alone [m^2], bitwise the first of ``__call__``: a law that needs no dA/dt skips the cosine."""

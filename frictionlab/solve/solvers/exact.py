@@ -268,10 +268,11 @@ def relax_stop(g0, b, lam, t0, T, margin):
 
 
 # --- F = s (a N + c dA/dt) --------------------------------------------------------------
-def _normal_integrals(normal, t, a=1.0, second=True):
+def _normal_integrals(normal, t, a=1.0, second=True, trig=None):
     """a IN and a IIN: IN = int_0^t N, IIN = int_0^t IN, for half-sine or constant N (a: a factor per
     scene, folded into the coefficients; the term of times after contact skipped when there are none).
-    second=False: (a IN, None), the same a IN for less work (a stop search reads the impulse only)."""
+    second=False: (a IN, None), the same a IN for less work (a stop search reads the impulse only).
+    trig: (cos x, sin x) of the half-sine's phase x at t (``_half_sine_trig``), when the caller has them."""
     t = np.asarray(t, dtype=float)
     if isinstance(normal, WeightNormal):
         return a * normal.value * t, (a * normal.value * t * t / 2.0 if second else None)
@@ -280,32 +281,49 @@ def _normal_integrals(normal, t, a=1.0, second=True):
     c = a * normal.peak / phi
     after = bool(((t.max(axis=-1, keepdims=True) if t.ndim else t) > tc).any())  # each row's latest time
     tau = np.minimum(t, tc) if after else t
-    x = phi * tau
-    if not second:
-        return c * (1.0 - np.cos(x)), None
-    if x.ndim == 0 or np.broadcast_shapes(x.shape, np.shape(c)) != x.shape:  # small inputs: plainly
-        IN, IIN = c * (1.0 - np.cos(x)), c * (tau - np.sin(x) / phi)
-    else:  # large grids: in place, no temporaries
-        IN = np.cos(x)
-        np.subtract(1.0, IN, out=IN)
-        IN *= c
-        IIN = np.sin(x, out=x)
-        IIN /= -phi
-        IIN += tau
-        IIN *= c
-    if after:
+    if trig is not None:  # the same numbers as below, from the shared cos and sin
+        cos_x, sin_x = trig
+        IN = c * (1.0 - cos_x)
+        IIN = c * (tau - sin_x / phi) if second else None
+    else:
+        x = phi * tau
+        if not second:
+            return c * (1.0 - np.cos(x)), None
+        if x.ndim == 0 or np.broadcast_shapes(x.shape, np.shape(c)) != x.shape:  # small inputs: plainly
+            IN, IIN = c * (1.0 - np.cos(x)), c * (tau - np.sin(x) / phi)
+        else:  # large grids: in place, no temporaries
+            IN = np.cos(x)
+            np.subtract(1.0, IN, out=IN)
+            IN *= c
+            IIN = np.sin(x, out=x)
+            IIN /= -phi
+            IIN += tau
+            IIN *= c
+    if after and second:
         IIN = IIN + (2.0 * c) * np.maximum(t - tc, 0.0)
     return IN, IIN
 
 
-def _area_integrals(area, t, second=True):
-    """A(t) and int_0^t A, for half-sine or constant A (zeros without an area model); second=False: (A, None)."""
+def _half_sine_trig(tc, t) -> tuple[np.ndarray, np.ndarray]:
+    """(cos x, sin x) with x = pi min(t, tc) / tc: what the integrals of a half-sine N and a half-sine A of the
+    same contact time tc [s] both evaluate, computed once for the two."""
+    x = (math.pi / tc) * np.minimum(t, tc)
+    return np.cos(x), np.sin(x)
+
+
+def _area_integrals(area, t, second=True, trig=None):
+    """A(t) and int_0^t A, for half-sine or constant A (zeros without an area model); second=False: (A, None).
+    trig: (cos x, sin x) of the half-sine's phase at t (``_half_sine_trig``), when the caller has them."""
     if area is None:
         return np.zeros_like(t), (np.zeros_like(t) if second else None)
     if isinstance(area, ConstantArea):
         return area.area + np.zeros_like(t), (area.area * t if second else None)  # a batch's areas: a column
     tc = area.contact_time
     phi = math.pi / tc
+    if trig is not None:
+        cos_x, sin_x = trig
+        A = np.where(t <= tc, area.peak * sin_x, 0.0)
+        return A, (area.peak / phi * (1.0 - cos_x) if second else None)
     tau = np.minimum(t, tc)
     A = np.where(t <= tc, area.peak * np.sin(phi * tau), 0.0)
     return A, (area.peak / phi * (1.0 - np.cos(phi * tau)) if second else None)
@@ -417,15 +435,20 @@ def _normal_area_rate(plan, form, t0, y0, direction, t, find_stop=True):
     area = s.area if (np.asarray(form.c) != 0.0).any() else None
     t0_ = np.atleast_1d(np.asarray(t0, dtype=float))  # (1,) for a float: broadcasts against t as before
 
+    # a half-sine N and a half-sine A of one contact time share the phase's cosine and sine
+    shared = (isinstance(s.normal, HalfSineNormal) and isinstance(area, HalfSineArea)
+              and np.array_equal(s.normal.contact_time, area.contact_time))
+
     def JK(tt):
         # terms that vanish (no area term; start at first contact) are skipped: a batch of many
         # scenes evaluates this on large grids
-        J, K = _normal_integrals(s.normal, tt, form.a)
+        trig = _half_sine_trig(area.contact_time, tt) if shared else None
+        J, K = _normal_integrals(s.normal, tt, form.a, trig=trig)
         if (t0_ != 0.0).any():
             IN0, IIN0 = _normal_integrals(s.normal, t0_, form.a)
             J, K = J - IN0, K - (IIN0 + IN0 * (tt - t0))
         if area is not None:
-            A, IA = _area_integrals(area, tt)
+            A, IA = _area_integrals(area, tt, trig=trig)
             A0, IA0 = _area_integrals(area, t0_)
             J, K = J + form.c * (A - A0), K + form.c * (IA - IA0 - A0 * (tt - t0))
         return (J, K) if (sgn == 1.0).all() else (sgn * J, sgn * K)
