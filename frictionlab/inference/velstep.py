@@ -132,6 +132,7 @@ class Series:
         self.phi_groups = np.zeros(self.refs.size)
         self.noise_ests: list = []
         self.search = _search_index(self.t, self.load.times)
+        self.t_search = np.ascontiguousarray(self.t[self.search])
         self.no_phi = np.zeros(self.search.size)  # the search's subsample is fitted as white noise
         self._set_weights()
         self._set_projection()
@@ -144,6 +145,7 @@ class Series:
         """What the compiled sums read of sigma and phi: 1 / sigma and the prewhitening gain 1 / sqrt(1 - phi^2)."""
         self.inv_sigma = 1.0 / self.sigma
         self.gain = 1.0 / np.sqrt(1.0 - self.phi ** 2)
+        self.inv_sigma_search = self.inv_sigma[self.search]
 
     def _set_projection(self):
         """The orthonormal columns of the (prewhitened) linear parameters, and the data less a first guess of their
@@ -154,6 +156,7 @@ class Series:
         self.Q_search = _basis(self.B[s] / self.sigma[s, None])
         self.y_ref = (self.y - self.B @ np.linalg.lstsq(self.B, self.y - (self.mu0 or 0.0), rcond=None)[0]
                       if self.B.shape[1] else self.y)
+        self.y_ref_search = self.y_ref[s]
 
     def set_noise(self, residual) -> float:
         """Profile phi from ``residual`` (model - data) and re-estimate sigma from the prewhitened data (estimated
@@ -261,12 +264,12 @@ class Problem:
         cost, g, A = 0.0, np.zeros(p), np.zeros((p, p))
         try:
             for s in self.series:
-                idx = s.search if search else slice(None)
-                sol = quasistatic.solve(self.code, v["a"], v["b"], v["Dc"], v["k"][s.index], s.load, s.t[idx],
-                                        rtol or (SEARCH_RTOL if search else self.rtol), sensitivities=True)
+                sol = quasistatic.solve(self.code, v["a"], v["b"], v["Dc"], v["k"][s.index], s.load,
+                                        s.t_search if search else s.t, rtol or (SEARCH_RTOL if search else self.rtol),
+                                        sensitivities=True)
                 M = self.combination(s, v, free)
                 if search:  # white noise on the subsample
-                    sums = basis_sums(s.y_ref[idx], s.offset(v["a"], v["b"]), sol.m, sol.S, s.inv_sigma[idx],
+                    sums = basis_sums(s.y_ref_search, s.offset(v["a"], v["b"]), sol.m, sol.S, s.inv_sigma_search,
                                       s.no_phi, s.no_phi, s.Q_search)
                 else:
                     sums = basis_sums(s.y_ref, s.offset(v["a"], v["b"]), sol.m, sol.S, s.inv_sigma, s.phi, s.gain,
@@ -346,7 +349,7 @@ class Problem:
             f = np.nonzero(~out)[0]
             if not f.size:
                 break
-            Af = A[np.ix_(f, f)]
+            Af = A if f.size == z.size else A[np.ix_(f, f)]
             d = np.diag(Af).copy()
             d[d <= 0] = 1e-12 * max(float(d.max()), 1e-300)
             try:

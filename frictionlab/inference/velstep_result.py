@@ -484,7 +484,7 @@ def _sign_check(problem, x, s, pc, ab, steps) -> list[str]:
 def _refit(problem, x, s, trend: bool):
     """(a - b, chi-square) of a refit of the problem with dataset s's trend switched on or off (None if it fails):
     the other datasets and the noise model as they are."""
-    B0, trend0, Q0, Qs0, y0 = s.B, s.trend, s.Q, s.Q_search, s.y_ref
+    B0, trend0, Q0, Qs0, y0, ys0 = s.B, s.trend, s.Q, s.Q_search, s.y_ref, s.y_ref_search
     try:
         s.trend = trend
         s.B = s.B[:, :-1] if not trend else np.column_stack([s.B, s.x - s.x_ref])
@@ -497,7 +497,7 @@ def _refit(problem, x, s, trend: bool):
         v = problem.values(xr)
         return v["a"] - v["b"], 2 * cost
     finally:
-        s.B, s.trend, s.Q, s.Q_search, s.y_ref = B0, trend0, Q0, Qs0, y0
+        s.B, s.trend, s.Q, s.Q_search, s.y_ref, s.y_ref_search = B0, trend0, Q0, Qs0, y0, ys0
         problem._cache = None
 
 

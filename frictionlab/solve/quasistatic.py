@@ -57,6 +57,10 @@ class Load:
 
     times: np.ndarray
     velocities: np.ndarray
+    vmax: float = attrs.field(init=False)  # the fastest load-point velocity [um/s]
+
+    def __attrs_post_init__(self):
+        object.__setattr__(self, "vmax", float(np.max(self.velocities)))
 
     @classmethod
     def of(cls, spring) -> "Load":
@@ -97,7 +101,7 @@ def solve(law_code: int, a: float, b: float, Dc_um: float, k_um: float, load: Lo
     m, psi = np.empty(n), np.empty(n)
     S = np.empty((n, 4)) if sensitivities else np.empty((0, 4))
     stats = np.zeros(5)
-    vmax = RUNAWAY * float(np.max(load.velocities))
+    vmax = RUNAWAY * load.vmax
     status = kernel.integrate(law_code, float(a), float(b), float(Dc_um), float(k_um), load.V1, load.times,
                               load.velocities, t, float(rtol), float(rtol) * float(a), bool(sensitivities), vmax,
                               m, psi, S, stats)
