@@ -230,8 +230,8 @@ def build(ctx) -> Section:
 
         d = views[0].dataset
         fit_figure(sec, d, c.fits_on(d.name), [r for r in c.ranking if r.dataset == d.name],
-                   f"{d.name}: the data ({d.provenance.kind}) with each law's best fit (ΔAIC from the lowest) and the "
-                   "residuals under them.")
+                   f"{d.name}: the data ({d.provenance.kind}) with each law's best fit (ΔAIC from the lowest), as "
+                   "'Fits' shows them.")
         sec.p(_side(views))
     elif views:
         shown = views[:MAX_PANELS]
