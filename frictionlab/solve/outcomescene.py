@@ -93,7 +93,7 @@ class HertzPulse:
 
     def shape(self, t):
         """(y, dy/ds) at times t [s]; zero outside the contact."""
-        s_end, dense = _hertz_solution()
+        s_end = _hertz_solution()[0]
         if isinstance(t, (float, np.floating)) or np.ndim(t) == 0:  # one time (an ODE's right-hand side)
             s = float(t) / self.time_scale
             if not 0.0 <= s <= s_end:
