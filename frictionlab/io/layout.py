@@ -221,7 +221,8 @@ def read_table(path, text: str, layout: Layout) -> Table:
         hi, sep, index = _header(path, rows, named)
         start = hi + 1
         if hi:
-            notes.append(f"{hi} line{'s' * (hi != 1)} before the header skipped")
+            notes.append(f"{hi} line{'s' * (hi != 1)} before the header skipped (line" +
+                         ("s 1 to " if hi > 1 else " ") + f"{hi})")
     else:
         start = next((i for i, r in enumerate(rows) if r.strip()), 0)
         sep, index = separator(rows[start]), {}

@@ -28,6 +28,7 @@ from ..core.files import MAX_CSV_BYTES, read_bytes
 from ..core.names import check_name
 from .layout import cells, separator
 from .segment import MIN_PIECE, Segmentation, segment
+from .segment_noise import last_digit
 
 #: Header names accepted for the four raw columns (case-insensitive; '_' or nothing between words).
 RAW_HEADER = (r"time\(s\)", r"displ(acement)?\(microns\)", r"friction", r"(effective_?)?normal_?stress\(mpa\)")
@@ -241,6 +242,10 @@ def analyse(raw: RawRecord, name: str, *, joint: bool | None = False, stiffness:
     several). ``stiffness`` [1/m]: the start of every dataset instead of the estimate; ``steps``: the number of
     steps expected (an error if another number is found)."""
     where = str(raw.path)
+    if float(np.ptp(raw.mu)) == 0.0:
+        raise DatasetError(f"{where}: friction is {raw.mu[0]:g} at every sample (lines {raw.line(0)} to "
+                           f"{raw.line(len(raw.mu) - 1)}): a constant channel has nothing to fit (is it the friction "
+                           "column?)")
     seg = segment(raw.t, raw.x_um, where, raw.line, "um")  # in the record's units: um, um/s
     m = len(seg.steps)
     joint = m > 1 if joint is None else joint
@@ -248,6 +253,10 @@ def analyse(raw: RawRecord, name: str, *, joint: bool | None = False, stiffness:
         found = ", ".join(f"line {raw.line(s.index)} (t = {s.time:.6f} s)" for s in seg.steps)
         raise DatasetError(f"{where}: expected {steps} velocity step{'s' * (steps != 1)} (--steps), found {m}: {found}")
     velocities, notes = _velocities(raw, seg)
+    if seg.exact_to:
+        notes.append(f"the displacement shows no noise beyond its last digit ({seg.exact_to:.3g} um): the standard "
+                     "errors are bounds of the rounding to it, which errs alike at every sample of a line sampled "
+                     "exactly, not a scatter")
     notes += [f"displacement jump of {j.size:.4g} ± {j.size_se:.2g} um at line {raw.line(j.index)} "
               f"(t = {raw.t[j.index]:.10g} s) without a change of velocity: stitched (later samples shifted back)"
               for j in seg.jumps]
@@ -332,6 +341,8 @@ def stiffness_start(t, mu, step, v1: float, v2: float, a: int, b: int) -> tuple[
         n = min(max(n + 1, int(n * 1.41)), b - i0)
     if best is None or best[2] > 0.1:
         return None
+    if abs(best[0]) * best[1] <= max(last_digit(mu[i0:b]), 1e-12 * float(np.max(np.abs(mu[i0:b])))):
+        return None  # a change below the channel's last digit: no loading seen
     k = best[0] / (v2 - v1)
     return (k, best[1]) if k > 0 and math.isfinite(k) else None
 
