@@ -201,9 +201,10 @@ class Plan(CompliantPatch):
             N = s.normal(t, A) if normal is None else normal
         state = ({n: y[self.index(k)] for n, k in zip(self.law.state_names, self.law_states)} or None
                  if self.law.states else None)
+        dmudt = s.spring.stiffness * (s.spring.velocity(t) - y[0]) if "dmudt" in req else None
         return Contact(t=np.asarray(t, dtype=float), u=np.asarray(u, dtype=float),
                        N=N if "N" in req else None, A=A if "A" in req else None, dAdt=dAdt if "dAdt" in req else None,
-                       state=state)
+                       state=state, dmudt=dmudt)
 
     def force(self, p, t, y, u) -> tuple[np.ndarray, Contact]:
         c = self.contact(t, y, u)
