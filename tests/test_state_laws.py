@@ -117,3 +117,68 @@ def test_a_two_state_law_with_b2_0_is_the_one_state_law(evolution):
         b = fl.simulate(f"rate-state-{evolution}2", scene, two, solver="ode:LSODA", t=T)
         assert np.max(np.abs(a.load - b.load)) < 1e-9
         assert np.max(np.abs(a.law_states["theta"] / b.law_states["theta1"] - 1)) < 1e-6
+
+
+def test_a_plugin_state_law_reads_dmudt_as_the_built_in_nagata_law_does():
+    from frictionlab.laws.rate_state_aging import RateStateAging
+    from frictionlab.physics.law import ParamSpec
+
+    class Plugin(RateStateAging):
+        name = "test-stress-aged"
+        params = RateStateAging.params + (ParamSpec("c", "", 2.0, 0.0, 20.0, 1.0, "stress weakening"),)
+        requires = RateStateAging.requires | {"dmudt"}
+
+        def rates(self, p, c):
+            theta = c.state["theta"]
+            return {"theta": 1.0 - abs(c.u) * theta / p["Dc"] - p["c"] / p["b"] * theta * c.dmudt}
+
+    fl.register_law(Plugin)
+    try:
+        p = _si(CASES["rate-state-nagata"])
+        scene = _scene(*STEPS["down"])
+        plugin = fl.simulate("test-stress-aged", scene, p, t=T)
+        built_in = fl.simulate("rate-state-nagata", scene, p, solver="ode:LSODA", t=T)
+        assert np.max(np.abs(plugin.load - built_in.load)) < 1e-9
+    finally:
+        fl.unregister_law("test-stress-aged")
+
+
+def test_where_no_scene_supplies_dmudt_the_law_is_refused_in_one_line():
+    from frictionlab.solve.solvers.prescribed import respond
+
+    with pytest.raises(fl.FrictionLabError, match=r"needs dmudt .* a spring-slider supplies it"):
+        fl.simulate("rate-state-nagata", fl.load_dataset("incline-oil-a100"))
+    with pytest.raises(fl.FrictionLabError, match="prescribed slip history does not supply"):
+        respond("rate-state-nagata", {}, np.linspace(0, 1, 5), lambda t: np.full_like(t, 1e-6))
+    prz = fl.simulate("rate-state-prz", fl.load_dataset("incline-oil-a100"))  # laws without dmudt go anywhere
+    assert np.all(np.isfinite(prz.v))
+
+
+def test_the_velocity_step_fit_serves_prz_and_recovers_its_truth(tmp_path):
+    """PRZ data (the quasi-static kernel at rtol 1e-10, white noise of known sigma): the velocity-step fit serves
+    the law, finds a, b, Dc within 3 standard errors of the truth, and the aging law fits the same data worse."""
+    import sys
+    from pathlib import Path
+
+    import attrs
+
+    from frictionlab.inference.predict import Target
+    from frictionlab.solve import quasistatic
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+    from calibration_ar1 import make_dataset
+
+    ds, _ = make_dataset(tmp_path, "none", True)
+    truth = dict(a=0.009, b=0.012, Dc=8.0)
+    load = quasistatic.Load.of(ds.scene.spring)
+    k_um = ds.scene.spring.stiffness * UM
+    y = 0.6 + quasistatic.solve(quasistatic.LAWS["rate-state-prz"], truth["a"], truth["b"], truth["Dc"], k_um, load,
+                                ds.t, 1e-10).m
+    y = y + np.random.default_rng(11).normal(0.0, 2e-4, y.size)
+    data = attrs.evolve(ds, columns=dict(ds.columns, mu=y), noise={"mu": 2e-4})
+    target = Target(data, "mu", y, np.full(y.size, 2e-4))
+    prz, aging = fl.fit("rate-state-prz", target), fl.fit("rate-state-aging", target)
+    assert prz.ok and prz.velstep is not None and prz.solver == "ode"
+    for name, value in truth.items():
+        assert abs(prz.value(name) - value * (UM if name == "Dc" else 1.0)) < 3 * prz.stderr(name), name
+    assert aging.stats.chisqr > prz.stats.chisqr + 10

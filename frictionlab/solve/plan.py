@@ -362,7 +362,8 @@ def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan
     if missing:
         hint = {"N": "add a [scene.normal] model (half-sine, hertz, column or weight)",
                 "A": "add a [scene.area] model (half-sine, constant, growth or column)",
-                "dAdt": "add a [scene.area] model (half-sine, constant, growth or column)"}
+                "dAdt": "add a [scene.area] model (half-sine, constant, growth or column)",
+                "dmudt": "a spring-slider supplies it (its load rate k (V_lp - V)); other scenes do not"}
         what = ", ".join(f"{q} ({QUANTITIES[q].split(' [')[0]})" for q in sorted(missing))
         raise SceneError(f"law '{law.name}' needs {what}, which {scene_name} cannot supply: "
                          + "; ".join(sorted({hint[q] for q in missing if q in hint})))
