@@ -46,9 +46,9 @@ E0, E1, E2, E3, E4 = 25.0 / 24.0 - 59.0 / 48.0, -49.0 / 48.0 + 17.0 / 96.0, 125.
 
 
 @jit
-def rates(law, a, b, Dc, k, c, V1, vlp, m, psi, f, J, Fp, want_fp):
-    """Fill f = (dm/dt, dpsi/dt), J = d f / d(m, psi) and (want_fp) Fp = d f / d(a, b, Dc, k) at (m, psi) (c:
-    Nagata's constant); return the slip rate V [um/s] (inf where ln(V/V1) exceeds MAX_EXPONENT or psi is beyond
+def rates(law, a, b, Dc, k, cn, V1, vlp, m, psi, f, J, Fp, want_fp):
+    """Fill f = (dm/dt, dpsi/dt), J = d f / d(m, psi) and (want_fp) Fp = d f / d(a, b, Dc, k) at (m, psi) (cn:
+    Nagata's c); return the slip rate V [um/s] (inf where ln(V/V1) exceeds MAX_EXPONENT or psi is beyond
     range)."""
     lnE = (m - b * psi) / a
     if not (lnE < MAX_EXPONENT) or not (-psi < MAX_EXPONENT) or (law == PRZ and not (psi + 2.0 * lnE < MAX_EXPONENT)):
@@ -84,7 +84,7 @@ def rates(law, a, b, Dc, k, c, V1, vlp, m, psi, f, J, Fp, want_fp):
     Fp[1, 2] = -f[1] / Dc  # every evolution rate above is proportional to 1 / Dc
     Fp[1, 3] = 0.0
     if law == NAGATA:  # - (c/b) dm/dt
-        q = c / b
+        q = cn / b
         f[1] -= q * f[0]
         J[1, 0] -= q * J[0, 0]
         J[1, 1] -= q * J[0, 1]
@@ -125,9 +125,9 @@ def _combine(i, h, y, K, base):
 
 
 @jit
-def integrate(law, a, b, Dc, k, c, V1, seg_t, seg_v, t_out, rtol, atol_m, sens, vmax, out_m, out_psi, out_S, stats):
-    """Integrate from the steady state at V1 (t = 0) (c: Nagata's constant, else unused) through the load-point segments (start times seg_t [s],
-    velocities seg_v [um/s]) and write m, psi and (sens) dm/d(a, b, Dc, k) at the sorted times t_out [s].
+def integrate(law, a, b, Dc, k, cn, V1, seg_t, seg_v, t_out, rtol, atol_m, sens, vmax, out_m, out_psi, out_S, stats):
+    """Integrate from the steady state at V1 (t = 0) through the load-point segments (start times seg_t [s],
+    velocities seg_v [um/s]; cn: Nagata's c, else unused) and write m, psi and (sens) dm/d(a, b, Dc, k) at the sorted times t_out [s].
 
     rtol: relative tolerance; atol_m: absolute tolerance of m (psi's is rtol). vmax: slip rate [um/s] beyond
     which the slider has run away. stats[0:5] receive (accepted steps, rejected steps, Newton iterations, time
@@ -171,7 +171,7 @@ def integrate(law, a, b, Dc, k, c, V1, seg_t, seg_v, t_out, rtol, atol_m, sens, 
         if not t1 > t0:
             continue
         vlp = seg_v[j]
-        V = rates(law, a, b, Dc, k, c, V1, vlp, y[0], y[1], f0, J, Fp, sens)
+        V = rates(law, a, b, Dc, k, cn, V1, vlp, y[0], y[1], f0, J, Fp, sens)
         if sens:
             for c in range(4):
                 KS0[0, c] = J[0, 0] * S[0, c] + J[0, 1] * S[1, c] + Fp[0, c]
@@ -203,7 +203,7 @@ def integrate(law, a, b, Dc, k, c, V1, seg_t, seg_v, t_out, rtol, atol_m, sens, 
                 converged = False
                 for _ in range(12):
                     newton += 1
-                    V = rates(law, a, b, Dc, k, c, V1, vlp, Y[0], Y[1], f, J, Fp, False)
+                    V = rates(law, a, b, Dc, k, cn, V1, vlp, Y[0], Y[1], f, J, Fp, False)
                     if not math.isfinite(V):
                         break
                     r0 = -(Y[0] - base[0] - h * G * f[0])
@@ -221,7 +221,7 @@ def integrate(law, a, b, Dc, k, c, V1, seg_t, seg_v, t_out, rtol, atol_m, sens, 
                 if not converged:
                     ok = False
                     break
-                V = rates(law, a, b, Dc, k, c, V1, vlp, Y[0], Y[1], f, J, Fp, sens)
+                V = rates(law, a, b, Dc, k, cn, V1, vlp, Y[0], Y[1], f, J, Fp, sens)
                 if not math.isfinite(V):
                     ok = False
                     break
