@@ -1,11 +1,11 @@
 """The quasi-static rate-and-state spring-slider in the field's own variables: the fast path of ``simulate``
-and of the velocity-step fit (``inference.velstep``).
+and of the velocity-step fit (``inference.velstep.fit``).
 
-For the built-in one-state rate-and-state laws (aging, slip, PRZ, Nagata) on a spring-slider without mass, the general plan
-(``solve.plan``) differentiates the force numerically at every right-hand-side call. Here the slider is
+For the built-in one-state rate-and-state laws (aging, slip, PRZ, Nagata) on a spring-slider without mass, the
+general plan (``solve.plan``) differentiates the force numerically at every right-hand-side call. Here the slider is
 written as the rate-and-state literature writes it (Marone 1998; rsfmodel): m = mu - mu_ss(V1) and
-psi = ln(V1 theta / Dc) (PRZ: ln(V1 theta / (2 Dc))), in um and s, with V0 = V1 (the first load-point velocity) and steady state there at
-t = 0, integrated by a compiled implicit method with its analytic Jacobian through every step and hold of the
+psi = ln(V1 theta / Dc) (PRZ: ln(V1 theta / (2 Dc))), in um and s, with V0 = V1 (the first load-point velocity)
+and steady state there at t = 0, integrated by a compiled implicit method with its analytic Jacobian through every step and hold of the
 load point (``quasistatic_kernel``), optionally with the forward sensitivities of m to (a, b, Dc, k).
 
 The friction is the log form mu = mu0 + a ln(V/V0) + b ln(V0 theta/Dc) (V0 = 1 um/s, the law's mu0), equal to
@@ -27,9 +27,9 @@ from ..physics.spring import runaway_message
 LAWS = {"rate-state-aging": 0, "rate-state-slip": 1, "rate-state-prz": 2, "rate-state-nagata": 3}
 LAW_NAMES = {code: name for name, code in LAWS.items()}
 #: The laws whose parameters are exactly (mu0, a, b, Dc): the kernel's sensitivities cover them all (the
-#: velocity-step fit, ``inference.velstep``); Nagata's c has none.
+#: velocity-step fit, ``inference.velstep.fit``); Nagata's c has none.
 FITTED = frozenset({"rate-state-aging", "rate-state-slip", "rate-state-prz"})
-#: Reference slip rate V0 of the laws' mu0 [um/s] (laws/rate_state.py: 1e-6 m/s).
+#: Reference slip rate V0 of the laws' mu0 [um/s] (frictionlab/laws/rate_state.py: 1e-6 m/s).
 V0_UM = 1.0
 #: A quasi-static slider has run away once its slip rate exceeds this multiple of the fastest load point
 #: (``solve.plan.QUASI_STATIC_LIMIT``; the same limit on both paths).
