@@ -44,6 +44,7 @@ QUANTITIES = {
     "A": "contact area [m^2]",
     "dAdt": "rate of change of contact area [m^2/s]",
     "t": "time since first contact [s]",
+    "dmudt": "rate of the friction coefficient d mu/dt [1/s] (a spring-slider's load rate k (V_lp - V))",
 }
 
 
@@ -101,7 +102,8 @@ class StateSpec:
 class Contact:
     """Contact quantities at sample times, SI arrays; a quantity the plan did not build is None.
 
-    ``state`` holds a law's internal states by their unprefixed names (None for a memoryless law).
+    ``state`` holds a law's internal states by their unprefixed names (None for a memoryless law); ``dmudt`` the
+    friction coefficient's rate [1/s] (only for a law that requires "dmudt").
     """
 
     t: np.ndarray
@@ -110,6 +112,7 @@ class Contact:
     A: np.ndarray | None = None
     dAdt: np.ndarray | None = None
     state: Mapping[str, np.ndarray] | None = None
+    dmudt: np.ndarray | None = None
 
 
 @attrs.frozen

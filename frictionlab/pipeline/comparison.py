@@ -169,7 +169,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
 
     laws: registered names, None for the default laws of each dataset kind (DEFAULT_LAWS on impacts and
-    inclines, DEFAULT_LAWS_BY_KIND: rate-and-state aging and slip on spring-sliders), or "all" for every
+    inclines, DEFAULT_LAWS_BY_KIND: rate-and-state aging, slip and PRZ on spring-sliders), or "all" for every
     registered law; datasets: built-in names, names of measured records, TOML paths or Datasets (default every
     built-in dataset and every measured record present, ``available_names``); solvers: None for the default
     choice, or a list of 'exact', 'series', 'ode[:METHOD]', 'auto'; free: scene quantities fitted per

@@ -1,6 +1,6 @@
 """The velocity-step fit: a rate-and-state law fitted to spring-slider records as the field fits them.
 
-``fitting.fit`` hands a fit here when the law is the built-in rate-state-aging or rate-state-slip, every
+``fitting.fit`` hands a fit here when the law is a built-in one of ``quasistatic.FITTED`` (aging, slip, PRZ), every
 dataset is a spring-slider whose slider is quasi-static (``solve.quasistatic.applies``), the solver is 'auto'
 or 'ode' and no law parameter is fitted per dataset ('local'). The result is the usual ``FitResult``.
 
@@ -70,6 +70,8 @@ def applies(law, targets, solver: str, local, free) -> bool:
     if solver not in ("auto", "ode") or local:
         return False
     if set(free or {}) - {"spring.stiffness"}:
+        return False
+    if law.name not in quasistatic.FITTED:
         return False
     return all(tg.dataset.kind == "spring-slider" and tg.observable == "mu" and not tg.derivation
                and tg.t is not None and not quasistatic.applies(law, tg.dataset.scene) for tg in targets)
