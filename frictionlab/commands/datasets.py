@@ -60,6 +60,8 @@ def add_parser(sub):
     rb.add_argument("--known-truth", action="store_true",
                     help="rebuild the known-truth datasets (default folder: ./examples/known-truth) instead of the "
                          "built-in ones")
+    rb.add_argument("--slide-hold-slide", action="store_true",
+                    help="rebuild the synthetic slide-hold-slide record (default folder: ./examples/slide-hold-slide)")
     rb.set_defaults(func=_rebuild)
 
 
@@ -279,11 +281,12 @@ def _template(args) -> int:
 
 
 def _rebuild(args) -> int:
-    from ..io.datagen import GENERATORS, KNOWN_TRUTH, KNOWN_TRUTH_DIR, rebuild
+    from ..io.datagen import GENERATORS, KNOWN_TRUTH, KNOWN_TRUTH_DIR, SLIDE_HOLD_SLIDE, SLIDE_HOLD_SLIDE_DIR, rebuild
     from ..io.dataset import builtin_dir
 
-    generators = KNOWN_TRUTH if args.known_truth else GENERATORS
-    home = (args.out or KNOWN_TRUTH_DIR) if args.known_truth else builtin_dir()
+    generators = KNOWN_TRUTH if args.known_truth else SLIDE_HOLD_SLIDE if args.slide_hold_slide else GENERATORS
+    home = ((args.out or KNOWN_TRUTH_DIR) if args.known_truth else
+            (args.out or SLIDE_HOLD_SLIDE_DIR) if args.slide_hold_slide else builtin_dir())
     if args.check:
         with tempfile.TemporaryDirectory() as tmp:
             written = rebuild(Path(tmp), generators)
