@@ -10,7 +10,7 @@ import pytest
 import frictionlab as fl
 from frictionlab.cli import main
 from frictionlab.core.errors import DatasetError
-from frictionlab.inference.healing import healing_table, holds_of, of_dataset
+from frictionlab.inference.velstep.healing import healing_table, holds_of, of_dataset
 from frictionlab.io.datagen.holds import HOLDS, TRUTH
 from frictionlab.io.dataset import load_dataset
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import frictionlab as fl
-from frictionlab.inference.record_steps import answer, ar1_neg2ll, fit_steps, state_laws
+from frictionlab.inference.velstep.record_steps import answer, ar1_neg2ll, fit_steps, state_laws
 from frictionlab.io.dataset import Dataset
 from frictionlab.io.provenance import Provenance
 from frictionlab.physics.scene import ConstantNormal, Scene, SpringLoad

@@ -26,9 +26,9 @@ def add_parser(sub):
 
 def run(args) -> int:
     from ..core.errors import ParameterError
-    from ..inference.fitting import fit
-    from ..inference.healing import lines, of_dataset
-    from ..inference.record_steps import state_laws
+    from ..inference.fitting.fit import fit
+    from ..inference.velstep.healing import lines, of_dataset
+    from ..inference.velstep.record_steps import state_laws
     from ..io.dataset import load_dataset
 
     laws = args.laws or state_laws()

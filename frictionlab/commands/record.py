@@ -34,7 +34,7 @@ def run(args) -> int:
 
     from ..core.errors import ParameterError
     from ..core.names import check_name
-    from ..inference.record_steps import answer, fit_steps, state_laws
+    from ..inference.velstep.record_steps import answer, fit_steps, state_laws
     from ..io.velstep import summary
     from ..io.velstep_join import read_joined
     from ..report.record_screen import screen

@@ -22,7 +22,7 @@ import math
 import attrs
 import numpy as np
 
-from ..core.errors import DatasetError
+from ...core.errors import DatasetError
 
 #: Samples of the running mean the peak is read from.
 SMOOTH = 5

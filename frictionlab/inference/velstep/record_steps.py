@@ -27,7 +27,7 @@ from collections.abc import Sequence
 import attrs
 import numpy as np
 
-from .transfer import ALPHA, SharedFit, shared_fit
+from ..equivalence.transfer import ALPHA, SharedFit, shared_fit
 
 
 def ar1_neg2ll(f) -> float:
@@ -46,8 +46,8 @@ def ar1_neg2ll(f) -> float:
 
 def state_laws() -> list[str]:
     """The registered laws the velocity-step fit serves (every state law of the quasi-static slider)."""
-    from ..physics.registry import available_laws
-    from ..solve.quasistatic import LAWS
+    from ...physics.registry import available_laws
+    from ...solve.quasistatic import LAWS
 
     registered = set(available_laws())
     return [name for name in LAWS if name in registered]
@@ -98,7 +98,7 @@ class LawSteps:
 def fit_steps(law: str, datasets: Sequence, *, joint=None, timeout: float | None = None, fit_kw=None) -> LawSteps:
     """``law`` fitted to each step window of ``datasets`` (Dataset objects, in step order), the shared-set test
     across them, and (``joint``: the whole-record Dataset) the whole record as one history."""
-    from .fitting import fit
+    from ..fitting.fit import fit
 
     kw = dict(fit_kw or {})
     steps = tuple(fit(law, d, timeout=timeout, **kw) for d in datasets)
