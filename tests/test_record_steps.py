@@ -71,3 +71,11 @@ def test_the_ar1_likelihood_profiles_phi_and_the_variance():
     white = n * (np.log(2 * np.pi * np.mean(r[1:] ** 2)) + 1)
     assert ar1_neg2ll(F(r)) < white - 5000  # the correlation is seen
     assert ar1_neg2ll(F(r, r)) == pytest.approx(2 * ar1_neg2ll(F(r)))
+
+
+def test_the_command_refuses_a_law_the_step_fit_does_not_serve(tmp_path, capsys):
+    from frictionlab.cli import main
+
+    assert main(["record", str(tmp_path / "absent.txt"), "--laws", "coulomb"]) == 2
+    err = capsys.readouterr().err
+    assert "--laws: coulomb is not a state law the velocity-step fit serves" in err and "Traceback" not in err

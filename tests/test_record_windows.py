@@ -13,6 +13,7 @@ from frictionlab.io.steadystate import steady_point
 from frictionlab.io.velstep import analyse
 from frictionlab.io.velstep_join import read_joined
 from frictionlab.physics.scene import ConstantNormal, Scene, SpringLoad
+from frictionlab.report.velstep import window
 
 TRUTH = {"mu0": 0.55, "a": 0.010, "b": 0.014, "Dc": 50e-6}
 K, SIGMA, CUT = 0.01e6, 2e-4, 110.0  # the record starts CUT s into the history: 10 s after a step up
@@ -102,3 +103,4 @@ def test_the_command_joins_files_and_says_where_each_window_starts(tmp_path, his
     assert "a.txt+b.txt: 7400 samples" in text and text.count("at steady state") == 3
     d = load_dataset(out / "e-step2.toml")
     assert "the window starts at" in d.provenance.method and "b.txt" in d.provenance.method
+    assert window(d).startswith("starts at a.txt line ") and "at steady state" in window(d)  # the report's sentence
