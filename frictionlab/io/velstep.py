@@ -7,8 +7,11 @@ whitespace- (or comma-) separated rows of time [s], load-point displacement [um]
 * segments the displacement into straight pieces (``segment``): every step's time is the kink of a
   continuous two-line fit, its velocities the fitted ones (not the machine's nominal set points), each with
   its standard error; transducer resets (jumps without a change of slope) are stitched;
-* keeps every sample: one dataset per step, its window from the step before (or the record's start) to the
-  step after (or the record's end), or one dataset holding every step (``joint``);
+* lays out the datasets: one per step, its window starting at a steady state the data show (``steadystate``:
+  the first new steady-state point after the step before, or the record's) and ending in the steady part
+  after its step, so that no window starts inside another step's transient (steps between which the record
+  shows no steady state, as around a hold, share one window); or one dataset holding every step from the
+  record's first steady state (``joint``), fitted as one history;
 * estimates a start for the machine stiffness from friction's initial slope after each step, over a run of
   samples chosen from the data (the shortest that gives the slope to 10 %), whatever the transient's length;
 * states the friction noise as estimated from the data with AR(1) correlation (no sigma is written).
@@ -185,6 +188,7 @@ class Window:
     stiffness: float
     stiffness_note: str
     steps: tuple  # indices of the Steps it holds
+    start_note: str = ""  # where the window starts and why (a steady state the data show)
 
     @property
     def stiffness_from(self) -> str:
@@ -253,23 +257,26 @@ def analyse(raw: RawRecord, name: str, *, joint: bool | None = False, stiffness:
         return DEFAULT_STIFFNESS, "start: a typical laboratory value (friction shows no loading after the step)"
 
     windows = []
+    from .steadystate import left_out, start_note, steady_points, step_windows
+
+    points = steady_points(seg.x, raw.mu, b, velocities)
     if joint:
         k, note = start(0)
         if stiffness is None and any(ks):
             k = float(np.median([k[0] for k in ks if k]))
             note = "start: the median over the steps of friction's initial slope after each step over the " \
                    "load-point velocity change"
-        windows.append(Window(name, 0, len(raw.t), (0.0,) + tuple(float(s.time - raw.t[0]) for s in seg.steps),
-                              tuple(velocities), k, note, tuple(range(m))))
+        a = next((p.index for p in points[:1] if p.found), 0)
+        windows.append(Window(name, a, len(raw.t), (0.0,) + tuple(float(s.time - raw.t[a]) for s in seg.steps),
+                              tuple(velocities), k, note, tuple(range(m)), start_note(raw, points, a, None)))
     else:
-        for i, s in enumerate(seg.steps):
-            a, e = b[i], b[i + 2]
-            kv, note = start(i)
-            windows.append(Window(name if m == 1 else f"{name}-step{i + 1}", a, e, (0.0, float(s.time - raw.t[a])),
-                                  (velocities[i], velocities[i + 1]), kv, note, (i,)))
-            if velocities[i] == 0:
-                notes.append(f"{windows[-1].name} starts in a hold (V = 0): a fit that starts from steady state "
-                             "cannot start there; fit the record's joint dataset (--joint) instead")
+        for a, e, held in step_windows(points, b):
+            kv, note = start(held[0])
+            windows.append(Window(name if m == 1 else f"{name}-step{held[0] + 1}", a, e,
+                                  (0.0,) + tuple(float(seg.steps[i].time - raw.t[a]) for i in held),
+                                  tuple(velocities[held[0]:held[-1] + 2]), kv, note, held,
+                                  start_note(raw, points, a, held)))
+        notes += [f"step {i + 1} has no window of its own: {why}" for i, why in left_out(points, m)]
     for w in windows:
         check_name(w.name, "datasets import: --name", DatasetError)
     return Imported(raw=raw, seg=seg, windows=tuple(windows), velocities=tuple(velocities), notes=tuple(notes))
@@ -358,7 +365,8 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
               "continuous two-line fit, velocities from one continuous fit through every kink (fitted values, not "
               "set points)" + (f"; {len(jumps)} displacement jump{'s' * (len(jumps) != 1)} without a change of "
                                "velocity stitched" if jumps else "") +
-              "; friction as measured (no trend removed); its noise estimated from the data, AR(1)")
+              "; friction as measured (no trend removed); its noise estimated from the data, AR(1)" +
+              (f"; the window {w.start_note}" if w.start_note else ""))
     at = f" at {raw.normal_text(stress)}" if stress is not None else ""
     description = (f"Velocity step{'s' * (len(steps) > 1)} {v_text} um/s{at} "
                    f"(record {raw.path.name}, lines {first} to {last}). MEASURED.")

@@ -24,6 +24,13 @@ def measured_steps(c, datasets=None) -> list:
     return out
 
 
+def window(d) -> str:
+    """Where an imported dataset's window starts and why ('starts at ..., at steady state: ...'), from its
+    provenance; '' for a dataset that does not say."""
+    method = d.provenance.method or ""
+    return method.split("; the window ", 1)[1] if "; the window " in method else ""
+
+
 def cell(q) -> str:
     """'0.00892 ± 0.00026' of a velstep_result.Quantity (its 95% interval is in the figure)."""
     if q is None:
@@ -50,6 +57,7 @@ def first_screen(sec, c, datasets=None) -> list[str]:
     for d, fits in steps:
         best = fits[0]
         said = [s for f in fits[:1] for s in (f.velstep.sign + f.velstep.bounds + f.velstep.noise + f.velstep.missing)]
+        said += [f"The parameters come from the dataset's window, which {w}" for w in [window(d)] if w]
         sec.fig(f"velstep-{d.name}.png", f"{d.name} (measured): the data with the {best.law} fit, the step close up, "
                 "the residuals (fit − data) and the fitted parameters.", lambda f=best: velstep_figure(f),
                 side=" ".join(f"{s}." for s in said), key=("velstep", id(best)))  # the index's and its group's
