@@ -58,6 +58,7 @@ class VelstepFit(DatasetFit):
     trend: float = 0.0
     x_ref: float = 0.0  # [m]
     x_data: np.ndarray | None = None  # the dataset's load-point displacement [m] (None: from the schedule)
+    loglik: np.ndarray | None = None  # each sample's log-likelihood under the fit's noise model (``vuong``)
 
     def trajectory(self, law, t=None, n: int = 401):
         tr = super().trajectory(law, t, n)
@@ -116,7 +117,7 @@ def build(problem, x, rounds, *, checks=True, errors=True, n_params=None, clock=
         per.append(VelstepFit(target, "ode", lawp, scene, p["model"], float(p["r"] @ p["r"]),
                               float(math.sqrt(np.mean(p["r"] ** 2))), float(p["z"] @ p["z"]), g,
                               trend=p["trend"] / UM, x_ref=s.x_ref * UM,
-                              x_data=s.x * UM if "x" in s.target.dataset.columns else None))
+                              x_data=s.x * UM if "x" in s.target.dataset.columns else None, loglik=p["loglik"]))
     ll = sum(p["ll"] for p in pieces)
     k_lik = k + n_phi
     reason = LIKELIHOOD_REASON.get(kind, "")
@@ -178,10 +179,11 @@ def _piece(problem, s, v, x, free, J, col: int) -> dict:
     if J.shape[1]:
         J[rows, :len(free)] = s.white(problem.columns(s, v, x, sol.S, free) / s.sigma[:, None])
         J[rows, col:col + s.B.shape[1]] = s.white(s.B / s.sigma[:, None])
-    ll = float(z @ z) + float(np.sum(np.log(2 * math.pi * s.sigma ** 2))) + s.log_det()
+    terms = z * z + np.log(2 * math.pi * s.sigma ** 2) + s.log_det_terms()  # each sample's -2 ln L
+    ll = float(np.sum(terms))
     mu_ss = (c[0] if s.mu0 is None else s.mu0 + (v["a"] - v["b"]) * s.L1)
     trend = float(c[-1]) if s.trend else 0.0
-    return dict(n=s.n, model=model, r=r, z=z, c=c, rows=rows, ll=ll, mu0=float(mu_ss - (v["a"] - v["b"]) * s.L1),
+    return dict(n=s.n, model=model, r=r, z=z, c=c, rows=rows, ll=ll, loglik=-0.5 * terms, mu0=float(mu_ss - (v["a"] - v["b"]) * s.L1),
                 mu_ss=float(mu_ss), trend=trend, kind=s.kind)
 
 

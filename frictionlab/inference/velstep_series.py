@@ -107,6 +107,10 @@ class Series:
         """The whitening's term of -2 ln L."""
         return self.noise.log_det() if self.arp else ar1.log_det(self.phi)
 
+    def log_det_terms(self) -> np.ndarray:
+        """Each sample's part of ``log_det``."""
+        return self.noise.log_det_terms() if self.arp else np.log1p(-self.phi ** 2)
+
     def set_noise(self, residual) -> float:
         """Profile phi from ``residual`` (model - data) and re-estimate sigma from the prewhitened data (estimated
         noise) or keep the declared one (known): the largest change of a group's phi. With the data's AR(p)

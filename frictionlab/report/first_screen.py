@@ -37,7 +37,7 @@ TITLE = "Answers"
 COLUMNS = (("best", "best law"), ("goodness", "goodness of fit"),
            ("equivalence", "λAu vs μN + μη′dA/dt"),
            ("threshold", "noise threshold"), ("series", "series vs exact"), ("accuracy", "what accuracy costs"),
-           ("transfer", "one parameter set for all conditions?"))
+           ("transfer", "one parameter set for all conditions?"), ("closer", "which law is closer"))
 #: characters a table cell shows (more: cut, the full text is in the notes)
 CELL_LIMIT = 70
 #: (Answer field, label) of the full sentences in the notes below the table.

@@ -135,7 +135,7 @@ def _arma11(x) -> tuple[tuple[float, float], float] | None:
     return (float(phi), float(th)), best.fun / (x.size - 1)
 
 
-def _startup(model: NoiseModel) -> tuple[list[np.ndarray], np.ndarray]:
+def startup(model: NoiseModel) -> tuple[list[np.ndarray], np.ndarray]:
     """The order-i predictors (i < p) of a stationary AR(p) from its reflection coefficients, and each start-up
     sample's prediction variance over the innovation variance."""
     preds, a = [], np.zeros(0)
@@ -163,7 +163,7 @@ def whiten(v, model: NoiseModel) -> np.ndarray:
         return out
     p = model.order
     out = lfilter(np.concatenate([[1.0], -np.asarray(model.ar)]), [1.0], v, axis=0)
-    preds, ratio = _startup(model)
+    preds, ratio = startup(model)
     for i in range(min(p, v.shape[0])):
         a = preds[i]
         e = v[i] - (np.tensordot(a, v[i - 1::-1][:i], axes=(0, 0)) if i else 0.0)
@@ -177,7 +177,7 @@ def log_det(model: NoiseModel, n: int) -> float:
         return 0.0
     if model.kind == "ARMA(1,1)":
         return math.log(model.variance_ratio)
-    _, ratio = _startup(model)
+    _, ratio = startup(model)
     return float(np.sum(np.log(ratio[:n])))
 
 

@@ -56,6 +56,19 @@ class RecordNoise:
             out[a:b] = arp.whiten(v[a:b], self.models[g])
         return out
 
+    def log_det_terms(self) -> np.ndarray:
+        """Each sample's part of ``log_det`` (nonzero at the start of a run only)."""
+        out = np.zeros(self.labels.size)
+        for a, b, g in self.runs:
+            m = self.models[g]
+            if m.kind == "ARMA(1,1)":
+                out[a] = math.log(m.variance_ratio)
+            elif m.kind == "AR":
+                _, ratio = arp.startup(m)
+                k = min(ratio.size, b - a)
+                out[a:a + k] = np.log(ratio[:k])
+        return out
+
     def log_det(self) -> float:
         """The whitening's term of -2 ln L over the runs."""
         return sum(arp.log_det(self.models[g], b - a) for a, b, g in self.runs)
