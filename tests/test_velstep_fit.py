@@ -233,7 +233,7 @@ def test_a_strengthening_evolution_ends_at_b_0_and_says_so(tmp_path):
 def test_the_strengthening_refit_starts_where_the_bound_held_b(tmp_path):
     """The search keeps its grid points whose a, b fit ended with b held at 0, best first and distinct; a fit that
     ends with b inside its range and no such grid point runs no refit (from there the bound did not act)."""
-    from frictionlab.inference import velstep, velstep_result
+    from frictionlab.inference import velstep, velstep_missing
 
     ds, _ = _measured_like(tmp_path)
     load = quasistatic.Load.of(ds.scene.spring)
@@ -252,7 +252,7 @@ def test_the_strengthening_refit_starts_where_the_bound_held_b(tmp_path):
     x = starts[0].copy()
     x[ib] = problem.params[ib].to_x(0.01)  # b inside its range: nothing to refit from
     before = problem.nfev
-    assert velstep_result._strengthening(problem, x) == "" and problem.nfev == before
+    assert velstep_missing._strengthening(problem, x) == "" and problem.nfev == before
 
 
 def test_bound_meanings_name_what_each_bound_says():

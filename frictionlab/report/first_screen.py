@@ -44,7 +44,8 @@ CELL_LIMIT = 70
 NOTES = (("headline", ""), ("goodness", "Goodness"), ("equivalence", "λAu against μN + μη′dA/dt, exact"),
          ("equivalence_series", "The truncated series of λAu against μN + μη′dA/dt"),
          ("qualitative", "Shared features"), ("noise_threshold", "Noise threshold"),
-         ("series_vs_exact", "Series vs exact"), ("accuracy", "What accuracy costs"), ("transfer", "Across conditions"))
+         ("series_vs_exact", "Series vs exact"), ("accuracy", "What accuracy costs"), ("transfer", "Across conditions"),
+         ("closer", "Which law is closer"))
 #: dataset kind -> block(ctx, sec, datasets) -> names drawn or None (all): a first-screen block of its own for the
 #: fitted datasets of that kind (module docstring); the generic figure leaves the datasets it drew out.
 KIND_BLOCKS: dict = {"spring-slider": lambda ctx, sec, datasets: velstep.first_screen(sec, ctx.c, datasets)}
