@@ -41,8 +41,6 @@ def make_answers(datasets, fits, ranking, groups) -> tuple[Answer, ...]:
         pool = ranking if len(dss) == 1 else groups
         key = names[0] if len(dss) == 1 else label
         rows = [r for r in pool if r.dataset == key and r.rank is not None]
-        if not rows and 1 < len(dss) == len(datasets):  # the group is every fitted dataset: ranked as 'ALL'
-            rows = [r for r in pool if r.dataset == "ALL" and r.rank is not None]
         kinds = {d.provenance.kind for d in dss}
         provenance = kinds.pop() if len(kinds) == 1 else "mixed"
         best, fits_ok, headline, goodness, details, short = _verdict(rows)
