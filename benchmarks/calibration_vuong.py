@@ -21,7 +21,6 @@ Printed: each row's share with its 95 % Wilson interval, and the CPU time. Resul
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 import tempfile
 import time

@@ -45,7 +45,6 @@ import numpy as np
 from ..core.errors import FrictionLabError, SolverError
 from ..solve import quasistatic
 from ..solve.quasistatic import UM, Load
-from . import ar1
 from .fitmodel import FitTimeout
 from .velstep_series import SEARCH_DENSE, SEARCH_POINTS, Series  # noqa: F401  (the fit's public names)
 
@@ -345,10 +344,12 @@ def _dc_grid(series, p: Param) -> np.ndarray:
 
 def fit(law, targets, *, fixed=None, free=None, initial=None, trend=None, stiffness=None, scan: int = 125,
         n_starts: int = 3, max_nfev=None, rtol=None, timeout=None, checks: bool = True, errors: bool = True,
-        n_params=None, progress=None, names=(), clock=None):
+        n_params=None, progress=None, names=(), clock=None, noise=None):
     """The velocity-step fit of ``law`` to ``targets`` (module docstring); arguments as ``fitting.fit``, plus
-    trend (None: fitted on measured data) and stiffness (None: fitted on measured data unless ``free`` names it;
-    False: held; True: fitted within K_BOUNDS of its start). Returns a FitResult."""
+    trend (None: fitted on measured data), stiffness (None: fitted on measured data unless ``free`` names it;
+    False: held; True: fitted within K_BOUNDS of its start) and noise (None: the datasets' noise models; else one
+    ``VelstepFit.noise_state`` per dataset, held: the noise model of a fit whose curve is refitted). Returns a
+    FitResult."""
     from .fitresult import FitResult
     from .velstep_result import build
 
@@ -361,6 +362,8 @@ def fit(law, targets, *, fixed=None, free=None, initial=None, trend=None, stiffn
 
     problem = make_problem(law, targets, fixed or {}, free or {}, initial or {}, trend, stiffness,
                            FIT_RTOL if rtol is None else rtol, deadline)
+    for s, state in zip(problem.series, noise or ()):
+        s.hold_noise(state)
     n_free = len(problem.free) + sum(s.B.shape[1] for s in problem.series)
     n_points = sum(s.n for s in problem.series)
     if n_points < n_free + 1:
@@ -401,10 +404,10 @@ def _solve(problem: Problem, scan: int, n_starts: int, max_nfev):
     if not ok:
         return problem.x_start(), math.inf, False, 0
     rounds = 0
-    if any(s.correlated for s in problem.series):
+    if any(s.correlated and not s.held for s in problem.series):
         for rounds in range(1, AR1_ROUNDS + 1):
             models = problem.model(x)
-            change = max(s.set_noise(m - s.y) for s, m in zip(problem.series, models) if s.correlated)
+            change = max(s.set_noise(m - s.y) for s, m in zip(problem.series, models) if s.correlated and not s.held)
             problem._cache = None
             x, cost, ok = problem.local(x, free, max_nfev=max_nfev)
             if not ok:

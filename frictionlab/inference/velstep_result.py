@@ -59,6 +59,8 @@ class VelstepFit(DatasetFit):
     x_ref: float = 0.0  # [m]
     x_data: np.ndarray | None = None  # the dataset's load-point displacement [m] (None: from the schedule)
     loglik: np.ndarray | None = None  # each sample's log-likelihood under the fit's noise model (``vuong``)
+    noise_state: dict | None = None  # the fitted noise model (``velstep_series.Series.noise_state``), for refits
+    refit: dict = attrs.field(factory=dict)  # the fit's own model for a refit: {'trend': bool, 'stiffness': bool}
 
     def trajectory(self, law, t=None, n: int = 401):
         tr = super().trajectory(law, t, n)
@@ -117,7 +119,9 @@ def build(problem, x, rounds, *, checks=True, errors=True, n_params=None, clock=
         per.append(VelstepFit(target, "ode", lawp, scene, p["model"], float(p["r"] @ p["r"]),
                               float(math.sqrt(np.mean(p["r"] ** 2))), float(p["z"] @ p["z"]), g,
                               trend=p["trend"] / UM, x_ref=s.x_ref * UM,
-                              x_data=s.x * UM if "x" in s.target.dataset.columns else None, loglik=p["loglik"]))
+                              x_data=s.x * UM if "x" in s.target.dataset.columns else None, loglik=p["loglik"],
+                              noise_state=s.noise_state(), refit={"trend": bool(s.trend), "stiffness": any(
+                                  q.key == "k" and q.target == s.index and q.vary for q in problem.params)}))
     ll = sum(p["ll"] for p in pieces)
     k_lik = k + n_phi
     reason = LIKELIHOOD_REASON.get(kind, "")

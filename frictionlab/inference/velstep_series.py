@@ -53,6 +53,7 @@ class Series:
         self.labels, self.refs = ar1.rate_groups(self.t)
         #: The data's AR(p) / ARMA(1,1) model per rate group ('arp'), None otherwise.
         self.noise = RecordNoise.of(self.t, self.sigma) if correlation == "arp" else None
+        self.held = False  # the noise model held as given (``hold_noise``), not estimated with the fit
         self.phi_groups = np.zeros(self.refs.size)
         self.noise_ests: list = []
         self.search = _search_index(self.t, self.load.times)
@@ -110,6 +111,33 @@ class Series:
     def log_det_terms(self) -> np.ndarray:
         """Each sample's part of ``log_det``."""
         return self.noise.log_det_terms() if self.arp else np.log1p(-self.phi ** 2)
+
+    def noise_state(self) -> dict | None:
+        """The fitted noise model, to hold in a refit (``hold_noise``): None for independent noise."""
+        if self.arp:
+            return {"kind": "arp", "models": tuple(self.noise.models), "sigma_g": self.noise.sigma_g.copy()}
+        if self.ar1:
+            return {"kind": "ar1", "phi_groups": self.phi_groups.copy(), "sigma": self.sigma.copy()}
+        return None
+
+    def hold_noise(self, state: dict | None) -> None:
+        """Hold the noise model ``state`` (``noise_state`` of a fit of the same dataset) instead of estimating one."""
+        if state is None:
+            return
+        if state["kind"] == "arp":
+            if self.noise is None:
+                self.noise = RecordNoise.of(self.t, self.sigma)
+            self.noise.models = list(state["models"])
+            self.noise.sigma_g = np.asarray(state["sigma_g"], dtype=float).copy()
+            self.sigma = self.noise.sigma
+        else:
+            self.ar1, self.noise = True, None
+            self.phi_groups = np.asarray(state["phi_groups"], dtype=float).copy()
+            self.phi = ar1.coefficients(self.t, self.labels, self.refs, self.phi_groups)
+            self.sigma = np.asarray(state["sigma"], dtype=float).copy()
+        self.held = True
+        self._set_weights()
+        self._set_projection()
 
     def set_noise(self, residual) -> float:
         """Profile phi from ``residual`` (model - data) and re-estimate sigma from the prewhitened data (estimated

@@ -95,3 +95,24 @@ class RecordNoise:
         """(rate label, model name) per group: ('100 Hz', 'AR(6)')."""
         return [(f"{1 / r:.3g} Hz", m.name + (" (AR order at its cap)" if m.capped else ""))
                 for r, m in zip(self.refs, self.models)]
+
+    def draw(self, rng) -> np.ndarray:
+        """One draw of the noise: each run of each group from its model at its innovation level (stationary)."""
+        out = np.empty(self.labels.size)
+        for a, b, g in self.runs:
+            out[a:b] = arp.draw(rng, self.models[g], b - a, float(self.sigma_g[g]), burn=500)
+        return out
+
+
+def noise_drawer(dataset, y, model, sigma):
+    """A function rng -> one draw of noise for a parametric replicate of data y around a fit's ``model`` of them:
+    where ``dataset`` declares ``correlation = "arp"``, from the noise model a fit of these data chooses (each
+    group's model and level from the residual y - model); otherwise ``ar1.noise_drawer``."""
+    if getattr(dataset, "noise_correlation", "none") != "arp" or "t" not in dataset.columns:
+        return ar1.noise_drawer(dataset, y, model, sigma)
+    t = np.asarray(dataset.columns["t"], dtype=float)
+    start = np.broadcast_to(np.asarray(sigma if sigma is not None else 1.0, dtype=float), t.shape)
+    rec = RecordNoise.of(t, start)
+    rec.estimate(np.asarray(model) - np.asarray(y))
+    return rec.draw
+
