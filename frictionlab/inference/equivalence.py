@@ -81,8 +81,8 @@ from .equivalence_result import (  # noqa: F401  (the test's public names, defin
 from .fitting import FitResult
 from .margin import MARGIN, Margin, parse_margin
 from .qualitative import qualitative
-from .replicates import (ROW, centring_fit, cross_chi2, distance, noise_of, one_family, refit_options, replicate_chunk,
-                         t_stat)
+from .replicates import (ROW, centring_fit, cross_chi2, distance, noise_of, one_family, profiled, refit_options,
+                         replicate_chunk, t_stat)
 from ..core.fpstate import with_own_errstate
 
 @with_own_errstate
@@ -184,11 +184,23 @@ def _common(fit_a: FitResult, fit_b: FitResult, timeout: float | None, margin: M
                 fits={f.law: (f.goodness.fits if f.goodness is not None else None) for f in (fit_a, fit_b)},
                 goodness={f.law: (f.goodness.reason if f.goodness is not None else "") for f in (fit_a, fit_b)},
                 qualitative=_qualitative_within(fit_a, fit_b, timeout),
-                chi2={fit_a.law: fit_a.stats.chisqr, fit_b.law: fit_b.stats.chisqr},
+                chi2=({f.law: f.stats.neg2loglik for f in (fit_a, fit_b)} if profiled(fit_a, fit_b)
+                      else {fit_a.law: fit_a.stats.chisqr, fit_b.law: fit_b.stats.chisqr}),
+                statistic="−2 ln L" if profiled(fit_a, fit_b) else "χ²", closer=_closer(fit_a, fit_b),
                 k={fit_a.law: fit_a.stats.n_params, fit_b.law: fit_b.stats.n_params},
                 margin=delta, margin_text=delta_text,
                 margin_relative=margin.relative and target.observable != "stated",
                 margin_sigmas=delta if target.observable == "stated" else delta / float(np.sqrt(np.mean(sig * sig))))
+
+
+def _closer(fit_a: FitResult, fit_b: FitResult) -> str:
+    """Vuong's test in words where both fits have pointwise log-likelihoods of their own noise model, else ''."""
+    from .vuong import vuong
+
+    if getattr(fit_a.per_dataset[0], "loglik", None) is None:
+        return ""
+    r = vuong(fit_a, fit_b)
+    return r.text if r is not None else ""
 
 
 def _qualitative_within(fit_a, fit_b, timeout: float | None) -> dict:

@@ -56,9 +56,9 @@ class EquivalenceResult:
     replicates: int = 0  # the most replicates per null
     seed: int = 0
     n_points: int = 0
-    chi2: dict = attrs.field(factory=dict)  # law -> chi2 on the data
+    chi2: dict = attrs.field(factory=dict)  # law -> chi2 on the data (``statistic``: -2 ln L where profiled)
     k: dict = attrs.field(factory=dict)  # law -> identifiable parameters
-    t_obs: float = math.nan  # chi2_A - chi2_B on the data
+    t_obs: float = math.nan  # chi2_A - chi2_B on the data (``statistic``)
     t_a: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # T on replicates of A's fit (failed refits dropped)
     t_b: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # T on replicates of B's fit
     c_a: float = math.nan  # B refitted to A's best curve: T's location under A is -c_a
@@ -99,6 +99,10 @@ class EquivalenceResult:
     p_adjusted: float = math.nan  # p after the family's adjustment (Holm)
     p_within_adjusted: float = math.nan
     family: str = ALONE  # the family the p-values were adjusted in
+    #: The statistic of ``chi2`` and ``t_obs``: 'χ²' at the noise the likelihood uses, or '−2 ln L' where each fit
+    #: profiles its noise model with the law (the data's AR(p): chi-square is n there).
+    statistic: str = "χ²"
+    closer: str = ""  # Vuong's test of which law is closer (``vuong``), where each fit has pointwise log-likelihoods
 
     @property
     def ok(self) -> bool:
@@ -237,21 +241,25 @@ def decide(e: EquivalenceResult) -> EquivalenceResult:
         d_aic = (e.chi2[worse] - e.chi2[better]) + 2 * (e.k[worse] - e.k[better])
         what = "stated numbers" if e.observable == "stated" else "points"
         gap = e.chi2[worse] - e.chi2[better]
-        less = (f"{better} misses less (Δχ² = {_num(gap)}, ΔAIC = {_num(d_aic)}), which says which description is less "
-                "poor, not that either holds" if gap > TIE_REL * max(e.n_points, e.chi2[better])
+        stat = e.statistic
+        less = (f"{better} misses less (Δ{stat} = {_num(gap)}, ΔAIC = {_num(d_aic)}), which says which description is "
+                "less poor, not that either holds" if gap > TIE_REL * max(e.n_points, abs(e.chi2[better]))
                 else "they miss equally (one curve)")
+        if e.closer:
+            less = f"which is closer, a test valid when both miss: {e.closer}"
         text = sentences(
             f"no test: {a} and {b} both fail their own fit tests ({e.law_a}: {e.goodness.get(e.law_a) or 'fails'}; "
             f"{e.law_b}: {e.goodness.get(e.law_b) or 'fails'}), so neither is a valid null for the other and the pair "
             "gets no p-value",
-            f"their misfits only: χ² = {_num(e.chi2[e.law_a])} ({e.law_a}) and {_num(e.chi2[e.law_b])} ({e.law_b}) "
-            f"over {e.n_points} {what}; {less}",
+            f"their misfits: {e.statistic} = {_num(e.chi2[e.law_a])} ({e.law_a}) and {_num(e.chi2[e.law_b])} "
+            f"({e.law_b}) over {e.n_points} {what}; {less}",
             f"the two best curves differ by {e.quantity(e.rms)} RMS (the margin: {e.margin_text})", *tail)
         return attrs.evolve(e, verdict=BOTH_FAIL, explanation=text, p=math.nan, p_adjusted=math.nan,
                             p_within=math.nan, p_within_adjusted=math.nan)
     m = min(e.t_a.size, e.t_b.size)
     adjusted = "" if e.family == ALONE else f" ({e.family}: adjusted p = {_p(e.p_adjusted)})"
-    head = (f"T = χ²({e.law_a}) − χ²({e.law_b}) = {e.t_obs:.4g} on the data ({e.noise} σ), centred at its location "
+    st = e.statistic
+    head = (f"T = {st}({e.law_a}) − {st}({e.law_b}) = {e.t_obs:.4g} on the data ({e.noise} σ), centred at its location "
             f"under each fit ({e.t_obs + e.c_a:.3g} under {e.law_a}, {e.t_obs - e.c_b:.3g} under {e.law_b}); against {m} "
             f"replicates from each fit ({e.stopped}): p = {_p(e.p_a)} ± {e.mc_error(e.p_a):.1g} under {a}, "
             f"p = {_p(e.p_b)} ± {e.mc_error(e.p_b):.1g} under {b}; two-sided p = {_p(e.p)}{adjusted} at α = {ALPHA:g}")
@@ -297,7 +305,8 @@ def decide(e: EquivalenceResult) -> EquivalenceResult:
     else:
         verdict, say = CANNOT, ("so: cannot tell at this noise: neither law is rejected, and the curves are not shown "
                                 "to lie within δ")
-    return attrs.evolve(e, verdict=verdict, explanation=sentences(head, which, dist, say, power, *tail))
+    beside = f"beside it, Vuong's test of which law is closer: {e.closer}" if e.closer else ""
+    return attrs.evolve(e, verdict=verdict, explanation=sentences(head, which, dist, say, power, beside, *tail))
 
 
 def one_family_result(e: EquivalenceResult) -> bool:

@@ -30,12 +30,16 @@ def noise_of(f: FitResult):
     return states if any(st is not None for st in states) else None
 
 
+def profiled(fit_a: FitResult, fit_b: FitResult) -> bool:
+    """Whether either fit estimates its noise model with the law (the data's AR(p), its level profiled)."""
+    return any((getattr(d, "noise_state", None) or {}).get("kind") == "arp" for f in (fit_a, fit_b)
+               for d in f.per_dataset)
+
+
 def t_stat(fit_a: FitResult, fit_b: FitResult) -> float:
     """T = -2 ln(L_A / L_B): chi2_A - chi2_B at the noise the likelihood uses; where a fit estimates its noise
-    model with the law (the data's AR(p)), the difference of the profiled -2 ln L (chi-square is then n)."""
-    profiled = any((getattr(d, "noise_state", None) or {}).get("kind") == "arp" for f in (fit_a, fit_b)
-                   for d in f.per_dataset)
-    if profiled:
+    model with the law (``profiled``), the difference of the profiled -2 ln L (chi-square is then n)."""
+    if profiled(fit_a, fit_b):
         return float(fit_a.stats.neg2loglik - fit_b.stats.neg2loglik)
     return float(fit_a.stats.chisqr - fit_b.stats.chisqr)
 
