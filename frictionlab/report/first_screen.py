@@ -92,7 +92,8 @@ ABSENT = {"best": "a best law", "goodness": "a goodness-of-fit test",
                                                                  "fitted)",
           "accuracy": f"what accuracy costs (it runs by default where cheap, unless --no-accuracy; `{ACCURACY_COMMAND}` "
                       "runs it everywhere)",
-          "transfer": "one parameter set across conditions (no group of two or more datasets)"}
+          "transfer": "one parameter set across conditions (no group of two or more datasets)",
+          "closer": "which law is closer (no two laws with pointwise likelihoods on one dataset)"}
 
 
 def _answer_table(sec: Section, answers, laws=()):
@@ -119,6 +120,8 @@ def _answer_table(sec: Section, answers, laws=()):
 def _could_apply(key: str, laws) -> bool:
     """Whether a column absent from the verdict table is worth naming: the paper's pair and the truncated series
     only where the paper's laws were compared."""
+    if key == "closer":  # said where it was tested, not missed elsewhere
+        return False
     if key in ("equivalence", "threshold"):
         return {WEAR, AREA_RATE} <= set(laws)
     if key == "series":
