@@ -27,7 +27,7 @@ from pathlib import Path
 import attrs
 import numpy as np
 
-from frictionlab.inference.ranking_bootstrap import wilson  # 95% Wilson score interval
+from frictionlab.inference.resampling.ranking_bootstrap import wilson  # 95% Wilson score interval
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import calibration_ar1  # noqa: E402
@@ -41,7 +41,7 @@ def replicate(ds, curve, model, seed: int):
     """(covered by name, fits, the chosen noise models) of one fit of the truth plus noise of ``model``."""
     import frictionlab as fl
     from frictionlab.inference.noise import arp
-    from frictionlab.inference.predict import Target
+    from frictionlab.inference.fitting.predict import Target
     from frictionlab.io.noise import estimate
 
     sigma = calibration_ar1.SIGMA / math.sqrt(model.variance_ratio)  # innovation sigma for the marginal one

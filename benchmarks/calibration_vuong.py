@@ -1,4 +1,4 @@
-"""Calibration of Vuong's test (``inference.vuong``) on synthetic velocity steps with AR(p) noise of known
+"""Calibration of Vuong's test (``inference.verdicts.vuong``) on synthetic velocity steps with AR(p) noise of known
 coefficients: its size when both laws are equally wrong, its power when one law is true.
 
     python benchmarks/calibration_vuong.py [--n 40] [--n-size 80] [--seed 0] [--quick]
@@ -29,7 +29,7 @@ from pathlib import Path
 import attrs
 import numpy as np
 
-from frictionlab.inference.ranking_bootstrap import wilson  # 95% Wilson score interval
+from frictionlab.inference.resampling.ranking_bootstrap import wilson  # 95% Wilson score interval
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import velstep_records  # noqa: E402
@@ -65,7 +65,7 @@ def truth(ds, x, v1, law: str) -> np.ndarray:
 
 
 def data_of(ds, y, correlation="arp"):
-    from frictionlab.inference.predict import Target
+    from frictionlab.inference.fitting.predict import Target
     from frictionlab.io.noise import estimate
 
     cols = dict(ds.columns, mu=y)
@@ -101,7 +101,7 @@ def replicate(ds, curve, seed: int) -> str | None:
     """'aging', 'slip' (the test says it is closer) or '' (equally close); None where a fit fails."""
     import frictionlab as fl
     from frictionlab.inference.noise import arp
-    from frictionlab.inference.vuong import vuong
+    from frictionlab.inference.verdicts.vuong import vuong
 
     noise = arp.draw(np.random.default_rng(seed), arp.from_coefficients(AR), curve.size, SIGMA)
     target = data_of(ds, curve + noise)

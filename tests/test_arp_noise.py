@@ -11,10 +11,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from frictionlab.inference.goodness import ljung_box
+from frictionlab.inference.diagnostics.goodness import ljung_box
 from frictionlab.inference.noise import arp
 from frictionlab.inference.noise.misfit import band_test
-from frictionlab.inference.vuong import long_run_variance, vuong
+from frictionlab.inference.verdicts.vuong import long_run_variance, vuong
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 

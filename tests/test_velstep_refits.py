@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import frictionlab as fl
-from frictionlab.inference import replicates as rp
+from frictionlab.inference.resampling import replicates as rp
 from frictionlab.inference.noise import arp
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))

@@ -164,7 +164,7 @@ class Dataset:
 
 
 def builtin_dir() -> Path:
-    """Folder of the built-in datasets (the repository's datasets/, installed as frictionlab.data)."""
+    """Folder of the built-in datasets (``frictionlab/data/``, the package ``frictionlab.data``)."""
     return Path(str(resources.files("frictionlab.data")))
 
 
@@ -345,8 +345,8 @@ def _si_of(col, value, where):
 
 
 #: ``[noise] correlation``: the samples' noise independent ('none', the default) or first-order autoregressive
-#: ('ar1': its coefficient profiled by each fit, inference/ar1.py) or chosen by the data ('arp': AR(p) by BIC per
-#: sampling rate, ARMA(1,1) where the order runs to its cap, fitted with the law; inference/noise/).
+#: ('ar1': its coefficient profiled by each fit, inference/noise/ar1.py) or chosen by the data ('arp': AR(p) by BIC
+#: per sampling rate, ARMA(1,1) where the order runs to its cap, fitted with the law; inference/noise/).
 NOISE_CORRELATIONS = ("none", "ar1", "arp")
 
 

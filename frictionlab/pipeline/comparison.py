@@ -27,11 +27,11 @@ import numpy as np
 
 from ..core.arguments import as_items
 from ..core.errors import FrictionLabError
-from ..inference.equivalence import PAIRS, REPLICATES, EquivalenceResult
-from ..inference.fitting import FitResult, scene_ranges
-from ..inference.margin import MARGIN
-from ..inference.ranking import RankRow
-from ..inference.transfer import TransferResult
+from ..inference.equivalence.discrimination import PAIRS, REPLICATES, EquivalenceResult
+from ..inference.fitting.fit import FitResult, scene_ranges
+from ..inference.equivalence.margin import MARGIN
+from ..inference.verdicts.ranking import RankRow
+from ..inference.equivalence.transfer import TransferResult
 from ..io.dataset import Dataset, available_names, load_dataset
 from .planning import (  # noqa: F401
     candidates,
@@ -100,14 +100,14 @@ class Comparison:
     def to_dataframe(self) -> pd.DataFrame:
         """The ranking as a tidy pandas DataFrame: one row per dataset and candidate (law, solver), with
         the observable and the units of rss and rmse; the rows of the declared groups after them."""
-        from ..inference.frames import ranking_frame
+        from ..inference.fitting.frames import ranking_frame
 
         return ranking_frame(self)
 
     def parameters_dataframe(self) -> pd.DataFrame:
         """Every fitted parameter as a tidy pandas DataFrame: dataset, law, solver, parameter, value,
         stderr, unit, kind, vary, fixed_by, lower, upper."""
-        from ..inference.frames import parameters_frame
+        from ..inference.fitting.frames import parameters_frame
 
         return parameters_frame(self.fits)
 
@@ -124,8 +124,8 @@ class Comparison:
         fitted dataset) the data with the ``top`` top-ranked candidates above and their residuals in units of
         sigma below, each labelled with its rank and whether it passes its goodness-of-fit tests. Returns the matplotlib Figure; with ``ax``
         (one Axes per group) the data and fits only, drawn there, and returns ``ax``."""
-        from ..inference.answers import group_of
-        from ..inference.plots import fits_text, plot_ranking
+        from ..inference.verdicts.answers import group_of
+        from ..inference.fitting.plots import fits_text, plot_ranking
 
         panels, seen = [], set()
         for d in self.fitted_datasets:
@@ -141,7 +141,7 @@ class Comparison:
         return plot_ranking(panels, ax, top)
 
     def _repr_html_(self) -> str:
-        from ..inference.frames import comparison_html
+        from ..inference.fitting.frames import comparison_html
 
         return comparison_html(self)
 
@@ -184,10 +184,10 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     to test (default equivalence.PAIRS); pairs where a law needs the ODE solver, or without a time
     series, are tested only with bootstrap_all. transfer: run the transfer stage. margin: the equivalence
     margin delta, a multiple of each dataset's noise sigma (default MARGIN = 1) or a quantity in the
-    observable's unit ('150 rpm'; ``inference.margin``). family: 'report' (default: Holm over every
+    observable's unit ('150 rpm'; ``inference.equivalence.margin``). family: 'report' (default: Holm over every
     hypothesis of the report's equivalence tests, one family-wise error rate ALPHA) or 'group' (Holm within
-    each dataset group only; ``inference.equivalence_groups``). accuracy: what accuracy costs (each solver's
-    error and time against the most accurate one at the fitted parameters, ``inference.accuracy``), where it
+    each dataset group only; ``inference.equivalence.family``). accuracy: what accuracy costs (each solver's
+    error and time against the most accurate one at the fitted parameters, ``inference.cost.accuracy``), where it
     is cheap; with ``tolerance`` given, everywhere.
     stages: the names of the stages to run (``stages.STAGES``: fit, rank, equivalence, transfer,
     tolerance, bootstrap, answer), None for every stage the options above switch on; ``run_stages``

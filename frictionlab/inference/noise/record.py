@@ -12,7 +12,7 @@ import math
 import attrs
 import numpy as np
 
-from .. import ar1
+from . import ar1
 from . import arp
 
 
