@@ -241,7 +241,7 @@ def test_the_strengthening_refit_starts_where_the_bound_held_b(tmp_path):
     """The search keeps its grid points whose a, b fit ended with b held at 0, best first and distinct; a fit that
     ends with b inside its range and no such grid point runs no refit (from there the bound did not act)."""
     from frictionlab.inference.velstep import fit as velstep
-    from frictionlab.inference.velstep import result as velstep_result
+    from frictionlab.inference.velstep import missing as velstep_missing
 
     ds, _ = _measured_like(tmp_path)
     load = quasistatic.Load.of(ds.scene.spring)
@@ -260,7 +260,7 @@ def test_the_strengthening_refit_starts_where_the_bound_held_b(tmp_path):
     x = starts[0].copy()
     x[ib] = problem.params[ib].to_x(0.01)  # b inside its range: nothing to refit from
     before = problem.nfev
-    assert velstep_result._strengthening(problem, x) == "" and problem.nfev == before
+    assert velstep_missing._strengthening(problem, x) == "" and problem.nfev == before
 
 
 def test_bound_meanings_name_what_each_bound_says():

@@ -247,7 +247,7 @@ def answer_lines(c) -> list[str]:
         parts = [a.cell("best"), a.cell("goodness"),
                  f"lambda A u vs mu N + mu eta' dA/dt: {eq}" if eq and eq != "not tested" else "", a.cell("threshold"),
                  a.cell("series"), f"accuracy {a.short['accuracy']}" if a.short.get("accuracy") else "",
-                 a.cell("transfer")]
+                 a.cell("transfer"), a.cell("closer")]
         out.append(f"  {a.group}: " + "; ".join(p for p in parts if p))
     out += [f"  {', '.join(groups)}: {reason}" + "".join(f"; registered laws that apply: {h}" for h in hints)
             for reason, groups, hints in unfitted(c.answers)]

@@ -14,7 +14,7 @@ whitespace- (or comma-) separated rows of time [s], load-point displacement [um]
   record's first steady state (``joint``), fitted as one history;
 * estimates a start for the machine stiffness from friction's initial slope after each step, over a run of
   samples chosen from the data (the shortest that gives the slope to 10 %), whatever the transient's length;
-* states the friction noise as estimated from the data with AR(1) correlation (no sigma is written).
+* states the friction noise as estimated from the data with an AR(p) model chosen by the data (no sigma is written).
 """
 from __future__ import annotations
 
@@ -365,7 +365,7 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
               "continuous two-line fit, velocities from one continuous fit through every kink (fitted values, not "
               "set points)" + (f"; {len(jumps)} displacement jump{'s' * (len(jumps) != 1)} without a change of "
                                "velocity stitched" if jumps else "") +
-              "; friction as measured (no trend removed); its noise estimated from the data, AR(1)" +
+              "; friction as measured (no trend removed); its noise estimated with the fit, AR(p) chosen by the data" +
               (f"; the window {w.start_note}" if w.start_note else ""))
     at = f" at {raw.normal_text(stress)}" if stress is not None else ""
     description = (f"Velocity step{'s' * (len(steps) > 1)} {v_text} um/s{at} "
@@ -383,9 +383,9 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
         'x = "um"                   # load-point displacement' + (" (jumps stitched)" if jumps else ""),
         'mu = ""',
         "",
-        "[noise]                    # friction's noise: estimated from the data, correlated (AR(1))",
+        "[noise]                    # friction's noise: estimated with the fit, AR(p) chosen by the data",
         'kind = "estimated"',
-        'correlation = "ar1"',
+        'correlation = "arp"',
         "",
         "[scene]",
         'mass = "1 kg"              # not used by a quasi-static slider',

@@ -62,7 +62,7 @@ class Comparison:
     datasets: tuple[Dataset, ...]  # every dataset asked for, fitted or not
     fits: tuple[FitResult, ...]
     ranking: tuple[RankRow, ...]  # per dataset
-    groups: tuple[RankRow, ...]  # ALL, ALL[kind] and each dataset group of two or more
+    groups: tuple[RankRow, ...]  # each declared dataset group of two or more
     equivalence: tuple[EquivalenceResult, ...]  # discrimination tests (law A vs law B per dataset)
     skipped_datasets: dict  # name -> reason
     wall_time: float
@@ -99,7 +99,7 @@ class Comparison:
 
     def to_dataframe(self) -> pd.DataFrame:
         """The ranking as a tidy pandas DataFrame: one row per dataset and candidate (law, solver), with
-        the observable and the units of rss and rmse; group rows (ALL, ALL[kind]) after them."""
+        the observable and the units of rss and rmse; the rows of the declared groups after them."""
         from ..inference.fitting.frames import ranking_frame
 
         return ranking_frame(self)
