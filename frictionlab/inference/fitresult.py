@@ -209,9 +209,12 @@ class FitResult:
         from ..core.display import param_text
 
         on = ", ".join(d.target.label for d in self.per_dataset) if self.per_dataset else ", ".join(self.datasets)
-        head = f"{self.law} [{self.solver}] on {on}: {self.status}"
         if not self.ok:
-            return f"{head}: {self.reason}"
+            return f"{self.law} [{self.solver}] on {on}: {self.status}: {self.reason}"
+        # the head gives the verdict of the goodness-of-fit tests, not the optimizer's status ("ok" only says it ran)
+        verdict = {True: "fits", False: "does not fit", None: "fitted (goodness of fit not tested)"}[
+            None if self.goodness is None else self.goodness.fits]
+        head = f"{self.law} [{self.solver}] on {on}: {verdict}"
         s = self.stats
         lines = [head, f"  chi2 = {s.chisqr:.5g}, reduced chi2 = {s.redchi:.4g}, AIC = {s.aic:.5g}, "
                        f"BIC = {s.bic:.5g}, n = {s.n_points}, k = {s.n_params}, nfev = {self.nfev}, "
@@ -235,7 +238,7 @@ class FitResult:
             lines.append(f"  warning: {w}")
         for n in self.notes:
             lines.append(f"  note: {n}")
-        if self.velstep is not None:
-            lines += self.velstep.lines()
+        if self.velstep is not None:  # its notes are the fit's notes, already printed above
+            lines += [line for line in self.velstep.lines() if line.strip() not in set(self.notes)]
         return "\n".join(lines)
 
