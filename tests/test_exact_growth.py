@@ -13,7 +13,7 @@ import pytest
 
 from frictionlab import Scene, simulate
 from frictionlab.core.errors import SolverError
-from frictionlab.inference.predict import applicable_solvers, auto_solver
+from frictionlab.solve.choice import applicable_solvers, auto_solver
 from frictionlab.io.dataset import load_dataset
 from frictionlab.physics.scene import G, GrowthArea, HalfSineArea, HalfSineNormal, WeightNormal
 from frictionlab.solve.batch import simulate_batch

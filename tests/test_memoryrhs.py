@@ -182,7 +182,7 @@ def test_rate_state_slip_fit_reaches_the_careful_minimum():
 def test_sampled_starts_fill_every_axis_between_the_grid_levels():
     """``_sampled_starts``: the given start first, then a Latin hypercube over the same spans (one point in
     each of ``limit`` equal slices of every axis, in log for positive parameters), inside the bounds."""
-    from frictionlab.inference.fitmodel import _law_slots, _sampled_starts, _start_grid
+    from frictionlab.inference.fitting.model import _law_slots, _sampled_starts, _start_grid
 
     law = get_law("rate-state-slip")
     tg = fl.make_target(fl.load_dataset("incline-oil-a200"))

@@ -6,7 +6,7 @@ import pytest
 from _fit_helpers import TRUTH, incline_scene, synthetic
 
 from frictionlab import compare
-from frictionlab.inference.ranking import COLUMNS, RankRow, _rank, rank_groups, to_csv
+from frictionlab.inference.verdicts.ranking import COLUMNS, RankRow, _rank, rank_groups, to_csv
 
 
 def row(ds, law, aic, solver="exact", n=20, k=1, status="ok"):
@@ -131,7 +131,7 @@ def test_one_family_is_represented_by_its_simplest_member_where_they_reach_one_m
     from _fit_helpers import impact_scene
 
     from frictionlab import fit
-    from frictionlab.inference.ranking import merge_identical
+    from frictionlab.inference.verdicts.ranking import merge_identical
 
     data = synthetic("wear", TRUTH["wear"], impact_scene(), name="one-family")
     w, c = fit("wear", data, solver="exact"), fit("couette", data, solver="exact")

@@ -14,7 +14,7 @@ from frictionlab.cli import main
 from frictionlab.core.errors import FrictionLabError, OutputError
 from frictionlab.core.files import MARKER
 from frictionlab.core.progress import Progress
-from frictionlab.inference.ranking import COLUMNS
+from frictionlab.inference.verdicts.ranking import COLUMNS
 
 
 @pytest.fixture(scope="module")
@@ -307,7 +307,7 @@ def test_a_new_dataset_kind_plugs_in_through_one_predictor(tmp_path, monkeypatch
     import attrs
 
     from frictionlab import simulate
-    from frictionlab.inference import fitting
+    from frictionlab.inference.fitting import fit as fitting
     from frictionlab.io.dataset import Dataset
 
     base = synthetic("wear", {"lam": 1.2e6})

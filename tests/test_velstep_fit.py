@@ -1,4 +1,4 @@
-"""The velocity-step fit (inference.velstep) and its quasi-static integrator (solve.quasistatic): against the
+"""The velocity-step fit (inference.velstep.fit) and its quasi-static integrator (solve.quasistatic): against the
 general plan, against finite differences, against a brute-force joint fit, and what it says at a bound."""
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ import pytest
 
 import frictionlab as fl
 from frictionlab.core.errors import ParameterError
-from frictionlab.inference.predict import Target
+from frictionlab.inference.fitting.predict import Target
 from frictionlab.physics.scene import ConstantNormal, Scene, SpringLoad
 from frictionlab.solve import quasistatic
 from frictionlab.solve import quasistatic_kernel as kernel
@@ -233,7 +233,8 @@ def test_a_strengthening_evolution_ends_at_b_0_and_says_so(tmp_path):
 def test_the_strengthening_refit_starts_where_the_bound_held_b(tmp_path):
     """The search keeps its grid points whose a, b fit ended with b held at 0, best first and distinct; a fit that
     ends with b inside its range and no such grid point runs no refit (from there the bound did not act)."""
-    from frictionlab.inference import velstep, velstep_result
+    from frictionlab.inference.velstep import fit as velstep
+    from frictionlab.inference.velstep import result as velstep_result
 
     ds, _ = _measured_like(tmp_path)
     load = quasistatic.Load.of(ds.scene.spring)
@@ -256,7 +257,7 @@ def test_the_strengthening_refit_starts_where_the_bound_held_b(tmp_path):
 
 
 def test_bound_meanings_name_what_each_bound_says():
-    from frictionlab.inference.velstep_result import BOUND_MEANING
+    from frictionlab.inference.velstep.result import BOUND_MEANING
 
     assert BOUND_MEANING[("b", "lower")] == ("b at 0: the evolution runs the other way; a single-state law cannot "
                                              "follow it")
@@ -297,7 +298,7 @@ def test_the_velocity_step_summary_gives_each_parameter_in_laboratory_units():
 
 def test_refits_of_a_velocity_step_fit_start_where_it_ended(small_step_fits):
     """The replicate refits of the equivalence test and the bootstrap go through the same path, warm-started."""
-    from frictionlab.inference.replicates import refit, refit_options
+    from frictionlab.inference.resampling.replicates import refit, refit_options
 
     fast, _ = small_step_fits
     again = refit("rate-state-aging", refit_options(fast), fast.per_dataset[0].target)
@@ -307,8 +308,9 @@ def test_refits_of_a_velocity_step_fit_start_where_it_ended(small_step_fits):
 def test_the_compiled_sums_equal_the_explicit_projected_jacobian(tmp_path):
     """velstep_kernel.basis_sums (one pass, nothing per sample kept) against the prewhitened, projected
     residual and Jacobian formed explicitly with numpy."""
-    from frictionlab.inference import ar1, velstep
-    from frictionlab.inference.velstep_kernel import basis_sums
+    from frictionlab.inference.noise import ar1
+    from frictionlab.inference.velstep import fit as velstep
+    from frictionlab.inference.velstep.kernel import basis_sums
 
     ds, curve = _measured_like(tmp_path, "ar1")
     y = curve + np.random.default_rng(6).normal(0.0, 4e-4, curve.size)
@@ -337,7 +339,7 @@ def test_the_compiled_sums_equal_the_explicit_projected_jacobian(tmp_path):
 def test_the_equivalence_test_runs_on_ar1_velocity_steps(tmp_path):
     """Both rate-and-state laws fitted to AR(1) data; the equivalence test draws AR(1) replicates and refits both
     through the velocity-step path."""
-    from frictionlab.inference.ar1 import draw
+    from frictionlab.inference.noise.ar1 import draw
     from frictionlab.io.noise import estimate
 
     ds, curve = _measured_like(tmp_path, "ar1")

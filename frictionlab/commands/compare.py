@@ -125,12 +125,12 @@ def run(args) -> int:
                              f"got {args.bootstrap}")
     if args.seed < 0:
         raise ParameterError(f"--seed must be a non-negative integer, got {args.seed}")
-    from ..inference.equivalence import MIN_REPLICATES
+    from ..inference.equivalence.discrimination import MIN_REPLICATES
 
     if args.replicates < MIN_REPLICATES:
         raise ParameterError(f"--replicates must be at least {MIN_REPLICATES}, got {args.replicates}")
     free = parse_free(args.free)
-    from ..inference.margin import parse_margin
+    from ..inference.equivalence.margin import parse_margin
 
     margin = parse_margin(args.margin)
     pairs = parse_pairs(args.pairs, args.laws or None) if args.pairs else None
@@ -235,7 +235,7 @@ def answer_lines(c) -> list[str]:
     """The report's first screen in a few lines: per dataset group one line of the verdict layer's
     short answers (Comparison.answers; the full sentences are in the report and results.json);
     without answers, says so instead of inventing verdicts."""
-    from ..inference.answers import unfitted
+    from ..inference.verdicts.answers import unfitted
 
     if not c.answers:
         return ["answers: none (the verdict layer filled no Comparison.answers); see the report's tables"]

@@ -236,7 +236,7 @@ class Dataset:
 
 
 def builtin_dir() -> Path:
-    """Folder of the built-in datasets (the repository's datasets/, installed as frictionlab.data)."""
+    """Folder of the built-in datasets (``frictionlab/data/``, the package ``frictionlab.data``)."""
     return Path(str(resources.files("frictionlab.data")))
 
 
@@ -442,7 +442,7 @@ def _si_of(col, value, where):
 
 
 #: ``[noise] correlation``: the samples' noise independent ('none', the default) or first-order autoregressive
-#: ('ar1': its coefficient profiled by each fit, inference/ar1.py).
+#: ('ar1': its coefficient profiled by each fit, inference/noise/ar1.py).
 NOISE_CORRELATIONS = ("none", "ar1")
 
 

@@ -68,8 +68,8 @@ def raw_dirs() -> list[Path]:
         return [Path(p) for p in env.split(os.pathsep) if p]
     from importlib import resources
 
-    builtin = Path(str(resources.files("frictionlab.data")))  # the repository's datasets/ folder
-    return [builtin.resolve().parent.parent / "shared" / "data"]
+    builtin = Path(str(resources.files("frictionlab.data")))  # the repository's frictionlab/data/ folder
+    return [builtin.resolve().parents[2] / "shared" / "data"]
 
 
 def _sha256(data: bytes) -> str:

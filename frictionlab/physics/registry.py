@@ -392,7 +392,7 @@ def get_law(name: str | FrictionLaw) -> FrictionLaw:
 
 def is_third_party(law) -> bool:
     """True for a law whose class is defined outside frictionlab (a plugin, a --load file, a notebook):
-    its code is not trusted to stop at a time budget (``inference.guard``)."""
+    its code is not trusted to stop at a time budget (``inference.fitting.guard``)."""
     return not type(get_law(law)).__module__.startswith("frictionlab.")
 
 

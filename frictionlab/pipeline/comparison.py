@@ -27,11 +27,11 @@ import numpy as np
 
 from ..core.arguments import as_items
 from ..core.errors import FrictionLabError
-from ..inference.equivalence import PAIRS, REPLICATES, EquivalenceResult
-from ..inference.fitting import FitResult, scene_ranges
-from ..inference.margin import MARGIN
-from ..inference.ranking import RankRow
-from ..inference.transfer import TransferResult
+from ..inference.equivalence.discrimination import PAIRS, REPLICATES, EquivalenceResult
+from ..inference.fitting.fit import FitResult, scene_ranges
+from ..inference.equivalence.margin import MARGIN
+from ..inference.verdicts.ranking import RankRow
+from ..inference.equivalence.transfer import TransferResult
 from ..io.dataset import Dataset, available_names, load_dataset
 from .planning import (  # noqa: F401
     candidates,
@@ -169,7 +169,7 @@ class Comparison:
             reduced chi-square, AIC, AICc, BIC, delta AIC, Akaike weight, reason; the group rows (dataset
             ``ALL``, ``ALL[kind]``) after them.
         """
-        from ..inference.frames import ranking_frame
+        from ..inference.fitting.frames import ranking_frame
 
         return ranking_frame(self)
 
@@ -182,7 +182,7 @@ class Comparison:
             One row per dataset, law, solver and parameter: value and stderr (SI), unit, kind, vary,
             fixed_by, lower, upper.
         """
-        from ..inference.frames import parameters_frame
+        from ..inference.fitting.frames import parameters_frame
 
         return parameters_frame(self.fits)
 
@@ -213,8 +213,8 @@ class Comparison:
         matplotlib.figure.Figure or Axes
             The new figure, or ``ax`` when given.
         """
-        from ..inference.answers import group_of
-        from ..inference.plots import fits_text, plot_ranking
+        from ..inference.verdicts.answers import group_of
+        from ..inference.fitting.plots import fits_text, plot_ranking
 
         panels, seen = [], set()
         for d in self.fitted_datasets:
@@ -230,7 +230,7 @@ class Comparison:
         return plot_ranking(panels, ax, top)
 
     def _repr_html_(self) -> str:
-        from ..inference.frames import comparison_html
+        from ..inference.fitting.frames import comparison_html
 
         return comparison_html(self)
 

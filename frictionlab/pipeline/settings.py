@@ -8,8 +8,8 @@ import numpy as np
 
 from ..core.arguments import as_items
 from ..core.errors import ParameterError
-from ..inference.equivalence import MIN_REPLICATES, PAIRS, REPLICATES
-from ..inference.margin import MARGIN
+from ..inference.equivalence.discrimination import MIN_REPLICATES, PAIRS, REPLICATES
+from ..inference.equivalence.margin import MARGIN
 from ..physics.registry import available_laws, get_law
 
 #: The laws ``compare`` fits by default on impacts and inclines: the four of the mission (the seed paper's
@@ -58,9 +58,9 @@ class Settings:
     replicates: int = REPLICATES
     pairs: tuple = PAIRS
     transfer: bool = True
-    margin: object = MARGIN  # the equivalence margin delta: a multiple of the noise or a quantity (inference.margin)
+    margin: object = MARGIN  # the equivalence margin delta: a multiple of the noise or a quantity (inference.equivalence.margin)
     family: str = "report"  # the family a report's test p-values are adjusted in (equivalence_groups.FAMILIES)
-    accuracy: bool = True  # what accuracy costs per law and dataset (inference.accuracy; in full with tolerance)
+    accuracy: bool = True  # what accuracy costs per law and dataset (inference.cost.accuracy; in full with tolerance)
     cluster: str = ""  # where the tasks ran when not on a local pool: "Dask cluster at ADDRESS (N workers)"
     by_kind: dict = attrs.field(factory=dict)  # dataset kind -> the laws fitted on it ({}: every law on every dataset)
 
@@ -79,8 +79,8 @@ class Settings:
         t = self.fit_timeout
         if t is not None and (isinstance(t, bool) or not isinstance(t, (int, float)) or not 0 < t < float("inf")):
             raise ParameterError(f"compare: fit_timeout must be a positive number of seconds, got {t!r}")
-        from ..inference.equivalence_groups import FAMILIES
-        from ..inference.margin import parse_margin
+        from ..inference.equivalence.family import FAMILIES
+        from ..inference.equivalence.margin import parse_margin
 
         object.__setattr__(self, "margin", parse_margin(self.margin))
         if self.family not in FAMILIES:

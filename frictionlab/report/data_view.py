@@ -12,8 +12,8 @@ import attrs
 import numpy as np
 
 from ..core.display import NAMES, fmt_time, unit
-from ..inference.answers import group_of
-from ..inference.ranking import family
+from ..inference.verdicts.answers import group_of
+from ..inference.verdicts.ranking import family
 from .text import sig
 
 @attrs.frozen

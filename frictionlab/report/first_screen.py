@@ -1,11 +1,11 @@
 """The first screen: the verdict table (``Comparison.answers``), what accuracy costs, and the figure of the data.
 
-The verdict table only renders the answers the verdict layer filled (``frictionlab/inference/answers.py``);
+The verdict table only renders the answers the verdict layer filled (``frictionlab/inference/verdicts/answers.py``);
 columns without data are named in one line under it, and groups without a fitted law fold into one
 line. Without answers it shows what the comparison does hold, labelled as such (the AIC ranking's
 first place and the equivalence analysis' verdict), never a verdict of its own. The full sentences of each
 row follow, folded, each part a labelled run of whole sentences; then, folded, what accuracy costs per law and
-dataset (``inference.accuracy``). The figure (``data_view``) draws each group's data with its top-ranked
+dataset (``inference.cost.accuracy``). The figure (``data_view``) draws each group's data with its top-ranked
 candidates, and the slip of the truncated series against the exact solution where that series is among them.
 
 Kinds of data with a first-screen block of their own plug in at one place, ``KIND_BLOCKS``: a dataset kind
@@ -21,9 +21,9 @@ import attrs
 import numpy as np
 
 from ..core.display import fmt_time
-from ..inference.accuracy import COMMAND as ACCURACY_COMMAND
-from ..inference.answers import group_of, unfitted
-from ..inference.equivalence import AREA_RATE, COULOMB, COUETTE, WEAR, sentence
+from ..inference.cost.accuracy import COMMAND as ACCURACY_COMMAND
+from ..inference.verdicts.answers import group_of, unfitted
+from ..inference.equivalence.discrimination import AREA_RATE, COULOMB, COUETTE, WEAR, sentence
 from ..solve.solvers.series import slip_zero
 from . import figures, velstep
 from .data_view import describe, group_views, spin_falls

@@ -3,9 +3,9 @@ from __future__ import annotations
 
 import json
 
-from ..inference.predict import FIT_RTOL
-from ..inference import rules
-from ..inference.ranking import COLUMNS
+from ..inference.fitting.predict import FIT_RTOL
+from ..inference.verdicts import rules
+from ..inference.verdicts.ranking import COLUMNS
 from .doc import Section
 from .results import SCHEMA
 from .text import rtol_text

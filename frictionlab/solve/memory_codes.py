@@ -10,5 +10,5 @@ NORMAL_CONSTANT, NORMAL_HALF_SINE = 0, 1
 NC = 26
 #: Values of C[BAD]: a value was not finite, the calls passed the cap, the slip turned (DAHL_SLID).
 NOT_FINITE, TOO_MANY, TURNED = 1, 2, 3
-#: Rate-and-state's reference speed V0 [m/s] (laws/rate_state.py).
+#: Rate-and-state's reference speed V0 [m/s] (frictionlab/laws/rate_state.py).
 V0 = 1e-6

@@ -1,5 +1,5 @@
 """The quasi-static rate-and-state spring-slider in the field's own variables: the fast path of ``simulate``
-and of the velocity-step fit (``inference.velstep``).
+and of the velocity-step fit (``inference.velstep.fit``).
 
 For the built-in rate-state-aging and rate-state-slip laws on a spring-slider without mass, the general plan
 (``solve.plan``) differentiates the force numerically at every right-hand-side call. Here the slider is
@@ -26,7 +26,7 @@ from ..physics.spring import runaway_message
 #: the kernel, which imports numba, is loaded on the first solve).
 LAWS = {"rate-state-aging": 0, "rate-state-slip": 1}
 LAW_NAMES = {code: name for name, code in LAWS.items()}
-#: Reference slip rate V0 of the laws' mu0 [um/s] (laws/rate_state.py: 1e-6 m/s).
+#: Reference slip rate V0 of the laws' mu0 [um/s] (frictionlab/laws/rate_state.py: 1e-6 m/s).
 V0_UM = 1.0
 #: A quasi-static slider has run away once its slip rate exceeds this multiple of the fastest load point
 #: (``solve.plan.QUASI_STATIC_LIMIT``; the same limit on both paths).

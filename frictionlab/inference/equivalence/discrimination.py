@@ -1,0 +1,618 @@
+"""Can the data tell two laws apart, and are their curves equivalent within a margin? Three answers.
+
+``analyze_equivalence(fit_a, fit_b, replicates=REPLICATES, seed=0, margin=MARGIN)`` takes the best fits of
+law A and law B to one dataset (each with its own solver) and answers one of:
+
+* **different**: the data reject one law against the other (Cox's test below, two-sided at ALPHA);
+* **equivalent within delta**: an upper confidence bound of the RMS distance between the two best curves
+  lies below the margin delta (in the observable's unit: ``margin``), and neither law is rejected;
+* **cannot tell at this noise**: neither.
+
+Where both laws fail their own goodness-of-fit tests neither is a valid null for the other: the pair gets
+no p-value and no bound (BOTH_FAIL), only their misfits compared. The p-values of a report's tests are
+adjusted together (Holm over every hypothesis of the report: ``equivalence_groups.adjust_family``); a
+single call decides on its own p-values (a family of one).
+
+1. Discrimination statistic: T = chi2_A - chi2_B on the data, at the sigma the likelihood uses (measured,
+   estimated from the data without any law, or a reconstruction's stated precision: ``fitting``), so T is -2
+   times the log-likelihood ratio of B against A. T > 0: B fits better. T is not pivotal: under B its
+   location is c_B(theta_B), A refitted to B's noise-free curve, and the fitted theta_B moves with
+   the data (area-rate's eta' at the pair's threshold noise spans 0.1-4x its true value; T and
+   c_B(theta_B_hat) then correlate at 0.996), so a bootstrap of T from B's fit is centred where T
+   already is and almost never rejects B. Each law is therefore tested with T centred at its own
+   location, Cox's (1961) statistic with the expectation taken at the fitted values:
+   S_A = T + c_A (c_A: B refitted to A's best curve) and S_B = T - c_B, each c warm-started at the
+   law's own fit to the same data.
+2. Null distributions (parametric bootstrap of S, Williams 1970, Godfrey 1998): replicate datasets
+   are simulated from each fit (its best-fit curve plus Gaussian noise of the likelihood's sigma; draws
+   from ``SeedSequence([seed, key])``, the same draws under both fits); both laws are refitted to every
+   replicate, T recomputed and centred at the replicate's own refitted curve, exactly as on the data.
+   With an estimated sigma each replicate's chi-squares are taken at its own estimate, sigma^2 times a
+   chi-square draw of the estimate's degrees of freedom over them, so the estimate's uncertainty is in
+   the p-values. Large S_A speaks against A, small S_B against B: p_A = P(S_A* >= S_A | A),
+   p_B = P(S_B* <= S_B | B), each (1 + count) / (m + 1) with ties (the same curve) counted half.
+3. Sequential Monte Carlo (after Besag and Clifford 1991): replicates come in batches of BATCH, up to
+   ``replicates`` per null; sampling stops once the decision is clear: every p-value's 99% Clopper-
+   Pearson interval lies above ALPHA / 2 (clear cases cost a batch or two), or one lies below it, or,
+   from FAR_MIN replicates on, a law's observed S lies beyond all of its replicates and an exponential
+   tail fitted to them (peaks over their TAIL_Q quantile u: p = (1 - TAIL_Q) exp(-(S - u) / b), b the
+   mean excess at its TAIL_CONF upper confidence bound) puts its p below FAR_P. Under normal,
+   chi-square (1 and 3 dof), Gumbel and exponential nulls the estimate is conservative: P(p <= v) <= v
+   at v = FAR_P, 1e-3 and 1e-4 (tests/test_equivalence_shortcut.py). That tail estimate (at least TAIL_FLOOR: beyond it, extrapolation)
+   is then the law's p, below the Monte-Carlo floor 1 / (m + 1) that a Holm step would
+   otherwise sit on. The Monte-Carlo standard error sqrt(p (1 - p) / m) of each p is reported, and how
+   many replicates were drawn.
+4. Different: p = min(1, 2 min(p_A, p_B)) (Bonferroni over the two one-sided nulls) below ALPHA, after the
+   family's adjustment; the text says which law is rejected (both, when the other's own p is below
+   ALPHA / 2 too), and a law that fails its own fit tests is never called consistent with the data.
+5. Equivalent within delta (an interval inclusion test in the sense of Schuirmann's two one-sided tests,
+   1987; the distance is not negative, so only its upper side tests anything): the distance D = RMS of the
+   two best curves' difference (``replicates.distance``: the observable's unit, or stated precisions), in
+   margins X = D / delta (delta re-estimated on each replicate when it is a multiple of an estimated sigma).
+   Under each law's fit L the distance the two laws' curves truly have is X_L = (L's curve against the
+   other law refitted to it) / delta, and each replicate's error is e* = X* - X_L. The bound under L is
+   U_L = X - mean(e*) + t(1 - ALPHA, m - 1) sd(e*) sqrt(1 + 1/m) (the t quantile and the sqrt(1 + 1/m)
+   carry the Monte-Carlo error of mean and sd from m replicates), its p-value
+   p_L = P(t(m - 1) >= (1 - X + mean(e*)) / (sd(e*) sqrt(1 + 1/m))). The larger of the two laws' bounds
+   and p-values is the test's (either law may be the truth): equivalent within delta when that p is below
+   ALPHA after the family's adjustment, i.e. when the upper bound of D lies below delta.
+   benchmarks/calibration.py measures how often this is said when the curves differ by delta or more.
+
+Noise threshold, both directions: law A refitted to B's noise-free best curve leaves D_AB (at the sigma
+used); with every sigma scaled by s the refit does not move and D scales as 1 / s^2, so at
+s_AB = sqrt(D_AB / CRITICAL) a fit of A to B's curve misses it by chi-square CRITICAL (3.84): data from B
+at that noise reject A about half the time. Likewise s_BA. Group answers and the family's adjustment are in
+``equivalence_groups``.
+"""
+from __future__ import annotations
+
+from concurrent.futures import Executor
+
+import math
+
+import attrs
+import numpy as np
+
+from ...core.display import unit
+from ...core.errors import FrictionLabError, ParameterError
+from .decomposition import Decomposition, decomposition
+from ..fitting.fit import FitResult
+from .margin import MARGIN, Margin, parse_margin
+from .qualitative import qualitative
+from .qualitative import text as qual_text
+from ..resampling.replicates import ROW, centring_fit, cross_chi2, distance, one_family, refit_options, replicate_chunk
+from ...core.fpstate import with_own_errstate
+
+WEAR, AREA_RATE, COUETTE, COULOMB = "wear", "area-rate", "couette", "coulomb"
+#: The pairs ``compare`` tests by default: the paper's claim, the structural identity, and the simplest law against the paper's.
+PAIRS = ((WEAR, AREA_RATE), (WEAR, COUETTE), (COULOMB, WEAR))
+ALPHA = 0.05  # level of every test of a report (family-wise, Holm): different, and equivalent within delta
+CRITICAL = 3.84  # chi-square (1 dof, 95%) by which a cross-fit misses at the threshold noise
+#: The tightest margin, in noise sigmas, at which 'equivalent within delta' is said where the replicates' distances
+#: vary: benchmarks/calibration.py measured the bound below delta where the curves differ by delta in at most 6%
+#: of datasets at delta = 1 sigma, and in 23% at 0.25 sigma (the fitted curves' own uncertainty, not the bound's
+#: spread, then decides the distance): a tighter margin gets 'cannot tell', saying why.
+MIN_MARGIN = 1.0
+REPLICATES = 400  # the most replicates per null (sequential: clear cases stop after a batch or two)
+BATCH = 20  # replicates per null drawn between stopping checks
+MIN_REPLICATES = 20  # the smallest allowed maximum
+CI_LEVEL = 0.99  # Clopper-Pearson interval of a Monte-Carlo p-value that decides when to stop
+FAR_MIN = 40  # replicates before T beyond all of a law's may stop sampling by its tail estimate
+TAIL_Q = 0.75  # the exponential tail is fitted to the replicates above this quantile
+TAIL_CONF = 0.95  # ... with its scale (mean excess) at this upper confidence bound
+FAR_P = ALPHA / 20  # ... when that tail puts T's p below this (clear of any Holm level up to 10 members)
+TAIL_FLOOR = 1e-6  # a tail estimate is extrapolation: smaller values are reported as this bound
+TIE_REL = 1e-4  # |T* - T| below this fraction of max(n, chi2) is a tie (the optimizer's resolution)
+DIFFERENT, WITHIN, CANNOT, BOTH_FAIL = ("different", "equivalent within δ", "cannot tell at this noise",
+                                        "both fail their fit tests")
+#: The answers of one test: the three of a valid test, and no test where both laws fail their fit tests.
+VERDICTS = (DIFFERENT, WITHIN, CANNOT, BOTH_FAIL)
+#: The family a single test's p-values are adjusted in when nobody adjusts them together.
+ALONE = "this test alone"
+
+
+@attrs.frozen(eq=False)
+class EquivalenceResult:
+    """The test of law A against law B on one dataset. SI units (stated numbers: stated precisions);
+    chi-square values are at the sigma the likelihood uses."""
+
+    dataset: str
+    law_a: str
+    law_b: str
+    solver_a: str
+    solver_b: str
+    status: str  # ok | skipped | failed
+    verdict: str = ""  # one of VERDICTS when status is ok
+    explanation: str = ""
+    reason: str = ""
+    replicates: int = 0  # the most replicates per null
+    seed: int = 0
+    n_points: int = 0
+    chi2: dict = attrs.field(factory=dict)  # law -> chi2 on the data
+    k: dict = attrs.field(factory=dict)  # law -> identifiable parameters
+    t_obs: float = math.nan  # chi2_A - chi2_B on the data
+    t_a: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # T on replicates of A's fit (failed refits dropped)
+    t_b: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # T on replicates of B's fit
+    c_a: float = math.nan  # B refitted to A's best curve: T's location under A is -c_a
+    c_b: float = math.nan  # A refitted to B's best curve: T's location under B is c_b
+    s_a: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # S_A = T + c_a on A's replicates (own refits' c_a)
+    s_b: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # S_B = T - c_b on B's replicates
+    p_a: float = math.nan  # P(S_A* >= S_A | A): small rejects A
+    p_b: float = math.nan  # P(S_B* <= S_B | B): small rejects B
+    q_a: float = math.nan  # P(S_A* <= S_A | A): small means the data lie beyond A's replicates on A's favourable side
+    q_b: float = math.nan  # P(S_B* >= S_B | B): likewise for B
+    p: float = math.nan  # two-sided: min(1, 2 min(p_A, p_B)); nan when both laws fail their fit tests
+    power_a: float = math.nan  # share of B's replicates that reject A at ALPHA / 2
+    power_b: float = math.nan  # share of A's replicates that reject B at ALPHA / 2
+    failed: int = 0  # replicates dropped because a refit failed
+    stopped: str = ""  # why sampling stopped
+    d_ab: float = math.nan  # A refitted to B's best curve: chi2 at the sigma used
+    d_ba: float = math.nan  # B refitted to A's best curve
+    sigma: float = math.nan  # sigma of the observable the likelihood uses (SI; the largest if it varies)
+    sigma_varies: bool = False
+    noise: str = ""  # the likelihood's noise kind: known | estimated | stated
+    observable: str = ""
+    rms: float = math.nan  # RMS difference of the two best curves (SI; 'stated': in stated precisions)
+    fits: dict = attrs.field(factory=dict)  # law -> passes its own fit tests (True / False / None)
+    goodness: dict = attrs.field(factory=dict)  # law -> its fit tests' reason (one phrase)
+    qualitative: dict = attrs.field(factory=dict)  # qualitative.qualitative: shared curve features
+    fitted: dict = attrs.field(factory=dict)  # law -> {param: SI value}
+    decomposition: Decomposition | None = None  # the paper's decomposition (wear [series] only)
+    margin: float = math.nan  # delta (SI; 'stated': stated precisions)
+    margin_text: str = ""  # 'δ = 1 × σ = 0.003 m/s (the default margin)'
+    margin_relative: bool = True  # delta is a multiple of the noise (re-estimated per replicate where estimated)
+    margin_sigmas: float = math.nan  # delta over the noise sigma (RMS; 'stated': delta itself, in stated precisions)
+    x_a: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # distance / delta of the refitted curves, A's replicates
+    x_b: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # ... on B's replicates
+    x_null_a: float = math.nan  # A's best curve against B refitted to it, / delta: the distance if A is the truth
+    x_null_b: float = math.nan  # B's best curve against A refitted to it, / delta
+    upper: float = math.nan  # upper (1 - ALPHA) bound of the distance (SI; 'stated': stated precisions)
+    p_within: float = math.nan  # p-value of 'the curves differ by delta or more'
+    p_adjusted: float = math.nan  # p after the family's adjustment (Holm)
+    p_within_adjusted: float = math.nan
+    family: str = ALONE  # the family the p-values were adjusted in
+
+    @property
+    def ok(self) -> bool:
+        """True when the test was run (status 'ok')."""
+        return self.status == "ok"
+
+    @property
+    def tested(self) -> bool:
+        """Whether the pair got p-values (ok, and not both laws failing their fit tests)."""
+        return self.ok and self.verdict != BOTH_FAIL
+
+    @property
+    def label(self) -> str:
+        """'law A [solver] vs law B [solver] on DATASET'."""
+        return f"{self.law_a} [{self.solver_a}] vs {self.law_b} [{self.solver_b}]"
+
+    @property
+    def involves_series(self) -> bool:
+        """True when one side is the paper's truncated series."""
+        return "series" in (self.solver_a, self.solver_b)
+
+    @property
+    def within(self) -> bool:
+        """Whether the curves are shown to lie within delta (after the family's adjustment)."""
+        return self.tested and self.p_within_adjusted < ALPHA
+
+    def scale(self, d: float) -> float:
+        """Noise (as a multiple of the sigma used) at which a cross-fit leaving ``d`` misses by CRITICAL."""
+        if not math.isfinite(d):
+            return math.nan
+        return 0.0 if d <= TIE_REL * max(self.n_points, 1) else math.sqrt(d / CRITICAL)
+
+    @property
+    def threshold(self) -> float:
+        """The larger of the two threshold noises (SI; 0: one curve; nan if unknown): below it at least
+        one direction is detected about half the time."""
+        return max(self.scale(self.d_ab), self.scale(self.d_ba)) * self.sigma
+
+    def mc_error(self, p: float) -> float:
+        """Monte-Carlo standard error of a p-value from the replicates drawn."""
+        m = min(self.s_a.size, self.s_b.size) or 1
+        return math.sqrt(max(p * (1 - p), 0.0) / m) if math.isfinite(p) else math.nan
+
+    def quantity(self, x: float) -> str:
+        """A distance in the observable's display unit ('0.078 m/s', '13.2 stated precisions')."""
+        if self.observable == "stated":
+            return f"{_num(x)} stated precision{'s' * (abs(x) != 1)}"
+        name, f = unit(self.observable)
+        return f"{_num(x * f)} {name}"
+
+    def _noise(self, s: float) -> str:
+        if self.observable == "stated":
+            return f"{_num(s)} × the stated precision"
+        name, f = unit(self.observable)
+        return f"σ = {_num(s * self.sigma * f)} {name}"
+
+    def threshold_text(self) -> str:
+        """Both directions of the noise threshold, with the curves' RMS difference beside them."""
+        sa, sb = self.scale(self.d_ab), self.scale(self.d_ba)
+        if not (math.isfinite(sa) and math.isfinite(sb)):
+            return ""
+        a, b = f"{self.law_a} [{self.solver_a}]", f"{self.law_b} [{self.solver_b}]"
+        if sa == 0.0 and sb == 0.0:
+            return f"one curve: {a} and {b} give the same curve, indistinguishable at any noise"
+        if self.observable == "stated":
+            used, rms = "the stated precision", f"{_num(self.rms)} stated precisions"
+        else:
+            name, f = unit(self.observable)
+            used = f"σ used: {_num(self.sigma * f)} {name}{' (largest)' if self.sigma_varies else ''}, {self.noise}"
+            rms = f"{_num(self.rms * f)} {name}"
+        return (f"a fit of {a} to {b}'s curve misses it by χ² {CRITICAL:g} (about 50% power to reject {self.law_a}) "
+                f"at {self._noise(sa)}, of {b} to {a}'s at {self._noise(sb)} ({used}); the two best curves differ "
+                f"by {rms} RMS")
+
+    def as_dict(self) -> dict:
+        """The result as plain values, as results.json records it."""
+        d = {k: v for k, v in attrs.asdict(self, recurse=False).items() if k != "decomposition"}
+        for k in ("t_a", "t_b", "s_a", "s_b", "x_a", "x_b"):
+            d[k] = getattr(self, k).tolist()
+        d["s_obs_a"], d["s_obs_b"] = self.t_obs + self.c_a, self.t_obs - self.c_b
+        d["p_a_mc_error"], d["p_b_mc_error"] = self.mc_error(self.p_a), self.mc_error(self.p_b)
+        d["alpha"], d["critical_dchi2"] = ALPHA, CRITICAL
+        d["threshold"], d["threshold_ab"], d["threshold_ba"] = (self.threshold, self.scale(self.d_ab) * self.sigma,
+                                                                self.scale(self.d_ba) * self.sigma)
+        d["threshold_text"] = self.threshold_text()
+        d["within"] = self.within
+        d["decomposition"] = self.decomposition.as_dict() if self.decomposition else None
+        return d
+
+
+def _num(x: float) -> str:
+    return f"{x:,.0f}" if abs(x) >= 100 else f"{x:.3g}"
+
+
+def sentence(text: str) -> str:
+    """``text`` as one sentence: a plain first word capitalized (never a name: a registered law, a dataset or a
+    symbol such as chi2, eta' or impact-golf-v28 stays as written), one full stop at the end ('' stays '')."""
+    import re
+
+    from ...physics.registry import available_laws
+
+    text = text.strip()
+    if not text:
+        return ""
+    m = re.match(r"[a-z]+(?=[\s,:;.)]|$)", text)
+    if m and m.group(0) not in available_laws():
+        text = text[0].upper() + text[1:]
+    return text if text.endswith((".", "!", "?")) else text + "."
+
+
+def sentences(*parts: str) -> str:
+    """Sentences joined by spaces, each made whole by ``sentence`` (empty parts dropped)."""
+    return " ".join(s for s in (sentence(p) for p in parts) if s)
+
+
+# --- the test -------------------------------------------------------------------------------------
+@with_own_errstate
+def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = REPLICATES, seed: int = 0,
+                        executor: Executor | None = None, chunk: int | None = None,
+                        timeout: float | None = None, margin: float | str = MARGIN) -> EquivalenceResult:
+    """The test of ``fit_a``'s law against ``fit_b``'s on their (common) dataset (module docstring).
+
+    replicates: the most replicates per null (sequential sampling stops earlier once the decision is
+    clear); seed: the draws depend on it and on the dataset and the pair only. executor: None (here) or
+    anything with ``submit`` (see bootstrap.py); chunk: replicates per task within a batch; timeout:
+    time budget of each refit in seconds (None: none), past which it counts as a failed refit. margin:
+    delta, a multiple of the noise (number) or a quantity in the observable's unit ('150 rpm'; ``margin``
+    module). The verdict is the test's own (a family of one): ``equivalence_groups.adjust_family`` decides a
+    report's tests together."""
+    base = dict(dataset=fit_a.datasets[0], law_a=fit_a.law, law_b=fit_b.law, solver_a=fit_a.solver,
+                solver_b=fit_b.solver, replicates=int(replicates), seed=int(seed))
+    if fit_a.datasets != fit_b.datasets or len(fit_a.datasets) != 1:
+        raise FrictionLabError(f"equivalence: the two fits must be of one and the same dataset "
+                               f"({', '.join(fit_a.datasets)} / {', '.join(fit_b.datasets)})")
+    margin = parse_margin(margin)
+    if not (fit_a.ok and fit_b.ok):
+        bad = fit_a if not fit_a.ok else fit_b
+        return EquivalenceResult(**base, status="skipped", reason=f"{bad.law} [{bad.solver}] {bad.status}: {bad.reason}")
+    if replicates < MIN_REPLICATES:
+        raise ParameterError(f"equivalence: replicates must be at least {MIN_REPLICATES} (so that a p-value can fall "
+                             f"below {ALPHA / 2:g}), got {replicates}")
+    if fit_a.stats.likelihood not in ("known", "estimated", "stated"):
+        return EquivalenceResult(**base, status="skipped",
+                                 reason=f"no likelihood to test with ({fit_a.stats.likelihood_reason})")
+    common = _common(fit_a, fit_b, timeout, margin)
+    d_ab, d_ba = cross_chi2(fit_a, fit_b, timeout), cross_chi2(fit_b, fit_a, timeout)
+    t_obs = float(fit_a.stats.chisqr - fit_b.stats.chisqr)
+    if common["fits"].get(fit_a.law) is False and common["fits"].get(fit_b.law) is False:
+        e = EquivalenceResult(**base, **common, status="ok", t_obs=t_obs, d_ab=d_ab, d_ba=d_ba,
+                              stopped="no replicates: both laws fail their fit tests")
+        return decide(e)
+    tol = TIE_REL * max(common["n_points"], fit_a.stats.chisqr, fit_b.stats.chisqr)
+    (c_a, x_null_a), (c_b, x_null_b) = _centrings(fit_a, fit_b, timeout, common["margin"])
+    if not (math.isfinite(c_a) and math.isfinite(c_b)):
+        return EquivalenceResult(**base, **common, status="failed", t_obs=t_obs, d_ab=d_ab, d_ba=d_ba,
+                                 reason="a law's refit to the other's best curve failed: T cannot be centred")
+    obs = (t_obs + c_a, t_obs - c_b)
+    rows, failed, stopped, drawn = _sample(fit_a, fit_b, replicates, seed, obs, tol, executor, chunk, timeout)
+    t_a, s_a, x_a = rows["a"]
+    t_b, s_b, x_b = rows["b"]
+    if not common["margin_relative"]:  # a margin given as a quantity does not move with the replicate's sigma
+        x_a, x_b = rows["a_abs"], rows["b_abs"]
+    x_a, x_b = x_a / common["margin"], x_b / common["margin"]
+    res = dict(**base, **common, t_obs=t_obs, t_a=t_a, t_b=t_b, c_a=c_a, c_b=c_b, s_a=s_a, s_b=s_b, failed=failed,
+               d_ab=d_ab, d_ba=d_ba, stopped=stopped, x_a=x_a, x_b=x_b, x_null_a=x_null_a, x_null_b=x_null_b)
+    if min(s_a.size, s_b.size) < MIN_REPLICATES // 2:
+        return EquivalenceResult(**res, status="failed",
+                                 reason=f"{failed} of {2 * drawn} replicate refits failed: too few left to test")
+    p_a, p_b = _p_side(s_a, obs[0], tol), _p_side(-s_b, -obs[1], tol)
+    crit_a, crit_b = float(np.quantile(t_a, 1 - ALPHA / 2)), float(np.quantile(t_b, ALPHA / 2))
+    upper, p_within = within_bound(common["rms"] / common["margin"], (x_a, x_null_a), (x_b, x_null_b))
+    p = min(1.0, 2 * min(p_a, p_b))
+    res.update(p_a=p_a, p_b=p_b, p=p, q_a=_p_upper(-s_a, -obs[0], tol), q_b=_p_upper(s_b, obs[1], tol),
+               power_a=float(np.mean(t_b > crit_a + tol)), power_b=float(np.mean(t_a < crit_b - tol)),
+               upper=upper * common["margin"], p_within=p_within, p_adjusted=p, p_within_adjusted=p_within)
+    return decide(EquivalenceResult(**res, status="ok"))
+
+
+def within_bound(x: float, *nulls) -> tuple[float, float]:
+    """(upper (1 - ALPHA) bound of the distance in margins, p-value of 'the distance is a margin or more') from
+    the distance ``x`` on the data and, per null, (its replicates' distances, the distance under that null):
+    the larger bound and p over the nulls (module docstring, 5)."""
+    from scipy.stats import t as student
+
+    bounds, ps = [], []
+    for sample, truth in nulls:
+        sample = sample[np.isfinite(sample)]
+        m = sample.size
+        if m < 2 or not math.isfinite(truth):
+            return math.inf, 1.0
+        err = sample - truth
+        centre, spread = x - float(np.mean(err)), float(np.std(err, ddof=1)) * math.sqrt(1 + 1 / m)
+        bounds.append(centre + float(student.ppf(1 - ALPHA, m - 1)) * spread)
+        if spread > 0:
+            ps.append(float(student.sf((1.0 - centre) / spread, m - 1)))
+        else:  # the same curve on every replicate: the bound is the distance itself
+            ps.append(0.0 if centre < 1.0 else 1.0)
+    return max(bounds), max(ps)
+
+
+def _common(fit_a: FitResult, fit_b: FitResult, timeout: float | None, margin: Margin) -> dict:
+    """The fields of a result that describe the data, the two fits and the margin (the qualitative comparison,
+    which simulates both fitted laws, within the time budget of a refit)."""
+    da, db = fit_a.per_dataset[0], fit_b.per_dataset[0]
+    target = da.target
+    sig = np.asarray(target.sigma, dtype=float)
+    delta, delta_text = margin.resolve(target, fit_a.datasets[0])
+    return dict(n_points=int(target.y.size), observable=target.observable, sigma=float(np.max(sig)),
+                sigma_varies=bool(np.ptp(sig) > 1e-12 * np.max(sig)) and target.observable != "stated",
+                noise=fit_a.stats.likelihood, rms=distance(target, da.model, db.model),
+                fitted={f.law: {k: p.value for k, p in f.params.items() if p.kind == "law"} for f in (fit_a, fit_b)},
+                decomposition=decomposition(fit_a) or decomposition(fit_b),
+                fits={f.law: (f.goodness.fits if f.goodness is not None else None) for f in (fit_a, fit_b)},
+                goodness={f.law: (f.goodness.reason if f.goodness is not None else "") for f in (fit_a, fit_b)},
+                qualitative=_qualitative_within(fit_a, fit_b, timeout),
+                chi2={fit_a.law: fit_a.stats.chisqr, fit_b.law: fit_b.stats.chisqr},
+                k={fit_a.law: fit_a.stats.n_params, fit_b.law: fit_b.stats.n_params},
+                margin=delta, margin_text=delta_text,
+                margin_relative=margin.relative and target.observable != "stated",
+                margin_sigmas=delta if target.observable == "stated" else delta / float(np.sqrt(np.mean(sig * sig))))
+
+
+def _qualitative_within(fit_a, fit_b, timeout: float | None) -> dict:
+    """``qualitative`` within ``timeout`` seconds (None: no limit); past it, 'not applicable'."""
+    from ...core.workers import beat
+    from ..fitting.model import FitTimeout, _alarm
+
+    beat()  # in a child of inference.fitting.guard: the simulations have the budget of one refit
+    try:
+        with _alarm(timeout):
+            return qualitative(fit_a, fit_b)
+    except FitTimeout:
+        return {"verdict": "not applicable", "differs": "", "data_differs": {}, "features": {}, "dt": float("nan"),
+                "peak_time": {}}
+
+
+def _centrings(fit_a, fit_b, timeout, delta: float) -> tuple[tuple[float, float], tuple[float, float]]:
+    """((B refitted to A's best curve: chi-square, A's curve's distance from it / delta), (A refitted to B's
+    curve: likewise)), each refit warm-started at its own fit to the data, as on every replicate (0 for one
+    model)."""
+    if one_family(fit_a, fit_b):
+        return (0.0, 0.0), (0.0, 0.0)
+    da, db = fit_a.per_dataset[0], fit_b.per_dataset[0]
+    opts_a, opts_b = (refit_options(f) | {"timeout": timeout} for f in (fit_a, fit_b))
+    out = []
+    for law, opts, curve in ((fit_b.law, opts_b, da.model), (fit_a.law, opts_a, db.model)):
+        chi, model = centring_fit(law, opts, None, da.target, curve)
+        out.append((chi, distance(da.target, curve, model) / delta if model is not None else math.nan))
+    return out[0], out[1]
+
+
+def _sample(fit_a, fit_b, most, seed, obs, tol, executor, chunk, timeout):
+    """Replicates under A's fit and under B's, in batches until the decision is clear (module docstring, 3).
+    Returns ({'a': (T, S_A, D / sigma-ratio), 'b': (T, S_B, D / sigma-ratio), 'a_abs': D, 'b_abs': D}, failed
+    refits, why sampling stopped, replicates drawn per null); failed replicates dropped. D / sigma-ratio is
+    the distance in units of the replicate's own noise estimate over the data's (the distance itself for a
+    measured sigma)."""
+    if one_family(fit_a, fit_b):  # one model: both refits of every replicate are the same fit, T* = 0, D* = 0
+        zeros = np.zeros(MIN_REPLICATES)
+        rows = {"a": (zeros, zeros.copy(), zeros.copy()), "b": (zeros.copy(), zeros.copy(), zeros.copy()),
+                "a_abs": zeros.copy(), "b_abs": zeros.copy()}
+        return rows, 0, "one model: T* = 0 on every replicate", MIN_REPLICATES
+    from ..resampling.replicates import seed_sequence
+
+    da, db = fit_a.per_dataset[0], fit_b.per_dataset[0]
+    opts_a, opts_b = (refit_options(f) | {"timeout": timeout} for f in (fit_a, fit_b))
+    est = (da.target.dataset.noise_est.get(da.target.observable) if fit_a.stats.likelihood == "estimated"
+           and getattr(da.target.dataset, "noise_correlation", "none") == "none" else None)  # AR(1): each refit
+    # estimates its own sigma from its replicate, so no draw of sigma is added
+    args = (fit_a.law, opts_a, fit_b.law, opts_b, da.target, da.model, db.model)
+    df = float(est.df) if est is not None else math.inf
+    ss = seed_sequence(seed, f"{fit_a.datasets[0]}|{fit_a.law}[{fit_a.solver}]|{fit_b.law}[{fit_b.solver}]")
+    found, why = [], f"the most replicates ({most} per null) drawn"
+    col = {name: i for i, name in enumerate(ROW)}
+    while len(found) < most:
+        batch = ss.spawn(min(BATCH, most - len(found)))
+        if executor is None:
+            found += replicate_chunk(*args, batch, df=df)
+        else:
+            size = max(1, int(chunk or math.ceil(len(batch) / 4)))
+            futures = [executor.submit(replicate_chunk, *args, batch[i:i + size], df=df)
+                       for i in range(0, len(batch), size)]
+            found += [r for fut in futures for r in fut.result()]
+        arr = np.array(found, dtype=float).reshape(-1, len(ROW))
+        ok_a = np.isfinite(arr[:, [col["t_a"], col["s_a"], col["d_a"]]]).all(axis=1)
+        ok_b = np.isfinite(arr[:, [col["t_b"], col["s_b"], col["d_b"]]]).all(axis=1)
+        ratio = arr[:, col["sigma_ratio"]]
+        rows = {"a": (arr[ok_a, col["t_a"]], arr[ok_a, col["s_a"]], arr[ok_a, col["d_a"]] / ratio[ok_a]),
+                "b": (arr[ok_b, col["t_b"]], arr[ok_b, col["s_b"]], arr[ok_b, col["d_b"]] / ratio[ok_b]),
+                "a_abs": arr[ok_a, col["d_a"]], "b_abs": arr[ok_b, col["d_b"]]}
+        done = _clear(rows["a"][1], obs[0], -rows["b"][1], -obs[1], tol)
+        if done:
+            why = f"{done} after {len(found)} replicates per null"
+            break
+    failed = int(np.sum(~ok_a) + np.sum(~ok_b))
+    return rows, failed, why, len(found)
+
+
+def _clear(u_a: np.ndarray, x_a: float, u_b: np.ndarray, x_b: float, tol: float) -> str:
+    """Why the decision is clear from the replicates so far ('' if it is not): each law's p is the upper tail
+    of its observed statistic x among its replicates u (S_A for A; -S_B for B)."""
+    if min(u_a.size, u_b.size) < BATCH // 2:
+        return ""
+    bounds = [_cp(_count(u_a, x_a, tol), u_a.size), _cp(_count(u_b, x_b, tol), u_b.size)]
+    if all(lo > ALPHA / 2 for lo, _ in bounds):
+        return f"every p-value's {CI_LEVEL:.0%} Monte-Carlo interval above {ALPHA / 2:g}"
+    if any(hi < ALPHA / 2 for _, hi in bounds):
+        return f"a p-value's {CI_LEVEL:.0%} Monte-Carlo interval below {ALPHA / 2:g}"
+    if _far(u_a, x_a) or _far(u_b, x_b):
+        return f"the data lie beyond every replicate of one law, with a tail-estimated p below {FAR_P:g}"
+    return ""
+
+
+def _tail(sample: np.ndarray, x: float) -> float:
+    """Exponential-tail estimate of P(S* >= x) from the replicates above their TAIL_Q quantile u, with the
+    mean excess at its one-sided TAIL_CONF upper confidence bound (2 k mean / chi2_2k quantile, k excesses;
+    the plain mean makes the estimate 2-15 times too small in a fifth of cases for chi-square-like nulls,
+    tests/test_equivalence_shortcut.py). nan if no excess."""
+    from scipy.stats import chi2
+
+    u = float(np.quantile(sample, TAIL_Q))
+    excess = sample[sample > u] - u
+    if not excess.size or not excess.mean() > 0:
+        return math.nan
+    scale = float(excess.mean()) * 2 * excess.size / float(chi2.ppf(1 - TAIL_CONF, 2 * excess.size))
+    return (1 - TAIL_Q) * math.exp(-(x - u) / scale)
+
+
+def _far(sample: np.ndarray, x: float) -> bool:
+    """Whether x lies above every value of sample (of at least FAR_MIN) with a tail-estimated p below FAR_P."""
+    return sample.size >= FAR_MIN and x > float(sample.max()) and _tail(sample, x) < FAR_P
+
+
+def _p_side(sample: np.ndarray, x: float, tol: float) -> float:
+    """The upper-tail p of x: Monte-Carlo, or below its floor the tail estimate where x is far beyond (_far)."""
+    p = _p_upper(sample, x, tol)
+    return min(p, max(_tail(sample, x), TAIL_FLOOR)) if _far(sample, x) else p
+
+
+def _count(sample: np.ndarray, x: float, tol: float) -> float:
+    return float(np.sum(sample > x + tol)) + 0.5 * float(np.sum(np.abs(sample - x) <= tol))
+
+
+def _cp(k: float, m: int) -> tuple[float, float]:
+    """Clopper-Pearson CI_LEVEL interval of a proportion k / m (k may be a half count: rounded up/down)."""
+    from scipy.special import betaincinv
+
+    a = (1 - CI_LEVEL) / 2
+    lo_k, hi_k = math.floor(k), math.ceil(k)
+    lo = 0.0 if lo_k == 0 else float(betaincinv(lo_k, m - lo_k + 1, a))
+    hi = 1.0 if hi_k >= m else float(betaincinv(hi_k + 1, m - hi_k, 1 - a))
+    return lo, hi
+
+
+def _p_upper(sample: np.ndarray, x: float, tol: float) -> float:
+    """(1 + #{sample > x} + #{ties} / 2) / (m + 1): the bootstrap p-value of x in the upper tail."""
+    return (1.0 + _count(sample, x, tol)) / (sample.size + 1.0)
+
+
+def _p(p: float) -> str:
+    return f"{p:.2g}"
+
+
+def decide(e: EquivalenceResult) -> EquivalenceResult:
+    """``e`` with its verdict and explanation decided from its (family-adjusted) p-values: sentences built
+    from whole parts, each ending in a full stop."""
+    a, b = f"{e.law_a} [{e.solver_a}]", f"{e.law_b} [{e.solver_b}]"
+    quali = qual_text(e.qualitative, e.law_a, e.law_b) if e.qualitative.get("verdict") not in (None, "not applicable") \
+        else ""
+    tail = [e.threshold_text(), f"qualitatively (shared curve features): {quali}" if quali else ""]
+    if one_family_result(e):
+        tail.append("both laws span one closed-form family here (one model), so each replicate's two refits are the "
+                    "same fit and T* = 0 on every replicate, without refitting")
+    if e.fits.get(e.law_a) is False and e.fits.get(e.law_b) is False:
+        better = e.law_a if e.chi2[e.law_a] < e.chi2[e.law_b] else e.law_b
+        worse = e.law_b if better == e.law_a else e.law_a
+        d_aic = (e.chi2[worse] - e.chi2[better]) + 2 * (e.k[worse] - e.k[better])
+        what = "stated numbers" if e.observable == "stated" else "points"
+        gap = e.chi2[worse] - e.chi2[better]
+        less = (f"{better} misses less (Δχ² = {_num(gap)}, ΔAIC = {_num(d_aic)}), which says which description is less "
+                "poor, not that either holds" if gap > TIE_REL * max(e.n_points, e.chi2[better])
+                else "they miss equally (one curve)")
+        text = sentences(
+            f"no test: {a} and {b} both fail their own fit tests ({e.law_a}: {e.goodness.get(e.law_a) or 'fails'}; "
+            f"{e.law_b}: {e.goodness.get(e.law_b) or 'fails'}), so neither is a valid null for the other and the pair "
+            "gets no p-value",
+            f"their misfits only: χ² = {_num(e.chi2[e.law_a])} ({e.law_a}) and {_num(e.chi2[e.law_b])} ({e.law_b}) "
+            f"over {e.n_points} {what}; {less}",
+            f"the two best curves differ by {e.quantity(e.rms)} RMS (the margin: {e.margin_text})", *tail)
+        return attrs.evolve(e, verdict=BOTH_FAIL, explanation=text, p=math.nan, p_adjusted=math.nan,
+                            p_within=math.nan, p_within_adjusted=math.nan)
+    m = min(e.t_a.size, e.t_b.size)
+    adjusted = "" if e.family == ALONE else f" ({e.family}: adjusted p = {_p(e.p_adjusted)})"
+    head = (f"T = χ²({e.law_a}) − χ²({e.law_b}) = {e.t_obs:.4g} on the data ({e.noise} σ), centred at its location "
+            f"under each fit ({e.t_obs + e.c_a:.3g} under {e.law_a}, {e.t_obs - e.c_b:.3g} under {e.law_b}); against {m} "
+            f"replicates from each fit ({e.stopped}): p = {_p(e.p_a)} ± {e.mc_error(e.p_a):.1g} under {a}, "
+            f"p = {_p(e.p_b)} ± {e.mc_error(e.p_b):.1g} under {b}; two-sided p = {_p(e.p)}{adjusted} at α = {ALPHA:g}")
+    power = (f"the test rejects {a} on {100 * e.power_a:.0f}% of {b}'s replicates and {b} on "
+             f"{100 * e.power_b:.0f}% of {a}'s")
+    different = e.p_adjusted < ALPHA
+    if different:
+        rej_a = e.p_a <= e.p_b
+        bad, good = (a, b) if rej_a else (b, a)
+        good_law = e.law_b if rej_a else e.law_a
+        q = e.q_b if rej_a else e.q_a
+        own = e.p_b if rej_a else e.p_a  # the kept law's own p: below alpha / 2 it is rejected too
+        if own < ALPHA / 2:
+            which = (f"the data reject {bad}, and {good} too (p = {_p(own)} under {good}, below α/2): "
+                     "the data are like neither")
+        elif q < ALPHA / 2:
+            which = (f"the data reject {bad}, and lie beyond {good}'s replicates on its favourable side "
+                     f"(p = {_p(q)}): the data are not like {good}'s either")
+        elif e.fits.get(good_law) is False:
+            which = f"the data reject {bad} against {good}, but {good} fails its own fit tests: the data are like neither"
+        else:
+            which = f"the data reject {bad} and are consistent with {good}"
+    else:
+        unfit = [f"{law} fails its own fit tests" for law, ok in e.fits.items() if ok is False]
+        which = "T rejects neither law" + (f" ({'; '.join(unfit)})" if unfit else "")
+    inside = e.p_within_adjusted < ALPHA
+    adjusted_w = "" if e.family == ALONE else f", adjusted {_p(e.p_within_adjusted)}"
+    dist = (f"the two best curves differ by {e.quantity(e.rms)} RMS; the upper {1 - ALPHA:.0%} bound of that "
+            f"distance, {e.quantity(e.upper) if math.isfinite(e.upper) else 'not available'}, "
+            f"{'lies below' if inside else 'does not lie below'} the margin {e.margin_text} (p = {_p(e.p_within)}"
+            f"{adjusted_w} for a distance of δ or more)")
+    if different:
+        verdict = DIFFERENT
+        say = ("so: different, though by less than δ: the data tell the laws apart, but their curves lie within the "
+               "margin" if inside else "so: different")
+    elif inside and e.margin_sigmas < MIN_MARGIN * (1 - 1e-9) and not one_family_result(e):
+        verdict, say = CANNOT, (f"so: cannot tell at this noise: neither law is rejected, and δ is {e.margin_sigmas:.2g} "
+                                f"σ, tighter than the {MIN_MARGIN:g} σ below which a bound of the distance is not "
+                                "calibrated (the fitted curves' own uncertainty decides it there)")
+    elif inside:
+        verdict, say = WITHIN, (f"so: equivalent within δ: neither law is rejected and their curves are shown to lie "
+                                f"within {e.margin_text.split(', ')[0]}")
+    else:
+        verdict, say = CANNOT, ("so: cannot tell at this noise: neither law is rejected, and the curves are not shown "
+                                "to lie within δ")
+    return attrs.evolve(e, verdict=verdict, explanation=sentences(head, which, dist, say, power, *tail))
+
+
+def one_family_result(e: EquivalenceResult) -> bool:
+    """Whether ``e`` was decided by the one-model shortcut (``one_family``)."""
+    return e.stopped.startswith("one model")
