@@ -73,9 +73,10 @@ import math
 import attrs
 import numpy as np
 
-from ...core.display import unit
 from ...core.errors import FrictionLabError, ParameterError
-from .decomposition import Decomposition, decomposition
+from .decomposition import decomposition
+from .result import (ALONE, ALPHA, BOTH_FAIL, CANNOT, CRITICAL, DIFFERENT, TIE_REL, VERDICTS,  # noqa: F401
+                     WITHIN, EquivalenceResult, number_text as _num)
 from ..fitting.fit import FitResult
 from .margin import MARGIN, Margin, parse_margin
 from .qualitative import qualitative
@@ -86,8 +87,6 @@ from ...core.fpstate import with_own_errstate
 WEAR, AREA_RATE, COUETTE, COULOMB = "wear", "area-rate", "couette", "coulomb"
 #: The pairs ``compare`` tests by default: the paper's claim, the structural identity, and the simplest law against the paper's.
 PAIRS = ((WEAR, AREA_RATE), (WEAR, COUETTE), (COULOMB, WEAR))
-ALPHA = 0.05  # level of every test of a report (family-wise, Holm): different, and equivalent within delta
-CRITICAL = 3.84  # chi-square (1 dof, 95%) by which a cross-fit misses at the threshold noise
 #: The tightest margin, in noise sigmas, at which 'equivalent within delta' is said where the replicates' distances
 #: vary: benchmarks/calibration.py measured the bound below delta where the curves differ by delta in at most 6%
 #: of datasets at delta = 1 sigma, and in 23% at 0.25 sigma (the fitted curves' own uncertainty, not the bound's
@@ -102,167 +101,8 @@ TAIL_Q = 0.75  # the exponential tail is fitted to the replicates above this qua
 TAIL_CONF = 0.95  # ... with its scale (mean excess) at this upper confidence bound
 FAR_P = ALPHA / 20  # ... when that tail puts T's p below this (clear of any Holm level up to 10 members)
 TAIL_FLOOR = 1e-6  # a tail estimate is extrapolation: smaller values are reported as this bound
-TIE_REL = 1e-4  # |T* - T| below this fraction of max(n, chi2) is a tie (the optimizer's resolution)
-DIFFERENT, WITHIN, CANNOT, BOTH_FAIL = ("different", "equivalent within δ", "cannot tell at this noise",
-                                        "both fail their fit tests")
-#: The answers of one test: the three of a valid test, and no test where both laws fail their fit tests.
-VERDICTS = (DIFFERENT, WITHIN, CANNOT, BOTH_FAIL)
-#: The family a single test's p-values are adjusted in when nobody adjusts them together.
-ALONE = "this test alone"
 
 
-@attrs.frozen(eq=False)
-class EquivalenceResult:
-    """The test of law A against law B on one dataset. SI units (stated numbers: stated precisions);
-    chi-square values are at the sigma the likelihood uses."""
-
-    dataset: str
-    law_a: str
-    law_b: str
-    solver_a: str
-    solver_b: str
-    status: str  # ok | skipped | failed
-    verdict: str = ""  # one of VERDICTS when status is ok
-    explanation: str = ""
-    reason: str = ""
-    replicates: int = 0  # the most replicates per null
-    seed: int = 0
-    n_points: int = 0
-    chi2: dict = attrs.field(factory=dict)  # law -> chi2 on the data
-    k: dict = attrs.field(factory=dict)  # law -> identifiable parameters
-    t_obs: float = math.nan  # chi2_A - chi2_B on the data
-    t_a: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # T on replicates of A's fit (failed refits dropped)
-    t_b: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # T on replicates of B's fit
-    c_a: float = math.nan  # B refitted to A's best curve: T's location under A is -c_a
-    c_b: float = math.nan  # A refitted to B's best curve: T's location under B is c_b
-    s_a: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # S_A = T + c_a on A's replicates (own refits' c_a)
-    s_b: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # S_B = T - c_b on B's replicates
-    p_a: float = math.nan  # P(S_A* >= S_A | A): small rejects A
-    p_b: float = math.nan  # P(S_B* <= S_B | B): small rejects B
-    q_a: float = math.nan  # P(S_A* <= S_A | A): small means the data lie beyond A's replicates on A's favourable side
-    q_b: float = math.nan  # P(S_B* >= S_B | B): likewise for B
-    p: float = math.nan  # two-sided: min(1, 2 min(p_A, p_B)); nan when both laws fail their fit tests
-    power_a: float = math.nan  # share of B's replicates that reject A at ALPHA / 2
-    power_b: float = math.nan  # share of A's replicates that reject B at ALPHA / 2
-    failed: int = 0  # replicates dropped because a refit failed
-    stopped: str = ""  # why sampling stopped
-    d_ab: float = math.nan  # A refitted to B's best curve: chi2 at the sigma used
-    d_ba: float = math.nan  # B refitted to A's best curve
-    sigma: float = math.nan  # sigma of the observable the likelihood uses (SI; the largest if it varies)
-    sigma_varies: bool = False
-    noise: str = ""  # the likelihood's noise kind: known | estimated | stated
-    observable: str = ""
-    rms: float = math.nan  # RMS difference of the two best curves (SI; 'stated': in stated precisions)
-    fits: dict = attrs.field(factory=dict)  # law -> passes its own fit tests (True / False / None)
-    goodness: dict = attrs.field(factory=dict)  # law -> its fit tests' reason (one phrase)
-    qualitative: dict = attrs.field(factory=dict)  # qualitative.qualitative: shared curve features
-    fitted: dict = attrs.field(factory=dict)  # law -> {param: SI value}
-    decomposition: Decomposition | None = None  # the paper's decomposition (wear [series] only)
-    margin: float = math.nan  # delta (SI; 'stated': stated precisions)
-    margin_text: str = ""  # 'δ = 1 × σ = 0.003 m/s (the default margin)'
-    margin_relative: bool = True  # delta is a multiple of the noise (re-estimated per replicate where estimated)
-    margin_sigmas: float = math.nan  # delta over the noise sigma (RMS; 'stated': delta itself, in stated precisions)
-    x_a: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # distance / delta of the refitted curves, A's replicates
-    x_b: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # ... on B's replicates
-    x_null_a: float = math.nan  # A's best curve against B refitted to it, / delta: the distance if A is the truth
-    x_null_b: float = math.nan  # B's best curve against A refitted to it, / delta
-    upper: float = math.nan  # upper (1 - ALPHA) bound of the distance (SI; 'stated': stated precisions)
-    p_within: float = math.nan  # p-value of 'the curves differ by delta or more'
-    p_adjusted: float = math.nan  # p after the family's adjustment (Holm)
-    p_within_adjusted: float = math.nan
-    family: str = ALONE  # the family the p-values were adjusted in
-
-    @property
-    def ok(self) -> bool:
-        """True when the test was run (status 'ok')."""
-        return self.status == "ok"
-
-    @property
-    def tested(self) -> bool:
-        """Whether the pair got p-values (ok, and not both laws failing their fit tests)."""
-        return self.ok and self.verdict != BOTH_FAIL
-
-    @property
-    def label(self) -> str:
-        """'law A [solver] vs law B [solver] on DATASET'."""
-        return f"{self.law_a} [{self.solver_a}] vs {self.law_b} [{self.solver_b}]"
-
-    @property
-    def involves_series(self) -> bool:
-        """True when one side is the paper's truncated series."""
-        return "series" in (self.solver_a, self.solver_b)
-
-    @property
-    def within(self) -> bool:
-        """Whether the curves are shown to lie within delta (after the family's adjustment)."""
-        return self.tested and self.p_within_adjusted < ALPHA
-
-    def scale(self, d: float) -> float:
-        """Noise (as a multiple of the sigma used) at which a cross-fit leaving ``d`` misses by CRITICAL."""
-        if not math.isfinite(d):
-            return math.nan
-        return 0.0 if d <= TIE_REL * max(self.n_points, 1) else math.sqrt(d / CRITICAL)
-
-    @property
-    def threshold(self) -> float:
-        """The larger of the two threshold noises (SI; 0: one curve; nan if unknown): below it at least
-        one direction is detected about half the time."""
-        return max(self.scale(self.d_ab), self.scale(self.d_ba)) * self.sigma
-
-    def mc_error(self, p: float) -> float:
-        """Monte-Carlo standard error of a p-value from the replicates drawn."""
-        m = min(self.s_a.size, self.s_b.size) or 1
-        return math.sqrt(max(p * (1 - p), 0.0) / m) if math.isfinite(p) else math.nan
-
-    def quantity(self, x: float) -> str:
-        """A distance in the observable's display unit ('0.078 m/s', '13.2 stated precisions')."""
-        if self.observable == "stated":
-            return f"{_num(x)} stated precision{'s' * (abs(x) != 1)}"
-        name, f = unit(self.observable)
-        return f"{_num(x * f)} {name}"
-
-    def _noise(self, s: float) -> str:
-        if self.observable == "stated":
-            return f"{_num(s)} × the stated precision"
-        name, f = unit(self.observable)
-        return f"σ = {_num(s * self.sigma * f)} {name}"
-
-    def threshold_text(self) -> str:
-        """Both directions of the noise threshold, with the curves' RMS difference beside them."""
-        sa, sb = self.scale(self.d_ab), self.scale(self.d_ba)
-        if not (math.isfinite(sa) and math.isfinite(sb)):
-            return ""
-        a, b = f"{self.law_a} [{self.solver_a}]", f"{self.law_b} [{self.solver_b}]"
-        if sa == 0.0 and sb == 0.0:
-            return f"one curve: {a} and {b} give the same curve, indistinguishable at any noise"
-        if self.observable == "stated":
-            used, rms = "the stated precision", f"{_num(self.rms)} stated precisions"
-        else:
-            name, f = unit(self.observable)
-            used = f"σ used: {_num(self.sigma * f)} {name}{' (largest)' if self.sigma_varies else ''}, {self.noise}"
-            rms = f"{_num(self.rms * f)} {name}"
-        return (f"a fit of {a} to {b}'s curve misses it by χ² {CRITICAL:g} (about 50% power to reject {self.law_a}) "
-                f"at {self._noise(sa)}, of {b} to {a}'s at {self._noise(sb)} ({used}); the two best curves differ "
-                f"by {rms} RMS")
-
-    def as_dict(self) -> dict:
-        """The result as plain values, as results.json records it."""
-        d = {k: v for k, v in attrs.asdict(self, recurse=False).items() if k != "decomposition"}
-        for k in ("t_a", "t_b", "s_a", "s_b", "x_a", "x_b"):
-            d[k] = getattr(self, k).tolist()
-        d["s_obs_a"], d["s_obs_b"] = self.t_obs + self.c_a, self.t_obs - self.c_b
-        d["p_a_mc_error"], d["p_b_mc_error"] = self.mc_error(self.p_a), self.mc_error(self.p_b)
-        d["alpha"], d["critical_dchi2"] = ALPHA, CRITICAL
-        d["threshold"], d["threshold_ab"], d["threshold_ba"] = (self.threshold, self.scale(self.d_ab) * self.sigma,
-                                                                self.scale(self.d_ba) * self.sigma)
-        d["threshold_text"] = self.threshold_text()
-        d["within"] = self.within
-        d["decomposition"] = self.decomposition.as_dict() if self.decomposition else None
-        return d
-
-
-def _num(x: float) -> str:
-    return f"{x:,.0f}" if abs(x) >= 100 else f"{x:.3g}"
 
 
 def sentence(text: str) -> str:
@@ -291,15 +131,39 @@ def sentences(*parts: str) -> str:
 def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = REPLICATES, seed: int = 0,
                         executor: Executor | None = None, chunk: int | None = None,
                         timeout: float | None = None, margin: float | str = MARGIN) -> EquivalenceResult:
-    """The test of ``fit_a``'s law against ``fit_b``'s on their (common) dataset (module docstring).
+    """Test one fitted law against another on their common dataset: different, equivalent within a
+    margin, or cannot tell at this noise (the module docstring says how).
 
-    replicates: the most replicates per null (sequential sampling stops earlier once the decision is
-    clear); seed: the draws depend on it and on the dataset and the pair only. executor: None (here) or
-    anything with ``submit`` (see bootstrap.py); chunk: replicates per task within a batch; timeout:
-    time budget of each refit in seconds (None: none), past which it counts as a failed refit. margin:
-    delta, a multiple of the noise (number) or a quantity in the observable's unit ('150 rpm'; ``margin``
-    module). The verdict is the test's own (a family of one): ``equivalence_groups.adjust_family`` decides a
-    report's tests together."""
+    The verdict is the test's own (a family of one); `compare` adjusts a report's tests together.
+
+    Parameters
+    ----------
+    fit_a, fit_b : FitResult
+        The two laws' fits to one dataset.
+    replicates : int
+        The most replicate datasets per null (sequential sampling stops earlier once the decision is clear).
+    seed : int, default 0
+        The draws depend on it, the dataset and the pair only.
+    executor : concurrent.futures.Executor, optional
+        Anything with ``submit`` (a process pool, a Dask client) to run the replicate refits on.
+    chunk : int, optional
+        Replicates per task within a batch.
+    timeout : float, optional
+        Time budget of each refit [s]; past it the refit counts as failed.
+    margin : float or str, default 1
+        The margin delta: a multiple of the noise sigma, or a quantity in the observable's unit
+        (``"150 rpm"``).
+
+    Returns
+    -------
+    EquivalenceResult
+        The verdict with its p-values, distance, bound and margin.
+
+    Raises
+    ------
+    ParameterError
+        The fits are not to one common dataset, or the margin or replicates are out of range.
+    """
     base = dict(dataset=fit_a.datasets[0], law_a=fit_a.law, law_b=fit_b.law, solver_a=fit_a.solver,
                 solver_b=fit_b.solver, replicates=int(replicates), seed=int(seed))
     if fit_a.datasets != fit_b.datasets or len(fit_a.datasets) != 1:
