@@ -34,3 +34,34 @@ def test_every_note_is_printed_once():
     text = f.summary()
     for note in f.notes:
         assert text.count(note) == 1, note
+
+
+def _listed(help_text: str, heading: str) -> dict[str, str]:
+    """name -> help of each entry argparse lists under ``heading`` (COMMAND, ACTION), wrapped lines joined."""
+    block = help_text.split(f"  {heading}\n", 1)[1].split("\n\n", 1)[0]
+    entries: dict[str, str] = {}
+    name = None
+    for line in block.splitlines():
+        words = line.split()
+        if line.startswith("    ") and not line.startswith("      ") and words:
+            name = words[0]
+            entries[name] = " ".join(words[1:])
+        elif name and words:
+            entries[name] += " " + " ".join(words)
+    return entries
+
+
+def test_the_top_level_help_lists_every_command_and_every_datasets_action():
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    cli = Path(sys.executable).with_name("frictionlab")
+    top = subprocess.run([str(cli), "--help"], capture_output=True, text=True, check=True).stdout
+    commands = _listed(top, "COMMAND")
+    assert {"laws", "datasets", "simulate", "fit", "compare"} <= set(commands)
+    actions = _listed(subprocess.run([str(cli), "datasets", "--help"], capture_output=True, text=True,
+                                     check=True).stdout, "ACTION")
+    assert {"show", "template", "rebuild", "import"} <= set(actions)
+    for action in set(actions) - {"list"}:  # 'datasets' alone lists
+        assert action in commands["datasets"], f"'datasets {action}' missing from --help: {commands['datasets']}"
