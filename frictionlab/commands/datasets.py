@@ -12,13 +12,14 @@ def add_parser(sub):
     from ..cli import subcommand
     from ..io.template import KINDS
 
-    p = subcommand(sub, "datasets", help="list, show, start (template) or rebuild datasets",
+    p = subcommand(sub, "datasets", help="list, show, import (raw laboratory records), template (start your own) or rebuild datasets",
                    description="Datasets are a CSV of columns plus a TOML of the same name that gives units, noise, "
                                "the scene and the provenance. 'datasets template KIND' writes a commented pair to "
                                "start from.",
                    examples="""  frictionlab datasets                       # the same as 'datasets list'
   frictionlab datasets show impact-golf-v28
   frictionlab datasets template impact --name my-impact --out .   # my-impact.toml + my-impact.csv
+  frictionlab datasets import velstep experiment.txt --name exp --out data/   # one dataset per velocity step
   frictionlab datasets rebuild --check""")
     p.set_defaults(func=_list)
     acts = p.add_subparsers(dest="action", metavar="ACTION")

@@ -48,7 +48,30 @@ COLUMN_SI = {
 
 @attrs.frozen(eq=False)
 class Dataset:
-    """A loaded dataset: SI arrays by column, the scene, fixed law parameters, provenance."""
+    """A loaded dataset: SI arrays by column, the scene, fixed law parameters and provenance (made by
+    `load_dataset`).
+
+    Attributes
+    ----------
+    name, kind, observable : str
+        The dataset's name, its scene kind and the column the laws are fitted to.
+    columns : dict of str to numpy.ndarray
+        The data by column, SI (``t`` [s], ``theta`` [rad], ``omega`` [rad/s], ``v`` [m/s], ``mu`` [-], ...).
+    units : dict of str to str
+        Each column's unit as its file writes it (what figures and tables show).
+    noise : dict of str to float
+        The noise standard deviation of each column [SI], known or estimated.
+    noise_kind : {"known", "estimated", "none"}
+        Whether sigma was measured, estimated from the data alone, or there is none (a reconstruction).
+    scene : Scene or None
+        The experiment the laws are solved on.
+    fixed : dict of str to float
+        Law parameters the dataset fixes [SI].
+    provenance : Provenance
+        Measured, reported, reconstructed or synthetic, with its source and the command that regenerates it.
+    stated : dict
+        For a reconstruction, the stated numbers (value, precision) the laws are compared on, SI.
+    """
 
     name: str
     kind: str
@@ -93,8 +116,21 @@ class Dataset:
         return len(next(iter(self.columns.values())))
 
     def to_dataframe(self) -> pd.DataFrame:
-        """The columns as a pandas DataFrame (SI; units by column in ``df.attrs['units']``, the file's own
-        units in ``df.attrs['file_units']``, the noise in ``df.attrs['noise']``)."""
+        """The columns as a pandas DataFrame.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One column per data column, SI; units by column in ``df.attrs['units']``, the file's own units in
+            ``df.attrs['file_units']``, the noise in ``df.attrs['noise']``.
+
+        Examples
+        --------
+        >>> import frictionlab as fl
+        >>> df = fl.load_dataset("incline-oil-a100").to_dataframe()
+        >>> df.attrs["units"]["v"]
+        'm/s'
+        """
         import pandas as pd
 
         df = pd.DataFrame(self.columns)
@@ -106,23 +142,59 @@ class Dataset:
         return f"<Dataset {self.name}: {self.kind}, {len(self)} points of {self.observable}, {self.provenance.kind}>"
 
     def shown(self, column: str) -> tuple[str, float]:
-        """(unit, factor) a column is shown in: the unit its file gives it (shown = SI * factor)."""
+        """The unit a column is shown in: the unit its file gives it.
+
+        Parameters
+        ----------
+        column : str
+            A column name.
+
+        Returns
+        -------
+        tuple of (str, float)
+            The unit and the factor from SI: shown value = SI value * factor.
+        """
         from ..core.display import display_unit
 
         return display_unit(column, self.units.get(column), COLUMN_SI.get(column, ""))
 
     def x_axis(self) -> tuple[str, str, float]:
-        """(column, unit shown, factor) of what the observable is drawn against: time, or for one impact
-        per row the incidence angle (else the row number, with column '')."""
+        """What the observable is drawn against: time, or for one impact per row the incidence angle (else
+        the row number, with column '').
+
+        Returns
+        -------
+        tuple of (str, str, float)
+            The column, the unit it is shown in, and the factor from SI.
+        """
         for col in ("t", "incidence", "speed"):
             if col in self.columns:
                 return (col, *self.shown(col))
         return "", "", 1.0
 
     def plot(self, y: str | None = None, ax: Axes | None = None, **style: object) -> Axes:
-        """Draw column ``y`` (default: the observable) against time, or against the incidence angle for one
-        impact per row, in the units of the dataset's file, with its noise as error bars where sigma is
-        known or estimated; returns the Axes (a new figure's if ``ax`` is None)."""
+        """Draw a column against time, or against the incidence angle for one impact per row, in the units of
+        the dataset's file, with its noise as error bars where sigma is known or estimated.
+
+        Parameters
+        ----------
+        y : str, optional
+            The column to draw; default the observable.
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; default a new figure's axes.
+        **style
+            Passed to matplotlib's ``errorbar``.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+
+        Raises
+        ------
+        DatasetError
+            No such column.
+        """
         from ..core.display import axis_label, figure_axes
 
         y = y or self.observable
@@ -194,8 +266,33 @@ def available_names() -> list[str]:
 
 
 def load_dataset(name_or_path: str | Path) -> Dataset:
-    """Load and validate a dataset by built-in name, name of a measured record (``external``), or path to
-    its TOML (or CSV)."""
+    """Load and validate a dataset.
+
+    Parameters
+    ----------
+    name_or_path : str or pathlib.Path or Dataset
+        A built-in name (``frictionlab datasets`` lists them), the name of a measured record present beside
+        the repository or in ``FRICTIONLAB_RAW_DATA``, or the path of a dataset's TOML file (or its CSV). A
+        Dataset is returned as it is.
+
+    Returns
+    -------
+    Dataset
+        SI arrays by column, the scene, the noise, fixed law parameters and the provenance.
+
+    Raises
+    ------
+    DatasetError
+        An unknown name, a file that does not exist, or a file whose content is not a valid dataset (the
+        message names the file, the field and what was expected).
+
+    Examples
+    --------
+    >>> import frictionlab as fl
+    >>> data = fl.load_dataset("impact-golf-v28")
+    >>> data.kind, data.observable, data.provenance.kind
+    ('impact', 'theta', 'reconstructed')
+    """
     if isinstance(name_or_path, Dataset):
         return name_or_path
     from . import external

@@ -357,7 +357,33 @@ class Plan(CompliantPatch):
 
 
 def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan:
-    """Assemble the plan for ``law`` on ``scene``; error if the scene cannot supply what the law needs."""
+    """The plan of a simulation: which contact quantities ``scene`` supplies for ``law``, and how.
+
+    Parameters
+    ----------
+    scene : Scene
+        The experiment (mass, slip, contact-area and normal-force models), SI.
+    law : FrictionLaw
+        The law to be solved on it.
+    scene_name : str, default "scene"
+        The name errors give the scene (a dataset's name).
+
+    Returns
+    -------
+    Plan
+        What `simulate` and the fits evaluate the law with.
+
+    Raises
+    ------
+    PlanError
+        The scene cannot supply a quantity the law requires (the message says which model to add).
+
+    Examples
+    --------
+    >>> import frictionlab as fl
+    >>> scene = fl.load_dataset("impact-golf-v28").scene
+    >>> plan = fl.make_plan(scene, fl.get_law("wear"))
+    """
     missing = set(law.requires) - scene.supplies()
     if missing:
         hint = {"N": "add a [scene.normal] model (half-sine, hertz, column or weight)",

@@ -41,8 +41,34 @@ ALONE = "this test alone"
 
 @attrs.frozen(eq=False)
 class EquivalenceResult:
-    """The test of law A against law B on one dataset. SI units (stated numbers: stated precisions);
-    chi-square values are at the sigma the likelihood uses."""
+    """The test of law A against law B on one dataset (what `analyze_equivalence` returns; `compare` gives
+    one per tested pair in ``Comparison.equivalence``). SI units; for stated numbers, stated precisions.
+
+    Attributes
+    ----------
+    dataset, law_a, law_b, solver_a, solver_b : str
+        What was tested.
+    status : {"ok", "skipped", "failed"}
+        Whether the test ran; ``reason`` says why not.
+    verdict : str
+        One of ``VERDICTS``: "different", "equivalent within δ", "cannot tell at this noise", or "both fail
+        their fit tests" (then ``closer`` says which law is nearer the data by Vuong's test).
+    explanation : str
+        The verdict in sentences.
+    p, p_adjusted : float
+        Two-sided p-value of "neither law is rejected", before and after the family's Holm adjustment.
+    rms, upper : float
+        The RMS difference of the two best curves and its upper confidence bound, in the observable's unit.
+    margin : float
+        The margin delta, in the observable's unit; ``margin_text`` says how it was chosen.
+    p_within, p_within_adjusted : float
+        p-value of "the curves differ by delta or more", before and after adjustment.
+    chi2, fits : dict
+        Each law's chi-square on the data, and whether it passes its own fit tests.
+    statistic, closer : str
+        The statistic the verdict rests on, and, where both laws fail their fit tests, which law is closer to
+        the data (Vuong's non-nested test with a HAC variance) or that they are equally close at this noise.
+    """
 
     dataset: str
     law_a: str

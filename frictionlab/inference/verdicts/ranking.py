@@ -51,7 +51,23 @@ COLUMNS = ("dataset", "law", "solver", "n_points", "n_params", "rss", "rmse", "r
 
 @attrs.frozen
 class RankRow:
-    """One row of ranking.csv. rss and rmse are in the observable's SI unit (nan for groups)."""
+    """One row of the ranking (``ranking.csv``, `Comparison.to_dataframe`).
+
+    Attributes
+    ----------
+    dataset : str
+        The dataset, or a group (``ALL``, ``ALL[kind]``).
+    law, solver, candidate : str
+        The law, its solver, and the candidate they form (``"wear [exact]"``).
+    rank : int
+        Its rank by AIC; candidates within ``TIE_AIC`` share one.
+    rss, rmse : float
+        Residual sum of squares and root mean square in the observable's SI unit (nan for groups).
+    aic, bic, delta_aic, akaike_weight : float
+        Information criteria, the distance to the best, and the Akaike weight among the candidates that fit.
+    fits : bool
+        Whether it passes its goodness-of-fit tests.
+    """
 
     dataset: str
     law: str
@@ -90,7 +106,13 @@ class RankRow:
         return f"{self.law} [{self.solver}]"
 
     def as_dict(self) -> dict:
-        """The row as plain values, as ranking.csv and results.json record it."""
+        """The row as plain values.
+
+        Returns
+        -------
+        dict
+            Column name to value, as ``ranking.csv`` and ``results.json`` record them.
+        """
         out = {c: getattr(self, c) for c in COLUMNS}
         out["flags"] = "; ".join(self.flags)
         out["at_bounds"] = "; ".join(self.at_bounds)
