@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING
 from ..core.errors import DatasetError, FrictionLabError
 from ..core.files import read_toml
 from ..core.names import check_name
-from ..core.units import MAX_SI, check_text, check_time_scale, unit_factor
+from ..core.units import MAX_SI, check_one_number, check_text, check_time_scale, unit_factor
 from ..physics.scene import KINDS, Scene
 from .csvread import _line_of_row, read_csv
 from .provenance import PROVENANCE_KINDS, Provenance, _provenance  # noqa: F401  (re-exported)
@@ -408,7 +408,9 @@ def _rest(meta, path, provenance) -> dict:
         for key, value in values.items():  # read by the report later: refuse what pint would choke on now
             if isinstance(value, str):
                 try:
-                    check_text(value, f"{path}: {table}.{key}")
+                    text = check_text(value, f"{path}: {table}.{key}")
+                    if table == "reported" and text[:1].isdigit():  # a quantity: one number and its unit
+                        check_one_number(text, f"{path}: {table}.{key}", value)
                 except FrictionLabError as exc:
                     raise DatasetError(str(exc)) from None
     if not isinstance(meta.get("description", ""), str):
