@@ -120,7 +120,7 @@ def check_text(text: str, where: str) -> str:
 #: A number and what stands before it, in a quantity or unit string: a number after another number or a unit with
 #: nothing but spaces between them is multiplied by pint ("1 810 000 Pa s/m" is 0, "2 3 Pa s/m" is 6).
 _BEFORE_OPERATOR = re.compile(r"(\*|/|\^)[\s(+-]*$")
-_LEADING = re.compile(r"\s*[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+_LEADING = re.compile(r"\s*[-+]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|(?:inf(?:inity)?|nan)\b)", re.IGNORECASE)
 
 
 def check_one_number(text: str, where: str, shown=None, quantity: bool = True) -> None:
@@ -146,6 +146,12 @@ def check_one_number(text: str, where: str, shown=None, quantity: bool = True) -
                                ", without spaces or separators inside a number (1810000 or 1.81e6, not 1 810 000)"
                                if quantity else ""))
         prev = m.group()
+
+
+def leading_number(text: str) -> float | None:
+    """The number a quantity string starts with (its sign included), or None."""
+    m = _LEADING.match(text.translate(_MINUS))
+    return float(m.group()) if m else None
 
 
 def _powered_group(text: str, op: int) -> bool:

@@ -26,8 +26,8 @@ import attrs
 import numpy as np
 
 from ..core.arguments import as_items
-from ..core.errors import FrictionLabError
-from ..inference.equivalence import PAIRS, REPLICATES, EquivalenceResult
+from ..core.errors import FrictionLabError, ParameterError
+from ..inference.equivalence import REPLICATES, EquivalenceResult
 from ..inference.fitting import FitResult, scene_ranges
 from ..inference.margin import MARGIN
 from ..inference.ranking import RankRow
@@ -43,7 +43,7 @@ from .planning import (  # noqa: F401
 from .perdataset import run_per_dataset
 from .runner import Progress, Run, select
 from .runner import run_stages as run_stages_with
-from .settings import DEFAULT_LAWS, DEFAULT_LAWS_BY_KIND, Settings, default_laws_by_kind, select_laws  # noqa: F401
+from .settings import DEFAULT_LAWS, DEFAULT_LAWS_BY_KIND, Settings, check_pairs, default_laws_by_kind, select_laws  # noqa: F401
 from .stages import STAGES
 from ..core.fpstate import with_own_errstate
 
@@ -163,7 +163,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             *, free: dict | None = None, equivalence: bool = True, jobs: int = 1,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
             tolerance: Sequence[float] = (), fit_timeout: float | None = None, replicates: int = REPLICATES,
-            pairs: Sequence = PAIRS, transfer: bool = True, stages: Sequence[str] | None = None,
+            pairs: Sequence | None = None, transfer: bool = True, stages: Sequence[str] | None = None,
             client: Client | None = None, margin: float | str = MARGIN, family: str = "report",
             accuracy: bool = True) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
@@ -181,7 +181,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     budget of each fit in seconds (None: none), the refits of the equivalence test, bootstrap, transfer
     and tolerance check included; a fit past it is a failed row saying so (a refit, a failed replicate). replicates: R per
     law of the equivalence test's parametric bootstrap (seeded by ``seed``); pairs: (law A, law B)
-    to test (default equivalence.PAIRS); pairs where a law needs the ODE solver, or without a time
+    to test, as ('wear', 'area-rate') or 'wear:area-rate', each two different compared laws (None: equivalence.PAIRS,
+    those whose laws are both compared); pairs where a law needs the ODE solver, or without a time
     series, are tested only with bootstrap_all. transfer: run the transfer stage. margin: the equivalence
     margin delta, a multiple of each dataset's noise sigma (default MARGIN = 1) or a quantity in the
     observable's unit ('150 rpm'; ``inference.margin``). family: 'report' (default: Holm over every
@@ -201,7 +202,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     settings = Settings(laws=(), solvers=tuple(solvers) if solvers else None,
                         free=scene_ranges(free, "compare: free"), equivalence=equivalence, jobs=jobs, bootstrap=bootstrap, seed=seed,
                         bootstrap_all=bootstrap_all, tolerance=tuple(tolerance), fit_timeout=fit_timeout,
-                        replicates=replicates, pairs=tuple(pairs), transfer=transfer, cluster=cluster_name(client),
+                        replicates=replicates, transfer=transfer, cluster=cluster_name(client),
                         margin=margin, family=family, accuracy=accuracy)
     chosen = select(STAGES, stages)
     dss = unique_datasets(load_dataset(d) for d in (as_items(datasets, "compare: datasets") if datasets is not None
@@ -214,8 +215,14 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                                 by_kind=by_kind)
     else:
         settings = attrs.evolve(settings, laws=select_laws(laws))
+    if pairs is not None:
+        groups = [settings.laws] if laws is not None else list(settings.by_kind.values())
+        settings = attrs.evolve(settings, pairs=check_pairs(pairs, groups))
     if equivalence:
         settings.margin.check(dss)
+    elif not settings.margin.default:
+        raise ParameterError(f"compare: margin {settings.margin.as_text()!r} applies to the equivalence tests, which "
+                             "equivalence=False skips; drop one of the two")
     run = _make_run(settings, dss, progress, client)
     settings.check_replicates()
     c = Comparison(laws=settings.laws, datasets=dss, fits=run.plan.skipped_fits, ranking=(), groups=(),
