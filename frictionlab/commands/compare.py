@@ -111,10 +111,12 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from ..core.cluster import Waits, close, connect, quiet_logs
+    from ..core.cluster import Waits, check_address, close, connect, quiet_logs
     from ..io.dataset import available_names, load_dataset
     from .fit import parse_free
 
+    if args.scheduler is not None:
+        check_address(args.scheduler)  # a malformed address refused before any work or connection
     parent = args.out.parent if str(args.out.parent) else Path(".")
     if not parent.is_dir():
         raise OutputError(f"{args.out}: cannot write: {parent} is not an existing folder")
