@@ -128,7 +128,7 @@ class Dataset:
         y = y or self.observable
         if y not in self.columns:
             raise DatasetError(f"dataset '{self.name}' has no column '{y}'; it has {', '.join(self.columns)}")
-        _, ax = figure_axes(ax)
+        _, ax = figure_axes(ax, where="Dataset.plot")
         xcol, xunit, xf = self.x_axis()
         x = self.columns[xcol] * xf if xcol else np.arange(len(self))
         shown, f = self.shown(y)
@@ -142,6 +142,14 @@ class Dataset:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
         return ax
+
+    def check(self, where: str = "dataset") -> Dataset:
+        """This dataset if it is still what loading made of it, else a DatasetError naming ``where`` and the field
+        (``intact.check_intact``: what fit, simulate and compare call before using it)."""
+        from .intact import check_intact
+
+        check_intact(self, where)
+        return self
 
     def _repr_html_(self) -> str:
         """A notebook's view: what the dataset is, where it comes from, its noise and columns in its units."""
@@ -199,6 +207,9 @@ def load_dataset(name_or_path: str | Path) -> Dataset:
     if isinstance(name_or_path, Dataset):
         return name_or_path
     from . import external
+    from .intact import check_dataset_like
+
+    check_dataset_like(name_or_path, "load_dataset")
 
     if isinstance(name_or_path, str) and name_or_path in external.RECORDS \
             and not (builtin_dir() / f"{name_or_path}.toml").exists():

@@ -33,6 +33,7 @@ from ..inference.margin import MARGIN
 from ..inference.ranking import RankRow
 from ..inference.transfer import TransferResult
 from ..io.dataset import Dataset, available_names, load_dataset
+from ..io.intact import check_dataset_like
 from .planning import (  # noqa: F401
     candidates,
     equivalence_pairs,
@@ -205,8 +206,8 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                         replicates=replicates, transfer=transfer, cluster=cluster_name(client),
                         margin=margin, family=family, accuracy=accuracy)
     chosen = select(STAGES, stages)
-    dss = unique_datasets(load_dataset(d) for d in (as_items(datasets, "compare: datasets") if datasets is not None
-                                                    else available_names()))
+    dss = unique_datasets(_dataset(d) for d in (as_items(datasets, "compare: datasets") if datasets is not None
+                                                else available_names()))
     if not dss:
         raise FrictionLabError("compare: no datasets to compare")
     if laws is None:  # the default laws of each dataset kind
@@ -252,6 +253,12 @@ def _run_stages(c: Comparison, run: Run, stages: list, forced: bool) -> Comparis
     if run.client is not None and any(s.name == "fit" for s in chosen):
         c, chosen = run_per_dataset(c, run, chosen)
     return run_stages_with(c, run, chosen, forced=True)
+
+
+def _dataset(d) -> Dataset:
+    """A dataset argument of compare loaded, or checked still to be what loading made of it (``io.intact``)."""
+    check_dataset_like(d, "compare: datasets")
+    return load_dataset(d).check("compare")
 
 
 def cluster_name(client) -> str:
