@@ -178,7 +178,8 @@ def parse_pairs(items, laws) -> tuple[tuple[str, str], ...]:
 
 
 def _run(args, free, pairs, datasets, client) -> int:
-    from ..core.files import check_target, output_lock
+    from ..core.files import output_lock
+    from ..core.outfolder import check_target
     from ..core.workers import long_run_gc
     from ..pipeline.comparison import compare
     from ..report import write_report
