@@ -7,7 +7,7 @@ fit applies to outside the quasi-static spring-slider (inclines, and the impacts
 are more numbers than parameters), prints the chi-square and CPU seconds of
 
   frictionlab   ``fl.fit(law, dataset)``: the compiled right-hand side with its analytic Jacobian, LSODA, the
-                search of ``inference.fitmodel`` (a fresh process's first fit also loads numba's cached kernel:
+                search of ``inference.fitting.model`` (a fresh process's first fit also loads numba's cached kernel:
                 shown once, as the cold start);
   plain scipy   ``plain_memory_fits.plain_fit``: written independently of frictionlab (float right-hand side,
                 analytic Jacobian, LSODA at rtol 1e-8, a 125-point scan, two least_squares runs),

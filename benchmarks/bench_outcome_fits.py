@@ -11,7 +11,7 @@ batch engine's closed forms finish those phases vectorized (``batchexact.exact_p
 import sys
 import time
 
-from frictionlab.inference.fitting import fit
+from frictionlab.inference.fitting.fit import fit
 from frictionlab.io.dataset import load_dataset
 
 DEFAULT = ["impact-outcome-synthetic", "kharaz2001-spin", "kharaz2001-tangential-cor", "kharaz2001-contact-angle"]

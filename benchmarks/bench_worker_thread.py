@@ -24,7 +24,7 @@ import time
 
 def fits_per_cpu(seconds: float) -> int:
     """How many area-rate fits of impact-golf-v28 this thread completes in ``seconds`` of its own CPU."""
-    from frictionlab.inference.fitting import fit
+    from frictionlab.inference.fitting.fit import fit
     from frictionlab.io.dataset import load_dataset
 
     ds = load_dataset("impact-golf-v28")

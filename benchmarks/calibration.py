@@ -48,7 +48,7 @@ from pathlib import Path
 import attrs
 import numpy as np
 
-from frictionlab.inference.ranking_bootstrap import wilson  # 95% Wilson score interval
+from frictionlab.inference.resampling.ranking_bootstrap import wilson  # 95% Wilson score interval
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
@@ -83,8 +83,8 @@ def threshold(truth: str) -> float:
     """The pair's noise threshold [rad/s] on the noise-free curve of ``truth``: the larger of the two noises at
     which one law's fit misses the other's best curve by chi-square 3.84."""
     from frictionlab import fit
-    from frictionlab.inference.equivalence import CRITICAL
-    from frictionlab.inference.replicates import cross_chi2
+    from frictionlab.inference.equivalence.discrimination import CRITICAL
+    from frictionlab.inference.resampling.replicates import cross_chi2
 
     ds = attrs.evolve(_dataset(truth, 1e-9, "known", 0), noise={"omega": 1.0})
     fw, fa = fit("wear", ds), fit("area-rate", ds)
@@ -94,7 +94,7 @@ def threshold(truth: str) -> float:
 def distance(truth: str) -> float:
     """D [rad/s]: the RMS distance of ``truth``'s noise-free curve from the other law's best fit to it."""
     from frictionlab import fit
-    from frictionlab.inference.replicates import distance as rms
+    from frictionlab.inference.resampling.replicates import distance as rms
 
     ds = attrs.evolve(_dataset(truth, 1e-9, "known", 0), noise={"omega": 1.0})
     other = "area-rate" if truth == "wear" else "wear"
@@ -108,7 +108,7 @@ def one(args) -> tuple:
     simulated dataset."""
     truth, noise, sigma, seed, margin = args
     from frictionlab import analyze_equivalence, fit
-    from frictionlab.inference.equivalence import ALPHA, WITHIN
+    from frictionlab.inference.equivalence.discrimination import ALPHA, WITHIN
 
     ds = _dataset(truth, sigma, noise, seed)
     fw, fa = fit("wear", ds), fit("area-rate", ds)
@@ -128,7 +128,7 @@ def pivot(truth: str, n: int) -> None:
     correlation of T = chi2(wear) - chi2(area-rate) with its location at each fitted law (the other law
     refitted to that law's best curve)."""
     from frictionlab import fit
-    from frictionlab.inference.replicates import cross_chi2
+    from frictionlab.inference.resampling.replicates import cross_chi2
 
     thr = threshold(truth)
     rows = []
@@ -147,8 +147,8 @@ def pivot(truth: str, n: int) -> None:
 def _spread_one(args):
     truth, sigma, seed, m = args
     from frictionlab import fit
-    from frictionlab.inference.equivalence import _centrings
-    from frictionlab.inference.replicates import refit_options, replicate_chunk, seed_sequence
+    from frictionlab.inference.equivalence.discrimination import _centrings
+    from frictionlab.inference.resampling.replicates import refit_options, replicate_chunk, seed_sequence
 
     ds = _dataset(truth, sigma, "known", 7000 + seed)
     fw, fa = fit("wear", ds), fit("area-rate", ds)
@@ -164,7 +164,7 @@ def spread(truth: str, scale: float, n: int, jobs: int, m: int = 100) -> None:
     """The true law's centred statistic on ``n`` datasets against its replicates, and the two curves' distance
     (module docstring, --spread)."""
     from frictionlab import fit
-    from frictionlab.inference.replicates import cross_chi2
+    from frictionlab.inference.resampling.replicates import cross_chi2
 
     thr = threshold(truth)
     with ProcessPoolExecutor(jobs) as pool:
@@ -192,7 +192,7 @@ def spread(truth: str, scale: float, n: int, jobs: int, m: int = 100) -> None:
 def _refits_exact(truth: str, sigma: float) -> float:
     """Largest |chi2(warm refit) - chi2(full fit)| of both laws over 6 replicates of each of 3 datasets."""
     from frictionlab import fit
-    from frictionlab.inference.replicates import refit, refit_options, with_y
+    from frictionlab.inference.resampling.replicates import refit, refit_options, with_y
 
     worst = 0.0
     for i in range(3):
@@ -217,7 +217,7 @@ def _pct(row: dict, key: str) -> str:
 def run(n: int, truths, noises, scales, jobs: int, seed: int, margin: float = 1.0) -> list[dict]:
     """The cases; a scale is a multiple of the pair's noise threshold, or 'boundary' (the curves' distance D
     equal to the margin delta = margin x sigma)."""
-    from frictionlab.inference.equivalence import ALPHA
+    from frictionlab.inference.equivalence.discrimination import ALPHA
 
 
     rows = []

@@ -30,7 +30,7 @@ from pathlib import Path
 import attrs
 import numpy as np
 
-from frictionlab.inference.ranking_bootstrap import wilson  # 95% Wilson score interval
+from frictionlab.inference.resampling.ranking_bootstrap import wilson  # 95% Wilson score interval
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import velstep_records  # noqa: E402
@@ -79,7 +79,7 @@ def draw(phi: float, n: int, rng) -> np.ndarray:
 def replicate(ds, curve, correlation: str, phi: float, seed: int):
     """One fit of the truth plus AR(1) noise: (covered by name, fits, fitted phi or nan)."""
     import frictionlab as fl
-    from frictionlab.inference.predict import Target
+    from frictionlab.inference.fitting.predict import Target
     from frictionlab.io.noise import estimate
 
     y = curve + draw(phi, curve.size, np.random.default_rng(seed))

@@ -34,8 +34,8 @@ def child(n: int, law: str) -> None:
     import attrs
 
     import frictionlab as fl
-    from frictionlab.inference.ar1 import draw
-    from frictionlab.inference.predict import Target
+    from frictionlab.inference.noise.ar1 import draw
+    from frictionlab.inference.fitting.predict import Target
     from frictionlab.io.noise import estimate
 
     sys.path.insert(0, str(Path(__file__).resolve().parent))

@@ -1,4 +1,4 @@
-"""AR(1) noise (inference.ar1): the prewhitened likelihood against a direct evaluation, phi recovered, sampling-
+"""AR(1) noise (inference.noise.ar1): the prewhitened likelihood against a direct evaluation, phi recovered, sampling-
 rate groups, the dataset's [noise] correlation, and the calibration on synthetic steps (--quick)."""
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ import pytest
 
 import frictionlab as fl
 from frictionlab.core.errors import DatasetError
-from frictionlab.inference import ar1
-from frictionlab.inference.goodness import ljung_box
+from frictionlab.inference.noise import ar1
+from frictionlab.inference.diagnostics.goodness import ljung_box
 from frictionlab.io import noise
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))

@@ -13,7 +13,7 @@ import pytest
 
 import frictionlab as fl
 from frictionlab.core.errors import LawError, RegistryError
-from frictionlab.inference.equivalence import MIN_REPLICATES
+from frictionlab.inference.equivalence.discrimination import MIN_REPLICATES
 from frictionlab.pipeline.comparison import run_stages
 from frictionlab.physics import registry
 from frictionlab.physics.law import FrictionLaw, ParamSpec
@@ -95,7 +95,7 @@ def test_a_plugin_swallowing_the_alarm_is_stopped_from_outside_in_every_stage(st
 
 def test_built_in_laws_are_not_forked(monkeypatch, fitted):
     """The trusted path: a comparison of built-in laws never runs a call in a bounded child."""
-    from frictionlab.inference import guard
+    from frictionlab.inference.fitting import guard
 
     calls = []
 
@@ -151,7 +151,7 @@ def test_a_load_file_that_hangs_at_import_leaves_nothing(monkeypatch, tmp_path):
 
 
 def test_a_plugin_that_takes_the_signals_over_in_a_call_gives_them_back():
-    from frictionlab.inference.guard import within_budget
+    from frictionlab.inference.fitting.guard import within_budget
 
     class Deaf(_Swallower):
         name = "deaf-in-calls"

@@ -1,4 +1,4 @@
-"""The batched refits (inference.batchfit) against the one-at-a-time refits they stand in for."""
+"""The batched refits (inference.fitting.batch) against the one-at-a-time refits they stand in for."""
 import math
 
 import numpy as np
@@ -6,10 +6,11 @@ import pytest
 from _fit_helpers import TRUTH, impact_scene, incline_scene, synthetic
 
 from frictionlab import fit
-from frictionlab.inference import batchfit, bootstrap
-from frictionlab.inference.predict import predict, predict_array
-from frictionlab.inference import replicates
-from frictionlab.inference.replicates import (batch_problem, refit, refit_options, replicate_chunk, seed_sequence,
+from frictionlab.inference.fitting import batch as batchfit
+from frictionlab.inference.resampling import bootstrap
+from frictionlab.inference.fitting.predict import predict, predict_array
+from frictionlab.inference.resampling import replicates
+from frictionlab.inference.resampling.replicates import (batch_problem, refit, refit_options, replicate_chunk, seed_sequence,
                                                with_y)
 
 CASES = [("coulomb", "exact", "impact"), ("wear", "exact", "impact"), ("wear", "series", "impact"),

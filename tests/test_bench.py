@@ -89,7 +89,7 @@ def test_failed_run_leaves_no_folder(tiny, tmp_path, monkeypatch):
 
 
 def test_fit_tolerance_study_rows():
-    from frictionlab.inference.fitcost import fit_tolerance_study, markdown
+    from frictionlab.inference.cost.tolerance import fit_tolerance_study, markdown
 
     rows = fit_tolerance_study(["couette"], "incline-oil-a100", methods=("LSODA",), rtols=(1e-3, 1e-8))
     assert [r["solver"] for r in rows] == ["exact", "ode:LSODA", "ode:LSODA"]
@@ -98,11 +98,11 @@ def test_fit_tolerance_study_rows():
     assert "| couette | exact |" in markdown(rows)
     import importlib
 
-    assert importlib.import_module("frictionlab.inference.predict").FIT_RTOL == 1e-6  # restored after the study
+    assert importlib.import_module("frictionlab.inference.fitting.predict").FIT_RTOL == 1e-6  # restored after the study
 
 
 def test_tied_laws_share_a_place_in_the_tolerance_study():
-    from frictionlab.inference.fitcost import fit_tolerance_study
+    from frictionlab.inference.cost.tolerance import fit_tolerance_study
 
     rows = fit_tolerance_study(["couette", "wear"], "incline-oil-a100", methods=("LSODA",), rtols=(1e-8,))
     assert all(r["rank"] == 1 and r["ranking"] == "wear = couette" and r["ranking_as_reference"] for r in rows)
@@ -112,7 +112,7 @@ def test_fit_takes_its_tolerance_as_an_argument():
     """rtol=None is the default FIT_RTOL exactly; a loose rtol changes the ODE fit; a bad one is one line."""
     from frictionlab import fit
     from frictionlab.core.errors import ParameterError
-    from frictionlab.inference.predict import FIT_RTOL
+    from frictionlab.inference.fitting.predict import FIT_RTOL
 
     default = fit("wear", "incline-oil-a100", solver="ode", scan=0)
     explicit = fit("wear", "incline-oil-a100", solver="ode", scan=0, rtol=FIT_RTOL)
@@ -128,7 +128,7 @@ def test_tolerance_study_on_threads_matches_serial():
     """No module state is patched: fits at different tolerances can run side by side."""
     from concurrent.futures import ThreadPoolExecutor
 
-    from frictionlab.inference.fitcost import fit_tolerance_study
+    from frictionlab.inference.cost.tolerance import fit_tolerance_study
 
     args = (["wear"], "incline-oil-a100", ("LSODA",), (1e-3, 1e-6))
     serial = fit_tolerance_study(*args)

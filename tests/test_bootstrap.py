@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from frictionlab.core.errors import FrictionLabError, ParameterError
-from frictionlab.inference.bootstrap import bootstrap, law_fit
-from frictionlab.inference.ranking_bootstrap import bootstrap_ranking, parameter_table, ranking_table
+from frictionlab.inference.resampling.bootstrap import bootstrap, law_fit
+from frictionlab.inference.resampling.ranking_bootstrap import bootstrap_ranking, parameter_table, ranking_table
 
 DS = "incline-oil-a100"  # synthetic Couette data, eta fixed: h is the one fitted parameter
 
@@ -103,7 +103,7 @@ def test_candidates_are_labelled_by_solver_and_reuse_given_fits():
 def test_slow_datasets_are_left_out_with_the_reason_and_the_flag():
     """An impact-outcome set simulates every impact at each evaluation: not bootstrapped by default."""
     from frictionlab import fit
-    from frictionlab.inference.ranking_bootstrap import bootstrap_fits
+    from frictionlab.inference.resampling.ranking_bootstrap import bootstrap_fits
 
     f = fit("wear", "impact-outcome-synthetic")
     done, skipped = bootstrap_fits([f], 5)

@@ -6,8 +6,8 @@ from pathlib import Path
 import pytest
 
 from frictionlab import fit, load_dataset
-from frictionlab.inference.identifiability import AT_BOUND_MEANING, at_bounds, bound_side, bounds_text
-from frictionlab.inference.ranking import fit_row, to_csv
+from frictionlab.inference.diagnostics.identifiability import AT_BOUND_MEANING, at_bounds, bound_side, bounds_text
+from frictionlab.inference.verdicts.ranking import fit_row, to_csv
 from frictionlab.report.results import fit_json
 
 KT = Path(__file__).resolve().parent.parent / "examples" / "known-truth"

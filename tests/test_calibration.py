@@ -31,7 +31,7 @@ def test_equivalent_within_the_margin_is_rarely_said_where_the_curves_differ_by_
     MIN_MARGIN the bound is not calibrated (it was below delta in about 20% there) and the claim is withheld."""
     import calibration
 
-    from frictionlab.inference.equivalence import MIN_MARGIN
+    from frictionlab.inference.equivalence.discrimination import MIN_MARGIN
 
     (row,) = calibration.run(200, [truth], [noise], ["boundary"], jobs=2, seed=2, margin=margin)
     assert row["d_delta"] == pytest.approx(1.0)

@@ -122,7 +122,7 @@ def test_quiet_silences_progress(tmp_path, capsys):
 
 def test_compare_summary_renders_the_answers_only():
     from frictionlab.commands.compare import answer_lines
-    from frictionlab.inference.answers import Answer
+    from frictionlab.inference.verdicts.answers import Answer
 
     class C:
         answers = ()
@@ -153,7 +153,7 @@ def test_defaults_that_differ_between_the_command_line_and_the_api_are_said_in_b
 
 def test_the_fit_tolerance_default_is_the_librarys_and_said_beside_simulates(capsys):
     from frictionlab.commands.fit import FIT_RTOL
-    from frictionlab.inference.predict import FIT_RTOL as LIBRARY
+    from frictionlab.inference.fitting.predict import FIT_RTOL as LIBRARY
 
     assert FIT_RTOL == LIBRARY
     assert main(["fit", "--help"]) == 0

@@ -248,7 +248,7 @@ def test_mdr_needs_a_coulomb_law_and_is_not_a_trajectory_model(tmp_path):
 
     with pytest.raises(SceneError, match="impact outcomes only"):
         make_plan(ds.scene.impact(V, 0.3).scene, get_law("coulomb"))
-    from frictionlab.inference.predict import applicable_solvers
+    from frictionlab.solve.choice import applicable_solvers
 
     ok = applicable_solvers("coulomb", ds.scene)
     assert ok["ode"] is None and "frictionlab.physics.mdr" in ok["exact"]  # fits run it under the name 'ode'

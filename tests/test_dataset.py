@@ -143,7 +143,7 @@ def test_cli_error_is_one_line_exit_2(run_cli, golf_copy):
 
 
 def test_group_key_declares_the_group_and_nothing_is_inferred_from_names(golf_copy):
-    from frictionlab.inference.answers import group_of
+    from frictionlab.inference.verdicts.answers import group_of
 
     d = fl.load_dataset(golf_copy)
     assert d.group == "impact-golf" and group_of(d) == "impact-golf"  # the built-in file declares it

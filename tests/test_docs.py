@@ -22,6 +22,7 @@ DOCS = ROOT / "docs"
 BLOCK = re.compile(r"^<!-- runnable(?::\s*file=(?P<file>[\w.-]+))?\s*-->\n```(?P<lang>[\w-]+)[^\n]*\n(?P<code>.*?)^```\s*$",
                    re.M | re.S)
 TIMEOUT = 300  # seconds a block may take on a loaded 2-core machine
+BUILD_TIMEOUT = 1500  # seconds the site's build may take there: it runs the gallery's examples
 
 
 def pages() -> list[Path]:
@@ -104,7 +105,7 @@ def test_the_site_builds_in_strict_mode(tmp_path):
     pytest.importorskip("mkdocs", reason="the docs tools are in the test extra: pip install -e '.[test]'")
     pytest.importorskip("mkdocstrings", reason="the docs tools are in the test extra: pip install -e '.[test]'")
     out = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(tmp_path / "site")],
-                         cwd=ROOT, env=_env(), capture_output=True, text=True, timeout=TIMEOUT)
+                         cwd=ROOT, env=_env(), capture_output=True, text=True, timeout=BUILD_TIMEOUT)
     assert out.returncode == 0, out.stderr[-5000:]
     assert "WARNING" not in out.stderr
     index = (tmp_path / "site" / "index.html").read_text(encoding="utf-8")

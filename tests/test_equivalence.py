@@ -11,7 +11,7 @@ import pytest
 from _fit_helpers import TC, TRUTH, impact_scene, incline_scene, synthetic
 
 from frictionlab import analyze_equivalence, compare, fit
-from frictionlab.inference.equivalence import BOTH_FAIL, CANNOT, CRITICAL, DIFFERENT, WITHIN, decomposition
+from frictionlab.inference.equivalence.discrimination import BOTH_FAIL, CANNOT, CRITICAL, DIFFERENT, WITHIN, decomposition
 
 R = 100  # the most replicates per law (sequential: clear cases stop at 20 or 60)
 
@@ -39,7 +39,7 @@ def test_wear_and_couette_are_equivalent_within_the_margin():
 def test_one_closed_form_family_needs_no_refits_and_gives_the_refits_answer(monkeypatch):
     """Wear and Couette span one family (F = k A u): the shortcut's T* = 0 is what refitting both laws to every
     replicate gives (to the optimizer's resolution), with the same p-values, powers and verdict."""
-    from frictionlab.inference import equivalence
+    from frictionlab.inference.equivalence import discrimination as equivalence
 
     ds = synthetic("wear", TRUTH["wear"], seed=4)
     fw, fc = fit("wear", ds), fit("couette", ds)
@@ -145,8 +145,8 @@ def test_failed_or_skipped_fit_skips_the_test():
 
 
 def test_group_answer_states_exact_and_series_separately():
-    from frictionlab.inference.answers import EQUIVALENCE
-    from frictionlab.inference.equivalence_groups import group_answer
+    from frictionlab.inference.verdicts.answers import EQUIVALENCE
+    from frictionlab.inference.equivalence.family import group_answer
 
     ds = synthetic("area-rate", TRUTH["area-rate"], seed=3, name="synth-v1")
     fa = fit("area-rate", ds)
@@ -161,8 +161,8 @@ def test_group_answer_states_exact_and_series_separately():
     assert "On synth-v1: a fit of wear" in a["noise_threshold"] and "The truncated series of wear" in a["noise_threshold"]
     assert group_answer(results, ["other"])["equivalence"] == "not tested"
     assert results[0].decomposition is None and results[1].decomposition is not None  # series only
-    from frictionlab.inference.answers import Answer
-    from frictionlab.inference.equivalence_groups import fill_answers
+    from frictionlab.inference.verdicts.answers import Answer
+    from frictionlab.inference.equivalence.family import fill_answers
 
     row = Answer(group="synth", datasets=("synth-v1",), provenance="synthetic", best=None, fits=False, headline="",
                  goodness="", equivalence="not tested", noise_threshold="", series_vs_exact="")
@@ -172,7 +172,7 @@ def test_group_answer_states_exact_and_series_separately():
 
 
 def test_slow_pairs_are_left_out_with_the_reason():
-    from frictionlab.inference.fitting import FitResult
+    from frictionlab.inference.fitting.fit import FitResult
     from frictionlab.pipeline.planning import slow_pair as _slow_pair
 
     ode = FitResult(law="wear", solver="ode", datasets=("x",), status="ok", cpu_time=2.5)
@@ -184,7 +184,7 @@ def test_slow_pairs_are_left_out_with_the_reason():
 
 def test_command_line_defaults_agree_with_the_library():
     from frictionlab.commands import compare as cmd
-    from frictionlab.inference.equivalence import MIN_REPLICATES, REPLICATES
+    from frictionlab.inference.equivalence.discrimination import MIN_REPLICATES, REPLICATES
 
     assert cmd.REPLICATES == REPLICATES and MIN_REPLICATES == 20
 
@@ -193,10 +193,10 @@ def test_replicate_refits_without_error_analysis_give_the_same_statistic(coulomb
     """The replicates' refits skip the Jacobian (fit(errors=False)): T on every replicate is what full fits give
     (a refit that reads values only ends where the batched starts end, a full fit polishes that end with lmfit's
     own run: the cross refits' chi-squares agree far within the fits' tolerance)."""
-    from frictionlab.inference import fitting
+    from frictionlab.inference.fitting import fit as fitting
 
     _, fc, fw, e = coulomb_data
-    from frictionlab.inference import replicates
+    from frictionlab.inference.resampling import replicates
 
     monkeypatch.setattr(replicates, "fit", lambda *a, errors=True, **k: fitting.fit(*a, **k))
     full = analyze_equivalence(fc, fw, replicates=R)
@@ -208,7 +208,7 @@ def test_replicate_refits_without_error_analysis_give_the_same_statistic(coulomb
 def test_a_kept_law_whose_own_p_is_below_half_alpha_is_rejected_too(coulomb_data):
     """The rule rejects each law whose own p is below alpha / 2: the law with the larger p is not called
     consistent with the data when its own p is below that too."""
-    from frictionlab.inference.equivalence import ALPHA, decide
+    from frictionlab.inference.equivalence.discrimination import ALPHA, decide
 
     _, _, _, e = coulomb_data  # A = coulomb (the truth, kept), B = wear (rejected)
     kept = attrs.evolve(e, q_a=0.5)  # nothing on coulomb's favourable side
@@ -239,7 +239,7 @@ def test_both_laws_failing_their_fit_tests_get_no_p_value_only_their_misfits():
 def test_a_peak_time_difference_is_quantitative_not_qualitative():
     """Two curves that both rise, peak inside the record and fall are qualitatively alike whatever their peak
     times; peaks more than a sampling interval apart are a quantitative difference, named as such."""
-    from frictionlab.inference.qualitative import Features, _first_difference, peak_text
+    from frictionlab.inference.equivalence.qualitative import Features, _first_difference, peak_text
 
     a = Features(rises=True, peak=True, t_peak=290e-6, falls=True, force_one_sign=True)
     b = attrs.evolve(a, t_peak=323e-6)
@@ -254,7 +254,7 @@ def test_a_peak_time_difference_is_quantitative_not_qualitative():
 def test_a_report_adjusts_every_hypothesis_as_one_family(coulomb_data):
     """Holm over the two hypotheses of every tested pair: adjusted p-values are at least the raw ones, each
     verdict is decided on them, and the family is named; 'group' adjusts within each group only."""
-    from frictionlab.inference.equivalence_groups import adjust_family, holm_adjusted
+    from frictionlab.inference.equivalence.family import adjust_family, holm_adjusted
 
     assert holm_adjusted([0.01, 0.04, 0.03]) == pytest.approx([0.03, 0.06, 0.06])
     _, fc, fw, e = coulomb_data

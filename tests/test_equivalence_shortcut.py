@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from frictionlab.inference import equivalence as eq
+from frictionlab.inference.equivalence import discrimination as eq
 
 
 def _null(rng, m=eq.FAR_MIN):

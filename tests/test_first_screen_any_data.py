@@ -8,7 +8,7 @@ import attrs
 import pytest
 
 from frictionlab import compare, load_dataset
-from frictionlab.inference.accuracy import BUDGET, COMMAND, RTOLS, solver_costs, study_fits
+from frictionlab.inference.cost.accuracy import BUDGET, COMMAND, RTOLS, solver_costs, study_fits
 from frictionlab.io.template import template
 from frictionlab.report import build, first_screen
 from frictionlab.report.data_view import group_views
@@ -90,7 +90,7 @@ def test_what_accuracy_costs_is_answered_for_every_law_and_dataset(users_impact)
 
 
 def test_where_it_is_not_cheap_it_says_how_to_run_it(users_impact, monkeypatch):
-    from frictionlab.inference import accuracy
+    from frictionlab.inference.cost import accuracy
 
     f = next(f for f in users_impact.fits if f.ok and f.solver == "exact")
     slow = attrs.evolve(f, cpu_time=BUDGET * f.nfev)  # as if one evaluation took BUDGET seconds
@@ -189,7 +189,7 @@ def test_a_comparison_of_many_groups_draws_the_first_of_them_and_says_so(monkeyp
 def test_each_kind_of_solver_is_warmed_once_before_it_is_timed(users_impact, monkeypatch):
     """The reference, the series and the first ODE tolerance get one untimed call first (a kernel compiled, a
     cache filled); a later ODE tolerance shares the first one's, so its first call is timed."""
-    from frictionlab.inference import accuracy
+    from frictionlab.inference.cost import accuracy
 
     warmed = []
     real = accuracy._timed

@@ -7,7 +7,7 @@ import time
 
 import pytest
 
-from frictionlab.inference.fitmodel import ALARM_RETRY, FitTimeout, _alarm
+from frictionlab.inference.fitting.model import ALARM_RETRY, FitTimeout, _alarm
 
 
 def _busy(seconds: float) -> None:

@@ -241,7 +241,7 @@ def test_the_best_fit_model_taken_from_the_last_evaluation_equals_a_fresh_predic
     prediction made afresh at the fitted parameters; and a fit with several starts gives the same answer."""
     import numpy as np
 
-    from frictionlab.inference.predict import predict
+    from frictionlab.inference.fitting.predict import predict
 
     data = synthetic(law, TRUTH[law], n=21, name=f"reuse-{law}")
     r = fit(law, data, solver=solver)
@@ -259,7 +259,7 @@ def test_a_repeated_evaluation_reused_gives_the_fit_of_the_general_path(law, sol
     best-fit model are reused: the same fit, number for number, as when every call evaluates afresh."""
     import numpy as np
 
-    from frictionlab.inference import fitting
+    from frictionlab.inference.fitting import fit as fitting
 
     data = synthetic(law, TRUTH[law], n=21, name=f"reuse2-{law}")
     fast = fit(law, data, solver=solver, **options)
@@ -294,7 +294,8 @@ def _numbers(r):
 def test_refits_run_levenberg_marquardt_directly_with_lmfits_numbers(law, options, monkeypatch):
     """fit(checks=False) runs lmfit's Levenberg-Marquardt through levmar.leastsq: values, error bars,
     correlations, chi-square, messages and evaluation counts are those of lmfit itself, bit for bit."""
-    from frictionlab.inference import batchfit, levmar
+    from frictionlab.inference.fitting import batch as batchfit
+    from frictionlab.inference.fitting import levmar
 
     monkeypatch.setattr(batchfit, "best_start", lambda *a: None)  # the batched starts aside (tests/test_batchfit.py)
     data = synthetic(law, TRUTH[law], n=21, name=f"direct-{law}", rel_noise=0.03)
@@ -313,7 +314,7 @@ def test_levenberg_marquardt_directly_declines_where_lmfit_goes_another_way():
     what it says there); an error bar that cannot be estimated is said as lmfit says it."""
     import numpy as np
 
-    from frictionlab.inference import levmar
+    from frictionlab.inference.fitting import levmar
 
     params = {"a": levmar.Param("a", 1.0, 0.0, 10.0, True)}
     assert levmar.leastsq(lambda v: np.array([np.nan, 1.0]), params, True, 50) is None
@@ -375,8 +376,10 @@ def test_refits_of_resampled_data_share_the_evaluations_the_data_do_not_change(m
     import numpy as np
 
     from frictionlab import get_law
-    from frictionlab.inference import batchfit, fitmodel, predict as predict_module
-    from frictionlab.inference.replicates import refit, refit_options, with_y
+    from frictionlab.inference.fitting import batch as batchfit
+    from frictionlab.inference.fitting import model as fitmodel
+    from frictionlab.inference.fitting import predict as predict_module
+    from frictionlab.inference.resampling.replicates import refit, refit_options, with_y
 
     monkeypatch.setattr(batchfit, "best_start", lambda *a: None)  # the one-at-a-time path (an ODE's, a plugin's)
 
@@ -427,8 +430,8 @@ def test_the_start_scan_of_impact_outcomes_in_one_batch_gives_the_fit_of_the_sca
     each prediction bitwise that of ``predict`` alone, and the fit number for number the one-by-one scan's."""
     import numpy as np
 
-    from frictionlab.inference import fitmodel
-    from frictionlab.inference.predict import make_target, predict, predict_many
+    from frictionlab.inference.fitting import model as fitmodel
+    from frictionlab.inference.fitting.predict import make_target, predict, predict_many
 
     tg = make_target(dataset)
     sets = [{"mu": mu, "eta_prime": eta} for mu in (0.05, 0.3, 2.0) for eta in (-3e4, 0.0, 5e2)]

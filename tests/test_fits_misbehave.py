@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import frictionlab as fl
-from frictionlab.inference import fitting
+from frictionlab.inference.fitting import fit as fitting
 from frictionlab.pipeline import comparison, stages
 from frictionlab.report import write_report
 

@@ -7,7 +7,7 @@ from _fit_helpers import TRUTH, impact_scene, incline_scene, synthetic
 
 from frictionlab import FrictionLabError, FrictionLaw, ParamSpec, fit, make_target
 from frictionlab.core.errors import DatasetError, ParameterError
-from frictionlab.inference.fitting import applicable_solvers, auto_solver
+from frictionlab.solve.choice import applicable_solvers, auto_solver
 from frictionlab.physics.derive import derive_omega
 from frictionlab.physics.law import AreaSlipForm
 
@@ -247,8 +247,8 @@ def test_fit_report_names_both_aic_conventions_and_the_laws_bounds():
 def test_a_flag_and_what_it_did_to_the_rank_are_in_the_ranking_frame():
     import pandas as pd
 
-    from frictionlab.inference.frames import ranking_frame
-    from frictionlab.inference.ranking import RankRow
+    from frictionlab.inference.fitting.frames import ranking_frame
+    from frictionlab.inference.verdicts.ranking import RankRow
 
     class C:
         datasets, groups = (), ()
@@ -265,7 +265,7 @@ def test_a_parameter_without_effect_does_not_stop_the_others_short_of_their_mini
     mu = 0.0939, chi-square 27.044, where Coulomb reaches 27.021 at mu = 0.0925 (kharaz2001-tangential-cor); the
     fit then refits the others with such a parameter held, says so in its notes, and ends at Coulomb's minimum.
     The batched starts (``batchfit.best_start``) reach it directly; without them the refit must."""
-    from frictionlab.inference import batchfit
+    from frictionlab.inference.fitting import batch as batchfit
 
     ds = "kharaz2001-tangential-cor"
     coulomb = fit("coulomb", ds)

@@ -204,9 +204,9 @@ class _StallsLater(_Sluggish):
 
 
 def test_refits_of_the_equivalence_test_bootstrap_and_transfer_keep_the_time_budget():
-    from frictionlab.inference.ranking_bootstrap import bootstrap_fits
-    from frictionlab.inference.equivalence import MIN_REPLICATES, analyze_equivalence
-    from frictionlab.inference.transfer import shared_fit
+    from frictionlab.inference.resampling.ranking_bootstrap import bootstrap_fits
+    from frictionlab.inference.equivalence.discrimination import MIN_REPLICATES, analyze_equivalence
+    from frictionlab.inference.equivalence.transfer import shared_fit
 
     fl.register_law(_StallsLater)
     try:

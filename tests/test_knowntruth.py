@@ -83,8 +83,8 @@ def test_transfer_verdicts_match_the_truth():
     assert {(p.source, p.target) for p in tr["kt-speeds"].predictions} == {("kt-speeds-v20", "kt-speeds-v40"),
                                                                           ("kt-speeds-v40", "kt-speeds-v20")}
     assert "yes for wear [exact]" in tr["kt-speeds"].answer() and "no, for no law" in tr["kt-twolam"].answer()
-    from frictionlab.inference.answers import Answer
-    from frictionlab.inference.transfer import fill_answers
+    from frictionlab.inference.verdicts.answers import Answer
+    from frictionlab.inference.equivalence.transfer import fill_answers
 
     rows = [Answer(group=g, datasets=tuple(tr[g].datasets), provenance="synthetic", best=None, fits=False, headline="",
                    goodness="", equivalence="not tested", noise_threshold="", series_vs_exact="") for g in tr]
@@ -96,8 +96,8 @@ def test_transfer_verdicts_match_the_truth():
 
 
 def test_a_group_of_different_observables_is_not_transferred_and_says_why():
-    from frictionlab.inference.answers import group_of
-    from frictionlab.inference.transfer import candidates_by_group, skipped
+    from frictionlab.inference.verdicts.answers import group_of
+    from frictionlab.inference.equivalence.transfer import candidates_by_group, skipped
 
     kharaz = [load_dataset(n) for n in ("kharaz2001-spin", "kharaz2001-tangential-cor")]
     assert {group_of(d) for d in kharaz} == {"kharaz2001"}  # declared by the TOML key 'group'

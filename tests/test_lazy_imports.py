@@ -36,9 +36,9 @@ def test_public_names_resolve(name):
 def test_predict_stays_the_function_after_its_module_is_imported():
     import importlib
 
-    importlib.import_module("frictionlab.inference.predict")
-    assert callable(fl.predict) and fl.predict.__module__ == "frictionlab.inference.predict"
-    assert fl.predict is importlib.import_module("frictionlab.inference.fitting").predict
+    importlib.import_module("frictionlab.inference.fitting.predict")
+    assert callable(fl.predict) and fl.predict.__module__ == "frictionlab.inference.fitting.predict"
+    assert fl.predict is importlib.import_module("frictionlab.inference.fitting.fit").predict
 
 
 def test_unknown_name_is_an_attribute_error():

@@ -177,7 +177,7 @@ def test_a_law_whose_force_ignores_the_slip_rate_is_refused_by_the_plan_and_skip
 
 def test_report_figures_survive_a_curve_the_solver_cannot_draw(monkeypatch):
     """A stiff law's dense best-fit curve may exceed the ODE budget: the figure keeps the fitted points."""
-    from frictionlab.inference.fitting import DatasetFit
+    from frictionlab.inference.fitting.fit import DatasetFit
     from frictionlab.report import figures
 
     ds = fl.load_dataset("incline-oil-a100")

@@ -9,7 +9,7 @@ import pytest
 
 import frictionlab as fl
 from frictionlab import fit, load_dataset
-from frictionlab.inference.equivalence_groups import holm
+from frictionlab.inference.equivalence.family import holm
 from frictionlab.io.datagen.golf import FRAME, STATED, spin_curve
 from frictionlab.io.noise import estimate, gsjs, replicate_spread
 

@@ -12,7 +12,7 @@ import pytest  # noqa: E402
 
 import frictionlab as fl  # noqa: E402
 from frictionlab.core.display import param_text, rounded  # noqa: E402
-from frictionlab.inference.fitresult import ParamResult  # noqa: E402
+from frictionlab.inference.fitting.result import ParamResult  # noqa: E402
 
 
 @pytest.fixture(scope="module")

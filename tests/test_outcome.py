@@ -219,8 +219,8 @@ def test_bad_outcome_datasets(tmp_path, old, new, match):
 
 def test_registered_predictor_fits_the_synthetic_truth(monkeypatch):
     """With the predictor registered, fitting Coulomb to the synthetic outcomes recovers mu = 0.25."""
-    from frictionlab.inference import fitting
-    from frictionlab.inference.predict import PREDICTORS, outcome_predictor
+    from frictionlab.inference.fitting import fit as fitting
+    from frictionlab.inference.fitting.predict import PREDICTORS, outcome_predictor
 
     monkeypatch.setitem(PREDICTORS, "impact-outcome", outcome_predictor)
     r = fitting.fit("coulomb", "impact-outcome-synthetic", solver="exact")

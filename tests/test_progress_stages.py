@@ -129,7 +129,7 @@ def test_the_runner_names_running_pool_tasks_while_none_finishes(monkeypatch):
 
 
 def test_a_fit_estimates_later_starts_from_the_ones_done():
-    from frictionlab.inference.fitprogress import FitProgress
+    from frictionlab.inference.fitting.progress import FitProgress
 
     calls = []
     fp = FitProgress(lambda d, t, label: calls.append((d, t, label)), "lugre on x", 10)

@@ -147,7 +147,7 @@ def test_same_data_in_other_units_fits_to_the_same_parameters(tmp_path, base, la
     a, b = fl.load_dataset(base), fl.load_dataset(toml)
     for col in a.columns:
         np.testing.assert_allclose(b.columns[col], a.columns[col], rtol=1e-12)
-    from frictionlab.inference.fitting import fit
+    from frictionlab.inference.fitting.fit import fit
 
     fa, fb = fit(law, a), fit(law, b)
     assert fa.ok and fb.ok

@@ -6,7 +6,7 @@ import pytest
 from _fit_helpers import TRUTH, incline_scene, synthetic
 
 from frictionlab import compare
-from frictionlab.inference.ranking import COLUMNS, RankRow, _rank, rank_groups, to_csv
+from frictionlab.inference.verdicts.ranking import COLUMNS, RankRow, _rank, rank_groups, to_csv
 
 
 def row(ds, law, aic, solver="exact", n=20, k=1, status="ok"):
@@ -47,8 +47,10 @@ def test_akaike_weights_compare_the_candidates_that_fit_and_say_so():
 def test_groups_sum_aic_and_mark_incomplete_candidates():
     rows = _rank([row("d1", "a", 10.0), row("d1", "b", 14.0), row("d1", "a", 9.0, solver="series")], 0.01)
     rows += _rank([row("d2", "a", 5.0, solver="ode"), row("d2", "b", 4.0)], 0.01)
-    groups = rank_groups(rows, {"d1": "impact", "d2": "incline"})
-    allg = {(r.law, r.solver): r for r in groups if r.dataset == "ALL"}
+    assert rank_groups(rows, {"d1": "impact", "d2": "incline"}) == []  # nothing declared: no sum over datasets
+    assert rank_groups(rows, named={"d1": "d1", "d2": "d2"}) == []  # one-dataset groups: no second ranking
+    groups = rank_groups(rows, named={"d1": "pair", "d2": "pair"})  # a group the datasets declare
+    allg = {(r.law, r.solver): r for r in groups if r.dataset == "pair"}
     assert allg[("a", "exact+ode")].aic == pytest.approx(15.0)  # exact and ode count as one candidate
     assert allg[("b", "exact")].aic == pytest.approx(18.0)
     assert allg[("a", "exact+ode")].rank == 1 and allg[("b", "exact")].rank == 2
@@ -131,7 +133,7 @@ def test_one_family_is_represented_by_its_simplest_member_where_they_reach_one_m
     from _fit_helpers import impact_scene
 
     from frictionlab import fit
-    from frictionlab.inference.ranking import merge_identical
+    from frictionlab.inference.verdicts.ranking import merge_identical
 
     data = synthetic("wear", TRUTH["wear"], impact_scene(), name="one-family")
     w, c = fit("wear", data, solver="exact"), fit("couette", data, solver="exact")

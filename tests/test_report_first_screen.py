@@ -7,8 +7,8 @@ import pytest
 from _fit_helpers import synthetic
 
 from frictionlab import compare
-from frictionlab.inference.answers import Answer
-from frictionlab.inference.equivalence import sentence
+from frictionlab.inference.verdicts.answers import Answer
+from frictionlab.inference.equivalence.discrimination import sentence
 from frictionlab.report import build, first_screen
 from frictionlab.report.render import html_page, markdown
 
@@ -205,7 +205,7 @@ def test_plausibility_flags_reach_the_parameter_they_name():
 
 
 def test_a_group_row_shows_its_first_flag_and_counts_the_others():
-    from frictionlab.inference.ranking import RankRow
+    from frictionlab.inference.verdicts.ranking import RankRow
     from frictionlab.report.ranking import group_table
 
     row = RankRow("ALL", "area-rate", "exact", 650, 16, aic=1.0, rank=3,

@@ -38,7 +38,7 @@ def test_screenshot_is_written(report, tmp_path):
 
 def _answer(group, best, goodness, eq="not tested", thr="", series="", transfer=""):
     """A row shaped like the built-in data's (seven groups, long sentences behind short cells)."""
-    from frictionlab.inference.answers import Answer
+    from frictionlab.inference.verdicts.answers import Answer
 
     long = "a sentence of sixty words that explains the verdict in full, with every p-value and number " * 3
     short = {k: v for k, v in (("best", best), ("goodness", goodness), ("equivalence", eq), ("threshold", thr),

@@ -8,15 +8,15 @@ from pathlib import Path
 import pytest
 
 from frictionlab import compare
-from frictionlab.inference import equivalence as eq
-from frictionlab.inference import goodness as gd
-from frictionlab.inference import identifiability as ident
-from frictionlab.inference import plausibility as pl
-from frictionlab.inference import ranking as rk
-from frictionlab.inference import rules
-from frictionlab.inference import transfer as tr
-from frictionlab.inference.equivalence import sentence
-from frictionlab.inference.margin import MARGIN
+from frictionlab.inference.equivalence import discrimination as eq
+from frictionlab.inference.diagnostics import goodness as gd
+from frictionlab.inference.diagnostics import identifiability as ident
+from frictionlab.inference.diagnostics import plausibility as pl
+from frictionlab.inference.verdicts import ranking as rk
+from frictionlab.inference.verdicts import rules
+from frictionlab.inference.equivalence import transfer as tr
+from frictionlab.inference.equivalence.discrimination import sentence
+from frictionlab.inference.equivalence.margin import MARGIN
 from frictionlab.io.dataset import builtin_names
 from frictionlab.report import build
 from frictionlab.report.render import markdown

@@ -10,7 +10,7 @@ from _scenes import incline, normal_impact
 import frictionlab as fl
 from frictionlab import Contact, FrictionLaw, ParamSpec, StateSpec, make_plan, simulate
 from frictionlab.core.errors import LawError, SolverError
-from frictionlab.inference.predict import applicable_solvers
+from frictionlab.solve.choice import applicable_solvers
 from frictionlab.physics.scene import G
 from frictionlab.solve.batch import simulate_batch
 from frictionlab.solve.solvers.prescribed import respond

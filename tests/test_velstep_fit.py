@@ -1,4 +1,4 @@
-"""The velocity-step fit (inference.velstep) and its quasi-static integrator (solve.quasistatic): against the
+"""The velocity-step fit (inference.velstep.fit) and its quasi-static integrator (solve.quasistatic): against the
 general plan, against finite differences, against a brute-force joint fit, and what it says at a bound."""
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ import pytest
 
 import frictionlab as fl
 from frictionlab.core.errors import ParameterError
-from frictionlab.inference.predict import Target
+from frictionlab.inference.fitting.predict import Target
 from frictionlab.physics.scene import ConstantNormal, Scene, SpringLoad
 from frictionlab.solve import quasistatic
 from frictionlab.solve import quasistatic_kernel as kernel
@@ -47,18 +47,19 @@ def test_sdirk4_coefficients_have_order_4_and_an_order_3_embedding():
     assert conditions(bhat)[:4] == [1, F(1, 2), F(1, 3), F(1, 6)] and conditions(bhat)[4] != F(1, 4)
 
 
-@pytest.mark.parametrize("law", [kernel.AGING, kernel.SLIP])
+@pytest.mark.parametrize("law", [kernel.AGING, kernel.SLIP, kernel.PRZ, kernel.NAGATA])
 def test_kernel_jacobian_and_parameter_derivatives_match_finite_differences(law):
-    p = dict(a=0.009, b=0.011, Dc=7.0, k=0.008, V1=3.0, vlp=10.0)
+    p = dict(a=0.009, b=0.011, Dc=7.0, k=0.008, c=2.0, V1=3.0, vlp=10.0)
     f, J, Fp = np.zeros(2), np.zeros((2, 2)), np.zeros((2, 4))
 
     def rates(m, psi, a=p["a"], b=p["b"], Dc=p["Dc"], k=p["k"]):
         out = np.zeros(2)
-        kernel.rates(law, a, b, Dc, k, p["V1"], p["vlp"], m, psi, out, np.zeros((2, 2)), np.zeros((2, 4)), False)
+        kernel.rates(law, a, b, Dc, k, p["c"], p["V1"], p["vlp"], m, psi, out, np.zeros((2, 2)), np.zeros((2, 4)),
+                     False)
         return out
 
     y = (0.004, -0.3)
-    kernel.rates(law, p["a"], p["b"], p["Dc"], p["k"], p["V1"], p["vlp"], *y, f, J, Fp, True)
+    kernel.rates(law, p["a"], p["b"], p["Dc"], p["k"], p["c"], p["V1"], p["vlp"], *y, f, J, Fp, True)
     h = 1e-7
     for j in range(2):
         e = np.eye(2)[j] * h
@@ -68,22 +69,26 @@ def test_kernel_jacobian_and_parameter_derivatives_match_finite_differences(law)
         hh = 1e-6 * p[name]
         up, dn = rates(*y, **{name: p[name] + hh}), rates(*y, **{name: p[name] - hh})
         assert Fp[:, j] == pytest.approx((up - dn) / (2 * hh), rel=1e-5, abs=1e-9)
-    assert quasistatic.LAWS == {"rate-state-aging": kernel.AGING, "rate-state-slip": kernel.SLIP}
+    assert quasistatic.LAWS == {"rate-state-aging": kernel.AGING, "rate-state-slip": kernel.SLIP,
+                                "rate-state-prz": kernel.PRZ, "rate-state-nagata": kernel.NAGATA}
 
 
-@pytest.mark.parametrize("law", LAWS)
+@pytest.mark.parametrize("law", LAWS + ("rate-state-prz", "rate-state-nagata"))
 def test_sensitivities_are_the_derivatives_of_the_computed_solution(law):
     load = quasistatic.Load(np.array([0.0, 20.0]), np.array([3.0, 10.0]))
     t = np.linspace(0.0, 60.0, 1500)
     code = quasistatic.LAWS[law]
     p = np.array([0.009, 0.0095, 7.0, 0.008])
-    S = quasistatic.solve(code, *p, load, t, 1e-11, sensitivities=True).S
+    sol = quasistatic.solve(code, *p, load, t, 1e-11, sensitivities=True, c=1.5)
+    assert np.array_equal(sol.m, quasistatic.solve(code, *p, load, t, 1e-11, c=1.5).m)  # S does not steer the steps
+    S = sol.S
     for j in range(4):
         h = 1e-6 * p[j]
         up, dn = p.copy(), p.copy()
         up[j] += h
         dn[j] -= h
-        fd = (quasistatic.solve(code, *up, load, t, 1e-11).m - quasistatic.solve(code, *dn, load, t, 1e-11).m) / (2 * h)
+        fd = (quasistatic.solve(code, *up, load, t, 1e-11, c=1.5).m
+              - quasistatic.solve(code, *dn, load, t, 1e-11, c=1.5).m) / (2 * h)
         assert np.max(np.abs(S[:, j] - fd)) <= 1e-4 * np.max(np.abs(fd))
 
 
@@ -92,16 +97,18 @@ def _slider(times, velocities, k=2000.0, T=300.0):
                  spring=SpringLoad(k, times, velocities))
 
 
-@pytest.mark.parametrize("law", LAWS)
+@pytest.mark.parametrize("law", LAWS + ("rate-state-prz", "rate-state-nagata"))
 @pytest.mark.parametrize("schedule", [((0.0, 5.0, 25.0), (1e-6, 1e-5, 1e-6)), ((0.0, 50.0, 150.0), (1e-6, 0.0, 1e-6))],
                          ids=["steps", "slide-hold-slide"])
 def test_fast_path_integrates_as_the_general_plan(law, schedule):
-    """solver 'ode' (the quasi-static integrator) against 'ode:LSODA' (the general plan, numerical force partials):
-    friction, slip rate and state through velocity steps and a hold."""
+    """solver 'ode' (the quasi-static integrator) against 'ode:LSODA' (the general plan, numerical force partials;
+    Nagata's d mu/dt the spring's load rate from the scene): friction, slip rate and state through velocity steps
+    and a hold."""
     scene = _slider(*schedule)
     t = np.linspace(0.0, 300.0, 1201)
-    fast = fl.simulate(law, scene, RS, solver="ode", t=t)
-    general = fl.simulate(law, scene, RS, solver="ode:LSODA", t=t)
+    p = dict(RS, c=1.0) if law == "rate-state-nagata" else RS
+    fast = fl.simulate(law, scene, p, solver="ode", t=t)
+    general = fl.simulate(law, scene, p, solver="ode:LSODA", t=t)
     assert fast.solver == "ode" and general.solver == "ode:LSODA"
     assert np.max(np.abs(fast.load - general.load)) < 1e-8
     assert np.max(np.abs(fast.v - general.v) / np.maximum(general.v, 1e-12)) < 1e-5
@@ -233,7 +240,8 @@ def test_a_strengthening_evolution_ends_at_b_0_and_says_so(tmp_path):
 def test_the_strengthening_refit_starts_where_the_bound_held_b(tmp_path):
     """The search keeps its grid points whose a, b fit ended with b held at 0, best first and distinct; a fit that
     ends with b inside its range and no such grid point runs no refit (from there the bound did not act)."""
-    from frictionlab.inference import velstep, velstep_result
+    from frictionlab.inference.velstep import fit as velstep
+    from frictionlab.inference.velstep import missing as velstep_missing
 
     ds, _ = _measured_like(tmp_path)
     load = quasistatic.Load.of(ds.scene.spring)
@@ -252,11 +260,11 @@ def test_the_strengthening_refit_starts_where_the_bound_held_b(tmp_path):
     x = starts[0].copy()
     x[ib] = problem.params[ib].to_x(0.01)  # b inside its range: nothing to refit from
     before = problem.nfev
-    assert velstep_result._strengthening(problem, x) == "" and problem.nfev == before
+    assert velstep_missing._strengthening(problem, x) == "" and problem.nfev == before
 
 
 def test_bound_meanings_name_what_each_bound_says():
-    from frictionlab.inference.velstep_result import BOUND_MEANING
+    from frictionlab.inference.velstep.result import BOUND_MEANING
 
     assert BOUND_MEANING[("b", "lower")] == ("b at 0: the evolution runs the other way; a single-state law cannot "
                                              "follow it")
@@ -297,7 +305,7 @@ def test_the_velocity_step_summary_gives_each_parameter_in_laboratory_units():
 
 def test_refits_of_a_velocity_step_fit_start_where_it_ended(small_step_fits):
     """The replicate refits of the equivalence test and the bootstrap go through the same path, warm-started."""
-    from frictionlab.inference.replicates import refit, refit_options
+    from frictionlab.inference.resampling.replicates import refit, refit_options
 
     fast, _ = small_step_fits
     again = refit("rate-state-aging", refit_options(fast), fast.per_dataset[0].target)
@@ -307,8 +315,9 @@ def test_refits_of_a_velocity_step_fit_start_where_it_ended(small_step_fits):
 def test_the_compiled_sums_equal_the_explicit_projected_jacobian(tmp_path):
     """velstep_kernel.basis_sums (one pass, nothing per sample kept) against the prewhitened, projected
     residual and Jacobian formed explicitly with numpy."""
-    from frictionlab.inference import ar1, velstep
-    from frictionlab.inference.velstep_kernel import basis_sums
+    from frictionlab.inference.noise import ar1
+    from frictionlab.inference.velstep import fit as velstep
+    from frictionlab.inference.velstep.kernel import basis_sums
 
     ds, curve = _measured_like(tmp_path, "ar1")
     y = curve + np.random.default_rng(6).normal(0.0, 4e-4, curve.size)
@@ -337,7 +346,7 @@ def test_the_compiled_sums_equal_the_explicit_projected_jacobian(tmp_path):
 def test_the_equivalence_test_runs_on_ar1_velocity_steps(tmp_path):
     """Both rate-and-state laws fitted to AR(1) data; the equivalence test draws AR(1) replicates and refits both
     through the velocity-step path."""
-    from frictionlab.inference.ar1 import draw
+    from frictionlab.inference.noise.ar1 import draw
     from frictionlab.io.noise import estimate
 
     ds, curve = _measured_like(tmp_path, "ar1")

@@ -11,9 +11,9 @@ from _fit_helpers import TRUTH, incline_scene, synthetic
 import frictionlab as fl
 from frictionlab import FrictionLaw, ParamSpec, compare, fit, load_dataset
 from frictionlab.commands.compare import answer_lines
-from frictionlab.inference.goodness import FITS_LEVEL, runs_test
-from frictionlab.inference.ranking import NEAR_TIE, RankRow, _rank, rank_groups
-from frictionlab.inference.verdicts import POOR
+from frictionlab.inference.diagnostics.goodness import FITS_LEVEL, runs_test
+from frictionlab.inference.verdicts.ranking import NEAR_TIE, RankRow, _rank, rank_groups
+from frictionlab.inference.verdicts.group_verdicts import POOR
 from frictionlab.io.datagen.knowntruth import QuadraticDrag  # registered nowhere
 
 REGISTERED = ["coulomb", "area-rate", "wear", "couette"]
@@ -35,7 +35,7 @@ def _incline(law, params, sigma=0.002, seed=11, name=None):
 def test_known_and_estimated_sigma_give_the_stated_aic_error_bars_and_f_test():
     """Known sigma: used as given. Estimated (no [noise] value used): sigma from GSJS differences of the data,
     the same plug-in likelihood, error bars from that sigma, and the fit test an F test with its degrees of freedom."""
-    from frictionlab.inference.goodness import f_pvalue
+    from frictionlab.inference.diagnostics.goodness import f_pvalue
     from frictionlab.io.noise import gsjs
 
     ds = _incline("couette", {"eta": 0.1, "h": 4e-5})
@@ -63,7 +63,7 @@ def test_fit_test_with_estimated_sigma_holds_its_level():
     """The true law on many independent noise draws, sigma estimated each time: the fit test's p (the exact
     null of chi2 at sigma-hat, both from the same noise) rejects about as often as its level; the F test
     with the estimate's degrees of freedom never more often (conservative)."""
-    from frictionlab.inference.goodness import f_pvalue
+    from frictionlab.inference.diagnostics.goodness import f_pvalue
     from frictionlab.io.noise import gsjs, ratio_pvalue
 
     rng = np.random.default_rng(5)
@@ -90,7 +90,7 @@ def test_group_totals_are_sums_over_the_separately_fitted_members():
                        ll + k * math.log(n), likelihood="known", neg2loglik=ll, k_lik=k)
 
     rows = _rank([row("d1", 10.0, 1, 20)], 0.01) + _rank([row("d2", -4.0, 2, 30)], 0.01)
-    g = next(r for r in rank_groups(rows) if r.dataset == "ALL")
+    g = next(r for r in rank_groups(rows, named={"d1": "g", "d2": "g"}) if r.dataset == "g")
     assert g.aic == pytest.approx(6.0 + 2 * 3)
     # separate fits: AICc and BIC are sums over the members, each with its own n and k (not the pooled n, k)
     assert g.aicc == pytest.approx((12.0 + 2 * 1 * 2 / 18) + (0.0 + 2 * 2 * 3 / 27))
@@ -184,7 +184,7 @@ def test_a_derived_omega_fit_carries_no_chi_square_statistics():
 
 # --- 4. bootstrap ------------------------------------------------------------------------------
 def test_bootstrap_is_parametric_and_skips_noise_free_series():
-    from frictionlab.inference.ranking_bootstrap import bootstrap_fits
+    from frictionlab.inference.resampling.ranking_bootstrap import bootstrap_fits
 
     golf = [fit(law, "impact-golf-v28") for law in ("wear", "coulomb")]
     oil = [fit(law, "incline-oil-a100") for law in ("wear", "couette", "coulomb")]
@@ -253,8 +253,8 @@ def test_a_parameter_without_effect_is_found_by_sensitivity():
 
 
 def test_a_trajectory_that_leaves_the_plausible_range_is_flagged():
-    from frictionlab.inference.fitting import DatasetFit, make_target
-    from frictionlab.inference.plausibility import RANGE, check_plausibility
+    from frictionlab.inference.fitting.fit import DatasetFit, make_target
+    from frictionlab.inference.diagnostics.plausibility import RANGE, check_plausibility
 
     class NoModel:  # no free parameters: only the trajectory checks run
         def residual(self, values):
@@ -289,8 +289,8 @@ class PushingDrag(FrictionLaw):
 
 
 def test_friction_that_supplies_energy_is_flagged():
-    from frictionlab.inference.fitting import DatasetFit, make_target
-    from frictionlab.inference.plausibility import check_plausibility
+    from frictionlab.inference.fitting.fit import DatasetFit, make_target
+    from frictionlab.inference.diagnostics.plausibility import check_plausibility
 
     class NoModel:
         def residual(self, values):
@@ -304,8 +304,8 @@ def test_friction_that_supplies_energy_is_flagged():
 
 
 def test_too_few_points_without_a_likelihood_is_untestable_not_a_poor_set():
-    from frictionlab.inference.goodness import goodness
-    from frictionlab.inference.verdicts import _verdict
+    from frictionlab.inference.diagnostics.goodness import goodness
+    from frictionlab.inference.verdicts.group_verdicts import _verdict
 
     g = goodness(np.array([0.3, -0.2, 0.1, 0.4, -0.5]), 1, "none")  # no likelihood: no runs test, no chi2
     row = RankRow("d", "coulomb", "exact", 5, 1, 1.0, 1.0, 1.0, 3.0, 3.0, 3.0, rank=1, fits=g.fits, goodness=g,
@@ -319,7 +319,7 @@ def test_a_group_where_no_law_could_be_fitted_is_not_answered_from_another_group
     """A group whose candidates all failed says so; it never borrows the ranking of all datasets."""
     from types import SimpleNamespace
 
-    from frictionlab.inference.verdicts import make_answers
+    from frictionlab.inference.verdicts.group_verdicts import make_answers
 
     prov = SimpleNamespace(kind="synthetic")
     dss = [SimpleNamespace(name=n, provenance=prov, group=n.split("-")[0])  # groups declared, never inferred
@@ -335,7 +335,7 @@ def test_a_group_where_no_law_could_be_fitted_is_not_answered_from_another_group
 
 def test_a_spring_slider_step_is_measured_against_its_fastest_load_point_velocity():
     """A velocity step 1 -> 10 um/s makes the slip overshoot 10x the first velocity: physics, not a pumping law."""
-    from frictionlab.inference.plausibility import _trajectories
+    from frictionlab.inference.diagnostics.plausibility import _trajectories
     from frictionlab.physics.registry import get_law
 
     d = load_dataset("spring-slider-aging")
@@ -370,7 +370,7 @@ def test_goodness_p_values_are_scipy_stats_own():
     numbers on residuals of many shapes (runs test, lag-1 correlation) and on a chi-square grid."""
     from scipy.stats import chi2, norm
 
-    from frictionlab.inference.goodness import RUNS_MIN, chi2_pvalue, lag1
+    from frictionlab.inference.diagnostics.goodness import RUNS_MIN, chi2_pvalue, lag1
 
     rng = np.random.default_rng(3)
     for _ in range(300):

@@ -3,13 +3,17 @@
     python tools/screenshot.py REPORT_FOLDER_OR_HTML [--out DIR] [--height 1000 --height 4000] [--open]
     python tools/screenshot.py --readme
     python tools/screenshot.py --site SITE_FOLDER --out DIR
+    python tools/screenshot.py --docs SITE_FOLDER --out DIR
 
 Writes DIR/screen-<height>.png (default DIR: the report folder) for a 1400 px wide window of each
 height: 1000 px is the first screen; --open opens every collapsible section first.
 --readme runs ``frictionlab compare`` (the README's command 1) into a temporary folder and saves the first
 screen of its report as docs/images/first-screen.png, the README's picture.
 --site saves the first screen of each page of a built documentation site (``mkdocs build --site-dir
-SITE_FOLDER``) as DIR/<page>.png. Needs Debian's ``chromium`` (apt-get install chromium).
+SITE_FOLDER``) as DIR/<page>.png.
+--docs saves five pages of a built site (DOCS_PAGES: the home page, the equations, the benchmarks' wide tables,
+a gallery example and an API page) at 1400 and 800 px wide, 2000 px high, as DIR/<page>-<width>.png: what to
+look at for tables or code cut off at the right edge. Needs Debian's ``chromium`` (apt-get install chromium).
 """
 from __future__ import annotations
 
@@ -120,11 +124,30 @@ def site_pictures(site: Path, out: Path, height: int = 1000) -> list[Path]:
     return done
 
 
+#: The pages --docs renders: one of each kind of content (text, maths, wide tables, a gallery example, API).
+DOCS_PAGES = ("", "science/equations", "benchmarks", "gallery/golf_claim", "api/results")
+DOCS_WIDTHS = (1400, 800)
+
+
+def docs_pictures(site: Path, out: Path, height: int = 2000) -> list[Path]:
+    """DOCS_PAGES of a built site at each of DOCS_WIDTHS, as out/<page>-<width>.png."""
+    out.mkdir(parents=True, exist_ok=True)
+    done = []
+    for rel in DOCS_PAGES:
+        page = site / rel / "index.html"
+        if not page.exists():
+            raise FileNotFoundError(f"{page}: no such page in the built site (mkdocs build --site-dir {site})")
+        for width in DOCS_WIDTHS:
+            done.append(screenshot(page, out / f"{rel.replace('/', '-') or 'home'}-{width}.png", height, width))
+    return done
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("report", type=Path, nargs="?", help="a report folder or its report.html")
     ap.add_argument("--readme", action="store_true", help="make the README's picture, docs/images/first-screen.png")
     ap.add_argument("--site", type=Path, help="a built documentation site: the first screen of each page")
+    ap.add_argument("--docs", type=Path, help="a built documentation site: five pages at 1400 and 800 px wide")
     ap.add_argument("--out", type=Path, help="folder for the PNGs (default: the report folder)")
     ap.add_argument("--height", type=int, action="append", help="window height in px (repeatable; default 1000)")
     ap.add_argument("--open", action="store_true", help="open every collapsible section (screen-open-<height>.png)")
@@ -136,8 +159,12 @@ def main(argv=None) -> int:
         for png in site_pictures(args.site, args.out or Path("site-screens"), (args.height or [1000])[0]):
             print(png)
         return 0
+    if args.docs:
+        for png in docs_pictures(args.docs, args.out or Path("site-screens"), (args.height or [2000])[0]):
+            print(png)
+        return 0
     if args.report is None:
-        ap.error("give a report folder, --readme or --site")
+        ap.error("give a report folder, --readme, --site or --docs")
     html = args.report / "report.html" if args.report.is_dir() else args.report
     out = args.out or html.parent
     out.mkdir(parents=True, exist_ok=True)

@@ -88,7 +88,7 @@ def fit_timeout(value: str) -> float:
 
 #: Default time budget of one fit [s]: far above the slowest built-in fit (an ODE fit, seconds).
 FIT_TIMEOUT = 900.0
-FIT_RTOL = 1e-6  # inference.predict.FIT_RTOL, here without importing the numerical stack for --help
+FIT_RTOL = 1e-6  # inference.fitting.predict.FIT_RTOL, here without importing the numerical stack for --help
 
 
 def parse_fix(law, items) -> dict:

@@ -29,7 +29,7 @@ from ..core.errors import DatasetError
 from ..core.files import MAX_CSV_BYTES, MAX_TOML_BYTES, read_bytes
 
 #: Bump when the importer's output changes: cached imports of an older importer are imported again.
-IMPORTER = "velstep-2"
+IMPORTER = "velstep-4"
 
 _STEADYSTATE = dict(
     format="velstep", license="MIT",
@@ -68,8 +68,8 @@ def raw_dirs() -> list[Path]:
         return [Path(p) for p in env.split(os.pathsep) if p]
     from importlib import resources
 
-    builtin = Path(str(resources.files("frictionlab.data")))  # the repository's datasets/ folder
-    return [builtin.resolve().parent.parent / "shared" / "data"]
+    builtin = Path(str(resources.files("frictionlab.data")))  # the repository's frictionlab/data/ folder
+    return [builtin.resolve().parents[2] / "shared" / "data"]
 
 
 def _sha256(data: bytes) -> str:

@@ -235,7 +235,7 @@ def measure_case(name, law, params, scene, rtols, repeats, batch_size, n_t=201, 
     return rows, meta
 
 
-#: The cost at the level users care about: fits at each tolerance (``frictionlab.inference.fitcost``).
+#: The cost at the level users care about: fits at each tolerance (``frictionlab.inference.cost.tolerance``).
 FIT_CASES = (("impact-golf-v28", ("wear", "area-rate", "coulomb")), ("incline-dry-d10", ("wear", "couette", "coulomb")))
 FIT_METHODS, QUICK_FIT_METHODS = ("LSODA", "DOP853"), ("LSODA",)
 FIT_RTOLS, QUICK_FIT_RTOLS = (1e-3, 1e-5, 1e-7, 1e-10), (1e-3, 1e-7)
@@ -289,7 +289,7 @@ def run_bench(quick: bool = False, progress=None, fits: bool = True) -> dict:
                 "load_average_at_start": list(os.getloadavg()) if hasattr(os, "getloadavg") else None}
     fit_rows = []
     if fits:
-        from ..inference.fitcost import fit_tolerance_study
+        from ..inference.cost.tolerance import fit_tolerance_study
 
         for dataset, laws in FIT_CASES:
             fit_rows += fit_tolerance_study(laws, dataset, QUICK_FIT_METHODS if quick else FIT_METHODS,

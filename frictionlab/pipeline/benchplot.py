@@ -179,7 +179,7 @@ def write_bench(out, result, force: bool = False) -> list[str]:
                 w.writerow({k: ("" if r[k] is None else r[k]) for k in fields})
         md = markdown(result)
         if result.get("fit_rows"):
-            from ..inference import fitcost
+            from ..inference.cost import tolerance as fitcost
 
             fit_fields = list(result["fit_rows"][0])
             with open(tmp / "fit_tolerance.csv", "w", newline="", encoding="utf-8") as fh:

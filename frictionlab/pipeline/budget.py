@@ -1,4 +1,4 @@
-"""A fit's time budget, enforced from outside the law's code (``inference.guard``).
+"""A fit's time budget, enforced from outside the law's code (``inference.fitting.guard``).
 
 ``fit`` keeps its own budget with an alarm that raises in the fitting process; a law plugin's bare
 ``except:`` can swallow that. So a fit of a third-party law with a budget runs in a forked child
@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import time
 
-from ..inference.fitting import FitResult, fit
-from ..inference.guard import within_budget
+from ..inference.fitting.fit import FitResult, fit
+from ..inference.fitting.guard import within_budget
 from ..physics.registry import get_law
 
 

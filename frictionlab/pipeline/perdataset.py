@@ -17,8 +17,8 @@ from concurrent.futures import as_completed
 import attrs
 
 from ..core.cluster import executor
-from ..inference.accuracy import study_fits
-from ..inference.ranking_bootstrap import bootstrap_fits
+from ..inference.cost.accuracy import study_fits
+from ..inference.resampling.ranking_bootstrap import bootstrap_fits
 from .runner import Run, run_stages, warm_worker
 from .stages import check_some_fit, equivalence_order, family_adjusted, fit_order
 

@@ -8,9 +8,10 @@ from collections.abc import Iterable, Sequence
 import attrs
 
 from ..core.errors import FrictionLabError
-from ..inference.fitting import PREDICTORS, FitResult, applicable_solvers, auto_solver
-from ..inference.predict import has_scene_quantity
-from ..inference.ranking import family
+from ..inference.fitting.fit import PREDICTORS, FitResult
+from ..solve.choice import applicable_solvers, auto_solver
+from ..inference.fitting.predict import has_scene_quantity
+from ..inference.verdicts.ranking import family
 from ..io.dataset import Dataset
 from ..physics.registry import available_laws, get_law
 

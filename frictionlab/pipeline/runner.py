@@ -191,7 +191,7 @@ def warm_worker() -> None:
     cached kernel), so that no task pays them."""
     import lmfit  # noqa: F401
 
-    from ..inference.fitting import fit  # noqa: F401
+    from ..inference.fitting.fit import fit  # noqa: F401
     from ..solve.compiled import available
 
     available()
@@ -202,7 +202,7 @@ def _timed(stage: Stage, comparison, run: Run) -> tuple[dict, float]:
     run.begin(stage.name)  # each stage counted apart, named as it begins
     try:
         part = stage.fn(comparison, run)
-    except BrokenProcessPool:  # --jobs 1: the child process of a third-party law's call (inference.guard) died
+    except BrokenProcessPool:  # --jobs 1: the child process of a third-party law's call (inference.fitting.guard) died
         raise WorkerLost(f"compare: {LOST} in the {stage.name} stage") from None
     except WorkerLost as exc:
         raise WorkerLost(f"{exc} in the {stage.name} stage") from None

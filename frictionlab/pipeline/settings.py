@@ -8,15 +8,18 @@ import numpy as np
 
 from ..core.arguments import as_items
 from ..core.errors import ParameterError
-from ..inference.equivalence import MIN_REPLICATES, PAIRS, REPLICATES
-from ..inference.margin import MARGIN
+from ..inference.equivalence.discrimination import MIN_REPLICATES, PAIRS, REPLICATES
+from ..inference.equivalence.margin import MARGIN
 from ..physics.registry import available_laws, get_law
 
 #: The laws ``compare`` fits by default on impacts and inclines: the four of the mission (the seed paper's
 #: question). Other registered laws (stribeck, lugre, dahl, installed plugins) join when named or with "all".
 DEFAULT_LAWS = ("coulomb", "area-rate", "wear", "couette")
-#: Dataset kinds whose default laws are others: rate-and-state friction on velocity steps of a spring-slider.
-DEFAULT_LAWS_BY_KIND = {"spring-slider": ("rate-state-aging", "rate-state-slip")}
+#: Dataset kinds whose default laws are others: rate-and-state friction on velocity steps of a spring-slider, the
+#: state laws the velocity-step fit serves (aging, slip, PRZ: ``solve.quasistatic.FITTED``). Nagata's and the
+#: two-state laws join when named: the velocity-step fit does not serve their extra parameters, and a law fitted
+#: through another model (no trend, stiffness or AR(1) noise) would be ranked against a different likelihood.
+DEFAULT_LAWS_BY_KIND = {"spring-slider": ("rate-state-aging", "rate-state-slip", "rate-state-prz")}
 
 
 def select_laws(laws: Sequence[str] | None) -> tuple[str, ...]:
@@ -93,9 +96,9 @@ class Settings:
     replicates: int = REPLICATES
     pairs: tuple = PAIRS
     transfer: bool = True
-    margin: object = MARGIN  # the equivalence margin delta: a multiple of the noise or a quantity (inference.margin)
+    margin: object = MARGIN  # the equivalence margin delta: a multiple of the noise or a quantity (inference.equivalence.margin)
     family: str = "report"  # the family a report's test p-values are adjusted in (equivalence_groups.FAMILIES)
-    accuracy: bool = True  # what accuracy costs per law and dataset (inference.accuracy; in full with tolerance)
+    accuracy: bool = True  # what accuracy costs per law and dataset (inference.cost.accuracy; in full with tolerance)
     cluster: str = ""  # where the tasks ran when not on a local pool: "Dask cluster at ADDRESS (N workers)"
     by_kind: dict = attrs.field(factory=dict)  # dataset kind -> the laws fitted on it ({}: every law on every dataset)
 
@@ -114,8 +117,8 @@ class Settings:
         t = self.fit_timeout
         if t is not None and (isinstance(t, bool) or not isinstance(t, (int, float)) or not 0 < t < float("inf")):
             raise ParameterError(f"compare: fit_timeout must be a positive number of seconds, got {t!r}")
-        from ..inference.equivalence_groups import FAMILIES
-        from ..inference.margin import parse_margin
+        from ..inference.equivalence.family import FAMILIES
+        from ..inference.equivalence.margin import parse_margin
 
         object.__setattr__(self, "margin", parse_margin(self.margin, "compare: margin"))
         if self.family not in FAMILIES:

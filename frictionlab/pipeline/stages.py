@@ -1,34 +1,34 @@
 """The named stages of ``compare``, in order: fit, rank, equivalence, transfer, tolerance, accuracy, bootstrap,
 answer. Each reads the comparison so far and returns the fields of ``Comparison`` it fills.
 
-- fit: every planned (law, dataset, solver) fitted (``inference.fitting.fit``) -> ``fits``
-- rank: per dataset and per group (``inference.ranking``) -> ``ranking``, ``groups``
-- equivalence: the discrimination test per pair and dataset (``inference.equivalence``) -> ``equivalence``
-- transfer: one parameter set across a group's conditions (``inference.transfer``) -> ``transfer``
-- tolerance: the ODE laws of one dataset refitted at other tolerances (``inference.fitcost``) -> ``tolerance``
+- fit: every planned (law, dataset, solver) fitted (``inference.fitting.fit.fit``) -> ``fits``
+- rank: per dataset and per group (``inference.verdicts.ranking``) -> ``ranking``, ``groups``
+- equivalence: the discrimination test per pair and dataset (``inference.equivalence.discrimination``) -> ``equivalence``
+- transfer: one parameter set across a group's conditions (``inference.equivalence.transfer``) -> ``transfer``
+- tolerance: the ODE laws of one dataset refitted at other tolerances (``inference.cost.tolerance``) -> ``tolerance``
 - accuracy: what accuracy costs, each solver's error and time against the most accurate one per law and
-  dataset (``inference.accuracy``; by default where cheap, in full with the tolerance check) -> ``accuracy``
-- bootstrap: parametric replicates, intervals and first-place shares (``inference.bootstrap``) ->
+  dataset (``inference.cost.accuracy``; by default where cheap, in full with the tolerance check) -> ``accuracy``
+- bootstrap: parametric replicates, intervals and first-place shares (``inference.resampling.bootstrap``) ->
   ``bootstrap``, ``bootstrap_skipped``
-- answer: one verdict row per dataset group, the first screen (``inference.verdicts``) -> ``answers``
+- answer: one verdict row per dataset group, the first screen (``inference.verdicts.group_verdicts``) -> ``answers``
 """
 from __future__ import annotations
 
 import functools
 
 from ..core.errors import FrictionLabError
-from ..inference import accuracy as _accuracy
-from ..inference import equivalence_groups as _equivalence
-from ..inference import transfer as _transfer
-from ..inference.answers import group_of
-from ..inference.accuracy import SolverCost, solver_costs, study_fits
-from ..inference.ranking_bootstrap import bootstrap_fits
-from ..inference.equivalence import EquivalenceResult, analyze_equivalence
-from ..inference.fitcost import tolerance_check
-from ..inference.fitting import FitResult
-from ..inference.ranking import family, rank_fits, rank_groups
-from ..inference.verdicts import make_answers, not_fitted_answers
-from ..inference.guard import within_budget  # a plugin's time budget kept from outside its code, every stage
+from ..inference.cost import accuracy as _accuracy
+from ..inference.equivalence import family as _equivalence
+from ..inference.equivalence import transfer as _transfer
+from ..inference.verdicts.answers import group_of
+from ..inference.cost.accuracy import SolverCost, solver_costs, study_fits
+from ..inference.resampling.ranking_bootstrap import bootstrap_fits
+from ..inference.equivalence.discrimination import EquivalenceResult, analyze_equivalence
+from ..inference.cost.tolerance import tolerance_check
+from ..inference.fitting.fit import FitResult
+from ..inference.verdicts.ranking import family, rank_fits, rank_groups
+from ..inference.verdicts.group_verdicts import make_answers, not_fitted_answers
+from ..inference.fitting.guard import within_budget  # a plugin's time budget kept from outside its code, every stage
 from .budget import fit_within_budget as fit_one
 from .planning import pair_index, slow_pair
 from .runner import Run, Stage

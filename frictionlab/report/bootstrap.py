@@ -4,8 +4,8 @@ from __future__ import annotations
 import math
 
 from ..core.display import fmt, interval_text, param_text
-from ..inference.ranking_bootstrap import parameter_table, ranking_table
-from ..inference.ranking import TIE_AIC
+from ..inference.resampling.ranking_bootstrap import parameter_table, ranking_table
+from ..inference.verdicts.ranking import TIE_AIC
 from .doc import Section
 from .summary import first_share
 from .text import pct

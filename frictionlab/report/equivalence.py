@@ -3,8 +3,8 @@ from __future__ import annotations
 
 
 from ..core.display import fmt
-from ..inference import rules
-from ..inference.equivalence import ALPHA, AREA_RATE, WEAR, sentence
+from ..inference.verdicts import rules
+from ..inference.equivalence.discrimination import ALPHA, AREA_RATE, WEAR, sentence
 from . import figures
 from .doc import Section
 
@@ -16,7 +16,7 @@ def _p(e, p: float) -> str:
 
 
 def method_text(replicates: int, margin_text: str, family_text: str) -> str:
-    """The rule as applied (``inference.rules``), and the decomposition's caveat."""
+    """The rule as applied (``inference.verdicts.rules``), and the decomposition's caveat."""
     return (rules.equivalence(replicates, margin_text, family_text) + " " + sentence(rules.qualitative()) + " The "
             "decomposition F ≈ λu0(1 − b)A + (λu0b/(φA0)) A dA/dt rests on the truncated slip (eq 7 of Arakawa 2017), "
             "so it is shown for the series fit only; that paper prints the second factor as φ/A0, dimensionally it "

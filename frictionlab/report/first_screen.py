@@ -1,11 +1,11 @@
 """The first screen: the verdict table (``Comparison.answers``), what accuracy costs, and the figure of the data.
 
-The verdict table only renders the answers the verdict layer filled (``frictionlab/inference/answers.py``);
+The verdict table only renders the answers the verdict layer filled (``frictionlab/inference/verdicts/answers.py``);
 columns without data are named in one line under it, and groups without a fitted law fold into one
 line. Without answers it shows what the comparison does hold, labelled as such (the AIC ranking's
 first place and the equivalence analysis' verdict), never a verdict of its own. The full sentences of each
 row follow, folded, each part a labelled run of whole sentences; then, folded, what accuracy costs per law and
-dataset (``inference.accuracy``). The figure (``data_view``) draws each group's data with its top-ranked
+dataset (``inference.cost.accuracy``). The figure (``data_view``) draws each group's data with its top-ranked
 candidates, and the slip of the truncated series against the exact solution where that series is among them.
 
 Kinds of data with a first-screen block of their own plug in at one place, ``KIND_BLOCKS``: a dataset kind
@@ -21,9 +21,9 @@ import attrs
 import numpy as np
 
 from ..core.display import fmt_time
-from ..inference.accuracy import COMMAND as ACCURACY_COMMAND
-from ..inference.answers import group_of, unfitted
-from ..inference.equivalence import AREA_RATE, COULOMB, COUETTE, WEAR, sentence
+from ..inference.cost.accuracy import COMMAND as ACCURACY_COMMAND
+from ..inference.verdicts.answers import group_of, unfitted
+from ..inference.equivalence.discrimination import AREA_RATE, COULOMB, COUETTE, WEAR, sentence
 from ..solve.solvers.series import slip_zero
 from . import figures, velstep
 from .data_view import describe, group_views, spin_falls
@@ -37,14 +37,15 @@ TITLE = "Answers"
 COLUMNS = (("best", "best law"), ("goodness", "goodness of fit"),
            ("equivalence", "λAu vs μN + μη′dA/dt"),
            ("threshold", "noise threshold"), ("series", "series vs exact"), ("accuracy", "what accuracy costs"),
-           ("transfer", "one parameter set for all conditions?"))
+           ("transfer", "one parameter set for all conditions?"), ("closer", "which law is closer"))
 #: characters a table cell shows (more: cut, the full text is in the notes)
 CELL_LIMIT = 70
 #: (Answer field, label) of the full sentences in the notes below the table.
 NOTES = (("headline", ""), ("goodness", "Goodness"), ("equivalence", "λAu against μN + μη′dA/dt, exact"),
          ("equivalence_series", "The truncated series of λAu against μN + μη′dA/dt"),
          ("qualitative", "Shared features"), ("noise_threshold", "Noise threshold"),
-         ("series_vs_exact", "Series vs exact"), ("accuracy", "What accuracy costs"), ("transfer", "Across conditions"))
+         ("series_vs_exact", "Series vs exact"), ("accuracy", "What accuracy costs"), ("transfer", "Across conditions"),
+         ("closer", "Which law is closer"))
 #: dataset kind -> block(ctx, sec, datasets) -> names drawn or None (all): a first-screen block of its own for the
 #: fitted datasets of that kind (module docstring); the generic figure leaves the datasets it drew out.
 KIND_BLOCKS: dict = {"spring-slider": lambda ctx, sec, datasets: velstep.first_screen(sec, ctx.c, datasets)}
@@ -91,7 +92,8 @@ ABSENT = {"best": "a best law", "goodness": "a goodness-of-fit test",
                                                                  "fitted)",
           "accuracy": f"what accuracy costs (it runs by default where cheap, unless --no-accuracy; `{ACCURACY_COMMAND}` "
                       "runs it everywhere)",
-          "transfer": "one parameter set across conditions (no group of two or more datasets)"}
+          "transfer": "one parameter set across conditions (no group of two or more datasets)",
+          "closer": "which law is closer (no two laws with pointwise likelihoods on one dataset)"}
 
 
 def _answer_table(sec: Section, answers, laws=()):
@@ -118,6 +120,8 @@ def _answer_table(sec: Section, answers, laws=()):
 def _could_apply(key: str, laws) -> bool:
     """Whether a column absent from the verdict table is worth naming: the paper's pair and the truncated series
     only where the paper's laws were compared."""
+    if key == "closer":  # said where it was tested, not missed elsewhere
+        return False
     if key in ("equivalence", "threshold"):
         return {WEAR, AREA_RATE} <= set(laws)
     if key == "series":

@@ -6,7 +6,7 @@ import re
 from ..core.display import param_cells, param_text
 from ..core.errors import FrictionLabError
 from ..core.units import to_si
-from ..inference.identifiability import AT_BOUND_MEANING
+from ..inference.diagnostics.identifiability import AT_BOUND_MEANING
 from ..physics.registry import get_law
 from . import figures
 from .doc import Section

@@ -18,7 +18,7 @@ TITLE = "Dataset groups"
 
 def groups_of(c) -> dict[str, list[str]]:
     """Group label -> its datasets' names, in the comparison's dataset order (``answers.group_of``)."""
-    from ..inference.answers import group_of
+    from ..inference.verdicts.answers import group_of
 
     out: dict[str, list[str]] = {}
     for d in c.datasets:

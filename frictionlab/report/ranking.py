@@ -4,8 +4,8 @@ from __future__ import annotations
 import math
 
 from ..core.display import OBSERVABLE_UNITS, fmt, unit
-from ..inference import rules
-from ..inference.equivalence import sentence
+from ..inference.verdicts import rules
+from ..inference.equivalence.discrimination import sentence
 from . import figures
 from .doc import Section
 from .text import fixed

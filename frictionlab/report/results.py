@@ -1,7 +1,7 @@
 """results.json, schema ``frictionlab.compare/1``, and ranking.csv.
 
 ranking.csv: columns ``ranking.COLUMNS`` then ``UNIT_COLUMNS`` (observable, rss_unit, rmse_unit); per-dataset
-  rows, then the group rows (ALL, ALL[kind]); rss and rmse in the observable's SI unit, empty for groups.
+  rows, then the rows of each declared group of two or more datasets; rss and rmse in the observable's SI unit, empty for groups.
 results.json:
     created, versions{package: version}, settings, wall_time_s,
     datasets[{name, kind, observable, n_points, status: fitted|skipped, reason,
@@ -55,7 +55,7 @@ results.json:
                     status, parameter, value, stderr, unit, shift_in_stderr, aic, rank}]},
     accuracy[{dataset, law, solver, rtol, label, reference, error (RMS against the reference solver: observable SI,
               'stated': stated precisions), error_sigma, time_s (CPU per prediction), time_ratio, observable, status
-              (ok|not run|failed), reason}] (inference/accuracy.py: what accuracy costs)
+              (ok|not run|failed), reason}] (inference/cost/accuracy.py: what accuracy costs)
   All numbers SI (rad/s, s, m, N) unless the key says otherwise; non-finite numbers are null.
 """
 from __future__ import annotations
@@ -65,10 +65,10 @@ import math
 
 import numpy as np
 
-from ..inference.ranking_bootstrap import parameter_table, ranking_table
-from ..inference.predict import FIT_RTOL
-from ..inference.ranking import COLUMNS, to_csv
-from ..inference.identifiability import AT_BOUND_MEANING, at_bounds
+from ..inference.resampling.ranking_bootstrap import parameter_table, ranking_table
+from ..inference.fitting.predict import FIT_RTOL
+from ..inference.verdicts.ranking import COLUMNS, to_csv
+from ..inference.diagnostics.identifiability import AT_BOUND_MEANING, at_bounds
 from ..io.dataset import COLUMN_SI
 
 #: Columns ranking.csv adds after ``ranking.COLUMNS``: what rss and rmse are measured in.

@@ -4,9 +4,9 @@ from __future__ import annotations
 import datetime as _dt
 import math
 
-from ..inference.ranking_bootstrap import wilson
-from ..inference.equivalence import AREA_RATE, WEAR
-from ..inference.ranking import weight_text
+from ..inference.resampling.ranking_bootstrap import wilson
+from ..inference.equivalence.discrimination import AREA_RATE, WEAR
+from ..inference.verdicts.ranking import weight_text
 from .doc import Section
 from .text import PROVENANCE_WORDS, pct
 

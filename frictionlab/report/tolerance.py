@@ -4,7 +4,7 @@ from __future__ import annotations
 import math
 
 from ..core.display import fmt, param_text
-from ..inference.predict import FIT_RTOL
+from ..inference.fitting.predict import FIT_RTOL
 from .doc import Section
 from .text import rtol_text
 

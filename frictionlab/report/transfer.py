@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from ..core.display import fmt
-from ..inference.transfer import ALPHA
+from ..inference.equivalence.transfer import ALPHA
 from .doc import Section
 
 TITLE = "Prediction across conditions"

@@ -356,7 +356,7 @@ def same_curve(a, b) -> bool:
     SAME_CURVE sigma), or are the ranking's one candidate (laws spanning one closed-form family, fitted to one
     dataset: 'wear = couette'; their best fits differ only by the optimizer's tolerance): laws of one
     functional form, or a law whose extra term has no effect there."""
-    from ...inference.ranking import family_key
+    from ...inference.verdicts.ranking import family_key
 
     if a.solver != b.solver or len(a.per_dataset) != len(b.per_dataset):
         return False
@@ -385,7 +385,7 @@ def distinct_curves(fits) -> list[tuple[object, list[str]]]:
 
 def simplest_first(laws) -> list[str]:
     """Laws of one curve in the order the ranking names them ('wear = couette'): fewest parameters first,
-    then by name (inference.ranking.merge_identical), so each merged candidate has one spelling."""
+    then by name (inference.verdicts.ranking.merge_identical), so each merged candidate has one spelling."""
     from ...physics.registry import get_law
 
     def key(law):

@@ -1,0 +1,1 @@
+"""Parametric replicates: the bootstrap of parameters and of the ranking."""
