@@ -24,11 +24,12 @@ from typing import TYPE_CHECKING
 from ..core.errors import DatasetError, FrictionLabError
 from ..core.files import read_toml
 from ..core.names import check_name
-from ..core.units import MAX_SI, check_text, check_time_scale, unit_factor
+from ..core.units import MAX_SI, unit_factor
 from ..physics.scene import KINDS, Scene
 from .csvread import _line_of_row, read_csv
 from .provenance import PROVENANCE_KINDS, Provenance, _provenance  # noqa: F401  (re-exported)
-from ..solve.outcome import OUTCOMES, OutcomeScene
+from ..solve.outcome import OUTCOMES
+from .dataset_tables import _fixed, _quantity, _rest, _scene, _table
 from .noise import NOISE_KINDS, STATED, noise_table, stated_table  # noqa: F401 (NOISE_KINDS, STATED: read from here too)
 
 DATA_KINDS = KINDS + ("contact-area",)
@@ -200,7 +201,7 @@ class Dataset:
         y = y or self.observable
         if y not in self.columns:
             raise DatasetError(f"dataset '{self.name}' has no column '{y}'; it has {', '.join(self.columns)}")
-        _, ax = figure_axes(ax)
+        _, ax = figure_axes(ax, where="Dataset.plot")
         xcol, xunit, xf = self.x_axis()
         x = self.columns[xcol] * xf if xcol else np.arange(len(self))
         shown, f = self.shown(y)
@@ -214,6 +215,14 @@ class Dataset:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
         return ax
+
+    def check(self, where: str = "dataset") -> Dataset:
+        """This dataset if it is still what loading made of it, else a DatasetError naming ``where`` and the field
+        (``intact.check_intact``: what fit, simulate and compare call before using it)."""
+        from .intact import check_intact
+
+        check_intact(self, where)
+        return self
 
     def _repr_html_(self) -> str:
         """A notebook's view: what the dataset is, where it comes from, its noise and columns in its units."""
@@ -296,6 +305,9 @@ def load_dataset(name_or_path: str | Path) -> Dataset:
     if isinstance(name_or_path, Dataset):
         return name_or_path
     from . import external
+    from .intact import check_dataset_like
+
+    check_dataset_like(name_or_path, "load_dataset")
 
     if isinstance(name_or_path, str) and name_or_path in external.RECORDS \
             and not (builtin_dir() / f"{name_or_path}.toml").exists():
@@ -312,14 +324,6 @@ def _req(meta, key, path, typ=str):
         what = {str: "string", dict: "table"}.get(typ, typ.__name__)
         raise DatasetError(f"{path}: '{key}' must be a {what}, got {type(meta[key]).__name__}")
     return meta[key]
-
-
-def _table(meta, key, path, where=None):
-    """An optional TOML table: {} when absent, an error when present but not a table."""
-    value = meta.get(key, {})
-    if not isinstance(value, dict):
-        raise DatasetError(f"{path}: {where or key} must be a table, got {type(value).__name__} {value!r}")
-    return value
 
 
 def from_meta(meta: dict, path: Path, raw: dict | None = None) -> Dataset:
@@ -455,125 +459,6 @@ def _correlation(value, path) -> str:
     return value
 
 
-def _scene(meta, path, kind, observable, columns, units, csv):
-    """The [scene] table as a Scene (or OutcomeScene); None for a contact-area series."""
-    if kind == "contact-area":
-        return None
-    spec = meta.get("scene")
-    if not isinstance(spec, dict):
-        raise DatasetError(f"{path}: missing required table [scene]")
-    try:
-        if kind == "impact-outcome":
-            scene = OutcomeScene.from_spec(spec, str(path))
-        else:
-            scene = Scene.from_spec(spec, kind, str(path), columns, columns.get("t"))
-    except FrictionLabError as exc:  # a model's own check (no file in it) still names the file
-        raise DatasetError(str(exc) if str(exc).startswith(str(path)) else f"{path}: [scene]: {exc}") from None
-    if kind == "impact-outcome":
-        _check_outcome_rows(columns, observable, path, csv, scene)
-    else:
-        _check_observable(scene, observable, path)
-        _check_time_unit(columns, units, spec, kind, scene, path)
-    return scene
-
-
-def _fixed(table, path):
-    """[fixed] law parameters in SI, each a parameter of some registered law and within its bounds."""
-    from ..physics.registry import available_laws
-
-    fixed, fixed_units = {}, {}
-    for key, value in table.items():
-        specs = [(law.name, s) for law in available_laws().values() for s in law.params if s.name == key]
-        if not specs:
-            raise DatasetError(f"{path}: fixed.{key} is not a parameter of any registered law")
-        unit = specs[0][1].unit
-        fixed[key] = _quantity(value, unit, f"{path}: fixed.{key}")
-        fixed_units[key] = unit
-        for law_name, spec in specs:
-            if spec.unit == unit and not spec.lower <= fixed[key] <= spec.upper:
-                raise DatasetError(f"{path}: fixed.{key} = {value!r} is outside the bounds of law '{law_name}' "
-                                   f"[{spec.lower:g}, {spec.upper:g}] {spec.unit}".rstrip())
-    return fixed, fixed_units
-
-
-def _rest(meta, path, provenance) -> dict:
-    """No unknown top-level key; [reported] and provenance.truth readable later; returns [reported]."""
-    extra = set(meta) - {"name", "group", "kind", "observable", "columns", "noise", "scene", "fixed", "provenance",
-                         "reported", "description", "time_zero", "stated"}
-    if extra:
-        raise DatasetError(f"{path}: unknown top-level key(s) {sorted(extra)}")
-    reported = _table(meta, "reported", path, "[reported]")
-    for table, values in (("reported", reported), ("provenance.truth", provenance.truth)):
-        for key, value in values.items():  # read by the report later: refuse what pint would choke on now
-            if isinstance(value, str):
-                try:
-                    check_text(value, f"{path}: {table}.{key}")
-                except FrictionLabError as exc:
-                    raise DatasetError(str(exc)) from None
-    if not isinstance(meta.get("description", ""), str):
-        raise DatasetError(f"{path}: 'description' must be a string")
-    return reported
-
-
-def _check_time_unit(columns, units, spec, kind, scene, path) -> None:
-    """The time column must span about the scene's duration (given, or the impact's contact time)."""
-    if "duration" in spec:
-        field = "scene.duration"
-    elif kind == "impact" and scene.duration > 0:
-        field = "the scene's contact time"
-    else:
-        return  # the duration was taken from the time column itself
-    try:
-        check_time_scale(float(columns["t"][-1]), scene.duration, units["t"], f"{path}: columns.t", field)
-    except FrictionLabError as exc:
-        raise DatasetError(str(exc)) from None
-
-
-#: Trajectory series each observable needs, and what in a scene provides it.
-def _check_observable(scene: Scene, observable: str, path) -> None:
-    """A dataset whose observable its own scene cannot produce would be fitted against zeros."""
-    if scene.kind not in ("impact", "incline"):
-        return
-    if observable in ("omega", "theta") and not ({"spin", "slip-coupling"} & scene.effects):
-        raise DatasetError(f"{path}: observable {observable!r} needs the scene to integrate spin; "
-                           "add \"spin\" to scene.effects (and a scene.radius)")
-    if observable == "A" and scene.area is None:
-        raise DatasetError(f"{path}: observable 'A' needs a [scene.area] model")
-    if observable == "N" and scene.normal is None:
-        raise DatasetError(f"{path}: observable 'N' needs a [scene.normal] model")
-
-
-def _check_outcome_rows(columns, observable, path, csv, scene) -> None:
-    """An impact-outcome dataset: one impact per row (speed, incidence), an outcome as observable."""
-    for col in ("speed", "incidence"):
-        if col not in columns:
-            raise DatasetError(f"{path}: an impact-outcome dataset needs a '{col}' column in [columns] "
-                               "(one impact per row)")
-    bad = np.nonzero(~(columns["speed"] > 0))[0]
-    if bad.size:
-        raise DatasetError(f"{csv}: column 'speed' line {_line_of_row(csv, int(bad[0]))}: impact speed must be positive")
-    inc = columns["incidence"]
-    bad = np.nonzero(~((inc > 0) & (inc < math.pi / 2)))[0]
-    if bad.size:
-        raise DatasetError(f"{csv}: column 'incidence' line {_line_of_row(csv, int(bad[0]))}: incidence must be "
-                           f"strictly between 0 and 90 deg (measured from the "
-                           f"{'surface normal' if scene.angle_reference == 'normal' else 'surface'})")
-
-
 def _names(columns) -> str:
     """Column names for a one-line message (repr when a name holds odd characters)."""
     return ", ".join(c if c.isprintable() and "," not in c else repr(c) for c in columns)
-
-
-def _si_of(col, value, where):
-    """A declared noise value of column ``col`` in SI."""
-    return _quantity(value, COLUMN_SI[col], where)
-
-
-def _quantity(value, si, where):
-    from ..core.units import to_si
-
-    try:
-        return to_si(value, si, where)
-    except FrictionLabError as exc:
-        raise DatasetError(str(exc)) from None
