@@ -162,7 +162,7 @@ def test_the_velocity_step_fit_serves_prz_and_recovers_its_truth(tmp_path):
 
     import attrs
 
-    from frictionlab.inference.predict import Target
+    from frictionlab.inference.fitting.predict import Target
     from frictionlab.solve import quasistatic
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
