@@ -63,6 +63,14 @@ class RawRecord:
         """The file's line (1-based) of sample i."""
         return int(self.lines[i]) if self.lines is not None else self.first_line + int(i)
 
+    def where(self, i: int) -> str:
+        """'line N' of sample i (a record joined from several files names the file too)."""
+        return f"line {self.line(i)}"
+
+    def span(self, a: int, b: int) -> str:
+        """'lines A to B of FILE' of samples [a, b)."""
+        return f"lines {self.line(a)} to {self.line(b - 1)} of {self.path.name}"
+
 
 def read_raw(path, data: bytes | None = None) -> RawRecord:
     """Read a raw velocity-step record (``data``: its bytes, already read); a one-line DatasetError naming the
@@ -317,7 +325,6 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
                  command: str = "") -> str:
     """The TOML of one imported window (provenance 'measured')."""
     raw, seg = imp.raw, imp.seg
-    first, last = raw.line(w.a), raw.line(w.b - 1)
     steps = [seg.steps[i] for i in w.steps]
     v_text = " -> ".join(f"{v * 1e6:.4g}" for v in w.velocities)
     stress = float(np.mean(raw.sn[w.a:w.b]))
@@ -325,7 +332,7 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
     fitted_v = ", ".join(f"{v:.7g} ± {seg.velocities_se[k]:.2g}"
                          for k, v in enumerate(seg.velocities) if k in _pieces(w))
     jumps = [j for j in seg.jumps if w.a < j.index < w.b]
-    method = (f"every sample of lines {first} to {last} of {raw.path.name} ({w.b - w.a} samples); load-point "
+    method = (f"every sample of {raw.span(w.a, w.b)} ({w.b - w.a} samples); load-point "
               f"velocities and step time{'s' * (len(steps) > 1)} from an exact piecewise-linear segmentation of the "
               f"displacement (optimal partitioning, PELT, penalty 3 ln n = {seg.penalty:.1f}; "
               f"{len(seg.steps)} step{'s' * (len(seg.steps) != 1)} in the record), each step at the kink of a "
@@ -335,14 +342,14 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
               "; friction as measured (no trend removed); its noise estimated from the data, AR(1)" +
               (f"; the window {w.start_note}" if w.start_note else ""))
     description = (f"Velocity step{'s' * (len(steps) > 1)} {v_text} um/s at {stress / 1e6:.4g} MPa {raw.stress} "
-                   f"(record {raw.path.name}, lines {first} to {last}). MEASURED.")
+                   f"({raw.span(w.a, w.b)}). MEASURED.")
     lines = [
         f"# Imported by `frictionlab datasets import velstep` from {raw.path.name}: measured data; do not edit by hand.",
         f"name = {_q(w.name)}",
         'kind = "spring-slider"',
         'observable = "mu"',
         f"description = {_q(description)}",
-        f'time_zero = "{float(raw.t[w.a])!r} s"   # the record\'s clock at line {first}',
+        f'time_zero = "{float(raw.t[w.a])!r} s"   # the record\'s clock at {raw.where(w.a)}',
         "",
         "[columns]",
         't = "s"',
@@ -387,7 +394,7 @@ def write_csv(fh, imp: Imported, w: Window) -> None:
     """Every sample of the window as t [s, the record's clock], x [um, jumps stitched, to 1e-9 um], mu, written
     in chunks, each number as read (the shortest text that gives it back)."""
     raw = imp.raw
-    fh.write(f"# Every sample of lines {raw.line(w.a)} to {raw.line(w.b - 1)} of {raw.path.name}, as recorded "
+    fh.write(f"# Every sample of {raw.span(w.a, w.b)}, as recorded "
              f"(x: load-point displacement{', jumps stitched' if any(w.a < j.index < w.b for j in imp.seg.jumps) else ''}"
              "); t in the record's clock (time_zero in the TOML is t = 0)\n" + CSV_HEADER + "\n")
     for lo in range(w.a, w.b, 100_000):
@@ -423,7 +430,7 @@ def summary(imp: Imported) -> list[str]:
     rows = [("step", "line", "time [s]", "V before [um/s]", "V after [um/s]", "samples before + after")]
     for i, s in enumerate(seg.steps):
         b = seg.bounds
-        rows.append((str(i + 1), str(raw.line(s.index)), _pm(s.time, s.time_se),
+        rows.append((str(i + 1), raw.where(s.index).removeprefix("line "), _pm(s.time, s.time_se),
                      _pm(imp.velocities[i] * 1e6, seg.velocities_se[i]),
                      _pm(imp.velocities[i + 1] * 1e6, seg.velocities_se[i + 1]),
                      f"{b[i + 1] - b[i]} + {b[i + 2] - b[i + 1]}"))
