@@ -52,3 +52,4 @@ def test_the_command_prints_the_table_with_each_laws_prediction(capsys):
 def test_the_record_is_what_its_command_regenerates(capsys):
     assert main(["datasets", "rebuild", "--slide-hold-slide", "--check"]) == 0
     assert "2 generated files equal the committed ones" in capsys.readouterr().out
+
