@@ -75,6 +75,14 @@ class RawRecord:
         return f"{value / 1e3:.4g} kN {self.stress}" if self.stress == "normal force" else \
             f"{value / 1e6:.4g} MPa {self.stress}"
 
+    def where(self, i: int) -> str:
+        """'line N' of sample i (a record joined from several files names the file too)."""
+        return f"line {self.line(i)}"
+
+    def span(self, a: int, b: int) -> str:
+        """'lines A to B of FILE' of samples [a, b)."""
+        return f"lines {self.line(a)} to {self.line(b - 1)} of {self.path.name}"
+
 
 def read_raw(path, data: bytes | None = None, columns=None) -> RawRecord:
     """Read a raw velocity-step record (``data``: its bytes, already read) in the steadystate routine's layout,
@@ -347,7 +355,6 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
                  command: str = "") -> str:
     """The TOML of one imported window (provenance 'measured')."""
     raw, seg = imp.raw, imp.seg
-    first, last = raw.line(w.a), raw.line(w.b - 1)
     steps = [seg.steps[i] for i in w.steps]
     v_text = " -> ".join(f"{v * 1e6:.4g}" for v in w.velocities)
     stress = float(np.mean(raw.sn[w.a:w.b])) if raw.sn is not None else None
@@ -357,7 +364,7 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
     jumps = [j for j in seg.jumps if w.a < j.index < w.b]
     read = "; ".join(([f"read as {raw.encoding}"] if raw.encoding else []) +
                      ([f"columns {raw.layout}"] if raw.layout else []) + list(raw.notes))
-    method = (f"every sample of lines {first} to {last} of {raw.path.name} ({w.b - w.a} samples"
+    method = (f"every sample of {raw.span(w.a, w.b)} ({w.b - w.a} samples"
               f"{'; ' + read if read else ''}); load-point "
               f"velocities and step time{'s' * (len(steps) > 1)} from an exact piecewise-linear segmentation of the "
               f"displacement (optimal partitioning, PELT, penalty 3 ln n = {seg.penalty:.1f}; "
@@ -369,14 +376,14 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
               (f"; the window {w.start_note}" if w.start_note else ""))
     at = f" at {raw.normal_text(stress)}" if stress is not None else ""
     description = (f"Velocity step{'s' * (len(steps) > 1)} {v_text} um/s{at} "
-                   f"(record {raw.path.name}, lines {first} to {last}). MEASURED.")
+                   f"({raw.span(w.a, w.b)}). MEASURED.")
     lines = [
         f"# Imported by `frictionlab datasets import velstep` from {raw.path.name}: measured data; do not edit by hand.",
         f"name = {_q(w.name)}",
         'kind = "spring-slider"',
         'observable = "mu"',
         f"description = {_q(description)}",
-        f'time_zero = "{float(raw.t[w.a])!r} s"   # the record\'s clock at line {first}',
+        f'time_zero = "{float(raw.t[w.a])!r} s"   # the record\'s clock at {raw.where(w.a)}',
         "",
         "[columns]",
         't = "s"',
@@ -423,7 +430,7 @@ def write_csv(fh, imp: Imported, w: Window) -> None:
     """Every sample of the window as t [s, the record's clock], x [um, jumps stitched, to 1e-9 um], mu, written
     in chunks, each number as read (the shortest text that gives it back)."""
     raw = imp.raw
-    fh.write(f"# Every sample of lines {raw.line(w.a)} to {raw.line(w.b - 1)} of {raw.path.name}, as recorded "
+    fh.write(f"# Every sample of {raw.span(w.a, w.b)}, as recorded "
              f"(x: load-point displacement{', jumps stitched' if any(w.a < j.index < w.b for j in imp.seg.jumps) else ''}"
              "); t in the record's clock (time_zero in the TOML is t = 0)\n" + CSV_HEADER + "\n")
     for lo in range(w.a, w.b, 100_000):
@@ -459,7 +466,7 @@ def summary(imp: Imported) -> list[str]:
     rows = [("step", "line", "time [s]", "V before [um/s]", "V after [um/s]", "samples before + after")]
     for i, s in enumerate(seg.steps):
         b = seg.bounds
-        rows.append((str(i + 1), str(raw.line(s.index)), _pm(s.time, s.time_se),
+        rows.append((str(i + 1), raw.where(s.index).removeprefix("line "), _pm(s.time, s.time_se),
                      _pm(imp.velocities[i] * 1e6, seg.velocities_se[i]),
                      _pm(imp.velocities[i + 1] * 1e6, seg.velocities_se[i + 1]),
                      f"{b[i + 1] - b[i]} + {b[i + 2] - b[i + 1]}"))

@@ -31,6 +31,10 @@ class JoinedRecord(RawRecord):
         """'FILE line N' of sample i."""
         return f"{self.files[int(self.source[i])].name} line {self.line(i)}"
 
+    def span(self, a: int, b: int) -> str:
+        """'FILE line A to FILE line B' of samples [a, b)."""
+        return f"{self.where(a)} to {self.where(b - 1)}"
+
 
 def read_joined(paths, columns=None) -> RawRecord:
     """One record from the raw files ``paths`` of one experiment, each read by ``read_raw`` in the layout
