@@ -16,7 +16,7 @@ import warnings
 
 from .core.errors import FrictionLabError, Terminated
 
-COMMANDS = ("laws", "datasets", "simulate", "fit", "compare", "bench")
+COMMANDS = ("laws", "datasets", "simulate", "fit", "compare", "bench", "record", "healing")
 
 
 LISTS_HELP = ("Lists: repeat an option or separate values with commas; both work everywhere "

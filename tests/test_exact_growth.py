@@ -17,7 +17,7 @@ from frictionlab.solve.choice import applicable_solvers, auto_solver
 from frictionlab.io.dataset import load_dataset
 from frictionlab.physics.scene import G, GrowthArea, HalfSineArea, HalfSineNormal, WeightNormal
 from frictionlab.solve.batch import simulate_batch
-from frictionlab.solve.solvers import exact
+from frictionlab.solve.solvers import area_slip
 
 
 def worn_incline(alpha_deg=30.0, u0=0.0, mass=1.15e-3, duration=1.0, A0=1e-7, rate=1e-6, rolling=False):
@@ -94,15 +94,15 @@ def test_stop_time_is_the_zero_of_the_closed_form(lam):
     g0 = 0.02 if lam < -1 else 0.7  # with lam < 0 below the unstable rest b / lam = 0.04
 
     def g(t):
-        return float(exact._relax(g0, b, lam, t - t0)[0])
+        return float(area_slip._relax(g0, b, lam, t - t0)[0])
 
     assert g(t0) == g0 and g(T) < 0
-    ts = float(exact.relax_stop(g0, b, lam, t0, T, 0.0))
+    ts = float(area_slip.relax_stop(g0, b, lam, t0, T, 0.0))
     assert ts == pytest.approx(brentq(g, t0, T, xtol=1e-15), rel=1e-12)
-    assert float(exact.relax_stop(g0, -b, lam, t0, T, 0.0)) == math.inf  # slip pushed on: no stop
-    assert float(exact.relax_stop(g0, b, lam, t0, 0.9 * ts, 0.0)) == math.inf  # not by T
+    assert float(area_slip.relax_stop(g0, -b, lam, t0, T, 0.0)) == math.inf  # slip pushed on: no stop
+    assert float(area_slip.relax_stop(g0, b, lam, t0, 0.9 * ts, 0.0)) == math.inf  # not by T
     if lam < -1:  # above the unstable rest slip runs away
-        assert float(exact.relax_stop(0.05, b, lam, t0, 1e9, 0.0)) == math.inf
+        assert float(area_slip.relax_stop(0.05, b, lam, t0, 1e9, 0.0)) == math.inf
 
 
 def test_batch_matches_the_scalar_solver():

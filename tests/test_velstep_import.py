@@ -51,7 +51,7 @@ def test_import_finds_the_step_its_fitted_velocities_and_a_stiffness_start(tmp_p
 
 def test_the_dataset_keeps_the_contract_with_the_fit(tmp_path):
     """CSV t,x,mu with every sample; TOML spring-slider, mu, [scene.spring] times exact to the microsecond,
-    fitted velocities, [noise] estimated with AR(1) correlation and no sigma, provenance measured."""
+    fitted velocities, [noise] estimated with an AR(p) model chosen by the data and no sigma, provenance measured."""
     _record(tmp_path / "raw.txt")
     out = tmp_path / "out"
     out.mkdir()
@@ -59,7 +59,7 @@ def test_the_dataset_keeps_the_contract_with_the_fit(tmp_path):
                  "--license", "MIT", "--citation", "nobody"]) == 0
     meta = tomllib.loads((out / "vs.toml").read_text())
     assert meta["kind"] == "spring-slider" and meta["observable"] == "mu"
-    assert meta["noise"] == {"kind": "estimated", "correlation": "ar1"}
+    assert meta["noise"] == {"kind": "estimated", "correlation": "arp"}
     assert "trend" not in (out / "vs.toml").read_text().split("[provenance]")[0]
     spring = meta["scene"]["spring"]
     assert spring["times"][0] == "0 s" and spring["stiffness"].endswith(" 1/um")
@@ -86,9 +86,13 @@ def test_several_steps_and_a_hold_import_as_one_dataset_each_or_one_joint_datase
     text = capsys.readouterr().out
     assert "3 velocity steps" in text and "hold from lines" in text
     assert "step  line" in text and "V before [um/s]" in text  # the table
-    assert sorted(p.name for p in out.iterdir()) == [f"exp-step{i}.{e}" for i in (1, 2, 3) for e in ("csv", "toml")]
+    # the hold has no steady state: the stop and the restart share one window, which starts at steady sliding
+    assert sorted(p.name for p in out.iterdir()) == [f"exp-step{i}.{e}" for i in (1, 2) for e in ("csv", "toml")]
+    assert "holds steps 2 to 3, simulated through" in text and "a hold (the load point at rest)" in text
     d2 = load_dataset(out / "exp-step2.toml")
-    assert d2.scene.spring.velocities == pytest.approx((2e-7, 0.0), abs=1e-9)
+    assert d2.scene.spring.velocities == pytest.approx((2e-7, 0.0, 2e-6), abs=1e-9)
+    d1 = load_dataset(out / "exp-step1.toml")
+    assert len(d1) + len(d2) <= 5000  # disjoint windows
     assert main(["datasets", "import", "velstep", str(tmp_path / "raw.txt"), "--name", "whole", "--out", str(out),
                  "--joint"]) == 0
     d = load_dataset(out / "whole.toml")

@@ -28,7 +28,7 @@ def add_parser(sub):
 
     p = subcommand(sub, "compare", help="compare laws on datasets and write a report folder",
                    description="Fit every law to every dataset (default: the laws of each dataset's kind, the "
-                               "four mission laws on impacts and inclines and rate-and-state aging and slip on "
+                               "four mission laws on impacts and inclines and rate-and-state aging, slip and PRZ on "
                                "spring-sliders, on every built-in dataset and measured record present), rank them, test the paper's equivalence claim, and write report.md, "
                                "report.html, figures/, ranking.csv and results.json. Two defaults differ from "
                                "the library's fl.compare(), which runs only what it is asked for: --bootstrap "
@@ -43,7 +43,7 @@ def add_parser(sub):
   frictionlab compare --bootstrap 0 --quiet --out quick   # fastest, no progress lines""")
     p.add_argument("--laws", "--law", action=ListAction, metavar="NAME", help="law names, or 'all' for every registered law "
                    "(default by dataset kind: coulomb, area-rate, wear, couette on impacts and inclines; "
-                   "rate-state-aging, rate-state-slip on spring-sliders)")
+                   "rate-state-aging, rate-state-slip, rate-state-prz on spring-sliders)")
     p.add_argument("--data", action=ListAction, nargs="+", metavar="NAME_OR_TOML",
                    help="datasets, several after one --data (e.g. a shell glob), comma-separated or repeated "
                         "(default: every built-in dataset and every measured record present)")
@@ -247,7 +247,7 @@ def answer_lines(c) -> list[str]:
         parts = [a.cell("best"), a.cell("goodness"),
                  f"lambda A u vs mu N + mu eta' dA/dt: {eq}" if eq and eq != "not tested" else "", a.cell("threshold"),
                  a.cell("series"), f"accuracy {a.short['accuracy']}" if a.short.get("accuracy") else "",
-                 a.cell("transfer")]
+                 a.cell("transfer"), a.cell("closer")]
         out.append(f"  {a.group}: " + "; ".join(p for p in parts if p))
     out += [f"  {', '.join(groups)}: {reason}" + "".join(f"; registered laws that apply: {h}" for h in hints)
             for reason, groups, hints in unfitted(c.answers)]

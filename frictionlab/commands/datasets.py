@@ -61,6 +61,8 @@ def add_parser(sub):
     rb.add_argument("--known-truth", action="store_true",
                     help="rebuild the known-truth datasets (default folder: ./examples/known-truth) instead of the "
                          "built-in ones")
+    rb.add_argument("--slide-hold-slide", action="store_true",
+                    help="rebuild the synthetic slide-hold-slide record (default folder: ./examples/slide-hold-slide)")
     rb.set_defaults(func=_rebuild)
 
 
@@ -75,23 +77,36 @@ def _add_import(acts):
                                  "straight pieces (optimal partitioning: the data choose the number of steps); each "
                                  "step's time is the kink of a continuous two-line fit, its velocities are fitted "
                                  "values, and a table of both with their standard errors is printed. One dataset per "
-                                 "step (NAME-step1, NAME-step2, ...; NAME alone for one step) holds every sample from "
-                                 "the step before to the step after; --joint writes one dataset with every step, for "
+                                 "step (NAME-step1, NAME-step2, ...; NAME alone for one step) starts at a steady state "
+                                 "the data show (the first new steady-state point after the step before, found as "
+                                 "the steadystate routine does) and ends in the steady part after its step; --joint writes one dataset with every step, for "
                                  "a joint fit across steps. A jump of displacement without a change of velocity (a "
                                  "transducer reset) is stitched and reported. The machine stiffness is a start "
-                                 "estimated from friction's loading after each step unless given.",
+                                 "estimated from friction's loading after each step unless given. --columns reads "
+                                 "any other lab's layout: which column is time, displacement and friction (or shear "
+                                 "and normal stress, friction = shear / normal), each with its unit; tab-, comma-, "
+                                 "semicolon- or space-separated, lines before the header and rows of text after it "
+                                 "skipped; UTF-8 or UTF-16 text.",
                      examples="""  frictionlab datasets import velstep experiment.txt --name exp13 --out data/ \\
       --source 'my lab, run 13' --license CC-BY-4.0 --citation 'me et al. (2026)'
   frictionlab datasets import velstep experiment.txt --name exp13 --joint --out data/
-  frictionlab fit rate-state-aging data/exp13-step1.toml""")
+  frictionlab datasets import velstep part1.txt part2.txt part3.txt --name exp13 --out data/
+  frictionlab fit rate-state-aging data/exp13-step1.toml
+  frictionlab datasets import velstep run.csv --name run --columns \\
+      'time=Time ms, displacement=LP_disp mm, shear=Tau MPa, normal=SigmaN MPa'""")
     imp.add_argument("format", choices=("velstep",), metavar="FORMAT", help="raw format: velstep")
-    imp.add_argument("raw", type=Path, metavar="RAWFILE", help="the raw record")
+    imp.add_argument("raw", type=Path, nargs="+", metavar="RAWFILE", help="the raw record; several files of one "
+                     "experiment (slices of one recording, in any order) are joined by time into one record")
     imp.add_argument("--name", required=True, help="dataset name, and file name: NAME-step1, ... for several steps")
     imp.add_argument("--out", type=Path, default=Path("."), help="folder to write into (default: here)")
     imp.add_argument("--joint", action="store_true", help="one dataset holding every step of the record (a joint "
                      "fit of a, b and Dc across steps) instead of one per step")
     imp.add_argument("--steps", type=int, metavar="N", help="check: the number of velocity steps expected (an error "
                                                            "names what was found when it differs)")
+    imp.add_argument("--columns", metavar="SPEC", help="the record's own layout: \"time=NAME UNIT, "
+                     "displacement=NAME UNIT, friction=NAME\" or with \"shear=NAME UNIT, normal=NAME UNIT\" instead "
+                     "of friction (NAME: the header's name, quoted when it holds spaces, or #N for the N-th column; "
+                     "UNIT: e.g. s, ms, um, mm, MPa, kN); default: the steadystate routine's four columns")
     imp.add_argument("--stiffness", help="start for the machine stiffness per unit normal stress, e.g. '0.01 1/um' "
                                          "(default: estimated from friction's loading after each step)")
     imp.add_argument("--source", default="", help="where the record comes from (default: its path)")
@@ -110,7 +125,8 @@ def _import(args) -> int:
     from ..core.names import check_name
     from ..core.units import to_si
     from ..io.dataset import from_meta
-    from ..io.velstep import analyse, dataset_toml, parts, read_raw, summary, write_csv
+    from ..io.layout import parse_columns
+    from ..io.velstep import analyse, dataset_toml, parts, summary, write_csv
 
     check_name(args.name, "datasets import --name", OutputError)  # before any path is made of it
     if args.steps is not None and not 1 <= args.steps <= 10_000:
@@ -119,20 +135,24 @@ def _import(args) -> int:
     if k is not None and not (k > 0 and math.isfinite(k)):
         raise ParameterError(f"--stiffness: {args.stiffness!r} must be a positive stiffness per unit normal stress, "
                              "e.g. '0.01 1/um'")
+    layout = parse_columns(args.columns, "--columns") if args.columns is not None else None
     if not args.out.is_dir():
         raise OutputError(f"{args.out}: folder does not exist")
-    raw = read_raw(args.raw)
+    from ..io.velstep_join import read_joined
+
+    raw = read_joined(args.raw, columns=layout)
     imp = analyse(raw, args.name, joint=args.joint, stiffness=k, steps=args.steps)
     files, pairs = {}, []
     for w in imp.windows:
         paths = args.out / f"{w.name}.toml", args.out / f"{w.name}.csv"
         for p in paths:
-            if p.resolve() == args.raw.resolve():
+            if any(p.resolve() == r.resolve() for r in args.raw):
                 raise OutputError(f"{p}: would overwrite the raw record; choose another --name or --out")
             if os.path.lexists(p) and not args.force:
                 raise OutputError(f"{p}: exists; choose another --name or --out, or pass --force")
         command = "frictionlab datasets import velstep " + " ".join(shlex.quote(a) for a in (
-            args.raw.name, "--name", args.name)) + (" --joint" if args.joint else "") + (
+            *(r.name for r in args.raw), "--name", args.name)) + (" --joint" if args.joint else "") + (
+            f" --columns {shlex.quote(layout.text())}" if layout else "") + (
             f" --stiffness {shlex.quote(args.stiffness)}" if k else "")
         toml = dataset_toml(imp, w, source=args.source, license=args.license, citation=args.citation,
                             command=command)
@@ -150,7 +170,8 @@ def _import(args) -> int:
     for w, (toml_path, csv_path) in pairs:
         v = " -> ".join(f"{x * 1e6:.4g}" for x in w.velocities)
         print(f"wrote {_shown(toml_path)} and {_shown(csv_path)}: lines {raw.line(w.a)} to {raw.line(w.b - 1)} ({w.b - w.a} samples), "
-              f"{v} um/s, k start {w.stiffness * 1e-6:.3g} 1/um ({w.stiffness_from}; fitted with the law)")
+              f"{v} um/s, k start {w.stiffness * 1e-6:.3g} 1/um ({w.stiffness_from}; fitted with the law)"
+              + (f"; the window {w.start_note}" if w.start_note else ""))
     return 0
 
 
@@ -274,11 +295,12 @@ def _template(args) -> int:
 
 
 def _rebuild(args) -> int:
-    from ..io.datagen import GENERATORS, KNOWN_TRUTH, KNOWN_TRUTH_DIR, rebuild
+    from ..io.datagen import GENERATORS, KNOWN_TRUTH, KNOWN_TRUTH_DIR, SLIDE_HOLD_SLIDE, SLIDE_HOLD_SLIDE_DIR, rebuild
     from ..io.dataset import builtin_dir
 
-    generators = KNOWN_TRUTH if args.known_truth else GENERATORS
-    home = (args.out or KNOWN_TRUTH_DIR) if args.known_truth else builtin_dir()
+    generators = KNOWN_TRUTH if args.known_truth else SLIDE_HOLD_SLIDE if args.slide_hold_slide else GENERATORS
+    home = ((args.out or KNOWN_TRUTH_DIR) if args.known_truth else
+            (args.out or SLIDE_HOLD_SLIDE_DIR) if args.slide_hold_slide else builtin_dir())
     if args.check:
         with tempfile.TemporaryDirectory() as tmp:
             written = rebuild(Path(tmp), generators)

@@ -90,7 +90,7 @@ class Dataset:
     noise_df: dict = attrs.field(factory=dict)  # column -> effective degrees of freedom of an estimated sigma
     noise_est: dict = attrs.field(factory=dict, repr=False)  # column -> noise.NoiseEstimate (estimated kind)
     noise_note: str = ""  # which noise is used, and why (one sentence, for the report and `datasets show`)
-    noise_correlation: str = "none"  # NOISE_CORRELATIONS: independent samples ('none') or AR(1) noise ('ar1')
+    noise_correlation: str = "none"  # NOISE_CORRELATIONS: independent ('none'), AR(1) ('ar1'), chosen by the data ('arp')
     stated: dict = attrs.field(factory=dict)  # STATED name -> (value, precision) in SI ([stated])
     group: str = ""  # declared group (TOML 'group'); "": the dataset is its own group (nothing is inferred from names)
     time_zero: float = 0.0  # the file's time of t = 0 [s] (TOML 'time_zero'), already subtracted from columns['t']
@@ -442,14 +442,16 @@ def _si_of(col, value, where):
 
 
 #: ``[noise] correlation``: the samples' noise independent ('none', the default) or first-order autoregressive
-#: ('ar1': its coefficient profiled by each fit, inference/noise/ar1.py).
-NOISE_CORRELATIONS = ("none", "ar1")
+#: ('ar1': its coefficient profiled by each fit, inference/noise/ar1.py) or chosen by the data ('arp': AR(p) by BIC
+#: per sampling rate, ARMA(1,1) where the order runs to its cap, fitted with the law; inference/noise/).
+NOISE_CORRELATIONS = ("none", "ar1", "arp")
 
 
 def _correlation(value, path) -> str:
     if not isinstance(value, str) or value not in NOISE_CORRELATIONS:
         raise DatasetError(f"{path}: noise.correlation = {value!r}, expected one of {', '.join(NOISE_CORRELATIONS)} "
-                           "(none: independent samples; ar1: first-order autoregressive noise, phi fitted)")
+                           "(none: independent samples; ar1: first-order autoregressive noise, phi fitted; arp: an "
+                           "AR(p) model chosen by the data)")
     return value
 
 

@@ -7,11 +7,14 @@ whitespace- (or comma-) separated rows of time [s], load-point displacement [um]
 * segments the displacement into straight pieces (``segment``): every step's time is the kink of a
   continuous two-line fit, its velocities the fitted ones (not the machine's nominal set points), each with
   its standard error; transducer resets (jumps without a change of slope) are stitched;
-* keeps every sample: one dataset per step, its window from the step before (or the record's start) to the
-  step after (or the record's end), or one dataset holding every step (``joint``);
+* lays out the datasets: one per step, its window starting at a steady state the data show (``steadystate``:
+  the first new steady-state point after the step before, or the record's) and ending in the steady part
+  after its step, so that no window starts inside another step's transient (steps between which the record
+  shows no steady state, as around a hold, share one window); or one dataset holding every step from the
+  record's first steady state (``joint``), fitted as one history;
 * estimates a start for the machine stiffness from friction's initial slope after each step, over a run of
   samples chosen from the data (the shortest that gives the slope to 10 %), whatever the transient's length;
-* states the friction noise as estimated from the data with AR(1) correlation (no sigma is written).
+* states the friction noise as estimated from the data with an AR(p) model chosen by the data (no sigma is written).
 """
 from __future__ import annotations
 
@@ -26,7 +29,9 @@ import numpy as np
 from ..core.errors import DatasetError
 from ..core.files import MAX_CSV_BYTES, read_bytes
 from ..core.names import check_name
+from .layout import cells, separator
 from .segment import MIN_PIECE, Segmentation, segment
+from .segment_noise import last_digit
 
 #: Header names accepted for the four raw columns (case-insensitive; '_' or nothing between words).
 RAW_HEADER = (r"time\(s\)", r"displ(acement)?\(microns\)", r"friction", r"(effective_?)?normal_?stress\(mpa\)")
@@ -40,16 +45,21 @@ LIMITS = {"time": 1e12, "displacement": 1e12, "friction": 1e3, "normal stress": 
 @attrs.frozen(eq=False)
 class RawRecord:
     """One raw record: time [s], displacement [um, as recorded; ``x`` in m], friction [-], normal stress [Pa]
-    (``stress``: what the file's header calls it), and the line of the file each sample was read from."""
+    or force [N] (``stress``: what the file's header calls it; ``sn`` None when the record has none), and the
+    line of the file each sample was read from; ``encoding``, ``layout`` (the columns, as ``--columns`` takes
+    them) and ``notes``: how it was read, when not as the steadystate routine writes it."""
 
     path: Path
     t: np.ndarray
     x_um: np.ndarray
     mu: np.ndarray
-    sn: np.ndarray
+    sn: np.ndarray | None
     stress: str = "effective normal stress"
     first_line: int = 2  # line of the first sample when every line after the header holds one
     lines: np.ndarray | None = None  # line of each sample otherwise
+    encoding: str = ""  # what the text was when not UTF-8, e.g. "UTF-16 (little-endian, without a byte-order mark)"
+    layout: str = ""
+    notes: tuple = ()
 
     @property
     def x(self) -> np.ndarray:
@@ -60,33 +70,41 @@ class RawRecord:
         """The file's line (1-based) of sample i."""
         return int(self.lines[i]) if self.lines is not None else self.first_line + int(i)
 
+    def normal_text(self, value: float) -> str:
+        """A mean normal stress [Pa] or force [N] as the description says it: '30 MPa effective normal stress'."""
+        return f"{value / 1e3:.4g} kN {self.stress}" if self.stress == "normal force" else \
+            f"{value / 1e6:.4g} MPa {self.stress}"
 
-def read_raw(path, data: bytes | None = None) -> RawRecord:
-    """Read a raw velocity-step record (``data``: its bytes, already read); a one-line DatasetError naming the
-    file and line on bad content (a bad number, fewer or more than four columns, time that does not increase
-    by at least MIN_DT, magnitudes beyond LIMITS, a normal stress that is not positive)."""
+
+def read_raw(path, data: bytes | None = None, columns=None) -> RawRecord:
+    """Read a raw velocity-step record (``data``: its bytes, already read) in the steadystate routine's layout,
+    or in the layout ``columns`` gives (``"time=NAME UNIT, displacement=NAME UNIT, friction=NAME"``, or with
+    ``shear=NAME UNIT, normal=NAME UNIT`` instead of friction: see ``io.layout``); UTF-8 or UTF-16 text. A
+    one-line DatasetError (UnitError, ParameterError for ``columns``) naming the file and line on bad content (a
+    bad number, a missing column, time that does not increase by at least MIN_DT, magnitudes beyond LIMITS, a
+    normal stress that is not positive)."""
     import pandas as pd
 
+    from .layout import decode, parse_columns, read_record
+
     path = Path(path)
+    layout = parse_columns(columns, "columns") if columns is not None else None
     data = read_bytes(path, MAX_CSV_BYTES) if data is None else data
-    if data.startswith(b"\xef\xbb\xbf"):
-        data = data[3:]
-    if not data.isascii():
-        try:
-            data.decode("utf-8")
-        except UnicodeDecodeError as exc:
-            raise DatasetError(f"{path}: not UTF-8 text (byte {exc.start + 1})") from None
+    data, encoding = decode(path, data)
+    if layout is not None:
+        return read_record(path, data, layout, encoding)
     head = re.match(rb"(?:[ \t\r\f\v]*\n)*([^\n]*)(?:\n|$)", data)
     header_no = data.count(b"\n", 0, head.start(1)) + 1
     header_text = head.group(1).decode("utf-8", "replace").strip()
-    header = header_text.split()
-    if not header:
+    header = cells(header_text, separator(header_text))
+    if not header_text:
         raise DatasetError(f"{path}: file is empty")
     if len(header) != 4 or not all(re.fullmatch(p, h, re.IGNORECASE) for p, h in zip(RAW_HEADER, header)):
         raise DatasetError(f"{path}: line {header_no}: header {header_text[:80]!r}; expected four columns: "
-                           "Time(s) Displ(microns) Friction EffectiveNormalstress(MPa) (or NormalStress(MPa))")
-    if b"," in data:
-        data = data.replace(b",", b" ")
+                           "Time(s) Displ(microns) Friction EffectiveNormalstress(MPa) (or NormalStress(MPa)), "
+                           "or give the file's own with --columns")
+    if b"," in data or b";" in data:
+        data = data.replace(b",", b" ").replace(b";", b" ")
     body = memoryview(data)[head.end():]
     try:
         table = pd.read_csv(io.BytesIO(body), sep=r"\s+", header=None, dtype=float, engine="c",
@@ -104,8 +122,8 @@ def read_raw(path, data: bytes | None = None) -> RawRecord:
     rec = RawRecord(path=path, t=table[:, 0].copy(), x_um=table[:, 1].copy(), mu=table[:, 2].copy(),
                     sn=table[:, 3] * 1e6,
                     stress="effective normal stress" if "effective" in header[3].lower() else "normal stress",
-                    first_line=first, lines=lines)
-    _check(rec, table)
+                    first_line=first, lines=lines, encoding=encoding)
+    check_record(rec)
     return rec
 
 
@@ -127,17 +145,20 @@ def _bad_row(path: Path, body: str, lines) -> None:
     raise DatasetError(f"{path}: no data rows after the header")
 
 
-def _check(rec: RawRecord, table: np.ndarray) -> None:
+def check_record(rec: RawRecord) -> None:
     """Magnitudes, time increments and normal stress, each refused with the line of the first bad sample."""
-    n = len(table)
+    n = len(rec.t)
     if n < 2 * MIN_PIECE:
         raise DatasetError(f"{rec.path}: {n} data rows; a velocity step needs at least {MIN_PIECE} on either side")
-    for j, (what, limit) in enumerate(LIMITS.items()):
-        bad = np.flatnonzero(np.abs(table[:, j]) > limit)
-        if bad.size:
+    scale = 1e3 if rec.stress == "normal force" else 1e6
+    cols = (rec.t, rec.x_um, rec.mu, None if rec.sn is None else rec.sn / scale)
+    units = "the record's units (s, um, -, MPa)" if not rec.layout else \
+        f"s, um, -, {'kN' if scale == 1e3 else 'MPa'} (the units they were converted to)"
+    for col, (what, limit) in zip(cols, LIMITS.items()):
+        bad = np.flatnonzero(np.abs(col) > limit) if col is not None else ()
+        if len(bad):
             i = int(bad[0])
-            raise DatasetError(f"{rec.path}: line {rec.line(i)}: {what} {table[i, j]:g} is beyond {limit:g} in the "
-                               "record's units (s, um, -, MPa)")
+            raise DatasetError(f"{rec.path}: line {rec.line(i)}: {what} {col[i]:g} is beyond {limit:g} in {units}")
     dt = np.diff(rec.t)
     bad = np.flatnonzero(~(dt >= MIN_DT))
     if bad.size:
@@ -145,10 +166,12 @@ def _check(rec: RawRecord, table: np.ndarray) -> None:
         what = "does not increase" if dt[i - 1] <= 0 else f"increases by {dt[i - 1]:.3g} s"
         raise DatasetError(f"{rec.path}: line {rec.line(i)}: time {rec.t[i]:.10g} s {what} after line {rec.line(i - 1)} "
                            f"({rec.t[i - 1]:.10g} s); time must increase by at least {MIN_DT:g} s a sample")
-    bad = np.flatnonzero(~(rec.sn > 0))
-    if bad.size:
-        raise DatasetError(f"{rec.path}: line {rec.line(int(bad[0]))}: normal stress must be positive, got "
-                           f"{table[int(bad[0]), 3]:g} MPa")
+    bad = np.flatnonzero(~(rec.sn > 0)) if rec.sn is not None else ()
+    if len(bad):
+        i = int(bad[0])
+        raise DatasetError(f"{rec.path}: line {rec.line(i)}: normal {'force' if scale == 1e3 else 'stress'} must be "
+                           f"positive, got "
+                           f"{cols[3][i]:g} {'kN' if scale == 1e3 else 'MPa'}")
 
 
 # --- what the import finds --------------------------------------------------------------------------
@@ -165,6 +188,7 @@ class Window:
     stiffness: float
     stiffness_note: str
     steps: tuple  # indices of the Steps it holds
+    start_note: str = ""  # where the window starts and why (a steady state the data show)
 
     @property
     def stiffness_from(self) -> str:
@@ -196,6 +220,10 @@ def analyse(raw: RawRecord, name: str, *, joint: bool | None = False, stiffness:
     several). ``stiffness`` [1/m]: the start of every dataset instead of the estimate; ``steps``: the number of
     steps expected (an error if another number is found)."""
     where = str(raw.path)
+    if float(np.ptp(raw.mu)) == 0.0:
+        raise DatasetError(f"{where}: friction is {raw.mu[0]:g} at every sample (lines {raw.line(0)} to "
+                           f"{raw.line(len(raw.mu) - 1)}): a constant channel has nothing to fit (is it the friction "
+                           "column?)")
     seg = segment(raw.t, raw.x_um, where, raw.line, "um")  # in the record's units: um, um/s
     m = len(seg.steps)
     joint = m > 1 if joint is None else joint
@@ -203,6 +231,10 @@ def analyse(raw: RawRecord, name: str, *, joint: bool | None = False, stiffness:
         found = ", ".join(f"line {raw.line(s.index)} (t = {s.time:.6f} s)" for s in seg.steps)
         raise DatasetError(f"{where}: expected {steps} velocity step{'s' * (steps != 1)} (--steps), found {m}: {found}")
     velocities, notes = _velocities(raw, seg)
+    if seg.exact_to:
+        notes.append(f"the displacement shows no noise beyond its last digit ({seg.exact_to:.3g} um): the standard "
+                     "errors are bounds of the rounding to it, which errs alike at every sample of a line sampled "
+                     "exactly, not a scatter")
     notes += [f"displacement jump of {j.size:.4g} ± {j.size_se:.2g} um at line {raw.line(j.index)} "
               f"(t = {raw.t[j.index]:.10g} s) without a change of velocity: stitched (later samples shifted back)"
               for j in seg.jumps]
@@ -225,23 +257,26 @@ def analyse(raw: RawRecord, name: str, *, joint: bool | None = False, stiffness:
         return DEFAULT_STIFFNESS, "start: a typical laboratory value (friction shows no loading after the step)"
 
     windows = []
+    from .steadystate import left_out, start_note, steady_points, step_windows
+
+    points = steady_points(seg.x, raw.mu, b, velocities)
     if joint:
         k, note = start(0)
         if stiffness is None and any(ks):
             k = float(np.median([k[0] for k in ks if k]))
             note = "start: the median over the steps of friction's initial slope after each step over the " \
                    "load-point velocity change"
-        windows.append(Window(name, 0, len(raw.t), (0.0,) + tuple(float(s.time - raw.t[0]) for s in seg.steps),
-                              tuple(velocities), k, note, tuple(range(m))))
+        a = next((p.index for p in points[:1] if p.found), 0)
+        windows.append(Window(name, a, len(raw.t), (0.0,) + tuple(float(s.time - raw.t[a]) for s in seg.steps),
+                              tuple(velocities), k, note, tuple(range(m)), start_note(raw, points, a, None)))
     else:
-        for i, s in enumerate(seg.steps):
-            a, e = b[i], b[i + 2]
-            kv, note = start(i)
-            windows.append(Window(name if m == 1 else f"{name}-step{i + 1}", a, e, (0.0, float(s.time - raw.t[a])),
-                                  (velocities[i], velocities[i + 1]), kv, note, (i,)))
-            if velocities[i] == 0:
-                notes.append(f"{windows[-1].name} starts in a hold (V = 0): a fit that starts from steady state "
-                             "cannot start there; fit the record's joint dataset (--joint) instead")
+        for a, e, held in step_windows(points, b):
+            kv, note = start(held[0])
+            windows.append(Window(name if m == 1 else f"{name}-step{held[0] + 1}", a, e,
+                                  (0.0,) + tuple(float(seg.steps[i].time - raw.t[a]) for i in held),
+                                  tuple(velocities[held[0]:held[-1] + 2]), kv, note, held,
+                                  start_note(raw, points, a, held)))
+        notes += [f"step {i + 1} has no window of its own: {why}" for i, why in left_out(points, m)]
     for w in windows:
         check_name(w.name, "datasets import: --name", DatasetError)
     return Imported(raw=raw, seg=seg, windows=tuple(windows), velocities=tuple(velocities), notes=tuple(notes))
@@ -287,6 +322,8 @@ def stiffness_start(t, mu, step, v1: float, v2: float, a: int, b: int) -> tuple[
         n = min(max(n + 1, int(n * 1.41)), b - i0)
     if best is None or best[2] > 0.1:
         return None
+    if abs(best[0]) * best[1] <= max(last_digit(mu[i0:b]), 1e-12 * float(np.max(np.abs(mu[i0:b])))):
+        return None  # a change below the channel's last digit: no loading seen
     k = best[0] / (v2 - v1)
     return (k, best[1]) if k > 0 and math.isfinite(k) else None
 
@@ -313,20 +350,25 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
     first, last = raw.line(w.a), raw.line(w.b - 1)
     steps = [seg.steps[i] for i in w.steps]
     v_text = " -> ".join(f"{v * 1e6:.4g}" for v in w.velocities)
-    stress = float(np.mean(raw.sn[w.a:w.b]))
+    stress = float(np.mean(raw.sn[w.a:w.b])) if raw.sn is not None else None
     fitted = "; ".join(f"step at {s.time - raw.t[w.a]:.6f} ± {s.time_se:.2g} s" for s in steps)
     fitted_v = ", ".join(f"{v:.7g} ± {seg.velocities_se[k]:.2g}"
                          for k, v in enumerate(seg.velocities) if k in _pieces(w))
     jumps = [j for j in seg.jumps if w.a < j.index < w.b]
-    method = (f"every sample of lines {first} to {last} of {raw.path.name} ({w.b - w.a} samples); load-point "
+    read = "; ".join(([f"read as {raw.encoding}"] if raw.encoding else []) +
+                     ([f"columns {raw.layout}"] if raw.layout else []) + list(raw.notes))
+    method = (f"every sample of lines {first} to {last} of {raw.path.name} ({w.b - w.a} samples"
+              f"{'; ' + read if read else ''}); load-point "
               f"velocities and step time{'s' * (len(steps) > 1)} from an exact piecewise-linear segmentation of the "
               f"displacement (optimal partitioning, PELT, penalty 3 ln n = {seg.penalty:.1f}; "
               f"{len(seg.steps)} step{'s' * (len(seg.steps) != 1)} in the record), each step at the kink of a "
               "continuous two-line fit, velocities from one continuous fit through every kink (fitted values, not "
               "set points)" + (f"; {len(jumps)} displacement jump{'s' * (len(jumps) != 1)} without a change of "
                                "velocity stitched" if jumps else "") +
-              "; friction as measured (no trend removed); its noise estimated from the data, AR(1)")
-    description = (f"Velocity step{'s' * (len(steps) > 1)} {v_text} um/s at {stress / 1e6:.4g} MPa {raw.stress} "
+              "; friction as measured (no trend removed); its noise estimated with the fit, AR(p) chosen by the data" +
+              (f"; the window {w.start_note}" if w.start_note else ""))
+    at = f" at {raw.normal_text(stress)}" if stress is not None else ""
+    description = (f"Velocity step{'s' * (len(steps) > 1)} {v_text} um/s{at} "
                    f"(record {raw.path.name}, lines {first} to {last}). MEASURED.")
     lines = [
         f"# Imported by `frictionlab datasets import velstep` from {raw.path.name}: measured data; do not edit by hand.",
@@ -341,16 +383,18 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
         'x = "um"                   # load-point displacement' + (" (jumps stitched)" if jumps else ""),
         'mu = ""',
         "",
-        "[noise]                    # friction's noise: estimated from the data, correlated (AR(1))",
+        "[noise]                    # friction's noise: estimated with the fit, AR(p) chosen by the data",
         'kind = "estimated"',
-        'correlation = "ar1"',
+        'correlation = "arp"',
         "",
         "[scene]",
         'mass = "1 kg"              # not used by a quasi-static slider',
         "",
-        f"[scene.normal]             # the mean {raw.stress} on a unit area: only a slider's inertia reads it",
+        f"[scene.normal]             # the mean {raw.stress} on a unit area: only a slider's inertia reads it"
+        if stress is not None else "[scene.normal]             # the record has no normal load: a unit load (only a "
+                                   "slider's inertia reads it)",
         'model = "constant"',
-        f'value = "{stress:.6g} N"',
+        f'value = "{stress if stress is not None else 1.0:.6g} N"',
         "",
         "[scene.spring]",
         f'stiffness = "{w.stiffness * 1e-6:.4g} 1/um"   # {w.stiffness_note}',
@@ -421,7 +465,8 @@ def summary(imp: Imported) -> list[str]:
                      f"{b[i + 1] - b[i]} + {b[i + 2] - b[i + 1]}"))
     widths = [max(len(r[j]) for r in rows) for j in range(len(rows[0]))]
     out += ["  " + "  ".join(c.ljust(wd) for c, wd in zip(r, widths)).rstrip() for r in rows]
-    out += [f"  note: {note}" for note in imp.notes]
+    read = ([f"read as {raw.encoding}"] if raw.encoding else []) + list(raw.notes)
+    out += [f"  note: {note}" for note in read + list(imp.notes)]
     return out
 
 

@@ -44,6 +44,7 @@ QUANTITIES = {
     "A": "contact area [m^2]",
     "dAdt": "rate of change of contact area [m^2/s]",
     "t": "time since first contact [s]",
+    "dmudt": "rate of the friction coefficient d mu/dt [1/s] (a spring-slider's load rate k (V_lp - V))",
 }
 
 
@@ -157,7 +158,10 @@ class Contact:
     dAdt : numpy.ndarray or None
         Rate of change of the contact area [m^2/s], or None.
     state : mapping of str to numpy.ndarray, or None
-        A law's internal states by their names (None for a memoryless law).
+        A law's internal states by their unprefixed names (None for a memoryless law).
+    dmudt : numpy.ndarray or None
+        The friction coefficient's rate [1/s], for a law that requires ``"dmudt"`` (Nagata's state law); None
+        otherwise.
     """
 
     t: np.ndarray
@@ -166,6 +170,7 @@ class Contact:
     A: np.ndarray | None = None
     dAdt: np.ndarray | None = None
     state: Mapping[str, np.ndarray] | None = None
+    dmudt: np.ndarray | None = None
 
 
 @attrs.frozen

@@ -144,6 +144,7 @@ def validate_law(law: FrictionLaw, source: str) -> None:
         N=np.full(n, 10.0) if "N" in law.requires else None,
         A=np.full(n, 1e-4) if "A" in law.requires else None,
         dAdt=np.zeros(n) if "dAdt" in law.requires else None,
+        dmudt=np.zeros(n) if "dmudt" in law.requires else None,
     )
     p = law.defaults()
     try:

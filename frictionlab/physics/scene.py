@@ -137,6 +137,8 @@ class Scene:
             q |= {"A", "dAdt"}
         if self.normal is not None:
             q.add("N")
+        if self.spring is not None:  # the spring's load rate per unit normal force, k (V_lp - V)
+            q.add("dmudt")
         return q
 
     def with_(self, **changes: object) -> "Scene":

@@ -82,7 +82,7 @@ class Comparison:
     datasets: tuple[Dataset, ...]  # every dataset asked for, fitted or not
     fits: tuple[FitResult, ...]
     ranking: tuple[RankRow, ...]  # per dataset
-    groups: tuple[RankRow, ...]  # ALL, ALL[kind] and each dataset group of two or more
+    groups: tuple[RankRow, ...]  # each declared dataset group of two or more
     equivalence: tuple[EquivalenceResult, ...]  # discrimination tests (law A vs law B per dataset)
     skipped_datasets: dict  # name -> reason
     wall_time: float
@@ -166,8 +166,8 @@ class Comparison:
         -------
         pandas.DataFrame
             One row per dataset and candidate (law, solver): rank, fits, rss and rmse with their units,
-            reduced chi-square, AIC, AICc, BIC, delta AIC, Akaike weight, reason; the group rows (dataset
-            ``ALL``, ``ALL[kind]``) after them.
+            reduced chi-square, AIC, AICc, BIC, delta AIC, Akaike weight, reason; the rows of the groups the
+            datasets declare after them.
         """
         from ..inference.fitting.frames import ranking_frame
 
@@ -264,7 +264,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     ----------
     laws : sequence of str or "all", optional
         Registered names; None for the default laws of each dataset kind (Coulomb, area-rate, wear and Couette
-        on impacts and inclines; rate-and-state aging and slip on spring-sliders); "all" for every registered
+        on impacts and inclines; rate-and-state aging, slip and PRZ on spring-sliders); "all" for every registered
         law.
     datasets : sequence, optional
         Built-in names, names of measured records, TOML paths or Datasets; default every built-in dataset and

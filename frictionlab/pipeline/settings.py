@@ -15,8 +15,11 @@ from ..physics.registry import available_laws, get_law
 #: The laws ``compare`` fits by default on impacts and inclines: the four of the mission (the seed paper's
 #: question). Other registered laws (stribeck, lugre, dahl, installed plugins) join when named or with "all".
 DEFAULT_LAWS = ("coulomb", "area-rate", "wear", "couette")
-#: Dataset kinds whose default laws are others: rate-and-state friction on velocity steps of a spring-slider.
-DEFAULT_LAWS_BY_KIND = {"spring-slider": ("rate-state-aging", "rate-state-slip")}
+#: Dataset kinds whose default laws are others: rate-and-state friction on velocity steps of a spring-slider, the
+#: state laws the velocity-step fit serves (aging, slip, PRZ: ``solve.quasistatic.FITTED``). Nagata's and the
+#: two-state laws join when named: the velocity-step fit does not serve their extra parameters, and a law fitted
+#: through another model (no trend, stiffness or AR(1) noise) would be ranked against a different likelihood.
+DEFAULT_LAWS_BY_KIND = {"spring-slider": ("rate-state-aging", "rate-state-slip", "rate-state-prz")}
 
 
 def select_laws(laws: Sequence[str] | None) -> tuple[str, ...]:

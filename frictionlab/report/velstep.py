@@ -24,6 +24,13 @@ def measured_steps(c, datasets=None) -> list:
     return out
 
 
+def window(d) -> str:
+    """Where an imported dataset's window starts and why ('starts at ..., at steady state: ...'), from its
+    provenance; '' for a dataset that does not say."""
+    method = d.provenance.method or ""
+    return method.split("; the window ", 1)[1] if "; the window " in method else ""
+
+
 def cell(q) -> str:
     """'0.00892 ± 0.00026' of a velstep_result.Quantity (its 95% interval is in the figure)."""
     if q is None:
@@ -43,13 +50,20 @@ def first_screen(sec, c, datasets=None) -> list[str]:
         for f in fits:
             q = f.velstep.rows[0].quantities
             law = f.law.replace("rate-state-", "")
-            rows.append([f"**{d.name}**", law] + [cell(q.get(key)) for key, _ in COLUMNS] + [f.goodness.short])
+            row = f.velstep.rows[0]
+            noise = ", ".join(f"{m} at {lab}" for lab, m in row.noise) or ", ".join(
+                f"AR(1) φ = {p:.2f} at {lab}" for lab, p in row.phi) or "independent"
+            white = ("white" if f.goodness.noise_ok else "not white") if f.goodness.noise_ok is not None else "—"
+            rows.append([f"**{d.name}**", law] + [cell(q.get(key)) for key, _ in COLUMNS]
+                        + [noise, white, f.goodness.short])
     sec.p("**Measured velocity steps** (value ± standard error; Dc in µm, k in 1/µm; the 95% intervals, μ0, the "
           "trend and the noise in each figure):")
-    sec.table(["dataset", "rate-and-state law"] + [h for _, h in COLUMNS] + ["goodness of fit"], rows)
+    sec.table(["dataset", "rate-and-state law"] + [h for _, h in COLUMNS]
+              + ["noise model", "whitened residuals", "does the law fit"], rows)
     for d, fits in steps:
         best = fits[0]
         said = [s for f in fits[:1] for s in (f.velstep.sign + f.velstep.bounds + f.velstep.noise + f.velstep.missing)]
+        said += [f"The parameters come from the dataset's window, which {w}" for w in [window(d)] if w]
         sec.fig(f"velstep-{d.name}.png", f"{d.name} (measured): the data with the {best.law} fit, the step close up, "
                 "the residuals (fit − data) and the fitted parameters.", lambda f=best: velstep_figure(f),
                 side=" ".join(f"{s}." for s in said), key=("velstep", id(best)))  # the index's and its group's

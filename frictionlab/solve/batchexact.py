@@ -8,7 +8,7 @@ from ..core.errors import SolverError
 from .batchcore import finish, plan_of, root, zero_slip
 from .batchstick import breakaway
 from .scenebatch import take_params
-from .solvers import exact, stick
+from .solvers import area_slip, exact, stick
 from .solvers.segments import MAX_SEGMENTS
 
 SCAN = 1024  # uniform points scanned for the first zero of slip when it is not provably monotone
@@ -27,7 +27,7 @@ def run_exact(law, batch, p, T, into=None):
     fallback = np.zeros(nsc, dtype=bool)
     dirs, info = None, {}
     if isinstance(form, exact.AreaSlipForm):
-        J, K = exact._area_slip(plan, form.k, 0.0, y0, T)
+        J, K = area_slip._area_slip(plan, form.k, 0.0, y0, T)
         Y = exact._states(plan, 0.0, y0, T, J, K, out=None if into is None else into["states"])
     else:
         u_s = np.broadcast_to(plan.rigid_slip(y0), (nsc, 1))
@@ -134,7 +134,7 @@ def sliding_states(plan, form, sgn, t0, y0, tt, out=None):
     """States at times tt (k, q) of sliding phases under F = s (a N + c dA/dt) from t0 in states y0, slip of sign
     sgn (k, 1). The slip's sign goes into the form (no pass over the grid), except on a growth area, where the
     area term c rate u does not carry it."""
-    if exact.growth_slip(plan, form, sgn, 0.0) is not None:
+    if area_slip.growth_slip(plan, form, sgn, 0.0) is not None:
         J, K, _ = exact._normal_area_rate(plan, form, t0, y0, sgn, tt, find_stop=False)
     else:
         signed = exact.NormalAreaRateForm(a=sgn * form.a, c=sgn * form.c)
@@ -165,10 +165,10 @@ def exact_stop(law, batch, p, ids, plan, form, t0, y0, u_s, sgn, t_end):
 
         return g
 
-    relaxing = exact.growth_slip(plan, form, sgn[:, None], u_s[:, None])
-    if relaxing is not None:  # in closed form (exact.relax_stop), by the scalar solver's rule and margin
+    relaxing = area_slip.growth_slip(plan, form, sgn[:, None], u_s[:, None])
+    if relaxing is not None:  # in closed form (area_slip.relax_stop), by the scalar solver's rule and margin
         margin = exact.SLIP_MARGIN * np.maximum(_slip_scale(plan, t_end), 1e-300)[:, None]
-        ts = exact.relax_stop(*relaxing, t0c, t_end[:, None], margin)
+        ts = area_slip.relax_stop(*relaxing, t0c, t_end[:, None], margin)
         ts = np.broadcast_to(ts, (k, 1))[:, 0]
         return np.where(ts < t_end, ts, np.nan)
     noise = 8 * np.finfo(float).eps * np.abs(u_s)  # slip is u_s minus terms of its size

@@ -201,9 +201,10 @@ class Plan(CompliantPatch):
             N = s.normal(t, A) if normal is None else normal
         state = ({n: y[self.index(k)] for n, k in zip(self.law.state_names, self.law_states)} or None
                  if self.law.states else None)
+        dmudt = s.spring.stiffness * (s.spring.velocity(t) - y[0]) if "dmudt" in req else None
         return Contact(t=np.asarray(t, dtype=float), u=np.asarray(u, dtype=float),
                        N=N if "N" in req else None, A=A if "A" in req else None, dAdt=dAdt if "dAdt" in req else None,
-                       state=state)
+                       state=state, dmudt=dmudt)
 
     def force(self, p, t, y, u) -> tuple[np.ndarray, Contact]:
         c = self.contact(t, y, u)
@@ -387,7 +388,8 @@ def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan
     if missing:
         hint = {"N": "add a [scene.normal] model (half-sine, hertz, column or weight)",
                 "A": "add a [scene.area] model (half-sine, constant, growth or column)",
-                "dAdt": "add a [scene.area] model (half-sine, constant, growth or column)"}
+                "dAdt": "add a [scene.area] model (half-sine, constant, growth or column)",
+                "dmudt": "a spring-slider supplies it (its load rate k (V_lp - V)); other scenes do not"}
         what = ", ".join(f"{q} ({QUANTITIES[q].split(' [')[0]})" for q in sorted(missing))
         raise SceneError(f"law '{law.name}' needs {what}, which {scene_name} cannot supply: "
                          + "; ".join(sorted({hint[q] for q in missing if q in hint})))

@@ -1,5 +1,5 @@
-"""The result of one equivalence test (law A against law B on one dataset), its verdicts and the levels they
-are decided at; the test itself is in ``discrimination``."""
+"""The equivalence test's result and its verdict (``decide``): the constants of the test, ``EquivalenceResult``
+and the sentences that state it. The test itself is ``equivalence.analyze_equivalence``."""
 from __future__ import annotations
 
 import math
@@ -9,9 +9,27 @@ import numpy as np
 
 from ...core.display import unit
 from .decomposition import Decomposition
+from .qualitative import text as qual_text
 
+WEAR, AREA_RATE, COUETTE, COULOMB = "wear", "area-rate", "couette", "coulomb"
+#: The pairs ``compare`` tests by default: the paper's claim, the structural identity, and the simplest law against the paper's.
+PAIRS = ((WEAR, AREA_RATE), (WEAR, COUETTE), (COULOMB, WEAR))
 ALPHA = 0.05  # level of every test of a report (family-wise, Holm): different, and equivalent within delta
 CRITICAL = 3.84  # chi-square (1 dof, 95%) by which a cross-fit misses at the threshold noise
+#: The tightest margin, in noise sigmas, at which 'equivalent within delta' is said where the replicates' distances
+#: vary: benchmarks/calibration.py measured the bound below delta where the curves differ by delta in at most 6%
+#: of datasets at delta = 1 sigma, and in 23% at 0.25 sigma (the fitted curves' own uncertainty, not the bound's
+#: spread, then decides the distance): a tighter margin gets 'cannot tell', saying why.
+MIN_MARGIN = 1.0
+REPLICATES = 400  # the most replicates per null (sequential: clear cases stop after a batch or two)
+BATCH = 20  # replicates per null drawn between stopping checks
+MIN_REPLICATES = 20  # the smallest allowed maximum
+CI_LEVEL = 0.99  # Clopper-Pearson interval of a Monte-Carlo p-value that decides when to stop
+FAR_MIN = 40  # replicates before T beyond all of a law's may stop sampling by its tail estimate
+TAIL_Q = 0.75  # the exponential tail is fitted to the replicates above this quantile
+TAIL_CONF = 0.95  # ... with its scale (mean excess) at this upper confidence bound
+FAR_P = ALPHA / 20  # ... when that tail puts T's p below this (clear of any Holm level up to 10 members)
+TAIL_FLOOR = 1e-6  # a tail estimate is extrapolation: smaller values are reported as this bound
 TIE_REL = 1e-4  # |T* - T| below this fraction of max(n, chi2) is a tie (the optimizer's resolution)
 DIFFERENT, WITHIN, CANNOT, BOTH_FAIL = ("different", "equivalent within δ", "cannot tell at this noise",
                                         "both fail their fit tests")
@@ -34,7 +52,7 @@ class EquivalenceResult:
         Whether the test ran; ``reason`` says why not.
     verdict : str
         One of ``VERDICTS``: "different", "equivalent within δ", "cannot tell at this noise", or "both fail
-        their fit tests" (then no p-value: the misfits are compared instead).
+        their fit tests" (then ``closer`` says which law is nearer the data by Vuong's test).
     explanation : str
         The verdict in sentences.
     p, p_adjusted : float
@@ -47,6 +65,9 @@ class EquivalenceResult:
         p-value of "the curves differ by delta or more", before and after adjustment.
     chi2, fits : dict
         Each law's chi-square on the data, and whether it passes its own fit tests.
+    statistic, closer : str
+        The statistic the verdict rests on, and, where both laws fail their fit tests, which law is closer to
+        the data (Vuong's non-nested test with a HAC variance) or that they are equally close at this noise.
     """
 
     dataset: str
@@ -61,9 +82,9 @@ class EquivalenceResult:
     replicates: int = 0  # the most replicates per null
     seed: int = 0
     n_points: int = 0
-    chi2: dict = attrs.field(factory=dict)  # law -> chi2 on the data
+    chi2: dict = attrs.field(factory=dict)  # law -> chi2 on the data (``statistic``: -2 ln L where profiled)
     k: dict = attrs.field(factory=dict)  # law -> identifiable parameters
-    t_obs: float = math.nan  # chi2_A - chi2_B on the data
+    t_obs: float = math.nan  # chi2_A - chi2_B on the data (``statistic``)
     t_a: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # T on replicates of A's fit (failed refits dropped)
     t_b: np.ndarray = attrs.field(factory=lambda: np.zeros(0))  # T on replicates of B's fit
     c_a: float = math.nan  # B refitted to A's best curve: T's location under A is -c_a
@@ -104,6 +125,10 @@ class EquivalenceResult:
     p_adjusted: float = math.nan  # p after the family's adjustment (Holm)
     p_within_adjusted: float = math.nan
     family: str = ALONE  # the family the p-values were adjusted in
+    #: The statistic of ``chi2`` and ``t_obs``: 'χ²' at the noise the likelihood uses, or '−2 ln L' where each fit
+    #: profiles its noise model with the law (the data's AR(p): chi-square is n there).
+    statistic: str = "χ²"
+    closer: str = ""  # Vuong's test of which law is closer (``vuong``), where each fit has pointwise log-likelihoods
 
     @property
     def ok(self) -> bool:
@@ -131,18 +156,7 @@ class EquivalenceResult:
         return self.tested and self.p_within_adjusted < ALPHA
 
     def scale(self, d: float) -> float:
-        """The noise at which a cross-fit leaving chi-square ``d`` misses by ``CRITICAL``.
-
-        Parameters
-        ----------
-        d : float
-            A cross-fit's chi-square at the sigma used (``d_ab`` or ``d_ba``).
-
-        Returns
-        -------
-        float
-            That noise as a multiple of the sigma used (0: one curve; nan if ``d`` is not finite).
-        """
+        """Noise (as a multiple of the sigma used) at which a cross-fit leaving ``d`` misses by CRITICAL."""
         if not math.isfinite(d):
             return math.nan
         return 0.0 if d <= TIE_REL * max(self.n_points, 1) else math.sqrt(d / CRITICAL)
@@ -154,53 +168,25 @@ class EquivalenceResult:
         return max(self.scale(self.d_ab), self.scale(self.d_ba)) * self.sigma
 
     def mc_error(self, p: float) -> float:
-        """The Monte-Carlo standard error of a p-value from the replicates drawn.
-
-        Parameters
-        ----------
-        p : float
-            A p-value of this test.
-
-        Returns
-        -------
-        float
-            sqrt(p (1 - p) / m), m the replicates per law; nan for a p that is not finite.
-        """
+        """Monte-Carlo standard error of a p-value from the replicates drawn."""
         m = min(self.s_a.size, self.s_b.size) or 1
         return math.sqrt(max(p * (1 - p), 0.0) / m) if math.isfinite(p) else math.nan
 
     def quantity(self, x: float) -> str:
-        """A distance as text in the observable's display unit.
-
-        Parameters
-        ----------
-        x : float
-            A distance, SI (for stated numbers, in stated precisions).
-
-        Returns
-        -------
-        str
-            ``"0.078 m/s"``, ``"13.2 stated precisions"``.
-        """
+        """A distance in the observable's display unit ('0.078 m/s', '13.2 stated precisions')."""
         if self.observable == "stated":
-            return f"{number_text(x)} stated precision{'s' * (abs(x) != 1)}"
+            return f"{_num(x)} stated precision{'s' * (abs(x) != 1)}"
         name, f = unit(self.observable)
-        return f"{number_text(x * f)} {name}"
+        return f"{_num(x * f)} {name}"
 
     def _noise(self, s: float) -> str:
         if self.observable == "stated":
-            return f"{number_text(s)} × the stated precision"
+            return f"{_num(s)} × the stated precision"
         name, f = unit(self.observable)
-        return f"σ = {number_text(s * self.sigma * f)} {name}"
+        return f"σ = {_num(s * self.sigma * f)} {name}"
 
     def threshold_text(self) -> str:
-        """Both directions of the noise threshold, with the curves' RMS difference beside them.
-
-        Returns
-        -------
-        str
-            One sentence; "" when a threshold is unknown.
-        """
+        """Both directions of the noise threshold, with the curves' RMS difference beside them."""
         sa, sb = self.scale(self.d_ab), self.scale(self.d_ba)
         if not (math.isfinite(sa) and math.isfinite(sb)):
             return ""
@@ -208,23 +194,17 @@ class EquivalenceResult:
         if sa == 0.0 and sb == 0.0:
             return f"one curve: {a} and {b} give the same curve, indistinguishable at any noise"
         if self.observable == "stated":
-            used, rms = "the stated precision", f"{number_text(self.rms)} stated precisions"
+            used, rms = "the stated precision", f"{_num(self.rms)} stated precisions"
         else:
             name, f = unit(self.observable)
-            used = f"σ used: {number_text(self.sigma * f)} {name}{' (largest)' if self.sigma_varies else ''}, {self.noise}"
-            rms = f"{number_text(self.rms * f)} {name}"
+            used = f"σ used: {_num(self.sigma * f)} {name}{' (largest)' if self.sigma_varies else ''}, {self.noise}"
+            rms = f"{_num(self.rms * f)} {name}"
         return (f"a fit of {a} to {b}'s curve misses it by χ² {CRITICAL:g} (about 50% power to reject {self.law_a}) "
                 f"at {self._noise(sa)}, of {b} to {a}'s at {self._noise(sb)} ({used}); the two best curves differ "
                 f"by {rms} RMS")
 
     def as_dict(self) -> dict:
-        """The result as plain values.
-
-        Returns
-        -------
-        dict
-            Every field (arrays as lists) and the derived numbers, as ``results.json`` records them.
-        """
+        """The result as plain values, as results.json records it."""
         d = {k: v for k, v in attrs.asdict(self, recurse=False).items() if k != "decomposition"}
         for k in ("t_a", "t_b", "s_a", "s_b", "x_a", "x_b"):
             d[k] = getattr(self, k).tolist()
@@ -239,6 +219,122 @@ class EquivalenceResult:
         return d
 
 
-def number_text(x: float) -> str:
-    """A number as the equivalence texts write it: thousands grouped from 100 up, else 3 significant digits."""
+def _num(x: float) -> str:
     return f"{x:,.0f}" if abs(x) >= 100 else f"{x:.3g}"
+
+
+def sentence(text: str) -> str:
+    """``text`` as one sentence: a plain first word capitalized (never a name: a registered law, a dataset or a
+    symbol such as chi2, eta' or impact-golf-v28 stays as written), one full stop at the end ('' stays '')."""
+    import re
+
+    from ...physics.registry import available_laws
+
+    text = text.strip()
+    if not text:
+        return ""
+    m = re.match(r"[a-z]+(?=[\s,:;.)]|$)", text)
+    if m and m.group(0) not in available_laws():
+        text = text[0].upper() + text[1:]
+    return text if text.endswith((".", "!", "?")) else text + "."
+
+
+def sentences(*parts: str) -> str:
+    """Sentences joined by spaces, each made whole by ``sentence`` (empty parts dropped)."""
+    return " ".join(s for s in (sentence(p) for p in parts) if s)
+
+
+# --- the test -------------------------------------------------------------------------------------
+
+
+def _p(p: float) -> str:
+    return f"{p:.2g}"
+
+
+def decide(e: EquivalenceResult) -> EquivalenceResult:
+    """``e`` with its verdict and explanation decided from its (family-adjusted) p-values: sentences built
+    from whole parts, each ending in a full stop."""
+    a, b = f"{e.law_a} [{e.solver_a}]", f"{e.law_b} [{e.solver_b}]"
+    quali = qual_text(e.qualitative, e.law_a, e.law_b) if e.qualitative.get("verdict") not in (None, "not applicable") \
+        else ""
+    tail = [e.threshold_text(), f"qualitatively (shared curve features): {quali}" if quali else ""]
+    if one_family_result(e):
+        tail.append("both laws span one closed-form family here (one model), so each replicate's two refits are the "
+                    "same fit and T* = 0 on every replicate, without refitting")
+    if e.fits.get(e.law_a) is False and e.fits.get(e.law_b) is False:
+        better = e.law_a if e.chi2[e.law_a] < e.chi2[e.law_b] else e.law_b
+        worse = e.law_b if better == e.law_a else e.law_a
+        d_aic = (e.chi2[worse] - e.chi2[better]) + 2 * (e.k[worse] - e.k[better])
+        what = "stated numbers" if e.observable == "stated" else "points"
+        gap = e.chi2[worse] - e.chi2[better]
+        stat = e.statistic
+        less = (f"{better} misses less (Δ{stat} = {_num(gap)}, ΔAIC = {_num(d_aic)}), which says which description is "
+                "less poor, not that either holds" if gap > TIE_REL * max(e.n_points, abs(e.chi2[better]))
+                else "they miss equally (one curve)")
+        if e.closer:
+            less = f"which is closer, a test valid when both miss: {e.closer}"
+        text = sentences(
+            f"no test: {a} and {b} both fail their own fit tests ({e.law_a}: {e.goodness.get(e.law_a) or 'fails'}; "
+            f"{e.law_b}: {e.goodness.get(e.law_b) or 'fails'}), so neither is a valid null for the other and the pair "
+            "gets no p-value",
+            f"their misfits: {e.statistic} = {_num(e.chi2[e.law_a])} ({e.law_a}) and {_num(e.chi2[e.law_b])} "
+            f"({e.law_b}) over {e.n_points} {what}; {less}",
+            f"the two best curves differ by {e.quantity(e.rms)} RMS (the margin: {e.margin_text})", *tail)
+        return attrs.evolve(e, verdict=BOTH_FAIL, explanation=text, p=math.nan, p_adjusted=math.nan,
+                            p_within=math.nan, p_within_adjusted=math.nan)
+    m = min(e.t_a.size, e.t_b.size)
+    adjusted = "" if e.family == ALONE else f" ({e.family}: adjusted p = {_p(e.p_adjusted)})"
+    st = e.statistic
+    head = (f"T = {st}({e.law_a}) − {st}({e.law_b}) = {e.t_obs:.4g} on the data ({e.noise} σ), centred at its location "
+            f"under each fit ({e.t_obs + e.c_a:.3g} under {e.law_a}, {e.t_obs - e.c_b:.3g} under {e.law_b}); against {m} "
+            f"replicates from each fit ({e.stopped}): p = {_p(e.p_a)} ± {e.mc_error(e.p_a):.1g} under {a}, "
+            f"p = {_p(e.p_b)} ± {e.mc_error(e.p_b):.1g} under {b}; two-sided p = {_p(e.p)}{adjusted} at α = {ALPHA:g}")
+    power = (f"the test rejects {a} on {100 * e.power_a:.0f}% of {b}'s replicates and {b} on "
+             f"{100 * e.power_b:.0f}% of {a}'s")
+    different = e.p_adjusted < ALPHA
+    if different:
+        rej_a = e.p_a <= e.p_b
+        bad, good = (a, b) if rej_a else (b, a)
+        good_law = e.law_b if rej_a else e.law_a
+        q = e.q_b if rej_a else e.q_a
+        own = e.p_b if rej_a else e.p_a  # the kept law's own p: below alpha / 2 it is rejected too
+        if own < ALPHA / 2:
+            which = (f"the data reject {bad}, and {good} too (p = {_p(own)} under {good}, below α/2): "
+                     "the data are like neither")
+        elif q < ALPHA / 2:
+            which = (f"the data reject {bad}, and lie beyond {good}'s replicates on its favourable side "
+                     f"(p = {_p(q)}): the data are not like {good}'s either")
+        elif e.fits.get(good_law) is False:
+            which = f"the data reject {bad} against {good}, but {good} fails its own fit tests: the data are like neither"
+        else:
+            which = f"the data reject {bad} and are consistent with {good}"
+    else:
+        unfit = [f"{law} fails its own fit tests" for law, ok in e.fits.items() if ok is False]
+        which = "T rejects neither law" + (f" ({'; '.join(unfit)})" if unfit else "")
+    inside = e.p_within_adjusted < ALPHA
+    adjusted_w = "" if e.family == ALONE else f", adjusted {_p(e.p_within_adjusted)}"
+    dist = (f"the two best curves differ by {e.quantity(e.rms)} RMS; the upper {1 - ALPHA:.0%} bound of that "
+            f"distance, {e.quantity(e.upper) if math.isfinite(e.upper) else 'not available'}, "
+            f"{'lies below' if inside else 'does not lie below'} the margin {e.margin_text} (p = {_p(e.p_within)}"
+            f"{adjusted_w} for a distance of δ or more)")
+    if different:
+        verdict = DIFFERENT
+        say = ("so: different, though by less than δ: the data tell the laws apart, but their curves lie within the "
+               "margin" if inside else "so: different")
+    elif inside and e.margin_sigmas < MIN_MARGIN * (1 - 1e-9) and not one_family_result(e):
+        verdict, say = CANNOT, (f"so: cannot tell at this noise: neither law is rejected, and δ is {e.margin_sigmas:.2g} "
+                                f"σ, tighter than the {MIN_MARGIN:g} σ below which a bound of the distance is not "
+                                "calibrated (the fitted curves' own uncertainty decides it there)")
+    elif inside:
+        verdict, say = WITHIN, (f"so: equivalent within δ: neither law is rejected and their curves are shown to lie "
+                                f"within {e.margin_text.split(', ')[0]}")
+    else:
+        verdict, say = CANNOT, ("so: cannot tell at this noise: neither law is rejected, and the curves are not shown "
+                                "to lie within δ")
+    beside = f"beside it, Vuong's test of which law is closer: {e.closer}" if e.closer else ""
+    return attrs.evolve(e, verdict=verdict, explanation=sentences(head, which, dist, say, power, beside, *tail))
+
+
+def one_family_result(e: EquivalenceResult) -> bool:
+    """Whether ``e`` was decided by the one-model shortcut (``one_family``)."""
+    return e.stopped.startswith("one model")

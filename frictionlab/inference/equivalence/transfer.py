@@ -224,9 +224,13 @@ def predict_from(source: FitResult, target: FitResult) -> Prediction:
     return Prediction(**base, status="ok", n=int(z.size), chi2=chi2, rms_sigma=math.sqrt(chi2 / z.size), loglik=loglik)
 
 
-def shared_fit(fits: Sequence[FitResult], free: dict | None = None, timeout: float | None = None) -> SharedFit:
-    """One parameter set for every member of ``fits`` (one candidate's separate fits) against them."""
+def shared_fit(fits: Sequence[FitResult], free: dict | None = None, timeout: float | None = None,
+               likelihood=None) -> SharedFit:
+    """One parameter set for every member of ``fits`` (one candidate's separate fits) against them; ``likelihood``:
+    -2 ln L of a FitResult under one noise model for both (default: each fit's own, ``Stats.neg2loglik``)."""
     from scipy.stats import chi2 as chi2_dist
+
+    _neg2ll_of = likelihood or _neg2ll
 
     law, solver = fits[0].law, fits[0].solver
     names = tuple(f.datasets[0] for f in fits)
@@ -235,7 +239,7 @@ def shared_fit(fits: Sequence[FitResult], free: dict | None = None, timeout: flo
     targets = [f.per_dataset[0].target for f in fits]
     if any(getattr(f.stats, "likelihood", "known") == "none" for f in fits):
         return SharedFit(**base, status="skipped", reason="a member's fit has no likelihood (a derived series)")
-    chi2_sep, k_sep = sum(_neg2ll(f) for f in fits), sum(_k(f) for f in fits)
+    chi2_sep, k_sep = sum(_neg2ll_of(f) for f in fits), sum(_k(f) for f in fits)
     best = None
     for f in sorted(fits, key=lambda f: f.stats.chisqr):
         start = {p.key: p.value for p in f.params.values() if p.kind == "law" and p.vary}
@@ -245,12 +249,12 @@ def shared_fit(fits: Sequence[FitResult], free: dict | None = None, timeout: flo
             best = r
     if best is None:
         return SharedFit(**base, status="failed", reason="the shared fit did not succeed from any member's parameters")
-    lr, dk = _neg2ll(best) - chi2_sep, k_sep - _k(best)
+    lr, dk = _neg2ll_of(best) - chi2_sep, k_sep - _k(best)
     if dk <= 0:
         return SharedFit(**base, status="skipped", reason="no law parameter is fitted per dataset: nothing to share",
-                         chi2_shared=_neg2ll(best), k_shared=_k(best), chi2_separate=chi2_sep, k_separate=k_sep)
+                         chi2_shared=_neg2ll_of(best), k_shared=_k(best), chi2_separate=chi2_sep, k_separate=k_sep)
     p = float(chi2_dist.sf(max(lr, 0.0), dk))
-    return SharedFit(**base, status="ok", chi2_shared=_neg2ll(best), k_shared=_k(best),
+    return SharedFit(**base, status="ok", chi2_shared=_neg2ll_of(best), k_shared=_k(best),
                      chi2_separate=chi2_sep, k_separate=k_sep, lr=lr, dk=dk, p_value=p, delta_aic=lr - 2 * dk,
                      shared=_determined(best))
 

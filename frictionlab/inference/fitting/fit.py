@@ -118,13 +118,13 @@ def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], s
         scan: int = 125, n_starts: int = 3, max_nfev: int | None = None, rtol: float | None = None,
         timeout: float | None = None, checks: bool = True, errors: bool = True, n_params: int | None = None,
         progress: Callable[[int, int, str], None] | None = None, trend: bool | None = None,
-        stiffness: bool | None = None) -> FitResult:
+        stiffness: bool | None = None, noise: Sequence | None = None) -> FitResult:
     """Fit ``law`` to one dataset or a group of them (a global fit) and return a FitResult.
 
     A built-in rate-and-state law on quasi-static spring-slider datasets (solver "auto" or "ode", no
-    ``local``) is fitted as the field fits velocity steps: the slider in its own variables, mu0 and a
-    friction-versus-displacement trend by variable projection, the machine stiffness fitted, a global start,
-    correlated noise where the dataset declares it.
+    ``local``) is fitted as the field fits velocity steps (``inference.velstep.fit``): the slider in its own
+    variables, mu0 and a friction-versus-displacement trend by variable projection, the machine stiffness
+    fitted, a global start, AR(1) noise or the AR(p) model the data choose where the dataset declares it.
 
     Parameters
     ----------
@@ -168,6 +168,9 @@ def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], s
     trend, stiffness : bool, optional
         For velocity steps: fit (True) or hold (False) the friction-displacement trend and the machine
         stiffness; None fits them on measured data.
+    noise : sequence, optional
+        For velocity steps: None uses the noise the dataset declares; a fit's per-dataset ``noise_state`` holds
+        that noise model (as a refit to a noise-free curve needs).
 
     Returns
     -------
@@ -221,9 +224,9 @@ def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], s
     if velstep.applies(law, targets, solver, local, free):
         return velstep.fit(law, targets, fixed=fixed, free=free, initial=initial, trend=trend, stiffness=stiffness,
                            scan=scan, n_starts=n_starts, max_nfev=max_nfev, rtol=rtol, timeout=timeout, checks=checks,
-                           errors=errors, n_params=n_params, progress=progress, names=names, clock=clock)
-    if trend is not None or stiffness is not None:
-        raise ParameterError("fit: trend and stiffness apply to the velocity-step fit only (a built-in rate-and-state "
+                           errors=errors, n_params=n_params, progress=progress, names=names, clock=clock, noise=noise)
+    if trend is not None or stiffness is not None or noise is not None:
+        raise ParameterError("fit: trend, stiffness and noise apply to the velocity-step fit only (a built-in rate-and-state "
                              "law on quasi-static spring-slider datasets, solver 'auto' or 'ode')")
     solvers = _solvers(law, targets, solver, rtol)
     if isinstance(solvers, str):

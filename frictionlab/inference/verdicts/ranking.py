@@ -20,8 +20,9 @@ Rules, stated once:
 * Near-ties: candidates within delta-AIC < ``NEAR_TIE`` (2) of each other are 'indistinguishable
   by these data' (Burnham and Anderson 2002: Delta < 2 means substantial support for both).
 
-Over a group of datasets ('ALL', 'ALL[kind]' when kinds differ, and each dataset group of two
-or more members, ``answers.group_of``) -2 ln L adds over the candidate's independent
+Over a group of datasets (each group of two or more members its datasets declare, ``answers.group_of``; no
+group of every dataset is formed: datasets of different experiments, materials or kinds are not summed unless
+their files say they belong together) -2 ln L adds over the candidate's independent
 per-dataset fits, k adds, and AIC, AICc and BIC are computed from the group's n and k; the
 goodness p-values are Bonferroni-adjusted over the members. A candidate is ranked there only if
 it fitted every dataset of the group. The 'series' solver is its own candidate; 'exact' and
@@ -278,24 +279,18 @@ def rank_fits(fits: list[FitResult], tie: float = TIE_AIC) -> list[RankRow]:
 
 def rank_groups(rows: list[RankRow], kinds: dict[str, str] | None = None, tie: float = TIE_AIC,
                 named: dict[str, str] | None = None) -> list[RankRow]:
-    """Aggregate per-dataset rows into 'ALL', 'ALL[kind]' when kinds differ, and each named group of
-    two or more datasets (``named``: dataset -> group label), and rank them.
+    """Aggregate per-dataset rows into each declared group of two or more datasets (``named``: dataset -> group
+    label; ``kinds`` is not used: datasets are pooled only where their files say they belong together), and rank
+    them.
 
     A group contains the datasets on which at least one candidate fitted; a candidate is ranked
     there only if it fitted all of them ('incomplete' otherwise, with the missing datasets named).
     """
-    kinds = kinds or {}
-    groups = {"ALL": sorted({r.dataset for r in rows})}
-    by_kind = defaultdict(list)
-    for d in groups["ALL"]:
-        by_kind[kinds.get(d, "?")].append(d)
-    if len(by_kind) > 1:
-        groups.update({f"ALL[{k}]": v for k, v in sorted(by_kind.items()) if len(v) > 1})
     by_name = defaultdict(list)
-    for d in groups["ALL"]:
+    for d in sorted({r.dataset for r in rows}):
         if named and d in named:
             by_name[named[d]].append(d)
-    groups.update({g: v for g, v in by_name.items() if 1 < len(v) < len(groups["ALL"]) and g not in groups})
+    groups = {g: v for g, v in by_name.items() if len(v) > 1}
     out = []
     for gname, members in groups.items():
         fitted = [d for d in members if any(r.status in RANKED and r.dataset == d for r in rows)]

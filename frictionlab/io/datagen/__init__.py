@@ -14,6 +14,9 @@ GENERATORS = ("golf", "incline", "outcome", "kharaz", "springslider")
 #: project's defaults were not tuned on, for checking its verdicts.
 KNOWN_TRUTH = ("knowntruth",)
 KNOWN_TRUTH_DIR = Path("examples") / "known-truth"
+#: The synthetic slide-hold-slide record (``examples/slide-hold-slide``): the healing table's known truth.
+SLIDE_HOLD_SLIDE = ("holds",)
+SLIDE_HOLD_SLIDE_DIR = Path("examples") / "slide-hold-slide"
 
 
 def rebuild(out_dir: Path, generators=GENERATORS) -> list[Path]:
