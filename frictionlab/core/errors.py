@@ -5,10 +5,10 @@ class FrictionLabError(Exception):
     """Base class of every error frictionlab raises for bad input: the message is one complete line naming
     the file, field or parameter and what was expected (the command line prints it and exits with status 2).
 
-    Parameters
+    Attributes
     ----------
-    message : str
-        What was wrong and what was expected.
+    args : tuple of str
+        The message, one line: what was wrong and what was expected.
 
     Examples
     --------

@@ -52,7 +52,7 @@ QUANTITIES = {
 class ParamSpec:
     """One parameter of a law.
 
-    Parameters
+    Attributes
     ----------
     name : str
         The parameter's name, a Python identifier (``lam``, ``mu``, ``Dc``).
@@ -102,7 +102,7 @@ class ParamSpec:
 class StateSpec:
     """One internal state of a law with memory.
 
-    Parameters
+    Attributes
     ----------
     name : str
         The state's name, a Python identifier (``theta``, ``z``).
@@ -178,7 +178,7 @@ class AreaSlipForm:
     """The form F = k A u, which a law's ``form`` returns to unlock closed-form solutions on half-sine and
     constant-area scenes.
 
-    Parameters
+    Attributes
     ----------
     k : float
         The coefficient [Pa s/m] (``lam`` for the wear law, ``eta / h`` for Couette friction).
@@ -192,7 +192,7 @@ class NormalAreaRateForm:
     """The form F = sign(u) (a N + c dA/dt), which a law's ``form`` returns to unlock closed forms (while
     the slip keeps its sign).
 
-    Parameters
+    Attributes
     ----------
     a : float
         The coefficient of the normal force [-] (``mu``).

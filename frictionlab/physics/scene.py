@@ -55,7 +55,7 @@ class SceneSource(Protocol):
 class Scene:
     """Everything about an experiment except the friction law; SI floats throughout.
 
-    Parameters
+    Attributes
     ----------
     kind : str
         The scene kind: ``impact``, ``incline``, ``spring-slider``, ... (``frictionlab datasets template``

@@ -91,15 +91,41 @@ from ...core.fpstate import with_own_errstate
 def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = REPLICATES, seed: int = 0,
                         executor: Executor | None = None, chunk: int | None = None,
                         timeout: float | None = None, margin: float | str = MARGIN) -> EquivalenceResult:
-    """The test of ``fit_a``'s law against ``fit_b``'s on their (common) dataset (module docstring).
+    """Test one fitted law against another on their common dataset: different, equivalent within a
+    margin, or cannot tell at this noise (the module docstring says how).
 
-    replicates: the most replicates per null (sequential sampling stops earlier once the decision is
-    clear); seed: the draws depend on it and on the dataset and the pair only. executor: None (here) or
-    anything with ``submit`` (see bootstrap.py); chunk: replicates per task within a batch; timeout:
-    time budget of each refit in seconds (None: none), past which it counts as a failed refit. margin:
-    delta, a multiple of the noise (number) or a quantity in the observable's unit ('150 rpm'; ``margin``
-    module). The verdict is the test's own (a family of one): ``equivalence_groups.adjust_family`` decides a
-    report's tests together."""
+    The verdict is the test's own (a family of one); `compare` adjusts a report's tests together.
+
+    Parameters
+    ----------
+    fit_a, fit_b : FitResult
+        The two laws' fits to one dataset.
+    replicates : int
+        The most replicate datasets per null (sequential sampling stops earlier once the decision is clear).
+    seed : int, default 0
+        The draws depend on it, the dataset and the pair only.
+    executor : concurrent.futures.Executor, optional
+        Anything with ``submit`` (a process pool, a Dask client) to run the replicate refits on.
+    chunk : int, optional
+        Replicates per task within a batch.
+    timeout : float, optional
+        Time budget of each refit [s]; past it the refit counts as failed.
+    margin : float or str, default 1
+        The margin delta: a multiple of the noise sigma, or a quantity in the observable's unit
+        (``"150 rpm"``).
+
+    Returns
+    -------
+    EquivalenceResult
+        The verdict with its p-values, distance, bound and margin.
+
+    Raises
+    ------
+    FrictionLabError
+        The two fits are not of one and the same dataset.
+    ParameterError
+        Fewer replicates than ``MIN_REPLICATES``, or a margin that does not read.
+    """
     base = dict(dataset=fit_a.datasets[0], law_a=fit_a.law, law_b=fit_b.law, solver_a=fit_a.solver,
                 solver_b=fit_b.solver, replicates=int(replicates), seed=int(seed))
     if fit_a.datasets != fit_b.datasets or len(fit_a.datasets) != 1:

@@ -156,7 +156,18 @@ class EquivalenceResult:
         return self.tested and self.p_within_adjusted < ALPHA
 
     def scale(self, d: float) -> float:
-        """Noise (as a multiple of the sigma used) at which a cross-fit leaving ``d`` misses by CRITICAL."""
+        """The noise at which a cross-fit leaving chi-square ``d`` misses by ``CRITICAL``.
+
+        Parameters
+        ----------
+        d : float
+            A cross-fit's chi-square at the sigma used (``d_ab`` or ``d_ba``).
+
+        Returns
+        -------
+        float
+            That noise as a multiple of the sigma used (0: one curve; nan if ``d`` is not finite).
+        """
         if not math.isfinite(d):
             return math.nan
         return 0.0 if d <= TIE_REL * max(self.n_points, 1) else math.sqrt(d / CRITICAL)
@@ -168,12 +179,34 @@ class EquivalenceResult:
         return max(self.scale(self.d_ab), self.scale(self.d_ba)) * self.sigma
 
     def mc_error(self, p: float) -> float:
-        """Monte-Carlo standard error of a p-value from the replicates drawn."""
+        """The Monte-Carlo standard error of a p-value from the replicates drawn.
+
+        Parameters
+        ----------
+        p : float
+            A p-value of this test.
+
+        Returns
+        -------
+        float
+            sqrt(p (1 - p) / m), m the replicates per law; nan for a p that is not finite.
+        """
         m = min(self.s_a.size, self.s_b.size) or 1
         return math.sqrt(max(p * (1 - p), 0.0) / m) if math.isfinite(p) else math.nan
 
     def quantity(self, x: float) -> str:
-        """A distance in the observable's display unit ('0.078 m/s', '13.2 stated precisions')."""
+        """A distance as text in the observable's display unit.
+
+        Parameters
+        ----------
+        x : float
+            A distance, SI (for stated numbers, in stated precisions).
+
+        Returns
+        -------
+        str
+            ``"0.078 m/s"``, ``"13.2 stated precisions"``.
+        """
         if self.observable == "stated":
             return f"{_num(x)} stated precision{'s' * (abs(x) != 1)}"
         name, f = unit(self.observable)
@@ -186,7 +219,13 @@ class EquivalenceResult:
         return f"σ = {_num(s * self.sigma * f)} {name}"
 
     def threshold_text(self) -> str:
-        """Both directions of the noise threshold, with the curves' RMS difference beside them."""
+        """Both directions of the noise threshold, with the curves' RMS difference beside them.
+
+        Returns
+        -------
+        str
+            One sentence; "" when a threshold is unknown.
+        """
         sa, sb = self.scale(self.d_ab), self.scale(self.d_ba)
         if not (math.isfinite(sa) and math.isfinite(sb)):
             return ""
@@ -204,7 +243,13 @@ class EquivalenceResult:
                 f"by {rms} RMS")
 
     def as_dict(self) -> dict:
-        """The result as plain values, as results.json records it."""
+        """The result as plain values.
+
+        Returns
+        -------
+        dict
+            Every field (arrays as lists) and the derived numbers, as ``results.json`` records them.
+        """
         d = {k: v for k, v in attrs.asdict(self, recurse=False).items() if k != "decomposition"}
         for k in ("t_a", "t_b", "s_a", "s_b", "x_a", "x_b"):
             d[k] = getattr(self, k).tolist()
