@@ -204,7 +204,7 @@ def cells(line: str, sep: str | None) -> list[str]:
 def read_record(path, data: bytes, layout: Layout, encoding: str = ""):
     """The ``velstep.RawRecord`` in the columns of ``layout`` of a record's text (UTF-8 bytes; ``encoding``: what
     it was read as, when not UTF-8), friction from shear over normal when it has no friction column."""
-    from .velstep import RawRecord, check_record
+    from .rawrecord import RawRecord, check_record
 
     tab = read_table(path, data.decode("utf-8"), layout)
     v, normal = tab.values, layout["normal"]

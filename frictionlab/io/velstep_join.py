@@ -16,7 +16,8 @@ import attrs
 import numpy as np
 
 from ..core.errors import DatasetError
-from .velstep import RawRecord, read_raw
+from .rawrecord import RawRecord
+from .velstep import read_raw
 
 
 @attrs.frozen(eq=False)

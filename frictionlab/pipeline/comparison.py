@@ -33,7 +33,7 @@ from ..inference.equivalence.margin import MARGIN
 from ..inference.verdicts.ranking import RankRow
 from ..inference.equivalence.transfer import TransferResult
 from ..io.dataset import Dataset, available_names, load_dataset
-from ..io.intact import check_dataset_like
+from ..io.dataset import check_dataset_like
 from .planning import (  # noqa: F401
     candidates,
     equivalence_pairs,
