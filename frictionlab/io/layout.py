@@ -201,32 +201,6 @@ def cells(line: str, sep: str | None) -> list[str]:
     return [p.strip().strip("\"'").strip() for p in parts]
 
 
-def read_record(path, data: bytes, layout: Layout, encoding: str = ""):
-    """The ``velstep.RawRecord`` in the columns of ``layout`` of a record's text (UTF-8 bytes; ``encoding``: what
-    it was read as, when not UTF-8), friction from shear over normal when it has no friction column."""
-    from .velstep import RawRecord, check_record
-
-    tab = read_table(path, data.decode("utf-8"), layout)
-    v, normal = tab.values, layout["normal"]
-    sn = v.get("normal")
-    mu = v.get("friction")
-    if mu is None:
-        bad = np.flatnonzero(~(sn > 0))
-        if bad.size:
-            i = int(bad[0])
-            raise DatasetError(f"{path}: line {tab.lines[i]}: normal={normal.name} is {sn[i] / normal.factor:g} "
-                               f"{normal.unit}; friction is shear / normal, which needs a positive normal "
-                               f"{'force' if normal.force else 'stress'}")
-        mu = v["shear"] / sn
-    stress = "" if normal is None else "normal force" if normal.force else "normal stress"
-    rec = RawRecord(path=path, t=v["time"], x_um=v["displacement"] * 1e6, mu=mu, sn=sn, stress=stress,
-                    first_line=int(tab.lines[0]), lines=tab.lines, encoding=encoding, layout=layout.text(),
-                    notes=tab.notes + ((f"friction = {layout['shear'].name} / {normal.name}",)
-                                       if layout["shear"] else ()))
-    check_record(rec)
-    return rec
-
-
 @attrs.frozen(eq=False)
 class Table:
     """The layout's columns read from a record: each role's values in SI (time s, displacement m, friction -,
