@@ -224,17 +224,18 @@ def read_table(path, text: str, layout: Layout) -> Table:
             notes.append(f"{hi} line{'s' * (hi != 1)} before the header skipped (line" +
                          ("s 1 to " if hi > 1 else " ") + f"{hi})")
     else:
-        start = next((i for i, r in enumerate(rows) if r.strip()), 0)
-        sep, index = separator(rows[start]), {}
-        hi = None
+        start, sep, index, hi = 0, None, {}, None
     index.update({c.role: c.position for c in layout.columns if c.position is not None})
     want = [index[c.role] for c in layout.columns]
-    first = _first_data(rows, start, sep, want)
+    first = _first_data(rows, start, sep, want, own=not named)
+    if first is not None and not named:
+        sep = separator(rows[first])
     if first is None:
         raise DatasetError(f"{path}: no data rows" + (f" after the header (line {hi + 1})" if hi is not None else ""))
     skipped = [i + 1 for i in range(start, first) if rows[i].strip()]
     if skipped:
-        notes.append(f"{len(skipped)} row{'s' * (len(skipped) != 1)} of text after the header skipped (line"
+        notes.append(f"{len(skipped)} row{'s' * (len(skipped) != 1)} of text "
+                     f"{'after the header' if hi is not None else 'before the data'} skipped (line"
                      f"{'s' * (len(skipped) != 1)} {skipped[0]}" + (f" to {skipped[-1]})" if len(skipped) > 1 else ")"))
     block, lines = _numbers(path, rows, first, sep, want, layout)
     values = {c.role: block[:, j] * c.factor for j, c in enumerate(layout.columns)}
@@ -276,12 +277,13 @@ def _number(cell: str) -> float:
         return math.nan
 
 
-def _first_data(rows: list[str], start: int, sep, want: list[int]) -> int | None:
-    """The first row from ``start`` whose wanted cells are all finite numbers."""
+def _first_data(rows: list[str], start: int, sep, want: list[int], own: bool = False) -> int | None:
+    """The first row from ``start`` whose wanted cells are all finite numbers (each row split by ``sep``, or by
+    its own separator when ``own``)."""
     for i in range(start, len(rows)):
         if not rows[i].strip():
             continue
-        c = cells(rows[i], sep)
+        c = cells(rows[i], separator(rows[i]) if own else sep)
         if len(c) > max(want) and all(math.isfinite(_number(c[j])) for j in want):
             return i
     return None
