@@ -71,7 +71,7 @@ def _add_import(acts):
 
     imp = subcommand(acts, "import", help="turn a raw laboratory record into datasets, one per velocity step",
                      description="Read a raw record and write measured datasets (NAME.toml + NAME.csv). FORMAT "
-                                 "velstep: whitespace-separated Time(s) Displ(microns) Friction "
+                                 "velstep: by default whitespace-, tab- or comma-separated Time(s) Displ(microns) Friction "
                                  "EffectiveNormalstress(MPa) (the records of the steadystate routine, Giacomel et al. "
                                  "2024), any number of velocity steps and holds. The displacement is segmented into "
                                  "straight pieces (optimal partitioning: the data choose the number of steps); each "

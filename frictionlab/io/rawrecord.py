@@ -1,7 +1,6 @@
 """A raw laboratory record as read, in SI but for displacement (um, as recorded): time, displacement, friction
 and normal stress or force, with the line of the file each sample came from, and the checks every reader applies
-(magnitudes, time increments, a positive normal stress). Read by ``velstep.read_raw`` (the steadystate layout) and
-``layout.read_record`` (any lab's columns)."""
+(magnitudes, time increments, a positive normal stress). Read by ``velstep.read_raw`` (the steadystate layout or any lab's columns)."""
 from __future__ import annotations
 
 from pathlib import Path

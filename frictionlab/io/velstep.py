@@ -49,14 +49,14 @@ def read_raw(path, data: bytes | None = None, columns=None) -> RawRecord:
     normal stress that is not positive)."""
     import pandas as pd
 
-    from .layout import decode, parse_columns, read_record
+    from .layout import decode, parse_columns
 
     path = Path(path)
     layout = parse_columns(columns, "columns") if columns is not None else None
     data = read_bytes(path, MAX_CSV_BYTES) if data is None else data
     data, encoding = decode(path, data)
     if layout is not None:
-        return read_record(path, data, layout, encoding)
+        return _read_layout(path, data, layout, encoding)
     head = re.match(rb"(?:[ \t\r\f\v]*\n)*([^\n]*)(?:\n|$)", data)
     header_no = data.count(b"\n", 0, head.start(1)) + 1
     header_text = head.group(1).decode("utf-8", "replace").strip()
@@ -87,6 +87,32 @@ def read_raw(path, data: bytes | None = None, columns=None) -> RawRecord:
                     sn=table[:, 3] * 1e6,
                     stress="effective normal stress" if "effective" in header[3].lower() else "normal stress",
                     first_line=first, lines=lines, encoding=encoding)
+    check_record(rec)
+    return rec
+
+
+def _read_layout(path, data: bytes, layout, encoding: str = "") -> RawRecord:
+    """The RawRecord in the columns of ``layout`` (io.layout) of a record's text (UTF-8 bytes; ``encoding``: what
+    it was read as, when not UTF-8), friction from shear over normal when it has no friction column."""
+    from .layout import read_table
+
+    tab = read_table(path, data.decode("utf-8"), layout)
+    v, normal = tab.values, layout["normal"]
+    sn = v.get("normal")
+    mu = v.get("friction")
+    if mu is None:
+        bad = np.flatnonzero(~(sn > 0))
+        if bad.size:
+            i = int(bad[0])
+            raise DatasetError(f"{path}: line {tab.lines[i]}: normal={normal.name} is {sn[i] / normal.factor:g} "
+                               f"{normal.unit}; friction is shear / normal, which needs a positive normal "
+                               f"{'force' if normal.force else 'stress'}")
+        mu = v["shear"] / sn
+    stress = "" if normal is None else "normal force" if normal.force else "normal stress"
+    rec = RawRecord(path=path, t=v["time"], x_um=v["displacement"] * 1e6, mu=mu, sn=sn, stress=stress,
+                    first_line=int(tab.lines[0]), lines=tab.lines, encoding=encoding, layout=layout.text(),
+                    notes=tab.notes + ((f"friction = {layout['shear'].name} / {normal.name}",)
+                                       if layout["shear"] else ()))
     check_record(rec)
     return rec
 
