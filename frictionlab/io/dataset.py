@@ -13,6 +13,7 @@ with a one-line ``DatasetError`` naming the file and the field.
 from __future__ import annotations
 
 import math
+import os
 from importlib import resources
 from pathlib import Path
 
@@ -274,6 +275,16 @@ def available_names() -> list[str]:
     return builtin_names() + external.present()
 
 
+#: What a dataset argument may be, for messages.
+DATASET_FORMS = "a Dataset, a dataset name or the path to its .toml"
+
+
+def check_dataset_like(value, where: str, more: tuple = ()) -> None:
+    """A TypeError naming ``where`` unless ``value`` is a Dataset, a name or a path (or one of the types ``more``)."""
+    if not isinstance(value, (str, os.PathLike, Dataset) + tuple(more)):
+        raise TypeError(f"{where}: expected {DATASET_FORMS}, got {type(value).__name__} {value!r:.60}")
+
+
 def load_dataset(name_or_path: str | Path) -> Dataset:
     """Load and validate a dataset.
 
@@ -305,7 +316,6 @@ def load_dataset(name_or_path: str | Path) -> Dataset:
     if isinstance(name_or_path, Dataset):
         return name_or_path
     from . import external
-    from .intact import check_dataset_like
 
     check_dataset_like(name_or_path, "load_dataset")
 

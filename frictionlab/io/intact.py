@@ -1,4 +1,4 @@
-"""A dataset argument checked where it is used (fit, simulate, compare): a dataset, and still what loading made.
+"""A Dataset checked where it is used (fit, simulate, compare): still what loading made of it.
 
 A Dataset's columns, noise and fixed values are a plain dict of arrays and dicts of floats, which code can change
 after loading (a column shortened, scaled or made a list, a fixed value set to True). Loading validated them; each
@@ -9,24 +9,11 @@ from __future__ import annotations
 
 import math
 import numbers
-import os
 
 import numpy as np
 
 from ..core.errors import DatasetError
 from ..core.units import MAX_SI
-
-#: What a dataset argument may be, for messages.
-DATASET_FORMS = "a Dataset, a dataset name or the path to its .toml"
-
-
-def check_dataset_like(value, where: str, more: tuple = ()) -> None:
-    """A TypeError naming ``where`` unless ``value`` is a Dataset, a name or a path (or one of the types ``more``)."""
-    from .dataset import Dataset
-
-    if not isinstance(value, (str, os.PathLike, Dataset) + tuple(more)):
-        raise TypeError(f"{where}: expected {DATASET_FORMS}, got {type(value).__name__} {value!r:.60}")
-
 
 def check_intact(ds, where: str) -> None:
     """Refuse a Dataset ``ds`` changed after loading: every column a finite 1-D float array of one length, within
