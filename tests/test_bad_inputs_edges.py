@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pytest
 
-from test_bad_inputs import clean_registry, prepare, snapshot  # noqa: F401 (a fixture)
-from test_bad_inputs_by_class import check, run_inprocess, run_python, run_subprocess
+from test_bad_inputs import clean_registry  # noqa: F401 (a fixture)
+from test_bad_inputs_by_class import run_case
 
 CASES = tomllib.loads((Path(__file__).parent / "bad_inputs" / "edges.toml").read_text(encoding="utf-8"))["case"]
 CLASSES = ("quantities", "family", "addresses", "arguments", "force", "physics")
@@ -31,19 +31,7 @@ def params():
 @pytest.mark.parametrize("case", params())
 def test_case(case, tmp_path, capsys, monkeypatch, clean_registry):
     assert set(case) <= FIELDS and case["class"] in CLASSES and case["sees"], case["id"]
-    argv = prepare(case, tmp_path, case.get("argv", []))
-    before = snapshot(tmp_path)
-    monkeypatch.chdir(tmp_path)
-    if "python" in case:
-        run_python(case, tmp_path)
-        if case.get("raises"):  # a refusal writes nothing
-            assert snapshot(tmp_path) == before, "the case folder changed although the call was refused"
-        return
-    if case.get("how") == "subprocess":
-        rc, out, err = run_subprocess(case, argv, tmp_path)
-    else:
-        rc, out, err = run_inprocess(argv, capsys)
-    check(case, rc, out, err, before, tmp_path)
+    run_case(case, tmp_path, capsys, monkeypatch, refusal_writes_nothing=True)
 
 
 def test_edges_corpus_counts():

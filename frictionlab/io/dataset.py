@@ -316,6 +316,7 @@ def load_dataset(name_or_path: str | Path) -> Dataset:
     if isinstance(name_or_path, Dataset):
         return name_or_path
     from . import external
+
     check_dataset_like(name_or_path, "load_dataset")
 
     if isinstance(name_or_path, str) and name_or_path in external.RECORDS \

@@ -1,4 +1,4 @@
-"""A dataset argument checked where it is used (fit, simulate, compare): a dataset, and still what loading made.
+"""A Dataset checked where it is used (fit, simulate, compare): still what loading made of it.
 
 A Dataset's columns, noise and fixed values are a plain dict of arrays and dicts of floats, which code can change
 after loading (a column shortened, scaled or made a list, a fixed value set to True). Loading validated them; each

@@ -32,8 +32,7 @@ from ..inference.fitting.fit import FitResult, scene_ranges
 from ..inference.equivalence.margin import MARGIN
 from ..inference.verdicts.ranking import RankRow
 from ..inference.equivalence.transfer import TransferResult
-from ..io.dataset import Dataset, available_names, load_dataset
-from ..io.dataset import check_dataset_like
+from ..io.dataset import Dataset, available_names, check_dataset_like, load_dataset
 from .planning import (  # noqa: F401
     candidates,
     equivalence_pairs,
@@ -357,9 +356,10 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
         settings = attrs.evolve(settings, pairs=check_pairs(pairs, groups))
     if equivalence:
         settings.margin.check(dss)
-    elif not settings.margin.default:
-        raise ParameterError(f"compare: margin {settings.margin.as_text()!r} applies to the equivalence tests, which "
-                             "equivalence=False skips; drop one of the two")
+    elif not settings.margin.default or pairs is not None:
+        what = f"margin {settings.margin.as_text()!r} applies" if not settings.margin.default else "pairs apply"
+        raise ParameterError(f"compare: {what} to the equivalence tests, which equivalence=False skips; drop one of "
+                             "the two")
     run = _make_run(settings, dss, progress, client)
     settings.check_replicates()
     c = Comparison(laws=settings.laws, datasets=dss, fits=run.plan.skipped_fits, ranking=(), groups=(),

@@ -58,8 +58,7 @@ from .stats import (
     _stats,
     neg2loglik,
 )
-from ...io.dataset import Dataset
-from ...io.dataset import check_dataset_like
+from ...io.dataset import Dataset, check_dataset_like
 from ...io.noise import ratio_pvalue
 from ..diagnostics.goodness import SHARPEN_BELOW, combine, f_pvalue, goodness
 from ..diagnostics.identifiability import find_structure, jacobian, jacobian_errors, make_verdict
