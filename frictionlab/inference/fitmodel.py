@@ -192,6 +192,7 @@ class _Model:
         self.nfev = 0
         self._last = None  # (values, models, residual) of the last evaluation that solved every target
         self.progress = None  # fitprogress.FitProgress, told of every evaluation
+        self._compiled_memory = None  # compiled_memory(self), worked out once
 
     def split(self, values: Mapping[str, float]):
         """Per-target law parameters and scenes for SI slot values (by lmfit name)."""

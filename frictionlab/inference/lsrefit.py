@@ -27,16 +27,16 @@ class Param:
     """What a fit reads of a fitted parameter (as of an lmfit Parameter): name, value, bounds, vary, stderr,
     correl."""
 
-    __slots__ = ("name", "value", "min", "max", "vary", "stderr", "correl")
+    __slots__ = ("correl", "max", "min", "name", "stderr", "value", "vary")
 
     def __init__(self, name, value, lo, hi, vary):
         self.name, self.min, self.max, self.vary = name, lo, hi, vary
-        self.value = hi if value > hi else (lo if value < lo else value)  # a value clipped into its bounds
+        self.value = min(max(value, lo), hi)  # a value clipped into its bounds
         self.stderr = self.correl = None
 
     def set(self, value) -> None:
         """The value clipped into the bounds (as lmfit's ``Parameter.set(value=...)``)."""
-        self.value = self.max if value > self.max else (self.min if value < self.min else value)
+        self.value = min(max(value, self.min), self.max)
 
 
 def lmfit_parameters(params):

@@ -47,7 +47,7 @@ def table() -> tuple[float, float, list, np.ndarray]:
 
 def at(s: float) -> tuple[float, float]:
     """(y, y') at one s in [0, s_end]."""
-    s_end, h, rows, _ = table()
+    _, h, rows, _ = table()
     u = s / h
     k = min(int(u), KNOTS - 1)
     x = u - k
@@ -60,7 +60,7 @@ def at(s: float) -> tuple[float, float]:
 
 def many(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(y, y') at every s of an array (any shape) in [0, s_end]."""
-    s_end, h, _, rows = table()
+    _, h, _, rows = table()
     u = np.asarray(s, dtype=float) / h
     k = np.minimum(np.where(u > 0, u, 0.0).astype(int), KNOTS - 1)  # (NaN: knot 0)
     x = u - k
