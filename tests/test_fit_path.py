@@ -194,7 +194,11 @@ def test_a_fit_without_checks_reaches_the_full_fits_minimum():
     assert full.plausibility and not lean.plausibility and lean.flags == ()
     assert lean.stats.chisqr == pytest.approx(full.stats.chisqr, rel=1e-9)
     assert (lean.stats.n_points, lean.stats.n_params) == (full.stats.n_points, full.stats.n_params)
+    assert any(p.stderr for p in full.params.values())
     for k, p in full.params.items():
+        if p.stderr is None:  # held
+            assert (lean.params[k].value, lean.params[k].stderr) == (p.value, None), k
+            continue
         assert abs(lean.params[k].value - p.value) <= 1e-3 * p.stderr, k
         assert lean.params[k].stderr == pytest.approx(p.stderr, rel=1e-3), k
 
@@ -282,6 +286,11 @@ def test_a_repeated_evaluation_reused_gives_the_fit_of_the_general_path(law, sol
     assert fast.nfev < slow.nfev  # evaluations saved, counted as such
 
 
+def _numbers(r):
+    return (r.status, r.message, r.nfev, r.stats.chisqr, r.stats.aic, sorted(r.correlations.items()),
+            {k: (p.value, p.stderr) for k, p in r.params.items()})
+
+
 @pytest.mark.parametrize("law, options", [
     ("area-rate", {"scan": 0, "n_starts": 1}),  # a bootstrap replicate: warm start, error analysis
     ("wear", {"scan": 0, "n_starts": 1, "errors": False}),  # an equivalence replicate
@@ -312,8 +321,10 @@ def test_refits_through_least_squares_reach_lmfits_minimum(law, options, monkeyp
             assert abs(q.value - p.value) <= 1e-3 * p.stderr, k
             if options.get("errors", True):
                 assert q.stderr == pytest.approx(p.stderr, rel=1e-3), k
+        elif p.vary:  # lmfit could not estimate its error bar: the data do not determine it; nor does the refit
+            assert not q.stderr, k
         else:
-            assert q.value == pytest.approx(p.value, rel=1e-9), k
+            assert q.value == p.value, k
 
 
 def test_a_refit_through_least_squares_declines_where_it_cannot_answer():

@@ -1,13 +1,16 @@
-"""A warm-started refit through scipy's public bounded least squares, for the replicate refits.
+"""A warm-started refit through scipy's public least squares, for the replicate refits.
 
 ``leastsq(fun, params, scale_covar, max_nfev, **options)`` minimizes sum(fun(values)**2) over the varying
-parameters from their values (the main fit's best values: a warm start) with ``scipy.optimize.least_squares``
-(trust region reflective, the bounds as they are, forward differences of relative step sqrt(epsfcn)), and returns
-what a fit reads of lmfit's result: the parameters (values, error bars and correlations from the Jacobian at the
-end, scaled by the reduced chi-square when asked), success, a message and chi-square. It skips what costs about
-0.5 ms a run in lmfit (copying the Parameters, uncertainty objects), which the thousands of refits of the
-equivalence test and the bootstrap (``fit(checks=False)``) would pay. Where the residual is not finite or the
-evaluation budget runs out it returns None, and the caller runs lmfit's own Levenberg-Marquardt.
+parameters from their values (the main fit's best values: a warm start) by Levenberg-Marquardt
+(``scipy.optimize.least_squares(method="lm")``, MINPACK's lmdif, forward differences of relative step
+sqrt(epsfcn)) in MINUIT's bounded coordinates (F. James, MINUIT reference manual, CERN D506, "parameter limits":
+arcsin for two bounds, sqrt for one; lmfit bounds its parameters the same way, so a refit walks as lmfit's would).
+It returns what a fit reads of lmfit's result: the parameters (values; error bars and correlations from the
+Jacobian at the end through the coordinates' gradient, scaled by the reduced chi-square when asked), success, a
+message and chi-square. It skips what costs about 0.5 ms a run in lmfit (copying the Parameters, uncertainty
+objects), which the thousands of refits of the equivalence test and the bootstrap (``fit(checks=False)``) would
+pay. Where the residual is not finite or the evaluation budget runs out it returns None, and the caller runs
+lmfit's own Levenberg-Marquardt.
 """
 from __future__ import annotations
 
@@ -58,6 +61,39 @@ class Result:
         self.params, self.success, self.message, self.chisqr = params, success, message, chisqr
 
 
+def internal(x: float, lo: float, hi: float) -> float:
+    """MINUIT's internal coordinate of a value x within [lo, hi] (either may be infinite)."""
+    if lo == -inf and hi == inf:
+        return x
+    if hi == inf:
+        return math.sqrt((x - lo + 1.0) ** 2 - 1.0)
+    if lo == -inf:
+        return math.sqrt((hi - x + 1.0) ** 2 - 1.0)
+    return math.asin(max(-1.0, min(1.0, 2.0 * (x - lo) / (hi - lo) - 1.0)))
+
+
+def external(u: float, lo: float, hi: float) -> float:
+    """The value of MINUIT's internal coordinate u (the inverse of ``internal``)."""
+    if lo == -inf and hi == inf:
+        return u
+    if hi == inf:
+        return lo - 1.0 + math.sqrt(u * u + 1.0)
+    if lo == -inf:
+        return hi + 1.0 - math.sqrt(u * u + 1.0)
+    return lo + (math.sin(u) + 1.0) * (hi - lo) / 2.0
+
+
+def gradient(u: float, lo: float, hi: float) -> float:
+    """d external / d internal at u."""
+    if lo == -inf and hi == inf:
+        return 1.0
+    if hi == inf:
+        return u / math.sqrt(u * u + 1.0)
+    if lo == -inf:
+        return -u / math.sqrt(u * u + 1.0)
+    return math.cos(u) * (hi - lo) / 2.0
+
+
 def leastsq(fun, params, scale_covar: bool, max_nfev: int, ftol: float = 1.5e-8, xtol: float = 1.5e-8,
             epsfcn: float = 1e-10) -> Result | None:
     """Minimize sum(fun(values)**2) over the varying parameters of ``params`` (lmfit Parameters, or a mapping
@@ -69,36 +105,37 @@ def leastsq(fun, params, scale_covar: bool, max_nfev: int, ftol: float = 1.5e-8,
             for k, p in params.items()}
     free = [p for p in pars.values() if p.vary]
     values = {k: p.value for k, p in pars.items()}
+    finite = [True]
 
-    def residual(x):
-        for p, v in zip(free, x):
-            values[p.name] = v
-        return np.asarray(fun(dict(values)), dtype=np.float64).ravel()
+    def residual(u):
+        for p, v in zip(free, u):
+            values[p.name] = min(max(external(v, p.min, p.max), p.min), p.max)
+        r = np.asarray(fun(dict(values)), dtype=np.float64).ravel()
+        if not np.isfinite(r).all():
+            finite[0] = False
+            r = np.where(np.isfinite(r), r, 1e150)  # MINPACK goes on; the refit is declined below
+        return r
 
-    lo = np.array([p.min for p in free])
-    hi = np.array([p.max for p in free])
-    x0 = np.clip([p.value for p in free], lo, hi)
+    u0 = np.array([internal(p.value, p.min, p.max) for p in free])
     with np.errstate(all="ignore"):
         try:
-            if not np.isfinite(residual(x0)).all():
-                return None
-            run = least_squares(residual, x0, bounds=(lo, hi), method="trf", diff_step=math.sqrt(epsfcn), ftol=ftol,
-                                xtol=xtol, gtol=None, max_nfev=max_nfev)
-        except ValueError:  # bounds that leave no room, or a residual that turned non-finite
+            run = least_squares(residual, u0, method="lm", diff_step=math.sqrt(epsfcn), ftol=ftol, xtol=xtol,
+                                gtol=np.finfo(float).eps, max_nfev=max_nfev)
+        except ValueError:  # fewer points than free parameters
             return None
         r = residual(run.x)
-        if run.status <= 0 or not np.isfinite(r).all():
+        if run.status <= 0 or not finite[0]:
             return None
         for p, v in zip(free, run.x):
-            p.set(float(v))
+            p.set(external(float(v), p.min, p.max))
         chisqr = float(r @ r)
         message = "Fit succeeded."
-        _errors(pars, free, run.jac, chisqr / max(1, len(r) - len(free)) if scale_covar else 1.0)
+        g = np.array([gradient(float(v), p.min, p.max) for p, v in zip(free, run.x)])
+        _errors(pars, free, run.jac / g if len(free) else run.jac,
+                chisqr / max(1, len(r) - len(free)) if scale_covar else 1.0)
         if free and free[0].stderr is None:
             message += " Could not estimate error-bars."
     return Result(pars, True, message, max(chisqr, 1.e-250 * len(r)))
-
-
 def _errors(pars: dict, free: list, jac, scale: float) -> None:
     """Error bars and correlations of the free parameters from the Jacobian at the end: covariance (J^T J)^-1,
     times ``scale`` (the reduced chi-square, or 1 where the noise is known); none where J^T J is singular."""
