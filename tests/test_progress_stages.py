@@ -6,7 +6,7 @@ import time
 from _fit_helpers import synthetic
 
 from frictionlab import compare, fit
-from frictionlab.core.progress import Progress, Running
+from frictionlab.core.progress import Progress, Running, _clock
 
 
 def test_a_fit_names_its_stages_and_counts_evaluations():
@@ -169,3 +169,23 @@ def test_a_count_that_moved_gets_its_plain_line_with_eta_from_the_heartbeat():
         bar.beat()
     last = out.getvalue().splitlines()[-1]
     assert last.endswith("bench: 3/10 (30%) d; ETA 0:00:13") and "still working" not in out.getvalue()
+
+
+def test_the_eta_leaves_out_a_first_step_that_paid_for_compilation():
+    """A fit whose first evaluation compiles for 100 s and whose others take 1 s each: once RATE_STEPS steps have
+    followed, the ETA is the remaining steps at 1 s (within a second), not at the mean since the start (11 s)."""
+    from frictionlab.core.progress import RATE_STEPS
+
+    clock, out = FakeClock(), io.StringIO()
+    with Progress("fit", stream=out, tty=False, clock=clock, thread=False, every=0) as bar:
+        bar(0, 100, "scan")
+        clock.t += 100
+        bar(1, 100, "scan")
+        for k in range(2, RATE_STEPS + 3):
+            clock.t += 1
+            bar(k, 100, "scan")
+        done = RATE_STEPS + 2
+        assert abs(bar.eta(done, 100, clock.t) - (100 - done)) <= 1.0
+        assert out.getvalue().splitlines()[-1].endswith(f"; ETA {_clock(100 - done)}")
+        clock.t += 30  # nothing for 30 s: the rate takes the wait in
+        assert bar.eta(done, 100, clock.t) > 3 * (100 - done)

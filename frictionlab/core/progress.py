@@ -20,6 +20,11 @@ import datetime as _dt
 import sys
 import threading
 import time
+from collections import deque
+
+#: Steps of the count the ETA's rate is measured over: the last RATE_STEPS moves of the count (a first step that
+#: paid for start-up or compilation leaves the rate once as many steps have followed).
+RATE_STEPS = 8
 
 
 def _clock(seconds: float) -> str:
@@ -47,6 +52,7 @@ class Progress:
         self.last_line = -1e18
         self.bar = None
         self.done, self.total, self.label, self.name = 0, 0, "", _stage
+        self.marks: deque = deque([(self.start, 0)], maxlen=RATE_STEPS + 1)  # (time, count) where the count moved
         self.parent = _parent
         self._lock = _parent._lock if _parent is not None else threading.Lock()
         self._stop = threading.Event()
@@ -60,6 +66,10 @@ class Progress:
         if done != self.done:
             self.since = now
         first, moved, back = self.last_line < -1e17, done != self.done, done < self.done
+        if back:
+            self.marks.clear()
+        if moved or back:
+            self.marks.append((now, done))
         self.done, self.total, self.label = done, total, label
         self._watch()
         if self.delay and now - self.start < self.delay:
@@ -121,12 +131,19 @@ class Progress:
         return f"{self.name} " if self.name else ""
 
     def line(self, done: int, total: int, label: str, now: float | None = None) -> str:
-        """The plain progress line: time stamp, stage, count, share, label and ETA."""
-        elapsed = (now if now is not None else self.clock()) - self.start
+        """The plain progress line: time stamp, stage, count, share, label and ETA (``eta``)."""
+        now = now if now is not None else self.clock()
         share = done / total if total else 1.0
-        eta = (f"ETA {_clock(elapsed * (1 - share) / share)}" if 0 < share < 1 else
-               "ETA after the first step" if share == 0 else f"took {_clock(elapsed)}")
+        eta = (f"ETA {_clock(self.eta(done, total, now))}" if 0 < share < 1 else
+               "ETA after the first step" if share == 0 else f"took {_clock(now - self.start)}")
         return f"{_stamp()} {self.desc}: {self._name()}{done}/{total} ({100 * share:.0f}%) {label}; {eta}"
+
+    def eta(self, done: int, total: int, now: float) -> float:
+        """Seconds left at the rate measured over the last RATE_STEPS moves of the count and the time since the
+        last one (not over the whole run: a first step that paid for imports or compilation would make every
+        later step look that slow)."""
+        t_ref, d_ref = next(((t, d) for t, d in self.marks if d < done), (self.start, 0))
+        return (total - done) * (now - t_ref) / max(done - d_ref, 1)
 
     def _draw(self, done: int, total: int, label: str) -> None:
         if self.bar is None:
