@@ -43,7 +43,7 @@ def heavy_imports(argv: list[str], cwd: str) -> list[str]:
     code = ("import sys; from frictionlab.cli import main\n"
             "try:\n    main(sys.argv[1:])\nexcept SystemExit:\n    pass\n"
             f"print(','.join(m for m in {HEAVY!r} if m in sys.modules), file=sys.stderr)")
-    out = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, cwd=cwd)
+    out = subprocess.run([sys.executable, "-c", code, *argv], capture_output=True, text=True, cwd=cwd, check=False)
     last = (out.stderr.splitlines() or [""])[-1]
     return [m for m in last.split(",") if m]
 

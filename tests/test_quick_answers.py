@@ -21,7 +21,7 @@ print(json.dumps([rc, [m for m in {heavy!r} if m in sys.modules]]), file=sys.std
 
 def _run(args, cwd):
     out = subprocess.run([sys.executable, "-c", CODE.format(heavy=HEAVY), *args], capture_output=True, text=True,
-                         cwd=cwd, timeout=120)
+                         cwd=cwd, timeout=120, check=False)
     *said, last = out.stderr.strip().splitlines()
     rc, heavy = json.loads(last)
     return rc, heavy, out.stdout + "\n".join(said)
