@@ -72,16 +72,19 @@ def test_stages_have_their_own_count_clock_and_eta():
         fit.close()
         clock.t += 50
         boot = root.stage("bootstrap")
-        boot(0, 4, "started")
+        boot(0, 8, "started")
+        clock.t += 40
+        boot(1, 8, "on x: 1/8 resamples")  # the first step's 40 s (start-up) are not the rate
         clock.t += 10
-        boot(1, 4, "on x: 1/4 resamples")  # 10 s for one: 30 s for the other three, whatever the fits took
+        boot(2, 8, "on x: 2/8 resamples")  # 10 s for one: 60 s for the other six, whatever the fits took
         clock.t += 60
         root.beat()
     lines = [x.split(" compare: ")[1] for x in out.getvalue().splitlines()]
-    assert lines[:4] == ["fit 0/2 (0%) 2 queued; ETA after the first step", "fit 2/2 (100%) b; took 0:01:40",
-                         "bootstrap 0/4 (0%) started; ETA after the first step",
-                         "bootstrap 1/4 (25%) on x: 1/4 resamples; ETA 0:00:30"]
-    assert lines[4].startswith("bootstrap 1/4 done, still working (nothing finished for 0:01:00") and len(lines) == 5
+    assert lines[:5] == ["fit 0/2 (0%) 2 queued; ETA after the first steps", "fit 2/2 (100%) b; took 0:01:40",
+                         "bootstrap 0/8 (0%) started; ETA after the first steps",
+                         "bootstrap 1/8 (12%) on x: 1/8 resamples; ETA after the first steps",
+                         "bootstrap 2/8 (25%) on x: 2/8 resamples; ETA 0:01:00"]
+    assert lines[5].startswith("bootstrap 2/8 done, still working (nothing finished for 0:01:00") and len(lines) == 6
 
 
 def test_running_names_the_tasks_a_pool_runs_now_from_the_parent_alone():
@@ -164,24 +167,30 @@ def test_a_count_that_moved_gets_its_plain_line_with_eta_from_the_heartbeat():
     with Progress("bench", stream=out, tty=False, clock=clock, thread=False) as bar:
         bar(0, 10, "a")
         clock.t += 1
+        bar(1, 10, "b")
+        clock.t += 1
         bar(3, 10, "d")  # within 'every' of the last line: not written now
         clock.t += 4.5
         bar.beat()
     last = out.getvalue().splitlines()[-1]
-    assert last.endswith("bench: 3/10 (30%) d; ETA 0:00:13") and "still working" not in out.getvalue()
+    assert last.endswith("bench: 3/10 (30%) d; ETA 0:00:19") and "still working" not in out.getvalue()
 
 
 def test_the_eta_leaves_out_a_first_step_that_paid_for_compilation():
-    """A fit whose first evaluation compiles for 100 s and whose others take 1 s each: once RATE_STEPS steps have
-    followed, the ETA is the remaining steps at 1 s (within a second), not at the mean since the start (11 s)."""
+    """A fit whose first evaluations compile for 100 s and whose others take 1 s each: no ETA from the first step
+    alone; once RATE_STEPS steps have followed the slow one, the ETA is the remaining steps at 1 s (within a
+    second), not at the mean since the start (11 s)."""
     from frictionlab.core.progress import RATE_STEPS
 
     clock, out = FakeClock(), io.StringIO()
     with Progress("fit", stream=out, tty=False, clock=clock, thread=False, every=0) as bar:
         bar(0, 100, "scan")
-        clock.t += 100
+        clock.t += 50
         bar(1, 100, "scan")
-        for k in range(2, RATE_STEPS + 3):
+        assert bar.eta(1, 100, clock.t) is None and out.getvalue().splitlines()[-1].endswith("after the first steps")
+        clock.t += 50
+        bar(2, 100, "scan")
+        for k in range(3, RATE_STEPS + 3):
             clock.t += 1
             bar(k, 100, "scan")
         done = RATE_STEPS + 2

@@ -22,8 +22,8 @@ import threading
 import time
 from collections import deque
 
-#: Steps of the count the ETA's rate is measured over: the last RATE_STEPS moves of the count (a first step that
-#: paid for start-up or compilation leaves the rate once as many steps have followed).
+#: Moves of the count the ETA's rate is measured over: the last RATE_STEPS (the time to the first move, which pays
+#: for imports and compilation, never counts; a slow step leaves the rate once as many moves have followed).
 RATE_STEPS = 8
 
 
@@ -52,7 +52,7 @@ class Progress:
         self.last_line = -1e18
         self.bar = None
         self.done, self.total, self.label, self.name = 0, 0, "", _stage
-        self.marks: deque = deque([(self.start, 0)], maxlen=RATE_STEPS + 1)  # (time, count) where the count moved
+        self.marks: deque = deque(maxlen=RATE_STEPS + 1)  # (time, count) where the count moved
         self.parent = _parent
         self._lock = _parent._lock if _parent is not None else threading.Lock()
         self._stop = threading.Event()
@@ -134,16 +134,17 @@ class Progress:
         """The plain progress line: time stamp, stage, count, share, label and ETA (``eta``)."""
         now = now if now is not None else self.clock()
         share = done / total if total else 1.0
-        eta = (f"ETA {_clock(self.eta(done, total, now))}" if 0 < share < 1 else
-               "ETA after the first step" if share == 0 else f"took {_clock(now - self.start)}")
+        left = self.eta(done, total, now) if 0 < share < 1 else None
+        eta = (f"ETA {_clock(left)}" if left is not None else "ETA after the first steps" if share < 1 else
+               f"took {_clock(now - self.start)}")
         return f"{_stamp()} {self.desc}: {self._name()}{done}/{total} ({100 * share:.0f}%) {label}; {eta}"
 
-    def eta(self, done: int, total: int, now: float) -> float:
-        """Seconds left at the rate measured over the last RATE_STEPS moves of the count and the time since the
-        last one (not over the whole run: a first step that paid for imports or compilation would make every
-        later step look that slow)."""
-        t_ref, d_ref = next(((t, d) for t, d in self.marks if d < done), (self.start, 0))
-        return (total - done) * (now - t_ref) / max(done - d_ref, 1)
+    def eta(self, done: int, total: int, now: float) -> float | None:
+        """Seconds left at the rate measured from the last RATE_STEPS moves of the count to now; None before the
+        count has moved twice. Not over the whole run: the first step pays for imports and compilation, and would
+        make every later step look that slow (a fit's first evaluation compiling for a minute promised hours)."""
+        ref = next(((t, d) for t, d in self.marks if d < done), None)
+        return None if ref is None else (total - done) * (now - ref[0]) / (done - ref[1])
 
     def _draw(self, done: int, total: int, label: str) -> None:
         if self.bar is None:
