@@ -45,10 +45,13 @@ def main() -> None:
         print(f"{m.group(1)}  ETA {eta:6d} s  left {left:6.0f} s  ETA / left {ratio:7.2f}")
         if left >= MIN_LEFT:
             ratios.append(ratio)
-    worst = max(ratios, default=float("nan"))
-    print(f"frictionlab {' '.join(argv)} ({'warm' if warm else 'numba cache empty'}): {len(ratios)} ETAs with at "
-          f"least {MIN_LEFT:g} s left; largest ETA / real time left {worst:.2f} (target at most 2: "
-          f"{'met' if worst <= 2 else 'NOT met'}); exit status {out.returncode}")
+    what = f"frictionlab {' '.join(argv)} ({'warm' if warm else 'numba cache empty'})"
+    if not ratios:
+        print(f"{what}: no ETA given with at least {MIN_LEFT:g} s left (nothing promised); exit status {out.returncode}")
+        return
+    worst = max(ratios)
+    print(f"{what}: {len(ratios)} ETAs with at least {MIN_LEFT:g} s left; largest ETA / real time left {worst:.2f} "
+          f"(target at most 2: {'met' if worst <= 2 else 'NOT met'}); exit status {out.returncode}")
 
 
 if __name__ == "__main__":
