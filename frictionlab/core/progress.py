@@ -22,9 +22,10 @@ import threading
 import time
 from collections import deque
 
-#: Moves of the count the ETA's rate is measured over: the last RATE_STEPS (the time to the first move, which pays
-#: for imports and compilation, never counts; a slow step leaves the rate once as many moves have followed).
-RATE_STEPS = 8
+#: Moves of the count the ETA's rate is measured over: the last RATE_STEPS, each move's seconds a step, their median
+#: (the time to the first move, which pays for imports and compilation, never counts; a move that compiled or waited
+#: is outvoted by the others).
+RATE_STEPS = 32
 
 
 def _clock(seconds: float) -> str:
@@ -140,11 +141,16 @@ class Progress:
         return f"{_stamp()} {self.desc}: {self._name()}{done}/{total} ({100 * share:.0f}%) {label}; {eta}"
 
     def eta(self, done: int, total: int, now: float) -> float | None:
-        """Seconds left at the rate measured from the last RATE_STEPS moves of the count to now; None before the
-        count has moved twice. Not over the whole run: the first step pays for imports and compilation, and would
-        make every later step look that slow (a fit's first evaluation compiling for a minute promised hours)."""
-        ref = next(((t, d) for t, d in self.marks if d < done), None)
-        return None if ref is None else (total - done) * (now - ref[0]) / (done - ref[1])
+        """Seconds left: the steps left times the median seconds a step of the last RATE_STEPS moves of the count;
+        None before the count has moved twice. Not the mean over the whole run: the first step pays for imports
+        and compilation, and would make every later step look that slow (a fit whose first evaluation compiled for
+        a minute promised hours)."""
+        marks = [m for m in self.marks if m[1] <= done]
+        rates = sorted((t1 - t0) / (d1 - d0) for (t0, d0), (t1, d1) in zip(marks, marks[1:]) if d1 > d0)
+        if not rates:
+            return None
+        mid = len(rates) // 2
+        return (total - done) * (rates[mid] if len(rates) % 2 else (rates[mid - 1] + rates[mid]) / 2)
 
     def _draw(self, done: int, total: int, label: str) -> None:
         if self.bar is None:
