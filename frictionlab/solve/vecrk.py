@@ -254,7 +254,8 @@ def _error_norm(cls, errs, h, scale):
 
 
 def _initial_step(rhs, t0, y0, f0, span, order, rtol, atol):
-    """scipy's select_initial_step (Hairer, Norsett and Wanner, II.4), per problem."""
+    """The starting step of Hairer, Norsett and Wanner (Solving ODEs I, section II.4; scipy's solvers start the
+    same way), per problem."""
     scale = atol + np.abs(y0) * rtol
     d0, d1 = _rms(y0 / scale), _rms(f0 / scale)
     h0 = np.where((d0 < 1e-5) | (d1 < 1e-5), 1e-6, 0.01 * d0 / np.where(d1 > 0, d1, 1.0))
