@@ -75,16 +75,19 @@ def test_stages_have_their_own_count_clock_and_eta():
         boot(0, 8, "started")
         clock.t += 40
         boot(1, 8, "on x: 1/8 resamples")  # the first step's 40 s (start-up) are not the rate
-        clock.t += 10
-        boot(2, 8, "on x: 2/8 resamples")  # 10 s for one: 60 s for the other six, whatever the fits took
+        for k in (2, 3, 4):
+            clock.t += 10
+            boot(k, 8, f"on x: {k}/8 resamples")  # 10 s for one: 40 s for the other four, whatever the fits took
         clock.t += 60
         root.beat()
     lines = [x.split(" compare: ")[1] for x in out.getvalue().splitlines()]
-    assert lines[:5] == ["fit 0/2 (0%) 2 queued; ETA after the first steps", "fit 2/2 (100%) b; took 0:01:40",
+    assert lines[:7] == ["fit 0/2 (0%) 2 queued; ETA after the first steps", "fit 2/2 (100%) b; took 0:01:40",
                          "bootstrap 0/8 (0%) started; ETA after the first steps",
                          "bootstrap 1/8 (12%) on x: 1/8 resamples; ETA after the first steps",
-                         "bootstrap 2/8 (25%) on x: 2/8 resamples; ETA 0:01:00"]
-    assert lines[5].startswith("bootstrap 2/8 done, still working (nothing finished for 0:01:00") and len(lines) == 6
+                         "bootstrap 2/8 (25%) on x: 2/8 resamples; ETA after the first steps",
+                         "bootstrap 3/8 (38%) on x: 3/8 resamples; ETA after the first steps",
+                         "bootstrap 4/8 (50%) on x: 4/8 resamples; ETA 0:00:40"]
+    assert lines[7].startswith("bootstrap 4/8 done, still working (nothing finished for 0:01:00") and len(lines) == 8
 
 
 def test_running_names_the_tasks_a_pool_runs_now_from_the_parent_alone():
@@ -170,10 +173,14 @@ def test_a_count_that_moved_gets_its_plain_line_with_eta_from_the_heartbeat():
         bar(1, 10, "b")
         clock.t += 1
         bar(3, 10, "d")  # within 'every' of the last line: not written now
-        clock.t += 4.5
+        clock.t += 1
+        bar(4, 10, "e")
+        clock.t += 1
+        bar(5, 10, "f")
+        clock.t += 2.5
         bar.beat()
     last = out.getvalue().splitlines()[-1]
-    assert last.endswith("bench: 3/10 (30%) d; ETA 0:00:04")  # 2 steps in 1 s: 0.5 s a step and "still working" not in out.getvalue()
+    assert last.endswith("bench: 5/10 (50%) f; ETA 0:00:05")  # the median step: 1 s and "still working" not in out.getvalue()
 
 
 def test_the_eta_leaves_out_a_first_step_that_paid_for_compilation():

@@ -26,6 +26,8 @@ from collections import deque
 #: (the time to the first move, which pays for imports and compilation, never counts; a move that compiled or waited
 #: is outvoted by the others).
 RATE_STEPS = 32
+#: Moves after the first the ETA waits for: a median of three outvotes one move that compiled.
+FIRST_RATES = 3
 
 
 def _clock(seconds: float) -> str:
@@ -142,12 +144,12 @@ class Progress:
 
     def eta(self, done: int, total: int, now: float) -> float | None:
         """Seconds left: the steps left times the median seconds a step of the last RATE_STEPS moves of the count;
-        None before the count has moved twice. Not the mean over the whole run: the first step pays for imports
+        None before the count has moved FIRST_RATES times after its first move. Not the mean over the whole run: the first step pays for imports
         and compilation, and would make every later step look that slow (a fit whose first evaluation compiled for
         a minute promised hours)."""
         marks = [m for m in self.marks if m[1] <= done]
         rates = sorted((t1 - t0) / (d1 - d0) for (t0, d0), (t1, d1) in zip(marks, marks[1:]) if d1 > d0)
-        if not rates:
+        if len(rates) < FIRST_RATES:
             return None
         mid = len(rates) // 2
         return (total - done) * (rates[mid] if len(rates) % 2 else (rates[mid - 1] + rates[mid]) / 2)
