@@ -24,7 +24,7 @@ def _data(truth: str, where: str):
 
 
 def _one_at_a_time(monkeypatch):
-    """Every refit one at a time through lmfit's Levenberg-Marquardt (levmar), no batch anywhere."""
+    """Every refit one at a time (lsrefit: Levenberg-Marquardt through scipy's least_squares), no batch anywhere."""
     monkeypatch.setattr(replicates, "batch_problem", lambda *a, **k: None)
     monkeypatch.setattr(batchfit, "best_start", lambda *a, **k: None)
 

@@ -86,6 +86,18 @@ def test_speed_dependent_contact_time_and_restitution():
     assert out["restitution"][-1] == 0.0  # kept within [0, 1]
 
 
+def test_the_tabulated_hertz_shape_is_the_dense_solution():
+    """The Hermite interpolants between the knots against scipy's dense output of the same solve."""
+    from frictionlab.solve import hertzshape
+
+    s_end, dense = hertzshape.solution()
+    s = np.linspace(0.0, s_end, 100_003)
+    (y, dy), (y_ref, dy_ref) = hertzshape.many(s), dense(s)
+    assert np.abs(y - y_ref).max() < 1e-13 and np.abs(dy - dy_ref).max() < 1e-10
+    assert hertzshape.end() == pytest.approx(hertzshape.exact_end(), rel=1e-11)
+    assert hertzshape.at(float(s[777])) == (y[777], dy[777])
+
+
 def test_hertz_pulse():
     s_end, y, dy = hertz_shape()
     assert s_end == pytest.approx(0.8 * beta(0.4, 0.5), rel=1e-11)  # 2 int_0^1 dy / sqrt(1 - y^(5/2))

@@ -6,7 +6,7 @@ import time
 from _fit_helpers import synthetic
 
 from frictionlab import compare, fit
-from frictionlab.core.progress import Progress, Running
+from frictionlab.core.progress import Progress, Running, _clock
 
 
 def test_a_fit_names_its_stages_and_counts_evaluations():
@@ -72,16 +72,22 @@ def test_stages_have_their_own_count_clock_and_eta():
         fit.close()
         clock.t += 50
         boot = root.stage("bootstrap")
-        boot(0, 4, "started")
-        clock.t += 10
-        boot(1, 4, "on x: 1/4 resamples")  # 10 s for one: 30 s for the other three, whatever the fits took
+        boot(0, 8, "started")
+        clock.t += 40
+        boot(1, 8, "on x: 1/8 resamples")  # the first step's 40 s (start-up) are not the rate
+        for k in (2, 3, 4):
+            clock.t += 10
+            boot(k, 8, f"on x: {k}/8 resamples")  # 10 s for one: 40 s for the other four, whatever the fits took
         clock.t += 60
         root.beat()
     lines = [x.split(" compare: ")[1] for x in out.getvalue().splitlines()]
-    assert lines[:4] == ["fit 0/2 (0%) 2 queued; ETA after the first step", "fit 2/2 (100%) b; took 0:01:40",
-                         "bootstrap 0/4 (0%) started; ETA after the first step",
-                         "bootstrap 1/4 (25%) on x: 1/4 resamples; ETA 0:00:30"]
-    assert lines[4].startswith("bootstrap 1/4 done, still working (nothing finished for 0:01:00") and len(lines) == 5
+    assert lines[:7] == ["fit 0/2 (0%) 2 queued; ETA after the first steps", "fit 2/2 (100%) b; took 0:01:40",
+                         "bootstrap 0/8 (0%) started; ETA after the first steps",
+                         "bootstrap 1/8 (12%) on x: 1/8 resamples; ETA after the first steps",
+                         "bootstrap 2/8 (25%) on x: 2/8 resamples; ETA after the first steps",
+                         "bootstrap 3/8 (38%) on x: 3/8 resamples; ETA after the first steps",
+                         "bootstrap 4/8 (50%) on x: 4/8 resamples; ETA 0:00:40"]
+    assert lines[7].startswith("bootstrap 4/8 done, still working (nothing finished for 0:01:00") and len(lines) == 8
 
 
 def test_running_names_the_tasks_a_pool_runs_now_from_the_parent_alone():
@@ -164,8 +170,39 @@ def test_a_count_that_moved_gets_its_plain_line_with_eta_from_the_heartbeat():
     with Progress("bench", stream=out, tty=False, clock=clock, thread=False) as bar:
         bar(0, 10, "a")
         clock.t += 1
+        bar(1, 10, "b")
+        clock.t += 1
         bar(3, 10, "d")  # within 'every' of the last line: not written now
-        clock.t += 4.5
+        clock.t += 1
+        bar(4, 10, "e")
+        clock.t += 1
+        bar(5, 10, "f")
+        clock.t += 2.5
         bar.beat()
     last = out.getvalue().splitlines()[-1]
-    assert last.endswith("bench: 3/10 (30%) d; ETA 0:00:13") and "still working" not in out.getvalue()
+    assert last.endswith("bench: 5/10 (50%) f; ETA 0:00:05")  # the median step: 1 s and "still working" not in out.getvalue()
+
+
+def test_the_eta_leaves_out_a_first_step_that_paid_for_compilation():
+    """A fit whose first evaluations compile for 100 s and whose others take 1 s each: no ETA from the first step
+    alone; once two steps have followed the slow one, the ETA is the remaining steps at 1 s (within a second),
+    not at the mean since the start (11 s); a later step that waits 30 s is outvoted."""
+    clock, out = FakeClock(), io.StringIO()
+    with Progress("fit", stream=out, tty=False, clock=clock, thread=False, every=0) as bar:
+        bar(0, 100, "scan")
+        clock.t += 50
+        bar(1, 100, "scan")
+        assert bar.eta(1, 100, clock.t) is None and out.getvalue().splitlines()[-1].endswith("after the first steps")
+        clock.t += 50
+        bar(2, 100, "scan")
+        for k in range(3, 5):
+            clock.t += 1
+            bar(k, 100, "scan")
+        assert abs(bar.eta(4, 100, clock.t) - 96) <= 1.0
+        assert out.getvalue().splitlines()[-1].endswith(f"; ETA {_clock(96)}")
+        clock.t += 30
+        bar(5, 100, "scan")
+        for k in range(6, 12):
+            clock.t += 1
+            bar(k, 100, "scan")
+        assert abs(bar.eta(11, 100, clock.t) - 89) <= 1.0

@@ -111,15 +111,21 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from ..core.cluster import Waits, check_address, close, connect, quiet_logs
-    from ..io.dataset import available_names, load_dataset
-    from .fit import parse_free
+    from .early import check_datasets, check_laws, check_out
 
-    if args.scheduler is not None:
-        check_address(args.scheduler)  # a malformed address refused before any work or connection
     parent = args.out.parent if str(args.out.parent) else Path(".")
     if not parent.is_dir():
         raise OutputError(f"{args.out}: cannot write: {parent} is not an existing folder")
+    check_laws(args.laws, args.load)  # the quick refusals, before the numerics are imported
+    check_datasets(args.data or ())
+    check_out(args.out, args.force)
+    from ..core.cluster import Waits, check_address, close, connect, quiet_logs
+
+    if args.scheduler is not None:
+        check_address(args.scheduler)  # a malformed address refused before any work or connection
+    from ..io.dataset import available_names, load_dataset
+    from .fit import parse_free
+
     if not 1 <= args.jobs <= MAX_JOBS:
         raise OutputError(f"--jobs must be between 1 and {MAX_JOBS}, got {args.jobs}")
     if not 0 <= args.bootstrap <= MAX_BOOTSTRAP:

@@ -103,6 +103,10 @@ def parse_fix(law, items) -> dict:
 
 
 def run(args) -> int:
+    from .early import check_datasets, check_laws
+
+    check_laws([args.law], args.load)  # before the numerics are imported
+    check_datasets(args.datasets)
     from ..core.inputs import check_apart
     from ..core.workers import process_pool
     from ..io.dataset import load_dataset

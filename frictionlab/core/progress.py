@@ -20,6 +20,14 @@ import datetime as _dt
 import sys
 import threading
 import time
+from collections import deque
+
+#: Moves of the count the ETA's rate is measured over: the last RATE_STEPS, each move's seconds a step, their median
+#: (the time to the first move, which pays for imports and compilation, never counts; a move that compiled or waited
+#: is outvoted by the others).
+RATE_STEPS = 32
+#: Moves after the first the ETA waits for: a median of three outvotes one move that compiled.
+FIRST_RATES = 3
 
 
 def _clock(seconds: float) -> str:
@@ -47,6 +55,7 @@ class Progress:
         self.last_line = -1e18
         self.bar = None
         self.done, self.total, self.label, self.name = 0, 0, "", _stage
+        self.marks: deque = deque(maxlen=RATE_STEPS + 1)  # (time, count) where the count moved
         self.parent = _parent
         self._lock = _parent._lock if _parent is not None else threading.Lock()
         self._stop = threading.Event()
@@ -60,6 +69,10 @@ class Progress:
         if done != self.done:
             self.since = now
         first, moved, back = self.last_line < -1e17, done != self.done, done < self.done
+        if back:
+            self.marks.clear()
+        if moved or back:
+            self.marks.append((now, done))
         self.done, self.total, self.label = done, total, label
         self._watch()
         if self.delay and now - self.start < self.delay:
@@ -121,12 +134,25 @@ class Progress:
         return f"{self.name} " if self.name else ""
 
     def line(self, done: int, total: int, label: str, now: float | None = None) -> str:
-        """The plain progress line: time stamp, stage, count, share, label and ETA."""
-        elapsed = (now if now is not None else self.clock()) - self.start
+        """The plain progress line: time stamp, stage, count, share, label and ETA (``eta``)."""
+        now = now if now is not None else self.clock()
         share = done / total if total else 1.0
-        eta = (f"ETA {_clock(elapsed * (1 - share) / share)}" if 0 < share < 1 else
-               "ETA after the first step" if share == 0 else f"took {_clock(elapsed)}")
+        left = self.eta(done, total, now) if 0 < share < 1 else None
+        eta = (f"ETA {_clock(left)}" if left is not None else "ETA after the first steps" if share < 1 else
+               f"took {_clock(now - self.start)}")
         return f"{_stamp()} {self.desc}: {self._name()}{done}/{total} ({100 * share:.0f}%) {label}; {eta}"
+
+    def eta(self, done: int, total: int, now: float) -> float | None:
+        """Seconds left: the steps left times the median seconds a step of the last RATE_STEPS moves of the count;
+        None before the count has moved FIRST_RATES times after its first move. Not the mean over the whole run: the first step pays for imports
+        and compilation, and would make every later step look that slow (a fit whose first evaluation compiled for
+        a minute promised hours)."""
+        marks = [m for m in self.marks if m[1] <= done]
+        rates = sorted((t1 - t0) / (d1 - d0) for (t0, d0), (t1, d1) in zip(marks, marks[1:]) if d1 > d0)
+        if len(rates) < FIRST_RATES:
+            return None
+        mid = len(rates) // 2
+        return (total - done) * (rates[mid] if len(rates) % 2 else (rates[mid - 1] + rates[mid]) / 2)
 
     def _draw(self, done: int, total: int, label: str) -> None:
         if self.bar is None:

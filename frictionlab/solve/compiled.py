@@ -185,7 +185,7 @@ def prepare(law, plan, p, n: int):
 
 
 def _tableau(method):
-    from scipy.integrate import DOP853, RK45
+    from .rktableau import DOP853, RK45
 
     cls = {"RK45": RK45, "DOP853": DOP853}[method]
     ns = cls.n_stages

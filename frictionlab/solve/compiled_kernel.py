@@ -207,7 +207,7 @@ def kernel(A, B, Cn, E, AX, CX, D, order, exponent, dop, codes, cols, ids, t0a, 
             f0, f1, f2, fin = _rhs(t, y0, y1, sp, cd, tsc, fac0, fac1, fac2, ssc0, ssc1, direction)
             K[0, 0], K[0, 1], K[0, 2] = f0, f1, f2
             g_old = _slip(y0, y1, ssc0, ssc1, r, coupled, dsc)
-            # initial step: scipy's select_initial_step
+            # initial step: Hairer, Norsett and Wanner, II.4 (as vecrk._initial_step)
             s0 = atol + abs(y0) * rtol
             s1 = atol + abs(y1) * rtol
             s2 = atol + abs(y2) * rtol

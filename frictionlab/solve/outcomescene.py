@@ -3,8 +3,6 @@ inbound impact as an ordinary Scene: normal-force and area models per row (half-
 Hertz pulse), their speed dependence, compliance and materials (see ``frictionlab.solve.outcome``)."""
 from __future__ import annotations
 
-import bisect
-import functools
 import math
 from collections.abc import Mapping
 
@@ -19,6 +17,7 @@ from ..physics.contact import (
     compliance_from_spec,
     materials_from_spec,
 )
+from . import hertzshape
 from ..physics.scene import (
     HalfSineArea,
     HalfSineNormal,
@@ -48,31 +47,27 @@ class SpeedLaw:
 
 
 # --- Hertz impact ----------------------------------------------------------------------------
-@functools.cache
-def _hertz_solution():
-    """(s_end, dense) of the dimensionless Hertz impact (see ``hertz_shape``): dense(s) -> (y, y') rows."""
-    from scipy.integrate import solve_ivp
-
-    def rhs(s, z):
-        return [z[1], -1.25 * max(z[0], 0.0) ** 1.5]
-
-    def end(s, z):
-        return z[0]
-
-    end.terminal, end.direction = True, -1
-    sol = solve_ivp(rhs, (0.0, 4.0), [0.0, 1.0], method="DOP853", rtol=1e-13, atol=1e-15, dense_output=True,
-                    events=end)
-    return float(sol.t_events[0][0]), sol.sol
-
-
 def hertz_shape():
     """Dimensionless elastic Hertz impact: y'' = -(5/4) y^(3/2), y(0) = 0, y'(0) = 1.
 
-    Returns (s_end, y, dy): the end of contact s_end = (4/5) B(2/5, 1/2) = 2.9432 and the dense
-    solution y(s), y'(s). Integrated once (DOP853, rtol 1e-13).
+    Returns (s_end, y, dy): the end of contact s_end = (4/5) B(2/5, 1/2) = 2.9432 and the solution y(s), y'(s)
+    (``hertzshape``: integrated once by DOP853 at rtol 1e-13, tabulated, Hermite-interpolated), zero past s_end.
     """
-    s_end, dense = _hertz_solution()
-    return s_end, (lambda s: np.maximum(dense(s)[0], 0.0)), (lambda s: dense(s)[1])
+    s_end = hertzshape.end()
+
+    def inside(s):
+        s = np.asarray(s, dtype=float)
+        return (s >= 0) & (s <= s_end), np.clip(s, 0.0, s_end)
+
+    def y(s):
+        ok, c = inside(s)
+        return np.where(ok, np.maximum(hertzshape.many(c)[0], 0.0), 0.0)
+
+    def dy(s):
+        ok, c = inside(s)
+        return np.where(ok, hertzshape.many(c)[1], 0.0)
+
+    return s_end, y, dy
 
 
 @attrs.frozen
@@ -93,59 +88,17 @@ class HertzPulse:
 
     def shape(self, t):
         """(y, dy/ds) at times t [s]; zero outside the contact."""
-        s_end = _hertz_solution()[0]
+        s_end = hertzshape.end()
         if isinstance(t, (float, np.floating)) or np.ndim(t) == 0:  # one time (an ODE's right-hand side)
             s = float(t) / self.time_scale
             if not 0.0 <= s <= s_end:
                 return np.float64(0.0), np.float64(0.0)
-            y, dy = _hertz_at(s)
+            y, dy = hertzshape.at(s)
             return np.float64(max(y, 0.0)), np.float64(dy)
         s = np.asarray(t, dtype=float) / self.time_scale
         inside = (s >= 0) & (s <= s_end)
-        y, dy = _hertz_many(np.clip(s, 0.0, s_end))
+        y, dy = hertzshape.many(np.clip(s, 0.0, s_end))
         return np.where(inside, np.maximum(y, 0.0), 0.0), np.where(inside, dy, 0.0)
-
-
-@functools.cache
-def _hertz_steps() -> tuple[list, list, tuple]:
-    """The solution's step times, each step's interpolant as (t_old, h, y_old, its coefficients last first), and
-    the same as arrays (t_old, h, y_old (steps, 2), coefficients last first (steps, 7, 2))."""
-    _, dense = _hertz_solution()
-    steps = [(f.t_old, f.h, tuple(f.y_old.tolist()), [tuple(row) for row in reversed(f.F.tolist())])
-             for f in dense.interpolants]
-    arrays = (np.array([f.t_old for f in dense.interpolants]), np.array([f.h for f in dense.interpolants]),
-              np.array([f.y_old for f in dense.interpolants]), np.array([f.F[::-1] for f in dense.interpolants]))
-    return dense.ts_sorted.tolist(), steps, arrays
-
-
-def _hertz_at(s: float) -> tuple[float, float]:
-    """(y, y') of the dimensionless Hertz impact at one s: the DOP853 interpolant of s's step, as scipy's
-    OdeSolution evaluates it (the same operations on floats, so the same numbers), without its array calls."""
-    times, steps, _ = _hertz_steps()
-    t_old, h, (y0, dy0), coefs = steps[min(max(bisect.bisect_left(times, s) - 1, 0), len(steps) - 1)]
-    x = (s - t_old) / h
-    y = dy = 0.0
-    for i, (f0, f1) in enumerate(coefs):
-        w = x if i % 2 == 0 else 1 - x
-        y, dy = (y + f0) * w, (dy + f1) * w
-    return y + y0, dy + dy0
-
-
-def _hertz_many(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``_hertz_at`` at every s of an array (any shape): each point's step found at once and every step's
-    interpolant evaluated together, the same operations elementwise (the same numbers as scipy's OdeSolution)."""
-    times, _, (t_old, h, y_old, coefs) = _hertz_steps()
-    k = np.clip(np.searchsorted(times, s, side="left") - 1, 0, t_old.size - 1)
-    x = (s - t_old[k]) / h[k]
-    y, dy = np.zeros(s.shape), np.zeros(s.shape)
-    c = coefs[k]
-    for i in range(c.shape[-2]):
-        w = x if i % 2 == 0 else 1 - x
-        y += c[..., i, 0]
-        y *= w
-        dy += c[..., i, 1]
-        dy *= w
-    return y + y_old[k, 0], dy + y_old[k, 1]
 
 
 @attrs.frozen

@@ -3,7 +3,7 @@ output times."""
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import RK45
+from .rktableau import RK45
 
 
 def rows_dot(M, K, out=None, tmp=None):
@@ -100,10 +100,6 @@ def dense_output(cls, rhs, K, t_old, h, y_old, y_new, f_new):
     Kf = K.reshape(nk, d * k)
     if cls is RK45:
         return Dense("RK45", t_old, h, y_old, rows_dot(cls.P.T, Kf[: cls.n_stages + 1]).reshape(-1, d, k))
-    from scipy.integrate._ivp import (
-        dop853_coefficients as dc,  # INTERPOLATOR_POWER only
-    )
-
     s0 = cls.n_stages + 1
     for j, (a, c) in enumerate(zip(cls.A_EXTRA, cls.C_EXTRA)):
         s = s0 + j
@@ -111,7 +107,7 @@ def dense_output(cls, rhs, K, t_old, h, y_old, y_new, f_new):
         dy *= h
         dy += y_old
         K[s] = rhs(t_old + c * h, dy)
-    Fc = np.empty((dc.INTERPOLATOR_POWER, d, k))
+    Fc = np.empty((3 + len(cls.D), d, k))  # DOP853's interpolant: 7 coefficient rows
     dyv = np.subtract(y_new, y_old, out=Fc[0])
     np.multiply(K[0], h, out=Fc[1])
     Fc[1] -= dyv

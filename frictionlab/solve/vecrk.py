@@ -5,19 +5,18 @@ step size and step control, exactly as scipy's RK45/DOP853 would take them alone
 iteration advances every unfinished problem by one step attempt with array operations over
 the batch. Output at requested times comes from each method's dense output, and a terminal
 event g(t, y) = 0 (crossing from g > 0 to g <= 0) is located per problem on the dense output.
-The Butcher tableaus are scipy's (``scipy.integrate.RK45`` and ``DOP853`` class attributes),
-so the same tolerances mean the same local error control. Stage combinations add the nonzero terms
-in order (not BLAS or einsum, whose order depends on the batch's size), so a problem's numbers do
-not depend on the other problems in its batch. With one output grid for all problems, each step's
+The Butcher tableaus are the published ones (``rktableau``: Dormand-Prince 5(4) and Hairer's DOP853, the
+numbers scipy's RK45 and DOP853 take), so the same tolerances mean the same local error control. Stage
+combinations add the nonzero terms in order (not BLAS or einsum, whose order depends on the batch's size), so a
+problem's numbers do not depend on the other problems in its batch. With one output grid for all problems, each step's
 outputs are one padded block of dense-output evaluations. Knows nothing about friction.
 """
 from __future__ import annotations
 
 import attrs
 import numpy as np
-from scipy.integrate import DOP853, RK45
-
 from ..core.errors import SolverError
+from .rktableau import DOP853, RK45
 from .vecdense import dense_output, fill_at_start, fill_dense, has_outputs, rows_dot, vec_dot
 
 METHODS = ("RK45", "DOP853")
@@ -255,7 +254,8 @@ def _error_norm(cls, errs, h, scale):
 
 
 def _initial_step(rhs, t0, y0, f0, span, order, rtol, atol):
-    """scipy's select_initial_step (Hairer, Norsett and Wanner, II.4), per problem."""
+    """The starting step of Hairer, Norsett and Wanner (Solving ODEs I, section II.4; scipy's solvers start the
+    same way), per problem."""
     scale = atol + np.abs(y0) * rtol
     d0, d1 = _rms(y0 / scale), _rms(f0 / scale)
     h0 = np.where((d0 < 1e-5) | (d1 < 1e-5), 1e-6, 0.01 * d0 / np.where(d1 > 0, d1, 1.0))

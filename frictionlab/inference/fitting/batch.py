@@ -11,7 +11,8 @@ impacts in one batch) of every running row's trial point and its forward-differe
 ``best_start(model, starts)`` runs a fit's starts the same way (``fitmodel._search``).
 
 The problem is the one ``fitting.fit`` poses (``replicates.refit``): the same parameter slots, scales and bounds
-(``fitmodel._law_slots``), lmfit's bounded coordinates (MINUIT's transformation, as ``levmar``), lmfit's
+(``fitmodel._law_slots``), MINUIT's bounded coordinates (F. James, MINUIT reference manual, CERN D506, 1994,
+"parameter limits"; lmfit bounds its parameters the same way), lmfit's
 forward-difference steps (relative sqrt(1e-10)), the chi-square at the dataset's sigma; Nielsen's damping. Each row
 stops where the Gauss-Newton step promises a fall in chi-square below ``FTOL`` of it, or a step is refused whose
 promise is below ``RESOLVED`` of it, or its step is below ``XTOL`` of its values, or no damped step lowers it:
@@ -31,7 +32,7 @@ import numpy as np
 
 from ...core.errors import FrictionLabError
 from ...physics.registry import is_third_party
-from .levmar import TINY, lmfit_bound
+from .lsrefit import lmfit_bound
 from .predict import predict_array
 
 FTOL = 1e-9  # relative fall in chi-square a Gauss-Newton step may still promise at a row's minimum
@@ -41,6 +42,7 @@ MAX_STEPS = 100  # Levenberg-Marquardt steps per row before it is handed back (n
 STEP = math.sqrt(1e-10)  # lmfit's relative forward-difference step (epsfcn 1e-10)
 LAMBDA0, LAMBDA_MAX = 1e-3, 1e12  # Marquardt's damping at the start; past this no step lowers chi-square
 XTOL = 1e-10  # relative step of the internal values below which a row stops
+TINY = 1.0e-15  # an internal coordinate closer to 0 than this is 0
 RESOLVED = 1e-8  # a refused step whose Gauss-Newton promise is below this fraction of chi-square ends the row: the
 # promise is then within what forward differences of relative step STEP resolve (a hundredth of fitmodel.FTOL)
 
@@ -98,7 +100,8 @@ class Problem:
         return out
 
     def internal(self, X: np.ndarray) -> np.ndarray:
-        """lmfit's ``setup_bounds`` per column (``levmar.Param.internal``), values clipped into the bounds first."""
+        """MINUIT's internal coordinates per column (arcsin for two bounds, sqrt for one), values clipped into the
+        bounds first."""
         lo, hi = self.lo, self.hi
         X = np.clip(X, lo, hi)
         both, upper_only, lower_only = (np.isfinite(lo) & np.isfinite(hi)), np.isinf(lo) & np.isfinite(hi), \
@@ -110,7 +113,7 @@ class Problem:
         return np.where(np.abs(U) < TINY, 0.0, U)
 
     def external(self, U: np.ndarray) -> np.ndarray:
-        """lmfit's ``from_internal`` per column (``levmar.Param.external``)."""
+        """MINUIT's external values per column (the inverse of ``internal``)."""
         lo, hi = self.lo, self.hi
         both, upper_only, lower_only = (np.isfinite(lo) & np.isfinite(hi)), np.isinf(lo) & np.isfinite(hi), \
             np.isfinite(lo) & np.isinf(hi)

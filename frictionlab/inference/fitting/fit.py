@@ -44,7 +44,7 @@ from ...core.errors import DatasetError, FrictionLabError, ParameterError
 from ...core.units import as_range, as_si
 from ...core.workers import beat
 from ...physics.registry import get_law
-from . import levmar
+from . import lsrefit
 from .model import (FTOL, ODE_STARTS, PENALTY, FitTimeout, _alarm, _law_slots, _Model, _scene_slots,
                        _search, _si, lmfit_leastsq)
 from .result import DatasetFit, FitResult, ParamResult, Stats
@@ -289,7 +289,7 @@ def _polished(lmfit, law, model, slots, found, scale_covar: bool, timeout):
     budget = 200 * (len(varying) + 1)
     try:
         with _alarm(timeout):
-            params = levmar.lmfit_parameters(best_params).copy()
+            params = lsrefit.lmfit_parameters(best_params).copy()
             for s in held:
                 params[s.pname].set(vary=False)
             first = lmfit_leastsq(lmfit, model, slots, params, scale_covar, budget)
@@ -383,12 +383,12 @@ def _solvers(law, targets, solver: str, rtol) -> list[str] | str:
 
 
 def _parameters(lmfit, slots, checks: bool):
-    """The optimizer's parameters (values / scale): levmar's light ones for replicate refits, lmfit's
+    """The optimizer's parameters (values / scale): ``lsrefit``'s light ones for replicate refits, lmfit's
     own (and its error where the bounds are no interval) otherwise."""
-    bounds = [(levmar.lmfit_bound(s.lower, s) / s.scale, levmar.lmfit_bound(s.upper, s) / s.scale) for s in slots]
+    bounds = [(lsrefit.lmfit_bound(s.lower, s) / s.scale, lsrefit.lmfit_bound(s.upper, s) / s.scale) for s in slots]
     if not checks and all(lo < hi and (math.isinf(lo) or math.isinf(hi) or hi - lo > 1e-13 + 1e-13 * abs(hi))
                           for lo, hi in bounds):  # an interval lmfit accepts
-        return {s.pname: levmar.Param(s.pname, s.value / s.scale, lo, hi, s.vary) for s, (lo, hi) in zip(slots, bounds)}
+        return {s.pname: lsrefit.Param(s.pname, s.value / s.scale, lo, hi, s.vary) for s, (lo, hi) in zip(slots, bounds)}
     params = lmfit.Parameters()
     for s, (lo, hi) in zip(slots, bounds):
         params.add(s.pname, value=s.value / s.scale, vary=s.vary, min=lo, max=hi)

@@ -15,7 +15,7 @@ import numpy as np
 
 from ...core.errors import FrictionLabError, ParameterError, SolverError
 from ...physics.freeable import SCENE_SHOWN
-from . import levmar
+from . import lsrefit
 from .predict import (
     SCENE_QUANTITIES,
     SkipDataset,
@@ -192,6 +192,7 @@ class _Model:
         self.nfev = 0
         self._last = None  # (values, models, residual) of the last evaluation that solved every target
         self.progress = None  # fitprogress.FitProgress, told of every evaluation
+        self._compiled_memory = None  # compiled_memory(self), worked out once
 
     def split(self, values: Mapping[str, float]):
         """Per-target law parameters and scenes for SI slot values (by lmfit name)."""
@@ -419,8 +420,8 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
             direct: bool = False, values_only: bool = False):
     """Score a grid of starts, refine the best distinct ones with Levenberg-Marquardt, keep the lowest
     chi-square. Returns (parameters, success, message, lmfit MinimizerResult or None, notes). scale_covar:
-    scale lmfit's error bars by sqrt(reduced chi2) (only when sigma is not known). direct: run lmfit's
-    Levenberg-Marquardt through ``levmar.leastsq`` (the same numbers without lmfit's bookkeeping; its
+    scale lmfit's error bars by sqrt(reduced chi2) (only when sigma is not known). direct: refit through
+    ``lsrefit.leastsq`` (scipy's bounded least squares from the warm start, without lmfit's bookkeeping; its
     result is not a MinimizerResult), lmfit itself where that declines. Closed forms run every start in one batch
     (``batchfit.best_start``) and Levenberg-Marquardt from the lowest end only; with values_only (direct, and the
     caller reads values and chi-square only: a replicate refit) that end is the answer."""
@@ -465,7 +466,7 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
         if moved is not None and values_only and direct:
             for k, v in moved[0].items():
                 params[k].set(value=v)
-            return params, True, "Fit succeeded.", levmar.Result(params, True, "Fit succeeded.", moved[1]), []
+            return params, True, "Fit succeeded.", lsrefit.Result(params, True, "Fit succeeded.", moved[1]), []
         if moved is not None:  # lmfit's own run from the lowest end, for its error analysis
             starts = [moved[0]]
     best, notes = None, []
@@ -478,12 +479,12 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
         r = None
         if direct:
             before = model.nfev, model.failures, model.last_error, model._last
-            r = levmar.leastsq(lambda v: model.residual({s.pname: v[s.pname] * s.scale for s in slots}), params,
+            r = lsrefit.leastsq(lambda v: model.residual({s.pname: v[s.pname] * s.scale for s in slots}), params,
                                scale_covar, budget, epsfcn=epsfcn(model), ftol=FTOL, xtol=FTOL)
             if r is None:  # lmfit takes another path here: run it, from the same state of the model
                 model.nfev, model.failures, model.last_error, model._last = before
         if r is None:
-            r = lmfit_leastsq(lmfit, model, slots, levmar.lmfit_parameters(params), scale_covar, budget)
+            r = lmfit_leastsq(lmfit, model, slots, lsrefit.lmfit_parameters(params), scale_covar, budget)
         if best is None or (r.success, -r.chisqr) > (best.success, -best.chisqr):
             best = r
         why = _valley(r) if slow and r.success and i + 1 < len(starts) else ""
@@ -536,7 +537,7 @@ def _tighter(lmfit, model: _Model, slots, best, scale_covar: bool, budget: int):
         return best
     finally:
         model.rtol, model._last = rtol, None
-    params = levmar.lmfit_parameters(best.params).copy()
+    params = lsrefit.lmfit_parameters(best.params).copy()
     for s, v in zip(varying, x):
         params[s.pname].set(value=v)
     r = lmfit_leastsq(lmfit, model, slots, params, scale_covar, budget)

@@ -8,7 +8,6 @@ import threading
 import numpy as np
 
 from ...core.errors import FrictionLabError
-from . import ticks
 
 LAW_COLORS = {"coulomb": "#7f7f7f", "area-rate": "#d95f02", "wear": "#1b9e77", "couette": "#7570b3"}
 EXTRA_COLORS = ["#e7298a", "#66a61e", "#e6ab02", "#a6761d", "#1f78b4"]
@@ -23,19 +22,20 @@ def _plt():
     return pyplot()
 
 
-def _png(fig) -> bytes:
-    """The figure as PNG bytes at DPI, drawn once: the report's figures are placed by ``margins`` (a layout
-    engine, or bbox_inches="tight", would draw the whole figure once more to measure it). RGB (``png``): on the
-    figures' opaque background the alpha channel is 255 everywhere."""
-    from .png import png
+#: zlib's level for the report's PNGs (Pillow's ``compress_level``): level 6 takes about twice the CPU for a
+#: tenth fewer bytes on these flat-coloured figures.
+PNG_LEVEL = 3
 
+
+def _png(fig) -> bytes:
+    """The figure as PNG bytes at DPI, drawn once by matplotlib's ``savefig`` (Pillow writes the file): the report's
+    figures are placed by ``margins`` (a layout engine, or bbox_inches="tight", would draw the whole figure once
+    more to measure it). No software stamp, so the bytes do not depend on the matplotlib version's name."""
     fig.set_dpi(DPI)
     raw = io.BytesIO()
-    with ticks.same(fig):
-        fig.savefig(raw, format="rgba", dpi=DPI)
-    w, h = fig.canvas.get_width_height()
+    fig.savefig(raw, format="png", dpi=DPI, metadata={"Software": None}, pil_kwargs={"compress_level": PNG_LEVEL})
     _plt().close(fig)
-    return png(np.frombuffer(raw.getbuffer(), dtype=np.uint8).reshape(h, w, 4)[:, :, :3], DPI)
+    return raw.getvalue()
 
 
 #: Per thread, the figure each kind of figure last drew on, by layout (``subplots``); at most KEEP of them.
@@ -72,14 +72,13 @@ def canvas(key, figsize: tuple[float, float], build):
 
 
 def figure(figsize: tuple[float, float]):
-    """A new matplotlib Figure of ``figsize`` inches, outside pyplot, drawn by ``agg.Canvas`` (not kept)."""
+    """A new matplotlib Figure of ``figsize`` inches, outside pyplot, on an Agg canvas (not kept)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     _plt()  # rcParams as every report figure has them (mathtext off)
-    from .agg import Canvas
-
     fig = Figure(figsize=figsize)
-    Canvas(fig)
+    FigureCanvasAgg(fig)
     return fig
 
 
@@ -110,11 +109,7 @@ def _emptied(fig) -> None:
 
 
 def release() -> None:
-    """Let go of this thread's kept figures (``subplots``, ``canvas``), their text measures (``agg``) and
-    trajectories (``trajectory``)."""
-    from . import agg
-
-    agg.release()
+    """Let go of this thread's kept figures (``subplots``, ``canvas``) and trajectories (``trajectory``)."""
     _KEPT.__dict__.pop("figures", None)
     _KEPT.__dict__.pop("trajectories", None)
 
@@ -192,13 +187,12 @@ def yaxes_in(fig) -> list[tuple[int, float, float]]:
     takes (ticks, tick labels and label; above, an offset text such as '1e8')."""
     renderer = fig.canvas.get_renderer()
     out = []
-    with ticks.same(fig):
-        for ax in fig.axes:
-            if ax.get_visible() and ax.axison and ax.get_subplotspec() is not None:
-                box, axes = ax.yaxis.get_tightbbox(renderer), ax.get_window_extent(renderer)
-                if box is not None:
-                    out.append((ax.get_subplotspec().rowspan.start, max(0.0, axes.x0 - box.x0) / fig.dpi,
-                                max(0.0, box.y1 - axes.y1) / fig.dpi))
+    for ax in fig.axes:
+        if ax.get_visible() and ax.axison and ax.get_subplotspec() is not None:
+            box, axes = ax.yaxis.get_tightbbox(renderer), ax.get_window_extent(renderer)
+            if box is not None:
+                out.append((ax.get_subplotspec().rowspan.start, max(0.0, axes.x0 - box.x0) / fig.dpi,
+                            max(0.0, box.y1 - axes.y1) / fig.dpi))
     return out
 
 
@@ -281,43 +275,6 @@ def draw_fit(ax, f, obs: str, t, tf: float, uf: float, label: str, **style):
         ax.plot(tr.t * tf, tr[obs] * uf, label=label, zorder=3, **style)
     except FrictionLabError:
         ax.plot(t * tf, d.model * uf, label=label, zorder=3, **style)
-
-
-def errorbar(ax, x, y, yerr, **kw):
-    """``ax.errorbar(x, y, yerr=yerr, **kw)``, its error bars built from plain arrays: matplotlib's ``vlines``
-    combines its inputs into masked arrays and makes each bar's path from a masked row, which costs more than
-    drawing it; for finite floats on rectilinear axes ``_vlines`` makes the same collection (the same paths, style
-    and data limits) from the plain rows. Anything else takes matplotlib's own way."""
-    x, y, yerr = (np.asarray(a, dtype=float) for a in (x, y, yerr))
-    plain = ax.name == "rectilinear" and all(np.all(np.isfinite(a)) for a in (x, y, yerr))
-    if plain:
-        ax.vlines = lambda *a, **k: _vlines(ax, *a, **k)  # what errorbar calls for its bars, on this axes only
-    try:
-        return ax.errorbar(x, y, yerr=yerr, **kw)
-    finally:
-        if plain:
-            del ax.vlines
-
-
-def _vlines(ax, x, ymin, ymax, colors=None, linestyles="solid", label="", **kw):
-    """``Axes.vlines`` for finite float arrays on rectilinear axes (what ``errorbar`` passes it), without its
-    masked arrays: one LineCollection of the segments (x, ymin)-(x, ymax), the axes' data limits taken from it."""
-    from matplotlib.collections import LineCollection
-
-    x, ymin, ymax = (np.ravel(np.asarray(a, dtype=float)) for a in (x, ymin, ymax))
-    verts = np.empty((len(x), 2, 2))
-    verts[:, 0, 0], verts[:, 0, 1], verts[:, 1, 0], verts[:, 1, 1] = x, ymin, x, ymax
-    lines = LineCollection(verts, colors=colors, linestyles=linestyles, label=label)
-    ax.add_collection(lines, autolim=False)
-    lines._internal_update(kw)
-    if len(x):
-        lim = lines.get_datalim(ax.transData)
-        t = lines.get_transform()  # the method's name before matplotlib 3.11: contains_branch_seperately
-        updatex, updatey = (getattr(t, "contains_branch_separately", None) or t.contains_branch_seperately)(ax.transData)
-        ax.update_datalim(((np.nanmin(lim.xmin), np.nanmin(lim.ymin)), (np.nanmax(lim.xmax), np.nanmax(lim.ymax))),
-                          updatex, updatey)
-        ax._request_autoscale_view()
-    return lines
 
 
 #: Points of a series beyond which a figure draws a thinned copy (``thinned``): at the report's figure widths

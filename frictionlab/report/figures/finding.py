@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...core.display import NAMES, time_unit, unit
-from . import base, ticks
+from . import base
 
 
 #: panels side by side in one row of the first screen's figure (five fill the page's width)
@@ -89,8 +89,7 @@ def _place(fig, panels, axw, axh, slip_h, under, title) -> None:
         return (max(0.0, box.x0 - tight.x0) / dpi, max(0.0, tight.x1 - box.x1) / dpi,
                 max(0.0, tight.y1 - box.y1) / dpi, max(0.0, box.y0 - tight.y0) / dpi)
 
-    with ticks.same(fig):
-        rooms = {id(a): room(a) for _, _, ax, ax_s in panels for a in (ax, ax_s) if a is not None and a.axison}
+    rooms = {id(a): room(a) for _, _, ax, ax_s in panels for a in (ax, ax_s) if a is not None and a.axison}
     zero = (0.0, 0.0, 0.0, 0.0)
     ncols, nrows = max(j for _, j, _, _ in panels) + 1, max(r for r, _, _, _ in panels) + 1
     left = [max((rooms.get(id(a), zero)[0] for _, j, ax, ax_s in panels if j == c for a in (ax, ax_s) if a), default=0)
@@ -158,7 +157,7 @@ def _against_time(ax, d, target, curves) -> str:
         uname, uf = unit(obs)
         y, sigma = target.y, np.broadcast_to(target.sigma, target.y.shape)
         k = base.thinned(target.t, y, y - sigma, y + sigma)  # a long record: what its pixels show
-        base.errorbar(ax, target.t[k] * tf, y[k] * uf, sigma[k] * uf, fmt="o", ms=3, color="black",
+        ax.errorbar(target.t[k] * tf, y[k] * uf, yerr=sigma[k] * uf, fmt="o", ms=3, color="black",
                       ecolor="0.75", elinewidth=0.7, label=f"data ({d.provenance.kind})", zorder=1)
     for f, label, style in curves:
         base.draw_fit(ax, f, obs, d.t, tf, uf, label, **style)

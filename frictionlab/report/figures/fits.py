@@ -32,7 +32,7 @@ def fit_figure(dataset, fits, rows) -> bytes:
     visible = base.visible_curves(curves, float(np.ptp(y)))
     sigma = np.broadcast_to(sigma, t.shape)
     k = base.thinned(t, y, y - sigma, y + sigma, *(f.per_dataset[0].residual for f, _, _ in visible))  # a long record
-    base.errorbar(ax, t[k] * tf, y[k] * uf, sigma[k] * uf, fmt="o", ms=3.2, color="black", ecolor="0.7", elinewidth=0.8,
+    ax.errorbar(t[k] * tf, y[k] * uf, yerr=sigma[k] * uf, fmt="o", ms=3.2, color="black", ecolor="0.7", elinewidth=0.8,
                   label=f"data ({kind})" + (f", {target.derivation}" if curves and target.derivation else ""), zorder=1)
     for i, (f, laws, hidden) in enumerate(visible):
         d = f.per_dataset[0]

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...core.display import plain_log
-from . import base, ticks
+from . import base
 
 
 def ranking_figure(rows, alias: dict | None = None) -> bytes:
@@ -56,9 +56,8 @@ def _place(fig, ax, cax, heat: tuple[float, float], top: float) -> None:
     measure: the candidates left, the slanted dataset names below (and left of the first), the colour bar right."""
     for _ in range(2):  # measured where placed: the slanted names' reach to the left depends on the cell width
         r = fig.canvas.get_renderer()
-        with ticks.same(fig):
-            box, names, bar = ax.get_window_extent(r), ax.xaxis.get_tightbbox(r), cax.yaxis.get_tightbbox(r)
-            left = max([(box.x0 - names.x0) / fig.dpi] + [side for _, side, _ in base.yaxes_in(fig)]) + base.EDGE
+        box, names, bar = ax.get_window_extent(r), ax.xaxis.get_tightbbox(r), cax.yaxis.get_tightbbox(r)
+        left = max([(box.x0 - names.x0) / fig.dpi] + [side for _, side, _ in base.yaxes_in(fig)]) + base.EDGE
         bottom = (box.y0 - names.y0) / fig.dpi + base.EDGE
         right = CBAR + (bar.x1 - cax.get_window_extent(r).x1) / fig.dpi + base.EDGE
         fig.set_size_inches(left + heat[0] + right, top + heat[1] + bottom)
