@@ -69,4 +69,8 @@ def screen(title: str, steps: list[dict], results, answer: str, joint_note: str 
         if r.joint is not None and r.joint.ok and r.joint.velstep is not None:
             said += [f"  whole record, {_law(r.law)}: {t}" for t in r.joint.velstep.bounds]
     out += ["", "Parameters at a bound, and what it means:"] + (said or ["  none"])
+    missed = [f"  {s['name']}, {_law(r.law)}: {t}" for r in results for s, f in zip(steps, r.steps)
+              for t in (f.velstep.missing if f.ok and f.velstep else ())]
+    if missed:
+        out += ["", "What the data show that a law misses:"] + missed
     return out
