@@ -17,7 +17,7 @@ _EXPORTS = {
     "Comparison": "pipeline.comparison", "compare": "pipeline.comparison",
     "Dataset": "io.dataset", "load_dataset": "io.dataset",
     "derive_omega": "physics.derive",
-    "EquivalenceResult": "inference.equivalence.discrimination", "analyze_equivalence": "inference.equivalence.discrimination",
+    "EquivalenceResult": "inference.equivalence.result", "analyze_equivalence": "inference.equivalence.discrimination",
     "FrictionLabError": "core.errors",
     "FitResult": "inference.fitting.fit", "ParamResult": "inference.fitting.fit", "Target": "inference.fitting.fit",
     "fit": "inference.fitting.fit", "make_target": "inference.fitting.fit", "predict": "inference.fitting.fit",

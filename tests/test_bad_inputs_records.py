@@ -22,9 +22,10 @@ from frictionlab.io import external
 
 from test_bad_inputs import ERROR_LINE, snapshot
 
-CASES = tomllib.loads((Path(__file__).parent / "bad_inputs" / "records.toml").read_text(encoding="utf-8"))["case"]
+CASES = [case for name in ("records.toml", "records_shapes.toml")
+         for case in tomllib.loads((Path(__file__).parent / "bad_inputs" / name).read_text(encoding="utf-8"))["case"]]
 CLASSES = ("raw", "options", "cache")
-FIELDS = {"id", "class", "sees", "record", "lines", "text", "text_python", "encoding", "fifo", "rename", "files",
+FIELDS = {"id", "class", "sees", "record", "lines", "text", "text_python", "encoding", "sep", "fifo", "rename", "files",
           "prime", "mutate", "env", "nopasswd", "tmpfs", "argv", "status", "error", "stdout", "stderr", "never",
           "written", "absent", "unchanged", "empty", "no_files_below"}
 HEADER = "Time(s)\tDispl(microns)\tFriction\tEffectiveNormalstress(MPa)"
@@ -37,15 +38,18 @@ def params():
 
 
 def write_record(case: dict, path: Path) -> None:
-    """The case's record in the raw format (four tab-separated columns under the usual header)."""
+    """The case's record in the raw format (four columns under the usual header, separated by ``sep``: a tab
+    unless the case says otherwise), in the case's ``encoding`` (UTF-8 unless it says otherwise)."""
     if "text" in case:
         path.write_bytes(case["text"].encode(case.get("encoding", "utf-8")))
         return
     rng = np.random.default_rng(0)
-    if "text_python" in case:
-        space = {}
+    space = {}
+    if "text_python" in case:  # t and x; optionally noise (um, default 0.05), quantum (um), mu, sn, fmt, header
         exec(case["text_python"], space)
-        t, x = space["t"], space["x"] + rng.normal(0, 0.05, space["t"].size)
+        t, x = space["t"], space["x"] + rng.normal(0, space.get("noise", 0.05), space["t"].size)
+        if "quantum" in space:
+            x = np.round(x / space["quantum"]) * space["quantum"]
     else:
         r = case["record"]
         n, dt = r["rows"], r["dt"]
@@ -58,12 +62,14 @@ def write_record(case: dict, path: Path) -> None:
         for when, size in r.get("jumps", []):
             x[t >= when] += size
     mu, sn = 0.6 + rng.normal(0, 5e-4, t.size), 30 + rng.normal(0, 0.01, t.size)
-    body = "\n".join(f"{a:.10g}\t{b:.6f}\t{c:.6f}\t{d:.6f}" for a, b, c, d in zip(t.tolist(), x.tolist(), mu.tolist(),
-                                                                                  sn.tolist()))
-    lines = [HEADER] + body.split("\n")
+    mu, sn = np.broadcast_to(space.get("mu", mu), t.shape), np.broadcast_to(space.get("sn", sn), t.shape)
+    sep, fx = case.get("sep", "\t"), space.get("fmt", "%.6f")
+    body = "\n".join(f"{a:.10g}{sep}{fx % b}{sep}{c:.6f}{sep}{d:.6f}" for a, b, c, d in zip(t.tolist(), x.tolist(),
+                                                                                         mu.tolist(), sn.tolist()))
+    lines = [space.get("header", HEADER).replace("\t", sep)] + body.split("\n")
     for no, text in case.get("lines", []):
         lines[no - 1] = text
-    path.write_text("\n".join(lines) + "\n")
+    path.write_bytes(("\n".join(lines) + "\n").encode(case.get("encoding", "utf-8")))
 
 
 @pytest.fixture

@@ -1,5 +1,5 @@
 """The default laws of ``compare`` are chosen by dataset kind: the seed paper's four on impacts and inclines,
-rate-and-state (aging and slip) on spring-slider velocity steps; named laws go to every dataset as before."""
+rate-and-state (aging, slip, PRZ) on spring-slider velocity steps; named laws go to every dataset as before."""
 from __future__ import annotations
 
 from types import SimpleNamespace
@@ -10,7 +10,7 @@ from frictionlab.pipeline.planning import plan_fits
 from frictionlab.pipeline.settings import DEFAULT_LAWS, Settings, default_laws_by_kind
 from frictionlab.report.summary import _laws_text
 
-RS = ("rate-state-aging", "rate-state-slip")
+RS = ("rate-state-aging", "rate-state-slip", "rate-state-prz")
 
 
 def test_the_default_laws_of_each_kind():
@@ -39,9 +39,9 @@ def test_the_command_line_and_the_report_say_which_laws_went_to_which_kind():
     c = SimpleNamespace(options=s, settings=s.as_dict(), laws=s.laws,
                         datasets=[SimpleNamespace(kind=k) for k in ("impact", "incline", "spring-slider")])
     assert laws_lines(c) == ["laws by dataset kind (the default): coulomb, area-rate, wear, couette on impact, "
-                             "incline; rate-state-aging, rate-state-slip on spring-slider"]
+                             "incline; rate-state-aging, rate-state-slip, rate-state-prz on spring-slider"]
     assert _laws_text(c) == ("coulomb, area-rate, wear, couette on impact, incline datasets; rate-state-aging, "
-                             "rate-state-slip on spring-slider datasets")
+                             "rate-state-slip, rate-state-prz on spring-slider datasets")
     named = SimpleNamespace(options=Settings(laws=("coulomb",)), settings={}, laws=("coulomb",), datasets=c.datasets)
     assert laws_lines(named) == [] and _laws_text(named) == "coulomb"
 

@@ -22,6 +22,7 @@ DOCS = ROOT / "docs"
 BLOCK = re.compile(r"^<!-- runnable(?::\s*file=(?P<file>[\w.-]+))?\s*-->\n```(?P<lang>[\w-]+)[^\n]*\n(?P<code>.*?)^```\s*$",
                    re.M | re.S)
 TIMEOUT = 300  # seconds a block may take on a loaded 2-core machine
+BUILD_TIMEOUT = 1500  # seconds the site's build may take there: it runs the gallery's examples
 
 
 def pages() -> list[Path]:
@@ -104,10 +105,44 @@ def test_the_site_builds_in_strict_mode(tmp_path):
     pytest.importorskip("mkdocs", reason="the docs tools are in the test extra: pip install -e '.[test]'")
     pytest.importorskip("mkdocstrings", reason="the docs tools are in the test extra: pip install -e '.[test]'")
     out = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(tmp_path / "site")],
-                         cwd=ROOT, env=_env(), capture_output=True, text=True, timeout=TIMEOUT)
+                         cwd=ROOT, env=_env(), capture_output=True, text=True, timeout=BUILD_TIMEOUT)
     assert out.returncode == 0, out.stderr[-5000:]
     assert "WARNING" not in out.stderr
     index = (tmp_path / "site" / "index.html").read_text(encoding="utf-8")
     assert "frictionlab" in index
     api = (tmp_path / "site" / "api" / "results" / "index.html").read_text(encoding="utf-8")
     assert "fit" in api and "Fit every law to every dataset" in api  # rendered from the docstrings
+
+
+def _gallery():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("docs_gallery", ROOT / "tools" / "docs_gallery.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_gallery_has_its_examples():
+    gallery = _gallery()
+    names = [p.stem for p in gallery.examples()]
+    assert len(names) >= 8 and names[: len(gallery.ORDER)] == list(gallery.ORDER)
+    for script in gallery.examples():
+        doc, cells = gallery.split_cells(script.read_text(encoding="utf-8"))
+        assert doc.startswith("# ") and len(cells) >= 2, script.name  # a title, then text and code cells
+
+
+def test_a_gallery_example_runs_cell_by_cell_and_a_failing_one_fails(tmp_path):
+    gallery = _gallery()
+    good = tmp_path / "good.py"
+    good.write_text('"""# Good\n\nText."""\n\n# %%\n# First.\nimport matplotlib.pyplot as plt\nprint("one")\n'
+                    "plt.plot([0, 1])\n\n# %%\n# Second.\nprint('two')\n", encoding="utf-8")
+    results = gallery.run_example(good, tmp_path / "out")
+    assert [r["stdout"] for r in results] == ["one\n", "two\n"]
+    assert results[0]["figures"] and (tmp_path / "out" / results[0]["figures"][0]).stat().st_size > 0
+    page = gallery.page(good, results)
+    assert "# Good" in page and "print(\"one\")" in page and "```text\none\n```" in page
+    bad = tmp_path / "bad.py"
+    bad.write_text('"""# Bad"""\n\n# %%\nraise ValueError("this example is broken")\n', encoding="utf-8")
+    with pytest.raises(RuntimeError, match="this example is broken"):
+        gallery.run_example(bad, tmp_path / "out")

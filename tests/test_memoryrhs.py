@@ -15,7 +15,7 @@ from frictionlab.solve.solvers.stick import vanishing_slip
 pytestmark = pytest.mark.skipif(not available(), reason="numba does not import here: no compiled path")
 
 LAWS = {"lugre": dict(sigma1=0.01, sigma2=0.05), "dahl": dict(alpha=0.6), "rate-state-aging": {},
-        "rate-state-slip": {}}
+        "rate-state-slip": {}, "rate-state-prz": {}}
 
 
 def _slider(mass):
@@ -27,7 +27,7 @@ def _cases():
     for ds in ("incline-oil-a100", "incline-dry-d10", "impact-golf-v28"):
         for law in LAWS:
             yield law, fl.load_dataset(ds).scene
-    for law in ("rate-state-aging", "rate-state-slip"):
+    for law in ("rate-state-aging", "rate-state-slip", "rate-state-prz"):
         yield law, _slider(3.0)
 
 
@@ -72,6 +72,7 @@ def _general(monkeypatch):
     ("dahl", "incline-dry-d10", dict(mu_c=0.8, sigma=300.0, alpha=1.5)),  # more turns than MAX_TURNS: then mu_d
     ("rate-state-aging", "incline-oil-a100", dict(mu0=0.2)),  # stick events
     ("rate-state-slip", "impact-golf-v28", dict(mu0=0.2)),
+    ("rate-state-prz", "incline-oil-a100", dict(mu0=0.2)),
 ])
 def test_solves_agree_with_the_general_path_to_the_tolerance(monkeypatch, law, ds, p):
     d = fl.load_dataset(ds)

@@ -47,8 +47,10 @@ def test_akaike_weights_compare_the_candidates_that_fit_and_say_so():
 def test_groups_sum_aic_and_mark_incomplete_candidates():
     rows = _rank([row("d1", "a", 10.0), row("d1", "b", 14.0), row("d1", "a", 9.0, solver="series")], 0.01)
     rows += _rank([row("d2", "a", 5.0, solver="ode"), row("d2", "b", 4.0)], 0.01)
-    groups = rank_groups(rows, {"d1": "impact", "d2": "incline"})
-    allg = {(r.law, r.solver): r for r in groups if r.dataset == "ALL"}
+    assert rank_groups(rows, {"d1": "impact", "d2": "incline"}) == []  # nothing declared: no sum over datasets
+    assert rank_groups(rows, named={"d1": "d1", "d2": "d2"}) == []  # one-dataset groups: no second ranking
+    groups = rank_groups(rows, named={"d1": "pair", "d2": "pair"})  # a group the datasets declare
+    allg = {(r.law, r.solver): r for r in groups if r.dataset == "pair"}
     assert allg[("a", "exact+ode")].aic == pytest.approx(15.0)  # exact and ode count as one candidate
     assert allg[("b", "exact")].aic == pytest.approx(18.0)
     assert allg[("a", "exact+ode")].rank == 1 and allg[("b", "exact")].rank == 2

@@ -47,18 +47,19 @@ def test_sdirk4_coefficients_have_order_4_and_an_order_3_embedding():
     assert conditions(bhat)[:4] == [1, F(1, 2), F(1, 3), F(1, 6)] and conditions(bhat)[4] != F(1, 4)
 
 
-@pytest.mark.parametrize("law", [kernel.AGING, kernel.SLIP])
+@pytest.mark.parametrize("law", [kernel.AGING, kernel.SLIP, kernel.PRZ, kernel.NAGATA])
 def test_kernel_jacobian_and_parameter_derivatives_match_finite_differences(law):
-    p = dict(a=0.009, b=0.011, Dc=7.0, k=0.008, V1=3.0, vlp=10.0)
+    p = dict(a=0.009, b=0.011, Dc=7.0, k=0.008, c=2.0, V1=3.0, vlp=10.0)
     f, J, Fp = np.zeros(2), np.zeros((2, 2)), np.zeros((2, 4))
 
     def rates(m, psi, a=p["a"], b=p["b"], Dc=p["Dc"], k=p["k"]):
         out = np.zeros(2)
-        kernel.rates(law, a, b, Dc, k, p["V1"], p["vlp"], m, psi, out, np.zeros((2, 2)), np.zeros((2, 4)), False)
+        kernel.rates(law, a, b, Dc, k, p["c"], p["V1"], p["vlp"], m, psi, out, np.zeros((2, 2)), np.zeros((2, 4)),
+                     False)
         return out
 
     y = (0.004, -0.3)
-    kernel.rates(law, p["a"], p["b"], p["Dc"], p["k"], p["V1"], p["vlp"], *y, f, J, Fp, True)
+    kernel.rates(law, p["a"], p["b"], p["Dc"], p["k"], p["c"], p["V1"], p["vlp"], *y, f, J, Fp, True)
     h = 1e-7
     for j in range(2):
         e = np.eye(2)[j] * h
@@ -68,22 +69,26 @@ def test_kernel_jacobian_and_parameter_derivatives_match_finite_differences(law)
         hh = 1e-6 * p[name]
         up, dn = rates(*y, **{name: p[name] + hh}), rates(*y, **{name: p[name] - hh})
         assert Fp[:, j] == pytest.approx((up - dn) / (2 * hh), rel=1e-5, abs=1e-9)
-    assert quasistatic.LAWS == {"rate-state-aging": kernel.AGING, "rate-state-slip": kernel.SLIP}
+    assert quasistatic.LAWS == {"rate-state-aging": kernel.AGING, "rate-state-slip": kernel.SLIP,
+                                "rate-state-prz": kernel.PRZ, "rate-state-nagata": kernel.NAGATA}
 
 
-@pytest.mark.parametrize("law", LAWS)
+@pytest.mark.parametrize("law", LAWS + ("rate-state-prz", "rate-state-nagata"))
 def test_sensitivities_are_the_derivatives_of_the_computed_solution(law):
     load = quasistatic.Load(np.array([0.0, 20.0]), np.array([3.0, 10.0]))
     t = np.linspace(0.0, 60.0, 1500)
     code = quasistatic.LAWS[law]
     p = np.array([0.009, 0.0095, 7.0, 0.008])
-    S = quasistatic.solve(code, *p, load, t, 1e-11, sensitivities=True).S
+    sol = quasistatic.solve(code, *p, load, t, 1e-11, sensitivities=True, c=1.5)
+    assert np.array_equal(sol.m, quasistatic.solve(code, *p, load, t, 1e-11, c=1.5).m)  # S does not steer the steps
+    S = sol.S
     for j in range(4):
         h = 1e-6 * p[j]
         up, dn = p.copy(), p.copy()
         up[j] += h
         dn[j] -= h
-        fd = (quasistatic.solve(code, *up, load, t, 1e-11).m - quasistatic.solve(code, *dn, load, t, 1e-11).m) / (2 * h)
+        fd = (quasistatic.solve(code, *up, load, t, 1e-11, c=1.5).m
+              - quasistatic.solve(code, *dn, load, t, 1e-11, c=1.5).m) / (2 * h)
         assert np.max(np.abs(S[:, j] - fd)) <= 1e-4 * np.max(np.abs(fd))
 
 
@@ -92,16 +97,18 @@ def _slider(times, velocities, k=2000.0, T=300.0):
                  spring=SpringLoad(k, times, velocities))
 
 
-@pytest.mark.parametrize("law", LAWS)
+@pytest.mark.parametrize("law", LAWS + ("rate-state-prz", "rate-state-nagata"))
 @pytest.mark.parametrize("schedule", [((0.0, 5.0, 25.0), (1e-6, 1e-5, 1e-6)), ((0.0, 50.0, 150.0), (1e-6, 0.0, 1e-6))],
                          ids=["steps", "slide-hold-slide"])
 def test_fast_path_integrates_as_the_general_plan(law, schedule):
-    """solver 'ode' (the quasi-static integrator) against 'ode:LSODA' (the general plan, numerical force partials):
-    friction, slip rate and state through velocity steps and a hold."""
+    """solver 'ode' (the quasi-static integrator) against 'ode:LSODA' (the general plan, numerical force partials;
+    Nagata's d mu/dt the spring's load rate from the scene): friction, slip rate and state through velocity steps
+    and a hold."""
     scene = _slider(*schedule)
     t = np.linspace(0.0, 300.0, 1201)
-    fast = fl.simulate(law, scene, RS, solver="ode", t=t)
-    general = fl.simulate(law, scene, RS, solver="ode:LSODA", t=t)
+    p = dict(RS, c=1.0) if law == "rate-state-nagata" else RS
+    fast = fl.simulate(law, scene, p, solver="ode", t=t)
+    general = fl.simulate(law, scene, p, solver="ode:LSODA", t=t)
     assert fast.solver == "ode" and general.solver == "ode:LSODA"
     assert np.max(np.abs(fast.load - general.load)) < 1e-8
     assert np.max(np.abs(fast.v - general.v) / np.maximum(general.v, 1e-12)) < 1e-5
@@ -234,7 +241,7 @@ def test_the_strengthening_refit_starts_where_the_bound_held_b(tmp_path):
     """The search keeps its grid points whose a, b fit ended with b held at 0, best first and distinct; a fit that
     ends with b inside its range and no such grid point runs no refit (from there the bound did not act)."""
     from frictionlab.inference.velstep import fit as velstep
-    from frictionlab.inference.velstep import result as velstep_result
+    from frictionlab.inference.velstep import missing as velstep_missing
 
     ds, _ = _measured_like(tmp_path)
     load = quasistatic.Load.of(ds.scene.spring)
@@ -253,7 +260,7 @@ def test_the_strengthening_refit_starts_where_the_bound_held_b(tmp_path):
     x = starts[0].copy()
     x[ib] = problem.params[ib].to_x(0.01)  # b inside its range: nothing to refit from
     before = problem.nfev
-    assert velstep_result._strengthening(problem, x) == "" and problem.nfev == before
+    assert velstep_missing._strengthening(problem, x) == "" and problem.nfev == before
 
 
 def test_bound_meanings_name_what_each_bound_says():

@@ -51,7 +51,7 @@ def test_import_finds_the_step_its_fitted_velocities_and_a_stiffness_start(tmp_p
 
 def test_the_dataset_keeps_the_contract_with_the_fit(tmp_path):
     """CSV t,x,mu with every sample; TOML spring-slider, mu, [scene.spring] times exact to the microsecond,
-    fitted velocities, [noise] estimated with AR(1) correlation and no sigma, provenance measured."""
+    fitted velocities, [noise] estimated with an AR(p) model chosen by the data and no sigma, provenance measured."""
     _record(tmp_path / "raw.txt")
     out = tmp_path / "out"
     out.mkdir()
@@ -59,7 +59,7 @@ def test_the_dataset_keeps_the_contract_with_the_fit(tmp_path):
                  "--license", "MIT", "--citation", "nobody"]) == 0
     meta = tomllib.loads((out / "vs.toml").read_text())
     assert meta["kind"] == "spring-slider" and meta["observable"] == "mu"
-    assert meta["noise"] == {"kind": "estimated", "correlation": "ar1"}
+    assert meta["noise"] == {"kind": "estimated", "correlation": "arp"}
     assert "trend" not in (out / "vs.toml").read_text().split("[provenance]")[0]
     spring = meta["scene"]["spring"]
     assert spring["times"][0] == "0 s" and spring["stiffness"].endswith(" 1/um")

@@ -90,7 +90,7 @@ def test_group_totals_are_sums_over_the_separately_fitted_members():
                        ll + k * math.log(n), likelihood="known", neg2loglik=ll, k_lik=k)
 
     rows = _rank([row("d1", 10.0, 1, 20)], 0.01) + _rank([row("d2", -4.0, 2, 30)], 0.01)
-    g = next(r for r in rank_groups(rows) if r.dataset == "ALL")
+    g = next(r for r in rank_groups(rows, named={"d1": "g", "d2": "g"}) if r.dataset == "g")
     assert g.aic == pytest.approx(6.0 + 2 * 3)
     # separate fits: AICc and BIC are sums over the members, each with its own n and k (not the pooled n, k)
     assert g.aicc == pytest.approx((12.0 + 2 * 1 * 2 / 18) + (0.0 + 2 * 2 * 3 / 27))

@@ -12,13 +12,14 @@ def add_parser(sub):
     from ..cli import subcommand
     from ..io.template import KINDS
 
-    p = subcommand(sub, "datasets", help="list, show, start (template) or rebuild datasets",
+    p = subcommand(sub, "datasets", help="list, show, import (raw laboratory records), template (start your own) or rebuild datasets",
                    description="Datasets are a CSV of columns plus a TOML of the same name that gives units, noise, "
                                "the scene and the provenance. 'datasets template KIND' writes a commented pair to "
                                "start from.",
                    examples="""  frictionlab datasets                       # the same as 'datasets list'
   frictionlab datasets show impact-golf-v28
   frictionlab datasets template impact --name my-impact --out .   # my-impact.toml + my-impact.csv
+  frictionlab datasets import velstep experiment.txt --name exp --out data/   # one dataset per velocity step
   frictionlab datasets rebuild --check""")
     p.set_defaults(func=_list)
     acts = p.add_subparsers(dest="action", metavar="ACTION")
@@ -70,7 +71,7 @@ def _add_import(acts):
 
     imp = subcommand(acts, "import", help="turn a raw laboratory record into datasets, one per velocity step",
                      description="Read a raw record and write measured datasets (NAME.toml + NAME.csv). FORMAT "
-                                 "velstep: whitespace-separated Time(s) Displ(microns) Friction "
+                                 "velstep: by default whitespace-, tab- or comma-separated Time(s) Displ(microns) Friction "
                                  "EffectiveNormalstress(MPa) (the records of the steadystate routine, Giacomel et al. "
                                  "2024), any number of velocity steps and holds. The displacement is segmented into "
                                  "straight pieces (optimal partitioning: the data choose the number of steps); each "
@@ -81,12 +82,18 @@ def _add_import(acts):
                                  "the steadystate routine does) and ends in the steady part after its step; --joint writes one dataset with every step, for "
                                  "a joint fit across steps. A jump of displacement without a change of velocity (a "
                                  "transducer reset) is stitched and reported. The machine stiffness is a start "
-                                 "estimated from friction's loading after each step unless given.",
+                                 "estimated from friction's loading after each step unless given. --columns reads "
+                                 "any other lab's layout: which column is time, displacement and friction (or shear "
+                                 "and normal stress, friction = shear / normal), each with its unit; tab-, comma-, "
+                                 "semicolon- or space-separated, lines before the header and rows of text after it "
+                                 "skipped; UTF-8 or UTF-16 text.",
                      examples="""  frictionlab datasets import velstep experiment.txt --name exp13 --out data/ \\
       --source 'my lab, run 13' --license CC-BY-4.0 --citation 'me et al. (2026)'
   frictionlab datasets import velstep experiment.txt --name exp13 --joint --out data/
   frictionlab datasets import velstep part1.txt part2.txt part3.txt --name exp13 --out data/
-  frictionlab fit rate-state-aging data/exp13-step1.toml""")
+  frictionlab fit rate-state-aging data/exp13-step1.toml
+  frictionlab datasets import velstep run.csv --name run --columns \\
+      'time=Time ms, displacement=LP_disp mm, shear=Tau MPa, normal=SigmaN MPa'""")
     imp.add_argument("format", choices=("velstep",), metavar="FORMAT", help="raw format: velstep")
     imp.add_argument("raw", type=Path, nargs="+", metavar="RAWFILE", help="the raw record; several files of one "
                      "experiment (slices of one recording, in any order) are joined by time into one record")
@@ -96,6 +103,10 @@ def _add_import(acts):
                      "fit of a, b and Dc across steps) instead of one per step")
     imp.add_argument("--steps", type=int, metavar="N", help="check: the number of velocity steps expected (an error "
                                                            "names what was found when it differs)")
+    imp.add_argument("--columns", metavar="SPEC", help="the record's own layout: \"time=NAME UNIT, "
+                     "displacement=NAME UNIT, friction=NAME\" or with \"shear=NAME UNIT, normal=NAME UNIT\" instead "
+                     "of friction (NAME: the header's name, quoted when it holds spaces, or #N for the N-th column; "
+                     "UNIT: e.g. s, ms, um, mm, MPa, kN); default: the steadystate routine's four columns")
     imp.add_argument("--stiffness", help="start for the machine stiffness per unit normal stress, e.g. '0.01 1/um' "
                                          "(default: estimated from friction's loading after each step)")
     imp.add_argument("--source", default="", help="where the record comes from (default: its path)")
@@ -114,6 +125,7 @@ def _import(args) -> int:
     from ..core.names import check_name
     from ..core.units import to_si
     from ..io.dataset import from_meta
+    from ..io.layout import parse_columns
     from ..io.velstep import analyse, dataset_toml, parts, summary, write_csv
 
     check_name(args.name, "datasets import --name", OutputError)  # before any path is made of it
@@ -123,11 +135,12 @@ def _import(args) -> int:
     if k is not None and not (k > 0 and math.isfinite(k)):
         raise ParameterError(f"--stiffness: {args.stiffness!r} must be a positive stiffness per unit normal stress, "
                              "e.g. '0.01 1/um'")
+    layout = parse_columns(args.columns, "--columns") if args.columns is not None else None
     if not args.out.is_dir():
         raise OutputError(f"{args.out}: folder does not exist")
     from ..io.velstep_join import read_joined
 
-    raw = read_joined(args.raw)
+    raw = read_joined(args.raw, columns=layout)
     imp = analyse(raw, args.name, joint=args.joint, stiffness=k, steps=args.steps)
     files, pairs = {}, []
     for w in imp.windows:
@@ -139,6 +152,7 @@ def _import(args) -> int:
                 raise OutputError(f"{p}: exists; choose another --name or --out, or pass --force")
         command = "frictionlab datasets import velstep " + " ".join(shlex.quote(a) for a in (
             *(r.name for r in args.raw), "--name", args.name)) + (" --joint" if args.joint else "") + (
+            f" --columns {shlex.quote(layout.text())}" if layout else "") + (
             f" --stiffness {shlex.quote(args.stiffness)}" if k else "")
         toml = dataset_toml(imp, w, source=args.source, license=args.license, citation=args.citation,
                             command=command)

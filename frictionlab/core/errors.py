@@ -2,7 +2,23 @@
 
 
 class FrictionLabError(Exception):
-    """Base class: a user-facing error whose message is one complete line."""
+    """Base class of every error frictionlab raises for bad input: the message is one complete line naming
+    the file, field or parameter and what was expected (the command line prints it and exits with status 2).
+
+    Attributes
+    ----------
+    args : tuple of str
+        The message, one line: what was wrong and what was expected.
+
+    Examples
+    --------
+    >>> import frictionlab as fl
+    >>> try:
+    ...     fl.get_law("no-such-law")
+    ... except fl.FrictionLabError as exc:
+    ...     print(str(exc).split(";")[0])
+    unknown law 'no-such-law'
+    """
 
     def __str__(self) -> str:
         # a name taken from a user's file (a TOML key, a CSV header) may hold a line break

@@ -13,6 +13,7 @@ with a one-line ``DatasetError`` naming the file and the field.
 from __future__ import annotations
 
 import math
+import os
 from importlib import resources
 from pathlib import Path
 
@@ -24,11 +25,12 @@ from typing import TYPE_CHECKING
 from ..core.errors import DatasetError, FrictionLabError
 from ..core.files import read_toml
 from ..core.names import check_name
-from ..core.units import MAX_SI, check_text, check_time_scale, unit_factor
+from ..core.units import MAX_SI, unit_factor
 from ..physics.scene import KINDS, Scene
 from .csvread import _line_of_row, read_csv
 from .provenance import PROVENANCE_KINDS, Provenance, _provenance  # noqa: F401  (re-exported)
-from ..solve.outcome import OUTCOMES, OutcomeScene
+from ..solve.outcome import OUTCOMES
+from .dataset_tables import _fixed, _quantity, _rest, _scene, _table
 from .noise import NOISE_KINDS, STATED, noise_table, stated_table  # noqa: F401 (NOISE_KINDS, STATED: read from here too)
 
 DATA_KINDS = KINDS + ("contact-area",)
@@ -48,7 +50,30 @@ COLUMN_SI = {
 
 @attrs.frozen(eq=False)
 class Dataset:
-    """A loaded dataset: SI arrays by column, the scene, fixed law parameters, provenance."""
+    """A loaded dataset: SI arrays by column, the scene, fixed law parameters and provenance (made by
+    `load_dataset`).
+
+    Attributes
+    ----------
+    name, kind, observable : str
+        The dataset's name, its scene kind and the column the laws are fitted to.
+    columns : dict of str to numpy.ndarray
+        The data by column, SI (``t`` [s], ``theta`` [rad], ``omega`` [rad/s], ``v`` [m/s], ``mu`` [-], ...).
+    units : dict of str to str
+        Each column's unit as its file writes it (what figures and tables show).
+    noise : dict of str to float
+        The noise standard deviation of each column [SI], known or estimated.
+    noise_kind : {"known", "estimated", "none"}
+        Whether sigma was measured, estimated from the data alone, or there is none (a reconstruction).
+    scene : Scene or None
+        The experiment the laws are solved on.
+    fixed : dict of str to float
+        Law parameters the dataset fixes [SI].
+    provenance : Provenance
+        Measured, reported, reconstructed or synthetic, with its source and the command that regenerates it.
+    stated : dict
+        For a reconstruction, the stated numbers (value, precision) the laws are compared on, SI.
+    """
 
     name: str
     kind: str
@@ -67,7 +92,7 @@ class Dataset:
     noise_df: dict = attrs.field(factory=dict)  # column -> effective degrees of freedom of an estimated sigma
     noise_est: dict = attrs.field(factory=dict, repr=False)  # column -> noise.NoiseEstimate (estimated kind)
     noise_note: str = ""  # which noise is used, and why (one sentence, for the report and `datasets show`)
-    noise_correlation: str = "none"  # NOISE_CORRELATIONS: independent samples ('none') or AR(1) noise ('ar1')
+    noise_correlation: str = "none"  # NOISE_CORRELATIONS: independent ('none'), AR(1) ('ar1'), chosen by the data ('arp')
     stated: dict = attrs.field(factory=dict)  # STATED name -> (value, precision) in SI ([stated])
     group: str = ""  # declared group (TOML 'group'); "": the dataset is its own group (nothing is inferred from names)
     time_zero: float = 0.0  # the file's time of t = 0 [s] (TOML 'time_zero'), already subtracted from columns['t']
@@ -93,8 +118,21 @@ class Dataset:
         return len(next(iter(self.columns.values())))
 
     def to_dataframe(self) -> pd.DataFrame:
-        """The columns as a pandas DataFrame (SI; units by column in ``df.attrs['units']``, the file's own
-        units in ``df.attrs['file_units']``, the noise in ``df.attrs['noise']``)."""
+        """The columns as a pandas DataFrame.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One column per data column, SI; units by column in ``df.attrs['units']``, the file's own units in
+            ``df.attrs['file_units']``, the noise in ``df.attrs['noise']``.
+
+        Examples
+        --------
+        >>> import frictionlab as fl
+        >>> df = fl.load_dataset("incline-oil-a100").to_dataframe()
+        >>> df.attrs["units"]["v"]
+        'm/s'
+        """
         import pandas as pd
 
         df = pd.DataFrame(self.columns)
@@ -106,29 +144,65 @@ class Dataset:
         return f"<Dataset {self.name}: {self.kind}, {len(self)} points of {self.observable}, {self.provenance.kind}>"
 
     def shown(self, column: str) -> tuple[str, float]:
-        """(unit, factor) a column is shown in: the unit its file gives it (shown = SI * factor)."""
+        """The unit a column is shown in: the unit its file gives it.
+
+        Parameters
+        ----------
+        column : str
+            A column name.
+
+        Returns
+        -------
+        tuple of (str, float)
+            The unit and the factor from SI: shown value = SI value * factor.
+        """
         from ..core.display import display_unit
 
         return display_unit(column, self.units.get(column), COLUMN_SI.get(column, ""))
 
     def x_axis(self) -> tuple[str, str, float]:
-        """(column, unit shown, factor) of what the observable is drawn against: time, or for one impact
-        per row the incidence angle (else the row number, with column '')."""
+        """What the observable is drawn against: time, or for one impact per row the incidence angle (else
+        the row number, with column '').
+
+        Returns
+        -------
+        tuple of (str, str, float)
+            The column, the unit it is shown in, and the factor from SI.
+        """
         for col in ("t", "incidence", "speed"):
             if col in self.columns:
                 return (col, *self.shown(col))
         return "", "", 1.0
 
     def plot(self, y: str | None = None, ax: Axes | None = None, **style: object) -> Axes:
-        """Draw column ``y`` (default: the observable) against time, or against the incidence angle for one
-        impact per row, in the units of the dataset's file, with its noise as error bars where sigma is
-        known or estimated; returns the Axes (a new figure's if ``ax`` is None)."""
+        """Draw a column against time, or against the incidence angle for one impact per row, in the units of
+        the dataset's file, with its noise as error bars where sigma is known or estimated.
+
+        Parameters
+        ----------
+        y : str, optional
+            The column to draw; default the observable.
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; default a new figure's axes.
+        **style
+            Passed to matplotlib's ``errorbar``.
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+
+        Raises
+        ------
+        DatasetError
+            No such column.
+        """
         from ..core.display import axis_label, figure_axes
 
         y = y or self.observable
         if y not in self.columns:
             raise DatasetError(f"dataset '{self.name}' has no column '{y}'; it has {', '.join(self.columns)}")
-        _, ax = figure_axes(ax)
+        _, ax = figure_axes(ax, where="Dataset.plot")
         xcol, xunit, xf = self.x_axis()
         x = self.columns[xcol] * xf if xcol else np.arange(len(self))
         shown, f = self.shown(y)
@@ -142,6 +216,14 @@ class Dataset:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
         return ax
+
+    def check(self, where: str = "dataset") -> Dataset:
+        """This dataset if it is still what loading made of it, else a DatasetError naming ``where`` and the field
+        (``intact.check_intact``: what fit, simulate and compare call before using it)."""
+        from .intact import check_intact
+
+        check_intact(self, where)
+        return self
 
     def _repr_html_(self) -> str:
         """A notebook's view: what the dataset is, where it comes from, its noise and columns in its units."""
@@ -193,12 +275,48 @@ def available_names() -> list[str]:
     return builtin_names() + external.present()
 
 
+#: What a dataset argument may be, for messages.
+DATASET_FORMS = "a Dataset, a dataset name or the path to its .toml"
+
+
+def check_dataset_like(value, where: str, more: tuple = ()) -> None:
+    """A TypeError naming ``where`` unless ``value`` is a Dataset, a name or a path (or one of the types ``more``)."""
+    if not isinstance(value, (str, os.PathLike, Dataset) + tuple(more)):
+        raise TypeError(f"{where}: expected {DATASET_FORMS}, got {type(value).__name__} {value!r:.60}")
+
+
 def load_dataset(name_or_path: str | Path) -> Dataset:
-    """Load and validate a dataset by built-in name, name of a measured record (``external``), or path to
-    its TOML (or CSV)."""
+    """Load and validate a dataset.
+
+    Parameters
+    ----------
+    name_or_path : str or pathlib.Path or Dataset
+        A built-in name (``frictionlab datasets`` lists them), the name of a measured record present beside
+        the repository or in ``FRICTIONLAB_RAW_DATA``, or the path of a dataset's TOML file (or its CSV). A
+        Dataset is returned as it is.
+
+    Returns
+    -------
+    Dataset
+        SI arrays by column, the scene, the noise, fixed law parameters and the provenance.
+
+    Raises
+    ------
+    DatasetError
+        An unknown name, a file that does not exist, or a file whose content is not a valid dataset (the
+        message names the file, the field and what was expected).
+
+    Examples
+    --------
+    >>> import frictionlab as fl
+    >>> data = fl.load_dataset("impact-golf-v28")
+    >>> data.kind, data.observable, data.provenance.kind
+    ('impact', 'theta', 'reconstructed')
+    """
     if isinstance(name_or_path, Dataset):
         return name_or_path
     from . import external
+    check_dataset_like(name_or_path, "load_dataset")
 
     if isinstance(name_or_path, str) and name_or_path in external.RECORDS \
             and not (builtin_dir() / f"{name_or_path}.toml").exists():
@@ -215,14 +333,6 @@ def _req(meta, key, path, typ=str):
         what = {str: "string", dict: "table"}.get(typ, typ.__name__)
         raise DatasetError(f"{path}: '{key}' must be a {what}, got {type(meta[key]).__name__}")
     return meta[key]
-
-
-def _table(meta, key, path, where=None):
-    """An optional TOML table: {} when absent, an error when present but not a table."""
-    value = meta.get(key, {})
-    if not isinstance(value, dict):
-        raise DatasetError(f"{path}: {where or key} must be a table, got {type(value).__name__} {value!r}")
-    return value
 
 
 def from_meta(meta: dict, path: Path, raw: dict | None = None) -> Dataset:
@@ -345,136 +455,19 @@ def _si_of(col, value, where):
 
 
 #: ``[noise] correlation``: the samples' noise independent ('none', the default) or first-order autoregressive
-#: ('ar1': its coefficient profiled by each fit, inference/noise/ar1.py).
-NOISE_CORRELATIONS = ("none", "ar1")
+#: ('ar1': its coefficient profiled by each fit, inference/noise/ar1.py) or chosen by the data ('arp': AR(p) by BIC
+#: per sampling rate, ARMA(1,1) where the order runs to its cap, fitted with the law; inference/noise/).
+NOISE_CORRELATIONS = ("none", "ar1", "arp")
 
 
 def _correlation(value, path) -> str:
     if not isinstance(value, str) or value not in NOISE_CORRELATIONS:
         raise DatasetError(f"{path}: noise.correlation = {value!r}, expected one of {', '.join(NOISE_CORRELATIONS)} "
-                           "(none: independent samples; ar1: first-order autoregressive noise, phi fitted)")
+                           "(none: independent samples; ar1: first-order autoregressive noise, phi fitted; arp: an "
+                           "AR(p) model chosen by the data)")
     return value
-
-
-def _scene(meta, path, kind, observable, columns, units, csv):
-    """The [scene] table as a Scene (or OutcomeScene); None for a contact-area series."""
-    if kind == "contact-area":
-        return None
-    spec = meta.get("scene")
-    if not isinstance(spec, dict):
-        raise DatasetError(f"{path}: missing required table [scene]")
-    try:
-        if kind == "impact-outcome":
-            scene = OutcomeScene.from_spec(spec, str(path))
-        else:
-            scene = Scene.from_spec(spec, kind, str(path), columns, columns.get("t"))
-    except FrictionLabError as exc:  # a model's own check (no file in it) still names the file
-        raise DatasetError(str(exc) if str(exc).startswith(str(path)) else f"{path}: [scene]: {exc}") from None
-    if kind == "impact-outcome":
-        _check_outcome_rows(columns, observable, path, csv, scene)
-    else:
-        _check_observable(scene, observable, path)
-        _check_time_unit(columns, units, spec, kind, scene, path)
-    return scene
-
-
-def _fixed(table, path):
-    """[fixed] law parameters in SI, each a parameter of some registered law and within its bounds."""
-    from ..physics.registry import available_laws
-
-    fixed, fixed_units = {}, {}
-    for key, value in table.items():
-        specs = [(law.name, s) for law in available_laws().values() for s in law.params if s.name == key]
-        if not specs:
-            raise DatasetError(f"{path}: fixed.{key} is not a parameter of any registered law")
-        unit = specs[0][1].unit
-        fixed[key] = _quantity(value, unit, f"{path}: fixed.{key}")
-        fixed_units[key] = unit
-        for law_name, spec in specs:
-            if spec.unit == unit and not spec.lower <= fixed[key] <= spec.upper:
-                raise DatasetError(f"{path}: fixed.{key} = {value!r} is outside the bounds of law '{law_name}' "
-                                   f"[{spec.lower:g}, {spec.upper:g}] {spec.unit}".rstrip())
-    return fixed, fixed_units
-
-
-def _rest(meta, path, provenance) -> dict:
-    """No unknown top-level key; [reported] and provenance.truth readable later; returns [reported]."""
-    extra = set(meta) - {"name", "group", "kind", "observable", "columns", "noise", "scene", "fixed", "provenance",
-                         "reported", "description", "time_zero", "stated"}
-    if extra:
-        raise DatasetError(f"{path}: unknown top-level key(s) {sorted(extra)}")
-    reported = _table(meta, "reported", path, "[reported]")
-    for table, values in (("reported", reported), ("provenance.truth", provenance.truth)):
-        for key, value in values.items():  # read by the report later: refuse what pint would choke on now
-            if isinstance(value, str):
-                try:
-                    check_text(value, f"{path}: {table}.{key}")
-                except FrictionLabError as exc:
-                    raise DatasetError(str(exc)) from None
-    if not isinstance(meta.get("description", ""), str):
-        raise DatasetError(f"{path}: 'description' must be a string")
-    return reported
-
-
-def _check_time_unit(columns, units, spec, kind, scene, path) -> None:
-    """The time column must span about the scene's duration (given, or the impact's contact time)."""
-    if "duration" in spec:
-        field = "scene.duration"
-    elif kind == "impact" and scene.duration > 0:
-        field = "the scene's contact time"
-    else:
-        return  # the duration was taken from the time column itself
-    try:
-        check_time_scale(float(columns["t"][-1]), scene.duration, units["t"], f"{path}: columns.t", field)
-    except FrictionLabError as exc:
-        raise DatasetError(str(exc)) from None
-
-
-#: Trajectory series each observable needs, and what in a scene provides it.
-def _check_observable(scene: Scene, observable: str, path) -> None:
-    """A dataset whose observable its own scene cannot produce would be fitted against zeros."""
-    if scene.kind not in ("impact", "incline"):
-        return
-    if observable in ("omega", "theta") and not ({"spin", "slip-coupling"} & scene.effects):
-        raise DatasetError(f"{path}: observable {observable!r} needs the scene to integrate spin; "
-                           "add \"spin\" to scene.effects (and a scene.radius)")
-    if observable == "A" and scene.area is None:
-        raise DatasetError(f"{path}: observable 'A' needs a [scene.area] model")
-    if observable == "N" and scene.normal is None:
-        raise DatasetError(f"{path}: observable 'N' needs a [scene.normal] model")
-
-
-def _check_outcome_rows(columns, observable, path, csv, scene) -> None:
-    """An impact-outcome dataset: one impact per row (speed, incidence), an outcome as observable."""
-    for col in ("speed", "incidence"):
-        if col not in columns:
-            raise DatasetError(f"{path}: an impact-outcome dataset needs a '{col}' column in [columns] "
-                               "(one impact per row)")
-    bad = np.nonzero(~(columns["speed"] > 0))[0]
-    if bad.size:
-        raise DatasetError(f"{csv}: column 'speed' line {_line_of_row(csv, int(bad[0]))}: impact speed must be positive")
-    inc = columns["incidence"]
-    bad = np.nonzero(~((inc > 0) & (inc < math.pi / 2)))[0]
-    if bad.size:
-        raise DatasetError(f"{csv}: column 'incidence' line {_line_of_row(csv, int(bad[0]))}: incidence must be "
-                           f"strictly between 0 and 90 deg (measured from the "
-                           f"{'surface normal' if scene.angle_reference == 'normal' else 'surface'})")
 
 
 def _names(columns) -> str:
     """Column names for a one-line message (repr when a name holds odd characters)."""
     return ", ".join(c if c.isprintable() and "," not in c else repr(c) for c in columns)
-
-
-def _si_of(col, value, where):
-    """A declared noise value of column ``col`` in SI."""
-    return _quantity(value, COLUMN_SI[col], where)
-
-
-def _quantity(value, si, where):
-    from ..core.units import to_si
-
-    try:
-        return to_si(value, si, where)
-    except FrictionLabError as exc:
-        raise DatasetError(str(exc)) from None

@@ -43,6 +43,8 @@ import attrs
 import numpy as np
 
 from ..core.errors import DatasetError
+from .segment_noise import (LD, StretchNoise, last_digit, least_count, noise_by_sample, resolution,
+                            sampled_exactly)
 
 #: Fewest samples of each velocity a step needs on either side.
 MIN_PIECE = 20
@@ -50,12 +52,9 @@ MIN_PIECE = 20
 GRID = 1000
 #: Samples at either end of the record that are always candidate breakpoints.
 DENSE = 200
-#: Samples per block of the noise by sample; largest lag there, and over a stretch.
-BLOCK, MAX_LAG, MAX_STRETCH_LAG = 4096, 512, 4096
 #: A union of two pieces is one line within MERGE times its noise; a piece between steps must be straight
 #: within STRAIGHT times its noise; a jump stands off by SHARP times its white noise.
 MERGE, STRAIGHT, SHARP = 3.0, 2.0, 5.0
-LD = np.longdouble  # extended precision where available: sums over long records keep their digits
 CHUNK = 1 << 18  # samples handled at once where a long record would need large temporaries
 
 
@@ -93,87 +92,9 @@ class Segmentation:
     velocities_se: tuple
     x: np.ndarray = attrs.field(eq=False)  # the displacement, jumps stitched
     noise: float = 0.0  # the record's typical total displacement noise (median over samples)
+    exact_to: float = 0.0  # the least count [x unit] when the record shows no noise beyond it, else 0
     breakpoints: tuple = ()  # every breakpoint of the optimal partition (move 2)
     penalty: float = 0.0
-
-
-# --- noise -------------------------------------------------------------------------------------
-def pseudo_residuals(t: np.ndarray, x: np.ndarray, lag: int) -> np.ndarray:
-    """x_i minus the chord through x_{i-lag} and x_{i+lag}, scaled to the noise's standard deviation
-    (for i = lag .. n - lag - 1)."""
-    a, b, c = t[:-2 * lag], t[lag:-lag], t[2 * lag:]
-    w = (b - a) / (c - a)
-    return (x[lag:-lag] - ((1 - w) * x[:-2 * lag] + w * x[2 * lag:])) / np.sqrt(1 + w * w + (1 - w) ** 2)
-
-
-def _lags(n: int, largest: int) -> list[int]:
-    out = [1]
-    while out[-1] * 2 <= min(largest, n // 16):
-        out.append(out[-1] * 2)
-    return out
-
-
-def noise_by_sample(t: np.ndarray, x: np.ndarray, cuts=()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(white, total, long-run variance) of the displacement noise by sample (move 1), from the
-    pseudo-residuals whose samples lie between two of ``cuts`` (breakpoints already known)."""
-    n = len(t)
-    piece = np.searchsorted(np.asarray(cuts, dtype=int), np.arange(n), side="right")
-    nb = max(1, round(n / BLOCK))
-    edges = np.linspace(0, n, nb + 1).astype(int)
-    lags = _lags(n, MAX_LAG)
-    scale = np.full((len(lags), nb), np.nan)
-    for k, lag in enumerate(lags):
-        r = np.abs(pseudo_residuals(t, x, lag))
-        if len(cuts):
-            r[piece[:-2 * lag] != piece[2 * lag:]] = np.nan
-        lo, hi = np.clip(edges[:-1] - lag, 0, r.size), np.clip(edges[1:] - lag, 0, r.size)
-        for j in range(nb):
-            rr = r[lo[j]:hi[j]]
-            rr = rr[~np.isnan(rr)] if len(cuts) else rr
-            if rr.size >= 8:
-                scale[k, j] = 1.4826 * float(np.median(rr))
-    floor = resolution(t, x)
-    s1 = np.fmax(np.nan_to_num(scale[0], nan=floor), floor)
-    total = np.fmax(np.nan_to_num(np.nanmax(scale, axis=0), nan=floor), s1)
-    q = np.clip((s1 / total) ** 2, 1e-4, 1.0)  # AR(1): sigma1^2 / sigma^2 = (1 - phi)(3 - phi) / 3
-    phi = np.clip(2.0 - np.sqrt(1.0 + 3.0 * q), 0.0, 0.99)
-    per = np.repeat(np.arange(nb), np.diff(edges))
-    return s1[per], total[per], (total ** 2 * (1 + phi) / (1 - phi))[per]
-
-
-def resolution(t: np.ndarray, x: np.ndarray) -> float:
-    """The smallest noise a record can show: what double precision resolves of its displacement about the chord
-    through its ends (a record without noise, exact to its last digit, still has pieces of finite cost)."""
-    chord = x[0] + (x[-1] - x[0]) * (t - t[0]) / (t[-1] - t[0])
-    return max(1e-8 * float(np.max(np.abs(x - chord))), 1e-150)
-
-
-class StretchNoise:
-    """The noise of any stretch [a, b) of a record: the root mean square of the pseudo-residuals inside it,
-    the largest over lags 1, 2, 4, ... up to (b - a) / parts (prefix sums on a grid, so O(1) a query); for a
-    stretch too short for that, the root mean square of ``floor``, the noise by sample, over it."""
-
-    def __init__(self, t, x, grid, floor: np.ndarray):
-        self.grid, self.floor = np.asarray(grid), np.concatenate([[0.0], np.cumsum(floor ** 2)])
-        self.least = resolution(t, x)
-        self.lags = _lags(len(t), MAX_STRETCH_LAG)
-        self.S = []
-        for lag in self.lags:  # sums of r^2 by centre index, at the grid positions
-            r2 = np.zeros(len(t))
-            r2[lag:-lag] = pseudo_residuals(t, x, lag) ** 2
-            self.S.append(np.concatenate([[0.0], np.cumsum(np.add.reduceat(r2, self.grid[:-1]), dtype=LD)]))
-
-    def __call__(self, a: int, b: int, parts: int = 16) -> float:
-        best = 0.0
-        for lag, S in zip(self.lags, self.S):
-            if parts * lag > b - a and lag > 1:
-                break
-            i, j = np.searchsorted(self.grid, a + lag), np.searchsorted(self.grid, b - lag, side="right") - 1
-            if self.grid[j] - self.grid[i] >= 8:
-                best = max(best, float((S[j] - S[i]) / (self.grid[j] - self.grid[i])))
-            elif lag == 1:  # too short a stretch: the noise by sample there
-                return math.sqrt((self.floor[b] - self.floor[a]) / (b - a))
-        return max(math.sqrt(best), self.least)
 
 
 # --- sums and line costs -------------------------------------------------------------------------
@@ -425,13 +346,11 @@ def segment(t: np.ndarray, x: np.ndarray, where: str = "record",
 
     if n < 2 * MIN_PIECE:
         raise DatasetError(f"{where}: {n} samples; a velocity step needs at least {MIN_PIECE} on either side")
-    s1, total, long_run = noise_by_sample(t, x)
     penalty = 3.0 * math.log(n)
     g = grid(n)
-    M = Moments(t, x, 1.0 / long_run, g)
-    bps = pelt(M, penalty)
-    if len(g) < n + 1:
-        bps = _refine(M, bps, n)
+    M, bps, s1, total = _partition(t, x, g, penalty)
+    exact_to = least_count(x) if float(np.median(s1)) <= resolution(t, x) * (1 + 1e-9) and \
+        sampled_exactly(x, last_digit(x)) else 0.0
     jumps, x = _jumps(t, x, M, s1, bps, penalty, n)
     del M
     noise = StretchNoise(t, x, g, total)
@@ -439,6 +358,8 @@ def segment(t: np.ndarray, x: np.ndarray, where: str = "record",
     cut = _merge(U, noise, [b for b in bps if b not in {j.index for j in jumps}], n)
     bounds = [0, *cut, n]
     for a, b in zip(bounds[:-1], bounds[1:]):
+        if b - a < MIN_PIECE and (a == 0 or b == n):
+            continue  # a change too near an end: refused below by what it is
         rms, level = math.sqrt(float(line_rss(U.between(a, b))) / (b - a)), noise(a, b)
         if rms > STRAIGHT * level:
             raise DatasetError(f"{where}: the displacement from {at(a)} to {at(b - 1)} is not a straight line: it "
@@ -461,9 +382,43 @@ def segment(t: np.ndarray, x: np.ndarray, where: str = "record",
     steps = [kink_fit(t, x, a, b, s, long_run) for a, s, b in zip(bounds[:-2], bounds[1:-1], bounds[2:])]
     bounds = [0, *(s.index for s in steps), n]  # the pieces now end at the kinks
     v, se = joint_velocities(t, x, bounds, [s.time for s in steps], long_run)
+    if exact_to > 0:
+        steps, se = _rounding_bounds(t, exact_to, steps, bounds, v, se)
     return Segmentation(steps=tuple(steps), jumps=tuple(jumps), bounds=tuple(bounds), velocities=tuple(v.tolist()),
                         velocities_se=tuple(se.tolist()), x=x, noise=float(np.median(total)), breakpoints=tuple(bps),
-                        penalty=penalty)
+                        penalty=penalty, exact_to=exact_to)
+
+
+def _rounding_bounds(t, q: float, steps: list, bounds: list, v: np.ndarray, se: np.ndarray):
+    """Standard errors of a record without noise beyond its least count ``q``: no smaller than the error that a
+    rounding of half a count at every sample after a step (or one count across a piece) makes, since rounding
+    exact data errs alike at many samples: half a count over the change of velocity for a step's time, a count
+    over the piece's duration for its velocity."""
+    se = np.array([max(s, q / float(t[b - 1] - t[a])) for s, a, b in zip(se, bounds[:-1], bounds[1:])])
+    steps = [attrs.evolve(st, time_se=max(st.time_se, 0.5 * q / abs(st.v2 - st.v1)), v1_se=max(st.v1_se, se[i]),
+                          v2_se=max(st.v2_se, se[i + 1])) for i, st in enumerate(steps)]
+    return steps, se
+
+
+def _partition(t, x, g, penalty: float, passes: int = 4):
+    """(moments, breakpoints, white and total noise by sample) of the optimal partition (move 2) weighted by the
+    noise measured between its own breakpoints: first by the white noise (lag 1, which no change of slope
+    inflates), then by the long-run noise of pseudo-residuals whose chords cross no breakpoint found, until the
+    breakpoints settle (steps cannot pass for noise however many the record holds)."""
+    n = len(t)
+    s1, total, long_run = noise_by_sample(t, x)
+    weights, bps = 1.0 / s1 ** 2, None
+    for _ in range(passes):
+        M = Moments(t, x, weights, g)
+        found = pelt(M, penalty)
+        if len(g) < n + 1:
+            found = _refine(M, found, n)
+        if found == bps:
+            break
+        bps = found
+        s1, total, long_run = noise_by_sample(t, x, bps)
+        weights = 1.0 / long_run
+    return M, bps, s1, total
 
 
 def _jumps(t, x, M: Moments, s1: np.ndarray, bps: list[int], penalty: float, n: int):

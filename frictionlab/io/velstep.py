@@ -14,7 +14,7 @@ whitespace- (or comma-) separated rows of time [s], load-point displacement [um]
   record's first steady state (``joint``), fitted as one history;
 * estimates a start for the machine stiffness from friction's initial slope after each step, over a run of
   samples chosen from the data (the shortest that gives the slope to 10 %), whatever the transient's length;
-* states the friction noise as estimated from the data with AR(1) correlation (no sigma is written).
+* states the friction noise as estimated from the data with an AR(p) model chosen by the data (no sigma is written).
 """
 from __future__ import annotations
 
@@ -29,75 +29,46 @@ import numpy as np
 from ..core.errors import DatasetError
 from ..core.files import MAX_CSV_BYTES, read_bytes
 from ..core.names import check_name
-from .segment import MIN_PIECE, Segmentation, segment
+from .layout import cells, separator
+from .rawrecord import LIMITS, MIN_DT, RawRecord, check_record  # noqa: F401  (the reader's names)
+from .segment import Segmentation, segment
+from .segment_noise import last_digit
 
 #: Header names accepted for the four raw columns (case-insensitive; '_' or nothing between words).
 RAW_HEADER = (r"time\(s\)", r"displ(acement)?\(microns\)", r"friction", r"(effective_?)?normal_?stress\(mpa\)")
-#: Smallest time increment of a record [s], and the largest magnitudes read (s, um, -, MPa).
-MIN_DT = 1e-9
 #: The stiffness start [1/m] (0.01 1/um, a typical laboratory value) where friction shows no loading after a step.
 DEFAULT_STIFFNESS = 1e4
-LIMITS = {"time": 1e12, "displacement": 1e12, "friction": 1e3, "normal stress": 1e6}
 
 
-@attrs.frozen(eq=False)
-class RawRecord:
-    """One raw record: time [s], displacement [um, as recorded; ``x`` in m], friction [-], normal stress [Pa]
-    (``stress``: what the file's header calls it), and the line of the file each sample was read from."""
-
-    path: Path
-    t: np.ndarray
-    x_um: np.ndarray
-    mu: np.ndarray
-    sn: np.ndarray
-    stress: str = "effective normal stress"
-    first_line: int = 2  # line of the first sample when every line after the header holds one
-    lines: np.ndarray | None = None  # line of each sample otherwise
-
-    @property
-    def x(self) -> np.ndarray:
-        """Displacement [m]."""
-        return self.x_um * 1e-6
-
-    def line(self, i: int) -> int:
-        """The file's line (1-based) of sample i."""
-        return int(self.lines[i]) if self.lines is not None else self.first_line + int(i)
-
-    def where(self, i: int) -> str:
-        """'line N' of sample i (a record joined from several files names the file too)."""
-        return f"line {self.line(i)}"
-
-    def span(self, a: int, b: int) -> str:
-        """'lines A to B of FILE' of samples [a, b)."""
-        return f"lines {self.line(a)} to {self.line(b - 1)} of {self.path.name}"
-
-
-def read_raw(path, data: bytes | None = None) -> RawRecord:
-    """Read a raw velocity-step record (``data``: its bytes, already read); a one-line DatasetError naming the
-    file and line on bad content (a bad number, fewer or more than four columns, time that does not increase
-    by at least MIN_DT, magnitudes beyond LIMITS, a normal stress that is not positive)."""
+def read_raw(path, data: bytes | None = None, columns=None) -> RawRecord:
+    """Read a raw velocity-step record (``data``: its bytes, already read) in the steadystate routine's layout,
+    or in the layout ``columns`` gives (``"time=NAME UNIT, displacement=NAME UNIT, friction=NAME"``, or with
+    ``shear=NAME UNIT, normal=NAME UNIT`` instead of friction: see ``io.layout``); UTF-8 or UTF-16 text. A
+    one-line DatasetError (UnitError, ParameterError for ``columns``) naming the file and line on bad content (a
+    bad number, a missing column, time that does not increase by at least MIN_DT, magnitudes beyond LIMITS, a
+    normal stress that is not positive)."""
     import pandas as pd
 
+    from .layout import decode, parse_columns
+
     path = Path(path)
+    layout = parse_columns(columns, "columns") if columns is not None else None
     data = read_bytes(path, MAX_CSV_BYTES) if data is None else data
-    if data.startswith(b"\xef\xbb\xbf"):
-        data = data[3:]
-    if not data.isascii():
-        try:
-            data.decode("utf-8")
-        except UnicodeDecodeError as exc:
-            raise DatasetError(f"{path}: not UTF-8 text (byte {exc.start + 1})") from None
+    data, encoding = decode(path, data)
+    if layout is not None:
+        return _read_layout(path, data, layout, encoding)
     head = re.match(rb"(?:[ \t\r\f\v]*\n)*([^\n]*)(?:\n|$)", data)
     header_no = data.count(b"\n", 0, head.start(1)) + 1
     header_text = head.group(1).decode("utf-8", "replace").strip()
-    header = header_text.split()
-    if not header:
+    header = cells(header_text, separator(header_text))
+    if not header_text:
         raise DatasetError(f"{path}: file is empty")
     if len(header) != 4 or not all(re.fullmatch(p, h, re.IGNORECASE) for p, h in zip(RAW_HEADER, header)):
         raise DatasetError(f"{path}: line {header_no}: header {header_text[:80]!r}; expected four columns: "
-                           "Time(s) Displ(microns) Friction EffectiveNormalstress(MPa) (or NormalStress(MPa))")
-    if b"," in data:
-        data = data.replace(b",", b" ")
+                           "Time(s) Displ(microns) Friction EffectiveNormalstress(MPa) (or NormalStress(MPa)), "
+                           "or give the file's own with --columns")
+    if b"," in data or b";" in data:
+        data = data.replace(b",", b" ").replace(b";", b" ")
     body = memoryview(data)[head.end():]
     try:
         table = pd.read_csv(io.BytesIO(body), sep=r"\s+", header=None, dtype=float, engine="c",
@@ -115,8 +86,34 @@ def read_raw(path, data: bytes | None = None) -> RawRecord:
     rec = RawRecord(path=path, t=table[:, 0].copy(), x_um=table[:, 1].copy(), mu=table[:, 2].copy(),
                     sn=table[:, 3] * 1e6,
                     stress="effective normal stress" if "effective" in header[3].lower() else "normal stress",
-                    first_line=first, lines=lines)
-    _check(rec, table)
+                    first_line=first, lines=lines, encoding=encoding)
+    check_record(rec)
+    return rec
+
+
+def _read_layout(path, data: bytes, layout, encoding: str = "") -> RawRecord:
+    """The RawRecord in the columns of ``layout`` (io.layout) of a record's text (UTF-8 bytes; ``encoding``: what
+    it was read as, when not UTF-8), friction from shear over normal when it has no friction column."""
+    from .layout import read_table
+
+    tab = read_table(path, data.decode("utf-8"), layout)
+    v, normal = tab.values, layout["normal"]
+    sn = v.get("normal")
+    mu = v.get("friction")
+    if mu is None:
+        bad = np.flatnonzero(~(sn > 0))
+        if bad.size:
+            i = int(bad[0])
+            raise DatasetError(f"{path}: line {tab.lines[i]}: normal={normal.name} is {sn[i] / normal.factor:g} "
+                               f"{normal.unit}; friction is shear / normal, which needs a positive normal "
+                               f"{'force' if normal.force else 'stress'}")
+        mu = v["shear"] / sn
+    stress = "" if normal is None else "normal force" if normal.force else "normal stress"
+    rec = RawRecord(path=path, t=v["time"], x_um=v["displacement"] * 1e6, mu=mu, sn=sn, stress=stress,
+                    first_line=int(tab.lines[0]), lines=tab.lines, encoding=encoding, layout=layout.text(),
+                    notes=tab.notes + ((f"friction = {layout['shear'].name} / {normal.name}",)
+                                       if layout["shear"] else ()))
+    check_record(rec)
     return rec
 
 
@@ -136,30 +133,6 @@ def _bad_row(path: Path, body: str, lines) -> None:
         if len(values) != 4 or not all(math.isfinite(v) for v in values):
             raise DatasetError(f"{path}: line {no}: expected four finite numbers, got {row.strip()[:60]!r}")
     raise DatasetError(f"{path}: no data rows after the header")
-
-
-def _check(rec: RawRecord, table: np.ndarray) -> None:
-    """Magnitudes, time increments and normal stress, each refused with the line of the first bad sample."""
-    n = len(table)
-    if n < 2 * MIN_PIECE:
-        raise DatasetError(f"{rec.path}: {n} data rows; a velocity step needs at least {MIN_PIECE} on either side")
-    for j, (what, limit) in enumerate(LIMITS.items()):
-        bad = np.flatnonzero(np.abs(table[:, j]) > limit)
-        if bad.size:
-            i = int(bad[0])
-            raise DatasetError(f"{rec.path}: line {rec.line(i)}: {what} {table[i, j]:g} is beyond {limit:g} in the "
-                               "record's units (s, um, -, MPa)")
-    dt = np.diff(rec.t)
-    bad = np.flatnonzero(~(dt >= MIN_DT))
-    if bad.size:
-        i = int(bad[0]) + 1
-        what = "does not increase" if dt[i - 1] <= 0 else f"increases by {dt[i - 1]:.3g} s"
-        raise DatasetError(f"{rec.path}: line {rec.line(i)}: time {rec.t[i]:.10g} s {what} after line {rec.line(i - 1)} "
-                           f"({rec.t[i - 1]:.10g} s); time must increase by at least {MIN_DT:g} s a sample")
-    bad = np.flatnonzero(~(rec.sn > 0))
-    if bad.size:
-        raise DatasetError(f"{rec.path}: line {rec.line(int(bad[0]))}: normal stress must be positive, got "
-                           f"{table[int(bad[0]), 3]:g} MPa")
 
 
 # --- what the import finds --------------------------------------------------------------------------
@@ -208,6 +181,10 @@ def analyse(raw: RawRecord, name: str, *, joint: bool | None = False, stiffness:
     several). ``stiffness`` [1/m]: the start of every dataset instead of the estimate; ``steps``: the number of
     steps expected (an error if another number is found)."""
     where = str(raw.path)
+    if float(np.ptp(raw.mu)) == 0.0:
+        raise DatasetError(f"{where}: friction is {raw.mu[0]:g} at every sample (lines {raw.line(0)} to "
+                           f"{raw.line(len(raw.mu) - 1)}): a constant channel has nothing to fit (is it the friction "
+                           "column?)")
     seg = segment(raw.t, raw.x_um, where, raw.line, "um")  # in the record's units: um, um/s
     m = len(seg.steps)
     joint = m > 1 if joint is None else joint
@@ -215,6 +192,10 @@ def analyse(raw: RawRecord, name: str, *, joint: bool | None = False, stiffness:
         found = ", ".join(f"line {raw.line(s.index)} (t = {s.time:.6f} s)" for s in seg.steps)
         raise DatasetError(f"{where}: expected {steps} velocity step{'s' * (steps != 1)} (--steps), found {m}: {found}")
     velocities, notes = _velocities(raw, seg)
+    if seg.exact_to:
+        notes.append(f"the displacement shows no noise beyond its last digit ({seg.exact_to:.3g} um): the standard "
+                     "errors are bounds of the rounding to it, which errs alike at every sample of a line sampled "
+                     "exactly, not a scatter")
     notes += [f"displacement jump of {j.size:.4g} ± {j.size_se:.2g} um at line {raw.line(j.index)} "
               f"(t = {raw.t[j.index]:.10g} s) without a change of velocity: stitched (later samples shifted back)"
               for j in seg.jumps]
@@ -302,6 +283,8 @@ def stiffness_start(t, mu, step, v1: float, v2: float, a: int, b: int) -> tuple[
         n = min(max(n + 1, int(n * 1.41)), b - i0)
     if best is None or best[2] > 0.1:
         return None
+    if abs(best[0]) * best[1] <= max(last_digit(mu[i0:b]), 1e-12 * float(np.max(np.abs(mu[i0:b])))):
+        return None  # a change below the channel's last digit: no loading seen
     k = best[0] / (v2 - v1)
     return (k, best[1]) if k > 0 and math.isfinite(k) else None
 
@@ -327,21 +310,25 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
     raw, seg = imp.raw, imp.seg
     steps = [seg.steps[i] for i in w.steps]
     v_text = " -> ".join(f"{v * 1e6:.4g}" for v in w.velocities)
-    stress = float(np.mean(raw.sn[w.a:w.b]))
+    stress = float(np.mean(raw.sn[w.a:w.b])) if raw.sn is not None else None
     fitted = "; ".join(f"step at {s.time - raw.t[w.a]:.6f} ± {s.time_se:.2g} s" for s in steps)
     fitted_v = ", ".join(f"{v:.7g} ± {seg.velocities_se[k]:.2g}"
                          for k, v in enumerate(seg.velocities) if k in _pieces(w))
     jumps = [j for j in seg.jumps if w.a < j.index < w.b]
-    method = (f"every sample of {raw.span(w.a, w.b)} ({w.b - w.a} samples); load-point "
+    read = "; ".join(([f"read as {raw.encoding}"] if raw.encoding else []) +
+                     ([f"columns {raw.layout}"] if raw.layout else []) + list(raw.notes))
+    method = (f"every sample of {raw.span(w.a, w.b)} ({w.b - w.a} samples"
+              f"{'; ' + read if read else ''}); load-point "
               f"velocities and step time{'s' * (len(steps) > 1)} from an exact piecewise-linear segmentation of the "
               f"displacement (optimal partitioning, PELT, penalty 3 ln n = {seg.penalty:.1f}; "
               f"{len(seg.steps)} step{'s' * (len(seg.steps) != 1)} in the record), each step at the kink of a "
               "continuous two-line fit, velocities from one continuous fit through every kink (fitted values, not "
               "set points)" + (f"; {len(jumps)} displacement jump{'s' * (len(jumps) != 1)} without a change of "
                                "velocity stitched" if jumps else "") +
-              "; friction as measured (no trend removed); its noise estimated from the data, AR(1)" +
+              "; friction as measured (no trend removed); its noise estimated with the fit, AR(p) chosen by the data" +
               (f"; the window {w.start_note}" if w.start_note else ""))
-    description = (f"Velocity step{'s' * (len(steps) > 1)} {v_text} um/s at {stress / 1e6:.4g} MPa {raw.stress} "
+    at = f" at {raw.normal_text(stress)}" if stress is not None else ""
+    description = (f"Velocity step{'s' * (len(steps) > 1)} {v_text} um/s{at} "
                    f"({raw.span(w.a, w.b)}). MEASURED.")
     lines = [
         f"# Imported by `frictionlab datasets import velstep` from {raw.path.name}: measured data; do not edit by hand.",
@@ -356,16 +343,18 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
         'x = "um"                   # load-point displacement' + (" (jumps stitched)" if jumps else ""),
         'mu = ""',
         "",
-        "[noise]                    # friction's noise: estimated from the data, correlated (AR(1))",
+        "[noise]                    # friction's noise: estimated with the fit, AR(p) chosen by the data",
         'kind = "estimated"',
-        'correlation = "ar1"',
+        'correlation = "arp"',
         "",
         "[scene]",
         'mass = "1 kg"              # not used by a quasi-static slider',
         "",
-        f"[scene.normal]             # the mean {raw.stress} on a unit area: only a slider's inertia reads it",
+        f"[scene.normal]             # the mean {raw.stress} on a unit area: only a slider's inertia reads it"
+        if stress is not None else "[scene.normal]             # the record has no normal load: a unit load (only a "
+                                   "slider's inertia reads it)",
         'model = "constant"',
-        f'value = "{stress:.6g} N"',
+        f'value = "{stress if stress is not None else 1.0:.6g} N"',
         "",
         "[scene.spring]",
         f'stiffness = "{w.stiffness * 1e-6:.4g} 1/um"   # {w.stiffness_note}',
@@ -436,7 +425,8 @@ def summary(imp: Imported) -> list[str]:
                      f"{b[i + 1] - b[i]} + {b[i + 2] - b[i + 1]}"))
     widths = [max(len(r[j]) for r in rows) for j in range(len(rows[0]))]
     out += ["  " + "  ".join(c.ljust(wd) for c, wd in zip(r, widths)).rstrip() for r in rows]
-    out += [f"  note: {note}" for note in imp.notes]
+    read = ([f"read as {raw.encoding}"] if raw.encoding else []) + list(raw.notes)
+    out += [f"  note: {note}" for note in read + list(imp.notes)]
     return out
 
 

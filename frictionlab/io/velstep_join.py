@@ -16,7 +16,8 @@ import attrs
 import numpy as np
 
 from ..core.errors import DatasetError
-from .velstep import RawRecord, read_raw
+from .rawrecord import RawRecord
+from .velstep import read_raw
 
 
 @attrs.frozen(eq=False)
@@ -36,16 +37,17 @@ class JoinedRecord(RawRecord):
         return f"{self.where(a)} to {self.where(b - 1)}"
 
 
-def read_joined(paths) -> RawRecord:
-    """One record from the raw files ``paths`` of one experiment (one path: that file as read); a one-line
+def read_joined(paths, columns=None) -> RawRecord:
+    """One record from the raw files ``paths`` of one experiment, each read by ``read_raw`` in the layout
+    ``columns`` gives (None: the steadystate layout; one path: that file as read); a one-line
     DatasetError naming both files where they overlap with different samples or mix stress columns."""
     paths = [Path(p) for p in paths]
     if len(paths) == 1:
-        return read_raw(paths[0])
+        return read_raw(paths[0], columns=columns)
     if len({p.resolve() for p in paths}) != len(paths):
         raise DatasetError(f"{', '.join(map(str, paths))}: a file is named twice")
-    recs = sorted((read_raw(p) for p in paths), key=lambda r: float(r.t[0]))
-    stress = {r.stress for r in recs}
+    recs = sorted((read_raw(p, columns=columns) for p in paths), key=lambda r: float(r.t[0]))
+    stress = {r.stress if r.sn is not None else "no normal stress" for r in recs}
     if len(stress) > 1:
         raise DatasetError(f"{recs[0].path} and {recs[-1].path}: one experiment's files must record the same normal "
                            f"stress column, got {' and '.join(sorted(stress))}")
@@ -57,13 +59,15 @@ def read_joined(paths) -> RawRecord:
         overlap = np.flatnonzero(~new)
         if overlap.size:
             _check_overlap(recs[k - 1], r, overlap, np.concatenate(t), np.concatenate(x), np.concatenate(mu),
-                           np.concatenate(sn))
-        t.append(r.t[new]), x.append(r.x_um[new]), mu.append(r.mu[new]), sn.append(r.sn[new])
+                           None if r.sn is None else np.concatenate(sn))
+        t.append(r.t[new]), x.append(r.x_um[new]), mu.append(r.mu[new]), sn.append(None if r.sn is None else r.sn[new])
         src.append(np.full(int(new.sum()), k, dtype=np.int64)), lines.append(own[new])
         end = max(end, float(r.t[-1]))
     names = "+".join(r.path.name for r in recs)
     return JoinedRecord(path=recs[0].path.parent / names, t=np.concatenate(t), x_um=np.concatenate(x),
-                        mu=np.concatenate(mu), sn=np.concatenate(sn), stress=recs[0].stress,
+                        mu=np.concatenate(mu), sn=None if recs[0].sn is None else np.concatenate(sn), stress=recs[0].stress,
+                        layout=recs[0].layout, encoding=recs[0].encoding,
+                        notes=tuple(dict.fromkeys(n for r in recs for n in r.notes)),
                         first_line=int(lines[0][0]), lines=np.concatenate(lines),
                         files=tuple(r.path for r in recs), source=np.concatenate(src))
 
@@ -73,7 +77,9 @@ def _check_overlap(before: RawRecord, r: RawRecord, overlap, t, x, mu, sn) -> No
     for value."""
     j = np.searchsorted(t, r.t[overlap])
     j = np.clip(j, 0, t.size - 1)
-    same = (t[j] == r.t[overlap]) & (x[j] == r.x_um[overlap]) & (mu[j] == r.mu[overlap]) & (sn[j] == r.sn[overlap])
+    same = (t[j] == r.t[overlap]) & (x[j] == r.x_um[overlap]) & (mu[j] == r.mu[overlap])
+    if sn is not None:
+        same &= sn[j] == r.sn[overlap]
     if not same.all():
         i = int(overlap[np.flatnonzero(~same)[0]])
         raise DatasetError(f"{r.path}: line {r.line(i)}: t = {r.t[i]:.10g} s lies within {before.path.name} "

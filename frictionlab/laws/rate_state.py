@@ -1,4 +1,4 @@
-"""Dieterich-Ruina rate-and-state friction, shared by the aging and slip evolution laws.
+"""Dieterich-Ruina rate-and-state friction, shared by the one-state evolution laws (aging, slip, PRZ, Nagata).
 
 mu = mu0 + a ln(V/V0) + b ln(V0 theta/Dc),  F = mu N sign(V). Evaluated in the regularized form
 mu = a asinh(V/(2 V0) exp(psi/a)), psi = mu0 + b ln(V0 theta/Dc) (Rice and Ben-Zion 1996), which
@@ -27,8 +27,19 @@ def asinh_exp(L):
     return np.where(L > 0, big, np.arcsinh(np.exp(np.minimum(L, 0.0))))
 
 
+def aging_rate(V, theta, Dc):
+    """d theta/dt [-] of the aging (Dieterich) law, 1 - |V| theta / Dc (V [m/s], theta [s], Dc [m])."""
+    return 1.0 - np.abs(V) * theta / Dc
+
+
+def slip_rate(V, theta, Dc):
+    """d theta/dt [-] of the slip (Ruina) law, -(|V| theta / Dc) ln(|V| theta / Dc), 0 at V = 0."""
+    x = np.abs(V) * theta / Dc
+    return -np.where(x > 0, x * np.log(np.where(x > 0, x, 1.0)), 0.0)
+
+
 class RateState(FrictionLaw):
-    """Base of the two rate-and-state laws (not registered itself): subclasses define ``rates``."""
+    """Base of the one-state rate-and-state laws (not registered itself): subclasses define ``rates``."""
 
     citation = ("Dieterich, J. Geophys. Res. 84 (1979); Ruina, J. Geophys. Res. 88 (1983); Marone, "
                 "Annu. Rev. Earth Planet. Sci. 26 (1998)")
@@ -42,17 +53,23 @@ class RateState(FrictionLaw):
     states = (StateSpec("theta", "s", "steady", 1.0, "state variable (contact age)"),)
     # at V -> 0 the force turns over from -capacity to +capacity within ~1e-30 m/s: stick there instead
     jumps_at_zero_slip = True
+    #: The steady state theta_ss = STEADY Dc / |V| (2 for the PRZ law, whose friction reads theta / (2 Dc)).
+    STEADY = 1.0
 
-    def mu(self, p, V, theta):
-        """Friction coefficient [-] at slip speed V [m/s] and state theta [s] (signed like V)."""
+    def evolution(self, p, state):
+        """The evolution effect [-] b ln(V0 theta / (STEADY Dc)) of the states (0 at steady sliding at V0)."""
+        return p["b"] * np.log(V0 * np.maximum(state["theta"], 1e-300) / (self.STEADY * p["Dc"]))
+
+    def mu(self, p, V, state):
+        """Friction coefficient [-] at slip speed V [m/s] and the states (by name, [s]), signed like V."""
         V = np.asarray(V, dtype=float)
-        psi = p["mu0"] + p["b"] * np.log(V0 * np.maximum(theta, 1e-300) / p["Dc"])
+        psi = p["mu0"] + self.evolution(p, state)
         with np.errstate(divide="ignore"):
             L = np.log(np.abs(V) / (2.0 * V0)) + psi / p["a"]
         return p["a"] * np.sign(V) * asinh_exp(L)
 
     def force(self, p, c):
-        return c.N * self.mu(p, c.u, c.state["theta"])
+        return c.N * self.mu(p, c.u, c.state)
 
     def steady_state(self, p, c):
-        return {"theta": p["Dc"] / np.maximum(np.abs(c.u), V_FLOOR)}
+        return {"theta": self.STEADY * p["Dc"] / np.maximum(np.abs(c.u), V_FLOOR)}

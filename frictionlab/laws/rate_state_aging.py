@@ -1,7 +1,7 @@
 """Rate-and-state friction with the aging (Dieterich) evolution law: d theta/dt = 1 - |V| theta / Dc.
 
 The state grows as the time of stationary contact (healing in a hold as ln t)."""
-from frictionlab.laws.rate_state import RateState
+from frictionlab.laws.rate_state import RateState, aging_rate
 
 
 class RateStateAging(RateState):
@@ -10,4 +10,4 @@ class RateStateAging(RateState):
     citation = "Dieterich, J. Geophys. Res. 84, 2161 (1979); " + RateState.citation
 
     def rates(self, p, c):
-        return {"theta": 1.0 - abs(c.u) * c.state["theta"] / p["Dc"]}
+        return {"theta": aging_rate(c.u, c.state["theta"], p["Dc"])}

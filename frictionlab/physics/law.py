@@ -44,14 +44,43 @@ QUANTITIES = {
     "A": "contact area [m^2]",
     "dAdt": "rate of change of contact area [m^2/s]",
     "t": "time since first contact [s]",
+    "dmudt": "rate of the friction coefficient d mu/dt [1/s] (a spring-slider's load rate k (V_lp - V))",
 }
 
 
 @attrs.frozen
 class ParamSpec:
-    """One law parameter. ``unit`` is the SI unit of the value; ``scale`` its typical size; ``display`` the unit
-    the value is shown in everywhere (reports, summaries, notebook views), e.g. "um" for a slip distance in m;
-    "" shows it in ``unit``."""
+    """One parameter of a law.
+
+    Attributes
+    ----------
+    name : str
+        The parameter's name, a Python identifier (``lam``, ``mu``, ``Dc``).
+    unit : str
+        The SI unit of its value (``"Pa s/m"``; ``""`` or ``"-"`` for a dimensionless one).
+    default : float
+        Its default value [unit], the start of a fit unless one is given.
+    lower, upper : float
+        The bounds a fit keeps it within [unit].
+    scale : float
+        Its typical size [unit]: the optimizer works on the value divided by it.
+    description : str
+        What it is, in a few words (shown by ``frictionlab laws``).
+    display : str, default ""
+        The unit it is shown in everywhere (reports, summaries, notebook views), e.g. ``"um"`` for a slip
+        distance in m; ``""`` shows it in ``unit``.
+
+    Raises
+    ------
+    LawError
+        A name that is not an identifier, a unit pint does not read, or a default outside its bounds.
+
+    Examples
+    --------
+    >>> from frictionlab import ParamSpec
+    >>> ParamSpec("v_s", "m/s", 0.1, 1e-6, 100.0, 0.1, "Stribeck velocity").unit
+    'm/s'
+    """
 
     name: str
     unit: str
@@ -73,8 +102,23 @@ class ParamSpec:
 class StateSpec:
     """One internal state of a law with memory.
 
-    ``unit`` is the SI unit of the value; ``initial`` its SI value at the start, or "steady" (the law's
-    ``steady_state`` at the initial slip); ``scale`` its typical size (the ODE's tolerances act relative to it).
+    Attributes
+    ----------
+    name : str
+        The state's name, a Python identifier (``theta``, ``z``).
+    unit : str
+        The SI unit of its value.
+    initial : float or "steady"
+        Its value at the start [unit], or ``"steady"``: the law's ``steady_state`` at the initial slip.
+    scale : float
+        Its typical size [unit]: the ODE solver's tolerances act relative to it.
+    description : str
+        What it is, in a few words.
+
+    Raises
+    ------
+    LawError
+        A name that is not an identifier, or an initial value that is neither a finite number nor "steady".
     """
 
     name: str
@@ -99,9 +143,25 @@ class StateSpec:
 
 @attrs.frozen
 class Contact:
-    """Contact quantities at sample times, SI arrays; a quantity the plan did not build is None.
+    """The contact quantities a law's ``force`` and ``rates`` receive, SI arrays at the sample times.
 
-    ``state`` holds a law's internal states by their unprefixed names (None for a memoryless law).
+    Attributes
+    ----------
+    t : numpy.ndarray
+        Time [s].
+    u : numpy.ndarray
+        Slip velocity [m/s].
+    N : numpy.ndarray or None
+        Normal force [N]; None when the plan did not build it (the law does not require it).
+    A : numpy.ndarray or None
+        Contact area [m^2], or None.
+    dAdt : numpy.ndarray or None
+        Rate of change of the contact area [m^2/s], or None.
+    state : mapping of str to numpy.ndarray, or None
+        A law's internal states by their unprefixed names (None for a memoryless law).
+    dmudt : numpy.ndarray or None
+        The friction coefficient's rate [1/s], for a law that requires ``"dmudt"`` (Nagata's state law); None
+        otherwise.
     """
 
     t: np.ndarray
@@ -110,18 +170,35 @@ class Contact:
     A: np.ndarray | None = None
     dAdt: np.ndarray | None = None
     state: Mapping[str, np.ndarray] | None = None
+    dmudt: np.ndarray | None = None
 
 
 @attrs.frozen
 class AreaSlipForm:
-    """F = k A u. Laws of this form have closed-form solutions on half-sine and constant-area scenes."""
+    """The form F = k A u, which a law's ``form`` returns to unlock closed-form solutions on half-sine and
+    constant-area scenes.
+
+    Attributes
+    ----------
+    k : float
+        The coefficient [Pa s/m] (``lam`` for the wear law, ``eta / h`` for Couette friction).
+    """
 
     k: float  # [Pa s/m]
 
 
 @attrs.frozen
 class NormalAreaRateForm:
-    """F = sign(u) (a N + c dA/dt). Closed forms exist while slip keeps its sign."""
+    """The form F = sign(u) (a N + c dA/dt), which a law's ``form`` returns to unlock closed forms (while
+    the slip keeps its sign).
+
+    Attributes
+    ----------
+    a : float
+        The coefficient of the normal force [-] (``mu``).
+    c : float
+        The coefficient of the area's rate [N s/m^2] (``mu eta'`` for the area-rate law).
+    """
 
     a: float  # [-]
     c: float  # [N s/m^2]
@@ -145,7 +222,35 @@ def _fenced(fn):
 
 
 class FrictionLaw:
-    """Base class of a law plugin. Subclasses set the class attributes and ``force``."""
+    """Base class of a friction law: subclass it, set the class attributes and ``force``, and register it
+    (`register_law`, or an entry point in group ``frictionlab.laws``).
+
+    Attributes
+    ----------
+    name : str
+        The registered name (``"exp-stribeck"``).
+    formula : str
+        The force in words and symbols, shown by ``frictionlab laws`` and in reports.
+    citation : str
+        Where the law comes from.
+    params : tuple of ParamSpec
+        Its parameters, each with its SI unit, bounds and typical scale.
+    requires : frozenset of str
+        The contact quantities ``force`` reads, from ``u``, ``N``, ``A``, ``dAdt`` and ``t``.
+    ratio_only : tuple of (str, str)
+        Parameter pairs that enter the force only through their ratio (``(("eta", "h"),)``).
+    states : tuple of StateSpec
+        Internal states of a law with memory, integrated with the motion; () for a memoryless law.
+    jumps_at_zero_slip : bool
+        A law with memory whose force jumps at zero slip: stick events instead of integrating through zero.
+
+    Examples
+    --------
+    >>> import frictionlab as fl
+    >>> law = fl.get_law("coulomb")
+    >>> isinstance(law, fl.FrictionLaw), sorted(law.requires)
+    (True, ['N', 'u'])
+    """
 
     name: ClassVar[str]
     formula: ClassVar[str]

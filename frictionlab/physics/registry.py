@@ -144,6 +144,7 @@ def validate_law(law: FrictionLaw, source: str) -> None:
         N=np.full(n, 10.0) if "N" in law.requires else None,
         A=np.full(n, 1e-4) if "A" in law.requires else None,
         dAdt=np.zeros(n) if "dAdt" in law.requires else None,
+        dmudt=np.zeros(n) if "dmudt" in law.requires else None,
     )
     p = law.defaults()
     try:
@@ -264,12 +265,46 @@ def _load() -> None:
 
 
 def register_law(obj: type[FrictionLaw] | FrictionLaw | None = None, *, replace: bool = False) -> object:
-    """Register a law class or instance at run time; usable as a class decorator (then it returns the class,
-    else what it was given).
+    """Register a law class or instance at run time; usable as a class decorator.
 
-    ``replace=True`` swaps out a law of the same name registered earlier at run time. Registering the
-    same class again (a notebook cell run twice) is a no-op with a warning; a class of the same module and
-    name defined anew (the cell edited) replaces the earlier one, with a warning saying so.
+    Registering the same class again (a notebook cell run twice) is a no-op with a warning; a class of the
+    same module and name defined anew (the cell edited) replaces the earlier one, with a warning saying so.
+
+    Parameters
+    ----------
+    obj : type[FrictionLaw] or FrictionLaw, optional
+        The law: a subclass of `FrictionLaw` (instantiated without arguments) or an instance. Omitted,
+        ``register_law(replace=True)`` returns a decorator.
+    replace : bool, default False
+        Swap out a law of the same name registered earlier at run time.
+
+    Returns
+    -------
+    object
+        What it was given (the class, when used as a decorator), or a decorator when ``obj`` is omitted.
+
+    Raises
+    ------
+    RegistryError
+        The law is not a valid `FrictionLaw` (a parameter without a unit, an unknown requirement, ...) or its
+        name is taken by a built-in or entry-point law, or by a run-time law and ``replace`` is False.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import frictionlab as fl
+    >>> @fl.register_law
+    ... class Viscous(fl.FrictionLaw):
+    ...     name = "viscous-doc"
+    ...     formula = "F = c u"
+    ...     citation = "a linear damper"
+    ...     params = (fl.ParamSpec("c", "N s/m", 1.0, 0.0, 1e6, 1.0, "damping coefficient"),)
+    ...     requires = frozenset({"u"})
+    ...     def force(self, p, c):
+    ...         return p["c"] * c.u
+    >>> fl.get_law("viscous-doc").formula
+    'F = c u'
+    >>> fl.unregister_law("viscous-doc")
     """
 
     def _register(o):
@@ -300,7 +335,18 @@ def _runtime_add(law: FrictionLaw, source: str, replace: bool) -> None:
 
 
 def unregister_law(name: str) -> None:
-    """Remove a law registered at run time (entry-point laws stay)."""
+    """Remove a law registered at run time (entry-point laws stay).
+
+    Parameters
+    ----------
+    name : str
+        The registered name of the law.
+
+    Raises
+    ------
+    RegistryError
+        No law of that name is registered, or it comes from an entry point (a package), not from run time.
+    """
     _load()
     if name not in _laws:
         raise RegistryError(f"unknown law '{name}'")
@@ -312,7 +358,30 @@ def unregister_law(name: str) -> None:
 
 
 def get_law(name: str | FrictionLaw) -> FrictionLaw:
-    """The registered law called ``name`` (a law instance is returned as is)."""
+    """The registered law called ``name``.
+
+    Parameters
+    ----------
+    name : str or FrictionLaw
+        A registered name (``frictionlab laws`` lists them); a law instance is returned as it is.
+
+    Returns
+    -------
+    FrictionLaw
+        The law: its parameters (``law.params``, SI units), formula, citation and force.
+
+    Raises
+    ------
+    RegistryError
+        No law of that name is registered (the message lists those that are).
+
+    Examples
+    --------
+    >>> import frictionlab as fl
+    >>> law = fl.get_law("wear")
+    >>> [(p.name, p.unit) for p in law.params]
+    [('lam', 'Pa s/m')]
+    """
     if isinstance(name, FrictionLaw):
         return name
     _load()
@@ -329,7 +398,19 @@ def is_third_party(law) -> bool:
 
 
 def available_laws() -> dict[str, FrictionLaw]:
-    """All registered laws by name, in registration order."""
+    """All registered laws by name, in registration order.
+
+    Returns
+    -------
+    dict of str to FrictionLaw
+        The built-in laws, those of installed packages (entry points) and those registered at run time.
+
+    Examples
+    --------
+    >>> import frictionlab as fl
+    >>> {"coulomb", "wear", "area-rate", "couette"} <= set(fl.available_laws())
+    True
+    """
     _load()
     return dict(_laws)
 

@@ -53,7 +53,41 @@ class SceneSource(Protocol):
 
 @attrs.frozen
 class Scene:
-    """Everything about an experiment except the friction law; SI floats throughout."""
+    """Everything about an experiment except the friction law; SI floats throughout.
+
+    Attributes
+    ----------
+    kind : str
+        The scene kind: ``impact``, ``incline``, ``spring-slider``, ... (``frictionlab datasets template``
+        lists them).
+    mass : float
+        Mass of the sliding body [kg].
+    u0 : float
+        Initial slip at the contact [m/s].
+    duration : float
+        Simulated time span [s].
+    radius : float, optional
+        Radius of a ball [m] (for spin).
+    inertia_factor : float, default 0.4
+        I = inertia_factor m r^2 (0.4 for a solid sphere).
+    omega0 : float, default 0.0
+        Initial spin [rad/s].
+    incline : float, optional
+        Incline angle [rad], between 0 and pi/2.
+    area, normal : object, optional
+        The contact-area and normal-force models (half-sine, constant, growth, Hertz, column, ...).
+    compliance : object, optional
+        Tangential compliance of the contact, for impact outcomes.
+    effects : frozenset of str
+        Extra effects of the scene.
+    spring : SpringLoad, optional
+        The driving spring and load-point history of a spring-slider.
+
+    Raises
+    ------
+    SceneError
+        A value outside its range (a negative mass, an incline not between 0 and pi/2, an unknown kind).
+    """
 
     kind: str
     mass: float = attrs.field(validator=positive)  # [kg]
@@ -103,6 +137,8 @@ class Scene:
             q |= {"A", "dAdt"}
         if self.normal is not None:
             q.add("N")
+        if self.spring is not None:  # the spring's load rate per unit normal force, k (V_lp - V)
+            q.add("dmudt")
         return q
 
     def with_(self, **changes: object) -> "Scene":

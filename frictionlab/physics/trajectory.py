@@ -18,11 +18,26 @@ CSV_UNITS = {"t": "s", "u": "m/s", "v": "m/s", "omega": "rad/s", "theta": "rad",
 
 @attrs.frozen(eq=False)
 class Trajectory:
-    """Sampled motion: time t [s], slip u [m/s], body velocity v [m/s], spin omega [rad/s],
-    rotation angle theta [rad], friction force [N], and contact area A [m^2] and normal force
-    N [N] where the plan built them. A body without a spin state has omega = theta = 0.
-    ``load`` is a spring-slider's spring force per unit normal force [-] (the measured friction coefficient).
-    ``law_states`` holds a law's internal states by name (SI, e.g. {"z": ...}); empty for a memoryless law.
+    """Sampled motion, what `simulate` returns; SI arrays.
+
+    Attributes
+    ----------
+    t : numpy.ndarray
+        Time [s].
+    u : numpy.ndarray
+        Slip velocity at the contact [m/s].
+    v : numpy.ndarray
+        Body velocity [m/s].
+    omega, theta : numpy.ndarray
+        Spin [rad/s] and rotation angle [rad]; zero for a body without a spin state.
+    force : numpy.ndarray
+        Friction force [N].
+    A, N : numpy.ndarray or None
+        Contact area [m^2] and normal force [N], where the plan built them.
+    load : numpy.ndarray or None
+        A spring-slider's spring force per unit normal force [-] (the measured friction coefficient).
+    law_states : dict of str to numpy.ndarray
+        A law's internal states by name (SI, e.g. ``{"z": ...}``); empty for a memoryless law.
     """
 
     t: np.ndarray
@@ -48,8 +63,14 @@ class Trajectory:
         return value
 
     def columns(self) -> dict[str, np.ndarray]:
-        """The series by name (SI): t, u, v, omega, theta, force, then A, N, load where built, then each
-        law state as ``state_NAME`` (a rate-and-state 'theta' is ``state_theta``, never the rotation angle)."""
+        """The series by name.
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            t, u, v, omega, theta, force, then A, N, load where built, then each law state as ``state_NAME``
+            (a rate-and-state 'theta' is ``state_theta``, never the rotation angle); SI.
+        """
         out = {k: getattr(self, k) for k in ("t", "u", "v", "omega", "theta", "force")}
         out.update({k: getattr(self, k) for k in ("A", "N", "load") if getattr(self, k) is not None})
         out.update({f"state_{k}": np.asarray(v) for k, v in self.law_states.items()
@@ -57,7 +78,20 @@ class Trajectory:
         return out
 
     def to_dataframe(self) -> pd.DataFrame:
-        """The columns as a pandas DataFrame (SI; units by column in ``df.attrs['units']``)."""
+        """The columns as a pandas DataFrame.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One column per series (SI; units by column in ``df.attrs['units']``).
+
+        Examples
+        --------
+        >>> import frictionlab as fl
+        >>> traj = fl.simulate("coulomb", fl.load_dataset("impact-golf-v28"), {"mu": 0.3}, solver="exact")
+        >>> list(traj.to_dataframe().columns[:6])
+        ['t', 'u', 'v', 'omega', 'theta', 'force']
+        """
         import pandas as pd
 
         df = pd.DataFrame(self.columns())
@@ -71,16 +105,34 @@ class Trajectory:
                 + (f"; stuck at {self.stick_time:.4g} s" if self.stick_time is not None else "") + ">")
 
     def plot(self, y: str = "omega", ax: Axes | None = None, **style: object) -> Axes:
-        """Draw the series ``y`` (a column name: omega, theta, u, v, force, A, N, load, or a law state as
-        ``state_NAME``) against time on ``ax`` (a new figure if None), in display units; returns the Axes.
-        ``style`` goes to matplotlib's ``plot`` (color, ls, label ...)."""
+        """Draw one series against time, in display units (rpm for spin, µs or ms for time).
+
+        Parameters
+        ----------
+        y : str, default "omega"
+            A column name: omega, theta, u, v, force, A, N, load, or a law state as ``state_NAME``.
+        ax : matplotlib.axes.Axes, optional
+            Where to draw; default a new figure's axes.
+        **style
+            Passed to matplotlib's ``plot`` (color, ls, label, ...).
+
+        Returns
+        -------
+        matplotlib.axes.Axes
+            The axes drawn on.
+
+        Raises
+        ------
+        KeyError
+            ``y`` is not one of the trajectory's columns.
+        """
         from ..core.display import axis_label, figure_axes, time_unit, unit
 
         cols = self.columns()
         if y not in cols and not (y == "mu" and "load" in cols):
             raise KeyError(f"trajectory has no series '{y}'; it has {', '.join(cols)}")
         values = cols[y] if y in cols else cols["load"]
-        _, ax = figure_axes(ax)
+        _, ax = figure_axes(ax, where="Trajectory.plot")
         tname, tf = time_unit(float(self.t[-1]) if len(self.t) else 0.0)
         shown, factor = unit(y)
         style.setdefault("label", f"{self.law} [{self.solver}]")
@@ -105,14 +157,31 @@ class Trajectory:
                 "<table><tr><th>column</th><th>unit (SI)</th><th>min</th><th>max</th></tr>" + rows + "</table>")
 
     def csv_text(self) -> str:
-        """The columns (SI, units in CSV_UNITS) as CSV text, full precision."""
+        """The columns as CSV text.
+
+        Returns
+        -------
+        str
+            A header line, then one row per sample: SI values at full precision (units in ``CSV_UNITS``).
+        """
         cols = self.columns()
         rows = np.column_stack(list(cols.values()))
         lines = [",".join(cols)] + [",".join(f"{x:.17g}" for x in row) for row in rows]
         return "\n".join(lines) + "\n"
 
     def to_csv(self, path: str | os.PathLike) -> None:
-        """Write the columns (SI) to ``path`` atomically."""
+        """Write the columns (SI) as CSV, whole or not at all.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The CSV file to write.
+
+        Raises
+        ------
+        OSError
+            The file cannot be written (nothing is left behind).
+        """
         from ..core.files import atomic_write_text
 
         atomic_write_text(path, self.csv_text())

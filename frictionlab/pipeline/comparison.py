@@ -26,13 +26,14 @@ import attrs
 import numpy as np
 
 from ..core.arguments import as_items
-from ..core.errors import FrictionLabError
-from ..inference.equivalence.discrimination import PAIRS, REPLICATES, EquivalenceResult
+from ..core.errors import FrictionLabError, ParameterError
+from ..inference.equivalence.discrimination import REPLICATES, EquivalenceResult
 from ..inference.fitting.fit import FitResult, scene_ranges
 from ..inference.equivalence.margin import MARGIN
 from ..inference.verdicts.ranking import RankRow
 from ..inference.equivalence.transfer import TransferResult
 from ..io.dataset import Dataset, available_names, load_dataset
+from ..io.dataset import check_dataset_like
 from .planning import (  # noqa: F401
     candidates,
     equivalence_pairs,
@@ -43,7 +44,7 @@ from .planning import (  # noqa: F401
 from .perdataset import run_per_dataset
 from .runner import Progress, Run, select
 from .runner import run_stages as run_stages_with
-from .settings import DEFAULT_LAWS, DEFAULT_LAWS_BY_KIND, Settings, default_laws_by_kind, select_laws  # noqa: F401
+from .settings import DEFAULT_LAWS, DEFAULT_LAWS_BY_KIND, Settings, check_pairs, default_laws_by_kind, select_laws  # noqa: F401
 from .stages import STAGES
 from ..core.fpstate import with_own_errstate
 
@@ -56,13 +57,33 @@ if TYPE_CHECKING:  # annotations only
 
 @attrs.frozen(eq=False)
 class Comparison:
-    """Everything a report needs: fits, rankings, equivalence results, and what was left out."""
+    """What `compare` returns: everything a report needs.
+
+    Attributes
+    ----------
+    laws : tuple of str
+        The laws compared.
+    datasets : tuple of Dataset
+        Every dataset asked for, fitted or not (``skipped_datasets`` says why one was not).
+    fits : tuple of FitResult
+        Every fit, per dataset, law and solver.
+    ranking : tuple of RankRow
+        The ranking per dataset; ``groups`` the same over each group of datasets.
+    equivalence : tuple of EquivalenceResult
+        The equivalence verdicts, law A against law B per dataset.
+    answers : tuple
+        The answer per dataset group: the report's first screen.
+    settings : dict
+        The options the comparison ran with, as ``results.json`` writes them.
+    wall_time : float
+        Wall-clock time of the comparison [s].
+    """
 
     laws: tuple[str, ...]
     datasets: tuple[Dataset, ...]  # every dataset asked for, fitted or not
     fits: tuple[FitResult, ...]
     ranking: tuple[RankRow, ...]  # per dataset
-    groups: tuple[RankRow, ...]  # ALL, ALL[kind] and each dataset group of two or more
+    groups: tuple[RankRow, ...]  # each declared dataset group of two or more
     equivalence: tuple[EquivalenceResult, ...]  # discrimination tests (law A vs law B per dataset)
     skipped_datasets: dict  # name -> reason
     wall_time: float
@@ -78,18 +99,60 @@ class Comparison:
     accuracy: tuple = ()  # accuracy.SolverCost rows: each solver's error and time per law and dataset
 
     def fit_for(self, dataset: str, law: str, solver: str | None = None) -> FitResult | None:
-        """The fit of ``law`` (with ``solver``, if given) to the single dataset ``dataset``, or None."""
+        """The fit of one law to one dataset.
+
+        Parameters
+        ----------
+        dataset : str
+            The dataset's name.
+        law : str
+            The law's name.
+        solver : str, optional
+            The solver (``"exact"``, ``"series"``, ``"ode"``); any when None.
+
+        Returns
+        -------
+        FitResult or None
+            The fit, or None when there is none.
+        """
         for f in self.fits:
             if f.datasets == (dataset,) and f.law == law and (solver is None or f.solver == solver):
                 return f
         return None
 
     def fits_on(self, dataset: str) -> list[FitResult]:
-        """Every single-dataset fit to ``dataset``."""
+        """Every fit to one dataset alone.
+
+        Parameters
+        ----------
+        dataset : str
+            The dataset's name.
+
+        Returns
+        -------
+        list of FitResult
+            Its fits, by law and solver.
+        """
         return [f for f in self.fits if f.datasets == (dataset,)]
 
     def dataset(self, name: str) -> Dataset:
-        """The compared dataset called ``name``."""
+        """The compared dataset called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            The dataset's name.
+
+        Returns
+        -------
+        Dataset
+            The dataset.
+
+        Raises
+        ------
+        StopIteration
+            No compared dataset has that name.
+        """
         return next(d for d in self.datasets if d.name == name)
 
     @property
@@ -98,15 +161,28 @@ class Comparison:
         return [d for d in self.datasets if d.name not in self.skipped_datasets]
 
     def to_dataframe(self) -> pd.DataFrame:
-        """The ranking as a tidy pandas DataFrame: one row per dataset and candidate (law, solver), with
-        the observable and the units of rss and rmse; group rows (ALL, ALL[kind]) after them."""
+        """The ranking as a tidy table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per dataset and candidate (law, solver): rank, fits, rss and rmse with their units,
+            reduced chi-square, AIC, AICc, BIC, delta AIC, Akaike weight, reason; the rows of the groups the
+            datasets declare after them.
+        """
         from ..inference.fitting.frames import ranking_frame
 
         return ranking_frame(self)
 
     def parameters_dataframe(self) -> pd.DataFrame:
-        """Every fitted parameter as a tidy pandas DataFrame: dataset, law, solver, parameter, value,
-        stderr, unit, kind, vary, fixed_by, lower, upper."""
+        """Every fitted parameter as a tidy table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per dataset, law, solver and parameter: value and stderr (SI), unit, kind, vary,
+            fixed_by, lower, upper.
+        """
         from ..inference.fitting.frames import parameters_frame
 
         return parameters_frame(self.fits)
@@ -120,10 +196,24 @@ class Comparison:
                 f"lowest AIC: {best}{more}>")
 
     def plot(self, ax: Axes | Sequence[Axes] | None = None, top: int = 3) -> Figure | Axes | Sequence[Axes]:
-        """What the report's first screen shows per dataset group, as one figure: for each group (its first
-        fitted dataset) the data with the ``top`` top-ranked candidates above and their residuals in units of
-        sigma below, each labelled with its rank and whether it passes its goodness-of-fit tests. Returns the matplotlib Figure; with ``ax``
-        (one Axes per group) the data and fits only, drawn there, and returns ``ax``."""
+        """What the report's first screen shows per dataset group, as one figure.
+
+        For each group (its first fitted dataset), the data with the ``top`` top-ranked candidates above and
+        their residuals in units of sigma below, each labelled with its rank and whether it passes its
+        goodness-of-fit tests.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes or sequence of them, optional
+            One Axes per group: the data and fits only, drawn there.
+        top : int, default 3
+            How many candidates to draw per group.
+
+        Returns
+        -------
+        matplotlib.figure.Figure or Axes
+            The new figure, or ``ax`` when given.
+        """
         from ..inference.verdicts.answers import group_of
         from ..inference.fitting.plots import fits_text, plot_ranking
 
@@ -163,49 +253,97 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             *, free: dict | None = None, equivalence: bool = True, jobs: int = 1,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
             tolerance: Sequence[float] = (), fit_timeout: float | None = None, replicates: int = REPLICATES,
-            pairs: Sequence = PAIRS, transfer: bool = True, stages: Sequence[str] | None = None,
+            pairs: Sequence | None = None, transfer: bool = True, stages: Sequence[str] | None = None,
             client: Client | None = None, margin: float | str = MARGIN, family: str = "report",
             accuracy: bool = True) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
 
-    laws: registered names, None for the default laws of each dataset kind (DEFAULT_LAWS on impacts and
-    inclines, DEFAULT_LAWS_BY_KIND: rate-and-state aging and slip on spring-sliders), or "all" for every
-    registered law; datasets: built-in names, names of measured records, TOML paths or Datasets (default every
-    built-in dataset and every measured record present, ``available_names``); solvers: None for the default
-    choice, or a list of 'exact', 'series', 'ode[:METHOD]', 'auto'; free: scene quantities fitted per
-    dataset, name -> bounds, 'low:high' with units or a tuple of SI numbers, quantity strings or pint
-    Quantities (see fitting.SCENE_QUANTITIES); jobs: worker processes; progress(done, total, label).
-    bootstrap: parametric replicates per dataset (0: none), drawn from ``seed``; datasets where a law
-    needs the ODE, or without a time series, are bootstrapped only with bootstrap_all. tolerance: looser ODE tolerances at
-    which the ODE laws of one dataset are refitted (empty: no tolerance check). fit_timeout: time
-    budget of each fit in seconds (None: none), the refits of the equivalence test, bootstrap, transfer
-    and tolerance check included; a fit past it is a failed row saying so (a refit, a failed replicate). replicates: R per
-    law of the equivalence test's parametric bootstrap (seeded by ``seed``); pairs: (law A, law B)
-    to test (default equivalence.PAIRS); pairs where a law needs the ODE solver, or without a time
-    series, are tested only with bootstrap_all. transfer: run the transfer stage. margin: the equivalence
-    margin delta, a multiple of each dataset's noise sigma (default MARGIN = 1) or a quantity in the
-    observable's unit ('150 rpm'; ``inference.equivalence.margin``). family: 'report' (default: Holm over every
-    hypothesis of the report's equivalence tests, one family-wise error rate ALPHA) or 'group' (Holm within
-    each dataset group only; ``inference.equivalence.family``). accuracy: what accuracy costs (each solver's
-    error and time against the most accurate one at the fitted parameters, ``inference.cost.accuracy``), where it
-    is cheap; with ``tolerance`` given, everywhere.
-    stages: the names of the stages to run (``stages.STAGES``: fit, rank, equivalence, transfer,
-    tolerance, bootstrap, answer), None for every stage the options above switch on; ``run_stages``
-    runs more of them on the result later. client: a dask.distributed Client; the fits, refits, tests and
-    bootstrap then run on its workers instead of ``jobs`` local processes (the same numbers either way).
-    The command line's ``frictionlab compare`` differs in two defaults (said in its --help): bootstrap
-    150 and fit_timeout 900 s; here each runs only when asked for. Neither runs the tolerance check unless
-    asked (``--tolerance``; here ``tolerance=(1e-3, 1e-10)``).
+    The command line's ``frictionlab compare`` differs in two defaults (said in its ``--help``): bootstrap 150
+    and fit_timeout 900 s; here each runs only when asked for.
+
+    Parameters
+    ----------
+    laws : sequence of str or "all", optional
+        Registered names; None for the default laws of each dataset kind (Coulomb, area-rate, wear and Couette
+        on impacts and inclines; rate-and-state aging, slip and PRZ on spring-sliders); "all" for every registered
+        law.
+    datasets : sequence, optional
+        Built-in names, names of measured records, TOML paths or Datasets; default every built-in dataset and
+        every measured record present.
+    solvers : sequence of str, optional
+        ``"exact"``, ``"series"``, ``"ode[:METHOD]"``, ``"auto"``; None for the default choice per law.
+    free : dict, optional
+        Scene quantities fitted per dataset: name -> bounds, ``"low:high"`` with units or a tuple of SI
+        numbers, quantity strings or pint Quantities (``u0`` [m/s], ...).
+    equivalence : bool, default True
+        Run the equivalence tests of ``pairs``.
+    jobs : int, default 1
+        Worker processes.
+    progress : Progress, optional
+        Called as ``progress(done, total, label)``.
+    bootstrap : int, default 0
+        Parametric replicates of the ranking per dataset (0: none), drawn from ``seed``.
+    seed : int, default 0
+        Seed of every random draw (bootstrap, replicates).
+    bootstrap_all : bool, default False
+        Also bootstrap and test datasets where a law needs the ODE, or without a time series.
+    tolerance : sequence of float, default ()
+        Looser ODE tolerances at which the ODE laws of one dataset are refitted (empty: no check).
+    fit_timeout : float, optional
+        Time budget of each fit [s], its refits included; a fit past it is a failed row saying so.
+    replicates : int
+        Replicates per law of the equivalence test's parametric bootstrap.
+    pairs : sequence of (str, str) or "LAW:LAW" strings, optional
+        The pairs of laws to test, each two different compared laws, each tested once whatever its order;
+        None: ``equivalence.PAIRS``, those whose laws are both compared.
+    transfer : bool, default True
+        Run the transfer stage (parameters fitted on one dataset of a group predicting the others).
+    stages : sequence of str, optional
+        The stages to run (fit, rank, equivalence, transfer, tolerance, bootstrap, answer); None for every
+        stage the options switch on. `run_stages` runs more of them on the result later.
+    client : distributed.Client, optional
+        A Dask client: fits, refits, tests and bootstrap run on its workers instead of ``jobs`` local
+        processes (the same numbers either way).
+    margin : float, str or pint Quantity, default 1
+        The equivalence margin delta: a positive multiple of each dataset's noise sigma, or a positive quantity
+        in the observable's unit (``"150 rpm"``); refused with ``equivalence=False``.
+    family : {"report", "group"}, default "report"
+        Holm's adjustment over every hypothesis of the report, or within each dataset group only.
+    accuracy : bool, default True
+        Measure what accuracy costs (each solver's error and time against the most accurate one at the fitted
+        parameters) where it is cheap; with ``tolerance`` given, everywhere.
+
+    Returns
+    -------
+    Comparison
+        The fits, rankings, equivalence verdicts and answers; `write_report` writes it as a report.
+
+    Raises
+    ------
+    FrictionLabError
+        An unknown law or dataset, a dataset that does not load, or an option out of range (the message
+        names it).
+
+    Examples
+    --------
+    >>> import frictionlab as fl
+    >>> c = fl.compare(laws=["wear", "coulomb"], datasets=["impact-golf-v28"], equivalence=False)
+    >>> table = c.to_dataframe()
+    >>> print(table[table.dataset == "impact-golf-v28"][["candidate", "rank", "fits"]].to_string(index=False))
+          candidate  rank  fits
+      wear [series]     1  True
+       wear [exact]     2 False
+    coulomb [exact]     3 False
     """
     started = time.perf_counter()
     settings = Settings(laws=(), solvers=tuple(solvers) if solvers else None,
                         free=scene_ranges(free, "compare: free"), equivalence=equivalence, jobs=jobs, bootstrap=bootstrap, seed=seed,
                         bootstrap_all=bootstrap_all, tolerance=tuple(tolerance), fit_timeout=fit_timeout,
-                        replicates=replicates, pairs=tuple(pairs), transfer=transfer, cluster=cluster_name(client),
+                        replicates=replicates, transfer=transfer, cluster=cluster_name(client),
                         margin=margin, family=family, accuracy=accuracy)
     chosen = select(STAGES, stages)
-    dss = unique_datasets(load_dataset(d) for d in (as_items(datasets, "compare: datasets") if datasets is not None
-                                                    else available_names()))
+    dss = unique_datasets(_dataset(d) for d in (as_items(datasets, "compare: datasets") if datasets is not None
+                                                else available_names()))
     if not dss:
         raise FrictionLabError("compare: no datasets to compare")
     if laws is None:  # the default laws of each dataset kind
@@ -214,8 +352,14 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                                 by_kind=by_kind)
     else:
         settings = attrs.evolve(settings, laws=select_laws(laws))
+    if pairs is not None:
+        groups = [settings.laws] if laws is not None else list(settings.by_kind.values())
+        settings = attrs.evolve(settings, pairs=check_pairs(pairs, groups))
     if equivalence:
         settings.margin.check(dss)
+    elif not settings.margin.default:
+        raise ParameterError(f"compare: margin {settings.margin.as_text()!r} applies to the equivalence tests, which "
+                             "equivalence=False skips; drop one of the two")
     run = _make_run(settings, dss, progress, client)
     settings.check_replicates()
     c = Comparison(laws=settings.laws, datasets=dss, fits=run.plan.skipped_fits, ranking=(), groups=(),
@@ -245,6 +389,12 @@ def _run_stages(c: Comparison, run: Run, stages: list, forced: bool) -> Comparis
     if run.client is not None and any(s.name == "fit" for s in chosen):
         c, chosen = run_per_dataset(c, run, chosen)
     return run_stages_with(c, run, chosen, forced=True)
+
+
+def _dataset(d) -> Dataset:
+    """A dataset argument of compare loaded, or checked still to be what loading made of it (``io.intact``)."""
+    check_dataset_like(d, "compare: datasets")
+    return load_dataset(d).check("compare")
 
 
 def cluster_name(client) -> str:

@@ -1,6 +1,7 @@
 """The comparison report: one folder, written whole or not at all.
 
-``write_report(comparison, out, force=False, progress=None)`` writes, through ``io.atomic_dir``:
+``write_report(comparison, out, force=False, progress=None)`` writes, through ``core.outfolder.atomic_dir`` (with
+``force``, what the user added to an earlier report folder is kept):
 ``report.md``; a self-contained ``report.html`` (figures embedded, a small inline script sorts
 tables); ``figures/*.png``; ``ranking.csv``; ``results.json`` (schema in ``results.py``).
 
@@ -42,7 +43,7 @@ import attrs
 
 from ..core.arguments import check_type
 from ..core.errors import OutputError
-from ..core.files import atomic_dir
+from ..core.outfolder import atomic_dir
 from ..core.inputs import check_apart
 from ..core.workers import long_run_gc
 from . import (
@@ -192,13 +193,36 @@ def _batches(items, n: int):
 def write_report(c: Comparison, out: str | os.PathLike, force: bool = False,
                  progress: Callable[[int, int, str], None] | None = None, jobs: int = 1,
                  client: Client | None = None) -> Path:
-    """Write the report folder ``out`` whole or not at all; an existing folder is replaced only with force=True.
+    """Write the report of a comparison into a folder, whole or not at all.
 
-    progress(done, total, label), if given, is called after each figure and file. jobs: worker
-    processes drawing the figures (the same PNG bytes as one process draws); client: a dask.distributed
-    Client whose workers draw them instead. A comparison of more than ``pages.GROUP_PAGES_AT`` dataset groups
-    is written as an index (report.html/.md: every group's verdict, the summary, a link per group) and one
-    page per group (groups/GROUP.html/.md, its figures in figures/GROUP/).
+    The folder holds ``report.html`` (self-contained), ``report.md``, ``figures/``, ``ranking.csv`` and
+    ``results.json``. A comparison of more than ``pages.GROUP_PAGES_AT`` dataset groups is written as an index
+    (every group's verdict, the summary, a link per group) and one page per group (``groups/GROUP.html``).
+
+    Parameters
+    ----------
+    c : Comparison
+        What `compare` returned.
+    out : str or os.PathLike
+        The report folder.
+    force : bool, default False
+        Replace an existing folder (otherwise an existing folder is an error).
+    progress : callable, optional
+        ``progress(done, total, label)``, called after each figure and file.
+    jobs : int, default 1
+        Worker processes drawing the figures (the same PNG bytes as one process draws).
+    client : distributed.Client, optional
+        A Dask client whose workers draw the figures instead.
+
+    Returns
+    -------
+    pathlib.Path
+        The report folder.
+
+    Raises
+    ------
+    OutputError
+        ``out`` exists and ``force`` is False, it lies inside a dataset it reports on, or cannot be written.
     """
     from ..pipeline.comparison import Comparison
 

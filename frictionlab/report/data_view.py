@@ -68,8 +68,6 @@ def group_views(c, findings, skip=frozenset()) -> list[DataView]:
 def _group_top(c, label: str, dss) -> list:
     """The group's rank-1 rows: its own ranking for two or more members, else its dataset's."""
     pool = [r for r in c.groups if r.dataset == label] if len(dss) > 1 else []
-    if len(dss) > 1 and not pool and len(dss) == len(c.fitted_datasets):
-        pool = [r for r in c.groups if r.dataset == "ALL"]
     if not pool:
         pool = [r for r in c.ranking if r.dataset == dss[0].name]
     return [r for r in pool if r.rank == 1]

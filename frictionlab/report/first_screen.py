@@ -37,14 +37,15 @@ TITLE = "Answers"
 COLUMNS = (("best", "best law"), ("goodness", "goodness of fit"),
            ("equivalence", "λAu vs μN + μη′dA/dt"),
            ("threshold", "noise threshold"), ("series", "series vs exact"), ("accuracy", "what accuracy costs"),
-           ("transfer", "one parameter set for all conditions?"))
+           ("transfer", "one parameter set for all conditions?"), ("closer", "which law is closer"))
 #: characters a table cell shows (more: cut, the full text is in the notes)
 CELL_LIMIT = 70
 #: (Answer field, label) of the full sentences in the notes below the table.
 NOTES = (("headline", ""), ("goodness", "Goodness"), ("equivalence", "λAu against μN + μη′dA/dt, exact"),
          ("equivalence_series", "The truncated series of λAu against μN + μη′dA/dt"),
          ("qualitative", "Shared features"), ("noise_threshold", "Noise threshold"),
-         ("series_vs_exact", "Series vs exact"), ("accuracy", "What accuracy costs"), ("transfer", "Across conditions"))
+         ("series_vs_exact", "Series vs exact"), ("accuracy", "What accuracy costs"), ("transfer", "Across conditions"),
+         ("closer", "Which law is closer"))
 #: dataset kind -> block(ctx, sec, datasets) -> names drawn or None (all): a first-screen block of its own for the
 #: fitted datasets of that kind (module docstring); the generic figure leaves the datasets it drew out.
 KIND_BLOCKS: dict = {"spring-slider": lambda ctx, sec, datasets: velstep.first_screen(sec, ctx.c, datasets)}
@@ -91,7 +92,8 @@ ABSENT = {"best": "a best law", "goodness": "a goodness-of-fit test",
                                                                  "fitted)",
           "accuracy": f"what accuracy costs (it runs by default where cheap, unless --no-accuracy; `{ACCURACY_COMMAND}` "
                       "runs it everywhere)",
-          "transfer": "one parameter set across conditions (no group of two or more datasets)"}
+          "transfer": "one parameter set across conditions (no group of two or more datasets)",
+          "closer": "which law is closer (no two laws with pointwise likelihoods on one dataset)"}
 
 
 def _answer_table(sec: Section, answers, laws=()):
@@ -118,6 +120,8 @@ def _answer_table(sec: Section, answers, laws=()):
 def _could_apply(key: str, laws) -> bool:
     """Whether a column absent from the verdict table is worth naming: the paper's pair and the truncated series
     only where the paper's laws were compared."""
+    if key == "closer":  # said where it was tested, not missed elsewhere
+        return False
     if key in ("equivalence", "threshold"):
         return {WEAR, AREA_RATE} <= set(laws)
     if key == "series":

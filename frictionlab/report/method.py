@@ -44,7 +44,7 @@ def build(ctx) -> list[Section]:
     ])
     files = Section("Files")
     files.items([
-        "`ranking.csv`: " + ", ".join(COLUMNS) + " — per-dataset rows, then group rows (ALL, ALL[kind]); rss and "
+        "`ranking.csv`: " + ", ".join(COLUMNS) + " — per-dataset rows, then the rows of each declared group of two or more datasets; rss and "
         "rmse in the observable's SI unit, named in the unit columns; empty for groups.",
         f"`results.json`: schema `{SCHEMA}` — every fit with parameters, errors, correlations, statistics, "
         "identifiability and notes; the rankings; the equivalence results; dataset provenance; versions. The "

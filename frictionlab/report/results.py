@@ -1,7 +1,7 @@
 """results.json, schema ``frictionlab.compare/1``, and ranking.csv.
 
 ranking.csv: columns ``ranking.COLUMNS`` then ``UNIT_COLUMNS`` (observable, rss_unit, rmse_unit); per-dataset
-  rows, then the group rows (ALL, ALL[kind]); rss and rmse in the observable's SI unit, empty for groups.
+  rows, then the rows of each declared group of two or more datasets; rss and rmse in the observable's SI unit, empty for groups.
 results.json:
     created, versions{package: version}, settings, wall_time_s,
     datasets[{name, kind, observable, n_points, status: fitted|skipped, reason,

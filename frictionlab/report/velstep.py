@@ -50,10 +50,16 @@ def first_screen(sec, c, datasets=None) -> list[str]:
         for f in fits:
             q = f.velstep.rows[0].quantities
             law = f.law.replace("rate-state-", "")
-            rows.append([f"**{d.name}**", law] + [cell(q.get(key)) for key, _ in COLUMNS] + [f.goodness.short])
+            row = f.velstep.rows[0]
+            noise = ", ".join(f"{m} at {lab}" for lab, m in row.noise) or ", ".join(
+                f"AR(1) φ = {p:.2f} at {lab}" for lab, p in row.phi) or "independent"
+            white = ("white" if f.goodness.noise_ok else "not white") if f.goodness.noise_ok is not None else "—"
+            rows.append([f"**{d.name}**", law] + [cell(q.get(key)) for key, _ in COLUMNS]
+                        + [noise, white, f.goodness.short])
     sec.p("**Measured velocity steps** (value ± standard error; Dc in µm, k in 1/µm; the 95% intervals, μ0, the "
           "trend and the noise in each figure):")
-    sec.table(["dataset", "rate-and-state law"] + [h for _, h in COLUMNS] + ["goodness of fit"], rows)
+    sec.table(["dataset", "rate-and-state law"] + [h for _, h in COLUMNS]
+              + ["noise model", "whitened residuals", "does the law fit"], rows)
     for d, fits in steps:
         best = fits[0]
         said = [s for f in fits[:1] for s in (f.velstep.sign + f.velstep.bounds + f.velstep.noise + f.velstep.missing)]

@@ -1,7 +1,7 @@
 """Numbers shared by ``frictionlab.solve.memoryrhs`` and its numba kernel ``memory_kernel`` (no imports)."""
 
 #: Law codes.
-LUGRE, DAHL, RS_AGING, RS_SLIP, DAHL_SLID = 0, 1, 2, 3, 4
+LUGRE, DAHL, RS_AGING, RS_SLIP, DAHL_SLID, RS_PRZ = 0, 1, 2, 3, 4, 5
 #: Normal-force model codes.
 NORMAL_CONSTANT, NORMAL_HALF_SINE = 0, 1
 #: Entries of the phase's constants C (``memoryrhs.Phase.C``).

@@ -11,7 +11,7 @@ import numpy as np
 
 from .memory_codes import (BAD, CALLS, COUPLED, DAHL, DAHL_SLID, DIRECTION, DRIVE, IL, ILOAD, INERTIA, ITH, IW, LAW,
                            LUGRE, MASS, MAXCALLS, NORMAL, NORMAL_HALF_SINE, NORMAL_PHI, NORMAL_TC, NORMAL_VALUE,
-                           NOT_FINITE, RADIUS, RS_SLIP, S0, SENSE, SPIN, STRICT, STIFFNESS, STOP_T, TINY, TOO_MANY, TSCALE,
+                           NOT_FINITE, RADIUS, RS_PRZ, RS_SLIP, S0, SENSE, SPIN, STRICT, STIFFNESS, STOP_T, TINY, TOO_MANY, TSCALE,
                            TURNED, V0)
 
 jit = numba.njit(cache=True, fastmath=False, error_model="numpy")
@@ -43,7 +43,7 @@ def dahl_slid(P, s0, X):
 @jit
 def law(code, P, C, u, x):
     """(mu, d mu/du, d mu/dx, rate, d rate/du, d rate/dx) of the law ``code`` per unit normal force at slip u
-    [m/s] and state x, parameters P in the law's order (laws/lugre.py, dahl.py, rate_state*.py). DAHL_SLID is
+    [m/s] and state x, parameters P in the law's order (laws/lugre.py, dahl.py, rate_state*.py; RS_PRZ: the PRZ law). DAHL_SLID is
     Dahl with the slip X [m] since the phase began as its state (x), while the slip keeps the sense C[SENSE]:
     mu_d = sense mu_c (1 - s(X)) from s(0) = C[S0] (``dahl_slid``), dX/dt = |u|: smooth where d mu_d/dt =
     sigma u |s|^alpha sign(s) is not (alpha < 1 at s = 0). Where the slip turns, ``rhs`` stops with C[BAD] =
@@ -74,6 +74,8 @@ def law(code, P, C, u, x):
         slope = alpha * a ** (alpha - 1.0) if a > 0.0 else (alpha if alpha >= 1.0 else 0.0)
         return x, 0.0, 1.0, rate, sigma * pw * _sign(s), -sigma * abs(u) * slope / mu_c
     mu0, a, b, Dc = P[0], P[1], P[2], P[3]
+    if code == RS_PRZ:  # PRZ reads theta / (2 Dc) where the others read theta / Dc
+        Dc = 2.0 * Dc
     th = max(x, 1e-300)
     psi = mu0 + b * math.log(V0 * th / Dc)
     au = abs(u)
@@ -100,6 +102,8 @@ def law(code, P, C, u, x):
             d = -(lg + 1.0)
             return mu, dmu_du, dmu_dth, -r * lg, d * su * x / Dc, d * au / Dc
         return mu, dmu_du, dmu_dth, 0.0, 0.0, 0.0
+    if code == RS_PRZ:
+        return mu, dmu_du, dmu_dth, 1.0 - r * r, -2.0 * r * su * x / Dc, -2.0 * r * au / Dc
     return mu, dmu_du, dmu_dth, 1.0 - r, -su * x / Dc, -au / Dc
 
 

@@ -6,7 +6,7 @@ calls a solve, and the implicit methods then also difference the right-hand side
 built-in laws with memory on the scenes below, ``phase`` gives the scaled right-hand side of a sliding phase
 and its Jacobian in closed form, compiled by numba (``memory_kernel``, about 1 us a call):
 
-  laws    LuGre, Dahl, rate-and-state aging and slip (laws/), by their class: a subclass may change any method;
+  laws    LuGre, Dahl, rate-and-state aging, slip and PRZ (laws/), by their class: a subclass may change any method;
   scenes  rigid impact or incline (states v, optionally omega and theta with spin and slip coupling; normal
           force half-sine, weight or constant), and the spring-slider with a mass (states v and load; constant
           normal force). The quasi-static spring-slider (its slip rate implicit) is not served here.
@@ -25,13 +25,14 @@ import numpy as np
 
 from .memory_codes import (BAD, CALLS, COUPLED, DAHL, DAHL_SLID, DIRECTION, DRIVE, IL, ILOAD, INERTIA, ITH, IW, LAW,
                            LUGRE, MASS, MAXCALLS, NC, NORMAL, NORMAL_CONSTANT, NORMAL_HALF_SINE, NORMAL_PHI, NORMAL_TC,
-                           NORMAL_VALUE, RADIUS, RS_AGING, RS_SLIP, S0, SENSE, SPIN, STIFFNESS, STOP_T, STRICT, TINY, TSCALE)
+                           NORMAL_VALUE, RADIUS, RS_AGING, RS_PRZ, RS_SLIP, S0, SENSE, SPIN, STIFFNESS, STOP_T, STRICT, TINY, TSCALE)
 
 #: The built-in laws with memory served here, by (module, class), with their code and parameter order.
 LAWS = {("frictionlab.laws.lugre", "LuGre"): (LUGRE, ("mu_c", "mu_s", "vs", "sigma0", "sigma1", "sigma2")),
         ("frictionlab.laws.dahl", "Dahl"): (DAHL, ("mu_c", "sigma", "alpha")),
         ("frictionlab.laws.rate_state_aging", "RateStateAging"): (RS_AGING, ("mu0", "a", "b", "Dc")),
-        ("frictionlab.laws.rate_state_slip", "RateStateSlip"): (RS_SLIP, ("mu0", "a", "b", "Dc"))}
+        ("frictionlab.laws.rate_state_slip", "RateStateSlip"): (RS_SLIP, ("mu0", "a", "b", "Dc")),
+        ("frictionlab.laws.rate_state_prz", "RateStatePRZ"): (RS_PRZ, ("mu0", "a", "b", "Dc"))}
 
 
 def _normal(model):

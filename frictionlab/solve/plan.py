@@ -201,9 +201,10 @@ class Plan(CompliantPatch):
             N = s.normal(t, A) if normal is None else normal
         state = ({n: y[self.index(k)] for n, k in zip(self.law.state_names, self.law_states)} or None
                  if self.law.states else None)
+        dmudt = s.spring.stiffness * (s.spring.velocity(t) - y[0]) if "dmudt" in req else None
         return Contact(t=np.asarray(t, dtype=float), u=np.asarray(u, dtype=float),
                        N=N if "N" in req else None, A=A if "A" in req else None, dAdt=dAdt if "dAdt" in req else None,
-                       state=state)
+                       state=state, dmudt=dmudt)
 
     def force(self, p, t, y, u) -> tuple[np.ndarray, Contact]:
         c = self.contact(t, y, u)
@@ -266,7 +267,7 @@ class Plan(CompliantPatch):
         fastest = QUASI_STATIC_LIMIT * max(s.spring.velocities)
         if abs(v) > fastest:
             raise SolverError(runaway_message(self.law.name, v, float(t), s.spring.velocities, p, s.spring.stiffness,
-                                              QUASI_STATIC_LIMIT))
+                                              QUASI_STATIC_LIMIT, s.spring.times))
         dF = self.slip_rate_partials(p, t, y)
         N = float(s.normal(t))
         return (s.spring.stiffness * N * (float(s.spring.velocity(t)) - v) - float(dF[1:] @ dy[1:])) / dF[0]
@@ -356,12 +357,39 @@ class Plan(CompliantPatch):
 
 
 def make_plan(scene: Scene, law: FrictionLaw, scene_name: str = "scene") -> Plan:
-    """Assemble the plan for ``law`` on ``scene``; error if the scene cannot supply what the law needs."""
+    """The plan of a simulation: which contact quantities ``scene`` supplies for ``law``, and how.
+
+    Parameters
+    ----------
+    scene : Scene
+        The experiment (mass, slip, contact-area and normal-force models), SI.
+    law : FrictionLaw
+        The law to be solved on it.
+    scene_name : str, default "scene"
+        The name errors give the scene (a dataset's name).
+
+    Returns
+    -------
+    Plan
+        What `simulate` and the fits evaluate the law with.
+
+    Raises
+    ------
+    PlanError
+        The scene cannot supply a quantity the law requires (the message says which model to add).
+
+    Examples
+    --------
+    >>> import frictionlab as fl
+    >>> scene = fl.load_dataset("impact-golf-v28").scene
+    >>> plan = fl.make_plan(scene, fl.get_law("wear"))
+    """
     missing = set(law.requires) - scene.supplies()
     if missing:
         hint = {"N": "add a [scene.normal] model (half-sine, hertz, column or weight)",
                 "A": "add a [scene.area] model (half-sine, constant, growth or column)",
-                "dAdt": "add a [scene.area] model (half-sine, constant, growth or column)"}
+                "dAdt": "add a [scene.area] model (half-sine, constant, growth or column)",
+                "dmudt": "a spring-slider supplies it (its load rate k (V_lp - V)); other scenes do not"}
         what = ", ".join(f"{q} ({QUANTITIES[q].split(' [')[0]})" for q in sorted(missing))
         raise SceneError(f"law '{law.name}' needs {what}, which {scene_name} cannot supply: "
                          + "; ".join(sorted({hint[q] for q in missing if q in hint})))

@@ -1,11 +1,11 @@
 """The quasi-static rate-and-state spring-slider in the field's own variables: the fast path of ``simulate``
 and of the velocity-step fit (``inference.velstep.fit``).
 
-For the built-in rate-state-aging and rate-state-slip laws on a spring-slider without mass, the general plan
-(``solve.plan``) differentiates the force numerically at every right-hand-side call. Here the slider is
+For the built-in one-state rate-and-state laws (aging, slip, PRZ, Nagata) on a spring-slider without mass, the
+general plan (``solve.plan``) differentiates the force numerically at every right-hand-side call. Here the slider is
 written as the rate-and-state literature writes it (Marone 1998; rsfmodel): m = mu - mu_ss(V1) and
-psi = ln(V1 theta / Dc), in um and s, with V0 = V1 (the first load-point velocity) and steady state there at
-t = 0, integrated by a compiled implicit method with its analytic Jacobian through every step and hold of the
+psi = ln(V1 theta / Dc) (PRZ: ln(V1 theta / (2 Dc))), in um and s, with V0 = V1 (the first load-point velocity)
+and steady state there at t = 0, integrated by a compiled implicit method with its analytic Jacobian through every step and hold of the
 load point (``quasistatic_kernel``), optionally with the forward sensitivities of m to (a, b, Dc, k).
 
 The friction is the log form mu = mu0 + a ln(V/V0) + b ln(V0 theta/Dc) (V0 = 1 um/s, the law's mu0), equal to
@@ -22,10 +22,13 @@ import numpy as np
 from ..core.errors import SolverError
 from ..physics.spring import runaway_message
 
-#: Built-in laws served here, by name: the kernel's evolution-law code (``quasistatic_kernel.AGING``, ``SLIP``;
-#: the kernel, which imports numba, is loaded on the first solve).
-LAWS = {"rate-state-aging": 0, "rate-state-slip": 1}
+#: Built-in laws served here, by name: the kernel's evolution-law code (``quasistatic_kernel.AGING``, ``SLIP``,
+#: ``PRZ``, ``NAGATA``; the kernel, which imports numba, is loaded on the first solve).
+LAWS = {"rate-state-aging": 0, "rate-state-slip": 1, "rate-state-prz": 2, "rate-state-nagata": 3}
 LAW_NAMES = {code: name for name, code in LAWS.items()}
+#: The laws whose parameters are exactly (mu0, a, b, Dc): the kernel's sensitivities cover them all (the
+#: velocity-step fit, ``inference.velstep.fit``); Nagata's c has none.
+FITTED = frozenset({"rate-state-aging", "rate-state-slip", "rate-state-prz"})
 #: Reference slip rate V0 of the laws' mu0 [um/s] (frictionlab/laws/rate_state.py: 1e-6 m/s).
 V0_UM = 1.0
 #: A quasi-static slider has run away once its slip rate exceeds this multiple of the fastest load point
@@ -91,9 +94,10 @@ class Solution:
 
 
 def solve(law_code: int, a: float, b: float, Dc_um: float, k_um: float, load: Load, t, rtol: float = 1e-8,
-          sensitivities: bool = False, law: str = "") -> Solution:
-    """Integrate the quasi-static slider (laboratory units: Dc [um], k [1/um]) from steady sliding at V1 and return
-    m and psi at the sorted times t [s] >= 0. A slider that runs away or a failed integration raises SolverError."""
+          sensitivities: bool = False, law: str = "", c: float = 0.0) -> Solution:
+    """Integrate the quasi-static slider (laboratory units: Dc [um], k [1/um]; c: Nagata's constant) from steady
+    sliding at V1 and return m and psi at the sorted times t [s] >= 0. A slider that runs away or a failed
+    integration raises SolverError."""
     from . import quasistatic_kernel as kernel
 
     t = np.ascontiguousarray(t, dtype=float)
@@ -102,7 +106,7 @@ def solve(law_code: int, a: float, b: float, Dc_um: float, k_um: float, load: Lo
     S = np.empty((n, 4)) if sensitivities else np.empty((0, 4))
     stats = np.zeros(5)
     vmax = RUNAWAY * load.vmax
-    status = kernel.integrate(law_code, float(a), float(b), float(Dc_um), float(k_um), load.V1, load.times,
+    status = kernel.integrate(law_code, float(a), float(b), float(Dc_um), float(k_um), float(c), load.V1, load.times,
                               load.velocities, t, float(rtol), float(rtol) * float(a), bool(sensitivities), vmax,
                               m, psi, S, stats)
     if status != kernel.OK:
@@ -114,13 +118,54 @@ def _failure(status: int, stats, a, b, Dc_um, k_um, load: Load, law: str) -> str
     from . import quasistatic_kernel as kernel
 
     t = float(stats[3])
-    if status == kernel.RUNAWAY:
-        return runaway_message(law, float(stats[4]) * UM, t, load.velocities * UM,
-                               {"a": a, "b": b, "Dc": Dc_um * UM}, k_um / UM, RUNAWAY)
     if status == kernel.TOO_MANY_STEPS:
         return f"quasi-static slider: more than {kernel.MAX_STEPS} steps by t = {t:.6g} s"
-    return f"quasi-static slider: the step size fell to round-off at t = {t:.6g} s (a, b, Dc, k = {a:g}, {b:g}, " \
-           f"{Dc_um:g} um, {k_um:g} 1/um)"
+    j = int(np.searchsorted(load.times, t, side="right")) - 1
+    before = load.velocities[j - 1] if j >= 1 else load.V1
+    stepped = j >= 1 and load.velocities[j] > before
+    if status == kernel.RUNAWAY:
+        largest = _largest_step(LAWS.get(law, 0), a, b, Dc_um, k_um, load, j, t) if stepped else None
+        return runaway_message(law, float(stats[4]) * UM, t, load.velocities * UM, {"a": a, "b": b, "Dc": Dc_um * UM},
+                               k_um / UM, RUNAWAY, load.times, None if largest is None else largest * UM)
+    where = f"(a, b, Dc, k = {a:g}, {b:g}, {Dc_um:g} um, {k_um:g} 1/um)"
+    if not stepped:
+        return f"quasi-static slider: the step size fell to round-off at t = {t:.6g} s, at the load-point velocity " \
+               f"{load.velocities[j]:.3g} um/s {where}"
+    works = _largest_step(LAWS.get(law, 0), a, b, Dc_um, k_um, load, j, t)
+    return (f"quasi-static slider: the load point's step at t = {load.times[j]:g} s from {before:.3g} to "
+            f"{load.velocities[j]:.3g} um/s (a factor {load.velocities[j] / before:.3g}) is beyond what the slider "
+            f"can be integrated through (its step size fell to round-off at t = {t:.6g} s) {where}; "
+            + (f"from {before:.3g} um/s, steps up to about {works:.2g} um/s integrate here: " if works else "")
+            + "use a smaller step, or several smaller ones")
+
+
+def _largest_step(code: int, a, b, Dc_um, k_um, load: Load, j: int, t_fail: float, tries: int = 10) -> float | None:
+    """The largest velocity [um/s] (to about 1.2 times, in log steps) that segment ``j`` of ``load`` may step to
+    from the velocity before it and integrate through to a little past ``t_fail`` [s]; None if even a small step
+    does not. Only on the way to an error: a few short integrations."""
+    from . import quasistatic_kernel as kernel
+
+    before = load.velocities[j - 1]
+    t0 = float(load.times[j])
+
+    def integrates(v: float) -> bool:
+        vel = load.velocities[:j + 1].copy()
+        vel[j] = v
+        end = t0 + max(2.0 * (t_fail - t0), 50.0 * a / (k_um * v))  # past the slider's response to the step
+        trial = Load(load.times[:j + 1].copy(), vel)
+        status = kernel.integrate(code, float(a), float(b), float(Dc_um), float(k_um), trial.V1, trial.times,
+                                  trial.velocities, np.array([end]), 1e-8, 1e-8 * float(a), False,
+                                  RUNAWAY * trial.vmax, np.empty(1), np.empty(1), np.empty((0, 4)), np.zeros(5))
+        return status == kernel.OK
+
+    lo, hi = math.log(before), math.log(load.velocities[j])
+    if not integrates(math.exp(lo + 0.01 * (hi - lo))):
+        return None
+    lo += 0.01 * (hi - lo)
+    for _ in range(tries):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if integrates(math.exp(mid)) else (lo, mid)
+    return math.exp(lo)
 
 
 def steady_friction(p, V1_um: float) -> float:
@@ -137,11 +182,11 @@ def simulate(law, scene, p, t, rtol: float = 1e-10):
     t = np.asarray(t, dtype=float)
     load = Load.of(scene.spring)
     k_um = scene.spring.stiffness * UM
-    sol = solve(LAWS[law.name], p["a"], p["b"], p["Dc"] / UM, k_um, load, t, rtol, law=law.name)
+    sol = solve(LAWS[law.name], p["a"], p["b"], p["Dc"] / UM, k_um, load, t, rtol, law=law.name, c=p.get("c", 0.0))
     V = load.V1 * np.exp((sol.m - p["b"] * sol.psi) / p["a"]) * UM
     mu = steady_friction(p, load.V1) + sol.m
     N = scene.normal(t)
-    theta = p["Dc"] / (load.V1 * UM) * np.exp(sol.psi)
+    theta = law.STEADY * p["Dc"] / (load.V1 * UM) * np.exp(sol.psi)
     for name, arr in (("slip rate", V), ("friction", mu), ("state", theta)):
         if not np.isfinite(arr).all():
             raise SolverError(f"quasi-static slider: the {name} became NaN or infinite for law '{law.name}' with {dict(p)}")

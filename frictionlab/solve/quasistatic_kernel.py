@@ -7,6 +7,9 @@ first load-point velocity and the slider in steady state there at t = 0 (m = psi
     dm/dt = k (V_lp(t) - V)
     dpsi/dt = (V1 exp(-psi) - V) / Dc               aging law, d theta/dt = 1 - V theta / Dc
     dpsi/dt = -(V / Dc) (ln(V/V1) + psi)            slip law, d theta/dt = -(V theta / Dc) ln(V theta / Dc)
+    dpsi/dt = (V1 e^-psi - V^2 e^psi / V1) / (2 Dc)  PRZ law, d theta/dt = 1 - (V theta / (2 Dc))^2,
+                                                    psi = ln(V1 theta / (2 Dc))
+    dpsi/dt = (V1 e^-psi - V) / Dc - (c/b) dm/dt    Nagata's law, d theta/dt = 1 - V theta/Dc - (c/b) theta dmu/dt
 
 Integrated by SDIRK4 (Hairer and Wanner, Solving ODEs II, Table IV.6.5: 5 stages, order 4, L-stable,
 stiffly accurate, embedded order 3), each stage by Newton's method on the analytic 2 x 2 Jacobian, restarted
@@ -14,7 +17,8 @@ at every load-point step. The forward sensitivities S = d(m, psi)/d(a, b, Dc, k)
 the discrete scheme (each stage's equation differentiated: (I - h g J) K^S = J (S + h sum a K^S) + f_p, the
 same matrix as the stage's Newton iteration), so the least-squares Jacobian is that of the computed solution.
 Outputs at the sample times come from the cubic Hermite interpolant of each step (m, its rate and their
-sensitivities: the interpolated sensitivity is the derivative of the interpolated m).
+sensitivities: the interpolated sensitivity is the derivative of the interpolated m). Nagata's c is a constant of
+the integration (no sensitivity to it).
 
 Module-level functions compiled by numba with an on-disk cache (``cache=True``) when numba imports; otherwise
 the same functions run as Python (correct, about a hundred times slower).
@@ -25,7 +29,7 @@ import numpy as np
 
 from ..core.jit import jit
 
-AGING, SLIP = 0, 1
+AGING, SLIP, PRZ, NAGATA = 0, 1, 2, 3
 #: Status codes of ``integrate``.
 OK, TOO_MANY_STEPS, RUNAWAY, STEP_TOO_SMALL = 0, 1, 2, 3
 #: Largest exponent ln(V/V1) the kernel evaluates (beyond it the step is rejected as not finite).
@@ -42,42 +46,56 @@ E0, E1, E2, E3, E4 = 25.0 / 24.0 - 59.0 / 48.0, -49.0 / 48.0 + 17.0 / 96.0, 125.
 
 
 @jit
-def rates(law, a, b, Dc, k, V1, vlp, m, psi, f, J, Fp, want_fp):
-    """Fill f = (dm/dt, dpsi/dt), J = d f / d(m, psi) and (want_fp) Fp = d f / d(a, b, Dc, k) at (m, psi);
-    return the slip rate V [um/s] (inf where ln(V/V1) exceeds MAX_EXPONENT or psi is beyond range)."""
+def rates(law, a, b, Dc, k, cn, V1, vlp, m, psi, f, J, Fp, want_fp):
+    """Fill f = (dm/dt, dpsi/dt), J = d f / d(m, psi) and (want_fp) Fp = d f / d(a, b, Dc, k) at (m, psi) (cn:
+    Nagata's c); return the slip rate V [um/s] (inf where ln(V/V1) exceeds MAX_EXPONENT or psi is beyond
+    range)."""
     lnE = (m - b * psi) / a
-    if not (lnE < MAX_EXPONENT) or not (-psi < MAX_EXPONENT):
+    if not (lnE < MAX_EXPONENT) or not (-psi < MAX_EXPONENT) or (law == PRZ and not (psi + 2.0 * lnE < MAX_EXPONENT)):
         return math.inf
     V = V1 * math.exp(lnE)
     f[0] = k * (vlp - V)
     J[0, 0] = -k * V / a
     J[0, 1] = k * b * V / a
-    if law == AGING:
-        g = V1 * math.exp(-psi)
-        f[1] = (g - V) / Dc
-        J[1, 0] = -V / (a * Dc)
-        J[1, 1] = (-g + b * V / a) / Dc
-    else:
+    dVa = -V * lnE / a
+    dVb = -V * psi / a
+    if law == SLIP:
         L = lnE + psi
         f[1] = -V * L / Dc
         J[1, 0] = -V * (L + 1.0) / (a * Dc)
         J[1, 1] = -(-b * V * L / a + V * (1.0 - b / a)) / Dc
+        Fp[1, 0] = -(dVa * L - V * lnE / a) / Dc
+        Fp[1, 1] = -(dVb * L - V * psi / a) / Dc
+    elif law == PRZ:
+        g = V1 * math.exp(-psi)
+        h = V1 * math.exp(psi + 2.0 * lnE)  # V^2 e^psi / V1
+        f[1] = (g - h) / (2.0 * Dc)
+        J[1, 0] = -h / (a * Dc)
+        J[1, 1] = (-g - h * (1.0 - 2.0 * b / a)) / (2.0 * Dc)
+        Fp[1, 0] = -h * dVa / (V * Dc)
+        Fp[1, 1] = -h * dVb / (V * Dc)
+    else:
+        g = V1 * math.exp(-psi)
+        f[1] = (g - V) / Dc
+        J[1, 0] = -V / (a * Dc)
+        J[1, 1] = (-g + b * V / a) / Dc
+        Fp[1, 0] = -dVa / Dc
+        Fp[1, 1] = -dVb / Dc
+    Fp[1, 2] = -f[1] / Dc  # every evolution rate above is proportional to 1 / Dc
+    Fp[1, 3] = 0.0
+    if law == NAGATA:  # - (c/b) dm/dt
+        q = cn / b
+        f[1] -= q * f[0]
+        J[1, 0] -= q * J[0, 0]
+        J[1, 1] -= q * J[0, 1]
+        Fp[1, 0] -= q * (-k * dVa)
+        Fp[1, 1] -= q * (-k * dVb) - q / b * f[0]
+        Fp[1, 3] = -q * (vlp - V)
     if want_fp:
-        dVa = -V * lnE / a
-        dVb = -V * psi / a
         Fp[0, 0] = -k * dVa
         Fp[0, 1] = -k * dVb
         Fp[0, 2] = 0.0
         Fp[0, 3] = vlp - V
-        if law == AGING:
-            Fp[1, 0] = -dVa / Dc
-            Fp[1, 1] = -dVb / Dc
-        else:
-            L = lnE + psi
-            Fp[1, 0] = -(dVa * L - V * lnE / a) / Dc
-            Fp[1, 1] = -(dVb * L - V * psi / a) / Dc
-        Fp[1, 2] = -f[1] / Dc
-        Fp[1, 3] = 0.0
     return V
 
 
@@ -107,9 +125,9 @@ def _combine(i, h, y, K, base):
 
 
 @jit
-def integrate(law, a, b, Dc, k, V1, seg_t, seg_v, t_out, rtol, atol_m, sens, vmax, out_m, out_psi, out_S, stats):
+def integrate(law, a, b, Dc, k, cn, V1, seg_t, seg_v, t_out, rtol, atol_m, sens, vmax, out_m, out_psi, out_S, stats):
     """Integrate from the steady state at V1 (t = 0) through the load-point segments (start times seg_t [s],
-    velocities seg_v [um/s]) and write m, psi and (sens) dm/d(a, b, Dc, k) at the sorted times t_out [s].
+    velocities seg_v [um/s]; cn: Nagata's c, else unused) and write m, psi and (sens) dm/d(a, b, Dc, k) at the sorted times t_out [s].
 
     rtol: relative tolerance; atol_m: absolute tolerance of m (psi's is rtol). vmax: slip rate [um/s] beyond
     which the slider has run away. stats[0:5] receive (accepted steps, rejected steps, Newton iterations, time
@@ -153,7 +171,7 @@ def integrate(law, a, b, Dc, k, V1, seg_t, seg_v, t_out, rtol, atol_m, sens, vma
         if not t1 > t0:
             continue
         vlp = seg_v[j]
-        V = rates(law, a, b, Dc, k, V1, vlp, y[0], y[1], f0, J, Fp, sens)
+        V = rates(law, a, b, Dc, k, cn, V1, vlp, y[0], y[1], f0, J, Fp, sens)
         if sens:
             for c in range(4):
                 KS0[0, c] = J[0, 0] * S[0, c] + J[0, 1] * S[1, c] + Fp[0, c]
@@ -185,7 +203,7 @@ def integrate(law, a, b, Dc, k, V1, seg_t, seg_v, t_out, rtol, atol_m, sens, vma
                 converged = False
                 for _ in range(12):
                     newton += 1
-                    V = rates(law, a, b, Dc, k, V1, vlp, Y[0], Y[1], f, J, Fp, False)
+                    V = rates(law, a, b, Dc, k, cn, V1, vlp, Y[0], Y[1], f, J, Fp, False)
                     if not math.isfinite(V):
                         break
                     r0 = -(Y[0] - base[0] - h * G * f[0])
@@ -203,7 +221,7 @@ def integrate(law, a, b, Dc, k, V1, seg_t, seg_v, t_out, rtol, atol_m, sens, vma
                 if not converged:
                     ok = False
                     break
-                V = rates(law, a, b, Dc, k, V1, vlp, Y[0], Y[1], f, J, Fp, sens)
+                V = rates(law, a, b, Dc, k, cn, V1, vlp, Y[0], Y[1], f, J, Fp, sens)
                 if not math.isfinite(V):
                     ok = False
                     break

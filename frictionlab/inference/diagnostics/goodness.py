@@ -53,6 +53,13 @@ class Goodness:
     reason: str  # one phrase: why it fits or does not
     members: int = 1  # datasets combined (p-values Bonferroni-adjusted when more than one)
     white_p: float = math.nan  # Ljung-Box p of prewhitened residuals (AR(1) noise only; NaN otherwise)
+    #: Under the data's AR(p) noise model (``law_fit``): the law-fit test of bands after the step, its band and
+    #: statistic, whether the noise model whitens the residuals, and that test in words.
+    band_p: float = math.nan
+    band: str = ""
+    band_what: str = ""
+    noise_ok: bool | None = None
+    whiteness_text: str = ""
 
     def as_dict(self) -> dict:
         return attrs.asdict(self)
@@ -65,8 +72,11 @@ class Goodness:
             parts.append(f"chi2 p = {_p(self.chi2_p)}")
         if math.isfinite(self.runs_p):
             parts.append(f"runs p = {_p(self.runs_p)}")
+        if math.isfinite(self.band_p):
+            parts.append(f"law fit (bands after the step) p = {_p(self.band_p)}: {self.band_what} {self.band}")
         if math.isfinite(self.white_p):
-            parts.append(f"whiteness p = {_p(self.white_p)}")
+            parts.append(f"whiteness p = {_p(self.white_p)}" + (" (the noise model's test, not the law's)"
+                                                                 if self.noise_ok is not None else ""))
         if math.isfinite(self.lag1):
             parts.append(f"lag-1 r = {self.lag1:+.2f}")
         text = ", ".join(parts) or "no test possible"
@@ -75,8 +85,11 @@ class Goodness:
     @property
     def short(self) -> str:
         """'fits: chi2 p = 0.96' / 'fails: runs p = 8e-10': the verdict and the p-value closest to failing."""
-        ps = [(name, p) for name, p in (("χ²" if self.likelihood != "estimated" else "χ²/σ̂²", self.chi2_p), ("runs", self.runs_p),
-                                        ("whiteness", self.white_p)) if math.isfinite(p)]
+        if self.noise_ok is not None:  # the data's AR(p) model: the law-fit test alone decides
+            ps = [("bands", self.band_p)] if math.isfinite(self.band_p) else []
+        else:
+            ps = [(name, p) for name, p in (("χ²" if self.likelihood != "estimated" else "χ²/σ̂²", self.chi2_p),
+                                            ("runs", self.runs_p), ("whiteness", self.white_p)) if math.isfinite(p)]
         if self.fits is None or not ps:
             return "not testable"
         name, p = min(ps, key=lambda x: x[1])
@@ -180,6 +193,28 @@ def goodness(z: np.ndarray, k: int, likelihood: str, df_sigma: float = math.inf,
     return _decide(likelihood, chi_p, runs_p, runs, expected, r1, r1_p, white_p)
 
 
+def law_fit(z: np.ndarray, white_p: float, white_text: str, bands) -> Goodness:
+    """Goodness under the data's AR(p) noise model (its innovation level profiled: no chi-square test): the law
+    fits unless the band test (``noise.misfit.BandTest``, None: not made) finds structure after a step below
+    FITS_LEVEL; the whiteness of the whitened residuals z is the noise model's test, reported apart."""
+    z = np.asarray(z, dtype=float)
+    runs, expected, runs_p = runs_test(z)
+    r1, r1_p = lag1(z)
+    noise_ok = bool(white_p >= FITS_LEVEL) if math.isfinite(white_p) else None
+    band_p = bands.p if bands is not None else math.nan
+    extra = dict(white_p=white_p, band_p=band_p, band=bands.band if bands is not None else "",
+                 band_what=bands.what if bands is not None else "", noise_ok=noise_ok, whiteness_text=white_text)
+    if not math.isfinite(band_p):
+        return Goodness("estimated", math.nan, runs_p, runs, expected, r1, r1_p, None,
+                        "no band after a step could be tested", **extra)
+    if band_p < FITS_LEVEL:
+        why = (f"structure after the step beyond the noise: the whitened residuals' {bands.what} over {bands.band}, "
+               f"p = {_p(band_p)} < {FITS_LEVEL:g} against the record's steady state")
+        return Goodness("estimated", math.nan, runs_p, runs, expected, r1, r1_p, False, why, **extra)
+    why = f"no structure after the step beyond the noise (bands p = {_p(band_p)} >= {FITS_LEVEL:g})"
+    return Goodness("estimated", math.nan, runs_p, runs, expected, r1, r1_p, True, why, **extra)
+
+
 def _decide(likelihood, chi_p, runs_p, runs, expected, r1, r1_p, white_p=math.nan) -> Goodness:
     tests = [(name, p) for name, p in (("chi-square" if likelihood != "estimated" else "chi-square at estimated sigma", chi_p), ("runs test", runs_p),
                                        ("whiteness test of the prewhitened residuals", white_p)) if math.isfinite(p)]
@@ -212,6 +247,13 @@ def combine(members: list[Goodness]) -> Goodness:
         ps = [p for p in ps if math.isfinite(p)]
         return min(1.0, m * min(ps)) if ps else math.nan
 
+    if all(g.noise_ok is not None for g in members):  # the data's AR(p) models: the band tests decide
+        from types import SimpleNamespace
+
+        worst = min(members, key=lambda g: g.band_p if math.isfinite(g.band_p) else math.inf)
+        bands = SimpleNamespace(p=adjusted(g.band_p for g in members), band=worst.band, what=worst.band_what)
+        texts = "; ".join(g.whiteness_text for g in members if g.whiteness_text)
+        return attrs.evolve(law_fit(np.zeros(0), adjusted(g.white_p for g in members), texts, bands), members=m)
     lags = [(g.lag1, g.lag1_p) for g in members if math.isfinite(g.lag1)]
     r1, r1_p = max(lags) if lags else (math.nan, math.nan)
     return attrs.evolve(_decide(kinds.pop() if len(kinds) == 1 else "mixed", adjusted(g.chi2_p for g in members),

@@ -10,6 +10,8 @@ import attrs
 import numpy as np
 
 CORRELATION_LIMIT = 0.95
+#: |r| at or beyond which two parameters are one direction of the fit: one of them may take any value in range
+SEPARABLE_LIMIT = 0.999
 
 
 @attrs.frozen
@@ -214,8 +216,10 @@ def make_verdict(structure, presults, correl) -> Identifiability:
         ka, kb = presults[a].key, presults[b].key
         if abs(r) > CORRELATION_LIMIT and not (ka in ratio_keys and kb in ratio_keys):
             high.append((a, b, r))
-            warn.append(f"{a} and {b} are correlated (r = {r:+.3f}): the data determine a combination of them "
-                        "better than either")
+            warn.append(f"{a} and {b} are correlated (r = {r:+.3f}): " + (
+                "the data determine only a combination of them, not each: they are not separately identifiable "
+                "from these data (hold one of them, or fit data that separate them)" if abs(r) >= SEPARABLE_LIMIT
+                else "the data determine a combination of them better than either"))
     problems = [label for label, flag in (("parameter at a bound", structure["at_bounds"]),
                                           ("ratio-only pair", structure["ratios"]),
                                           ("parameter without effect", structure["no_effect"]),

@@ -31,6 +31,7 @@ quantity) raises a one-line FrictionLabError.
 from __future__ import annotations
 
 import math
+import numbers
 import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING
@@ -57,6 +58,8 @@ from .stats import (
     _stats,
     neg2loglik,
 )
+from ...io.dataset import Dataset
+from ...io.dataset import check_dataset_like
 from ...io.noise import ratio_pvalue
 from ..diagnostics.goodness import SHARPEN_BELOW, combine, f_pvalue, goodness
 from ..diagnostics.identifiability import find_structure, jacobian, jacobian_errors, make_verdict
@@ -118,38 +121,77 @@ def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], s
         scan: int = 125, n_starts: int = 3, max_nfev: int | None = None, rtol: float | None = None,
         timeout: float | None = None, checks: bool = True, errors: bool = True, n_params: int | None = None,
         progress: Callable[[int, int, str], None] | None = None, trend: bool | None = None,
-        stiffness: bool | None = None) -> FitResult:
+        stiffness: bool | None = None, noise: Sequence | None = None) -> FitResult:
     """Fit ``law`` to one dataset or a group of them (a global fit) and return a FitResult.
 
-    law: name or FrictionLaw. datasets: a Dataset, name, path or Target, or a list of them.
-    solver: 'auto' (exact where a closed form exists, else ode), 'exact', 'series', 'ode[:METHOD]'.
-    free: scene quantities to fit per dataset, name -> bounds (see SCENE_QUANTITIES): 'low:high[:start]'
-    with units, or (lower, upper[, start]) of SI numbers, quantity strings or pint Quantities.
-    fixed: law parameters held for every dataset, on top of each dataset's [fixed]; initial: start values;
-    each value an SI number, a quantity string or a pint Quantity. local: law parameters fitted
-    separately per dataset in a global fit. observable / derive: what to fit (see make_target).
-    scan: number of grid points scored before Levenberg-Marquardt (0: start from the defaults);
-    n_starts: Levenberg-Marquardt runs from the best distinct grid points (the lowest chi2 wins);
-    at most ODE_STARTS when a dataset is solved by 'ode' (deterministic, never timing-dependent).
-    rtol: relative (and scaled absolute) tolerance of every ODE solve in the fit, in (0, 1);
-    None uses predict.FIT_RTOL (1e-6; simulate's default is 1e-10). Closed forms and the series ignore it.
-    timeout: time budget of the fit in seconds (None: none); past it the fit is 'failed'.
-    checks: False skips the plausibility flags and the SI copy of lmfit's result (``minimizer_result``
-    None): for replicate refits (equivalence, bootstrap, transfer) that read only the values, their
-    error bars, the chi-square and the information criteria, which are the same either way.
-    errors: False skips the error analysis beyond lmfit's (the Jacobian, and what it shows: parameters
-    without effect, ratio-only pairs, identifiable directions; every free parameter counts in k): for
-    refits that read only the values and the chi-square (the equivalence test's replicates).
-    n_params: with errors=False, the number of parameters the information criteria and fit tests count
-    (a bootstrap replicate takes its base fit's ``stats.n_params``, which the skipped analysis found);
-    None counts every free parameter.
-    progress(done, total, label): told the stage (start scan, each Levenberg-Marquardt start, error
-    analysis) and its count of model evaluations (core.progress.Progress takes it).
-    A built-in rate-and-state law on quasi-static spring-slider datasets (solver 'auto' or 'ode', no ``local``)
-    is fitted as the field fits velocity steps (``inference.velstep.fit``: the slider in its own variables, mu0 and a
-    friction-vs-displacement trend by variable projection, the machine stiffness fitted, a global start, AR(1)
-    noise where the dataset declares it); there trend (None: fitted on measured data) and stiffness (None: fitted
-    on measured data or where ``free`` names spring.stiffness; True / False: fitted / held) apply.
+    A built-in rate-and-state law on quasi-static spring-slider datasets (solver "auto" or "ode", no
+    ``local``) is fitted as the field fits velocity steps (``inference.velstep.fit``): the slider in its own
+    variables, mu0 and a friction-versus-displacement trend by variable projection, the machine stiffness
+    fitted, a global start, AR(1) noise or the AR(p) model the data choose where the dataset declares it.
+
+    Parameters
+    ----------
+    law : str or FrictionLaw
+        A registered name or a law.
+    datasets : Dataset, str, path or Target, or a sequence of them
+        One dataset, or several fitted together with shared law parameters.
+    solver : str, default "auto"
+        ``"auto"`` (exact where a closed form exists, else the ODE), ``"exact"``, ``"series"``,
+        ``"ode[:METHOD]"``.
+    free : mapping, optional
+        Scene quantities fitted per dataset, name -> bounds: ``"low:high[:start]"`` with units, or
+        ``(lower, upper[, start])`` of SI numbers, quantity strings or pint Quantities (``u0`` [m/s], ...).
+    fixed, initial : mapping, optional
+        Law parameters held for every dataset (on top of each dataset's ``[fixed]``), and start values; each
+        value an SI number, a quantity string or a pint Quantity.
+    local : sequence of str, default ()
+        Law parameters fitted separately per dataset in a global fit.
+    observable : str, optional
+        The column to fit (default the dataset's observable); see `make_target`.
+    derive : {"poly9", "spline"}, optional
+        Fit omega derived from the theta column by this smoother.
+    scan : int, default 125
+        Grid points scored before Levenberg-Marquardt (0: start from the defaults).
+    n_starts : int, default 3
+        Levenberg-Marquardt runs from the best distinct grid points (the lowest chi-square wins).
+    max_nfev : int, optional
+        Most model evaluations per run.
+    rtol : float, optional
+        Relative (and scaled absolute) tolerance of every ODE solve in the fit, in (0, 1); None: 1e-6.
+        Closed forms and the series ignore it.
+    timeout : float, optional
+        Time budget of the fit [s]; past it the fit is "failed".
+    checks, errors : bool, default True
+        False skips the plausibility flags, or the error analysis beyond lmfit's: for replicate refits that
+        read only values and the chi-square.
+    n_params : int, optional
+        With ``errors=False``, the number of parameters the criteria and tests count.
+    progress : callable, optional
+        ``progress(done, total, label)``, told each stage and its count of model evaluations.
+    trend, stiffness : bool, optional
+        For velocity steps: fit (True) or hold (False) the friction-displacement trend and the machine
+        stiffness; None fits them on measured data.
+    noise : sequence, optional
+        For velocity steps: None uses the noise the dataset declares; a fit's per-dataset ``noise_state`` holds
+        that noise model (as a refit to a noise-free curve needs).
+
+    Returns
+    -------
+    FitResult
+        Values with standard errors (SI), the statistics, the goodness-of-fit verdict, identifiability
+        warnings and notes; ``status`` is "failed" or "skipped" with a ``reason`` when the fit could not run.
+
+    Raises
+    ------
+    FrictionLabError
+        An unknown law, parameter or dataset, a value outside its bounds, or a quantity in the wrong unit.
+
+    Examples
+    --------
+    >>> import frictionlab as fl
+    >>> r = fl.fit("wear", "impact-golf-v28", solver="series")
+    >>> r.goodness.fits, f"{r.value('lam'):.3g} Pa s/m"
+    (True, '1.79e+06 Pa s/m')
     """
     import lmfit  # slow to import: only when fitting
 
@@ -166,6 +208,10 @@ def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], s
         return FitResult(law=law.name, solver=solver, datasets=names, status=status, reason=reason,
                          wall_time=time.perf_counter() - clock[0], cpu_time=time.thread_time() - clock[1], **kw)
 
+    for d in items:  # a dataset argument as given, and a Dataset still what loading made of it
+        check_dataset_like(d, "fit: datasets", (Target,))
+        if isinstance(d, Dataset):
+            d.check("fit")
     try:
         targets = [d if isinstance(d, Target) else make_target(d, observable, derive) for d in items]
     except SkipDataset as exc:
@@ -177,6 +223,7 @@ def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], s
     fixed, initial = law_values(law, fixed, "fit: fixed"), law_values(law, initial, "fit: initial")
     free = scene_ranges(free, "fit: free")
     _check_arguments(law, fixed, local, initial, rtol, timeout)
+    _check_budget(scan, n_starts, max_nfev)
     if n_params is not None and (isinstance(n_params, bool) or not isinstance(n_params, int) or n_params < 0
                                  or errors):
         raise ParameterError(f"fit: n_params must be a whole number >= 0 given with errors=False, got {n_params!r}")
@@ -185,9 +232,9 @@ def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], s
     if velstep.applies(law, targets, solver, local, free):
         return velstep.fit(law, targets, fixed=fixed, free=free, initial=initial, trend=trend, stiffness=stiffness,
                            scan=scan, n_starts=n_starts, max_nfev=max_nfev, rtol=rtol, timeout=timeout, checks=checks,
-                           errors=errors, n_params=n_params, progress=progress, names=names, clock=clock)
-    if trend is not None or stiffness is not None:
-        raise ParameterError("fit: trend and stiffness apply to the velocity-step fit only (a built-in rate-and-state "
+                           errors=errors, n_params=n_params, progress=progress, names=names, clock=clock, noise=noise)
+    if trend is not None or stiffness is not None or noise is not None:
+        raise ParameterError("fit: trend, stiffness and noise apply to the velocity-step fit only (a built-in rate-and-state "
                              "law on quasi-static spring-slider datasets, solver 'auto' or 'ode')")
     solvers = _solvers(law, targets, solver, rtol)
     if isinstance(solvers, str):
@@ -300,6 +347,16 @@ def _check_arguments(law, fixed, local, initial, rtol, timeout) -> None:
     if timeout is not None and (isinstance(timeout, bool) or not isinstance(timeout, (int, float))
                                 or not 0 < timeout < math.inf):
         raise ParameterError(f"fit: timeout must be a positive number of seconds, got {timeout!r}")
+
+
+def _check_budget(scan, n_starts, max_nfev) -> None:
+    """scan a whole number >= 0, n_starts >= 1, max_nfev None or >= 1, else a ParameterError naming it."""
+    for name, value, least in (("scan", scan, 0), ("n_starts", n_starts, 1), ("max_nfev", max_nfev, 1)):
+        if value is None and name == "max_nfev":
+            continue
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < least:
+            raise ParameterError(f"fit: {name} must be a whole number, at least {least}"
+                                 + (" (or None: no limit)" if name == "max_nfev" else "") + f", got {value!r:.40}")
 
 
 def _solvers(law, targets, solver: str, rtol) -> list[str] | str:

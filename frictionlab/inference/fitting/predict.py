@@ -47,7 +47,19 @@ DatasetLike = "Dataset | str | os.PathLike"
 # --- targets: what is fitted -------------------------------------------------------------
 @attrs.frozen(eq=False)
 class Target:
-    """One fitted series: the dataset, the observable, its values y and 1-sigma per point (SI)."""
+    """One fitted series (made by `make_target`).
+
+    Attributes
+    ----------
+    dataset : Dataset
+        Where the series comes from.
+    observable : str
+        The column fitted (``theta``, ``omega``, ``v``, ``mu``, or ``stated`` for a reconstruction's numbers).
+    y, sigma : numpy.ndarray
+        The values and their 1-sigma noise per point, SI.
+    derivation : str
+        How ``y`` was derived (e.g. omega from theta by poly9), or "".
+    """
 
     dataset: Dataset
     observable: str
@@ -72,9 +84,33 @@ class Target:
 
 
 def make_target(dataset: DatasetLike, observable: str | None = None, derive: str | None = None) -> Target:
-    """The series to fit from ``dataset``: its observable, another column, or omega derived from theta.
+    """The series to fit from a dataset: its observable, another column, or omega derived from theta.
 
-    derive: None, 'poly9' or 'spline' (then observable is omega, computed from the theta column).
+    Parameters
+    ----------
+    dataset : Dataset, str or path
+        The dataset (loaded by `load_dataset` when a name or path).
+    observable : str, optional
+        The column to fit; default the dataset's observable (a reconstruction's stated numbers).
+    derive : {"poly9", "spline"}, optional
+        Fit omega, derived from the theta column by this smoother.
+
+    Returns
+    -------
+    Target
+        The values and their noise, SI.
+
+    Raises
+    ------
+    DatasetError
+        No such column, or a column without noise to fit against.
+
+    Examples
+    --------
+    >>> import frictionlab as fl
+    >>> target = fl.make_target("incline-oil-a100")
+    >>> target.observable, target.y.shape
+    ('v', (101,))
     """
     ds = load_dataset(dataset)
     if ds.kind == "contact-area":
@@ -126,8 +162,17 @@ PREDICTORS: dict[str, Predictor] = {}
 
 
 def register_predictor(kind: str, fn: Predictor) -> None:
-    """Make dataset ``kind`` fittable: fn(law, target, scene, params, solver[, rtol=...]) -> model of
-    target.y (SI). A predictor that solves ODEs takes the keyword ``rtol`` (always given a number)."""
+    """Make a dataset kind fittable by saying how a law predicts its observable.
+
+    Parameters
+    ----------
+    kind : str
+        The dataset kind (``impact``, ``incline``, or a kind of your own).
+    fn : callable
+        ``fn(law, target, scene, params, solver[, rtol=...])`` returning the model of ``target.y`` (SI) at law
+        parameters ``params`` (SI). A predictor that solves ODEs takes the keyword ``rtol`` (always given a
+        number).
+    """
     PREDICTORS[kind] = fn
 
 
@@ -218,9 +263,41 @@ def design(target: Target) -> tuple | None:
 
 def predict(law: str | FrictionLaw, target: Target, params: Mapping[str, float], solver: str = "exact",
             scene: Scene | None = None, rtol: float | None = None) -> np.ndarray:
-    """The law's prediction of ``target.y`` (SI) for law parameters ``params`` (SI), on ``scene``
-    (default: the dataset's), solving any ODE to ``rtol`` (None: FIT_RTOL). Raises SkipDataset
-    for a kind nobody can predict yet."""
+    """A law's prediction of a fitted series.
+
+    Parameters
+    ----------
+    law : str or FrictionLaw
+        A registered name or a law.
+    target : Target
+        The series (`make_target`).
+    params : mapping of str to float
+        Law parameters, SI.
+    solver : str, default "exact"
+        ``"exact"``, ``"series"`` or ``"ode[:METHOD]"``.
+    scene : Scene, optional
+        The scene to solve on; default the dataset's.
+    rtol : float, optional
+        Tolerance of any ODE solve; None: 1e-6.
+
+    Returns
+    -------
+    numpy.ndarray
+        The model of ``target.y``, SI, one value per point.
+
+    Raises
+    ------
+    SkipDataset
+        No predictor for the dataset's kind.
+
+    Examples
+    --------
+    >>> import frictionlab as fl
+    >>> target = fl.make_target("incline-oil-a100")
+    >>> model = fl.predict("couette", target, {"eta": 0.1, "h": 1e-4}, solver="exact")
+    >>> model.shape == target.y.shape
+    True
+    """
     law = get_law(law)
     kind = target.dataset.kind
     if kind not in PREDICTORS:

@@ -22,7 +22,21 @@ if TYPE_CHECKING:  # annotations only
 
 @attrs.frozen
 class ParamResult:
-    """A fitted (or held) parameter: SI value and standard error, unit, bounds and role."""
+    """A fitted (or held) parameter of a `FitResult`.
+
+    Attributes
+    ----------
+    name : str
+        Display name: ``lam``, or ``u0[impact-golf-v28]`` for a per-dataset scene quantity.
+    value, stderr : float
+        The value and its standard error in ``unit`` (SI); ``stderr`` None where there is none.
+    unit : str
+        The SI unit; ``shown`` the unit it is displayed in ("" for ``unit``).
+    vary : bool
+        Fitted (True) or held (False; ``fixed_by`` says why).
+    lower, upper : float
+        The bounds of the fit [SI]; ``at_bound`` is "lower" or "upper" when the fit ends at one.
+    """
 
     name: str  # display name: 'lam', or 'u0[impact-golf-v28]' for a per-dataset quantity
     key: str  # law parameter or scene quantity
@@ -45,8 +59,14 @@ class ParamResult:
         return {"lower": self.lower, "upper": self.upper}.get(self.at_bound, math.nan)
 
     def text(self) -> str:
-        """'Dc = 397 ± 11 µm': the value in its display unit, rounded to its standard error; a parameter at a
-        bound says so ('k = 0.9974 1/µm (at its upper bound 1 1/µm: not identifiable)')."""
+        """The parameter as one line of text.
+
+        Returns
+        -------
+        str
+            ``"Dc = 397 ± 11 µm"``: the value in its display unit, rounded to its standard error; a parameter at
+            a bound says so (``"k = 0.9974 1/µm (at its upper bound 1 1/µm: not identifiable)"``).
+        """
         from ...core.display import param_text
 
         at = (f" (at its {self.at_bound} bound {param_text(self.bound, None, self.unit, self.shown)}: not identifiable)"
@@ -113,7 +133,33 @@ class DatasetFit:
 
 @attrs.frozen(eq=False)
 class FitResult:
-    """Outcome of ``fit``: parameters with errors, statistics, identifiability, per-dataset fits."""
+    """What `fit` returns: parameters with errors, statistics, goodness of fit, identifiability.
+
+    Attributes
+    ----------
+    law, solver : str
+        The law and the solver fitted.
+    datasets : tuple of str
+        The datasets fitted (several in a global fit).
+    status : {"ok", "failed", "skipped"}
+        Whether the fit ran; ``reason`` says why it did not. "ok" says nothing about whether the law
+        describes the data: ``goodness.fits`` does.
+    params : dict of str to ParamResult
+        Every parameter, fitted, held or derived, SI.
+    correlations : dict of (str, str) to float
+        Correlation coefficients between free parameters.
+    stats : Stats
+        chi-square, reduced chi-square, AIC, BIC, the number of points and of identifiable directions, and
+        the likelihood used (known, estimated or stated sigma).
+    goodness : Goodness
+        The goodness-of-fit tests (chi-square, runs, whiteness) and their verdict, ``goodness.fits``.
+    identifiability : Identifiability
+        Parameters at a bound, without effect, or correlated; ``identifiability.warnings`` says each.
+    notes : tuple of str
+        What else a reader should know about this fit.
+    velstep : StepReport or None
+        A velocity-step fit's parameters in laboratory units.
+    """
 
     law: str
     solver: str
@@ -154,13 +200,30 @@ class FitResult:
         return lmfit_parameters(self)
 
     def fit_report(self, **kwargs: object) -> str:
-        """lmfit's fit report of this fit (SI units, ours statistics first); kwargs go to lmfit.fit_report."""
+        """lmfit's fit report of this fit.
+
+        Parameters
+        ----------
+        **kwargs
+            Passed to ``lmfit.fit_report``.
+
+        Returns
+        -------
+        str
+            The report (SI units), frictionlab's statistics first.
+        """
         from .frames import fit_report
 
         return fit_report(self, **kwargs)
 
     def to_dataframe(self) -> pd.DataFrame:
-        """The parameters as a tidy pandas DataFrame, one row per parameter, with units."""
+        """The parameters as a tidy table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per parameter: value, stderr, unit, vary, bounds.
+        """
         from .frames import parameters_frame
 
         return parameters_frame([self])
@@ -174,9 +237,23 @@ class FitResult:
 
     def plot(self, ax: Axes | Sequence[Axes] | None = None) -> Figure | Axes | Sequence[Axes]:
         """The data with the best fit above and the residuals (in units of sigma) below, one column per
-        fitted dataset; returns the matplotlib Figure. With ``ax`` (an Axes, or one per dataset), the data
-        and the fit only, drawn there; returns ``ax``. The legend says whether the fit passes its goodness-of-fit
-        tests."""
+        fitted dataset; the legend says whether the fit passes its goodness-of-fit tests.
+
+        Parameters
+        ----------
+        ax : matplotlib.axes.Axes or sequence of them, optional
+            One Axes per dataset: the data and the fit only, drawn there.
+
+        Returns
+        -------
+        matplotlib.figure.Figure or Axes
+            The new figure, or ``ax`` when given.
+
+        Raises
+        ------
+        ValueError
+            The fit did not run (status "failed" or "skipped"), or ``ax`` has the wrong number of axes.
+        """
         from .plots import plot_fit
 
         return plot_fit(self, ax)
@@ -187,7 +264,23 @@ class FitResult:
         return fit_html(self)
 
     def value(self, name: str) -> float:
-        """The fitted (or held) value of parameter ``name``, SI."""
+        """The fitted (or held) value of one parameter.
+
+        Parameters
+        ----------
+        name : str
+            The parameter's display name (``"lam"``, ``"u0[impact-golf-v28]"``).
+
+        Returns
+        -------
+        float
+            Its value, SI.
+
+        Raises
+        ------
+        KeyError
+            No parameter of that name.
+        """
         return self.params[name].value
 
     @property
@@ -200,18 +293,44 @@ class FitResult:
                      if (p.vary and not {k, p.key} & arbitrary) or p.kind == "derived")
 
     def stderr(self, name: str) -> float | None:
-        """The standard error of parameter ``name`` (SI), None where there is none."""
+        """The standard error of one parameter.
+
+        Parameters
+        ----------
+        name : str
+            The parameter's display name.
+
+        Returns
+        -------
+        float or None
+            Its standard error, SI; None where there is none (held, at a bound, not identifiable).
+        """
         return self.params[name].stderr
 
     def summary(self) -> str:
-        """A few lines for the terminal: statistics, goodness of fit, and each parameter in its display unit,
-        rounded to its standard error."""
+        """A few lines for the terminal.
+
+        Returns
+        -------
+        str
+            The verdict of the goodness-of-fit tests, the statistics, the likelihood, each parameter in its
+            display unit rounded to its standard error, and the warnings and notes.
+
+        Examples
+        --------
+        >>> import frictionlab as fl
+        >>> print(fl.fit("wear", "impact-golf-v28", solver="exact").summary().splitlines()[0])
+        wear [exact] on impact-golf-v28 (stated): does not fit
+        """
         from ...core.display import param_text
 
         on = ", ".join(d.target.label for d in self.per_dataset) if self.per_dataset else ", ".join(self.datasets)
-        head = f"{self.law} [{self.solver}] on {on}: {self.status}"
         if not self.ok:
-            return f"{head}: {self.reason}"
+            return f"{self.law} [{self.solver}] on {on}: {self.status}: {self.reason}"
+        # the head gives the verdict of the goodness-of-fit tests, not the optimizer's status ("ok" only says it ran)
+        verdict = {True: "fits", False: "does not fit", None: "fitted (goodness of fit not tested)"}[
+            None if self.goodness is None else self.goodness.fits]
+        head = f"{self.law} [{self.solver}] on {on}: {verdict}"
         s = self.stats
         lines = [head, f"  chi2 = {s.chisqr:.5g}, reduced chi2 = {s.redchi:.4g}, AIC = {s.aic:.5g}, "
                        f"BIC = {s.bic:.5g}, n = {s.n_points}, k = {s.n_params}, nfev = {self.nfev}, "
@@ -235,7 +354,7 @@ class FitResult:
             lines.append(f"  warning: {w}")
         for n in self.notes:
             lines.append(f"  note: {n}")
-        if self.velstep is not None:
-            lines += self.velstep.lines()
+        if self.velstep is not None:  # its notes are the fit's notes, already printed above
+            lines += [line for line in self.velstep.lines() if line.strip() not in set(self.notes)]
         return "\n".join(lines)
 

@@ -147,8 +147,8 @@ def _resample(datasets, models, method, rng):
         if method == "case":
             idx = np.sort(rng.integers(0, len(ds), len(ds)))
             cols = {k: v[idx] for k, v in cols.items()}
-        elif method == "parametric" and getattr(ds, "noise_correlation", "none") == "ar1":  # AR(1) noise
-            from ..noise.ar1 import noise_drawer
+        elif method == "parametric" and getattr(ds, "noise_correlation", "none") in ("ar1", "arp"):  # correlated
+            from ..noise.record import noise_drawer
 
             cols[ds.observable] = model + noise_drawer(ds, ds.y, model, None)(rng)
         elif method == "parametric":

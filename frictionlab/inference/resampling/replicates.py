@@ -19,7 +19,29 @@ def refit_options(f: FitResult) -> dict:
     fixed = {p.key: p.value for p in f.params.values()
              if p.kind == "law" and (p.fixed_by == "held by the caller" or (p.vary and p.name in held))}
     free = {p.key: (p.lower, p.upper, p.value) for p in f.params.values() if p.kind == "scene" and p.vary}
-    return {"solver": f.per_dataset[0].solver, "initial": initial, "fixed": fixed, "free": free}
+    out = {"solver": f.per_dataset[0].solver, "initial": initial, "fixed": fixed, "free": free}
+    own = getattr(f.per_dataset[0], "refit", None)  # a velocity-step fit: its trend and stiffness, as fitted
+    return out | own if own else out
+
+
+def noise_of(f: FitResult):
+    """A velocity-step fit's noise model per dataset, to hold in a refit to its noise-free curve (None: none)."""
+    states = tuple(getattr(d, "noise_state", None) for d in f.per_dataset)
+    return states if any(st is not None for st in states) else None
+
+
+def profiled(fit_a: FitResult, fit_b: FitResult) -> bool:
+    """Whether either fit estimates its noise model with the law (the data's AR(p), its level profiled)."""
+    return any((getattr(d, "noise_state", None) or {}).get("kind") == "arp" for f in (fit_a, fit_b)
+               for d in f.per_dataset)
+
+
+def t_stat(fit_a: FitResult, fit_b: FitResult) -> float:
+    """T = -2 ln(L_A / L_B): chi2_A - chi2_B at the noise the likelihood uses; where a fit estimates its noise
+    model with the law (``profiled``), the difference of the profiled -2 ln L (chi-square is then n)."""
+    if profiled(fit_a, fit_b):
+        return float(fit_a.stats.neg2loglik - fit_b.stats.neg2loglik)
+    return float(fit_a.stats.chisqr - fit_b.stats.chisqr)
 
 
 def batch_problem(law, opts: dict, target: Target):
@@ -42,13 +64,21 @@ def batch_problem(law, opts: dict, target: Target):
 
 
 def refit(law: str, opts: dict, target: Target, scan: int = 0, n_starts: int = 1) -> FitResult:
+    """``law`` refitted to ``target`` with ``opts`` (``refit_options``; a velocity-step fit's trend and stiffness
+    as fitted, and 'noise': a noise model to hold)."""
+    extra = {k: opts[k] for k in ("trend", "stiffness", "noise") if opts.get(k) is not None}
     return fit(law, target, solver=opts["solver"], initial=opts["initial"], fixed=opts["fixed"] or None,
                free=opts["free"] or None, scan=scan, n_starts=n_starts, checks=False, errors=False,
-               timeout=opts.get("timeout"))
+               timeout=opts.get("timeout"), **extra)
 
 
 def with_y(target: Target, y: np.ndarray, what: str) -> Target:
-    return Target(target.dataset, target.observable, y, target.sigma, what)
+    """``target`` with values y (a replicate or a fitted curve, ``what``). A measured friction series of a
+    spring-slider keeps being one, so that its refit is the velocity-step fit of the data (trend, stiffness, step
+    time, noise); elsewhere y is marked as ``what`` (its refit's likelihood is then the caller's to state)."""
+    velocity_steps = (target.dataset.kind == "spring-slider" and target.observable == "mu" and not target.derivation
+                      and target.t is not None)
+    return Target(target.dataset, target.observable, y, target.sigma, "" if velocity_steps else what)
 
 
 def cross_chi2(own: FitResult, other: FitResult, timeout: float | None = None) -> float:
@@ -56,20 +86,23 @@ def cross_chi2(own: FitResult, other: FitResult, timeout: float | None = None) -
     at the declared noise (nan if the refit fails, or takes longer than ``timeout`` seconds)."""
     d = other.per_dataset[0]
     tg = with_y(d.target, d.model.copy(), f"best fit of {other.law}")
-    r = refit(own.law, refit_options(own) | {"timeout": timeout}, tg, scan=25, n_starts=2)
+    r = refit(own.law, refit_options(own) | {"timeout": timeout, "noise": noise_of(other)}, tg, scan=25, n_starts=2)
     return float(r.stats.chisqr) if r.ok else math.nan
 
 
-def centring(law: str, opts: dict, start: FitResult | None, target: Target, curve: np.ndarray) -> float:
+def centring(law: str, opts: dict, start: FitResult | None, target: Target, curve: np.ndarray, noise=None) -> float:
     """``law`` refitted to the noise-free ``curve`` (on ``target``'s points and sigma), warm-started at
     ``start``'s values (``opts``' when None): the chi-square it is left with, the plug-in for the
-    location of T under the law that made ``curve`` (nan if the refit fails)."""
-    return centring_fit(law, opts, start, target, curve)[0]
+    location of T under the law that made ``curve`` (nan if the refit fails). noise: the noise model of the fit
+    that made ``curve`` (``noise_of``), held in the refit."""
+    return centring_fit(law, opts, start, target, curve, noise)[0]
 
 
 def centring_fit(law: str, opts: dict, start: FitResult | None, target: Target,
-                 curve: np.ndarray) -> tuple[float, np.ndarray | None]:
+                 curve: np.ndarray, noise=None) -> tuple[float, np.ndarray | None]:
     """``centring``'s chi-square and the refitted curve itself (None if the refit fails)."""
+    if noise is not None:
+        opts = opts | {"noise": noise}
     if start is not None:
         now = {p.key: p.value for p in start.params.values()}
         opts = opts | {"initial": {k: now.get(k, v) for k, v in opts["initial"].items()},
@@ -103,9 +136,9 @@ def replicate_chunk(law_a, opts_a, law_b, opts_b, target, model_a, model_b, seed
     the two refitted curves (``distance``). With an estimated sigma of ``df`` degrees of freedom each
     replicate's chi-squares are at its own estimate sigma^2 chi2_df / df. The refits of every seed are made
     together where a batched route serves (``batchfit``), else one at a time. Runs in a worker."""
-    from ..noise.ar1 import noise_drawer
+    from ..noise.record import noise_drawer
 
-    noise = noise_drawer(target.dataset, target.y, model_a, target.sigma)  # Gaussian, or AR(1) where declared
+    noise = noise_drawer(target.dataset, target.y, model_a, target.sigma)  # Gaussian, AR(1) or AR(p) as declared
     eps, scale = [], []
     for ss in seeds:
         rng = np.random.default_rng(ss)
@@ -161,11 +194,11 @@ def _null_row(laws, target, null: str, y: np.ndarray) -> list[float]:
         return [math.nan] * 3
     if not (ra.ok and rb.ok):
         return [math.nan] * 3
-    t = ra.stats.chisqr - rb.stats.chisqr
+    t = t_stat(ra, rb)
     if null == "a":
-        s = t + centring(law_b, opts_b, rb, target, ra.per_dataset[0].model)
+        s = t + centring(law_b, opts_b, rb, target, ra.per_dataset[0].model, noise_of(ra))
     else:
-        s = t - centring(law_a, opts_a, ra, target, rb.per_dataset[0].model)
+        s = t - centring(law_a, opts_a, ra, target, rb.per_dataset[0].model, noise_of(rb))
     return [t, s, distance(target, ra.per_dataset[0].model, rb.per_dataset[0].model)]
 
 

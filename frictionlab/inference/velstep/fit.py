@@ -1,6 +1,6 @@
 """The velocity-step fit: a rate-and-state law fitted to spring-slider records as the field fits them.
 
-``fitting.fit`` hands a fit here when the law is the built-in rate-state-aging or rate-state-slip, every
+``fitting.fit`` hands a fit here when the law is a built-in one of ``quasistatic.FITTED`` (aging, slip, PRZ), every
 dataset is a spring-slider whose slider is quasi-static (``solve.quasistatic.applies``), the solver is 'auto'
 or 'ode' and no law parameter is fitted per dataset ('local'). The result is the usual ``FitResult``.
 
@@ -26,7 +26,10 @@ displacement (the dataset's x column, else the schedule's) and x_ref its value a
   SEARCH_POINTS samples, full fits from the best distinct grid points on that subsample, and the lowest one
   then fitted on every sample.
 * Noise: the dataset's sigma (known or estimated), or, where it declares ``correlation = "ar1"``, the AR(1)
-  model of ``inference.noise.ar1``: the fit and phi's profile alternate until phi settles.
+  model of ``inference.noise.ar1``: the fit and phi's profile alternate until phi settles; where it declares
+  ``correlation = "arp"``, the data's AR(p) / ARMA(1,1) model per rate group (``noise.record``), chosen from the
+  fit's residuals with its innovation level profiled, alternating with the fit (feasible GLS) until the models
+  stay the same and the levels settle (``velstep.series``).
 
 ``velstep_result.build`` turns the fitted problem into the FitResult (parameters, statistics, goodness of fit,
 identifiability with what a bound means, the parameter table in laboratory units).
@@ -42,14 +45,9 @@ import numpy as np
 from ...core.errors import FrictionLabError, SolverError
 from ...solve import quasistatic
 from ...solve.quasistatic import UM, Load
-from ..noise import ar1
 from ..fitting.model import FitTimeout
-from ..fitting.stats import noise_kind
+from .series import SEARCH_DENSE, SEARCH_POINTS, Series  # noqa: F401  (the fit's public names)
 
-#: Samples per dataset the grid of starts is scored on (every sample when there are fewer).
-SEARCH_POINTS = 1500
-#: Samples kept whole after each step in the search's subsample.
-SEARCH_DENSE = 200
 #: Grid of the global start: points along ln Dc, and along ln k where k is fitted (its span: start / K_SPAN to
 #: start * K_SPAN); Levenberg-Marquardt iterations of a and b at each grid point.
 GRID_DC, GRID_K, K_SPAN, SEARCH_ITERS = 8, 5, 30.0, 6
@@ -70,6 +68,8 @@ def applies(law, targets, solver: str, local, free) -> bool:
     if solver not in ("auto", "ode") or local:
         return False
     if set(free or {}) - {"spring.stiffness"}:
+        return False
+    if law.name not in quasistatic.FITTED:
         return False
     return all(tg.dataset.kind == "spring-slider" and tg.observable == "mu" and not tg.derivation
                and tg.t is not None and not quasistatic.applies(law, tg.dataset.scene) for tg in targets)
@@ -104,109 +104,6 @@ class Param:
         if self.transform == "lin":
             return self.lower / AB_SCALE, self.upper / AB_SCALE
         return math.log(self.lower), math.log(self.upper)
-
-
-class Series:
-    """One dataset prepared for the fit: times, data, load history, load-point displacement, linear columns and
-    the noise model (sigma and phi per sample)."""
-
-    def __init__(self, target, index: int, trend: bool, mu0: float | None):
-        ds = target.dataset
-        self.target, self.index = target, index
-        self.t = np.asarray(target.t, dtype=float)
-        self.y = np.asarray(target.y, dtype=float)
-        self.load = Load.of(ds.scene.spring)
-        self.x = ds.columns["x"] / UM if "x" in ds.columns else self.load.displacement(self.t)
-        first = self.load.times[1] if self.load.times.size > 1 else 0.0
-        self.x_ref = float(np.interp(first, self.t, self.x)) if "x" in ds.columns else float(
-            self.load.displacement(first))
-        self.trend, self.mu0 = trend, mu0
-        self.L1 = math.log(self.load.V1 / quasistatic.V0_UM)
-        cols = ([np.ones_like(self.t)] if mu0 is None else []) + ([self.x - self.x_ref] if trend else [])
-        self.B = np.column_stack(cols) if cols else np.zeros((self.t.size, 0))
-        self.kind = noise_kind(target)
-        self.ar1 = getattr(ds, "noise_correlation", "none") == "ar1"
-        self.sigma = np.broadcast_to(np.asarray(target.sigma, dtype=float), self.y.shape).copy()
-        self.phi = np.zeros(self.t.size)
-        self.labels, self.refs = ar1.rate_groups(self.t)
-        self.phi_groups = np.zeros(self.refs.size)
-        self.noise_ests: list = []
-        self.search = _search_index(self.t, self.load.times)
-        self.t_search = np.ascontiguousarray(self.t[self.search])
-        self.no_phi = np.zeros(self.search.size)  # the search's subsample is fitted as white noise
-        self._set_weights()
-        self._set_projection()
-
-    @property
-    def n(self) -> int:
-        return self.t.size
-
-    def _set_weights(self):
-        """What the compiled sums read of sigma and phi: 1 / sigma and the prewhitening gain 1 / sqrt(1 - phi^2)."""
-        self.inv_sigma = 1.0 / self.sigma
-        self.gain = 1.0 / np.sqrt(1.0 - self.phi ** 2)
-        self.inv_sigma_search = self.inv_sigma[self.search]
-
-    def _set_projection(self):
-        """The orthonormal columns of the (prewhitened) linear parameters, and the data less a first guess of their
-        linear part (y_ref): the sums of ``velstep_kernel`` then add numbers of the size of the transient and the
-        noise, not of mu itself, and lose no precision; the projection removes any such part exactly."""
-        self.Q = _basis(ar1.whiten(self.B / self.sigma[:, None], self.phi))
-        s = self.search
-        self.Q_search = _basis(self.B[s] / self.sigma[s, None])
-        self.y_ref = (self.y - self.B @ np.linalg.lstsq(self.B, self.y - (self.mu0 or 0.0), rcond=None)[0]
-                      if self.B.shape[1] else self.y)
-        self.y_ref_search = self.y_ref[s]
-
-    def set_noise(self, residual) -> float:
-        """Profile phi from ``residual`` (model - data) and re-estimate sigma from the prewhitened data (estimated
-        noise) or keep the declared one (known): the largest change of a group's phi."""
-        phi = ar1.estimate_phi(residual, self.t, self.labels, self.refs)
-        change = float(np.max(np.abs(phi - self.phi_groups))) if phi.size else 0.0
-        self.phi_groups = phi
-        self.phi = ar1.coefficients(self.t, self.labels, self.refs, phi)
-        if self.kind == "estimated":
-            self.sigma, self.noise_ests = ar1.noise_sigma(self.t, self.y, self.phi, self.labels, self.refs)
-            if not np.all(np.isfinite(self.sigma) & (self.sigma > 0)):
-                raise FrictionLabError(f"dataset '{self.target.name}': the noise of the prewhitened data cannot be "
-                                       "estimated")
-        self._set_weights()
-        self._set_projection()
-        return change
-
-    def offset(self, a: float, b: float) -> float:
-        """The model's part fixed by a held mu0 (at V0): mu0 + (a - b) ln(V1 / V0); 0 when mu_ss is fitted."""
-        return 0.0 if self.mu0 is None else self.mu0 + (a - b) * self.L1
-
-    def linear(self, a: float, b: float, m: np.ndarray) -> np.ndarray:
-        """The linear coefficients (mu_ss and/or trend) for the nonlinear solution m, whitened least squares."""
-        if not self.B.shape[1]:
-            return np.zeros(0)
-        w = ar1.whiten((self.y - self.offset(a, b) - m) / self.sigma, self.phi)
-        Bw = ar1.whiten(self.B / self.sigma[:, None], self.phi)
-        return np.linalg.lstsq(Bw, w, rcond=None)[0]
-
-
-def _basis(A) -> np.ndarray:
-    """An orthonormal basis of A's columns (n x 0 for none)."""
-    if not A.shape[1]:
-        return A[:, :0]
-    return np.linalg.qr(A)[0]
-
-
-def _search_index(t, step_times) -> np.ndarray:
-    """Indices of the search's subsample: every sample when few, else SEARCH_DENSE samples whole after each step
-    and an even stride elsewhere (about SEARCH_POINTS in all)."""
-    n = t.size
-    if n <= SEARCH_POINTS:
-        return np.arange(n)
-    keep = np.zeros(n, dtype=bool)
-    keep[:: max(1, n // SEARCH_POINTS)] = True
-    for ts in step_times[1:]:
-        i = int(np.searchsorted(t, ts))
-        keep[i:i + SEARCH_DENSE] = True
-    keep[-1] = True
-    return np.nonzero(keep)[0]
 
 
 class Problem:
@@ -271,6 +168,8 @@ class Problem:
                 if search:  # white noise on the subsample
                     sums = basis_sums(s.y_ref_search, s.offset(v["a"], v["b"]), sol.m, sol.S, s.inv_sigma_search,
                                       s.no_phi, s.no_phi, s.Q_search)
+                elif s.arp:
+                    sums = s.whitened_sums(s.offset(v["a"], v["b"]), sol.m, sol.S)
                 else:
                     sums = basis_sums(s.y_ref, s.offset(v["a"], v["b"]), sol.m, sol.S, s.inv_sigma, s.phi, s.gain,
                                       s.Q)
@@ -447,10 +346,12 @@ def _dc_grid(series, p: Param) -> np.ndarray:
 
 def fit(law, targets, *, fixed=None, free=None, initial=None, trend=None, stiffness=None, scan: int = 125,
         n_starts: int = 3, max_nfev=None, rtol=None, timeout=None, checks: bool = True, errors: bool = True,
-        n_params=None, progress=None, names=(), clock=None):
+        n_params=None, progress=None, names=(), clock=None, noise=None):
     """The velocity-step fit of ``law`` to ``targets`` (module docstring); arguments as ``fitting.fit``, plus
-    trend (None: fitted on measured data) and stiffness (None: fitted on measured data unless ``free`` names it;
-    False: held; True: fitted within K_BOUNDS of its start). Returns a FitResult."""
+    trend (None: fitted on measured data), stiffness (None: fitted on measured data unless ``free`` names it;
+    False: held; True: fitted within K_BOUNDS of its start) and noise (None: the datasets' noise models; else one
+    ``VelstepFit.noise_state`` per dataset, held: the noise model of a fit whose curve is refitted). Returns a
+    FitResult."""
     from ..fitting.result import FitResult
     from .result import build
 
@@ -463,6 +364,8 @@ def fit(law, targets, *, fixed=None, free=None, initial=None, trend=None, stiffn
 
     problem = make_problem(law, targets, fixed or {}, free or {}, initial or {}, trend, stiffness,
                            FIT_RTOL if rtol is None else rtol, deadline)
+    for s, state in zip(problem.series, noise or ()):
+        s.hold_noise(state)
     n_free = len(problem.free) + sum(s.B.shape[1] for s in problem.series)
     n_points = sum(s.n for s in problem.series)
     if n_points < n_free + 1:
@@ -503,10 +406,10 @@ def _solve(problem: Problem, scan: int, n_starts: int, max_nfev):
     if not ok:
         return problem.x_start(), math.inf, False, 0
     rounds = 0
-    if any(s.ar1 for s in problem.series):
+    if any(s.correlated and not s.held for s in problem.series):
         for rounds in range(1, AR1_ROUNDS + 1):
             models = problem.model(x)
-            change = max(s.set_noise(m - s.y) for s, m in zip(problem.series, models) if s.ar1)
+            change = max(s.set_noise(m - s.y) for s, m in zip(problem.series, models) if s.correlated and not s.held)
             problem._cache = None
             x, cost, ok = problem.local(x, free, max_nfev=max_nfev)
             if not ok:

@@ -9,12 +9,12 @@ units (``StepReport``).
 * The sign of a - b and the trend: where a trend is fitted, the result says whether the sign of a - b depends on
   it: when |s| times the slip over the record exceeds |a - b| ln(V2/V1) at the largest step, or when a refit
   without the trend gives a - b of the other sign.
-* What the data show that the law misses, where it does not fit: a trend it was not given (a refit with one
-  lowers chi-square beyond the 0.1 % point of chi-square with one degree of freedom), a strengthening evolution
-  (b pressed to 0: a refit that lets b go below 0, from the fit and the search's grid points where the bound held
-  b at 0), and residual structure after a step (runs of same-sign mean residual in windows of slip,
-  each beyond MISSING_Z standard errors of a mean of correlated noise): slower than the fitted evolution, a
-  second state variable.
+* Goodness under the data's AR(p) model (``correlation = "arp"``): two questions kept apart. Whether the noise
+  model is adequate: the Ljung-Box test of the whitened residuals (reported, not a verdict on the law). Whether
+  the law fits: the bands of slip after each step against the record's steady state (``noise.misfit``); "does
+  not fit" rests on that test alone, with its band named. The innovation level is profiled, so chi-square is
+  n by construction and is no test there.
+* What the data show that the law misses, where it does not fit: ``velstep.missing``.
 """
 from __future__ import annotations
 
@@ -28,16 +28,12 @@ from ...solve.quasistatic import UM
 from ..noise import ar1
 from ..fitting.result import DatasetFit, FitResult, ParamResult, Stats
 from ..fitting.stats import LIKELIHOOD_REASON
-from ..diagnostics.goodness import SHARPEN_BELOW, combine, f_pvalue, goodness, ljung_box
+from ..diagnostics.goodness import FITS_LEVEL, SHARPEN_BELOW, WHITE_LAGS, combine, f_pvalue, goodness, law_fit, ljung_box
+from . import missing as velstep_missing
 from ..diagnostics.identifiability import make_verdict
 
-#: A parameter within this distance of a bound (in its optimizer coordinate: a / 0.01, b / 0.01, ln Dc, ln k;
-#: relative for the last two) is at the bound.
-AT_BOUND = 1e-3
-#: Residual windows after a step beyond this many standard errors count as structure the law misses.
-MISSING_Z = 4.0
-CHI2_1_999 = 10.828  # the 0.1 % point of chi-square with one degree of freedom
-REFIT_EVALS = 40  # evaluations on every sample of a diagnostic refit (after it converged on the subsample)
+from .missing import AT_BOUND, CHI2_1_999, MISSING_Z, REFIT_EVALS  # noqa: F401  (the fit's public names)
+from .table import Quantity, StepReport, StepRow  # noqa: F401  (the fit's public names)
 
 #: What a parameter at a bound means on velocity-step data: (key, 'lower' | 'upper') -> sentence.
 BOUND_MEANING = {
@@ -55,79 +51,6 @@ BOUND_MEANING = {
 }
 
 
-@attrs.frozen
-class Quantity:
-    """A value with its standard error and 95% interval, in the display unit."""
-
-    value: float
-    stderr: float | None
-    low: float
-    high: float
-    unit: str
-    held: bool = False  # held by the caller or the dataset (no interval: not fitted)
-    bound: str = ""  # 'lower' | 'upper' where the fit ended at that bound (no interval: the bound's value)
-
-    @property
-    def digits(self) -> int:
-        """Significant digits that resolve the standard error (at least 4)."""
-        if not self.stderr or not self.value:
-            return 4
-        return max(4, min(10, math.ceil(math.log10(abs(self.value) / self.stderr)) + 2))
-
-    @property
-    def missing(self) -> str:
-        """Why there is no interval: 'held', 'at its lower bound', 'at its upper bound' or 'no interval'."""
-        return "held" if self.held else f"at its {self.bound} bound" if self.bound else "no interval"
-
-    def text(self) -> str:
-        unit = f" {self.unit}" if self.unit else ""
-        if self.stderr is None:
-            return f"{self.value:.4g}{unit} ({self.missing})"
-        d = self.digits
-        return f"{self.value:.{d}g} ± {self.stderr:.2g}{unit} [{self.low:.{d}g}, {self.high:.{d}g}]"
-
-
-@attrs.frozen
-class StepRow:
-    """One dataset's velocity-step parameters in laboratory units (a, b, a - b, mu0 and mu_ss plain; Dc in um;
-    k and the trend in 1/um)."""
-
-    dataset: str
-    law: str
-    quantities: dict  # name -> Quantity: 'a', 'b', 'a-b', 'Dc', 'k', 'mu0', 'trend'
-    phi: tuple  # (rate label, phi) per rate group, () without the AR(1) model
-    steps: tuple  # ((V before, V after) [um/s]) of each step
-    fits: bool | None
-    goodness: str
-
-
-@attrs.frozen
-class StepReport:
-    """What a velocity-step fit says, in the field's units: per dataset the parameter table, the sign of a - b
-    against the trend, the parameters at a bound and what that means, and what the law misses."""
-
-    rows: tuple[StepRow, ...]
-    sign: tuple[str, ...] = ()
-    bounds: tuple[str, ...] = ()
-    missing: tuple[str, ...] = ()
-    noise: tuple[str, ...] = ()
-
-    ORDER = ("a", "b", "a-b", "Dc", "k", "mu0", "trend")
-
-    def lines(self) -> list[str]:
-        out = []
-        for r in self.rows:
-            steps = ", ".join(f"{v1:g} -> {v2:g} um/s" for v1, v2 in r.steps)
-            out.append(f"  velocity steps of {r.dataset} ({steps}), {r.law}: value ± standard error [95% interval]")
-            for name in self.ORDER:
-                if name in r.quantities:
-                    out.append(f"    {name:<6} = {r.quantities[name].text()}")
-            if r.phi:
-                out.append("    noise: AR(1), " + ", ".join(f"phi = {p:.3f} ({lab})" for lab, p in r.phi))
-        out += [f"  {s}" for s in self.sign + self.bounds + self.noise + self.missing]
-        return out
-
-
 @attrs.frozen(eq=False)
 class VelstepFit(DatasetFit):
     """A dataset's part of a velocity-step fit: its model includes the fitted trend s (x - x_ref) [s in 1/m]."""
@@ -135,6 +58,9 @@ class VelstepFit(DatasetFit):
     trend: float = 0.0
     x_ref: float = 0.0  # [m]
     x_data: np.ndarray | None = None  # the dataset's load-point displacement [m] (None: from the schedule)
+    loglik: np.ndarray | None = None  # each sample's log-likelihood under the fit's noise model (``vuong``)
+    noise_state: dict | None = None  # the fitted noise model (``velstep.series.Series.noise_state``), for refits
+    refit: dict = attrs.field(factory=dict)  # the fit's own model for a refit: {'trend': bool, 'stiffness': bool}
 
     def trajectory(self, law, t=None, n: int = 401):
         tr = super().trajectory(law, t, n)
@@ -179,13 +105,13 @@ def build(problem, x, rounds, *, checks=True, errors=True, n_params=None, clock=
         full[np.ix_(keep, keep)] = cov
     chisqr = float(sum(p["z"] @ p["z"] for p in pieces))
     n = sum(p["n"] for p in pieces)
-    n_phi = sum(s.refs.size for s in problem.series if s.ar1)
+    n_phi = sum(s.n_noise for s in problem.series)
     k = (rank if errors else (len(free) + sum(n_lin) if n_params is None else int(n_params)))
     kind = pieces[0]["kind"] if len({p["kind"] for p in pieces}) == 1 else "mixed"
     per, goods = [], []
     for s, p in zip(problem.series, pieces):
-        g = _goodness(s, p, round(k / len(pieces)) + (s.refs.size if s.ar1 else 0), J[p["rows"], keep]
-                      if errors and checks else None)
+        g = _goodness(s, p, round(k / len(pieces)) + s.n_noise, J[p["rows"], keep] if errors and checks else None,
+                      v)
         goods.append(g)
         lawp = {"mu0": p["mu0"], "a": v["a"], "b": v["b"], "Dc": v["Dc"] * UM}
         scene = set_scene_quantity(s.target.dataset.scene, "spring.stiffness", v["k"][s.index] / UM)
@@ -193,11 +119,17 @@ def build(problem, x, rounds, *, checks=True, errors=True, n_params=None, clock=
         per.append(VelstepFit(target, "ode", lawp, scene, p["model"], float(p["r"] @ p["r"]),
                               float(math.sqrt(np.mean(p["r"] ** 2))), float(p["z"] @ p["z"]), g,
                               trend=p["trend"] / UM, x_ref=s.x_ref * UM,
-                              x_data=s.x * UM if "x" in s.target.dataset.columns else None))
+                              x_data=s.x * UM if "x" in s.target.dataset.columns else None, loglik=p["loglik"],
+                              noise_state=s.noise_state(), refit={"trend": bool(s.trend), "stiffness": any(
+                                  q.key == "k" and q.target == s.index and q.vary for q in problem.params)}))
     ll = sum(p["ll"] for p in pieces)
     k_lik = k + n_phi
     reason = LIKELIHOOD_REASON.get(kind, "")
-    if n_phi:
+    if any(s.arp for s in problem.series):
+        reason += ("; correlated noise chosen by the data: AR(p) by BIC (ARMA(1,1) where the order runs to its cap) "
+                   "per sampling rate, its innovation level profiled, alternated with the fit; coefficients and "
+                   "levels counted as parameters; the likelihood, tests and error bars on the whitened series")
+    elif n_phi:
         reason += ("; correlated noise: AR(1) per sampling rate (phi profiled, counted as a parameter), the "
                    "likelihood, tests and error bars on the prewhitened series")
     stats = Stats(n_points=n, n_params=k, n_free=len(free) + sum(n_lin), chisqr=chisqr,
@@ -216,13 +148,15 @@ def build(problem, x, rounds, *, checks=True, errors=True, n_params=None, clock=
     ident = attrs.evolve(ident, warnings=tuple(_with_meaning(w, meanings) for w in ident.warnings))
     notes = []
     if rounds:
-        notes.append(f"AR(1) noise: the fit and the profile of phi alternated {rounds} times")
+        notes.append(f"AR(p) noise chosen by the data: the fit and the noise model alternated {rounds} times"
+                     if any(s.arp for s in problem.series) else
+                     f"AR(1) noise: the fit and the profile of phi alternated {rounds} times")
     if problem.failures:
         notes.append(f"{problem.failures} of {problem.nfev} evaluations could not be solved and were penalized "
                      f"(last: {problem.last_error})")
     report = None
     if checks and errors:
-        report = _report(problem, x, v, pieces, quantities, at_bound, goods)
+        report = velstep_missing.report(problem, x, v, pieces, quantities, at_bound, goods)
         notes += list(report.sign) + list(report.noise) + list(report.missing)
     clock = clock or (time.perf_counter(), time.thread_time())
     return FitResult(law=law.name, solver="ode", datasets=tuple(names), status="ok", params=params,
@@ -243,16 +177,17 @@ def _piece(problem, s, v, x, free, J, col: int) -> dict:
     c = s.linear(v["a"], v["b"], sol.m)
     model = s.offset(v["a"], v["b"]) + sol.m + s.B @ c
     r = model - s.y
-    z = ar1.whiten(r / s.sigma, s.phi)
+    z = s.white(r / s.sigma)
     start = sum(t.n for t in problem.series[:s.index])
     rows = slice(start, start + s.n)
     if J.shape[1]:
-        J[rows, :len(free)] = ar1.whiten(problem.columns(s, v, x, sol.S, free) / s.sigma[:, None], s.phi)
-        J[rows, col:col + s.B.shape[1]] = ar1.whiten(s.B / s.sigma[:, None], s.phi)
-    ll = float(z @ z) + float(np.sum(np.log(2 * math.pi * s.sigma ** 2))) + ar1.log_det(s.phi)
+        J[rows, :len(free)] = s.white(problem.columns(s, v, x, sol.S, free) / s.sigma[:, None])
+        J[rows, col:col + s.B.shape[1]] = s.white(s.B / s.sigma[:, None])
+    terms = z * z + np.log(2 * math.pi * s.sigma ** 2) + s.log_det_terms()  # each sample's -2 ln L
+    ll = float(np.sum(terms))
     mu_ss = (c[0] if s.mu0 is None else s.mu0 + (v["a"] - v["b"]) * s.L1)
     trend = float(c[-1]) if s.trend else 0.0
-    return dict(n=s.n, model=model, r=r, z=z, c=c, rows=rows, ll=ll, mu0=float(mu_ss - (v["a"] - v["b"]) * s.L1),
+    return dict(n=s.n, model=model, r=r, z=z, c=c, rows=rows, ll=ll, loglik=-0.5 * terms, mu0=float(mu_ss - (v["a"] - v["b"]) * s.L1),
                 mu_ss=float(mu_ss), trend=trend, kind=s.kind)
 
 
@@ -298,11 +233,18 @@ def _with_meaning(warning: str, meanings: dict) -> str:
     return warning
 
 
-def _goodness(s, p, k_each: int, J):
-    """The goodness of fit of one dataset on its prewhitened residuals (``inference.diagnostics.goodness``)."""
+def _goodness(s, p, k_each: int, J, v=None):
+    """The goodness of fit of one dataset on its prewhitened residuals (``inference.diagnostics.goodness``); under
+    the data's AR(p) model, the noise model's whiteness and the law's band test apart (``goodness.law_fit``)."""
     from ...io.noise import ratio_pvalue_moments
 
     z = p["z"]
+    if s.arp:
+        from ..noise.misfit import band_test
+
+        white_p, white_text = _whiteness(s, z)
+        bands = band_test(z, s.t, s.x, s.load.times[1:], v["Dc"], s.labels) if v is not None else None
+        return law_fit(z, white_p, white_text, bands)
     chi = float(z @ z)
     white = ljung_box(z, s.refs.size) if s.ar1 else math.nan  # the AR(1) model says the prewhitened z are white
     if s.kind != "estimated":
@@ -318,6 +260,24 @@ def _goodness(s, p, k_each: int, J):
         sharp = ratio_pvalue_moments(est, chi, J)
         chi_p = chi_p if sharp is None else sharp
     return goodness(z, k_each, "estimated", df, chi_p, white_p=white)
+
+
+def _whiteness(s, z) -> tuple[float, str]:
+    """(p, words) of the Ljung-Box test of the whitened residuals of each rate group (over max(WHITE_LAGS, p + 10)
+    lags, the model's coefficients subtracted from the degrees of freedom), Bonferroni over the groups."""
+    ps, parts = [], []
+    for g, m in enumerate(s.noise.models):
+        zg = z[s.labels == g]
+        lags = max(WHITE_LAGS, m.order + 10)
+        pg = ljung_box(zg, m.n_coef, lags)
+        if math.isfinite(pg):
+            ps.append(pg)
+            parts.append(f"p = {pg:.2g} at {1 / s.refs[g]:.3g} Hz ({lags} lags)")
+    if not ps:
+        return math.nan, "whiteness not testable (too few samples)"
+    p = min(1.0, min(ps) * len(ps))
+    verdict = "whitened residuals white" if p >= FITS_LEVEL else "whitened residuals not white"
+    return p, f"{verdict}: Ljung-Box " + ", ".join(parts)
 
 
 def _params(problem, x, v, pieces, free, cov, at_bound, errors) -> tuple[dict, dict, dict]:
@@ -439,155 +399,3 @@ def _quantity(p: ParamResult, factor: float, unit: str, log: bool = False, bound
     return Quantity(v, e, v - 1.959964 * e, v + 1.959964 * e, unit)
 
 
-def _report(problem, x, v, pieces, quantities, at_bound, goods) -> StepReport:
-    """The StepReport: the table, the sign of a - b against the trend, bounds, the noise and what the law misses."""
-    rows, sign, noise = [], [], []
-    ab = v["a"] - v["b"]
-    for s, pc, g in zip(problem.series, pieces, goods):
-        V = s.load.velocities
-        steps = tuple((float(V[i]), float(V[i + 1])) for i in range(V.size - 1))
-        phi = tuple((f"{1 / r:.3g} Hz", float(p)) for r, p in zip(s.refs, s.phi_groups)) if s.ar1 else ()
-        rows.append(StepRow(s.target.name, problem.law.name, quantities[s.target.name], phi, steps, g.fits, g.text))
-        if s.trend:
-            sign += _sign_check(problem, x, s, pc, ab, steps)
-        if s.ar1 and math.isfinite(g.lag1) and abs(g.lag1) > MISSING_Z / math.sqrt(s.n):
-            noise.append(f"{s.target.name}: the noise is not AR(1): the prewhitened residuals keep a lag-1 "
-                         f"autocorrelation of {g.lag1:+.2f} (beyond {MISSING_Z:g} / sqrt(n))")
-    missing = _missing(problem, x, pieces, goods, v, at_bound) if at_bound or any(g.fits is False for g in goods) else []
-    bounds = tuple(text for _, _, text in at_bound.values())
-    return StepReport(tuple(rows), tuple(sign), bounds, tuple(missing), tuple(noise))
-
-
-def _sign_check(problem, x, s, pc, ab, steps) -> list[str]:
-    """Whether the sign of a - b on dataset s depends on its fitted trend (module docstring)."""
-    ratios = [abs(math.log(v2 / v1)) for v1, v2 in steps if v1 > 0 and v2 > 0]
-    if not ratios:
-        return []
-    slip = float(s.x[-1] - s.x[0])
-    size = abs(pc["trend"]) * slip
-    evo = abs(ab) * max(ratios)
-    refit = _refit(problem, x, s, trend=False)
-    without = None if refit is None else refit[0]
-    flips = without is not None and math.copysign(1, without) != math.copysign(1, ab)
-    if size > evo or flips:
-        why = []
-        if size > evo:
-            why.append(f"the trend over the record's slip ({pc['trend']:.3g} /um x {slip:.4g} um = {size:.2g}) exceeds "
-                       f"|a - b| ln(V2/V1) = {evo:.2g}")
-        if flips:
-            why.append(f"without the trend a - b = {without:+.4g}")
-        return [f"{s.target.name}: the sign of a - b ({ab:+.4g}) depends on the trend: " + "; ".join(why)]
-    tail = f" (without the trend a - b = {without:+.4g})" if without is not None else ""
-    return [f"{s.target.name}: the sign of a - b ({ab:+.4g}) does not depend on the trend{tail}"]
-
-
-def _refit(problem, x, s, trend: bool):
-    """(a - b, chi-square) of a refit of the problem with dataset s's trend switched on or off (None if it fails):
-    the other datasets and the noise model as they are."""
-    B0, trend0, Q0, Qs0, y0, ys0 = s.B, s.trend, s.Q, s.Q_search, s.y_ref, s.y_ref_search
-    try:
-        s.trend = trend
-        s.B = s.B[:, :-1] if not trend else np.column_stack([s.B, s.x - s.x_ref])
-        s._set_projection()
-        problem._cache = None
-        xr, _, ok = problem.local(x, problem.free, search=True)  # on the subsample, then on every sample
-        xr, cost, ok = problem.local(xr if ok else x, problem.free, max_nfev=REFIT_EVALS)
-        if not ok:
-            return None
-        v = problem.values(xr)
-        return v["a"] - v["b"], 2 * cost
-    finally:
-        s.B, s.trend, s.Q, s.Q_search, s.y_ref, s.y_ref_search = B0, trend0, Q0, Qs0, y0, ys0
-        problem._cache = None
-
-
-def _strengthening(problem, x) -> str:
-    """A refit with b free to go below 0 from where the bound held b at 0: the fit, if it ends there, and the best
-    grid points of the search whose a, b fit ended there (``Problem.b_held``); from anywhere else the bound did not
-    act, and a local refit returns where it started. The sentence when it finds b < 0 and lowers chi-square beyond
-    CHI2_1_999 ('' otherwise)."""
-    ib = next(i for i, p in enumerate(problem.params) if p.key == "b")
-    p = problem.params[ib]
-    starts = ([x] if x[ib] <= p.bounds_x[0] + AT_BOUND else []) + problem.b_held[:2]
-    if not p.vary or not starts:
-        return ""
-    chi_now = problem.evaluate(x, problem.free)[0]
-    best = None
-    try:
-        problem.params[ib] = attrs.evolve(p, lower=-p.upper)
-        problem._cache = None
-        tried = [problem.local(x0, problem.free, search=True) for x0 in starts]
-        tried = [t for t in tried if t[2]]  # on the subsample; the best one then on every sample
-        if tried:
-            xr, cost, ok = problem.local(min(tried, key=lambda t: t[1])[0], problem.free, max_nfev=REFIT_EVALS)
-            best = (xr, cost) if ok else None
-    finally:
-        problem.params[ib] = p
-        problem._cache = None
-    if best is None:
-        return ""
-    xr, cost = best
-    v = problem.values(xr)
-    drop = chi_now - 2 * cost
-    if v["b"] < 0 and drop > CHI2_1_999:
-        return (f"a strengthening evolution: a refit that lets b go below 0 gives b = {v['b']:.3g} (a = {v['a']:.3g}, "
-                f"Dc = {v['Dc']:.3g} um) and lowers chi-square by {drop:.4g}; the rate-and-state laws here need b >= 0")
-    return ""
-
-
-def _missing(problem, x, pieces, goods, v, at_bound) -> list[str]:
-    """What the data show that the law misses (module docstring), from the fit's residuals and refits."""
-    text = _strengthening(problem, x)
-    if text:  # the first feature found; the others would be judged on a law the data reject
-        return [f"{', '.join(s.target.name for s in problem.series)}: {text}"]
-    out = []
-    for s, pc, g in zip(problem.series, pieces, goods):
-        if not s.trend:
-            r = _refit(problem, x, s, trend=True)
-            chi_now = float(pc["z"] @ pc["z"])
-            if r is not None and chi_now - r[1] > CHI2_1_999:
-                out.append(f"{s.target.name}: a trend of friction with slip (a refit with one lowers chi-square by "
-                           f"{chi_now - r[1]:.4g})")
-        if g.fits is False:
-            out += _structure(s, pc, v)
-    return out
-
-
-def _structure(s, pc, v) -> list[str]:
-    """Windows of slip after each step where the mean residual departs from 0 by more than MISSING_Z standard
-    errors of a mean of the fitted noise (AR(1): the variance of a mean inflated by (1 + phi) / (1 - phi))."""
-    out = []
-    Dc = v["Dc"]
-    r = pc["r"] / s.sigma
-    times = list(s.load.times[1:]) + [math.inf]
-    for j, ts in enumerate(times[:-1]):
-        sel = (s.t >= ts) & (s.t < times[j + 1])
-        if sel.sum() < 20:
-            continue
-        slip = s.x[sel] - float(np.interp(ts, s.t, s.x))
-        top = float(slip.max())
-        if not top > Dc / 10:
-            continue
-        edges = np.geomspace(Dc / 10, top, 9)
-        flagged = []
-        for lo, hi in zip(edges[:-1], edges[1:]):
-            w = (slip >= lo) & (slip < hi)
-            nw = int(w.sum())
-            if nw < 10:
-                continue
-            phi = float(np.median(s.phi[sel][w])) if s.ar1 else 0.0
-            se = math.sqrt((1 + phi) / (1 - phi) / nw) if phi < 1 else math.inf
-            zmean = float(np.mean(r[sel][w])) / se
-            if abs(zmean) > MISSING_Z:
-                flagged.append((lo, hi, zmean))
-        beyond = [f for f in flagged if f[0] >= 3 * Dc]
-        if len(beyond) >= 2:
-            span = f"{beyond[0][0]:.3g} to {beyond[-1][1]:.3g} um"
-            out.append(f"{s.target.name}: a slower evolution after step {j + 1} (a second state variable): mean "
-                       f"residuals beyond {MISSING_Z:g} standard errors from {span} of slip after the step, beyond "
-                       f"3 Dc = {3 * Dc:.3g} um")
-        elif flagged:
-            span = ", ".join(f"{lo:.3g}-{hi:.3g} um ({z:+.1f} SE)" for lo, hi, z in flagged)
-            out.append(f"{s.target.name}: the shape of the transient after step {j + 1}: mean residuals beyond "
-                       f"{MISSING_Z:g} standard errors at slip {span}")
-    return out

@@ -13,7 +13,8 @@ import attrs
 
 #: Keys of ``Answer.short``, in table order, with the long field each one summarizes.
 SHORT = {"best": "headline", "goodness": "goodness", "equivalence": "equivalence",
-         "threshold": "noise_threshold", "series": "series_vs_exact", "accuracy": "accuracy", "transfer": "transfer"}
+         "threshold": "noise_threshold", "series": "series_vs_exact", "accuracy": "accuracy", "transfer": "transfer",
+         "closer": "closer"}
 
 #: The equivalence verdicts a row may carry: a test's (``equivalence.VERDICTS``) or none.
 EQUIVALENCE = ("different", "equivalent within δ", "cannot tell at this noise", "both fail their fit tests",
@@ -38,6 +39,7 @@ class Answer:
     equivalence_series: str = ""  # one of EQUIVALENCE: the paper's series of lambda A u against mu N + mu eta' dA/dt
     qualitative: str = ""  # do the two laws' fitted curves share the data's features (one sentence)
     accuracy: str = ""  # what accuracy costs: each solver's error and time against the most accurate one
+    closer: str = ""  # which of the two best laws is closer to the data, on one likelihood (``vuong``)
     details: dict = attrs.field(factory=dict)  # machine-readable numbers behind the texts (SI), for results.json
     #: a few words per cell with the decisive number, for the first screen's table and the CLI's closing lines;
     #: keys SHORT (filled by the producer of the matching long field; absent when it gave none)

@@ -41,8 +41,6 @@ def make_answers(datasets, fits, ranking, groups) -> tuple[Answer, ...]:
         pool = ranking if len(dss) == 1 else groups
         key = names[0] if len(dss) == 1 else label
         rows = [r for r in pool if r.dataset == key and r.rank is not None]
-        if not rows and 1 < len(dss) == len(datasets):  # the group is every fitted dataset: ranked as 'ALL'
-            rows = [r for r in pool if r.dataset == "ALL" and r.rank is not None]
         kinds = {d.provenance.kind for d in dss}
         provenance = kinds.pop() if len(kinds) == 1 else "mixed"
         best, fits_ok, headline, goodness, details, short = _verdict(rows)
@@ -52,9 +50,14 @@ def make_answers(datasets, fits, ranking, groups) -> tuple[Answer, ...]:
         details["series_vs_exact"] = series_numbers
         if series_numbers:
             short["series"] = series_short(series_numbers)
+        closer = ""
+        if len(dss) == 1:
+            closer, closer_short, numbers = _closer(rows, fits, names[0])
+            if closer:
+                details["closer"], short["closer"] = numbers, closer_short
         out.append(Answer(group=label, datasets=names, provenance=provenance, best=best, fits=fits_ok,
                           headline=headline, goodness=goodness, equivalence="not tested", noise_threshold="",
-                          series_vs_exact=series_text, details=details, short=short))
+                          series_vs_exact=series_text, details=details, short=short, closer=closer))
     return tuple(out)
 
 
@@ -138,6 +141,21 @@ def series_short(numbers: dict) -> str:
             return "never"
         return "at " + " / ".join("never" if t is None else f"{t * 1e6:.0f}" for t in ts) + " µs"
     return f"series slip u = 0 {when('slip_zero_series_s')}; exact {when('slip_zero_exact_s')}"
+
+
+def _closer(rows, fits, name: str) -> tuple[str, str, dict]:
+    """Vuong's test of the two best-ranked candidates of dataset ``name`` (``vuong.closer_sentence``)."""
+    from .vuong import closer_sentence
+
+    ranked = sorted((r for r in rows if r.rank is not None), key=lambda r: r.rank)
+    chosen = []
+    for r in ranked:
+        f = next((f for f in fits if f.ok and f.law == r.law and f.solver == r.solver and f.datasets == (name,)), None)
+        if f is not None and f.law not in {c.law for c in chosen}:
+            chosen.append(f)
+        if len(chosen) == 2:
+            return closer_sentence(*chosen)
+    return "", "", {}
 
 
 def series_vs_exact(fits) -> tuple[str, dict]:

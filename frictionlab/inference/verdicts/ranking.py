@@ -20,8 +20,9 @@ Rules, stated once:
 * Near-ties: candidates within delta-AIC < ``NEAR_TIE`` (2) of each other are 'indistinguishable
   by these data' (Burnham and Anderson 2002: Delta < 2 means substantial support for both).
 
-Over a group of datasets ('ALL', 'ALL[kind]' when kinds differ, and each dataset group of two
-or more members, ``answers.group_of``) -2 ln L adds over the candidate's independent
+Over a group of datasets (each group of two or more members its datasets declare, ``answers.group_of``; no
+group of every dataset is formed: datasets of different experiments, materials or kinds are not summed unless
+their files say they belong together) -2 ln L adds over the candidate's independent
 per-dataset fits, k adds, and AIC, AICc and BIC are computed from the group's n and k; the
 goodness p-values are Bonferroni-adjusted over the members. A candidate is ranked there only if
 it fitted every dataset of the group. The 'series' solver is its own candidate; 'exact' and
@@ -50,7 +51,23 @@ COLUMNS = ("dataset", "law", "solver", "n_points", "n_params", "rss", "rmse", "r
 
 @attrs.frozen
 class RankRow:
-    """One row of ranking.csv. rss and rmse are in the observable's SI unit (nan for groups)."""
+    """One row of the ranking (``ranking.csv``, `Comparison.to_dataframe`).
+
+    Attributes
+    ----------
+    dataset : str
+        The dataset, or a group (``ALL``, ``ALL[kind]``).
+    law, solver, candidate : str
+        The law, its solver, and the candidate they form (``"wear [exact]"``).
+    rank : int
+        Its rank by AIC; candidates within ``TIE_AIC`` share one.
+    rss, rmse : float
+        Residual sum of squares and root mean square in the observable's SI unit (nan for groups).
+    aic, bic, delta_aic, akaike_weight : float
+        Information criteria, the distance to the best, and the Akaike weight among the candidates that fit.
+    fits : bool
+        Whether it passes its goodness-of-fit tests.
+    """
 
     dataset: str
     law: str
@@ -89,7 +106,13 @@ class RankRow:
         return f"{self.law} [{self.solver}]"
 
     def as_dict(self) -> dict:
-        """The row as plain values, as ranking.csv and results.json record it."""
+        """The row as plain values.
+
+        Returns
+        -------
+        dict
+            Column name to value, as ``ranking.csv`` and ``results.json`` record them.
+        """
         out = {c: getattr(self, c) for c in COLUMNS}
         out["flags"] = "; ".join(self.flags)
         out["at_bounds"] = "; ".join(self.at_bounds)
@@ -256,24 +279,18 @@ def rank_fits(fits: list[FitResult], tie: float = TIE_AIC) -> list[RankRow]:
 
 def rank_groups(rows: list[RankRow], kinds: dict[str, str] | None = None, tie: float = TIE_AIC,
                 named: dict[str, str] | None = None) -> list[RankRow]:
-    """Aggregate per-dataset rows into 'ALL', 'ALL[kind]' when kinds differ, and each named group of
-    two or more datasets (``named``: dataset -> group label), and rank them.
+    """Aggregate per-dataset rows into each declared group of two or more datasets (``named``: dataset -> group
+    label; ``kinds`` is not used: datasets are pooled only where their files say they belong together), and rank
+    them.
 
     A group contains the datasets on which at least one candidate fitted; a candidate is ranked
     there only if it fitted all of them ('incomplete' otherwise, with the missing datasets named).
     """
-    kinds = kinds or {}
-    groups = {"ALL": sorted({r.dataset for r in rows})}
-    by_kind = defaultdict(list)
-    for d in groups["ALL"]:
-        by_kind[kinds.get(d, "?")].append(d)
-    if len(by_kind) > 1:
-        groups.update({f"ALL[{k}]": v for k, v in sorted(by_kind.items()) if len(v) > 1})
     by_name = defaultdict(list)
-    for d in groups["ALL"]:
+    for d in sorted({r.dataset for r in rows}):
         if named and d in named:
             by_name[named[d]].append(d)
-    groups.update({g: v for g, v in by_name.items() if 1 < len(v) < len(groups["ALL"]) and g not in groups})
+    groups = {g: v for g, v in by_name.items() if len(v) > 1}
     out = []
     for gname, members in groups.items():
         fitted = [d for d in members if any(r.status in RANKED and r.dataset == d for r in rows)]

@@ -82,6 +82,8 @@ def _table_text(fit) -> str:
             lines.append(f"{'':<6}[{q.low:.{d}g}, {q.high:.{d}g}]")
     for label, phi in row.phi:
         lines.append(f"φ {label}: {phi:.3f}")
+    for label, model in row.noise:
+        lines.append(f"noise {label}: {model}")
     lines.append("")
     lines.append(f"goodness: {fit.goodness.short}")
     return "\n".join(lines)

@@ -43,19 +43,57 @@ def parse_solver(text: str) -> tuple[str, str | None]:
 def simulate(law: str | FrictionLaw, scene: Scene | SceneSource, params: Mapping[str, object] | None = None,
              solver: str = "ode", t: np.ndarray | None = None, rtol: float = 1e-10, atol: float | None = None,
              n: int = 201) -> Trajectory:
-    """Simulate ``law`` on a scene (or a dataset's scene) and return a Trajectory.
+    """Solve a law on a scene: the motion, the friction force and the spin over time.
 
-    law: a registered name or a FrictionLaw; scene: a Scene or a Dataset (its ``[fixed]``
-    parameters apply and its time column is the default ``t``); params: values overriding the law's
-    defaults, each an SI number, a quantity string or a pint Quantity; solver: 'exact', 'series', 'ode' (LSODA) or 'ode:METHOD'; t: sample times [s],
-    default n points over the scene's duration. 'ode' for a built-in rate-and-state law on a quasi-static
-    spring-slider integrates the slider in the field's variables (``solve.quasistatic``); 'ode:LSODA' and the
-    other methods take the general plan.
+    Parameters
+    ----------
+    law : str or FrictionLaw
+        A registered name or a law.
+    scene : Scene or Dataset
+        The experiment; a Dataset's ``[fixed]`` parameters apply and its time column is the default ``t``.
+    params : mapping, optional
+        Values overriding the law's defaults, each an SI number, a quantity string (``"1.81e6 Pa s/m"``) or a
+        pint Quantity.
+    solver : str, default "ode"
+        ``"exact"`` (closed form), ``"series"`` (the paper's first-order series), ``"ode"`` (LSODA) or
+        ``"ode:METHOD"`` (a scipy ``solve_ivp`` method). ``"ode"`` for a built-in rate-and-state law on a
+        quasi-static spring-slider integrates the slider in the field's variables.
+    t : array_like, optional
+        Sample times [s]; default ``n`` points over the scene's duration.
+    rtol, atol : float
+        The ODE solver's relative and absolute tolerances (``atol`` default: relative to each state's scale).
+    n : int, default 201
+        Number of sample times when ``t`` is not given.
+
+    Returns
+    -------
+    Trajectory
+        SI arrays: ``t`` [s], ``v`` [m/s], ``u`` (slip) [m/s], ``omega`` [rad/s], ``force`` [N], ...
+
+    Raises
+    ------
+    SolverError
+        The solver does not apply to this law on this scene (no closed form), or the integration failed.
+    ParameterError
+        An unknown parameter, a value outside its bounds, or a quantity in the wrong unit.
+
+    Examples
+    --------
+    >>> import frictionlab as fl
+    >>> data = fl.load_dataset("impact-golf-v28")
+    >>> traj = fl.simulate("wear", data, {"lam": "1.81e6 Pa s/m"}, solver="exact")
+    >>> round(traj.omega[-1] * 60 / (2 * 3.14159265))   # spin at the end of contact [rpm]
+    10810
     """
     law = get_law(law)
     name = "scene"
     fixed = {}
+    if params is not None and not isinstance(params, Mapping):
+        raise TypeError(f"simulate: params: expected a mapping of parameter names to values, got "
+                        f"{type(params).__name__} {params!r:.40}")
     if not isinstance(scene, Scene) and hasattr(scene, "scene") and hasattr(scene, "fixed"):  # a Dataset
+        if hasattr(scene, "check"):
+            scene.check("simulate")  # still what loading made of it
         name = f"dataset '{scene.name}'"
         fixed = {k: v for k, v in scene.fixed.items() if k in law.param_names}
         if scene.kind == "impact-outcome":
@@ -68,7 +106,7 @@ def simulate(law: str | FrictionLaw, scene: Scene | SceneSource, params: Mapping
             t = scene.t
         scene = scene.scene
     if not isinstance(scene, Scene):
-        raise SolverError(f"simulate: expected a Scene or Dataset, got {type(scene).__name__}")
+        raise TypeError(f"simulate: scene: expected a Scene or a Dataset, got {type(scene).__name__} {scene!r:.40}")
     p = law.resolve({**fixed, **(params or {})})
     if t is None:
         t = np.linspace(0.0, scene.duration, n)

@@ -29,6 +29,9 @@ def respond(law: str | FrictionLaw, params: Mapping[str, float], t: np.ndarray,
     A [m^2] are held constant, dA/dt = 0.
     """
     law = get_law(law)
+    if "dmudt" in law.requires:
+        raise SolverError(f"law '{law.name}' reads d mu/dt (dmudt), which a prescribed slip history does not supply; "
+                          "simulate it on a spring-slider")
     p = law.resolve(params)
     t = np.asarray(t, dtype=float)
 

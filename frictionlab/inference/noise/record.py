@@ -1,0 +1,118 @@
+"""A record's noise chosen by the data: one ``arp`` model and one innovation level per sampling-rate group.
+
+Samples are grouped by rate as for AR(1) noise (``ar1.rate_groups``); each contiguous run of a group is whitened
+on its own (the filter restarts at a change of rate). ``estimate`` chooses every group's model from a fit's
+residuals and profiles its innovation standard deviation (the maximum-likelihood value, the root mean square of
+the whitened residuals); the fit then weights by it, and the two alternate (feasible GLS, ``velstep``).
+"""
+from __future__ import annotations
+
+import math
+
+import attrs
+import numpy as np
+
+from . import ar1
+from . import arp
+
+
+@attrs.define
+class RecordNoise:
+    """Per rate group: the model, its innovation standard deviation sigma_g; the runs of each group."""
+
+    labels: np.ndarray  # rate group of each sample
+    refs: np.ndarray  # median interval [s] of each group
+    models: list  # arp.NoiseModel per group
+    sigma_g: np.ndarray  # innovation standard deviation per group (the data's unit)
+    runs: list = attrs.field(factory=list)  # (start, stop, group) of each contiguous run
+
+    @classmethod
+    def of(cls, t, sigma_start) -> "RecordNoise":
+        """White noise at the level ``sigma_start`` (per sample) until ``estimate`` is called."""
+        labels, refs = ar1.rate_groups(t)
+        sig = np.broadcast_to(np.asarray(sigma_start, dtype=float), np.shape(t))
+        sigma_g = np.array([float(np.median(sig[labels == g])) if np.any(labels == g) else 1.0
+                            for g in range(refs.size)])
+        cuts = np.nonzero(np.diff(labels))[0] + 1
+        edges = np.concatenate([[0], cuts, [labels.size]])
+        runs = [(int(a), int(b), int(labels[a])) for a, b in zip(edges[:-1], edges[1:]) if b > a]
+        return cls(labels, refs, [arp.WHITE] * refs.size, sigma_g, runs)
+
+    @property
+    def sigma(self) -> np.ndarray:
+        """Innovation standard deviation of each sample."""
+        return self.sigma_g[self.labels]
+
+    @property
+    def n_coef(self) -> int:
+        """Noise coefficients fitted over the groups (AR orders, ARMA's two), their levels not counted."""
+        return sum(m.n_coef for m in self.models)
+
+    def whiten(self, v) -> np.ndarray:
+        """v (samples, or samples x columns) whitened run by run with each group's model (innovation scale)."""
+        v = np.asarray(v, dtype=float)
+        out = np.empty_like(v)
+        for a, b, g in self.runs:
+            out[a:b] = arp.whiten(v[a:b], self.models[g])
+        return out
+
+    def log_det_terms(self) -> np.ndarray:
+        """Each sample's part of ``log_det`` (nonzero at the start of a run only)."""
+        out = np.zeros(self.labels.size)
+        for a, b, g in self.runs:
+            m = self.models[g]
+            if m.kind == "ARMA(1,1)":
+                out[a] = math.log(m.variance_ratio)
+            elif m.kind == "AR":
+                _, ratio = arp.startup(m)
+                k = min(ratio.size, b - a)
+                out[a:a + k] = np.log(ratio[:k])
+        return out
+
+    def log_det(self) -> float:
+        """The whitening's term of -2 ln L over the runs."""
+        return sum(arp.log_det(self.models[g], b - a) for a, b, g in self.runs)
+
+    def estimate(self, residual, profile: bool = True) -> float:
+        """Choose each group's model from ``residual`` (model - data) and, when ``profile``, set sigma_g to the root
+        mean square of its whitened residual. Returns the largest relative change of a group's sigma_g."""
+        r = np.asarray(residual, dtype=float)
+        old = self.sigma_g.copy()
+        for g in range(self.refs.size):
+            pieces = [r[a:b] for a, b, gg in self.runs if gg == g]
+            x = np.concatenate(pieces) if pieces else np.zeros(0)
+            self.models[g], _ = arp.select(x - x.mean() if x.size else x, 1.0 / self.refs[g])
+        if profile:
+            w = self.whiten(r)
+            for g in range(self.refs.size):
+                sel = self.labels == g
+                ms = float(np.mean(w[sel] ** 2)) if sel.any() else math.nan
+                if math.isfinite(ms) and ms > 0:
+                    self.sigma_g[g] = math.sqrt(ms)
+        return float(np.max(np.abs(self.sigma_g / old - 1.0))) if old.size else 0.0
+
+    def describe(self) -> list[tuple[str, str]]:
+        """(rate label, model name) per group: ('100 Hz', 'AR(6)')."""
+        return [(f"{1 / r:.3g} Hz", m.name + (" (AR order at its cap)" if m.capped else ""))
+                for r, m in zip(self.refs, self.models)]
+
+    def draw(self, rng) -> np.ndarray:
+        """One draw of the noise: each run of each group from its model at its innovation level (stationary)."""
+        out = np.empty(self.labels.size)
+        for a, b, g in self.runs:
+            out[a:b] = arp.draw(rng, self.models[g], b - a, float(self.sigma_g[g]), burn=500)
+        return out
+
+
+def noise_drawer(dataset, y, model, sigma):
+    """A function rng -> one draw of noise for a parametric replicate of data y around a fit's ``model`` of them:
+    where ``dataset`` declares ``correlation = "arp"``, from the noise model a fit of these data chooses (each
+    group's model and level from the residual y - model); otherwise ``ar1.noise_drawer``."""
+    if getattr(dataset, "noise_correlation", "none") != "arp" or "t" not in dataset.columns:
+        return ar1.noise_drawer(dataset, y, model, sigma)
+    t = np.asarray(dataset.columns["t"], dtype=float)
+    start = np.broadcast_to(np.asarray(sigma if sigma is not None else 1.0, dtype=float), t.shape)
+    rec = RecordNoise.of(t, start)
+    rec.estimate(np.asarray(model) - np.asarray(y))
+    return rec.draw
+

@@ -1,0 +1,118 @@
+"""Noise chosen by the data (inference.noise): AR(p) by BIC and Burg, ARMA(1,1) where the order runs to its cap,
+the exact whitened likelihood, the law-fit test of bands after a step, Vuong's test, and the velocity-step fit
+under the data's noise model."""
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from frictionlab.inference.diagnostics.goodness import ljung_box
+from frictionlab.inference.noise import arp
+from frictionlab.inference.noise.misfit import band_test
+from frictionlab.inference.verdicts.vuong import long_run_variance, vuong
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+
+
+def test_bic_and_burg_recover_an_ar2_and_its_whitened_residuals_are_white():
+    truth = arp.from_coefficients((0.6, -0.3))
+    x = arp.draw(np.random.default_rng(1), truth, 20000)
+    model, var = arp.select(x, 100.0)
+    assert model.name == "AR(2)" and not model.capped
+    assert model.ar == pytest.approx((0.6, -0.3), abs=0.03) and var == pytest.approx(1.0, rel=0.05)
+    assert ljung_box(arp.whiten(x, model), model.n_coef) > 0.01
+    assert ljung_box(x, 0) < 1e-10  # the data themselves are far from white
+
+
+def test_an_order_that_runs_to_its_cap_is_replaced_by_arma11():
+    truth = arp.from_coefficients((0.5,), ma=0.8)  # an AR(infinity) tail of (-0.8)^j: no short AR order describes it
+    x = arp.draw(np.random.default_rng(2), truth, 5000)
+    model, _ = arp.select(x, 10.0)  # cap 6 at 10 Hz
+    assert arp.order_cap(10.0, 5000) == 6 and model.capped
+    assert model.name == "ARMA(1,1)" and model.ar[0] == pytest.approx(0.5, abs=0.05)
+    assert model.ma == pytest.approx(0.8, abs=0.05)
+
+
+def test_the_whitened_likelihood_is_the_exact_multivariate_normal_one():
+    from scipy.linalg import toeplitz
+    from scipy.signal import lfilter
+    from scipy.stats import multivariate_normal
+
+    model = arp.from_coefficients((0.5, 0.1, -0.3))
+    n = 40
+    x = arp.draw(np.random.default_rng(3), model, n, sigma=2.0)
+    h = lfilter([1.0], np.concatenate([[1.0], -np.asarray(model.ar)]), np.r_[1.0, np.zeros(4000)])
+    gamma = np.array([h[:4000 - k] @ h[k:4000] for k in range(n)]) * 4.0
+    exact = -2 * multivariate_normal(np.zeros(n), toeplitz(gamma)).logpdf(x)
+    w = arp.whiten(x, model)
+    mine = float(w @ w) / 4.0 + n * math.log(2 * math.pi * 4.0) + arp.log_det(model, n)
+    assert mine == pytest.approx(exact, rel=1e-9)
+
+
+def _step_record(n_before=2000, n_after=3000, dc=10.0, v=10.0, rate=100.0):
+    t = np.arange(n_before + n_after) / rate
+    ts = n_before / rate
+    x = np.where(t < ts, 3.0 * t, 3.0 * ts + v * (t - ts))
+    return t, x, ts
+
+
+def test_bands_pass_white_residuals_and_name_the_band_a_misfit_leaves():
+    t, x, ts = _step_record()
+    rng = np.random.default_rng(4)
+    alarms = sum(band_test(rng.standard_normal(t.size), t, x, [ts], 10.0).p < 0.01 for _ in range(100))
+    assert alarms <= 4  # 1 % nominal, Bonferroni: conservative
+    w = rng.standard_normal(t.size)
+    slip = x - 3.0 * ts
+    w[(t >= ts) & (slip >= 10.0) & (slip < 30.0)] += 0.5  # a misfit between 1 and 3 Dc after the step
+    r = band_test(w, t, x, [ts], 10.0)
+    assert r.p < 0.01 and r.band == "1-3 Dc after step 1" and r.what == "mean"
+
+
+def test_the_newey_west_variance_of_ar1_approaches_its_long_run_variance():
+    phi = 0.5
+    x = arp.draw(np.random.default_rng(5), arp.from_coefficients((phi,)), 200000)
+    assert long_run_variance(x, 60) == pytest.approx(1 / (1 - phi) ** 2, rel=0.05)
+
+
+def _fake_fit(law, loglik, k=5):
+    d = SimpleNamespace(loglik=loglik)
+    return SimpleNamespace(ok=True, law=law, per_dataset=(d,), stats=SimpleNamespace(k_lik=k))
+
+
+def test_vuong_names_the_closer_law_or_says_equally_close():
+    rng = np.random.default_rng(6)
+    base = rng.standard_normal(4000)
+    a = _fake_fit("A", -0.5 * base ** 2)
+    b_far = _fake_fit("B", -0.5 * (base + 0.3) ** 2)  # B's residuals carry an offset: A is closer
+    r = vuong(a, b_far)
+    assert r.closer == "A" and r.z > 0 and "A is closer (p = " in r.text
+    b_same = _fake_fit("B", -0.5 * base ** 2 + 1e-3 * rng.standard_normal(4000))
+    r = vuong(a, b_same)
+    assert r.closer == "" and "equally close at this noise" in r.text
+
+
+def test_a_velocity_step_fit_chooses_the_noise_model_and_keeps_the_two_questions_apart(tmp_path):
+    import frictionlab as fl
+    from calibration_vuong import AGING, data_of, make_dataset, truth
+
+    ds, x, v1 = make_dataset(tmp_path, 3.0)
+    curve = truth(ds, x, v1, AGING)
+    noise = arp.draw(np.random.default_rng(7), arp.from_coefficients((0.6, -0.2)), curve.size, 3e-4)
+    f = fl.fit(AGING, data_of(ds, curve + noise), trend=True, stiffness=True)
+    row = f.velstep.rows[0]
+    assert row.noise == (("100 Hz", "AR(2)"),) and "white" in row.whiteness
+    assert f.goodness.fits and f.goodness.noise_ok and math.isnan(f.goodness.chi2_p)
+    assert abs(f.value("a") - 0.009) < 3 * f.params["a"].stderr
+    assert abs(f.value("Dc") - 10e-6) < 3 * f.params["Dc"].stderr
+    # the per-sample log-likelihoods add up to the fit's -2 ln L
+    assert -2 * float(np.sum(f.per_dataset[0].loglik)) == pytest.approx(f.stats.neg2loglik, rel=1e-12)
+    # a misfit: the slip law on an aging record with a large step leaves structure in a named band
+    ds30, x30, v30 = make_dataset(tmp_path, 30.0)
+    aging30 = truth(ds30, x30, v30, AGING)
+    g = fl.fit("rate-state-slip", data_of(ds30, aging30 + noise[:aging30.size]), trend=True, stiffness=True).goodness
+    assert g.fits is False and "Dc after step 1" in g.band
