@@ -29,8 +29,9 @@ def _step(name, v1, v2, params, seed, law="rate-state-aging"):
 
 def test_the_state_laws_are_the_registered_ones_the_fit_serves():
     laws = state_laws()
-    assert {"rate-state-aging", "rate-state-slip"} <= set(laws)
+    assert {"rate-state-aging", "rate-state-slip"} <= set(laws) and "coulomb" not in laws
     assert all(name in fl.available_laws() for name in laws)
+    assert set(state_laws(fitted_only=True)) <= set(laws)
 
 
 def test_one_set_is_accepted_on_one_law_and_refused_on_two(tmp_path):
@@ -78,4 +79,4 @@ def test_the_command_refuses_a_law_the_step_fit_does_not_serve(tmp_path, capsys)
 
     assert main(["record", str(tmp_path / "absent.txt"), "--laws", "coulomb"]) == 2
     err = capsys.readouterr().err
-    assert "--laws: coulomb is not a state law the velocity-step fit serves" in err and "Traceback" not in err
+    assert "--laws: coulomb is not a state law of the quasi-static slider" in err and "Traceback" not in err

@@ -18,8 +18,8 @@ def add_parser(sub):
   frictionlab healing data/shs.toml --laws rate-state-aging""")
     p.add_argument("dataset", metavar="DATASET", help="built-in dataset name or TOML path")
     p.add_argument("--laws", "--law", action=ListAction, default=[], metavar="NAME",
-                   help="state laws to fit and predict with (default: every registered law the velocity-step fit "
-                        "serves)")
+                   help="state laws to fit and predict with (default: every registered state law the velocity-step "
+                        "fit serves; another state law, e.g. rate-state-nagata, by the general path)")
     p.add_argument("--fit-timeout", type=float, metavar="SECONDS", help="time budget of each fit")
     p.set_defaults(func=run)
 
@@ -31,10 +31,10 @@ def run(args) -> int:
     from ..inference.velstep.record_steps import state_laws
     from ..io.dataset import load_dataset
 
-    laws = args.laws or state_laws()
+    laws = args.laws or state_laws(fitted_only=True)
     unknown = [n for n in laws if n not in state_laws()]
     if unknown:
-        raise ParameterError(f"--laws: {', '.join(unknown)} is not a state law the velocity-step fit serves; "
+        raise ParameterError(f"--laws: {', '.join(unknown)} is not a state law of the quasi-static slider; "
                              f"expected one of {', '.join(state_laws())}")
     d = load_dataset(args.dataset)
     tables = [of_dataset(d)]

@@ -23,7 +23,8 @@ def add_parser(sub):
     p.add_argument("raw", nargs="+", metavar="RAWFILE", help="the raw record (several files: slices of one recording)")
     p.add_argument("--name", default="record", help="the record's name (its step windows: NAME-step1, ...)")
     p.add_argument("--laws", "--law", action=ListAction, default=[], metavar="NAME",
-                   help="state laws to fit (default: every registered law the velocity-step fit serves)")
+                   help="state laws to fit (default: every registered state law the velocity-step fit serves; another "
+                        "state law, e.g. rate-state-nagata, by the general path)")
     p.add_argument("--no-joint", action="store_true", help="skip the whole-record fit (the slowest part)")
     p.add_argument("--fit-timeout", type=float, metavar="SECONDS", help="time budget of each fit")
     p.set_defaults(func=run)
@@ -40,10 +41,10 @@ def run(args) -> int:
     from ..report.record_screen import screen
 
     check_name(args.name, "record --name", ParameterError)
-    laws = args.laws or state_laws()
+    laws = args.laws or state_laws(fitted_only=True)
     unknown = [n for n in laws if n not in state_laws()]
     if unknown:
-        raise ParameterError(f"--laws: {', '.join(unknown)} is not a state law the velocity-step fit serves; "
+        raise ParameterError(f"--laws: {', '.join(unknown)} is not a state law of the quasi-static slider; "
                              f"expected one of {', '.join(state_laws())}")
     if args.fit_timeout is not None and not (args.fit_timeout > 0 and math.isfinite(args.fit_timeout)):
         raise ParameterError(f"--fit-timeout: {args.fit_timeout!r}; expected a positive number of seconds")

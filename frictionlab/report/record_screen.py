@@ -27,11 +27,12 @@ def screen(title: str, steps: list[dict], results, answer: str, joint_note: str 
     'window' (lines and samples), 'note' (where it starts and why)}; ``results``: LawSteps per law."""
     out = [title, "", answer]
     out += [f"  {r.verdict()}" for r in results]
-    unwhite = sorted({s["name"] for r in results for s, f in zip(steps, r.steps)
-                      if f.ok and f.goodness is not None and "whiteness" in f.goodness.short})
-    if unwhite:
-        out.append(f"  note: AR(1) does not whiten the residuals of {', '.join(unwhite)} (structure the law leaves, "
-                   "or a slow wander): the likelihood ratio's chi-square reference, and its p-value, are approximate")
+    failing = sorted({s["name"] for r in results for s, f in zip(steps, r.steps)
+                      if f.ok and f.goodness is not None and f.goodness.short.startswith("fails")})
+    if failing:
+        out.append(f"  note: a law fails its goodness-of-fit tests on {', '.join(failing)} (structure it leaves, or noise "
+                   "its model does not describe): the likelihood ratio's chi-square reference, and its p-value, are "
+                   "approximate")
     out += ["", "Each step's own parameters (value ± standard error), each from its own window (below):"]
     rows = [["step", "V [um/s]", "", "law"] + [h for _, h in COLUMNS] + ["goodness of fit"]]
     for i, s in enumerate(steps):
@@ -69,4 +70,8 @@ def screen(title: str, steps: list[dict], results, answer: str, joint_note: str 
         if r.joint is not None and r.joint.ok and r.joint.velstep is not None:
             said += [f"  whole record, {_law(r.law)}: {t}" for t in r.joint.velstep.bounds]
     out += ["", "Parameters at a bound, and what it means:"] + (said or ["  none"])
+    missed = [f"  {s['name']}, {_law(r.law)}: {t}" for r in results for s, f in zip(steps, r.steps)
+              for t in (f.velstep.missing if f.ok and f.velstep else ())]
+    if missed:
+        out += ["", "What the data show that a law misses:"] + missed
     return out

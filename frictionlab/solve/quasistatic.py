@@ -125,7 +125,7 @@ def _failure(status: int, stats, slider: tuple, load: Load, law: str) -> str:
         return f"quasi-static slider: more than {kernel.MAX_STEPS} steps by t = {t:.6g} s"
     j = int(np.searchsorted(load.times, t, side="right")) - 1
     before = load.velocities[j - 1] if j >= 1 else load.V1
-    stepped = j >= 1 and load.velocities[j] > before
+    stepped = j >= 1 and load.velocities[j] > before > 0  # a re-slide from a hold has no step ratio to search
     if status == kernel.RUNAWAY:
         largest = _largest_step(slider, load, j, t) if stepped else None
         return runaway_message(law, float(stats[4]) * UM, t, load.velocities * UM, {"a": a, "b": b, "Dc": Dc_um * UM},

@@ -118,7 +118,7 @@ def _arma11(x) -> tuple[tuple[float, float], float] | None:
     from scipy.signal import lfilter
 
     def sse(p):
-        phi, th = np.tanh(p)  # inside the stationary and invertible region
+        phi, th = np.clip(np.tanh(p), -0.99999, 0.99999)  # inside the stationary and invertible region (tanh rounds to 1)
         e = lfilter([1.0, -phi], [1.0, th], x)
         return float(e[1:] @ e[1:])
 
@@ -131,7 +131,7 @@ def _arma11(x) -> tuple[tuple[float, float], float] | None:
             best = r
     if best is None or not np.isfinite(best.fun):
         return None
-    phi, th = np.tanh(best.x)
+    phi, th = np.clip(np.tanh(best.x), -0.99999, 0.99999)  # as the AR reflections: never a unit root
     return (float(phi), float(th)), best.fun / (x.size - 1)
 
 

@@ -44,13 +44,14 @@ def ar1_neg2ll(f) -> float:
     return total
 
 
-def state_laws() -> list[str]:
-    """The registered laws the velocity-step fit serves (every state law of the quasi-static slider)."""
+def state_laws(fitted_only: bool = False) -> list[str]:
+    """The registered state laws of the quasi-static slider (``fitted_only``: those the velocity-step fit serves;
+    another, such as Nagata's with its c, is fitted by the general path, far slower on long records)."""
     from ...physics.registry import available_laws
-    from ...solve.quasistatic import LAWS
+    from ...solve.quasistatic import FITTED, LAWS
 
     registered = set(available_laws())
-    return [name for name in LAWS if name in registered]
+    return [name for name in LAWS if name in registered and (name in FITTED or not fitted_only)]
 
 
 @attrs.frozen
