@@ -181,15 +181,16 @@ def test_rate_state_slip_fit_reaches_the_careful_minimum():
 
 
 def test_sampled_starts_fill_every_axis_between_the_grid_levels():
-    """``_sampled_starts``: the given start first, then a Latin hypercube over the same spans (one point in
+    """``sampled_starts``: the given start first, then a Latin hypercube over the same spans (one point in
     each of ``limit`` equal slices of every axis, in log for positive parameters), inside the bounds."""
-    from frictionlab.inference.fitting.model import _law_slots, _sampled_starts, _start_grid
+    from frictionlab.inference.fitting.model import _law_slots
+    from frictionlab.inference.fitting.starts import sampled_starts, start_grid
 
     law = get_law("rate-state-slip")
     tg = fl.make_target(fl.load_dataset("incline-oil-a200"))
     slots = _law_slots(law, [tg], {}, set(), {})
-    levels = _start_grid(slots, np.random.default_rng(1), 375, 1.5)
-    grid = _sampled_starts(slots, np.random.default_rng(3), 125, 1.5)
+    levels = start_grid(slots, np.random.default_rng(1), 375, 1.5)
+    grid = sampled_starts(slots, np.random.default_rng(3), 125, 1.5)
     assert len(grid) == 126 and grid[0] == {s.pname: s.value / s.scale for s in slots}
     for s in slots:
         x = np.array([g[s.pname] for g in grid[1:]])

@@ -234,11 +234,11 @@ def _closer(fit_a: FitResult, fit_b: FitResult) -> str:
 def _qualitative_within(fit_a, fit_b, timeout: float | None) -> dict:
     """``qualitative`` within ``timeout`` seconds (None: no limit); past it, 'not applicable'."""
     from ...core.workers import beat
-    from ..fitting.model import FitTimeout, _alarm
+    from ..fitting.alarm import FitTimeout, alarm
 
     beat()  # in a child of inference.fitting.guard: the simulations have the budget of one refit
     try:
-        with _alarm(timeout):
+        with alarm(timeout):
             return qualitative(fit_a, fit_b)
     except FitTimeout:
         return {"verdict": "not applicable", "differs": "", "data_differs": {}, "features": {}, "dt": float("nan"),

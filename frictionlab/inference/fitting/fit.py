@@ -45,7 +45,8 @@ from ...core.units import as_range, as_si
 from ...core.workers import beat
 from ...physics.registry import get_law
 from . import lsrefit
-from .model import (FTOL, ODE_STARTS, PENALTY, FitTimeout, _alarm, _law_slots, _Model, _scene_slots,
+from .alarm import FitTimeout, alarm
+from .model import (FTOL, ODE_STARTS, PENALTY, _law_slots, _Model, _scene_slots,
                        _search, _si, lmfit_leastsq)
 from .result import DatasetFit, FitResult, ParamResult, Stats
 from .stats import (
@@ -288,7 +289,7 @@ def _polished(lmfit, law, model, slots, found, scale_covar: bool, timeout):
         return found, (J, structure)
     budget = 200 * (len(varying) + 1)
     try:
-        with _alarm(timeout):
+        with alarm(timeout):
             params = lsrefit.lmfit_parameters(best_params).copy()
             for s in held:
                 params[s.pname].set(vary=False)
@@ -316,7 +317,7 @@ def _run_search(lmfit, model, params, slots, solvers, budget, likelihood, checks
     values_only: the caller reads values and chi-square only (``fitmodel._search``)."""
     success, message = True, ""
     try:
-        with _alarm(timeout):
+        with alarm(timeout):
             best_params, success, message, best, notes = _search(lmfit, model, params, slots, solvers, *budget,
                                                                  scale_covar=likelihood not in AS_GIVEN,
                                                                  direct=not checks, values_only=values_only)

@@ -4,11 +4,8 @@ from __future__ import annotations
 
 import math
 import re
-import signal
-import threading
 import time
 from collections.abc import Mapping
-from contextlib import contextmanager
 
 import attrs
 import numpy as np
@@ -16,6 +13,8 @@ import numpy as np
 from ...core.errors import FrictionLabError, ParameterError, SolverError
 from ...physics.freeable import SCENE_SHOWN
 from . import lsrefit
+from .alarm import FitTimeout
+from .starts import distinct, sampled_starts, start_grid
 from .predict import (
     SCENE_QUANTITIES,
     SkipDataset,
@@ -137,50 +136,6 @@ def _scene_slots(targets, free) -> list[_Slot]:
     return slots
 
 
-class FitTimeout(BaseException):
-    """A fit ran past its time budget (a BaseException, so that no handler of a law's errors keeps it)."""
-
-
-#: Seconds after which an alarm that rang inside an import or numba's compiler rings again.
-ALARM_RETRY = 0.02
-
-
-def _importing_or_compiling(frame) -> bool:
-    """Whether ``frame`` runs inside Python's import system or numba (a module being imported, a kernel being
-    compiled or loaded from numba's cache): an exception raised there would leave the process's modules or
-    numba's registries half set up for every later call, not just this fit."""
-    while frame is not None:
-        name = frame.f_globals.get("__name__", "")
-        if name.startswith(("importlib", "numba.", "llvmlite.")):
-            return True
-        frame = frame.f_back
-    return False
-
-
-@contextmanager
-def _alarm(seconds: float | None):
-    """Raise FitTimeout in the main thread after ``seconds`` (no-op elsewhere, or if an alarm is set); where the
-    alarm rings inside an import or numba (``_importing_or_compiling``), once that is done."""
-    if (seconds is None or not hasattr(signal, "setitimer") or threading.current_thread() is not threading.main_thread()
-            or signal.getitimer(signal.ITIMER_REAL)[0] > 0):
-        yield
-        return
-
-    def ring(signum, frame):
-        if _importing_or_compiling(frame):  # never leave a module half imported or numba half set up
-            signal.setitimer(signal.ITIMER_REAL, ALARM_RETRY)
-            return
-        raise FitTimeout()
-
-    old = signal.signal(signal.SIGALRM, ring)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old)
-
-
 class _Model:
     """Evaluates the weighted residual for a vector of scaled parameter values."""
 
@@ -280,73 +235,6 @@ def _si(params, slots) -> dict[str, float]:
     return {s.pname: params[s.pname].value * s.scale for s in slots}
 
 
-def _start_grid(slots, rng, limit: int, decades: float = 1.5) -> list[dict[str, float]]:
-    """Candidate starts in scaled units, the given start first: log-spaced multiples of the start
-    for positive quantities (10^-decades to 10^decades), steps of the scale around it for signed ones, the
-    bounds' span for scene quantities; clipped into the bounds. A full grid if it has at most ``limit`` points,
-    else ``limit`` points of it drawn at random."""
-    levels = max(3, min(15, int(round(limit ** (1.0 / len(slots))))))
-    axes = []
-    for s in slots:
-        x0 = s.value / s.scale
-        lo, hi = s.lower / s.scale, s.upper / s.scale
-        if s.kind == "scene":
-            c = np.linspace(lo, hi, levels)
-        elif lo >= 0 and x0 > 0:
-            c = x0 * np.logspace(-decades, decades, levels)
-        else:
-            c = x0 + np.sinh(np.linspace(-4.0, 4.0, levels))  # dense near the start, out to +/- 27 scales
-        axes.append(np.unique(np.clip(c, lo, hi)))
-    total = math.prod(len(a) for a in axes)
-    if total <= limit:
-        grid = np.array(np.meshgrid(*axes, indexing="ij")).reshape(len(axes), -1).T
-    else:
-        grid = np.array([[rng.choice(a) for a in axes] for _ in range(limit)])
-    return _starts(slots, grid)
-
-
-def _sampled_starts(slots, rng, limit: int, decades: float = 1.5) -> list[dict[str, float]]:
-    """As ``_start_grid``, ``limit`` points of a Latin hypercube over the same spans instead of a grid's levels,
-    every axis continuous (rate-and-state's a and b trade off: where the data want b near 0, the levels hold no a
-    that matches them, and the grid's best starts all have b large)."""
-    from scipy.stats import qmc
-
-    u = qmc.LatinHypercube(d=len(slots), seed=rng).random(limit)
-    axes = []
-    for s, w in zip(slots, u.T):
-        x0, lo, hi = s.value / s.scale, s.lower / s.scale, s.upper / s.scale
-        if s.kind == "scene":
-            c = lo + (hi - lo) * w
-        elif lo >= 0 and x0 > 0:
-            c = x0 * 10.0 ** (decades * (2.0 * w - 1.0))
-        else:
-            c = x0 + np.sinh(8.0 * w - 4.0)
-        axes.append(np.clip(c, lo, hi))
-    return _starts(slots, np.array(axes).T)
-
-
-def _starts(slots, grid) -> list[dict[str, float]]:
-    """The given start (scaled), then each row of ``grid``, as {parameter name: scaled value}."""
-    grid = np.vstack([[s.value / s.scale for s in slots], grid])
-    return [dict(zip((s.pname for s in slots), row)) for row in grid]
-
-
-def _distinct(scored: list[tuple], n: int) -> list[dict]:
-    """Up to n starts from (cost, order, candidate) sorted by cost: each differs from those taken by
-    more than 10% in some coordinate and has a different cost (equal costs mean a plateau, such as
-    a body stuck throughout, where a second start teaches nothing)."""
-    out, costs = [], []
-    for cost, _, c in scored:
-        if any(abs(cost - k) <= 1e-9 * max(abs(cost), 1e-300) for k in costs):
-            continue
-        if all(any(abs(c[k] - o[k]) > 0.1 * max(abs(c[k]), abs(o[k]), 1e-3) for k in c) for o in out):
-            out.append(c)
-            costs.append(cost)
-        if len(out) == n:
-            break
-    return out
-
-
 def _valley(result) -> str:
     """Why a converged Levenberg-Marquardt run ended in a valley the data do not close ('' if not):
     two parameters correlated beyond VALLEY_R, or a parameter at a bound. Another start ends in the
@@ -377,7 +265,7 @@ def lmfit_leastsq(lmfit, model: _Model, slots, params, scale_covar: bool, budget
 MEMORY_SCAN = 4
 MEMORY_DECADES = (1.5, 3.0)
 #: How many times the given number of start points a compiled law with memory also draws from a Latin hypercube
-#: over the finer grid's spans (``_sampled_starts``: coordinates between the grid's levels), and how many of
+#: over the finer grid's spans (``sampled_starts``: coordinates between the grid's levels), and how many of
 #: the best of those it refines.
 MEMORY_SAMPLED, MEMORY_SAMPLED_STARTS = 1, 2
 
@@ -441,23 +329,23 @@ def _search(lmfit, model: _Model, params, slots, solvers, scan: int, n_starts: i
         model.progress.stage("scanning start points", k, total=k + n_starts * lm + 2 * len(varying) + 2)
     if scan:
         fixed_part = {s.pname: s.value / s.scale for s in slots if not s.vary}
-        grid = _start_grid(varying, np.random.default_rng(0), scan)
+        grid = start_grid(varying, np.random.default_rng(0), scan)
         given = fine = widest = len(grid)
         if wide and MEMORY_SCAN > 1:  # the same grid, MEMORY_SCAN - 1 times as many on a finer and wider one, and
             # as many as given on the widest (a start 3 decades off: LuGre's soft bristles on incline-oil-a400)
-            grid += _start_grid(varying, np.random.default_rng(1), (MEMORY_SCAN - 1) * scan, MEMORY_DECADES[0])[1:]
+            grid += start_grid(varying, np.random.default_rng(1), (MEMORY_SCAN - 1) * scan, MEMORY_DECADES[0])[1:]
             fine = len(grid)
-            grid += _start_grid(varying, np.random.default_rng(2), scan, MEMORY_DECADES[1])[1:]
+            grid += start_grid(varying, np.random.default_rng(2), scan, MEMORY_DECADES[1])[1:]
             widest = len(grid)  # and as many again sampled over the finer grid's spans, every axis continuous
-            grid += _sampled_starts(varying, np.random.default_rng(3), MEMORY_SAMPLED * scan, MEMORY_DECADES[0])[1:]
+            grid += sampled_starts(varying, np.random.default_rng(3), MEMORY_SAMPLED * scan, MEMORY_DECADES[0])[1:]
         points = [{s.pname: vals[s.pname] * s.scale for s in slots} for vals in ({**fixed_part, **c} for c in grid)]
         scored = [(float(r @ r), i, c) for i, (r, c) in enumerate(zip(model.residuals(points), grid))]
         scored.sort(key=lambda x: x[:2])  # ties keep grid order: the given start wins
-        starts = _distinct([x for x in scored if x[1] < fine], min(n_starts, ODE_STARTS) if slow else n_starts)
+        starts = distinct([x for x in scored if x[1] < fine], min(n_starts, ODE_STARTS) if slow else n_starts)
         if wide:  # the best of the given grid alone, as a fit of a law without memory starts, and of the widest
-            starts += [c for c in _distinct([x for x in scored if x[1] < given], n_starts) if c not in starts]
-            starts += [c for c in _distinct([x for x in scored if fine <= x[1] < widest], n_starts) if c not in starts]
-            starts += [c for c in _distinct([x for x in scored if x[1] >= widest], MEMORY_SAMPLED_STARTS)
+            starts += [c for c in distinct([x for x in scored if x[1] < given], n_starts) if c not in starts]
+            starts += [c for c in distinct([x for x in scored if fine <= x[1] < widest], n_starts) if c not in starts]
+            starts += [c for c in distinct([x for x in scored if x[1] >= widest], MEMORY_SAMPLED_STARTS)
                        if c not in starts]
     if not slow and (values_only or len(starts) > 1):  # closed forms: every start's run in one batch
         from .batch import best_start

@@ -9,7 +9,6 @@ module state, so fits at different tolerances can run side by side.
 """
 from __future__ import annotations
 
-import os
 
 import functools
 import inspect

@@ -45,7 +45,7 @@ import numpy as np
 from ...core.errors import FrictionLabError, SolverError
 from ...solve import quasistatic
 from ...solve.quasistatic import UM, Load
-from ..fitting.model import FitTimeout
+from ..fitting.alarm import FitTimeout
 from .series import SEARCH_DENSE, SEARCH_POINTS, Series  # noqa: F401  (the fit's public names)
 
 #: Grid of the global start: points along ln Dc, and along ln k where k is fitted (its span: start / K_SPAN to
