@@ -7,7 +7,7 @@ import time
 
 import pytest
 
-from frictionlab.inference.fitting.model import ALARM_RETRY, FitTimeout, _alarm
+from frictionlab.inference.fitting.alarm import ALARM_RETRY, FitTimeout, alarm
 
 
 def _busy(seconds: float) -> None:
@@ -22,7 +22,7 @@ def test_a_module_imported_when_the_budget_runs_out_is_imported_whole(tmp_path, 
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.delitem(sys.modules, "slow_import_probe", raising=False)
     with pytest.raises(FitTimeout):  # after the import: the busy loop's five seconds never end on their own
-        with _alarm(0.05):
+        with alarm(0.05):
             import slow_import_probe  # noqa: F401  (the alarm rings in the middle of this)
             _busy(5.0)
     assert sys.modules["slow_import_probe"].done is True
@@ -30,5 +30,5 @@ def test_a_module_imported_when_the_budget_runs_out_is_imported_whole(tmp_path, 
 
 def test_outside_an_import_the_alarm_stops_the_fit():
     with pytest.raises(FitTimeout):
-        with _alarm(ALARM_RETRY):
+        with alarm(ALARM_RETRY):
             _busy(5.0)
