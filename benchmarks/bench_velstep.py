@@ -10,7 +10,8 @@ difference Jacobian of all six parameters jointly, scaled by the residual varian
 
 frictionlab's fit is ``fl.fit(law, dataset)`` on a dataset of every sample of the same record with the same step
 time and velocities (written to a temporary folder, never into the repository): its defaults fit the trend and
-the stiffness, start from a grid, and use the AR(1) noise model the dataset declares.
+the stiffness, start from a grid, and use the noise model the dataset declares (``--noise``: the data's AR(p),
+as ``datasets import velstep`` writes, or AR(1)).
 
 Printed: per record and law the two fits' a, b, a - b, Dc [um], k [1/um] with standard errors and the difference
 in units of the combined standard error; the CPU time of frictionlab's fit (warm, the median of --repeats) over
@@ -18,7 +19,7 @@ the reference's, measured right before and after it; and the cold start (a new p
 with numba's on-disk cache as it is and with an empty one).
 
     python benchmarks/bench_velstep.py [--records basalt-velstep4,sepiolite-velstep1] [--laws aging,slip]
-                                       [--repeats 3]
+                                       [--repeats 3] [--noise arp|ar1] [--no-cold]
 """
 from __future__ import annotations
 
@@ -158,6 +159,9 @@ def main(argv=None) -> int:
     ap.add_argument("--records", default=",".join(velstep_records.RECORDS))
     ap.add_argument("--laws", default="aging,slip")
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--noise", default="arp", choices=("arp", "ar1"),
+                    help="the datasets' [noise] correlation: the data's AR(p) (as imported) or AR(1)")
+    ap.add_argument("--no-cold", action="store_true", help="skip the cold-start measurement")
     args = ap.parse_args(argv)
     raw = velstep_records.raw_folder()
     if raw is None:
@@ -170,12 +174,13 @@ def main(argv=None) -> int:
         folder = Path(tmp)
         found = {}
         for name in args.records.split(","):
-            found[name] = velstep_records.write(folder, name, raw / velstep_records.RECORDS[name])
+            found[name] = velstep_records.write(folder, name, raw / velstep_records.RECORDS[name], args.noise)
         first = next(iter(found))
         law0 = args.laws.split(",")[0]
-        print(f"cold start (new process: import, load {first}, one {LAWS[law0]} fit): numba cache as it is "
-              f"{cold_start(law0, folder / f'{first}.toml', False)}; empty numba cache "
-              f"{cold_start(law0, folder / f'{first}.toml', True)}")
+        if not args.no_cold:
+            print(f"cold start (new process: import, load {first}, one {LAWS[law0]} fit): numba cache as it is "
+                  f"{cold_start(law0, folder / f'{first}.toml', False)}; empty numba cache "
+                  f"{cold_start(law0, folder / f'{first}.toml', True)}")
         ratios = []
         for name, info in found.items():
             t, x, mu = velstep_records.read(raw / velstep_records.RECORDS[name])

@@ -85,8 +85,9 @@ def stiffness_start(t, mu, ts, v1, v2) -> float:
     return k if k > 0 and math.isfinite(k) else 1e-3
 
 
-def write(folder: Path, name: str, raw: Path) -> dict:
-    """Write ``name``.csv/.toml of every sample of ``raw`` into ``folder``; returns what was found."""
+def write(folder: Path, name: str, raw: Path, correlation: str = "ar1") -> dict:
+    """Write ``name``.csv/.toml of every sample of ``raw`` into ``folder`` (its noise estimated, of the given
+    ``[noise] correlation``); returns what was found."""
     t, x, mu = read(raw)
     ts = kink(t, x)
     v1, v2 = velocities(t, x, ts)
@@ -96,7 +97,7 @@ def write(folder: Path, name: str, raw: Path) -> dict:
                                         + "\n")
     (folder / f"{name}.toml").write_text(toml_text(
         name, f"Every sample of {raw.name} (benchmark copy in a temporary folder). MEASURED.", k0, ts - t0, v1, v2,
-        'kind = "estimated"\ncorrelation = "ar1"',
+        f'kind = "estimated"\ncorrelation = "{correlation}"',
         f'kind = "measured"\nsource = "pgiacomel/steadystate, {raw.name} (MIT)"', time_zero=t0))
     return {"t_step": ts, "v1": v1, "v2": v2, "k0": k0, "t0": t0, "n": t.size}
 

@@ -90,11 +90,19 @@ def run_python(case, tmp: Path):
 @pytest.mark.parametrize("case", params())
 def test_case(case, tmp_path, capsys, monkeypatch, clean_registry):
     assert set(case) <= FIELDS and case["class"] in CLASSES and case["sees"], case["id"]
+    run_case(case, tmp_path, capsys, monkeypatch)
+
+
+def run_case(case, tmp_path, capsys, monkeypatch, refusal_writes_nothing: bool = False):
+    """Prepare the case folder, run the case (its Python, or its command line in this process or a subprocess)
+    and check what it did; with ``refusal_writes_nothing`` a Python case that raises leaves the folder as it was."""
     argv = prepare(case, tmp_path, case.get("argv", []))
     before = snapshot(tmp_path)
     monkeypatch.chdir(tmp_path)
     if "python" in case:
         run_python(case, tmp_path)
+        if refusal_writes_nothing and case.get("raises"):
+            assert snapshot(tmp_path) == before, "the case folder changed although the call was refused"
         return
     if case.get("how") == "subprocess" or any(k in case for k in ("env", "stdout_to", "close", "signal")):
         rc, out, err = run_subprocess(case, argv, tmp_path)

@@ -149,7 +149,7 @@ def test_fit_refuses_held_or_start_values_outside_the_bounds(kw):
 
 # -- never lose a result ------------------------------------------------------------------------
 def test_a_failed_forced_rewrite_keeps_the_previous_report(tmp_path):
-    from frictionlab.core.files import MARKER, atomic_dir
+    from frictionlab.core.outfolder import MARKER, atomic_dir
 
     out = tmp_path / "report"
     out.mkdir()

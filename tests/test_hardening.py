@@ -21,6 +21,7 @@ import pytest
 
 import frictionlab as fl
 from frictionlab.core import files as io
+from frictionlab.core import outfolder
 from frictionlab.core.errors import LawError, OutputError, UnitError
 from frictionlab.physics import registry
 from frictionlab.physics.law import FrictionLaw, ParamSpec
@@ -262,7 +263,7 @@ def test_full_disk_names_the_path_and_leaves_nothing(tmp_path, monkeypatch):
     out = tmp_path / "report"
     monkeypatch.setattr(Path, "write_text", full)
     with pytest.raises(OutputError) as info:
-        with io.atomic_dir(out) as tmp:
+        with outfolder.atomic_dir(out) as tmp:
             (tmp / "report.md").write_text("a report")
     assert str(info.value).startswith(f"{out}: cannot write") and "No space left on device" in str(info.value)
     assert list(tmp_path.iterdir()) == []
@@ -293,7 +294,7 @@ def test_full_disk_names_the_path_and_leaves_nothing(tmp_path, monkeypatch):
 def test_outputs_get_their_permissions_from_the_umask(tmp_path):
     old = os.umask(0o027)
     try:
-        with io.atomic_dir(tmp_path / "rep") as tmp:
+        with outfolder.atomic_dir(tmp_path / "rep") as tmp:
             (tmp / "figures").mkdir()
             (tmp / "figures" / "a.png").write_bytes(b"png")
         io.atomic_write_text(tmp_path / "one.csv", "t\n")
@@ -301,14 +302,14 @@ def test_outputs_get_their_permissions_from_the_umask(tmp_path):
         os.umask(old)
     mode = lambda p: p.stat().st_mode & 0o777  # noqa: E731
     assert mode(tmp_path / "rep") == 0o750 and mode(tmp_path / "rep" / "figures") == 0o750
-    assert mode(tmp_path / "rep" / "figures" / "a.png") == 0o640 and mode(tmp_path / "rep" / io.MARKER) == 0o640
+    assert mode(tmp_path / "rep" / "figures" / "a.png") == 0o640 and mode(tmp_path / "rep" / outfolder.MARKER) == 0o640
     assert mode(tmp_path / "one.csv") == 0o640
 
 
 def test_the_final_move_checks_the_target_again(tmp_path):
     out = tmp_path / "rep"
     with pytest.raises(OutputError, match="output folder exists"):
-        with io.atomic_dir(out) as tmp:
+        with outfolder.atomic_dir(out) as tmp:
             (tmp / "report.md").write_text("mine")
             out.mkdir()  # someone else (not frictionlab: no lock) made it meanwhile
             (out / "theirs.txt").write_text("theirs")
@@ -319,16 +320,16 @@ def test_the_final_move_checks_the_target_again(tmp_path):
 def test_force_replaces_a_report_or_an_empty_folder_and_nothing_else(tmp_path):
     out = tmp_path / "rep"
     for _ in range(2):  # the first creates it, the second replaces a report
-        with io.atomic_dir(out, force=True) as tmp:
+        with outfolder.atomic_dir(out, force=True) as tmp:
             (tmp / "report.md").write_text("new")
     empty = tmp_path / "empty"
     empty.mkdir()
-    with io.atomic_dir(empty, force=True) as tmp:
+    with outfolder.atomic_dir(empty, force=True) as tmp:
         (tmp / "report.md").write_text("new")
     victim = tmp_path / "notes.txt"
     victim.write_text("precious")
     with pytest.raises(OutputError, match="this is not a folder"):
-        with io.atomic_dir(victim, force=True):
+        with outfolder.atomic_dir(victim, force=True):
             pass
     assert victim.read_text() == "precious"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["empty", "notes.txt", "rep"]  # no .old, .tmp, .lock
@@ -377,7 +378,7 @@ def test_two_concurrent_runs_to_one_output_never_both_succeed(tmp_path):
     assert codes == [0, 2], results
     loser = next(err for rc, err in results if rc == 2)
     assert "another frictionlab run is writing this output" in loser or "output folder exists" in loser, loser
-    assert (out / "report.md").exists() and (out / io.MARKER).exists()
+    assert (out / "report.md").exists() and (out / outfolder.MARKER).exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["rep"]
 
 

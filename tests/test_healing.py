@@ -46,9 +46,10 @@ def test_the_command_prints_the_table_with_each_laws_prediction(capsys):
     assert main(["healing", str(SHS), "--laws", "rate-state-aging", "--quiet"]) == 0
     out = capsys.readouterr().out
     assert "6 holds" in out and "healing (truth: aging)" in out and "healing (aging, best parameters)" in out
-    assert "per decade" in out and "rate-state-aging fitted to the whole record" in out
+    assert "per decade" in out and "rate-state-aging at its best parameters on the whole record" in out
 
 
 def test_the_record_is_what_its_command_regenerates(capsys):
     assert main(["datasets", "rebuild", "--slide-hold-slide", "--check"]) == 0
     assert "2 generated files equal the committed ones" in capsys.readouterr().out
+

@@ -104,3 +104,14 @@ def test_a_column_the_header_does_not_name_and_a_bad_cell_are_refused_with_the_l
         read_raw(tmp_path / "r.csv", columns="time=Time s, displacement=Disp um, friction=Friction")
     with pytest.raises(FrictionLabError, match=r"r.csv: line 501: friction=Mu: 'n/a' is not a finite number"):
         read_raw(tmp_path / "r.csv", columns="time=Time s, displacement=Disp um, friction=Mu")
+
+
+def test_crlf_lines_and_text_before_the_data_with_columns_by_position(tmp_path):
+    """Windows line ends, a title and a header before the data: columns by position find the first row of
+    numbers in its own separator, and say which rows were skipped."""
+    t, x, mu = _step()
+    rows = "".join(f"{a!r},{b!r},{c!r}\r\n" for a, b, c in zip(t.tolist(), x.tolist(), mu.tolist()))
+    (tmp_path / "r.csv").write_bytes(("Run 7 title\r\nt,x,mu\r\n" + rows).encode())
+    raw = read_raw(tmp_path / "r.csv", columns="time=#1 s, displacement=#2 um, friction=#3")
+    assert raw.notes == ("2 rows of text before the data skipped (lines 1 to 2)",) and raw.line(0) == 3
+    assert raw.t == pytest.approx(t) and raw.mu == pytest.approx(mu)

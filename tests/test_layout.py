@@ -111,7 +111,7 @@ def test_imports_flow_one_way():
         if unit(m) in LAYERS or m in ("", "__main__"):
             continue  # a layer's own __init__ and the public API re-export
         g.setdefault(unit(m), set()).update(unit(t) for t in ts if unit(t) != unit(m) and unit(t) not in LAYERS)
-    assert {"io.dataset", "solve.outcome"} <= g["inference.fitting.predict"] and "solve.outcome" in g["io.datasetfields"]
+    assert {"io.dataset", "solve.outcome"} <= g["inference.fitting.predict"] and "solve.outcome" in g["io.dataset"]
     assert "io.dataset" not in g["solve.solvers"] and "io.dataset" not in g["solve.outcome"]
     found = cycles(g)
     assert [tuple(c) for c in found if tuple(c) not in KNOWN] == []

@@ -72,7 +72,7 @@ def _general(monkeypatch):
     ("dahl", "incline-dry-d10", dict(mu_c=0.8, sigma=300.0, alpha=1.5)),  # more turns than MAX_TURNS: then mu_d
     ("rate-state-aging", "incline-oil-a100", dict(mu0=0.2)),  # stick events
     ("rate-state-slip", "impact-golf-v28", dict(mu0=0.2)),
-    ("rate-state-prz", "impact-golf-v28", dict(mu0=0.2)),
+    ("rate-state-prz", "incline-oil-a100", dict(mu0=0.2)),
 ])
 def test_solves_agree_with_the_general_path_to_the_tolerance(monkeypatch, law, ds, p):
     d = fl.load_dataset(ds)

@@ -104,3 +104,13 @@ def test_the_command_joins_files_and_says_where_each_window_starts(tmp_path, his
     d = load_dataset(out / "e-step2.toml")
     assert "the window starts at" in d.provenance.method and "b.txt" in d.provenance.method
     assert window(d).startswith("starts at a.txt line ") and "at steady state" in window(d)  # the report's sentence
+
+
+def test_the_record_command_answers_for_a_record_of_one_law(tmp_path, history, capsys):
+    t, x, _, mu = history
+    _write(tmp_path / "r.txt", t, x, mu, int(CUT / DT), t.size)
+    assert main(["record", str(tmp_path / "r.txt"), "--name", "r", "--laws", "rate-state-aging", "--no-joint",
+                 "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "Does one parameter set describe the up and the down steps? Yes, for every law tested (aging)" in out
+    assert out.count("at steady state") == 2 and "r-step1 (2 -> 0.2 um/s)" in out

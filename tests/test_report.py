@@ -12,7 +12,7 @@ from _fit_helpers import TRUTH, synthetic
 from frictionlab import compare, write_report
 from frictionlab.cli import main
 from frictionlab.core.errors import FrictionLabError, OutputError
-from frictionlab.core.files import MARKER
+from frictionlab.core.outfolder import MARKER
 from frictionlab.core.progress import Progress
 from frictionlab.inference.verdicts.ranking import COLUMNS
 

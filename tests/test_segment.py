@@ -125,3 +125,35 @@ def test_a_long_record_is_segmented_on_a_grid_and_refined_to_the_sample():
     s = segment(t, piecewise(t, [10000.03], [1.0, 10.0]) + rng.normal(0, 0.05, t.size))
     (st,) = s.steps
     assert st.index == 100001 and abs(st.time - 10000.03) < 4 * st.time_se
+
+
+def test_twenty_steps_up_and_down_are_twenty_steps_at_their_times():
+    """Steps every 95 s between 1 and 10 um/s: the noise is measured between them, so they are not noise."""
+    t = np.arange(19950) * 0.1
+    knots = [95.0 * k for k in range(1, 21)]
+    rng = np.random.default_rng(10)
+    s = segment(t, piecewise(t, knots, [1.0 if k % 2 == 0 else 10.0 for k in range(21)]) + rng.normal(0, 0.05, t.size))
+    assert len(s.steps) == 20 and 0.04 < s.noise < 0.06
+    assert all(abs(st.time - k) < 4 * st.time_se for st, k in zip(s.steps, knots))
+
+
+def test_a_displacement_in_counts_is_straight_and_its_step_within_its_error():
+    """0.1 um a sample read in counts of 0.5 um (a staircase): one step, the count's rounding as its noise."""
+    z = []
+    for seed in range(5):
+        rng = np.random.default_rng(seed)
+        ts = 150.0 + rng.uniform(0, 0.1)
+        x = np.round((piecewise(T, [ts], [1.0, 3.0]) + rng.normal(0, 0.05, T.size)) / 0.5) * 0.5
+        (st,) = segment(T, x).steps
+        z.append((st.time - ts) / st.time_se)
+    assert np.max(np.abs(z)) < 4, z
+
+
+def test_a_record_without_noise_has_errors_that_bound_its_rounding():
+    """Lines sampled exactly and written to 4 decimals: every sample after the step rounds alike, so the step
+    time errs by up to half a digit over the change of velocity; its standard error says at least that."""
+    t = np.arange(3000) * 0.01
+    x = np.round(1554.674 + piecewise(t, [15.00333], [3.0, 10.0]), 4)
+    s = segment(t, x)
+    (st,) = s.steps
+    assert s.exact_to == pytest.approx(1e-4) and st.time_se >= 0.5e-4 / 7 and abs(st.time - 15.00333) < st.time_se

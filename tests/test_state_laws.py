@@ -162,7 +162,7 @@ def test_the_velocity_step_fit_serves_prz_and_recovers_its_truth(tmp_path):
 
     import attrs
 
-    from frictionlab.inference.predict import Target
+    from frictionlab.inference.fitting.predict import Target
     from frictionlab.solve import quasistatic
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
@@ -182,3 +182,17 @@ def test_the_velocity_step_fit_serves_prz_and_recovers_its_truth(tmp_path):
     for name, value in truth.items():
         assert abs(prz.value(name) - value * (UM if name == "Dc" else 1.0)) < 3 * prz.stderr(name), name
     assert aging.stats.chisqr > prz.stats.chisqr + 10
+
+
+def test_nagata_on_a_slider_with_mass_reads_the_load_rate_and_tends_to_the_quasi_static_slider():
+    import attrs
+
+    p = _si(CASES["rate-state-nagata"])
+    scene = _scene(*STEPS["up"])
+    quasi = fl.simulate("rate-state-nagata", scene, p, t=T)
+    gaps = []
+    for mass in (1e3, 10.0):
+        heavy = attrs.evolve(scene, spring=SpringLoad(scene.spring.stiffness, scene.spring.times,
+                                                      scene.spring.velocities, mass=mass))
+        gaps.append(np.max(np.abs(fl.simulate("rate-state-nagata", heavy, p, t=T, solver="ode:BDF").load - quasi.load)))
+    assert gaps[1] < gaps[0] and gaps[1] < 1e-5

@@ -111,10 +111,12 @@ def add_parser(sub):
 
 
 def run(args) -> int:
-    from ..core.cluster import Waits, close, connect, quiet_logs
+    from ..core.cluster import Waits, check_address, close, connect, quiet_logs
     from ..io.dataset import available_names, load_dataset
     from .fit import parse_free
 
+    if args.scheduler is not None:
+        check_address(args.scheduler)  # a malformed address refused before any work or connection
     parent = args.out.parent if str(args.out.parent) else Path(".")
     if not parent.is_dir():
         raise OutputError(f"{args.out}: cannot write: {parent} is not an existing folder")
@@ -132,7 +134,10 @@ def run(args) -> int:
     free = parse_free(args.free)
     from ..inference.equivalence.margin import parse_margin
 
-    margin = parse_margin(args.margin)
+    margin = parse_margin(args.margin, "--margin")
+    if args.no_equivalence and (args.margin is not None or args.pairs):
+        raise ParameterError(f"{'--margin' if args.margin is not None else '--pairs'} applies to the equivalence "
+                             "tests, which --no-equivalence skips; drop one of the two")
     pairs = parse_pairs(args.pairs, args.laws or None) if args.pairs else None
     datasets = [load_dataset(d) for d in args.data or available_names()]  # read first: --out keeps clear of them
     if not args.no_equivalence:
@@ -161,34 +166,20 @@ def _say(text: str) -> None:
 
 def parse_pairs(items, laws) -> tuple[tuple[str, str], ...]:
     """--pairs 'wear:area-rate' ... -> (('wear', 'area-rate'), ...): registered names, two different laws, both
-    among the compared ``laws`` (None: the default laws of every dataset kind)."""
+    among the compared ``laws`` (None: the default laws of every dataset kind), each pair once."""
     from ..physics.registry import get_law
-    from ..pipeline.settings import DEFAULT_LAWS_BY_KIND, select_laws
+    from ..pipeline.settings import DEFAULT_LAWS_BY_KIND, check_pairs, select_laws
 
     # the laws compared together: the named ones, or the default laws of each dataset kind (a pair of laws from
     # two kinds' defaults is never fitted on one dataset)
     groups = [set(select_laws(laws))] + ([{get_law(n).name for n in v} for v in DEFAULT_LAWS_BY_KIND.values()]
                                          if laws is None else [])
-    pairs = []
-    for item in items:
-        a, sep, b = item.partition(":")
-        if not sep or not a.strip() or not b.strip() or ":" in b:
-            raise ParameterError(f"--pairs {item!r}: expected LAW:LAW, e.g. wear:area-rate")
-        a, b = get_law(a.strip()).name, get_law(b.strip()).name
-        if a == b:
-            raise ParameterError(f"--pairs {item!r}: a law is always equivalent to itself; name two different laws")
-        if not any({a, b} <= g for g in groups):
-            compared = next((g for g in groups if b in g or a in g), groups[0])
-            missing = [x for x in (a, b) if x not in compared]
-            raise ParameterError(f"--pairs {item!r}: {', '.join(missing)} {'is' if len(missing) == 1 else 'are'} not "
-                                 f"among the compared laws ({', '.join(sorted(compared))}); add "
-                                 f"{'it' if len(missing) == 1 else 'them'} to --laws")
-        pairs.append((a, b))
-    return tuple(dict.fromkeys(pairs))
+    return check_pairs(items, groups, "--pairs", "--laws")
 
 
 def _run(args, free, pairs, datasets, client) -> int:
-    from ..core.files import check_target, output_lock
+    from ..core.files import output_lock
+    from ..core.outfolder import check_target
     from ..core.workers import long_run_gc
     from ..pipeline.comparison import compare
     from ..report import write_report

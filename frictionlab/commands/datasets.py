@@ -71,7 +71,7 @@ def _add_import(acts):
 
     imp = subcommand(acts, "import", help="turn a raw laboratory record into datasets, one per velocity step",
                      description="Read a raw record and write measured datasets (NAME.toml + NAME.csv). FORMAT "
-                                 "velstep: whitespace-separated Time(s) Displ(microns) Friction "
+                                 "velstep: by default whitespace-, tab- or comma-separated Time(s) Displ(microns) Friction "
                                  "EffectiveNormalstress(MPa) (the records of the steadystate routine, Giacomel et al. "
                                  "2024), any number of velocity steps and holds. The displacement is segmented into "
                                  "straight pieces (optimal partitioning: the data choose the number of steps); each "
@@ -169,7 +169,7 @@ def _import(args) -> int:
         print(line)
     for w, (toml_path, csv_path) in pairs:
         v = " -> ".join(f"{x * 1e6:.4g}" for x in w.velocities)
-        print(f"wrote {_shown(toml_path)} and {_shown(csv_path)}: lines {raw.line(w.a)} to {raw.line(w.b - 1)} ({w.b - w.a} samples), "
+        print(f"wrote {_shown(toml_path)} and {_shown(csv_path)}: {raw.span(w.a, w.b).split(' of ')[0]} ({w.b - w.a} samples), "
               f"{v} um/s, k start {w.stiffness * 1e-6:.3g} 1/um ({w.stiffness_from}; fitted with the law)"
               + (f"; the window {w.start_note}" if w.start_note else ""))
     return 0

@@ -76,8 +76,11 @@ def parse_params(law, items) -> dict[str, float]:
     from .fit import _split
 
     out = {}
-    for item in items:
+    for item, after in zip(items, list(items[1:]) + [""]):
         name, value = _split(item, "--param")
+        if value[-1:].isdigit() and after[:1].isdigit() and "=" not in after:  # '--param h=80,5 um'
+            raise ParameterError(f"--param {name}: {value + ',' + after!r}: a comma separates list items here; "
+                                 f"write a decimal point ({value}.{after})")
         spec = law.spec(name)
         out[name] = to_si(value, spec.unit, f"--param {name}")
     return out

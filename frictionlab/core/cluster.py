@@ -26,6 +26,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Callable
 
+from .address import check_host_port
 from .errors import ClusterError, FrictionLabError, ParameterError, WorkerLost
 from .taskhost import pack, pack_warm_up, relay, task_name, unpack, warm_children
 from .workers import process_pool
@@ -312,7 +313,8 @@ def _usable_protocols(registry) -> list[str]:
 
 def check_address(address: str) -> tuple[str, dict]:
     """(the address with its protocol, the connection arguments) of a scheduler address, or a one-line
-    ParameterError naming --scheduler: an unknown protocol, a tls:// address without certificates, no host."""
+    ParameterError naming --scheduler: an unknown protocol, a tls:// address without certificates, a malformed host
+    or port (``address.check_host_port``)."""
     try:
         from distributed.comm import registry
         from distributed.comm.addressing import parse_address
@@ -334,9 +336,7 @@ def check_address(address: str) -> tuple[str, dict]:
     if f"{scheme}://" not in known:
         raise ParameterError(f"{where}: unknown or unusable protocol {scheme}://; a Dask scheduler is reached here "
                              f"through {known}")
-    host = loc.rpartition(":")[0] if ":" in loc else loc
-    if not host.strip("[]") or not loc.rpartition(":")[2].isdigit():
-        raise ParameterError(f"{where}: expected PROTOCOL://HOST:PORT (e.g. tcp://10.0.0.5:8786)")
+    check_host_port(loc, where)
     try:
         args = Security().get_connection_args("client")
     except Exception as exc:  # noqa: BLE001 (certificate files named in the Dask configuration that do not load)

@@ -235,13 +235,29 @@ def describe(obj, unit_: str = "") -> list[str]:
 
 # -- what a result draws in a notebook (the .plot() methods) ---------------------------------------------
 
-def figure_axes(ax=None, rows: int = 1, cols: int = 1, size: tuple[float, float] | None = None, **kw):
-    """(figure, axes) to draw on: ``ax`` and its figure when given, else a new figure of ``rows`` x ``cols``
-    axes (a single Axes, or an array squeezed as matplotlib does). The caller's pyplot backend is kept, so
-    a notebook shows the figure inline."""
+def check_axes(ax, where: str, many: bool = False) -> list:
+    """The matplotlib Axes ``ax`` (with ``many``: a sequence or array of them) as a list, or a TypeError naming
+    ``where``'s ``ax`` and what it takes (a Figure is told to pass one of its Axes)."""
+    import numpy as np
+    from matplotlib.axes import Axes
+
+    items = list(np.asarray(ax, dtype=object).ravel()) if many and isinstance(ax, (list, tuple, np.ndarray)) else [ax]
+    for a in items:
+        if not isinstance(a, Axes):
+            hint = "; pass one of its Axes (fig.axes[0], or fig.add_subplot())" if hasattr(a, "add_subplot") else ""
+            raise TypeError(f"{where}: ax: expected a matplotlib Axes{' or a list of them' if many else ''} (or None "
+                            f"for a new figure), got {type(a).__name__} {a!r:.40}{hint}")
+    return items
+
+
+def figure_axes(ax=None, rows: int = 1, cols: int = 1, size: tuple[float, float] | None = None,
+                where: str = "plot", **kw):
+    """(figure, axes) to draw on: ``ax`` and its figure when given (one Axes, else a TypeError naming
+    ``where``), else a new figure of ``rows`` x ``cols`` axes (a single Axes, or an array squeezed as matplotlib
+    does). The caller's pyplot backend is kept, so a notebook shows the figure inline."""
     if ax is not None:
-        first = ax if not hasattr(ax, "flat") else ax.flat[0]
-        return first.figure, ax
+        check_axes(ax, where)
+        return ax.figure, ax
     import matplotlib.pyplot as plt
 
     size = size or (6.4 * cols, 2.6 + 1.9 * rows)

@@ -10,19 +10,18 @@ Rules (stated once):
   that folder is followed, a link out of it is refused.
 * TOML may start with a UTF-8 byte-order mark (it is dropped); brackets, braces and dotted keys
   nest at most ``MAX_TOML_DEPTH`` deep.
-* An output folder is built in a temporary folder beside it and moved into place at the end,
-  while a lock (``.NAME.lock`` beside the target, removed afterwards) keeps a second frictionlab
-  run away from the same target: that run fails at once, naming the target. The target is
-  checked again just before the move. ``force`` replaces only a folder that holds the marker
-  file ``MARKER`` (every folder written here gets one) or an empty folder; anything else,
-  a regular file included, is refused.
+* Every output is written under a lock (``.NAME.lock`` beside the target, removed afterwards) that keeps a
+  second frictionlab run away from the same target: that run fails at once, naming the target. An output
+  folder is built beside its target and moved into place whole (``outfolder.atomic_dir``).
 * Several files written by one command (a dataset's TOML and CSV, a simulation and its plot) are a set
   (``atomic_files``, ``write_files``): written into a temporary folder beside their targets and moved into place
   together at the end, or, on any failure, none of them (a target replaced with ``force`` is put back).
 * Every temporary file and folder, and every lock, carries its owner: the name of a temporary holds the
   owner's process id and start time (``.NAME.PID-START.XXXX.tmp``), a lock file holds them as text. A run that
-  takes a lock removes what dead owners left beside that target (a run killed with SIGKILL); a lock whose
-  owner is dead is taken over even when a process the owner forked still holds its flock.
+  takes a lock removes what dead owners left beside that target (a run killed with SIGKILL), except an old
+  output folder moved aside while its target is missing (a run killed between moving the old folder out and the
+  new one in), which is put back; a lock whose owner is dead is taken over even when a process the owner forked
+  still holds its flock.
 * Every error names the path it concerns, "No space left on device" included.
 """
 from __future__ import annotations
@@ -43,8 +42,6 @@ from .inputs import check_apart, note_input
 MAX_TOML_BYTES = 1 << 20  # 1 MiB: a dataset's sidecar is a few kB
 MAX_CSV_BYTES = 256 << 20  # 256 MiB
 MAX_TOML_DEPTH = 16
-#: File that marks a folder written by frictionlab (a report, a bench report, rebuilt datasets).
-MARKER = ".frictionlab-output"
 
 
 # --- reading --------------------------------------------------------------------------------
@@ -233,7 +230,17 @@ def clear_dead(path) -> None:
     for name in names:
         m = pattern.fullmatch(name)
         if m and not _alive(int(m[1]), int(m[2])):
+            _put_back(os.path.join(parent, name), path)
             _remove(os.path.join(parent, name))
+
+
+def _put_back(aside: str, target) -> None:
+    """An old output folder moved aside (``ASIDE/x``) put back at ``target`` if nothing is there."""
+    if aside.endswith(".old") and os.path.isdir(os.path.join(aside, "x")) and not os.path.lexists(target):
+        try:
+            os.replace(os.path.join(aside, "x"), target)
+        except OSError:
+            pass
 
 
 _leftovers: set[str] = set()  # temporary files and folders, and locks, of this process not yet removed
@@ -254,6 +261,8 @@ def remove_leftovers() -> None:
     """Remove every temporary file, folder and lock this process made and has not removed yet (for an
     exit that cannot run the normal clean-up: a plugin that swallowed SIGTERM)."""
     for path in list(_leftovers):
+        if path.endswith(".old"):  # '.NAME.PID-START.XXXX.old' beside the target NAME
+            _put_back(path, os.path.join(os.path.dirname(path), os.path.basename(path)[1:].split(f".{owner()}.")[0]))
         _remove(path)
 
 
@@ -391,75 +400,6 @@ def _same_file(fd: int, path: Path) -> bool:
         return False
 
 
-def _replaceable(path: Path) -> bool:
-    """True if ``force`` may replace ``path``: a folder with frictionlab's marker, or an empty one."""
-    return path.is_dir() and not path.is_symlink() and ((path / MARKER).is_file() or not any(path.iterdir()))
-
-
-def check_target(path, force: bool = False) -> Path:
-    """Raise OutputError unless an output folder may be created (or, with ``force``, replaced) at ``path``."""
-    path = Path(path)
-    check_apart(path)
-    if os.path.lexists(path):
-        if not force:
-            raise OutputError(f"{path}: output folder exists; choose another --out or pass --force")
-        if not _replaceable(path):
-            what = "a folder frictionlab did not write" if path.is_dir() and not path.is_symlink() else \
-                "not a folder" if not path.is_symlink() else "a symbolic link"
-            raise OutputError(f"{path}: --force replaces only a folder written by frictionlab (it holds {MARKER}) "
-                              f"or an empty one; this is {what}: remove it yourself or choose another --out")
-    parent = path.parent if str(path.parent) else Path(".")
-    if not parent.exists():
-        raise OutputError(f"{path}: parent folder {parent} does not exist")
-    if not parent.is_dir():
-        raise OutputError(f"{path}: cannot write: {parent} is not a directory")
-    return path
-
-
-@contextmanager
-def atomic_dir(path, force: bool = False, marker: str = "frictionlab output\n"):
-    """Yield a temporary folder beside ``path``; move it into place only if the block succeeds.
-
-    An existing ``path`` is refused unless ``force`` and it is a frictionlab output folder (it holds
-    MARKER) or empty; it is then replaced at the end. The folder gets a MARKER file holding
-    ``marker``, and permissions from the umask. The target is locked throughout (output_lock).
-    """
-    path = Path(path)
-    with output_lock(path):
-        check_target(path, force)
-        parent = path.parent if str(path.parent) else Path(".")
-        try:
-            tmp = Path(tempfile.mkdtemp(dir=parent, prefix=_tag(path), suffix=".tmp"))
-        except OSError as exc:
-            raise _oserror(path, exc) from None
-        _leftovers.add(str(tmp))
-        try:
-            try:
-                os.chmod(tmp, 0o777 & ~_umask())
-                yield tmp
-                (tmp / MARKER).write_text(marker, encoding="utf-8")
-                _fix_modes(tmp)
-            except OSError as exc:
-                raise _oserror(path, exc) from None
-            check_target(path, force)  # again: something may have appeared during the work
-            old = None
-            try:
-                if os.path.lexists(path):
-                    old = Path(tempfile.mkdtemp(dir=parent, prefix=_tag(path), suffix=".old"))
-                    _leftovers.add(str(old))
-                    os.replace(path, old / "x")
-                os.replace(tmp, path)
-            except OSError as exc:
-                if old is not None and (old / "x").exists() and not os.path.lexists(path):
-                    os.replace(old / "x", path)  # put the old one back
-                raise _oserror(path, exc) from None
-            finally:
-                if old is not None:
-                    _remove(str(old))
-        finally:
-            _remove(str(tmp))
-
-
 @contextmanager
 def atomic_files(paths, force: bool = False):
     """Yield one temporary path per target in ``paths`` (in their order) to write; when the block ends normally
@@ -540,17 +480,3 @@ def write_files(contents, force: bool = False) -> None:
                 tmp.write_bytes(data.encode("utf-8") if isinstance(data, str) else bytes(data))
             except OSError as exc:
                 raise OutputError(f"{p}: cannot write: {exc.strerror or exc}") from None
-
-
-def _fix_modes(folder: Path) -> None:
-    """Give files and folders below ``folder`` the permissions the umask allows (0666 / 0777 & ~umask),
-    whatever created them (tempfile makes them private)."""
-    mask = _umask()
-    for root, dirs, files in os.walk(folder):
-        for d in dirs:
-            os.chmod(os.path.join(root, d), 0o777 & ~mask)
-        for f in files:
-            p = os.path.join(root, f)
-            if not os.path.islink(p):
-                os.chmod(p, (0o777 if os.stat(p).st_mode & 0o111 else 0o666) & ~mask)
-

@@ -3,7 +3,7 @@
 While a command runs (``inputs_of_run``), every file read through ``core.files`` and every file named
 by ``note_input`` (a ``--load`` plugin) is recorded by its real path; ``check_apart`` refuses an output
 that is (by path, or as a hard link of it), contains or lies inside one of them. ``core.files`` checks every output path with it before
-writing (``check_writable``, ``check_target``), so ``--force`` never removes what the run reads.
+writing (``check_writable``, ``outfolder.check_target``), so ``--force`` never removes what the run reads.
 """
 from __future__ import annotations
 

@@ -23,6 +23,10 @@ MAX_LITERAL = 1e300  # largest number written in a quantity string
 MAX_SI = 1e100
 MIN_SI = 1e-100
 
+#: Minus signs other than the ASCII hyphen-minus that a quantity may hold, read as "-": the minus sign U+2212
+#: (what word processors and PDFs write), the dashes U+2012-U+2015 and the small and fullwidth hyphen-minus.
+MINUS_SIGNS = "\u2212\u2012\u2013\u2014\u2015\ufe63\uff0d"
+_MINUS = str.maketrans(dict.fromkeys(MINUS_SIGNS, "-"))
 _POWER = re.compile(r"\*\*|\^")
 _EXPONENT = re.compile(r"\s*(\(\s*[-+]?\s*\d+(?:\.\d*)?\s*\)|[-+]?\s*\d+(?:\.\d*)?)(?![\d.eE])")
 _LITERAL = re.compile(r"(?<![A-Za-z_\d.])(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?")
@@ -81,12 +85,16 @@ def _target(unit: str):
 def check_text(text: str, where: str) -> str:
     """Refuse a quantity or unit string pint could choke on, before pint sees it: longer than
     MAX_TEXT, control characters, a power that is not a plain number of at most MAX_POWER, a
-    chained power (a**b**c), a number beyond MAX_LITERAL or one that underflows to 0."""
+    chained power (a**b**c), a number beyond MAX_LITERAL or one that underflows to 0. Returns the text
+    stripped, each of MINUS_SIGNS made "-"."""
     shown = text if len(text) <= 40 else text[:37] + "..."
     if len(text) > MAX_TEXT:
         raise UnitError(f"{where}: {shown!r} is {len(text)} characters long; a quantity has at most {MAX_TEXT}")
     if not text.isprintable():
-        raise UnitError(f"{where}: {shown!r} holds control characters")
+        odd = next(c for c in text if not c.isprintable())
+        raise UnitError(f"{where}: {shown!r} holds control characters or odd spaces (U+{ord(odd):04X}); "
+                        "write a number and its unit with plain spaces")
+    text = text.translate(_MINUS)
     last_end = None
     for m in _POWER.finditer(text):
         if (last_end is not None and not text[last_end:m.start()].strip()) or _powered_group(text, m.start()):
@@ -107,6 +115,43 @@ def check_text(text: str, where: str) -> str:
         if value == 0 and re.search(r"[1-9]", m.group(1)):
             raise UnitError(f"{where}: {shown!r}: the number {m.group()} underflows to 0")
     return text.strip()
+
+
+#: A number and what stands before it, in a quantity or unit string: a number after another number or a unit with
+#: nothing but spaces between them is multiplied by pint ("1 810 000 Pa s/m" is 0, "2 3 Pa s/m" is 6).
+_BEFORE_OPERATOR = re.compile(r"(\*|/|\^)[\s(+-]*$")
+_LEADING = re.compile(r"\s*[-+]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|(?:inf(?:inity)?|nan)\b)", re.IGNORECASE)
+
+
+def check_one_number(text: str, where: str, shown=None, quantity: bool = True) -> None:
+    """Refuse a quantity string (``quantity``) that does not start with a number, and a quantity or unit string
+    in which a number follows another number or a unit with only spaces between them (pint would multiply
+    them): a number after the first is accepted only after an operator (``*``, ``/``, ``**``, ``^``), or as
+    the 1 of "1/m". ``text`` as ``check_text`` returns it; ``shown`` as given."""
+    shown = text if shown is None else shown
+    lead = _LEADING.match(text)
+    if quantity and lead is None:
+        raise UnitError(f"{where}: {shown!r} does not start with a number; write one number and its unit, "
+                        "like '1.5 m/s'")
+    prev = lead.group().strip() if lead else ""
+    for m in _LITERAL.finditer(text, lead.end() if lead else 0):
+        before = text[:m.start()]
+        if before.strip() and not _BEFORE_OPERATOR.search(before) \
+                and not (m.group() == "1" and text[m.end():].lstrip().startswith("/")):  # "2000 1/m"
+            comma = "," in before[-2:]
+            what = "one number and its unit" if quantity else "a unit with no number but its powers (m^2, 1/s)"
+            raise UnitError(f"{where}: {shown!r} holds more than one number ({prev or before.split()[-1]} then "
+                            f"{m.group()}, which would be multiplied); write {what}"
+                            + (" (a decimal point, not a comma: 1.5, not 1,5)" if comma else
+                               ", without spaces or separators inside a number (1810000 or 1.81e6, not 1 810 000)"
+                               if quantity else ""))
+        prev = m.group()
+
+
+def leading_number(text: str) -> float | None:
+    """The number a quantity string starts with (its sign included), or None."""
+    m = _LEADING.match(text.translate(_MINUS))
+    return float(m.group()) if m else None
 
 
 def _powered_group(text: str, op: int) -> bool:
@@ -134,7 +179,8 @@ def check_magnitude(value: float, shown, where: str, si_unit: str = "") -> float
 
 def unit_factor(unit: str, si_unit: str, where: str) -> float:
     """Factor that converts a value in ``unit`` to ``si_unit``; ``where`` names the field."""
-    unit = check_text(unit, where)
+    shown, unit = unit, check_text(unit, where)
+    check_one_number(unit, where, shown, quantity=False)
     known = KNOWN.get(si_unit, {}).get(unit)
     if known is not None:
         return known
@@ -177,6 +223,7 @@ def to_si(value, si_unit: str, where: str) -> float:
             out = math.inf
     elif isinstance(value, str):
         text = check_text(value, where)
+        check_one_number(text, where, value)
         m = _QUANTITY.fullmatch(text)
         known = KNOWN.get(si_unit, {}).get(m[2]) if m else None
         if known is not None:

@@ -13,6 +13,7 @@ with a one-line ``DatasetError`` naming the file and the field.
 from __future__ import annotations
 
 import math
+import os
 from importlib import resources
 from pathlib import Path
 
@@ -21,18 +22,30 @@ import numpy as np
 
 from typing import TYPE_CHECKING
 
-from ..core.errors import DatasetError
+from ..core.errors import DatasetError, FrictionLabError
 from ..core.files import read_toml
-from ..physics.scene import Scene
-from .csvread import read_csv
+from ..core.names import check_name
+from ..core.units import MAX_SI, unit_factor
+from ..physics.scene import KINDS, Scene
+from .csvread import _line_of_row, read_csv
 from .provenance import PROVENANCE_KINDS, Provenance, _provenance  # noqa: F401  (re-exported)
+from ..solve.outcome import OUTCOMES
+from .dataset_tables import _fixed, _quantity, _rest, _scene, _table
 from .noise import NOISE_KINDS, STATED, noise_table, stated_table  # noqa: F401 (NOISE_KINDS, STATED: read from here too)
-from .datasetfields import (COLUMN_SI, _check_series, _columns, _correlation, _fixed, _header, _quantity, _rest,
-                            _scene, _si_of, _table, _time_origin)
 
+DATA_KINDS = KINDS + ("contact-area",)
+
+#: SI unit of each well-known column; other columns must declare a unit of their own.
 if TYPE_CHECKING:  # annotations only
     import pandas as pd
     from matplotlib.axes import Axes
+
+COLUMN_SI = {
+    "t": "s", "omega": "rad/s", "theta": "rad", "u": "m/s", "v": "m/s", "A": "m^2", "N": "N", "x": "m",
+    "speed": "m/s", "incidence": "rad", "spin": "rad/s", "rebound_spin": "rad/s", "tangential_cor": "",
+    "rebound_angle": "rad", "cm_tangential_cor": "", "normal_cor": "", "contact_rebound_angle": "rad", "psi1": "",
+    "psi2": "", "mu": "",
+}
 
 
 @attrs.frozen(eq=False)
@@ -189,7 +202,7 @@ class Dataset:
         y = y or self.observable
         if y not in self.columns:
             raise DatasetError(f"dataset '{self.name}' has no column '{y}'; it has {', '.join(self.columns)}")
-        _, ax = figure_axes(ax)
+        _, ax = figure_axes(ax, where="Dataset.plot")
         xcol, xunit, xf = self.x_axis()
         x = self.columns[xcol] * xf if xcol else np.arange(len(self))
         shown, f = self.shown(y)
@@ -203,6 +216,14 @@ class Dataset:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
         return ax
+
+    def check(self, where: str = "dataset") -> Dataset:
+        """This dataset if it is still what loading made of it, else a DatasetError naming ``where`` and the field
+        (``intact.check_intact``: what fit, simulate and compare call before using it)."""
+        from .intact import check_intact
+
+        check_intact(self, where)
+        return self
 
     def _repr_html_(self) -> str:
         """A notebook's view: what the dataset is, where it comes from, its noise and columns in its units."""
@@ -254,6 +275,16 @@ def available_names() -> list[str]:
     return builtin_names() + external.present()
 
 
+#: What a dataset argument may be, for messages.
+DATASET_FORMS = "a Dataset, a dataset name or the path to its .toml"
+
+
+def check_dataset_like(value, where: str, more: tuple = ()) -> None:
+    """A TypeError naming ``where`` unless ``value`` is a Dataset, a name or a path (or one of the types ``more``)."""
+    if not isinstance(value, (str, os.PathLike, Dataset) + tuple(more)):
+        raise TypeError(f"{where}: expected {DATASET_FORMS}, got {type(value).__name__} {value!r:.60}")
+
+
 def load_dataset(name_or_path: str | Path) -> Dataset:
     """Load and validate a dataset.
 
@@ -286,12 +317,23 @@ def load_dataset(name_or_path: str | Path) -> Dataset:
         return name_or_path
     from . import external
 
+    check_dataset_like(name_or_path, "load_dataset")
+
     if isinstance(name_or_path, str) and name_or_path in external.RECORDS \
             and not (builtin_dir() / f"{name_or_path}.toml").exists():
         meta, path, raw = external.load(name_or_path)  # a measured record placed beside the repository, not in it
         return from_meta(meta, path, raw=raw)
     path = resolve(name_or_path)
     return from_meta(read_toml(path), path)
+
+
+def _req(meta, key, path, typ=str):
+    if key not in meta:
+        raise DatasetError(f"{path}: missing required key '{key}'")
+    if not isinstance(meta[key], typ):
+        what = {str: "string", dict: "table"}.get(typ, typ.__name__)
+        raise DatasetError(f"{path}: '{key}' must be a {what}, got {type(meta[key]).__name__}")
+    return meta[key]
 
 
 def from_meta(meta: dict, path: Path, raw: dict | None = None) -> Dataset:
@@ -317,3 +359,116 @@ def from_meta(meta: dict, path: Path, raw: dict | None = None) -> Dataset:
                    noise_df={k: e.df for k, e in noise_est.items()}, noise_est=noise_est, noise_note=noise_note,
                    noise_correlation=correlation,
                    stated=stated_table(_table(meta, "stated", path, "[stated]"), path, kind, noise_kind, _quantity))
+
+
+def _header(meta, path):
+    """name, group, kind, observable and the [columns] units, checked against one another."""
+    name = check_name(_req(meta, "name", path), f"{path}: name", DatasetError)
+    group = meta.get("group", "")
+    if "group" in meta:
+        if not isinstance(group, str):
+            raise DatasetError(f"{path}: group = {group!r}, expected a quoted name (letters, digits, . _ + -)")
+        group = check_name(group, f"{path}: group", DatasetError)
+    kind = _req(meta, "kind", path)
+    if kind not in DATA_KINDS:
+        raise DatasetError(f"{path}: kind = {kind!r}, expected one of {', '.join(DATA_KINDS)}")
+    observable = _req(meta, "observable", path)
+    if observable == "t":
+        raise DatasetError(f"{path}: observable = 't': the time column cannot be the observable")
+    if kind == "impact-outcome":
+        if observable not in OUTCOMES:
+            raise DatasetError(f"{path}: observable {observable!r} is not an impact outcome ({', '.join(OUTCOMES)})")
+    units = _req(meta, "columns", path, dict)
+    for col, u in units.items():
+        if not isinstance(u, str):
+            raise DatasetError(f"{path}: columns.{col} must be a unit string like 'us' or 'rpm'")
+    if "t" not in units and kind != "impact-outcome":
+        raise DatasetError(f"{path}: [columns] must declare the time column 't'")
+    if observable not in units:
+        raise DatasetError(f"{path}: observable {observable!r} is not declared in [columns] ({', '.join(units)})")
+    return name, group, kind, observable, units
+
+
+def _columns(raw, units, path, csv) -> dict:
+    """The declared columns of the CSV in SI units, each a known quantity of sane magnitude."""
+    columns = {}
+    for col, unit in units.items():
+        if col not in raw:
+            raise DatasetError(f"{csv}: missing column '{col}' declared in {path.name} (has: {_names(raw)})")
+        si = COLUMN_SI.get(col)
+        if si is None:
+            raise DatasetError(f"{path}: column '{col}' is not a known quantity ({', '.join(COLUMN_SI)})")
+        try:
+            columns[col] = raw[col] * unit_factor(unit, si, f"{path}: columns.{col}")
+        except FrictionLabError as exc:
+            raise DatasetError(str(exc)) from None
+        bad = np.nonzero(~(np.abs(columns[col]) <= MAX_SI))[0]
+        if bad.size:
+            i = int(bad[0])
+            raise DatasetError(f"{csv}: column {col!r} line {_line_of_row(csv, i)}: {raw[col][i]:g} {unit} is beyond "
+                               f"the accepted magnitude {MAX_SI:g} in SI units")
+    return columns
+
+
+def _time_origin(meta, columns, raw, kind, path, csv) -> float:
+    """The file's time of t = 0 [s] (TOML ``time_zero``, default 0), subtracted from column t in place.
+
+    Times count from first contact, release or the start of the load-point schedule; a column that
+    starts elsewhere (a later first frame, a lab clock, epoch seconds) is an error unless ``time_zero``
+    says where t = 0 lies: an offset is never guessed, so no series is fitted against the wrong origin."""
+    if "time_zero" not in meta:
+        if "t" in columns and kind != "contact-area" and columns["t"][0] > 0:  # negative: _check_series
+            first = raw["t"][0]
+            raise DatasetError(f"{csv}: column 't' starts at {first:.10g}, not 0: times count from first contact (or "
+                               f"release, or the start of loading); say where t = 0 lies in the file's clock with "
+                               f"time_zero = \"{first:.10g} <unit>\" at the top of {path.name} (subtracted from t), "
+                               "or time_zero = \"0 s\" if the first sample is later than t = 0")
+        return 0.0
+    if "t" not in columns:
+        raise DatasetError(f"{path}: time_zero needs a time column 't'")
+    zero = _quantity(meta["time_zero"], "s", f"{path}: time_zero")
+    if columns["t"][0] < zero:
+        raise DatasetError(f"{path}: time_zero = {meta['time_zero']!r} is after the first time in {csv.name} "
+                           f"({raw['t'][0]:.10g}): t = 0 must not lie after the first sample")
+    columns["t"] = columns["t"] - zero
+    return zero
+
+
+def _check_series(columns, raw, kind, csv) -> None:
+    """Time increases strictly and starts at t >= 0; areas and normal forces are not negative."""
+    if "t" in columns:
+        t = columns["t"]
+        bad = np.nonzero(np.diff(t) <= 0)[0]
+        if bad.size:
+            i = int(bad[0])
+            raise DatasetError(f"{csv}: column 't' must increase strictly; line {_line_of_row(csv, i + 1)} "
+                               f"({raw['t'][i + 1]:g}) does not exceed the line before ({raw['t'][i]:g})")
+        if kind != "contact-area" and t[0] < 0:
+            raise DatasetError(f"{csv}: column 't' line {_line_of_row(csv, 0)}: time {raw['t'][0]:g} is negative; "
+                               "times count from first contact (or release) at t = 0")
+    for col in ("A", "N"):
+        if col in columns and np.any(columns[col] < 0):
+            raise DatasetError(f"{csv}: column '{col}' has negative values")
+
+def _si_of(col, value, where):
+    """A declared noise value of column ``col`` in SI."""
+    return _quantity(value, COLUMN_SI[col], where)
+
+
+#: ``[noise] correlation``: the samples' noise independent ('none', the default) or first-order autoregressive
+#: ('ar1': its coefficient profiled by each fit, inference/noise/ar1.py) or chosen by the data ('arp': AR(p) by BIC
+#: per sampling rate, ARMA(1,1) where the order runs to its cap, fitted with the law; inference/noise/).
+NOISE_CORRELATIONS = ("none", "ar1", "arp")
+
+
+def _correlation(value, path) -> str:
+    if not isinstance(value, str) or value not in NOISE_CORRELATIONS:
+        raise DatasetError(f"{path}: noise.correlation = {value!r}, expected one of {', '.join(NOISE_CORRELATIONS)} "
+                           "(none: independent samples; ar1: first-order autoregressive noise, phi fitted; arp: an "
+                           "AR(p) model chosen by the data)")
+    return value
+
+
+def _names(columns) -> str:
+    """Column names for a one-line message (repr when a name holds odd characters)."""
+    return ", ".join(c if c.isprintable() and "," not in c else repr(c) for c in columns)

@@ -201,32 +201,6 @@ def cells(line: str, sep: str | None) -> list[str]:
     return [p.strip().strip("\"'").strip() for p in parts]
 
 
-def read_record(path, data: bytes, layout: Layout, encoding: str = ""):
-    """The ``velstep.RawRecord`` in the columns of ``layout`` of a record's text (UTF-8 bytes; ``encoding``: what
-    it was read as, when not UTF-8), friction from shear over normal when it has no friction column."""
-    from .velstep import RawRecord, check_record
-
-    tab = read_table(path, data.decode("utf-8"), layout)
-    v, normal = tab.values, layout["normal"]
-    sn = v.get("normal")
-    mu = v.get("friction")
-    if mu is None:
-        bad = np.flatnonzero(~(sn > 0))
-        if bad.size:
-            i = int(bad[0])
-            raise DatasetError(f"{path}: line {tab.lines[i]}: normal={normal.name} is {sn[i] / normal.factor:g} "
-                               f"{normal.unit}; friction is shear / normal, which needs a positive normal "
-                               f"{'force' if normal.force else 'stress'}")
-        mu = v["shear"] / sn
-    stress = "" if normal is None else "normal force" if normal.force else "normal stress"
-    rec = RawRecord(path=path, t=v["time"], x_um=v["displacement"] * 1e6, mu=mu, sn=sn, stress=stress,
-                    first_line=int(tab.lines[0]), lines=tab.lines, encoding=encoding, layout=layout.text(),
-                    notes=tab.notes + ((f"friction = {layout['shear'].name} / {normal.name}",)
-                                       if layout["shear"] else ()))
-    check_record(rec)
-    return rec
-
-
 @attrs.frozen(eq=False)
 class Table:
     """The layout's columns read from a record: each role's values in SI (time s, displacement m, friction -,
@@ -250,17 +224,18 @@ def read_table(path, text: str, layout: Layout) -> Table:
             notes.append(f"{hi} line{'s' * (hi != 1)} before the header skipped (line" +
                          ("s 1 to " if hi > 1 else " ") + f"{hi})")
     else:
-        start = next((i for i, r in enumerate(rows) if r.strip()), 0)
-        sep, index = separator(rows[start]), {}
-        hi = None
+        start, sep, index, hi = 0, None, {}, None
     index.update({c.role: c.position for c in layout.columns if c.position is not None})
     want = [index[c.role] for c in layout.columns]
-    first = _first_data(rows, start, sep, want)
+    first = _first_data(rows, start, sep, want, own=not named)
+    if first is not None and not named:
+        sep = separator(rows[first])
     if first is None:
         raise DatasetError(f"{path}: no data rows" + (f" after the header (line {hi + 1})" if hi is not None else ""))
     skipped = [i + 1 for i in range(start, first) if rows[i].strip()]
     if skipped:
-        notes.append(f"{len(skipped)} row{'s' * (len(skipped) != 1)} of text after the header skipped (line"
+        notes.append(f"{len(skipped)} row{'s' * (len(skipped) != 1)} of text "
+                     f"{'after the header' if hi is not None else 'before the data'} skipped (line"
                      f"{'s' * (len(skipped) != 1)} {skipped[0]}" + (f" to {skipped[-1]})" if len(skipped) > 1 else ")"))
     block, lines = _numbers(path, rows, first, sep, want, layout)
     values = {c.role: block[:, j] * c.factor for j, c in enumerate(layout.columns)}
@@ -302,12 +277,13 @@ def _number(cell: str) -> float:
         return math.nan
 
 
-def _first_data(rows: list[str], start: int, sep, want: list[int]) -> int | None:
-    """The first row from ``start`` whose wanted cells are all finite numbers."""
+def _first_data(rows: list[str], start: int, sep, want: list[int], own: bool = False) -> int | None:
+    """The first row from ``start`` whose wanted cells are all finite numbers (each row split by ``sep``, or by
+    its own separator when ``own``)."""
     for i in range(start, len(rows)):
         if not rows[i].strip():
             continue
-        c = cells(rows[i], sep)
+        c = cells(rows[i], separator(rows[i]) if own else sep)
         if len(c) > max(want) and all(math.isfinite(_number(c[j])) for j in want):
             return i
     return None

@@ -131,8 +131,7 @@ def step_windows(points: list[SteadyPoint], bounds) -> list[tuple[int, int, tupl
 
 
 def _at(raw, i: int) -> str:
-    where = raw.where(i) if hasattr(raw, "where") else f"line {raw.line(i)}"
-    return f"{where} (t = {raw.t[i]:.10g} s)"
+    return f"{raw.where(i)} (t = {raw.t[i]:.10g} s)"
 
 
 def start_note(raw, points: list[SteadyPoint], a: int, held: tuple | None) -> str:

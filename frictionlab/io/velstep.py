@@ -30,50 +30,14 @@ from ..core.errors import DatasetError
 from ..core.files import MAX_CSV_BYTES, read_bytes
 from ..core.names import check_name
 from .layout import cells, separator
-from .segment import MIN_PIECE, Segmentation, segment
+from .rawrecord import LIMITS, MIN_DT, RawRecord, check_record  # noqa: F401  (the reader's names)
+from .segment import Segmentation, segment
 from .segment_noise import last_digit
 
 #: Header names accepted for the four raw columns (case-insensitive; '_' or nothing between words).
 RAW_HEADER = (r"time\(s\)", r"displ(acement)?\(microns\)", r"friction", r"(effective_?)?normal_?stress\(mpa\)")
-#: Smallest time increment of a record [s], and the largest magnitudes read (s, um, -, MPa).
-MIN_DT = 1e-9
 #: The stiffness start [1/m] (0.01 1/um, a typical laboratory value) where friction shows no loading after a step.
 DEFAULT_STIFFNESS = 1e4
-LIMITS = {"time": 1e12, "displacement": 1e12, "friction": 1e3, "normal stress": 1e6}
-
-
-@attrs.frozen(eq=False)
-class RawRecord:
-    """One raw record: time [s], displacement [um, as recorded; ``x`` in m], friction [-], normal stress [Pa]
-    or force [N] (``stress``: what the file's header calls it; ``sn`` None when the record has none), and the
-    line of the file each sample was read from; ``encoding``, ``layout`` (the columns, as ``--columns`` takes
-    them) and ``notes``: how it was read, when not as the steadystate routine writes it."""
-
-    path: Path
-    t: np.ndarray
-    x_um: np.ndarray
-    mu: np.ndarray
-    sn: np.ndarray | None
-    stress: str = "effective normal stress"
-    first_line: int = 2  # line of the first sample when every line after the header holds one
-    lines: np.ndarray | None = None  # line of each sample otherwise
-    encoding: str = ""  # what the text was when not UTF-8, e.g. "UTF-16 (little-endian, without a byte-order mark)"
-    layout: str = ""
-    notes: tuple = ()
-
-    @property
-    def x(self) -> np.ndarray:
-        """Displacement [m]."""
-        return self.x_um * 1e-6
-
-    def line(self, i: int) -> int:
-        """The file's line (1-based) of sample i."""
-        return int(self.lines[i]) if self.lines is not None else self.first_line + int(i)
-
-    def normal_text(self, value: float) -> str:
-        """A mean normal stress [Pa] or force [N] as the description says it: '30 MPa effective normal stress'."""
-        return f"{value / 1e3:.4g} kN {self.stress}" if self.stress == "normal force" else \
-            f"{value / 1e6:.4g} MPa {self.stress}"
 
 
 def read_raw(path, data: bytes | None = None, columns=None) -> RawRecord:
@@ -85,14 +49,14 @@ def read_raw(path, data: bytes | None = None, columns=None) -> RawRecord:
     normal stress that is not positive)."""
     import pandas as pd
 
-    from .layout import decode, parse_columns, read_record
+    from .layout import decode, parse_columns
 
     path = Path(path)
     layout = parse_columns(columns, "columns") if columns is not None else None
     data = read_bytes(path, MAX_CSV_BYTES) if data is None else data
     data, encoding = decode(path, data)
     if layout is not None:
-        return read_record(path, data, layout, encoding)
+        return _read_layout(path, data, layout, encoding)
     head = re.match(rb"(?:[ \t\r\f\v]*\n)*([^\n]*)(?:\n|$)", data)
     header_no = data.count(b"\n", 0, head.start(1)) + 1
     header_text = head.group(1).decode("utf-8", "replace").strip()
@@ -127,6 +91,32 @@ def read_raw(path, data: bytes | None = None, columns=None) -> RawRecord:
     return rec
 
 
+def _read_layout(path, data: bytes, layout, encoding: str = "") -> RawRecord:
+    """The RawRecord in the columns of ``layout`` (io.layout) of a record's text (UTF-8 bytes; ``encoding``: what
+    it was read as, when not UTF-8), friction from shear over normal when it has no friction column."""
+    from .layout import read_table
+
+    tab = read_table(path, data.decode("utf-8"), layout)
+    v, normal = tab.values, layout["normal"]
+    sn = v.get("normal")
+    mu = v.get("friction")
+    if mu is None:
+        bad = np.flatnonzero(~(sn > 0))
+        if bad.size:
+            i = int(bad[0])
+            raise DatasetError(f"{path}: line {tab.lines[i]}: normal={normal.name} is {sn[i] / normal.factor:g} "
+                               f"{normal.unit}; friction is shear / normal, which needs a positive normal "
+                               f"{'force' if normal.force else 'stress'}")
+        mu = v["shear"] / sn
+    stress = "" if normal is None else "normal force" if normal.force else "normal stress"
+    rec = RawRecord(path=path, t=v["time"], x_um=v["displacement"] * 1e6, mu=mu, sn=sn, stress=stress,
+                    first_line=int(tab.lines[0]), lines=tab.lines, encoding=encoding, layout=layout.text(),
+                    notes=tab.notes + ((f"friction = {layout['shear'].name} / {normal.name}",)
+                                       if layout["shear"] else ()))
+    check_record(rec)
+    return rec
+
+
 def _lines(body: str, header_no: int) -> np.ndarray:
     """The line of each non-blank line of ``body`` (which starts on the line after ``header_no``)."""
     return np.array([header_no + 1 + k for k, s in enumerate(body.split("\n")) if s.strip()], dtype=np.int64)
@@ -143,35 +133,6 @@ def _bad_row(path: Path, body: str, lines) -> None:
         if len(values) != 4 or not all(math.isfinite(v) for v in values):
             raise DatasetError(f"{path}: line {no}: expected four finite numbers, got {row.strip()[:60]!r}")
     raise DatasetError(f"{path}: no data rows after the header")
-
-
-def check_record(rec: RawRecord) -> None:
-    """Magnitudes, time increments and normal stress, each refused with the line of the first bad sample."""
-    n = len(rec.t)
-    if n < 2 * MIN_PIECE:
-        raise DatasetError(f"{rec.path}: {n} data rows; a velocity step needs at least {MIN_PIECE} on either side")
-    scale = 1e3 if rec.stress == "normal force" else 1e6
-    cols = (rec.t, rec.x_um, rec.mu, None if rec.sn is None else rec.sn / scale)
-    units = "the record's units (s, um, -, MPa)" if not rec.layout else \
-        f"s, um, -, {'kN' if scale == 1e3 else 'MPa'} (the units they were converted to)"
-    for col, (what, limit) in zip(cols, LIMITS.items()):
-        bad = np.flatnonzero(np.abs(col) > limit) if col is not None else ()
-        if len(bad):
-            i = int(bad[0])
-            raise DatasetError(f"{rec.path}: line {rec.line(i)}: {what} {col[i]:g} is beyond {limit:g} in {units}")
-    dt = np.diff(rec.t)
-    bad = np.flatnonzero(~(dt >= MIN_DT))
-    if bad.size:
-        i = int(bad[0]) + 1
-        what = "does not increase" if dt[i - 1] <= 0 else f"increases by {dt[i - 1]:.3g} s"
-        raise DatasetError(f"{rec.path}: line {rec.line(i)}: time {rec.t[i]:.10g} s {what} after line {rec.line(i - 1)} "
-                           f"({rec.t[i - 1]:.10g} s); time must increase by at least {MIN_DT:g} s a sample")
-    bad = np.flatnonzero(~(rec.sn > 0)) if rec.sn is not None else ()
-    if len(bad):
-        i = int(bad[0])
-        raise DatasetError(f"{rec.path}: line {rec.line(i)}: normal {'force' if scale == 1e3 else 'stress'} must be "
-                           f"positive, got "
-                           f"{cols[3][i]:g} {'kN' if scale == 1e3 else 'MPa'}")
 
 
 # --- what the import finds --------------------------------------------------------------------------
@@ -347,7 +308,6 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
                  command: str = "") -> str:
     """The TOML of one imported window (provenance 'measured')."""
     raw, seg = imp.raw, imp.seg
-    first, last = raw.line(w.a), raw.line(w.b - 1)
     steps = [seg.steps[i] for i in w.steps]
     v_text = " -> ".join(f"{v * 1e6:.4g}" for v in w.velocities)
     stress = float(np.mean(raw.sn[w.a:w.b])) if raw.sn is not None else None
@@ -357,7 +317,7 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
     jumps = [j for j in seg.jumps if w.a < j.index < w.b]
     read = "; ".join(([f"read as {raw.encoding}"] if raw.encoding else []) +
                      ([f"columns {raw.layout}"] if raw.layout else []) + list(raw.notes))
-    method = (f"every sample of lines {first} to {last} of {raw.path.name} ({w.b - w.a} samples"
+    method = (f"every sample of {raw.span(w.a, w.b)} ({w.b - w.a} samples"
               f"{'; ' + read if read else ''}); load-point "
               f"velocities and step time{'s' * (len(steps) > 1)} from an exact piecewise-linear segmentation of the "
               f"displacement (optimal partitioning, PELT, penalty 3 ln n = {seg.penalty:.1f}; "
@@ -369,14 +329,14 @@ def dataset_toml(imp: Imported, w: Window, *, source: str = "", license: str = "
               (f"; the window {w.start_note}" if w.start_note else ""))
     at = f" at {raw.normal_text(stress)}" if stress is not None else ""
     description = (f"Velocity step{'s' * (len(steps) > 1)} {v_text} um/s{at} "
-                   f"(record {raw.path.name}, lines {first} to {last}). MEASURED.")
+                   f"({raw.span(w.a, w.b)}). MEASURED.")
     lines = [
         f"# Imported by `frictionlab datasets import velstep` from {raw.path.name}: measured data; do not edit by hand.",
         f"name = {_q(w.name)}",
         'kind = "spring-slider"',
         'observable = "mu"',
         f"description = {_q(description)}",
-        f'time_zero = "{float(raw.t[w.a])!r} s"   # the record\'s clock at line {first}',
+        f'time_zero = "{float(raw.t[w.a])!r} s"   # the record\'s clock at {raw.where(w.a)}',
         "",
         "[columns]",
         't = "s"',
@@ -423,7 +383,7 @@ def write_csv(fh, imp: Imported, w: Window) -> None:
     """Every sample of the window as t [s, the record's clock], x [um, jumps stitched, to 1e-9 um], mu, written
     in chunks, each number as read (the shortest text that gives it back)."""
     raw = imp.raw
-    fh.write(f"# Every sample of lines {raw.line(w.a)} to {raw.line(w.b - 1)} of {raw.path.name}, as recorded "
+    fh.write(f"# Every sample of {raw.span(w.a, w.b)}, as recorded "
              f"(x: load-point displacement{', jumps stitched' if any(w.a < j.index < w.b for j in imp.seg.jumps) else ''}"
              "); t in the record's clock (time_zero in the TOML is t = 0)\n" + CSV_HEADER + "\n")
     for lo in range(w.a, w.b, 100_000):
@@ -459,7 +419,7 @@ def summary(imp: Imported) -> list[str]:
     rows = [("step", "line", "time [s]", "V before [um/s]", "V after [um/s]", "samples before + after")]
     for i, s in enumerate(seg.steps):
         b = seg.bounds
-        rows.append((str(i + 1), str(raw.line(s.index)), _pm(s.time, s.time_se),
+        rows.append((str(i + 1), raw.where(s.index).removeprefix("line "), _pm(s.time, s.time_se),
                      _pm(imp.velocities[i] * 1e6, seg.velocities_se[i]),
                      _pm(imp.velocities[i + 1] * 1e6, seg.velocities_se[i + 1]),
                      f"{b[i + 1] - b[i]} + {b[i + 2] - b[i + 1]}"))

@@ -16,7 +16,8 @@ import attrs
 import numpy as np
 
 from ..core.errors import DatasetError
-from .velstep import RawRecord, read_raw
+from .rawrecord import RawRecord
+from .velstep import read_raw
 
 
 @attrs.frozen(eq=False)
@@ -30,6 +31,10 @@ class JoinedRecord(RawRecord):
     def where(self, i: int) -> str:
         """'FILE line N' of sample i."""
         return f"{self.files[int(self.source[i])].name} line {self.line(i)}"
+
+    def span(self, a: int, b: int) -> str:
+        """'FILE line A to FILE line B' of samples [a, b)."""
+        return f"{self.where(a)} to {self.where(b - 1)}"
 
 
 def read_joined(paths, columns=None) -> RawRecord:

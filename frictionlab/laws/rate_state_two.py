@@ -2,8 +2,8 @@
 
 mu = mu0 + a ln(V/V0) + b1 ln(V0 theta1/Dc1) + b2 ln(V0 theta2/Dc2), each state evolving by the aging or
 the slip law with its own Dc. Steady state theta_i = Dc_i/|V|, mu_ss = mu0 + (a - b1 - b2) ln(|V|/V0);
-b2 = 0 is the one-state law. The two (b, Dc) pairs are interchangeable: report Dc1 < Dc2 as the
-short and the long evolution."""
+b2 = 0 is the one-state law. The two (b, Dc) pairs are interchangeable: a fit may return them in
+either order, and with b2 near 0 Dc2 is not determined."""
 import numpy as np
 
 from frictionlab.laws.rate_state import V0, V_FLOOR, RateState, aging_rate, slip_rate

@@ -1,6 +1,7 @@
 """The spring-slider's drive: a spring pulled at a load-point velocity that steps, from ``[scene.spring]``."""
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 
 import attrs
@@ -82,22 +83,51 @@ def spring_from_spec(spec, where, q, kind):
         raise SceneError(f"{where}: scene.spring: {exc}") from None
 
 
-def runaway_cause(p, k: float) -> str:
-    """Why a spring-slider of stiffness k [1/m] ran away, from the rate-and-state parameters in p (SI) if any."""
+def runaway_cause(p, k: float, step: str = "", largest: float | None = None) -> str:
+    """Why a spring-slider of stiffness k [1/m] ran away, from the rate-and-state parameters in p (SI) if any, and
+    what to change; ``step``: the load point's velocity step it ran away after ('' if none), ``largest``: the
+    largest step [m/s] from the same velocity found to run through (None: not known)."""
+    mass = "give the slider a mass ([scene.spring] mass) to simulate"
     if not {"a", "b", "Dc"} <= set(p):
-        return "the law's friction falls with slip rate faster than the spring can follow"
+        return f"the law's friction falls with slip rate faster than the spring can follow; {mass} the slip"
     k_c = (p["b"] - p["a"]) / p["Dc"]
+    against = f"the critical stiffness k_c = (b - a)/Dc = {k_c:.4g} /m"
+    if k_c > 0 and math.isclose(k, k_c, rel_tol=CRITICAL_WITHIN):
+        return (f"k = {k:.4g} /m is at {against}, where a perturbation neither grows nor decays; raise [scene.spring] "
+                f"stiffness above k_c (e.g. {2 * k_c:.3g} 1/m), or {mass} the oscillation")
     if k < k_c:
-        return f"k = {k:.4g} /m is below the critical stiffness k_c = (b - a)/Dc = {k_c:.4g} /m: stick-slip"
-    return (f"k = {k:.4g} /m is above the critical stiffness k_c = (b - a)/Dc = {k_c:.4g} /m, which is stable to small "
-            "perturbations only: the slip law runs away after large velocity jumps above k_c (Gu, Rice, Ruina and "
-            "Tse 1984)")
+        return (f"k = {k:.4g} /m is below {against}: stick-slip; raise [scene.spring] stiffness above {k_c:.4g} 1/m "
+                f"(or choose a, b and Dc with (b - a)/Dc below k), or {mass} the stick-slip")
+    return (f"k = {k:.4g} /m is above {against}, which is stable to small perturbations only: a rate-and-state slider "
+            "runs away after large velocity jumps above k_c (Gu, Rice, Ruina and Tse 1984)"
+            + (f", here {step}" if step else "") + "; make the velocity step smaller"
+            + (f" (from the same velocity, steps up to about {largest * 1e6:.2g} um/s run through here)" if largest else "")
+            + f", or {mass} the slip")
 
 
-def runaway_message(law: str, v: float, t: float, velocities, p, k: float, limit: float) -> str:
+#: |k - k_c| / k_c within which a slider is said to sit at its critical stiffness.
+CRITICAL_WITHIN = 1e-3
+
+
+def step_at(t: float, times, velocities) -> str:
+    """'after the load point's step at t = 5 s from 1 to 1e+06 um/s' for the segment of the schedule (start times
+    [s], velocities [m/s]) holding time t [s], or '' where t follows no velocity change."""
+    if times is None or len(times) < 2:
+        return ""
+    j = int(np.searchsorted(np.asarray(times, dtype=float), t, side="right")) - 1
+    if j < 1 or velocities[j] == velocities[j - 1]:
+        return ""
+    return (f"after the load point's step at t = {times[j]:g} s from {velocities[j - 1] * 1e6:.3g} to "
+            f"{velocities[j] * 1e6:.3g} um/s")
+
+
+def runaway_message(law: str, v: float, t: float, velocities, p, k: float, limit: float, times=None,
+                    largest: float | None = None) -> str:
     """The error of a quasi-static slider whose slip rate v [m/s] passed ``limit`` times the fastest load point at
-    time t [s] (load-point velocities [m/s]; law parameters p, SI; stiffness k [1/m])."""
-    return (f"law '{law}' on a spring-slider: the slip rate reached {v:.3g} m/s at t = {t:.6g} s, beyond {limit:g} "
-            f"times the fastest load-point velocity ([scene.spring] velocities, up to {max(velocities):.3g} m/s), as "
-            f"far as the quasi-static model follows a slider: an unstable slider ({runaway_cause(p, k)}); give the "
-            "slider a mass ([scene.spring] mass) to simulate the slip")
+    time t [s] (load-point velocities [m/s] from ``times`` [s]; law parameters p, SI; stiffness k [1/m]; the largest
+    step that runs through, ``runaway_cause``): the stiffness against k_c and what to change first, then how far
+    it ran."""
+    cause = runaway_cause(p, k, step_at(t, times, velocities), largest)
+    return (f"law '{law}' on a spring-slider: an unstable slider: {cause} "
+            f"(its slip rate reached {v:.3g} m/s at t = {t:.6g} s, beyond {limit:g} times the fastest load-point "
+            f"velocity, {max(velocities):.3g} m/s, as far as the quasi-static model follows a slider)")

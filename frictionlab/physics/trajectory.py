@@ -132,7 +132,7 @@ class Trajectory:
         if y not in cols and not (y == "mu" and "load" in cols):
             raise KeyError(f"trajectory has no series '{y}'; it has {', '.join(cols)}")
         values = cols[y] if y in cols else cols["load"]
-        _, ax = figure_axes(ax)
+        _, ax = figure_axes(ax, where="Trajectory.plot")
         tname, tf = time_unit(float(self.t[-1]) if len(self.t) else 0.0)
         shown, factor = unit(y)
         style.setdefault("label", f"{self.law} [{self.solver}]")

@@ -163,7 +163,7 @@ def write_bench(out, result, force: bool = False) -> list[str]:
     """Write PNGs, workprecision.csv, workprecision.md and environment.json into ``out``, whole or not at all."""
     import csv
 
-    from ..core.files import atomic_dir
+    from ..core.outfolder import atomic_dir
 
     written = []
     with atomic_dir(out, force=force) as tmp:

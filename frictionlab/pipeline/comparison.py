@@ -26,13 +26,13 @@ import attrs
 import numpy as np
 
 from ..core.arguments import as_items
-from ..core.errors import FrictionLabError
-from ..inference.equivalence.discrimination import PAIRS, REPLICATES, EquivalenceResult
+from ..core.errors import FrictionLabError, ParameterError
+from ..inference.equivalence.discrimination import REPLICATES, EquivalenceResult
 from ..inference.fitting.fit import FitResult, scene_ranges
 from ..inference.equivalence.margin import MARGIN
 from ..inference.verdicts.ranking import RankRow
 from ..inference.equivalence.transfer import TransferResult
-from ..io.dataset import Dataset, available_names, load_dataset
+from ..io.dataset import Dataset, available_names, check_dataset_like, load_dataset
 from .planning import (  # noqa: F401
     candidates,
     equivalence_pairs,
@@ -43,7 +43,7 @@ from .planning import (  # noqa: F401
 from .perdataset import run_per_dataset
 from .runner import Progress, Run, select
 from .runner import run_stages as run_stages_with
-from .settings import DEFAULT_LAWS, DEFAULT_LAWS_BY_KIND, Settings, default_laws_by_kind, select_laws  # noqa: F401
+from .settings import DEFAULT_LAWS, DEFAULT_LAWS_BY_KIND, Settings, check_pairs, default_laws_by_kind, select_laws  # noqa: F401
 from .stages import STAGES
 from ..core.fpstate import with_own_errstate
 
@@ -252,7 +252,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
             *, free: dict | None = None, equivalence: bool = True, jobs: int = 1,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,
             tolerance: Sequence[float] = (), fit_timeout: float | None = None, replicates: int = REPLICATES,
-            pairs: Sequence = PAIRS, transfer: bool = True, stages: Sequence[str] | None = None,
+            pairs: Sequence | None = None, transfer: bool = True, stages: Sequence[str] | None = None,
             client: Client | None = None, margin: float | str = MARGIN, family: str = "report",
             accuracy: bool = True) -> Comparison:
     """Fit every law to every dataset with every applicable solver, rank, and test the equivalence.
@@ -292,8 +292,9 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
         Time budget of each fit [s], its refits included; a fit past it is a failed row saying so.
     replicates : int
         Replicates per law of the equivalence test's parametric bootstrap.
-    pairs : sequence of (str, str)
-        The pairs of laws to test (default ``equivalence.PAIRS``).
+    pairs : sequence of (str, str) or "LAW:LAW" strings, optional
+        The pairs of laws to test, each two different compared laws, each tested once whatever its order;
+        None: ``equivalence.PAIRS``, those whose laws are both compared.
     transfer : bool, default True
         Run the transfer stage (parameters fitted on one dataset of a group predicting the others).
     stages : sequence of str, optional
@@ -302,9 +303,9 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     client : distributed.Client, optional
         A Dask client: fits, refits, tests and bootstrap run on its workers instead of ``jobs`` local
         processes (the same numbers either way).
-    margin : float or str, default 1
-        The equivalence margin delta: a multiple of each dataset's noise sigma, or a quantity in the
-        observable's unit (``"150 rpm"``).
+    margin : float, str or pint Quantity, default 1
+        The equivalence margin delta: a positive multiple of each dataset's noise sigma, or a positive quantity
+        in the observable's unit (``"150 rpm"``); refused with ``equivalence=False``.
     family : {"report", "group"}, default "report"
         Holm's adjustment over every hypothesis of the report, or within each dataset group only.
     accuracy : bool, default True
@@ -337,11 +338,11 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     settings = Settings(laws=(), solvers=tuple(solvers) if solvers else None,
                         free=scene_ranges(free, "compare: free"), equivalence=equivalence, jobs=jobs, bootstrap=bootstrap, seed=seed,
                         bootstrap_all=bootstrap_all, tolerance=tuple(tolerance), fit_timeout=fit_timeout,
-                        replicates=replicates, pairs=tuple(pairs), transfer=transfer, cluster=cluster_name(client),
+                        replicates=replicates, transfer=transfer, cluster=cluster_name(client),
                         margin=margin, family=family, accuracy=accuracy)
     chosen = select(STAGES, stages)
-    dss = unique_datasets(load_dataset(d) for d in (as_items(datasets, "compare: datasets") if datasets is not None
-                                                    else available_names()))
+    dss = unique_datasets(_dataset(d) for d in (as_items(datasets, "compare: datasets") if datasets is not None
+                                                else available_names()))
     if not dss:
         raise FrictionLabError("compare: no datasets to compare")
     if laws is None:  # the default laws of each dataset kind
@@ -350,8 +351,15 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
                                 by_kind=by_kind)
     else:
         settings = attrs.evolve(settings, laws=select_laws(laws))
+    if pairs is not None:
+        groups = [settings.laws] if laws is not None else list(settings.by_kind.values())
+        settings = attrs.evolve(settings, pairs=check_pairs(pairs, groups))
     if equivalence:
         settings.margin.check(dss)
+    elif not settings.margin.default or pairs is not None:
+        what = f"margin {settings.margin.as_text()!r} applies" if not settings.margin.default else "pairs apply"
+        raise ParameterError(f"compare: {what} to the equivalence tests, which equivalence=False skips; drop one of "
+                             "the two")
     run = _make_run(settings, dss, progress, client)
     settings.check_replicates()
     c = Comparison(laws=settings.laws, datasets=dss, fits=run.plan.skipped_fits, ranking=(), groups=(),
@@ -381,6 +389,12 @@ def _run_stages(c: Comparison, run: Run, stages: list, forced: bool) -> Comparis
     if run.client is not None and any(s.name == "fit" for s in chosen):
         c, chosen = run_per_dataset(c, run, chosen)
     return run_stages_with(c, run, chosen, forced=True)
+
+
+def _dataset(d) -> Dataset:
+    """A dataset argument of compare loaded, or checked still to be what loading made of it (``io.intact``)."""
+    check_dataset_like(d, "compare: datasets")
+    return load_dataset(d).check("compare")
 
 
 def cluster_name(client) -> str:

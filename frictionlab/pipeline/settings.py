@@ -30,6 +30,41 @@ def select_laws(laws: Sequence[str] | None) -> tuple[str, ...]:
     return tuple(dict.fromkeys(get_law(n).name for n in names))
 
 
+def check_pairs(items, groups, where: str = "compare: pairs", laws_option: str = "laws") -> tuple[tuple[str, str], ...]:
+    """The pairs of laws whose equivalence is tested, from ``items``: 'LAW:LAW' strings or (law, law) pairs (one
+    string is one pair). Each names two different registered laws compared together (both in one of ``groups``,
+    sets of law names fitted on the same datasets); a pair named twice, in either order, is tested once (the first
+    order kept: law A's series is tested on the first pair), so that it counts once in the family of hypotheses.
+    A ParameterError (a TypeError for an item that is neither) names ``where`` and the pair."""
+    from ..core.errors import FrictionLabError
+
+    out: dict[frozenset, tuple[str, str]] = {}
+    for item in as_items(items, where):
+        if isinstance(item, str):
+            a, sep, b = item.partition(":")
+            if not sep or not a.strip() or not b.strip() or ":" in b:
+                raise ParameterError(f"{where} {item!r}: expected LAW:LAW, e.g. wear:area-rate")
+        elif isinstance(item, (tuple, list)) and len(item) == 2 and all(isinstance(x, str) for x in item):
+            a, b = item
+        else:
+            raise TypeError(f"{where}: expected pairs of law names, ('wear', 'area-rate') or 'wear:area-rate', got "
+                            f"{type(item).__name__} {item!r:.60}")
+        try:
+            a, b = get_law(a.strip()).name, get_law(b.strip()).name
+        except FrictionLabError as exc:
+            raise ParameterError(f"{where} {item!r}: {exc}") from None
+        if a == b:
+            raise ParameterError(f"{where} {item!r}: a law is always equivalent to itself; name two different laws")
+        if not any({a, b} <= set(g) for g in groups):
+            compared = next((set(g) for g in groups if b in g or a in g), set(groups[0]) if groups else set())
+            missing = [x for x in (a, b) if x not in compared]
+            raise ParameterError(f"{where} {item!r}: {', '.join(missing)} {'is' if len(missing) == 1 else 'are'} not "
+                                 f"among the compared laws ({', '.join(sorted(compared))}); add "
+                                 f"{'it' if len(missing) == 1 else 'them'} to {laws_option}")
+        out.setdefault(frozenset((a, b)), (a, b))
+    return tuple(out.values())
+
+
 def laws_groups(by_kind: dict, kinds) -> list[tuple[tuple[str, ...], list[str]]]:
     """(laws, the dataset kinds they were fitted on) for the kinds present, from a kind -> laws mapping."""
     groups: dict[tuple, list[str]] = {}
@@ -85,7 +120,7 @@ class Settings:
         from ..inference.equivalence.family import FAMILIES
         from ..inference.equivalence.margin import parse_margin
 
-        object.__setattr__(self, "margin", parse_margin(self.margin))
+        object.__setattr__(self, "margin", parse_margin(self.margin, "compare: margin"))
         if self.family not in FAMILIES:
             raise ParameterError(f"compare: family must be one of {', '.join(FAMILIES)}, got {self.family!r}")
         for r in self.tolerance:

@@ -1,6 +1,7 @@
 """The comparison report: one folder, written whole or not at all.
 
-``write_report(comparison, out, force=False, progress=None)`` writes, through ``io.atomic_dir``:
+``write_report(comparison, out, force=False, progress=None)`` writes, through ``core.outfolder.atomic_dir`` (with
+``force``, what the user added to an earlier report folder is kept):
 ``report.md``; a self-contained ``report.html`` (figures embedded, a small inline script sorts
 tables); ``figures/*.png``; ``ranking.csv``; ``results.json`` (schema in ``results.py``).
 
@@ -42,7 +43,7 @@ import attrs
 
 from ..core.arguments import check_type
 from ..core.errors import OutputError
-from ..core.files import atomic_dir
+from ..core.outfolder import atomic_dir
 from ..core.inputs import check_apart
 from ..core.workers import long_run_gc
 from . import (

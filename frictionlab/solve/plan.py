@@ -267,7 +267,7 @@ class Plan(CompliantPatch):
         fastest = QUASI_STATIC_LIMIT * max(s.spring.velocities)
         if abs(v) > fastest:
             raise SolverError(runaway_message(self.law.name, v, float(t), s.spring.velocities, p, s.spring.stiffness,
-                                              QUASI_STATIC_LIMIT))
+                                              QUASI_STATIC_LIMIT, s.spring.times))
         dF = self.slip_rate_partials(p, t, y)
         N = float(s.normal(t))
         return (s.spring.stiffness * N * (float(s.spring.velocity(t)) - v) - float(dF[1:] @ dy[1:])) / dF[0]

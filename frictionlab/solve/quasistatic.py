@@ -110,21 +110,66 @@ def solve(law_code: int, a: float, b: float, Dc_um: float, k_um: float, load: Lo
                               load.velocities, t, float(rtol), float(rtol) * float(a), bool(sensitivities), vmax,
                               m, psi, S, stats)
     if status != kernel.OK:
-        raise SolverError(_failure(status, stats, a, b, Dc_um, k_um, load, law or LAW_NAMES[law_code]))
+        raise SolverError(_failure(status, stats, (law_code, a, b, Dc_um, k_um, float(c)), load, law or LAW_NAMES[law_code]))
     return Solution(m, psi, S if sensitivities else None, int(stats[0]))
 
 
-def _failure(status: int, stats, a, b, Dc_um, k_um, load: Load, law: str) -> str:
+def _failure(status: int, stats, slider: tuple, load: Load, law: str) -> str:
+    """The message of a failed integration; ``slider``: (law code, a, b, Dc [um], k [1/um], c) as integrated."""
     from . import quasistatic_kernel as kernel
 
+    _, a, b, Dc_um, k_um, _ = slider
+
     t = float(stats[3])
-    if status == kernel.RUNAWAY:
-        return runaway_message(law, float(stats[4]) * UM, t, load.velocities * UM,
-                               {"a": a, "b": b, "Dc": Dc_um * UM}, k_um / UM, RUNAWAY)
     if status == kernel.TOO_MANY_STEPS:
         return f"quasi-static slider: more than {kernel.MAX_STEPS} steps by t = {t:.6g} s"
-    return f"quasi-static slider: the step size fell to round-off at t = {t:.6g} s (a, b, Dc, k = {a:g}, {b:g}, " \
-           f"{Dc_um:g} um, {k_um:g} 1/um)"
+    j = int(np.searchsorted(load.times, t, side="right")) - 1
+    before = load.velocities[j - 1] if j >= 1 else load.V1
+    stepped = j >= 1 and load.velocities[j] > before
+    if status == kernel.RUNAWAY:
+        largest = _largest_step(slider, load, j, t) if stepped else None
+        return runaway_message(law, float(stats[4]) * UM, t, load.velocities * UM, {"a": a, "b": b, "Dc": Dc_um * UM},
+                               k_um / UM, RUNAWAY, load.times, None if largest is None else largest * UM)
+    where = f"(a, b, Dc, k = {a:g}, {b:g}, {Dc_um:g} um, {k_um:g} 1/um)"
+    if not stepped:
+        return f"quasi-static slider: the step size fell to round-off at t = {t:.6g} s, at the load-point velocity " \
+               f"{load.velocities[j]:.3g} um/s {where}"
+    works = _largest_step(slider, load, j, t)
+    return (f"quasi-static slider: the load point's step at t = {load.times[j]:g} s from {before:.3g} to "
+            f"{load.velocities[j]:.3g} um/s (a factor {load.velocities[j] / before:.3g}) is beyond what the slider "
+            f"can be integrated through (its step size fell to round-off at t = {t:.6g} s) {where}; "
+            + (f"from {before:.3g} um/s, steps up to about {works:.2g} um/s integrate here: " if works else "")
+            + "use a smaller step, or several smaller ones")
+
+
+def _largest_step(slider: tuple, load: Load, j: int, t_fail: float, tries: int = 10) -> float | None:
+    """The largest velocity [um/s] (to about 1.2 times, in log steps) that segment ``j`` of ``load`` may step to
+    from the velocity before it and integrate through to a little past ``t_fail`` [s]; None if even a small step
+    does not. Only on the way to an error: a few short integrations."""
+    from . import quasistatic_kernel as kernel
+
+    code, a, b, Dc_um, k_um, c = slider
+    before = load.velocities[j - 1]
+    t0 = float(load.times[j])
+
+    def integrates(v: float) -> bool:
+        vel = load.velocities[:j + 1].copy()
+        vel[j] = v
+        end = t0 + max(2.0 * (t_fail - t0), 50.0 * a / (k_um * v))  # past the slider's response to the step
+        trial = Load(load.times[:j + 1].copy(), vel)
+        status = kernel.integrate(code, float(a), float(b), float(Dc_um), float(k_um), c, trial.V1, trial.times,
+                                  trial.velocities, np.array([end]), 1e-8, 1e-8 * float(a), False,
+                                  RUNAWAY * trial.vmax, np.empty(1), np.empty(1), np.empty((0, 4)), np.zeros(5))
+        return status == kernel.OK
+
+    lo, hi = math.log(before), math.log(load.velocities[j])
+    if not integrates(math.exp(lo + 0.01 * (hi - lo))):
+        return None
+    lo += 0.01 * (hi - lo)
+    for _ in range(tries):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if integrates(math.exp(mid)) else (lo, mid)
+    return math.exp(lo)
 
 
 def steady_friction(p, V1_um: float) -> float:

@@ -93,7 +93,7 @@ def simulate_sweep(law: str | FrictionLaw, scenes: Sequence[Scene] | SceneBatch,
     fields = _check_fields(fields)
     if out is None:
         return _streamed(law, jobs, slices, executor, None, reduce, fields)
-    from ..core.files import atomic_dir
+    from ..core.outfolder import atomic_dir
 
     try:
         import pyarrow.parquet

@@ -20,7 +20,9 @@ from ...core.errors import FrictionLabError, ParameterError
 #: The default margin: delta = MARGIN x the noise sigma. Curves closer than one noise sigma (RMS) differ by less
 #: than the scatter of one measurement.
 MARGIN = 1.0
-_MULTIPLE = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*(?:x|×|σ|sigma|s\.d\.)?\s*$")
+#: A multiple of the noise: a number (any sign, inf or nan: refused unless positive and finite), then x, σ or sigma.
+_MULTIPLE = re.compile(r"^\s*([-+]?(?:[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?|inf(?:inity)?|nan))\s*(?:x|×|σ|sigma|s\.d\.)?\s*$",
+                       re.IGNORECASE)
 
 
 @attrs.frozen
@@ -84,31 +86,46 @@ class Margin:
         return self.quantity or f"{self.multiple:g} × σ"
 
 
-def parse_margin(value) -> Margin:
-    """A Margin from what a user gives: a number or '2', '2x', '2 sigma' (a multiple of the noise), or a quantity
-    string with a unit ('150 rpm'). None: the default."""
+#: What a margin may be, said whenever one is refused.
+FORMS = "a positive multiple of the noise (e.g. 2) or a positive quantity in the observable's unit (e.g. '150 rpm')"
+
+
+def parse_margin(value, where: str = "margin") -> Margin:
+    """A Margin from what a user gives: a number or '2', '2x', '2 sigma' (a multiple of the noise), a quantity
+    string with a unit ('150 rpm') or a pint Quantity. None: the default. Anything not positive and finite is
+    refused here, once, naming ``where`` (the parameter or option) and what a margin may be."""
+    import numbers
+
+    from ...core.units import check_one_number, check_text, is_quantity, leading_number
+
     if value is None:
         return Margin()
     if isinstance(value, Margin):
         return value
+    refused = ParameterError(f"{where} must be {FORMS}, got {value!r:.60}")
     if isinstance(value, bool):
-        raise ParameterError(f"margin must be a positive multiple of the noise or a quantity, got {value!r}")
-    if isinstance(value, (int, float)):
+        raise refused
+    if isinstance(value, numbers.Real):
         if not (math.isfinite(value) and value > 0):
-            raise ParameterError(f"margin must be a positive multiple of the noise, got {value!r}")
+            raise refused
         return Margin(float(value))
-    if not isinstance(value, str) or not value.strip():
-        raise ParameterError(f"margin must be a positive multiple of the noise or a quantity, got {value!r}")
-    m = _MULTIPLE.match(value)
-    if m:
-        return parse_margin(float(m.group(1)))
-    from ...core.units import check_text
-
+    if is_quantity(value):
+        if str(value.units) == "dimensionless":
+            return parse_margin(float(value.magnitude), where)
+        value = f"{float(value.magnitude)!r} {value.units}"
+    if not isinstance(value, str):
+        raise TypeError(f"{where}: expected {FORMS}, got {type(value).__name__} {value!r:.60}")
     try:
-        check_text(value, "margin")
+        text = check_text(value, where)
+        m = _MULTIPLE.match(text)
+        if not m:
+            check_one_number(text, where, value)
     except FrictionLabError as exc:
         raise ParameterError(str(exc)) from None
-    return Margin(quantity=value.strip())
+    first = float(m.group(1)) if m else leading_number(text)
+    if first is None or not (math.isfinite(first) and first > 0):
+        raise refused
+    return Margin(first) if m else Margin(quantity=text)
 
 
 def _num(x: float) -> str:

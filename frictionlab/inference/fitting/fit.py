@@ -31,6 +31,7 @@ quantity) raises a one-line FrictionLabError.
 from __future__ import annotations
 
 import math
+import numbers
 import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import TYPE_CHECKING
@@ -57,6 +58,7 @@ from .stats import (
     _stats,
     neg2loglik,
 )
+from ...io.dataset import Dataset, check_dataset_like
 from ...io.noise import ratio_pvalue
 from ..diagnostics.goodness import SHARPEN_BELOW, combine, f_pvalue, goodness
 from ..diagnostics.identifiability import find_structure, jacobian, jacobian_errors, make_verdict
@@ -205,6 +207,10 @@ def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], s
         return FitResult(law=law.name, solver=solver, datasets=names, status=status, reason=reason,
                          wall_time=time.perf_counter() - clock[0], cpu_time=time.thread_time() - clock[1], **kw)
 
+    for d in items:  # a dataset argument as given, and a Dataset still what loading made of it
+        check_dataset_like(d, "fit: datasets", (Target,))
+        if isinstance(d, Dataset):
+            d.check("fit")
     try:
         targets = [d if isinstance(d, Target) else make_target(d, observable, derive) for d in items]
     except SkipDataset as exc:
@@ -216,6 +222,7 @@ def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], s
     fixed, initial = law_values(law, fixed, "fit: fixed"), law_values(law, initial, "fit: initial")
     free = scene_ranges(free, "fit: free")
     _check_arguments(law, fixed, local, initial, rtol, timeout)
+    _check_budget(scan, n_starts, max_nfev)
     if n_params is not None and (isinstance(n_params, bool) or not isinstance(n_params, int) or n_params < 0
                                  or errors):
         raise ParameterError(f"fit: n_params must be a whole number >= 0 given with errors=False, got {n_params!r}")
@@ -339,6 +346,16 @@ def _check_arguments(law, fixed, local, initial, rtol, timeout) -> None:
     if timeout is not None and (isinstance(timeout, bool) or not isinstance(timeout, (int, float))
                                 or not 0 < timeout < math.inf):
         raise ParameterError(f"fit: timeout must be a positive number of seconds, got {timeout!r}")
+
+
+def _check_budget(scan, n_starts, max_nfev) -> None:
+    """scan a whole number >= 0, n_starts >= 1, max_nfev None or >= 1, else a ParameterError naming it."""
+    for name, value, least in (("scan", scan, 0), ("n_starts", n_starts, 1), ("max_nfev", max_nfev, 1)):
+        if value is None and name == "max_nfev":
+            continue
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < least:
+            raise ParameterError(f"fit: {name} must be a whole number, at least {least}"
+                                 + (" (or None: no limit)" if name == "max_nfev" else "") + f", got {value!r:.40}")
 
 
 def _solvers(law, targets, solver: str, rtol) -> list[str] | str:

@@ -7,9 +7,11 @@ differ in kind (a spin, a time, an angle).
 """
 from __future__ import annotations
 
+import numbers
+
 import numpy as np
 
-from ...core.display import axis_label, figure_axes
+from ...core.display import axis_label, check_axes, figure_axes
 
 #: Colours of the candidates, in rank order (colour-blind safe, as the report's).
 COLORS = ("#1b9e77", "#d95f02", "#7570b3", "#e7298a", "#66a61e", "#e6ab02")
@@ -89,7 +91,7 @@ def plot_fit(result, ax=None):
                          f"({result.reason})")
     per = result.per_dataset
     if ax is not None:
-        axes = list(np.ravel(ax)) if hasattr(ax, "__len__") or hasattr(ax, "flat") else [ax]
+        axes = check_axes(ax, "FitResult.plot", many=True)
         if len(axes) != len(per):
             raise ValueError(f"plot: {len(per)} datasets need {len(per)} axes, got {len(axes)}")
         for a, d in zip(axes, per):
@@ -113,10 +115,12 @@ def plot_ranking(panels, ax=None, top: int = 3):
     """Comparison.plot's drawing: ``panels`` is a list of (title, dataset fits of the top-ranked candidates
     with their labels); one column each, data and fits above, residuals below. Returns the Figure, or
     ``ax`` (one Axes per panel: data and fits only) when given."""
+    if isinstance(top, bool) or not isinstance(top, numbers.Integral) or top < 1:
+        raise ValueError(f"Comparison.plot: top: expected a whole number of candidates, at least 1, got {top!r:.40}")
     if not panels:
         raise ValueError("plot: no fitted dataset to draw")
     if ax is not None:
-        axes = list(np.ravel(ax)) if hasattr(ax, "__len__") or hasattr(ax, "flat") else [ax]
+        axes = check_axes(ax, "Comparison.plot", many=True)
         if len(axes) != len(panels):
             raise ValueError(f"plot: {len(panels)} dataset groups need {len(panels)} axes, got {len(axes)}")
         grid = None

@@ -88,8 +88,10 @@ class LawSteps:
         s = self.shared
         if s is None or s.status != "ok":
             return f"{law}: no test: {s.reason if s is not None else 'the shared fit was not run'}"
-        nums = (f"LR = {s.lr:.4g} on {s.dk} degrees of freedom, p = {s.p_value:.2g}; delta-AIC = {s.delta_aic:+.4g}, "
-                f"delta-BIC = {self.delta_bic:+.4g}")
+        full = sum(1 for p in self.steps[0].params.values() if p.key in ("a", "b", "Dc") and p.vary) * (len(self.steps) - 1)
+        held = f", not {full}: a parameter at a bound is not counted" if 0 < s.dk < full else ""
+        nums = (f"LR = {s.lr:.4g} on {s.dk} degrees of freedom{held}, p = {s.p_value:.2g}; delta-AIC = "
+                f"{s.delta_aic:+.4g}, delta-BIC = {self.delta_bic:+.4g}")
         if self.one_set:
             return f"{law}: one set of a, b, Dc describes every step ({nums})"
         return f"{law}: the steps ask for separate a, b, Dc ({nums})"

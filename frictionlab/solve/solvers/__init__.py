@@ -88,7 +88,12 @@ def simulate(law: str | FrictionLaw, scene: Scene | SceneSource, params: Mapping
     law = get_law(law)
     name = "scene"
     fixed = {}
+    if params is not None and not isinstance(params, Mapping):
+        raise TypeError(f"simulate: params: expected a mapping of parameter names to values, got "
+                        f"{type(params).__name__} {params!r:.40}")
     if not isinstance(scene, Scene) and hasattr(scene, "scene") and hasattr(scene, "fixed"):  # a Dataset
+        if hasattr(scene, "check"):
+            scene.check("simulate")  # still what loading made of it
         name = f"dataset '{scene.name}'"
         fixed = {k: v for k, v in scene.fixed.items() if k in law.param_names}
         if scene.kind == "impact-outcome":
@@ -101,7 +106,7 @@ def simulate(law: str | FrictionLaw, scene: Scene | SceneSource, params: Mapping
             t = scene.t
         scene = scene.scene
     if not isinstance(scene, Scene):
-        raise SolverError(f"simulate: expected a Scene or Dataset, got {type(scene).__name__}")
+        raise TypeError(f"simulate: scene: expected a Scene or a Dataset, got {type(scene).__name__} {scene!r:.40}")
     p = law.resolve({**fixed, **(params or {})})
     if t is None:
         t = np.linspace(0.0, scene.duration, n)
