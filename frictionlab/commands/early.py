@@ -47,7 +47,7 @@ def check_datasets(names) -> None:
 
 
 def check_out(path, force: bool) -> None:
-    """OutputError for an output folder that exists, unless --force (``core.files.check_target``)."""
-    from ..core.files import check_target
+    """OutputError for an output folder that exists, unless --force (``core.outfolder.check_target``)."""
+    from ..core.outfolder import check_target
 
     check_target(path, force)
