@@ -118,7 +118,7 @@ def run(args) -> int:
         raise OutputError(f"{args.out}: cannot write: {parent} is not an existing folder")
     check_laws(args.laws, args.load)  # the quick refusals, before the numerics are imported
     check_datasets(args.data or ())
-    check_out(args.out, args.force)
+    check_out(args.out, args.force, args.data or ())
     from ..core.cluster import Waits, check_address, close, connect, quiet_logs
 
     if args.scheduler is not None:

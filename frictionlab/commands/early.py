@@ -46,8 +46,14 @@ def check_datasets(names) -> None:
         raise DatasetError(f"unknown dataset '{name}'; built-in: {builtin} (or give a .toml path)")
 
 
-def check_out(path, force: bool) -> None:
-    """OutputError for an output folder that exists, unless --force (``core.outfolder.check_target``)."""
+def check_out(path, force: bool, data=()) -> None:
+    """OutputError for an output that is, holds or lies inside a dataset file named in ``data`` (and its CSV), or
+    a folder that exists, unless --force (``core.inputs.check_apart``, ``core.outfolder.check_target``)."""
+    import os
+
+    from ..core.inputs import check_apart
     from ..core.outfolder import check_target
 
+    files = [p for d in data if str(d).endswith(".toml") for p in (str(d), str(d)[:-5] + ".csv") if os.path.lexists(p)]
+    check_apart(path, files)
     check_target(path, force)

@@ -35,7 +35,7 @@ def check_host_port(loc: str, where: str) -> tuple[str, int]:
     else:
         host, colon, port = loc.rpartition(":")
         if not colon:
-            raise ParameterError(f"{where}: no port; expected PROTOCOL://HOST:PORT ({EXAMPLE})")
+            raise ParameterError(f"{where}: expected PROTOCOL://HOST:PORT, got no port ({EXAMPLE})")
         if ":" in host or "[" in host or "]" in host:
             raise ParameterError(f"{where}: more than one ':' before the port; an IPv6 address goes in brackets, like "
                                  "tcp://[::1]:8786")

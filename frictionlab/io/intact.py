@@ -12,7 +12,7 @@ import numbers
 
 import numpy as np
 
-from ..core.errors import DatasetError
+from ..core.errors import DatasetError, ParameterError
 from ..core.units import MAX_SI
 
 def check_intact(ds, where: str) -> None:
@@ -37,13 +37,18 @@ def check_intact(ds, where: str) -> None:
                                f"must have one length {after}")
         if arr.size and not -MAX_SI <= arr.min() <= arr.max() <= MAX_SI:  # min and max are NaN if any value is
             i = int(np.argmax(~(np.abs(arr) <= MAX_SI)))
+            if not math.isfinite(arr[i]):
+                raise DatasetError(f"{name}: column {col} holds a value that is not a finite number in row {i + 1} "
+                                   f"{after}")
             raise DatasetError(f"{name}: column {col!r} value {i} is {arr[i]:.3g} in SI units, beyond the accepted "
-                               f"magnitude {MAX_SI:g} (or not finite) {after}")
+                               f"magnitude {MAX_SI:g} {after}")
     if ds.observable not in columns:
         raise DatasetError(f"{name}: the observable {ds.observable!r} is no longer among its columns {after}")
     t = columns.get("t")
     if t is not None and n > 1 and not (t[1:] > t[:-1]).all():
-        raise DatasetError(f"{name}: column 't' no longer increases strictly {after}")
+        i = int(np.argmax(~(t[1:] > t[:-1]))) + 1
+        what = "must not decrease" if t[i] < t[i - 1] else "must increase strictly; it repeats a time"
+        raise DatasetError(f"{name}: column t {what} (row {i + 1}) {after}")
     for table, values in (("noise", ds.noise), ("fixed", ds.fixed)):
         if not isinstance(values, dict):
             raise DatasetError(f"{name}: {table} is {type(values).__name__}, expected a dict {after}")
@@ -51,4 +56,5 @@ def check_intact(ds, where: str) -> None:
             ok = isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_)) and (
                 math.isfinite(v) or (table == "noise" and ds.noise_kind == "none" and math.isnan(v)))
             if not ok:
-                raise DatasetError(f"{name}: {table}.{key} = {v!r:.40} is not a finite number in SI units {after}")
+                error = ParameterError if table == "fixed" else DatasetError
+                raise error(f"{name}: [{table}] {key} = {v!r:.40} is not a finite number in SI units {after}")
