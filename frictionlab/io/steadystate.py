@@ -6,8 +6,9 @@ the slip after the step, approaches the steady slope S1 (the background trend) o
 the first window start where it does is the first new steady-state point, and [point, point + LS2] the window
 of the linear detrend. Here, for each sliding piece of the load-point history (between two steps):
 
-* S1 is the piece's own steady slope: the line through its second half (the background trend at this velocity,
-  which on a real gouge differs from one velocity to the next);
+* S1 is the piece's own steady slope: the median slope of the windows in its second half (the background trend
+  at this velocity, which on a real gouge differs from one velocity to the next; a median, so that a sample at
+  the piece's edge that already shows the next step does not tilt it);
 * the threshold is not the routine's fixed 5e-7 1/um but the scatter the data show: three times the robust
   spread (1.4826 MAD) of S2 over the windows of the piece's second half, so that a record is judged by its own
   noise and wander (a fixed threshold is crossed by chance on a noisy record and never met on a wandering one);
@@ -79,22 +80,23 @@ def steady_point(x_um, mu, a: int, e: int, piece: int) -> SteadyPoint:
         s2, _ = _slopes(x, y, starts, length)
         tail = s2[starts >= half]
         if tail.size >= 3:
-            spread = 1.4826 * float(np.median(np.abs(tail - np.median(tail))))
+            steady = float(np.median(tail))  # S1 as the second half's windows give it: a sample at the piece's
+            spread = 1.4826 * float(np.median(np.abs(tail - steady)))  # edge does not tilt it as it tilts a line
             thr = SPREAD * spread
-            out = np.abs(s2 - s1) > thr
+            out = np.abs(s2 - steady) > thr
             # sustained: no window starting within the next `length` of slip is out
             reach = np.searchsorted(x[starts], x[starts] + length)
             bad = np.concatenate([[0], np.cumsum(out)])
             ok = (bad[np.minimum(reach, starts.size)] - bad[starts]) == 0
             if ok.any():
                 i = int(np.argmax(ok))
-                found.append((float(x[i] - x[0]), length, thr, a + i))
+                found.append((float(x[i] - x[0]), length, thr, a + i, steady))
         length *= 2
     if not found:
         return SteadyPoint(piece, None, slope=s1, slip=slip,
                            why="the slope of friction never settles to the piece's own steady slope")
-    at, length, thr, index = max(found)
-    return SteadyPoint(piece, index, length, s1, thr, at)
+    at, length, thr, index, steady = max(found)
+    return SteadyPoint(piece, index, length, steady, thr, at)
 
 
 def steady_points(x_um, mu, bounds, velocities) -> list[SteadyPoint]:
