@@ -17,7 +17,7 @@ from ..core.units import MAX_SI
 
 def check_intact(ds, where: str) -> None:
     """Refuse a Dataset ``ds`` changed after loading: every column a finite 1-D float array of one length, within
-    the accepted magnitude (``units.MAX_SI``), the observable among them, the time strictly increasing; every
+    the accepted magnitude (``units.MAX_SI``), the observable among them, the time never decreasing; every
     noise and fixed value a real number (finite, or NaN for a noise-free reconstruction's sigma)."""
     name = f"{where}: dataset '{ds.name}'"
     after = "(changed after loading? load the dataset again)"
@@ -45,10 +45,9 @@ def check_intact(ds, where: str) -> None:
     if ds.observable not in columns:
         raise DatasetError(f"{name}: the observable {ds.observable!r} is no longer among its columns {after}")
     t = columns.get("t")
-    if t is not None and n > 1 and not (t[1:] > t[:-1]).all():
-        i = int(np.argmax(~(t[1:] > t[:-1]))) + 1
-        what = "must not decrease" if t[i] < t[i - 1] else "must increase strictly; it repeats a time"
-        raise DatasetError(f"{name}: column t {what} (row {i + 1}) {after}")
+    if t is not None and n > 1 and not (t[1:] >= t[:-1]).all():  # a case resample repeats times
+        i = int(np.argmax(~(t[1:] >= t[:-1]))) + 1
+        raise DatasetError(f"{name}: column t must not decrease (row {i + 1}) {after}")
     for table, values in (("noise", ds.noise), ("fixed", ds.fixed)):
         if not isinstance(values, dict):
             raise DatasetError(f"{name}: {table} is {type(values).__name__}, expected a dict {after}")
