@@ -107,7 +107,7 @@ def test_workers_are_prepared_once_per_warm_function():
             assert ran == f"{pid}," and pid not in workers
         for modules in worker_modules.values():  # the worker imports no more of frictionlab than passing tasks on
             assert set(modules) <= {"frictionlab", "frictionlab.core", "frictionlab.core.errors",
-                                    "frictionlab.core.taskhost", "frictionlab.core.cluster",
+                                    "frictionlab.core.taskhost", "frictionlab.core.cluster", "frictionlab.core.address",
                                     "frictionlab.core.workers"}, modules
 
 

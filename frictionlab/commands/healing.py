@@ -13,9 +13,9 @@ def add_parser(sub):
                                "re-sliding; the healing per decade of hold time with its 95% interval; beside it "
                                "each state law's table from the law fitted to the whole record (and, for a "
                                "synthetic record, from its generating law and parameters).",
-                   examples="""  frictionlab datasets rebuild --slide-hold-slide
-  frictionlab healing examples/slide-hold-slide/kt-slide-hold-slide.toml
-  frictionlab healing data/shs.toml --laws rate-state-aging""")
+                   examples="""  frictionlab healing examples/slide-hold-slide/kt-slide-hold-slide.toml
+  frictionlab healing data/shs.toml --laws rate-state-aging
+  frictionlab datasets rebuild --slide-hold-slide    # the synthetic record again, from its generator""")
     p.add_argument("dataset", metavar="DATASET", help="built-in dataset name or TOML path")
     p.add_argument("--laws", "--law", action=ListAction, default=[], metavar="NAME",
                    help="state laws to fit and predict with (default: every registered state law the velocity-step "

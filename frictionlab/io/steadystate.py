@@ -33,6 +33,8 @@ import numpy as np
 MIN_WINDOW = 50.0
 #: Multiples of the robust spread of S2 that set the threshold on a wandering record.
 SPREAD = 3.0
+#: A threshold below this [1/um] is friction flat to its last digits: said so, not quoted.
+FLAT = 1e-9
 
 
 @attrs.frozen
@@ -142,9 +144,10 @@ def start_note(raw, points: list[SteadyPoint], a: int, held: tuple | None) -> st
     p = max((q for q in points if q.found and q.index <= a), key=lambda q: q.index, default=None)
     if p is None:
         return f"starts at the record's first sample, {_at(raw, a)}: no steady state found before it"
+    settles = (f"stays within {p.threshold:.2g} 1/um of its steady slope {p.slope:.2g} 1/um" if p.threshold >= FLAT
+               else "stays at its steady slope, friction flat to its last digits")  # no slope of 1e-18 1/um quoted
     test = (f"the first new steady-state point of the piece at {_at(raw, p.index)}, {p.slip:.4g} um into it: friction's "
-            f"slope over {p.window:g} um windows stays within {p.threshold:.2g} 1/um of its steady slope "
-            f"{p.slope:.2g} 1/um from there on")
+            f"slope over {p.window:g} um windows {settles} from there on")
     text = f"starts at {_at(raw, a)}, at steady state: " + (test if a == p.index else
                                                             f"in the steady part after {test}")
     if held is not None and len(held) > 1:
