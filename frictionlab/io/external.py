@@ -29,7 +29,7 @@ from ..core.errors import DatasetError
 from ..core.files import MAX_CSV_BYTES, MAX_TOML_BYTES, read_bytes
 
 #: Bump when the importer's output changes: cached imports of an older importer are imported again.
-IMPORTER = "velstep-5"
+IMPORTER = "velstep-6"
 
 _STEADYSTATE = dict(
     format="velstep", license="MIT",

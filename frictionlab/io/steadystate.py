@@ -6,9 +6,9 @@ the slip after the step, approaches the steady slope S1 (the background trend) o
 the first window start where it does is the first new steady-state point, and [point, point + LS2] the window
 of the linear detrend. Here, for each sliding piece of the load-point history (between two steps):
 
-* S1 is the piece's own steady slope: the median slope of the windows in its second half (the background trend
-  at this velocity, which on a real gouge differs from one velocity to the next; a median, so that a sample at
-  the piece's edge that already shows the next step does not tilt it);
+* S1 is the piece's own steady slope: the line through its second half but its last EDGE samples (the background
+  trend at this velocity, which on a real gouge differs from one velocity to the next; a sample at the piece's
+  edge may already show the next step, and one such sample tilts a line);
 * the threshold is not the routine's fixed 5e-7 1/um but the scatter the data show: three times the robust
   spread (1.4826 MAD) of S2 over the windows of the piece's second half, so that a record is judged by its own
   noise and wander (a fixed threshold is crossed by chance on a noisy record and never met on a wandering one);
@@ -33,6 +33,8 @@ import numpy as np
 MIN_WINDOW = 50.0
 #: Multiples of the robust spread of S2 that set the threshold on a wandering record.
 SPREAD = 3.0
+#: Samples at a piece's end left out of its steady slope.
+EDGE = 3
 #: A threshold below this [1/um] is friction flat to its last digits: said so, not quoted.
 FLAT = 1e-9
 
@@ -73,7 +75,8 @@ def steady_point(x_um, mu, a: int, e: int, piece: int) -> SteadyPoint:
         return SteadyPoint(piece, None, why=f"{x.size} samples, {slip:.4g} um of slip: too short for a steady-state "
                                             "window")
     half = x.size // 2
-    s1 = float(np.polyfit(x[half:] - x[half], y[half:], 1)[0])
+    edge = x.size - EDGE  # the piece's last samples may already show the next step (a kink between two samples)
+    s1 = float(np.polyfit(x[half:edge] - x[half], y[half:edge], 1)[0])
     found = []
     length = min(MIN_WINDOW, slip / 16)
     while length <= slip / 8:
@@ -82,8 +85,8 @@ def steady_point(x_um, mu, a: int, e: int, piece: int) -> SteadyPoint:
         s2, _ = _slopes(x, y, starts, length)
         tail = s2[starts >= half]
         if tail.size >= 3:
-            steady = float(np.median(tail))  # S1 as the second half's windows give it: a sample at the piece's
-            spread = 1.4826 * float(np.median(np.abs(tail - steady)))  # edge does not tilt it as it tilts a line
+            steady = s1
+            spread = 1.4826 * float(np.median(np.abs(tail - np.median(tail))))
             thr = SPREAD * spread
             out = np.abs(s2 - steady) > thr
             # sustained: no window starting within the next `length` of slip is out
