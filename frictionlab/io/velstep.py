@@ -30,7 +30,7 @@ from ..core.errors import DatasetError
 from ..core.files import MAX_CSV_BYTES, read_bytes
 from ..core.names import check_name
 from .layout import cells, separator
-from .rawrecord import LIMITS, MIN_DT, RawRecord, check_record  # noqa: F401  (the reader's names)
+from .rawrecord import RawRecord, check_record
 from .segment import Segmentation, segment
 from .segment_noise import last_digit
 
@@ -45,8 +45,8 @@ def read_raw(path, data: bytes | None = None, columns=None) -> RawRecord:
     or in the layout ``columns`` gives (``"time=NAME UNIT, displacement=NAME UNIT, friction=NAME"``, or with
     ``shear=NAME UNIT, normal=NAME UNIT`` instead of friction: see ``io.layout``); UTF-8 or UTF-16 text. A
     one-line DatasetError (UnitError, ParameterError for ``columns``) naming the file and line on bad content (a
-    bad number, a missing column, time that does not increase by at least MIN_DT, magnitudes beyond LIMITS, a
-    normal stress that is not positive)."""
+    bad number, a missing column, time that does not increase by at least ``rawrecord.MIN_DT``, magnitudes
+    beyond ``rawrecord.LIMITS``, a normal stress that is not positive)."""
     import pandas as pd
 
     from .layout import decode, parse_columns
