@@ -5,8 +5,9 @@ For the built-in one-state rate-and-state laws (aging, slip, PRZ, Nagata) on a s
 general plan (``solve.plan``) differentiates the force numerically at every right-hand-side call. Here the slider is
 written as the rate-and-state literature writes it (Marone 1998; rsfmodel): m = mu - mu_ss(V1) and
 psi = ln(V1 theta / Dc) (PRZ: ln(V1 theta / (2 Dc))), in um and s, with V0 = V1 (the first load-point velocity)
-and steady state there at t = 0, integrated by a compiled implicit method with its analytic Jacobian through every step and hold of the
-load point (``quasistatic_kernel``), optionally with the forward sensitivities of m to (a, b, Dc, k).
+and steady state there at t = 0, integrated by a compiled implicit method with its analytic Jacobian through
+every step and hold of the load point (``quasistatic_kernel``), optionally with the forward sensitivities of m
+to (a, b, Dc, k).
 
 The friction is the log form mu = mu0 + a ln(V/V0) + b ln(V0 theta/Dc) (V0 = 1 um/s, the law's mu0), equal to
 the laws' regularized form a asinh(V/(2 V0) exp(psi/a)) to relative exp(-2 mu/a) (1e-50 at laboratory
@@ -110,11 +111,11 @@ def solve(law_code: int, a: float, b: float, Dc_um: float, k_um: float, load: Lo
                               load.velocities, t, float(rtol), float(rtol) * float(a), bool(sensitivities), vmax,
                               m, psi, S, stats)
     if status != kernel.OK:
-        raise SolverError(_failure(status, stats, a, b, Dc_um, k_um, load, law or LAW_NAMES[law_code]))
+        raise SolverError(_failure(status, stats, a, b, Dc_um, k_um, load, law or LAW_NAMES[law_code], law_code, c))
     return Solution(m, psi, S if sensitivities else None, int(stats[0]))
 
 
-def _failure(status: int, stats, a, b, Dc_um, k_um, load: Load, law: str) -> str:
+def _failure(status: int, stats, a, b, Dc_um, k_um, load: Load, law: str, code: int, c: float) -> str:
     from . import quasistatic_kernel as kernel
 
     t = float(stats[3])
@@ -124,14 +125,14 @@ def _failure(status: int, stats, a, b, Dc_um, k_um, load: Load, law: str) -> str
     before = load.velocities[j - 1] if j >= 1 else load.V1
     stepped = j >= 1 and load.velocities[j] > before
     if status == kernel.RUNAWAY:
-        largest = _largest_step(LAWS.get(law, 0), a, b, Dc_um, k_um, load, j, t) if stepped else None
+        largest = _largest_step(code, a, b, Dc_um, k_um, c, load, j, t) if stepped else None
         return runaway_message(law, float(stats[4]) * UM, t, load.velocities * UM, {"a": a, "b": b, "Dc": Dc_um * UM},
                                k_um / UM, RUNAWAY, load.times, None if largest is None else largest * UM)
     where = f"(a, b, Dc, k = {a:g}, {b:g}, {Dc_um:g} um, {k_um:g} 1/um)"
     if not stepped:
         return f"quasi-static slider: the step size fell to round-off at t = {t:.6g} s, at the load-point velocity " \
                f"{load.velocities[j]:.3g} um/s {where}"
-    works = _largest_step(LAWS.get(law, 0), a, b, Dc_um, k_um, load, j, t)
+    works = _largest_step(code, a, b, Dc_um, k_um, c, load, j, t)
     return (f"quasi-static slider: the load point's step at t = {load.times[j]:g} s from {before:.3g} to "
             f"{load.velocities[j]:.3g} um/s (a factor {load.velocities[j] / before:.3g}) is beyond what the slider "
             f"can be integrated through (its step size fell to round-off at t = {t:.6g} s) {where}; "
@@ -139,10 +140,10 @@ def _failure(status: int, stats, a, b, Dc_um, k_um, load: Load, law: str) -> str
             + "use a smaller step, or several smaller ones")
 
 
-def _largest_step(code: int, a, b, Dc_um, k_um, load: Load, j: int, t_fail: float, tries: int = 10) -> float | None:
+def _largest_step(code: int, a, b, Dc_um, k_um, c, load: Load, j: int, t_fail: float, tries: int = 10) -> float | None:
     """The largest velocity [um/s] (to about 1.2 times, in log steps) that segment ``j`` of ``load`` may step to
     from the velocity before it and integrate through to a little past ``t_fail`` [s]; None if even a small step
-    does not. Only on the way to an error: a few short integrations."""
+    does not (c: Nagata's constant). Only on the way to an error: a few short integrations."""
     from . import quasistatic_kernel as kernel
 
     before = load.velocities[j - 1]
@@ -153,7 +154,7 @@ def _largest_step(code: int, a, b, Dc_um, k_um, load: Load, j: int, t_fail: floa
         vel[j] = v
         end = t0 + max(2.0 * (t_fail - t0), 50.0 * a / (k_um * v))  # past the slider's response to the step
         trial = Load(load.times[:j + 1].copy(), vel)
-        status = kernel.integrate(code, float(a), float(b), float(Dc_um), float(k_um), trial.V1, trial.times,
+        status = kernel.integrate(code, float(a), float(b), float(Dc_um), float(k_um), float(c), trial.V1, trial.times,
                                   trial.velocities, np.array([end]), 1e-8, 1e-8 * float(a), False,
                                   RUNAWAY * trial.vmax, np.empty(1), np.empty(1), np.empty((0, 4)), np.zeros(5))
         return status == kernel.OK
