@@ -50,12 +50,11 @@ def test_sdirk4_coefficients_have_order_4_and_an_order_3_embedding():
 @pytest.mark.parametrize("law", [kernel.AGING, kernel.SLIP, kernel.PRZ, kernel.NAGATA])
 def test_kernel_jacobian_and_parameter_derivatives_match_finite_differences(law):
     p = dict(a=0.009, b=0.011, Dc=7.0, k=0.008, c=2.0, V1=3.0, vlp=10.0)
-    f, J, Fp = np.zeros(2), np.zeros((2, 2)), np.zeros((2, 4))
+    f, J, Fp = np.zeros(2), np.zeros((2, 2)), np.zeros((2, 5))
 
-    def rates(m, psi, a=p["a"], b=p["b"], Dc=p["Dc"], k=p["k"]):
+    def rates(m, psi, a=p["a"], b=p["b"], Dc=p["Dc"], k=p["k"], c=p["c"]):
         out = np.zeros(2)
-        kernel.rates(law, a, b, Dc, k, p["c"], p["V1"], p["vlp"], m, psi, out, np.zeros((2, 2)), np.zeros((2, 4)),
-                     False)
+        kernel.rates(law, a, b, Dc, k, c, p["V1"], p["vlp"], m, psi, out, np.zeros((2, 2)), np.zeros((2, 5)), False)
         return out
 
     y = (0.004, -0.3)
@@ -65,10 +64,11 @@ def test_kernel_jacobian_and_parameter_derivatives_match_finite_differences(law)
         e = np.eye(2)[j] * h
         fd = (rates(y[0] + e[0], y[1] + e[1]) - rates(y[0] - e[0], y[1] - e[1])) / (2 * h)
         assert J[:, j] == pytest.approx(fd, rel=1e-6, abs=1e-9)
-    for j, name in enumerate(("a", "b", "Dc", "k")):
+    for j, name in enumerate(("a", "b", "Dc", "k", "c")):  # c: Nagata's (no effect on the other laws)
         hh = 1e-6 * p[name]
         up, dn = rates(*y, **{name: p[name] + hh}), rates(*y, **{name: p[name] - hh})
         assert Fp[:, j] == pytest.approx((up - dn) / (2 * hh), rel=1e-5, abs=1e-9)
+    assert (law == kernel.NAGATA) == (abs(Fp[1, 4]) > 0)
     assert quasistatic.LAWS == {"rate-state-aging": kernel.AGING, "rate-state-slip": kernel.SLIP,
                                 "rate-state-prz": kernel.PRZ, "rate-state-nagata": kernel.NAGATA}
 
@@ -82,13 +82,15 @@ def test_sensitivities_are_the_derivatives_of_the_computed_solution(law):
     sol = quasistatic.solve(code, *p, load, t, 1e-11, sensitivities=True, c=1.5)
     assert np.array_equal(sol.m, quasistatic.solve(code, *p, load, t, 1e-11, c=1.5).m)  # S does not steer the steps
     S = sol.S
-    for j in range(4):
+    assert S.shape[1] == (5 if law == "rate-state-nagata" else 4)  # Nagata's: dm/dc in the fifth column
+    p = np.append(p, 1.5)
+    for j in range(S.shape[1]):
         h = 1e-6 * p[j]
         up, dn = p.copy(), p.copy()
         up[j] += h
         dn[j] -= h
-        fd = (quasistatic.solve(code, *up, load, t, 1e-11, c=1.5).m
-              - quasistatic.solve(code, *dn, load, t, 1e-11, c=1.5).m) / (2 * h)
+        fd = (quasistatic.solve(code, *up[:4], load, t, 1e-11, c=up[4]).m
+              - quasistatic.solve(code, *dn[:4], load, t, 1e-11, c=dn[4]).m) / (2 * h)
         assert np.max(np.abs(S[:, j] - fd)) <= 1e-4 * np.max(np.abs(fd))
 
 

@@ -6,7 +6,8 @@ general plan (``solve.plan``) differentiates the force numerically at every righ
 written as the rate-and-state literature writes it (Marone 1998; rsfmodel): m = mu - mu_ss(V1) and
 psi = ln(V1 theta / Dc) (PRZ: ln(V1 theta / (2 Dc))), in um and s, with V0 = V1 (the first load-point velocity)
 and steady state there at t = 0, integrated by a compiled implicit method with its analytic Jacobian through every step and hold of the
-load point (``quasistatic_kernel``), optionally with the forward sensitivities of m to (a, b, Dc, k).
+load point (``quasistatic_kernel``), optionally with the forward sensitivities of m to (a, b, Dc, k) (and to
+Nagata's c).
 
 The friction is the log form mu = mu0 + a ln(V/V0) + b ln(V0 theta/Dc) (V0 = 1 um/s, the law's mu0), equal to
 the laws' regularized form a asinh(V/(2 V0) exp(psi/a)) to relative exp(-2 mu/a) (1e-50 at laboratory
@@ -26,9 +27,11 @@ from ..physics.spring import runaway_message
 #: ``PRZ``, ``NAGATA``; the kernel, which imports numba, is loaded on the first solve).
 LAWS = {"rate-state-aging": 0, "rate-state-slip": 1, "rate-state-prz": 2, "rate-state-nagata": 3}
 LAW_NAMES = {code: name for name, code in LAWS.items()}
-#: The laws whose parameters are exactly (mu0, a, b, Dc): the kernel's sensitivities cover them all (the
-#: velocity-step fit, ``inference.velstep.fit``); Nagata's c has none.
-FITTED = frozenset({"rate-state-aging", "rate-state-slip", "rate-state-prz"})
+#: The laws the velocity-step fit serves (``inference.velstep.fit``): the kernel's sensitivities cover all their
+#: parameters, (mu0, a, b, Dc) and Nagata's c.
+FITTED = frozenset({"rate-state-aging", "rate-state-slip", "rate-state-prz", "rate-state-nagata"})
+#: Law parameters beyond (mu0, a, b, Dc) with a sensitivity column, by law code (after a, b, Dc, k).
+EXTRA = {3: ("c",)}
 #: Reference slip rate V0 of the laws' mu0 [um/s] (frictionlab/laws/rate_state.py: 1e-6 m/s).
 V0_UM = 1.0
 #: A quasi-static slider has run away once its slip rate exceeds this multiple of the fastest load point
@@ -85,7 +88,8 @@ class Load:
 @attrs.frozen
 class Solution:
     """m = mu - mu_ss(V1) [-] and psi = ln(V1 theta/Dc) [-] at the requested times; ``S``: dm/d(a, b, Dc, k) with
-    Dc in um and k in 1/um (None unless asked); ``steps``: accepted steps."""
+    Dc in um and k in 1/um, then dm/d of the law's ``EXTRA`` parameters (None unless asked); ``steps``: accepted
+    steps."""
 
     m: np.ndarray
     psi: np.ndarray
@@ -103,7 +107,7 @@ def solve(law_code: int, a: float, b: float, Dc_um: float, k_um: float, load: Lo
     t = np.ascontiguousarray(t, dtype=float)
     n = t.size
     m, psi = np.empty(n), np.empty(n)
-    S = np.empty((n, 4)) if sensitivities else np.empty((0, 4))
+    S = np.empty((n, 4 + len(EXTRA.get(law_code, ())))) if sensitivities else np.empty((0, 4))
     stats = np.zeros(5)
     vmax = RUNAWAY * load.vmax
     status = kernel.integrate(law_code, float(a), float(b), float(Dc_um), float(k_um), float(c), load.V1, load.times,

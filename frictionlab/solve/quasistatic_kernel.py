@@ -13,12 +13,12 @@ first load-point velocity and the slider in steady state there at t = 0 (m = psi
 
 Integrated by SDIRK4 (Hairer and Wanner, Solving ODEs II, Table IV.6.5: 5 stages, order 4, L-stable,
 stiffly accurate, embedded order 3), each stage by Newton's method on the analytic 2 x 2 Jacobian, restarted
-at every load-point step. The forward sensitivities S = d(m, psi)/d(a, b, Dc, k) are the exact derivatives of
+at every load-point step. The forward sensitivities S = d(m, psi)/d(a, b, Dc, k) (and for Nagata's law to c, a
+fifth column) are the exact derivatives of
 the discrete scheme (each stage's equation differentiated: (I - h g J) K^S = J (S + h sum a K^S) + f_p, the
 same matrix as the stage's Newton iteration), so the least-squares Jacobian is that of the computed solution.
 Outputs at the sample times come from the cubic Hermite interpolant of each step (m, its rate and their
-sensitivities: the interpolated sensitivity is the derivative of the interpolated m). Nagata's c is a constant of
-the integration (no sensitivity to it).
+sensitivities: the interpolated sensitivity is the derivative of the interpolated m).
 
 Module-level functions compiled by numba with an on-disk cache (``cache=True``) when numba imports; otherwise
 the same functions run as Python (correct, about a hundred times slower).
@@ -48,7 +48,7 @@ E0, E1, E2, E3, E4 = 25.0 / 24.0 - 59.0 / 48.0, -49.0 / 48.0 + 17.0 / 96.0, 125.
 @jit
 def rates(law, a, b, Dc, k, cn, V1, vlp, m, psi, f, J, Fp, want_fp):
     """Fill f = (dm/dt, dpsi/dt), J = d f / d(m, psi) and (want_fp) Fp = d f / d(a, b, Dc, k) at (m, psi) (cn:
-    Nagata's c); return the slip rate V [um/s] (inf where ln(V/V1) exceeds MAX_EXPONENT or psi is beyond
+    Nagata's c; where Fp has a fifth column, d f / d c there); return the slip rate V [um/s] (inf where ln(V/V1) exceeds MAX_EXPONENT or psi is beyond
     range)."""
     lnE = (m - b * psi) / a
     if not (lnE < MAX_EXPONENT) or not (-psi < MAX_EXPONENT) or (law == PRZ and not (psi + 2.0 * lnE < MAX_EXPONENT)):
@@ -83,6 +83,8 @@ def rates(law, a, b, Dc, k, cn, V1, vlp, m, psi, f, J, Fp, want_fp):
         Fp[1, 1] = -dVb / Dc
     Fp[1, 2] = -f[1] / Dc  # every evolution rate above is proportional to 1 / Dc
     Fp[1, 3] = 0.0
+    for c in range(4, Fp.shape[1]):
+        Fp[1, c] = 0.0
     if law == NAGATA:  # - (c/b) dm/dt
         q = cn / b
         f[1] -= q * f[0]
@@ -91,11 +93,15 @@ def rates(law, a, b, Dc, k, cn, V1, vlp, m, psi, f, J, Fp, want_fp):
         Fp[1, 0] -= q * (-k * dVa)
         Fp[1, 1] -= q * (-k * dVb) - q / b * f[0]
         Fp[1, 3] = -q * (vlp - V)
+        if Fp.shape[1] > 4:
+            Fp[1, 4] = -f[0] / b
     if want_fp:
         Fp[0, 0] = -k * dVa
         Fp[0, 1] = -k * dVb
         Fp[0, 2] = 0.0
         Fp[0, 3] = vlp - V
+        for c in range(4, Fp.shape[1]):
+            Fp[0, c] = 0.0
     return V
 
 
@@ -107,7 +113,7 @@ def _solve2(M00, M01, M10, M11, r0, r1):
 
 @jit
 def _combine(i, h, y, K, base):
-    """base = y + h sum_{j<i} a_ij K[j] for SDIRK4's stage i (y, base: (2,) or (2, 4); K: (5,) + y.shape)."""
+    """base = y + h sum_{j<i} a_ij K[j] for SDIRK4's stage i (y, base: (2,) or (2, P); K: (5,) + y.shape)."""
     yf = y.ravel()
     bf = base.ravel()
     Kf = K.reshape((5, yf.size))
@@ -127,7 +133,8 @@ def _combine(i, h, y, K, base):
 @jit
 def integrate(law, a, b, Dc, k, cn, V1, seg_t, seg_v, t_out, rtol, atol_m, sens, vmax, out_m, out_psi, out_S, stats):
     """Integrate from the steady state at V1 (t = 0) through the load-point segments (start times seg_t [s],
-    velocities seg_v [um/s]; cn: Nagata's c, else unused) and write m, psi and (sens) dm/d(a, b, Dc, k) at the sorted times t_out [s].
+    velocities seg_v [um/s]; cn: Nagata's c, else unused) and write m, psi and (sens) dm/d(a, b, Dc, k) at the
+    sorted times t_out [s] (out_S: n x 4, or n x 5 for Nagata's law with dm/dc in the fifth column).
 
     rtol: relative tolerance; atol_m: absolute tolerance of m (psi's is rtol). vmax: slip rate [um/s] beyond
     which the slider has run away. stats[0:5] receive (accepted steps, rejected steps, Newton iterations, time
@@ -135,19 +142,21 @@ def integrate(law, a, b, Dc, k, cn, V1, seg_t, seg_v, t_out, rtol, atol_m, sens,
     status code (OK, TOO_MANY_STEPS, RUNAWAY, STEP_TOO_SMALL)."""
     n = t_out.size
     y = np.zeros(2)
-    S = np.zeros((2, 4))
+    P = out_S.shape[1]  # sensitivity columns: (a, b, Dc, k), and c for Nagata's law
+    S = np.zeros((2, P))
     f0 = np.zeros(2)
     J = np.zeros((2, 2))
-    Fp = np.zeros((2, 4))
+    Fp = np.zeros((2, P))
     K = np.zeros((5, 2))
-    KS = np.zeros((5, 2, 4))
+    KS = np.zeros((5, 2, P))
     Js = np.zeros((5, 2, 2))
-    Fps = np.zeros((5, 2, 4))
+    Fps = np.zeros((5, 2, P))
     base = np.zeros(2)
-    baseS = np.zeros((2, 4))
-    S1 = np.zeros((2, 4))
+    baseS = np.zeros((2, P))
+    S1 = np.zeros((2, P))
     Y = np.zeros(2)
-    KS0 = np.zeros((2, 4))
+    KS0 = np.zeros((2, P))
+    H = np.zeros((4, P))  # a step's m-sensitivities and their rates at both ends, for the dense output
     f = np.zeros(2)
     i_out = 0
     while i_out < n and t_out[i_out] <= 0.0:  # samples at t = 0: the steady state
@@ -173,7 +182,7 @@ def integrate(law, a, b, Dc, k, cn, V1, seg_t, seg_v, t_out, rtol, atol_m, sens,
         vlp = seg_v[j]
         V = rates(law, a, b, Dc, k, cn, V1, vlp, y[0], y[1], f0, J, Fp, sens)
         if sens:
-            for c in range(4):
+            for c in range(P):
                 KS0[0, c] = J[0, 0] * S[0, c] + J[0, 1] * S[1, c] + Fp[0, c]
                 KS0[1, c] = J[1, 0] * S[0, c] + J[1, 1] * S[1, c] + Fp[1, c]
         stiff = max(abs(J[0, 0]), abs(J[1, 1]), abs(J[0, 1] * J[1, 0]) ** 0.5, 1e-300)
@@ -254,23 +263,22 @@ def integrate(law, a, b, Dc, k, cn, V1, seg_t, seg_v, t_out, rtol, atol_m, sens,
                     Ji = Js[i]
                     M00, M01 = 1.0 - h * G * Ji[0, 0], -h * G * Ji[0, 1]
                     M10, M11 = -h * G * Ji[1, 0], 1.0 - h * G * Ji[1, 1]
-                    for c in range(4):
+                    for c in range(P):
                         r0 = Ji[0, 0] * baseS[0, c] + Ji[0, 1] * baseS[1, c] + Fps[i, 0, c]
                         r1 = Ji[1, 0] * baseS[0, c] + Ji[1, 1] * baseS[1, c] + Fps[i, 1, c]
                         KS[i, 0, c], KS[i, 1, c] = _solve2(M00, M01, M10, M11, r0, r1)
                 _combine(4, h, S, KS, baseS)
-                for c in range(4):
+                for c in range(P):
                     S1[0, c] = baseS[0, c] + h * G * KS[4, 0, c]
                     S1[1, c] = baseS[1, c] + h * G * KS[4, 1, c]
             # dense output on (t, t_new]: cubic Hermite of m, psi (and of the sensitivities of m); the step's
-            # values held in scalars (an output array might alias the small arrays: they would be read again)
+            # values held in scalars and in H (an output array might alias the small arrays: they would be read again)
             dt = t_new - t
             m0, m1, dm0, dm1 = y[0], Y[0], f0[0], K[4, 0]
             q0, q1, dq0, dq1 = y[1], Y[1], f0[1], K[4, 1]
-            sa0, sb0, sc0_, sd0 = S[0, 0], S[0, 1], S[0, 2], S[0, 3]
-            sa1, sb1, sc1_, sd1 = S1[0, 0], S1[0, 1], S1[0, 2], S1[0, 3]
-            da0, db0, dc0, dd0 = KS0[0, 0], KS0[0, 1], KS0[0, 2], KS0[0, 3]
-            da1, db1, dc1, dd1 = KS[4, 0, 0], KS[4, 0, 1], KS[4, 0, 2], KS[4, 0, 3]
+            if sens:
+                for c in range(P):
+                    H[0, c], H[1, c], H[2, c], H[3, c] = S[0, c], KS0[0, c], S1[0, c], KS[4, 0, c]
             final = last and j == nseg - 1
             while i_out < n and (t_out[i_out] <= t_new or (final and t_out[i_out] <= t_end)):
                 th = (t_out[i_out] - t) / dt
@@ -286,13 +294,11 @@ def integrate(law, a, b, Dc, k, cn, V1, seg_t, seg_v, t_out, rtol, atol_m, sens,
                 out_m[i_out] = h00 * m0 + h10 * dm0 + h01 * m1 + h11 * dm1
                 out_psi[i_out] = h00 * q0 + h10 * dq0 + h01 * q1 + h11 * dq1
                 if sens:
-                    out_S[i_out, 0] = h00 * sa0 + h10 * da0 + h01 * sa1 + h11 * da1
-                    out_S[i_out, 1] = h00 * sb0 + h10 * db0 + h01 * sb1 + h11 * db1
-                    out_S[i_out, 2] = h00 * sc0_ + h10 * dc0 + h01 * sc1_ + h11 * dc1
-                    out_S[i_out, 3] = h00 * sd0 + h10 * dd0 + h01 * sd1 + h11 * dd1
+                    for c in range(P):
+                        out_S[i_out, c] = h00 * H[0, c] + h10 * H[1, c] + h01 * H[2, c] + h11 * H[3, c]
                 i_out += 1
             if sens:
-                for c in range(4):
+                for c in range(P):
                     S[0, c] = S1[0, c]
                     S[1, c] = S1[1, c]
                     KS0[0, c] = KS[4, 0, c]
@@ -307,7 +313,7 @@ def integrate(law, a, b, Dc, k, cn, V1, seg_t, seg_v, t_out, rtol, atol_m, sens,
         out_m[i_out] = y[0]
         out_psi[i_out] = y[1]
         if sens:
-            for c in range(4):
+            for c in range(P):
                 out_S[i_out, c] = S[0, c]
         i_out += 1
     stats[0], stats[1], stats[2], stats[3] = accepted, rejected, newton, t

@@ -1,18 +1,20 @@
 """The velocity-step fit: a rate-and-state law fitted to spring-slider records as the field fits them.
 
-``fitting.fit`` hands a fit here when the law is a built-in one of ``quasistatic.FITTED`` (aging, slip, PRZ), every
+``fitting.fit`` hands a fit here when the law is a built-in one of ``quasistatic.FITTED`` (aging, slip, PRZ,
+Nagata), every
 dataset is a spring-slider whose slider is quasi-static (``solve.quasistatic.applies``), the solver is 'auto'
 or 'ode' and no law parameter is fitted per dataset ('local'). The result is the usual ``FitResult``.
 
 Model of dataset i, in laboratory units (t in s, displacements in um):
 
-    mu_obs(t) = mu_ss,i + m(t; a, b, Dc, k_i) + s_i (x(t) - x_ref,i)
+    mu_obs(t) = mu_ss,i + m(t; a, b, Dc, k_i) + s_i (x(t) - x_ref,i)     (Nagata's law: m(t; a, b, Dc, c, k_i))
 
 m = mu - mu_ss(V1) of the quasi-static slider (``solve.quasistatic``: steady state at the first load-point
 velocity V1 until the first step, then through every step and hold of ``[scene.spring]``), x the load-point
 displacement (the dataset's x column, else the schedule's) and x_ref its value at the first step.
 
-* Nonlinear parameters: a, b and Dc shared by the datasets, and the machine stiffness k_i of each: fitted by
+* Nonlinear parameters: a, b and Dc (and Nagata's c, seen as itself, within the law's bounds, 0 the aging law)
+  shared by the datasets, and the machine stiffness k_i of each: fitted by
   default on measured data (a start: the dataset's stiffness), held at the dataset's value elsewhere, or as
   ``free={'spring.stiffness': (lo, hi)}`` says. Levenberg-Marquardt with bounds (``Problem.lm``; the laws'
   bounds for a, b, Dc) sees a / 0.01, b / 0.01, ln Dc and ln k, and the normal equations of the forward
@@ -22,7 +24,7 @@ displacement (the dataset's x column, else the schedule's) and x_ref its value a
   not depend on the nonlinear parameters, the projected sensitivities are the exact Jacobian). The trend is
   fitted by default on measured data (``trend``: None, True or False). The reported covariance is the full one
   of every parameter fitted jointly; the law's mu0 (at V0 = 1 um/s) is mu_ss - (a - b) ln(V1 / V0).
-* Global start: a grid over ln Dc (and ln k where it is fitted), a, b fitted at each grid point on at most
+* Global start: a grid over ln Dc (and ln k where it is fitted), a, b (and c) fitted at each grid point on at most
   SEARCH_POINTS samples, full fits from the best distinct grid points on that subsample, and the lowest one
   then fitted on every sample.
 * Noise: the dataset's sigma (known or estimated), or, where it declares ``correlation = "ar1"``, the AR(1)
@@ -59,7 +61,8 @@ SEARCH_RTOL, FIT_RTOL = 1e-5, 1e-8
 AR1_ROUNDS, AR1_TOL = 8, 1e-3
 #: Optimizer scale of a and b (the laws' typical size).
 AB_SCALE = 0.01
-#: Columns every Jacobian column combines (``velstep_kernel``): the sensitivities to a, b, Dc and k, and a constant.
+#: Columns every Jacobian column combines (``velstep_kernel``): the sensitivities to a, b, Dc and k, and a constant
+#: (then those to a law's ``quasistatic.EXTRA`` parameters).
 NBASIS = 5
 
 
@@ -80,7 +83,7 @@ class Param:
     """A nonlinear parameter: ``x`` = value / scale ('lin') or ln(value) ('log') in laboratory units (um)."""
 
     name: str  # display name ('a', 'Dc', 'spring.stiffness' or 'spring.stiffness[NAME]')
-    key: str  # 'a', 'b', 'Dc' or 'k'
+    key: str  # 'a', 'b', 'Dc', 'k' or an extra law parameter ('c')
     target: int  # the dataset of a stiffness, -1 for a shared law parameter
     transform: str  # 'lin' | 'log'
     value: float  # start, laboratory units
@@ -88,21 +91,22 @@ class Param:
     upper: float
     vary: bool
     fixed_by: str = ""
+    scale: float = AB_SCALE  # of a 'lin' parameter
 
     def to_x(self, v: float) -> float:
-        return v / AB_SCALE if self.transform == "lin" else math.log(v)
+        return v / self.scale if self.transform == "lin" else math.log(v)
 
     def from_x(self, x: float) -> float:
-        return x * AB_SCALE if self.transform == "lin" else math.exp(x)
+        return x * self.scale if self.transform == "lin" else math.exp(x)
 
     def slope(self, x: float) -> float:
         """d value / d x at x."""
-        return AB_SCALE if self.transform == "lin" else math.exp(x)
+        return self.scale if self.transform == "lin" else math.exp(x)
 
     @property
     def bounds_x(self) -> tuple[float, float]:
         if self.transform == "lin":
-            return self.lower / AB_SCALE, self.upper / AB_SCALE
+            return self.lower / self.scale, self.upper / self.scale
         return math.log(self.lower), math.log(self.upper)
 
 
@@ -113,6 +117,7 @@ class Problem:
                  progress=None):
         self.law, self.targets, self.params, self.series = law, targets, params, series
         self.code = quasistatic.LAWS[law.name]
+        self.extra = quasistatic.EXTRA.get(self.code, ())
         self.rtol, self.deadline, self.progress = rtol, deadline, progress
         self.free = [i for i, p in enumerate(params) if p.vary]
         self.nfev = 0
@@ -128,7 +133,8 @@ class Problem:
         return np.array([p.to_x(p.value) for p in self.params])
 
     def values(self, x) -> dict:
-        """Laboratory values: {'a', 'b', 'Dc' [um], 'k': [1/um per dataset]} at the full parameter vector x."""
+        """Laboratory values: {'a', 'b', 'Dc' [um], 'k': [1/um per dataset], and an extra law parameter such as
+        'c'} at the full parameter vector x."""
         v = {"k": [0.0] * len(self.series)}
         for p, xi in zip(self.params, x):
             if p.key == "k":
@@ -146,7 +152,7 @@ class Problem:
         """(chi-square r'r, J'r, J'J, solved) of the weighted, prewhitened, projected residual r and its Jacobian J by
         the parameters ``free`` at the full vector x (``velstep_kernel``: nothing per sample is kept); a model
         that cannot be solved there gives (inf, 0, 0, False)."""
-        from .kernel import basis_sums
+        from .kernel import all_sums
 
         key = (np.asarray(x).tobytes(), tuple(free), search, rtol)
         if self._cache is not None and self._cache[0] == key:
@@ -161,17 +167,16 @@ class Problem:
         cost, g, A = 0.0, np.zeros(p), np.zeros((p, p))
         try:
             for s in self.series:
-                sol = quasistatic.solve(self.code, v["a"], v["b"], v["Dc"], v["k"][s.index], s.load,
-                                        s.t_search if search else s.t, rtol or (SEARCH_RTOL if search else self.rtol),
-                                        sensitivities=True)
+                sol = self.solve(v, s, s.t_search if search else s.t,
+                                 rtol or (SEARCH_RTOL if search else self.rtol), True)
                 M = self.combination(s, v, free)
                 if search:  # white noise on the subsample
-                    sums = basis_sums(s.y_ref_search, s.offset(v["a"], v["b"]), sol.m, sol.S, s.inv_sigma_search,
+                    sums = all_sums(s.y_ref_search, s.offset(v["a"], v["b"]), sol.m, sol.S, s.inv_sigma_search,
                                       s.no_phi, s.no_phi, s.Q_search)
                 elif s.arp:
                     sums = s.whitened_sums(s.offset(v["a"], v["b"]), sol.m, sol.S)
                 else:
-                    sums = basis_sums(s.y_ref, s.offset(v["a"], v["b"]), sol.m, sol.S, s.inv_sigma, s.phi, s.gain,
+                    sums = all_sums(s.y_ref, s.offset(v["a"], v["b"]), sol.m, sol.S, s.inv_sigma, s.phi, s.gain,
                                       s.Q)
                 ww, Bw, BB, Qw, QB = sums
                 QC = QB @ M
@@ -186,11 +191,17 @@ class Problem:
         self._cache = (key, out)
         return out
 
+    def solve(self, v, s: Series, t, rtol: float, sensitivities: bool = False):
+        """The quasi-static slider of dataset s at the laboratory values v (``values``) at times t."""
+        return quasistatic.solve(self.code, v["a"], v["b"], v["Dc"], v["k"][s.index], s.load, t, rtol,
+                                 sensitivities=sensitivities, c=v.get("c", 0.0))
+
     def combination(self, s: Series, v, free) -> np.ndarray:
-        """M (5 x len(free)): the columns d(model)/d(x_j) of the parameters ``free`` on dataset s are [S, 1] M, with
-        S = dm/d(a, b, Dc, k) the sensitivities (a zero column for another dataset's stiffness)."""
+        """M ((5 + extra) x len(free)): the columns d(model)/d(x_j) of the parameters ``free`` on dataset s are
+        [S[:, :4], 1, S[:, 4:]] M, with S = dm/d(a, b, Dc, k, extra) the sensitivities (a zero column for another
+        dataset's stiffness)."""
         held = s.L1 if s.mu0 is not None else 0.0  # a held mu0 at V0 puts (a - b) ln(V1 / V0) in the model
-        M = np.zeros((NBASIS, len(free)))
+        M = np.zeros((NBASIS + len(self.extra), len(free)))
         for j, i in enumerate(free):
             p = self.params[i]
             if p.key == "a":
@@ -199,20 +210,23 @@ class Problem:
                 M[1, j], M[4, j] = AB_SCALE, -held * AB_SCALE
             elif p.key == "Dc":
                 M[2, j] = v["Dc"]
+            elif p.key in self.extra:
+                M[NBASIS + self.extra.index(p.key), j] = p.scale
             elif p.target == s.index:  # this dataset's stiffness
                 M[3, j] = v["k"][s.index]
         return M
 
     def columns(self, s: Series, v, x, S, free) -> np.ndarray:
-        """d(model)/d(x_j) for the parameters ``free`` on dataset s, from the sensitivities S = dm/d(a, b, Dc, k)."""
-        return np.column_stack([S, np.ones(S.shape[0])]) @ self.combination(s, v, free)
+        """d(model)/d(x_j) for the parameters ``free`` on dataset s, from the sensitivities S = dm/d(a, b, Dc, k,
+        extra)."""
+        return np.column_stack([S[:, :4], np.ones(S.shape[0]), S[:, 4:]]) @ self.combination(s, v, free)
 
     def model(self, x) -> list[np.ndarray]:
         """Each dataset's model of mu (linear parameters solved) at the full vector x, every sample."""
         v = self.values(x)
         out = []
         for s in self.series:
-            sol = quasistatic.solve(self.code, v["a"], v["b"], v["Dc"], v["k"][s.index], s.load, s.t, self.rtol)
+            sol = self.solve(v, s, s.t, self.rtol)
             m = s.offset(v["a"], v["b"]) + sol.m
             out.append(m + s.B @ s.linear(v["a"], v["b"], sol.m))
         return out
@@ -281,7 +295,7 @@ class Problem:
         by_key = {p.key: i for i, p in enumerate(self.params) if p.target < 0}
         iDc = by_key["Dc"]
         ks = [i for i, p in enumerate(self.params) if p.key == "k" and p.vary]
-        ab = [by_key[k] for k in ("a", "b") if self.params[by_key[k]].vary]
+        ab = [by_key[k] for k in ("a", "b") + self.extra if self.params[by_key[k]].vary]
         dcs = _dc_grid(self.series, self.params[iDc]) if self.params[iDc].vary else [self.params[iDc].value]
         kf = np.geomspace(1 / K_SPAN, K_SPAN, GRID_K) if ks else np.ones(1)
         scored = []
@@ -423,7 +437,8 @@ def make_problem(law, targets, fixed, free, initial, trend, stiffness, rtol, dea
     """The Problem of fitting ``law`` to ``targets`` (module docstring): parameters with their starts and bounds,
     and each dataset prepared."""
     held = {}
-    for name in ("mu0", "a", "b", "Dc"):
+    extra = quasistatic.EXTRA.get(quasistatic.LAWS[law.name], ())
+    for name in ("mu0", "a", "b", "Dc") + extra:
         if name in fixed:
             held[name] = (float(fixed[name]), "held by the caller")
             continue
@@ -435,14 +450,14 @@ def make_problem(law, targets, fixed, free, initial, trend, stiffness, rtol, dea
             raise FrictionLabError(f"law '{law.name}': '{name}' is held by some datasets and not by others; the "
                                    "velocity-step fit shares it (fit them separately, or with solver 'ode:LSODA')")
     params = []
-    for name, unit in (("a", 1.0), ("b", 1.0), ("Dc", UM)):
+    for name, unit in (("a", 1.0), ("b", 1.0), ("Dc", UM)) + tuple((e, 1.0) for e in extra):
         spec = law.spec(name)
         value = held[name][0] if name in held else float(initial.get(name, spec.default))
         lo, hi = spec.lower / unit, spec.upper / unit
         if name == "Dc":  # an evolution longer than the record's slip after its first step is a trend, not a Dc
             lo, hi = max(lo, 1e-6), min(hi, max(_slip_after_step(tg) for tg in targets))
         params.append(Param(name, name, -1, "log" if name == "Dc" else "lin", value / unit, lo, hi, name not in held,
-                            held.get(name, (0, ""))[1]))
+                            held.get(name, (0, ""))[1], AB_SCALE if name in ("a", "b") else spec.scale))
     series = []
     multi = len(targets) > 1
     for i, tg in enumerate(targets):

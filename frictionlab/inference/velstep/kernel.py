@@ -85,3 +85,63 @@ def basis_sums(y, off, m, S, inv_sigma, phi, gain, Q):
     Qw = np.array([qw0, qw1])[:q].copy()
     QB = np.array([[q00, q01, q02, q03, q04], [q10, q11, q12, q13, q14]])[:q].copy()
     return ww, Bw, BB, Qw, QB
+
+
+@jit
+def extra_sums(y, off, m, S, inv_sigma, phi, gain, Q):
+    """The sums of ``basis_sums`` that involve the extra basis columns E = S[:, 4:] / sigma (a law's parameters
+    beyond a, b, Dc and k, e.g. Nagata's c), prewhitened alike: (E'w (e,), E'B (e, 5), E'E (e, e), Q'E (q, e)),
+    B the five columns of ``basis_sums``."""
+    n = y.size
+    e = S.shape[1] - 4
+    q = Q.shape[1]
+    Ew = np.zeros(e)
+    EB = np.zeros((e, 5))
+    EE = np.zeros((e, e))
+    QE = np.zeros((q, e))
+    c, cp, d = np.zeros(5), np.zeros(5), np.zeros(5)
+    x, xp, g = np.zeros(e), np.zeros(e), np.zeros(e)
+    zp = 0.0
+    for i in range(n):
+        s = inv_sigma[i]
+        z = (off + m[i] - y[i]) * s
+        for j in range(4):
+            c[j] = S[i, j] * s
+        c[4] = s
+        for j in range(e):
+            x[j] = S[i, 4 + j] * s
+        f = phi[i]
+        if f != 0.0:
+            k = gain[i]
+            w = (z - f * zp) * k
+            for j in range(5):
+                d[j] = (c[j] - f * cp[j]) * k
+            for j in range(e):
+                g[j] = (x[j] - f * xp[j]) * k
+        else:
+            w = z
+            d[:] = c
+            g[:] = x
+        zp = z
+        cp[:] = c
+        xp[:] = x
+        for j in range(e):
+            Ew[j] += g[j] * w
+            for l in range(5):
+                EB[j, l] += g[j] * d[l]
+            for l in range(e):
+                EE[j, l] += g[j] * g[l]
+            for r in range(q):
+                QE[r, j] += Q[i, r] * g[j]
+    return Ew, EB, EE, QE
+
+
+def all_sums(y, off, m, S, inv_sigma, phi, gain, Q):
+    """``basis_sums`` over the basis (S[:, :4], 1, S[:, 4:]) / sigma: the five columns of ``basis_sums``, then those
+    of ``extra_sums`` where S has more than four columns."""
+    sums = basis_sums(y, off, m, S, inv_sigma, phi, gain, Q)
+    if S.shape[1] == 4:
+        return sums
+    ww, Bw, BB, Qw, QB = sums
+    Ew, EB, EE, QE = extra_sums(y, off, m, S, inv_sigma, phi, gain, Q)
+    return ww, np.concatenate([Bw, Ew]), np.block([[BB, EB.T], [EB, EE]]), Qw, np.hstack([QB, QE])

@@ -45,8 +45,8 @@ def ar1_neg2ll(f) -> float:
 
 
 def state_laws(fitted_only: bool = False) -> list[str]:
-    """The registered state laws of the quasi-static slider (``fitted_only``: those the velocity-step fit serves;
-    another, such as Nagata's with its c, is fitted by the general path, far slower on long records)."""
+    """The registered state laws of the quasi-static slider (``fitted_only``: those the velocity-step fit serves,
+    aging, slip, PRZ and Nagata's)."""
     from ...physics.registry import available_laws
     from ...solve.quasistatic import FITTED, LAWS
 

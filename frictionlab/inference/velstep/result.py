@@ -44,6 +44,8 @@ BOUND_MEANING = {
     ("Dc", "lower"): "Dc at its lower bound: the evolution is faster than the sampling resolves",
     ("Dc", "upper"): "Dc at its upper bound (the record's slip after the step): the evolution is slower than the "
                      "record is long, and cannot be told from a trend",
+    ("c", "lower"): "c at 0: no stress-weakening of the state is resolved (Nagata's law is the aging law here)",
+    ("c", "upper"): "c at its upper bound: the state weakens with stress more than the law allows",
     ("k", "lower"): "k at its lower bound: the machine looks softer than the data can tell apart from the law's "
                     "evolution",
     ("k", "upper"): "k at its upper bound: the machine looks rigid (the loading right after the step is not "
@@ -113,7 +115,7 @@ def build(problem, x, rounds, *, checks=True, errors=True, n_params=None, clock=
         g = _goodness(s, p, round(k / len(pieces)) + s.n_noise, J[p["rows"], keep] if errors and checks else None,
                       v)
         goods.append(g)
-        lawp = {"mu0": p["mu0"], "a": v["a"], "b": v["b"], "Dc": v["Dc"] * UM}
+        lawp = {"mu0": p["mu0"], "a": v["a"], "b": v["b"], "Dc": v["Dc"] * UM} | {e: v[e] for e in problem.extra}
         scene = set_scene_quantity(s.target.dataset.scene, "spring.stiffness", v["k"][s.index] / UM)
         target = attrs.evolve(s.target, sigma=s.sigma.copy())
         per.append(VelstepFit(target, "ode", lawp, scene, p["model"], float(p["r"] @ p["r"]),
@@ -170,10 +172,7 @@ def _piece(problem, s, v, x, free, J, col: int) -> dict:
     """One dataset at the solution: model, residuals (plain and prewhitened), the linear coefficients, -2 ln L; its
     rows of the full prewhitened Jacobian J (the nonlinear columns, and its linear ones from column ``col``) are
     written into J."""
-    from ...solve import quasistatic
-
-    sol = quasistatic.solve(problem.code, v["a"], v["b"], v["Dc"], v["k"][s.index], s.load, s.t, problem.rtol,
-                            sensitivities=bool(J.shape[1]))
+    sol = problem.solve(v, s, s.t, problem.rtol, bool(J.shape[1]))
     c = s.linear(v["a"], v["b"], sol.m)
     model = s.offset(v["a"], v["b"]) + sol.m + s.B @ c
     r = model - s.y
@@ -372,7 +371,8 @@ def _params(problem, x, v, pieces, free, cov, at_bound, errors) -> tuple[dict, d
         q = quantities[s.target.name]
         kname = next(p.name for p in problem.params if p.key == "k" and p.target == s.index)
         for key, name, factor, unit in (("a", "a", 1.0, ""), ("b", "b", 1.0, ""), ("a-b", "a-b", 1.0, ""),
-                                        ("Dc", "Dc", 1 / UM, "um"), ("k", kname, UM, "1/um"),
+                                        ("Dc", "Dc", 1 / UM, "um"), *((e, e, 1.0, "") for e in problem.extra),
+                                        ("k", kname, UM, "1/um"),
                                         ("mu0", "mu0" + suffix, 1.0, ""), ("trend", "trend" + suffix, UM, "1/um")):
             if key != "trend" or s.trend:
                 q[key] = _quantity(params[name], factor, unit, log=key in ("Dc", "k"),

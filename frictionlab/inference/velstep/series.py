@@ -167,13 +167,14 @@ class Series:
         return change
 
     def whitened_sums(self, off: float, m, S):
-        """``velstep_kernel.basis_sums`` under the data's AR(p) model: the residual and the basis columns weighted,
+        """``velstep_kernel.all_sums`` under the data's AR(p) model: the residual and the basis columns weighted,
         whitened by a linear filter (``noise.record``), and their sums (w'w, B'w, B'B, Q'w, Q'B)."""
         inv = self.inv_sigma
-        Z = np.empty((self.n, 6))
+        Z = np.empty((self.n, 2 + S.shape[1]))  # the residual, then the basis (S[:, :4], 1, S[:, 4:]) / sigma
         Z[:, 0] = (off + m - self.y_ref) * inv
-        Z[:, 1:5] = S * inv[:, None]
+        Z[:, 1:5] = S[:, :4] * inv[:, None]
         Z[:, 5] = inv
+        Z[:, 6:] = S[:, 4:] * inv[:, None]
         W = self.noise.whiten(Z)
         w, D = W[:, 0], W[:, 1:]
         return float(w @ w), D.T @ w, D.T @ D, self.Q.T @ w, self.Q.T @ D

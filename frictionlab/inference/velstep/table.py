@@ -46,7 +46,7 @@ class StepRow:
 
     dataset: str
     law: str
-    quantities: dict  # name -> Quantity: 'a', 'b', 'a-b', 'Dc', 'k', 'mu0', 'trend'
+    quantities: dict  # name -> Quantity: 'a', 'b', 'a-b', 'Dc', 'c' (Nagata's law), 'k', 'mu0', 'trend'
     phi: tuple  # (rate label, phi) per rate group, () without the AR(1) model
     steps: tuple  # ((V before, V after) [um/s]) of each step
     fits: bool | None
@@ -66,7 +66,7 @@ class StepReport:
     missing: tuple[str, ...] = ()
     noise: tuple[str, ...] = ()
 
-    ORDER = ("a", "b", "a-b", "Dc", "k", "mu0", "trend")
+    ORDER = ("a", "b", "a-b", "Dc", "c", "k", "mu0", "trend")  # c: Nagata's law
 
     def lines(self) -> list[str]:
         out = []
