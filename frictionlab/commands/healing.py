@@ -19,7 +19,8 @@ def add_parser(sub):
     p.add_argument("dataset", metavar="DATASET", help="built-in dataset name or TOML path")
     p.add_argument("--laws", "--law", action=ListAction, default=[], metavar="NAME",
                    help="state laws to fit and predict with (default: every registered state law the velocity-step "
-                        "fit serves; another state law, e.g. rate-state-nagata, by the general path)")
+                        "fit serves: aging, slip, PRZ, Nagata; another, e.g. rate-state-aging2, by the general "
+                        "path)")
     p.add_argument("--fit-timeout", type=float, metavar="SECONDS", help="time budget of each fit")
     p.set_defaults(func=run)
 

@@ -23,8 +23,8 @@ def add_parser(sub):
     p.add_argument("raw", nargs="+", metavar="RAWFILE", help="the raw record (several files: slices of one recording)")
     p.add_argument("--name", default="record", help="the record's name (its step windows: NAME-step1, ...)")
     p.add_argument("--laws", "--law", action=ListAction, default=[], metavar="NAME",
-                   help="state laws to fit (default: every registered state law the velocity-step fit serves; another "
-                        "state law, e.g. rate-state-nagata, by the general path)")
+                   help="state laws to fit (default: every registered state law the velocity-step fit serves: aging, "
+                        "slip, PRZ, Nagata; another, e.g. rate-state-aging2, by the general path)")
     p.add_argument("--no-joint", action="store_true", help="skip the whole-record fit (the slowest part)")
     p.add_argument("--fit-timeout", type=float, metavar="SECONDS", help="time budget of each fit")
     p.set_defaults(func=run)

@@ -48,8 +48,8 @@ E0, E1, E2, E3, E4 = 25.0 / 24.0 - 59.0 / 48.0, -49.0 / 48.0 + 17.0 / 96.0, 125.
 @jit
 def rates(law, a, b, Dc, k, cn, V1, vlp, m, psi, f, J, Fp, want_fp):
     """Fill f = (dm/dt, dpsi/dt), J = d f / d(m, psi) and (want_fp) Fp = d f / d(a, b, Dc, k) at (m, psi) (cn:
-    Nagata's c; where Fp has a fifth column, d f / d c there); return the slip rate V [um/s] (inf where ln(V/V1) exceeds MAX_EXPONENT or psi is beyond
-    range)."""
+    Nagata's c; where Fp has a fifth column, d f / d c there); return the slip rate V [um/s] (inf where ln(V/V1)
+    exceeds MAX_EXPONENT or psi is beyond range)."""
     lnE = (m - b * psi) / a
     if not (lnE < MAX_EXPONENT) or not (-psi < MAX_EXPONENT) or (law == PRZ and not (psi + 2.0 * lnE < MAX_EXPONENT)):
         return math.inf

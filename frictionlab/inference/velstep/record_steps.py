@@ -4,12 +4,14 @@ A raw experiment's steps (``io.velstep.analyse``: each step's window starting at
 are fitted by the velocity-step fit (``velstep``) three ways, for each state law the fit serves:
 
 * per step: a, b, Dc, the machine stiffness k, mu_ss and the trend of each window, its own;
-* shared: a, b and Dc one set for every step (k, mu_ss and the trend still each window's own: the stiffness
-  the fit sees mixes the machine with the gouge layer, which compacts between steps), the transfer test of
+* shared: a, b and Dc (and Nagata's c) one set for every step (k, mu_ss and the trend still each window's own:
+  the stiffness the fit sees mixes the machine with the gouge layer, which compacts between steps), the transfer
+  test of
   ``transfer.shared_fit`` (the impacts' one-parameter-set test): the likelihood-ratio statistic
   LR = -2 ln L_shared + 2 ln L_per-step, both under one noise model (``ar1_neg2ll``: each window's residuals
   as AR(1), phi and the innovation variance profiled: the conditional Gaussian likelihood), against
-  chi-square with dk = 3 (steps - 1) degrees of freedom, and delta-AIC = LR - 2 dk, delta-BIC = LR - dk ln n.
+  chi-square with dk = 3 (steps - 1) degrees of freedom (4 (steps - 1) with Nagata's c), and delta-AIC =
+  LR - 2 dk, delta-BIC = LR - dk ln n.
   One set describes the steps when p >= ALPHA. Where AR(1) does not whiten the residuals (a slow wander the
   law does not follow) the chi-square reference is approximate and the screen says so;
 * whole record (optional): the load-point history of every step and hold driving one simulation from the
@@ -89,13 +91,15 @@ class LawSteps:
         s = self.shared
         if s is None or s.status != "ok":
             return f"{law}: no test: {s.reason if s is not None else 'the shared fit was not run'}"
-        full = sum(1 for p in self.steps[0].params.values() if p.key in ("a", "b", "Dc") and p.vary) * (len(self.steps) - 1)
+        shared = [p for p in self.steps[0].params.values() if p.kind == "law" and p.key != "mu0"]  # a, b, Dc (, c)
+        full = sum(1 for p in shared if p.vary) * (len(self.steps) - 1)
         held = f", not {full}: a parameter at a bound is not counted" if 0 < s.dk < full else ""
         nums = (f"LR = {s.lr:.4g} on {s.dk} degrees of freedom{held}, p = {s.p_value:.2g}; delta-AIC = "
                 f"{s.delta_aic:+.4g}, delta-BIC = {self.delta_bic:+.4g}")
+        names = ", ".join(p.key for p in shared)
         if self.one_set:
-            return f"{law}: one set of a, b, Dc describes every step ({nums})"
-        return f"{law}: the steps ask for separate a, b, Dc ({nums})"
+            return f"{law}: one set of {names} describes every step ({nums})"
+        return f"{law}: the steps ask for separate {names} ({nums})"
 
 
 def fit_steps(law: str, datasets: Sequence, *, joint=None, timeout: float | None = None, fit_kw=None) -> LawSteps:
