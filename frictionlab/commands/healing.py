@@ -50,8 +50,9 @@ def run(args) -> int:
             continue
         tables.append(of_dataset(d, f.per_dataset[0].model, law.replace("rate-state-", "") + ", best parameters"))
         p = {k: v.value for k, v in f.params.items() if v.kind == "law"}
+        extra = "".join(f", {k} = {p[k]:.4g}" for k in ("c",) if k in p)  # Nagata's c
         notes.append(f"{law} at its best parameters on the whole record: a = {p['a']:.4g}, b = {p['b']:.4g}, Dc = "
-                     f"{p['Dc'] * 1e6:.4g} um; {f.goodness.short if f.goodness is not None else ''}".rstrip("; "))
+                     f"{p['Dc'] * 1e6:.4g} um{extra}; {f.goodness.short if f.goodness is not None else ''}".rstrip("; "))
     print(f"{d.name} ({d.provenance.kind}): {len(tables[0].holds)} holds; healing = peak friction on re-sliding "
           "(largest 5-sample running mean) minus the steady friction before the hold (the line through the second "
           "half of the sliding before it, at the hold's start)")
