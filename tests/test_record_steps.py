@@ -51,6 +51,27 @@ def test_one_set_is_accepted_on_one_law_and_refused_on_two(tmp_path):
     assert "Yes, for every law tested (aging)" in lines[2] and any("one set of a, b, Dc" in x for x in lines)
 
 
+def test_nagata_shares_c_with_a_b_dc_across_the_steps_and_the_screen_shows_it():
+    """Nagata data (c = 2) stepped up and down with one parameter set: the velocity-step fit serves each step, the
+    shared set includes c (4 shared parameters, one per step beyond the first), one set is accepted, and the
+    first screen has a column for c in the per-step and the shared tables."""
+    assert "rate-state-nagata" in state_laws(fitted_only=True)
+    truth = dict(TRUTH, c=2.0)
+    same = [_step("n-up", 1e-6, 1e-5, truth, 5, "rate-state-nagata"),
+            _step("n-down", 1e-5, 1e-6, truth, 6, "rate-state-nagata")]
+    r = fit_steps("rate-state-nagata", same)
+    assert all(f.solver == "ode" and f.velstep is not None for f in r.steps)
+    assert r.ok and r.one_set and r.shared.dk == 4, r.verdict()
+    assert abs(r.shared.shared["c"] - 2.0) < 3 * max(f.stderr("c") for f in r.steps)
+    steps = [dict(name=d.name, label="1 -> 10", direction="up", window="500 samples", note="starts at steady state")
+             for d in same]
+    lines = screen("title", steps, [r], answer([r], ["up", "down"]))
+    assert any("one set of a, b, Dc, c describes every step" in x for x in lines)
+    assert any(x.startswith("One set for every step (a, b, Dc, c shared") for x in lines)
+    header = next(x for x in lines if x.lstrip().startswith("step "))
+    assert "Dc [um]  c " in header or " c  " in header
+
+
 def test_the_ar1_likelihood_profiles_phi_and_the_variance():
     class D:  # a fit's dataset part: only its residuals are read
         def __init__(self, r):

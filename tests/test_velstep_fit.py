@@ -270,7 +270,8 @@ def test_bound_meanings_name_what_each_bound_says():
 
     assert BOUND_MEANING[("b", "lower")] == ("b at 0: the evolution runs the other way; a single-state law cannot "
                                              "follow it")
-    assert {key for key, _ in BOUND_MEANING} == {"a", "b", "Dc", "k"}
+    assert {key for key, _ in BOUND_MEANING} == {"a", "b", "Dc", "k", "c"}  # c: Nagata's
+    assert BOUND_MEANING[("c", "lower")].startswith("c at 0: no stress-weakening")
 
 
 def test_a_multi_step_record_fits_a_b_dc_jointly_across_its_steps():
