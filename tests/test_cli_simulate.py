@@ -13,6 +13,7 @@ from frictionlab import cli
 from frictionlab.io.dataset import builtin_dir
 from frictionlab.report.figures import is_png
 from frictionlab.solve.outcome import predict_outcomes
+from test_bad_inputs import PROGRESS_LINE
 
 RPM = 60 / (2 * math.pi)
 
@@ -26,8 +27,9 @@ def run(capsys, *argv):
 def test_series_summary_reproduces_the_paper(run_cli):
     res = run_cli("simulate", "wear", "impact-golf-v28", "--param", "lam=1.81e6 Pa s/m",
                   "--solver", "series", "--points", "5001")
-    out, err = res.stdout, res.stderr
-    assert res.returncode == 0
+    out = res.stdout
+    err = "".join(x for x in res.stderr.splitlines(keepends=True) if not PROGRESS_LINE.match(x))  # a slow machine's
+    assert res.returncode == 0  # progress lines (time-stamped, written when the run outlasts two seconds)
     b = 1.81e6 * 130e-6 * 500e-6 / (0.046 * math.pi)
     assert err.startswith("warning: series: b = 0.814") and err.count("\n") == 1  # the accuracy warning names b
     peak = 5 * 12.0 / (4 * 0.0213) * RPM  # eq (9) at cos(phi t) = -(1 - b)/b
