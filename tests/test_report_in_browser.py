@@ -48,9 +48,10 @@ def _answer(group, best, goodness, eq="not tested", thr="", series="", transfer=
                   series_vs_exact=long if series else "", transfer=long if transfer else "", short=short)
 
 
-def test_seven_groups_of_long_verdicts_still_leave_the_finding_on_the_first_screen(tmp_path):
+@pytest.fixture(scope="module")
+def seven_groups(tmp_path_factory):
+    """A report whose answers table has seven groups of long verdicts."""
     import attrs
-
 
     ds = synthetic("wear", {"lam": 1.81e6}, seed=2, n=26, name="impact-browser")
     c = compare(laws=["wear", "coulomb"], datasets=[ds], equivalence=False)
@@ -69,7 +70,19 @@ def test_seven_groups_of_long_verdicts_still_leave_the_finding_on_the_first_scre
             _answer("spring-slider", "no law fits (best of a poor set: wear = couette [exact+ode])",
                     "fails: χ² p < 1e-300"),
             _answer("spring-slider-small", "no law could be fitted", ""))
-    out = write_report(attrs.evolve(c, answers=rows), tmp_path / "rep")
-    box = screenshot.first_screen_layout(out / "report.html", height=1000)
+    return write_report(attrs.evolve(c, answers=rows), tmp_path_factory.mktemp("seven") / "rep")
+
+
+def test_seven_groups_of_long_verdicts_still_leave_the_finding_on_the_first_screen(seven_groups):
+    box = screenshot.first_screen_layout(seven_groups / "report.html", height=1000)
     assert box["table"] is not None and box["figure"] is not None
     assert box["table"]["bottom"] <= box["figure"]["top"] < box["figure"]["bottom"] <= 1000, box
+
+
+@pytest.mark.parametrize("width", [800, 1400])
+def test_every_table_fits_its_box_at_800_and_1400_px(seven_groups, width):
+    """No column is cut at the right edge of a window 800 or 1400 px wide: every table, the answers table of long
+    verdicts in every column too, is no wider than the box it lies in."""
+    tables = screenshot.table_widths(seven_groups / "report.html", width=width)
+    assert tables[0]["columns"] >= 7, tables  # the answers table
+    assert all(t["width"] <= t["box"] + 0.5 for t in tables), tables

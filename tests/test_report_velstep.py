@@ -1,5 +1,6 @@
 """The first screen's measured velocity steps (report.velstep): each step's a, b, a - b, Dc and k with intervals
 beside its figure (data, fit, residuals); nothing for synthetic or non-slider data."""
+import shutil
 import sys
 from pathlib import Path
 
@@ -11,9 +12,10 @@ from frictionlab import compare
 from frictionlab.report import build, first_screen
 from frictionlab.report import velstep as report_velstep
 from frictionlab.report.figures import is_png
-from frictionlab.report.render import markdown
+from frictionlab.report.render import html_page, markdown
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tools"))
 
 
 @pytest.fixture(scope="module")
@@ -80,3 +82,18 @@ def test_a_velocity_step_figure_on_a_kept_canvas_is_the_figure_a_fresh_canvas_gi
         fresh.append(velstep_figure(f))
     base.release()
     assert kept == fresh and kept[0] != kept[1]
+
+
+@pytest.mark.skipif(shutil.which("chromium") is None, reason="chromium is not installed")
+@pytest.mark.parametrize("width", [800, 1400])
+def test_the_measured_steps_table_fits_the_page_at_800_and_1400_px(comp, tmp_path, width):
+    """Headless Chromium lays out the first screen: the ten-column table of measured steps (a, b, a - b, Dc, k with
+    their errors, the noise model, the law's fit) is no wider than its box, so no column is cut at the right."""
+    import screenshot
+
+    sections, _ = build(comp, modules=[first_screen])
+    page = tmp_path / "report.html"
+    page.write_text(html_page("t", sections, {f.name: b"" for s in sections for f in s.figures}), encoding="utf-8")
+    tables = screenshot.table_widths(page, width=width)
+    assert any(t["columns"] == 10 for t in tables), tables
+    assert all(t["width"] <= t["box"] + 0.5 for t in tables), tables

@@ -45,9 +45,7 @@ def test_step_times_and_velocities_agree_with_the_truth_within_their_errors(nois
     assert np.sqrt(np.mean(np.square(zv))) < 1.5, zv
 
 
-@pytest.mark.parametrize("phi", [0.0, 0.9, pytest.param(0.99, marks=pytest.mark.xfail(
-    reason="open: the partition weighted by the white noise (which finds 20 and 200 steps) reads AR(0.99) wander as "
-           "jumps and, on 1 of these 40 records, as a step; 3 more are refused as curved", strict=False))])
+@pytest.mark.parametrize("phi", [0.0, 0.9, 0.99])
 def test_a_record_without_a_step_is_refused_not_cut_into_pieces(phi):
     """Pure noise about one line, white or strongly correlated: the data choose no step (40 records each)."""
     for seed in range(40):
@@ -92,6 +90,22 @@ def test_a_reset_alone_is_no_step_and_is_named():
     x[T >= 120.0] += 5000.0
     with pytest.raises(DatasetError, match=r"no velocity step found.*a jump of 5000 at line 1201 \(t = 120 s\) stitched"):
         segment(T, x, "rec")
+
+
+def test_correlated_wander_is_no_jump_and_a_servo_correction_on_it_is_one():
+    """Three samples standing off the three before are weighed against the noise of that difference: AR(0.99) wander
+    alone (which moves neighbouring samples together) has no jump stitched, while a 1 um correction at 120 s on
+    AR(0.9) noise is stitched there, and only there."""
+    for seed in range(100, 110):
+        rng = np.random.default_rng(seed)
+        with pytest.raises(DatasetError, match="no velocity step found") as wander:
+            segment(T, piecewise(T, [], [1.0]) + ar1(rng, T.size, 0.99, 0.05), "rec")
+        assert "jump" not in str(wander.value)
+        x = piecewise(T, [], [1.0]) + ar1(rng, T.size, 0.9, 0.05)
+        x[T >= 120.0] += 1.0
+        with pytest.raises(DatasetError, match=r"no velocity step found[^;]*; a jump of [\d.]+ at line 1201 "
+                                               r"\(t = 120 s\) stitched$"):
+            segment(T, x, "rec")
 
 
 @pytest.mark.parametrize("at, side", [(3, "after the start of the record"), (T.size - 2, "before the end of the record"),

@@ -73,8 +73,28 @@ _MEASURE = """<script>window.addEventListener("load", function () {
 });</script>"""
 
 
+#: Every table with every collapsible section open: its columns, its width and its box's (CSS px).
+_TABLES = """<script>window.addEventListener("load", function () {
+  document.querySelectorAll("details").forEach(function (d) { d.open = true; });
+  document.body.dataset.layout = JSON.stringify(Array.prototype.map.call(document.querySelectorAll("table"),
+    function (t) { return {columns: t.rows[0].cells.length, width: t.getBoundingClientRect().width,
+                           box: t.parentElement.clientWidth}; }));
+});</script>"""
+
+
 def first_screen_layout(html: Path, height: int = 1000, width: int = WIDTH, timeout: float = 120.0) -> dict:
     """Where the verdict table and the finding figure sit in a ``width`` x ``height`` window (CSS px)."""
+    return laid_out(html, _MEASURE, height, width, timeout)
+
+
+def table_widths(html: Path, width: int = WIDTH, timeout: float = 120.0) -> list[dict]:
+    """Each table of the page in a ``width`` px wide window, every section open: {columns, width, box} (CSS px;
+    box: the width of the box it lies in, which scrolls what is wider)."""
+    return laid_out(html, _TABLES, 1000, width, timeout)
+
+
+def laid_out(html: Path, script: str, height: int, width: int, timeout: float = 120.0):
+    """What ``script`` (run once the page has loaded) writes as JSON into <body data-layout>."""
     import json
     import re
 
@@ -83,7 +103,7 @@ def first_screen_layout(html: Path, height: int = 1000, width: int = WIDTH, time
         raise RuntimeError("no chromium found: apt-get install -y chromium")
     with tempfile.TemporaryDirectory(prefix="frictionlab-chromium-") as profile:
         probe = Path(profile) / "probe.html"
-        probe.write_text(Path(html).read_text(encoding="utf-8").replace("</body>", _MEASURE + "</body>"),
+        probe.write_text(Path(html).read_text(encoding="utf-8").replace("</body>", script + "</body>"),
                          encoding="utf-8")
         cmd = [exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
                "--disable-background-networking", "--disable-component-update", "--disable-sync",

@@ -17,9 +17,10 @@ The record is taken as straight pieces plus noise and segmented in five moves:
    candidate breakpoints (every sample within ``DENSE`` samples of either end, so that a change near an
    end is seen), and each breakpoint then moves to the best sample between its grid neighbours.
 3. **Jumps.** A breakpoint where the displacement jumps (sharply: three samples after it stand off the
-   three before by more than ``SHARP`` times their white noise) with no change of slope (parallel lines
-   cost less than the penalty more than free ones) is a transducer reset or a servo correction: it is
-   stitched (the samples after it shifted back by the jump) and reported.
+   three before by more than ``SHARP`` times the noise of that difference, from the white and total noise
+   read as AR(1) noise: a correlated wander moves neighbouring samples together and is no jump) with no
+   change of slope (parallel lines cost less than the penalty more than free ones) is a transducer reset or
+   a servo correction: it is stitched (the samples after it shifted back by the jump) and reported.
 4. **Merges.** Neighbouring pieces are merged, the straightest union first, while each piece strays from
    the union's line by at most ``MERGE`` times the two pieces' pooled noise (root mean square): drift and wander of the servo are not velocity steps. What is left
    are the steps; each piece between them must be straight within ``STRAIGHT`` times its noise, else the
@@ -43,8 +44,8 @@ import attrs
 import numpy as np
 
 from ..core.errors import DatasetError
-from .segment_noise import (LD, StretchNoise, last_digit, least_count, noise_by_sample, resolution,
-                            sampled_exactly)
+from .segment_noise import (LD, StretchNoise, ar1_coefficient, last_digit, least_count, noise_by_sample,
+                            resolution, sampled_exactly, shift_noise)
 
 #: Fewest samples of each velocity a step needs on either side.
 MIN_PIECE = 20
@@ -351,7 +352,7 @@ def segment(t: np.ndarray, x: np.ndarray, where: str = "record",
     M, bps, s1, total = _partition(t, x, g, penalty)
     exact_to = least_count(x) if float(np.median(s1)) <= resolution(t, x) * (1 + 1e-9) and \
         sampled_exactly(x, last_digit(x)) else 0.0
-    jumps, x = _jumps(t, x, M, s1, bps, penalty, n)
+    jumps, x = _jumps(t, x, M, (s1, total), bps, penalty, n)
     del M
     noise = StretchNoise(t, x, g, total)
     U = Moments(t, x, 1.0, g)
@@ -421,8 +422,11 @@ def _partition(t, x, g, penalty: float, passes: int = 4):
     return M, bps, s1, total
 
 
-def _jumps(t, x, M: Moments, s1: np.ndarray, bps: list[int], penalty: float, n: int):
-    """The breakpoints that are jumps (move 3) and x with them stitched."""
+def _jumps(t, x, M: Moments, noise: tuple, bps: list[int], penalty: float, n: int):
+    """The breakpoints that are jumps (move 3) and x with them stitched; ``noise``: the white and total noise by
+    sample."""
+    s1, total = noise
+    phi = ar1_coefficient(s1, total)
     fine = [0, *bps, n]
     found = []
     for a, p, b in zip(fine[:-2], fine[1:-1], fine[2:]):
@@ -433,7 +437,7 @@ def _jumps(t, x, M: Moments, s1: np.ndarray, bps: list[int], penalty: float, n: 
             continue  # the slope changes
         v = (x[b - 1] - x[p] + x[p - 1] - x[a]) / (t[b - 1] - t[p] + t[p - 1] - t[a])  # the pieces' velocity
         d = np.mean(x[p:p + 3] - v * t[p:p + 3]) - np.mean(x[p - 3:p] - v * t[p - 3:p])
-        if abs(d) > SHARP * s1[p] * math.sqrt(2 / 3):
+        if abs(d) > SHARP * shift_noise(total[p], phi[p]):
             found.append((a, p, b))
     jumps, x = [], x.copy()
     for a, p, b in found:  # the offset of parallel lines through [a, p) and [p, b)

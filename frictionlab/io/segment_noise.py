@@ -56,10 +56,25 @@ def noise_by_sample(t: np.ndarray, x: np.ndarray, cuts=()) -> tuple[np.ndarray, 
     floor = resolution(t, x)
     s1 = np.fmax(np.nan_to_num(scale[0], nan=floor), floor)
     total = np.fmax(np.nan_to_num(np.nanmax(scale, axis=0), nan=floor), s1)
-    q = np.clip((s1 / total) ** 2, 1e-4, 1.0)  # AR(1): sigma1^2 / sigma^2 = (1 - phi)(3 - phi) / 3
-    phi = np.clip(2.0 - np.sqrt(1.0 + 3.0 * q), 0.0, 0.99)
+    phi = ar1_coefficient(s1, total)
     per = np.repeat(np.arange(nb), np.diff(edges))
     return s1[per], total[per], (total ** 2 * (1 + phi) / (1 - phi))[per]
+
+
+def ar1_coefficient(s1, total):
+    """The coefficient phi of AR(1) noise of standard deviation ``total`` whose lag-1 pseudo-residuals have the
+    scale ``s1``: sigma1^2 / sigma^2 = (1 - phi)(3 - phi) / 3 (0 for white noise, at most 0.99)."""
+    q = np.clip((np.asarray(s1) / np.asarray(total)) ** 2, 1e-4, 1.0)
+    return np.clip(2.0 - np.sqrt(1.0 + 3.0 * q), 0.0, 0.99)
+
+
+def shift_noise(total: float, phi: float, k: int = 3) -> float:
+    """The standard deviation of the mean of k samples less the mean of the k before them, for AR(1) noise of
+    standard deviation ``total`` and coefficient ``phi``: total sqrt(2 / k) for white noise, and more for
+    correlated noise, whose wander moves neighbouring samples together."""
+    w = np.repeat([-1.0, 1.0], k) / k
+    lag = np.abs(np.subtract.outer(np.arange(2 * k), np.arange(2 * k)))
+    return float(total) * math.sqrt(max(float(w @ (float(phi) ** lag) @ w), 0.0))
 
 
 def resolution(t: np.ndarray, x: np.ndarray) -> float:

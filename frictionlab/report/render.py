@@ -25,6 +25,21 @@ def inline_html(text: str) -> Markup:
     return Markup(re.sub(r"`(.+?)`", r"<code>\1</code>", s))
 
 
+_NUMBER = r"[-+−]?(?:\d+\.?\d*|\.\d+)(?:e[-+]?\d+)?"
+#: The number a numeric cell starts with, and its standard error: '0.0114 ± 0.0012'.
+_VALUE = re.compile(rf"^\s*[#≈]?{_NUMBER}(?: ± {_NUMBER})?")
+
+
+def num_html(text: str) -> Markup:
+    """A numeric cell: the number it starts with (and its ± error) in a ``span.v`` that the page's style keeps on
+    one line; the rest of the cell (a unit, a note in brackets) free to wrap."""
+    text = str(text)
+    m = _VALUE.match(text)
+    if not m:
+        return inline_html(text)
+    return Markup('<span class="v">') + inline_html(m.group(0)) + Markup("</span>") + inline_html(text[m.end():])
+
+
 #: What could open a block at the start of a line: a heading, a list item, a numbered item, a rule,
 #: a fence (a quote '>' is already an entity).
 _BLOCK_START = re.compile(r"^(\d+)?(#|[-+*](?=\s)|[.)](?=\s|$)|```|~~~)")
@@ -51,7 +66,7 @@ def md_cell(text: str) -> str:
 
 def sort_key(cell: str) -> str:
     """The number a cell starts with (for sorting), else the cell itself."""
-    m = re.match(r"^\s*[#≈]?([-+−]?(?:\d+\.?\d*|\.\d+)(?:e[-+]?\d+)?)", cell)
+    m = re.match(rf"^\s*[#≈]?({_NUMBER})", cell)
     return m.group(1).replace("−", "-") if m else cell.lower()
 
 
@@ -75,7 +90,7 @@ def environment():
                              autoescape=jinja2.select_autoescape(["html", "html.j2"]),
                              trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True,
                              finalize=_inert_value)
-    env.filters.update(inline=inline_html, md=md_text, mdcell=md_cell, sortkey=sort_key, b64=b64)
+    env.filters.update(inline=inline_html, num=num_html, md=md_text, mdcell=md_cell, sortkey=sort_key, b64=b64)
     env.tests["numeric"] = is_numeric
     return env
 
