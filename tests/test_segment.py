@@ -28,27 +28,47 @@ def ar1(rng, n, phi, sigma):
 T = np.arange(3000) * 0.1
 
 
+def one_step_z(noise: str, seed: int) -> tuple[float, list[float]]:
+    """A record of one step (1 -> 3 um/s near 150 s; white noise or AR(1) noise of coefficient 0.9) segmented:
+    (estimate - truth) / standard error of the step time, and of the two velocities. Exactly one step is found."""
+    rng = np.random.default_rng(seed)
+    ts = 150.0 + rng.uniform(0, 0.1)
+    e = rng.normal(0, 0.1, T.size) if noise == "white" else ar1(rng, T.size, 0.9, 0.05)
+    s = segment(T, piecewise(T, [ts], [1.0, 3.0]) + e)
+    assert len(s.steps) == 1
+    return (s.steps[0].time - ts) / s.steps[0].time_se, \
+        [(v - truth) / se for v, truth, se in zip(s.velocities, (1.0, 3.0), s.velocities_se)]
+
+
+@pytest.mark.parametrize("noise", ["white", "ar1"])
+def test_each_step_time_and_velocity_is_within_four_standard_errors_of_the_truth(noise):
+    """Five records of the calibration below, each on its own: one step, found within 4 standard errors."""
+    for seed in range(5):
+        z, zv = one_step_z(noise, seed)
+        assert abs(z) < 4 and max(map(abs, zv)) < 4, (seed, z, zv)
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize("noise", ["white", "ar1"])
 def test_step_times_and_velocities_agree_with_the_truth_within_their_errors(noise):
     """Over 30 records, the step time lands within its standard error as often as a normal variable does (the
-    rms of (estimate - truth) / error near 1), with AR(1) noise of coefficient 0.9 too."""
+    rms of (estimate - truth) / error near 1), with AR(1) noise of coefficient 0.9 too (a calibration: run by
+    ``python benchmarks/calibration_segment.py``)."""
     z, zv = [], []
     for seed in range(30):
-        rng = np.random.default_rng(seed)
-        ts = 150.0 + rng.uniform(0, 0.1)
-        e = rng.normal(0, 0.1, T.size) if noise == "white" else ar1(rng, T.size, 0.9, 0.05)
-        s = segment(T, piecewise(T, [ts], [1.0, 3.0]) + e)
-        assert len(s.steps) == 1
-        z.append((s.steps[0].time - ts) / s.steps[0].time_se)
-        zv += [(v - truth) / se for v, truth, se in zip(s.velocities, (1.0, 3.0), s.velocities_se)]
+        zt, zvs = one_step_z(noise, seed)
+        z.append(zt)
+        zv += zvs
     assert 0.6 < np.sqrt(np.mean(np.square(z))) < 1.5, z
     assert np.sqrt(np.mean(np.square(zv))) < 1.5, zv
 
 
 @pytest.mark.parametrize("phi", [0.0, 0.9, 0.99])
-def test_a_record_without_a_step_is_refused_not_cut_into_pieces(phi):
-    """Pure noise about one line, white or strongly correlated: the data choose no step (40 records each)."""
-    for seed in range(40):
+@pytest.mark.parametrize("records", [5, pytest.param(40, marks=pytest.mark.slow)])
+def test_a_record_without_a_step_is_refused_not_cut_into_pieces(phi, records):
+    """Pure noise about one line, white or strongly correlated: the data choose no step (5 records each; 40 in
+    the calibration run by ``python benchmarks/calibration_segment.py``)."""
+    for seed in range(records):
         rng = np.random.default_rng(seed)
         e = rng.normal(0, 0.1, T.size) if phi == 0 else ar1(rng, T.size, phi, 0.05)
         with pytest.raises(DatasetError, match="no velocity step found: the displacement is one straight line"):
