@@ -35,6 +35,8 @@ class NoiseModel:
     refl: tuple = ()  # reflection coefficients k_1..k_p (AR)
     cap: int = 0  # the largest order BIC could choose
     capped: bool = False  # BIC's AR order was the cap
+    robust: str = ""  # why this AR(1) is a working model only (no candidate whitened the residuals), '' otherwise
+    best: "NoiseModel | None" = None  # a working model's stand-in: the data's best candidate (``candidates``)
 
     @property
     def order(self) -> int:
@@ -88,28 +90,42 @@ def burg(x, pmax: int) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
     return coefs, np.array(ks), np.array(E)
 
 
-def select(x, rate: float) -> tuple[NoiseModel, float]:
-    """The noise model of residuals x of one group sampled at ``rate`` [Hz] (module docstring) and its innovation
-    variance."""
+def candidates(x, rate: float) -> list[tuple[NoiseModel, float]]:
+    """The noise models of residuals x of one group sampled at ``rate`` [Hz], best first, each with its innovation
+    variance: the AR(p) of BIC's order; where that order is the cap, ARMA(1,1) too, the two ordered by BIC (module
+    docstring)."""
     x = np.asarray(x, dtype=float)
     n = x.size
     cap = order_cap(rate, n)
     if n < 10:
-        return WHITE, float(x @ x) / max(n, 1)
+        return [(WHITE, float(x @ x) / max(n, 1))]
     coefs, ks, E = burg(x, cap)
     E = np.maximum(E, 1e-300)
     bic = n * np.log(E) + np.arange(cap + 1) * math.log(n)
     p = int(np.argmin(bic))
     if p == 0:
-        return attrs.evolve(WHITE, cap=cap), float(E[0])
-    model = NoiseModel("AR", tuple(coefs[p]), 0.0, tuple(ks[:p]), cap, p == cap)
-    var = float(E[p])
+        return [(attrs.evolve(WHITE, cap=cap), float(E[0]))]
+    out = [(NoiseModel("AR", tuple(coefs[p]), 0.0, tuple(ks[:p]), cap, p == cap), float(E[p]))]
     if p == cap:
         arma = _arma11(x)
-        if arma is not None and n * math.log(arma[1]) + 2 * math.log(n) < bic[p]:
-            model = NoiseModel("ARMA(1,1)", (arma[0][0],), arma[0][1], (), cap, True)
-            var = arma[1]
-    return model, var
+        if arma is not None:
+            model = (NoiseModel("ARMA(1,1)", (arma[0][0],), arma[0][1], (), cap, True), arma[1])
+            better = n * math.log(arma[1]) + 2 * math.log(n) < bic[p]
+            out = [model] + out if better else out + [model]
+    return out
+
+
+def select(x, rate: float) -> tuple[NoiseModel, float]:
+    """The noise model of residuals x of one group sampled at ``rate`` [Hz] (the first of ``candidates``) and its
+    innovation variance."""
+    return candidates(x, rate)[0]
+
+
+def ar1_working(x, why: str, best: NoiseModel) -> tuple[NoiseModel, float]:
+    """AR(1) of x by Burg's method, marked as the working model of noise that no candidate whitens (``why``;
+    ``best``: the data's best candidate, which the law-fit test keeps)."""
+    coefs, ks, E = burg(np.asarray(x, dtype=float), 1)
+    return NoiseModel("AR", tuple(coefs[1]), 0.0, tuple(ks), robust=why, best=best), float(max(E[1], 1e-300))
 
 
 def _arma11(x) -> tuple[tuple[float, float], float] | None:

@@ -48,12 +48,14 @@ class RecordNoise:
         """Noise coefficients fitted over the groups (AR orders, ARMA's two), their levels not counted."""
         return sum(m.n_coef for m in self.models)
 
-    def whiten(self, v) -> np.ndarray:
-        """v (samples, or samples x columns) whitened run by run with each group's model (innovation scale)."""
+    def whiten(self, v, best: bool = False) -> np.ndarray:
+        """v (samples, or samples x columns) whitened run by run with each group's model (innovation scale); with
+        ``best``, a working model's stand-in (``arp.ar1_working``) in its place."""
         v = np.asarray(v, dtype=float)
         out = np.empty_like(v)
         for a, b, g in self.runs:
-            out[a:b] = arp.whiten(v[a:b], self.models[g])
+            m = self.models[g]
+            out[a:b] = arp.whiten(v[a:b], m.best if best and m.best is not None else m)
         return out
 
     def log_det_terms(self) -> np.ndarray:
@@ -73,15 +75,45 @@ class RecordNoise:
         """The whitening's term of -2 ln L over the runs."""
         return sum(arp.log_det(self.models[g], b - a) for a, b, g in self.runs)
 
+    def whiteness(self, z, g: int, model=None) -> tuple[float, int]:
+        """(p, lags) of the Ljung-Box test that z (residuals, every sample) whitened by ``model`` (default: group g's
+        own; the filter restarts at each of the group's runs) are white over group g's samples: max(WHITE_LAGS,
+        order + 10) lags, the model's coefficients taken from the degrees of freedom; p is NaN when too short."""
+        from ..diagnostics.goodness import WHITE_LAGS, ljung_box
+
+        m = self.models[g] if model is None else model
+        pieces = [arp.whiten(z[a:b], m) for a, b, gg in self.runs if gg == g]
+        lags = max(WHITE_LAGS, m.order + 10)
+        return (ljung_box(np.concatenate(pieces), m.n_coef, lags) if pieces else math.nan), lags
+
     def estimate(self, residual, profile: bool = True) -> float:
-        """Choose each group's model from ``residual`` (model - data) and, when ``profile``, set sigma_g to the root
-        mean square of its whitened residual. Returns the largest relative change of a group's sigma_g."""
+        """Choose each group's model from ``residual`` (model - data): the first of ``arp.candidates`` whose whitened
+        residuals pass the Ljung-Box test (``whiteness``) at FITS_LEVEL, Bonferroni over the groups; where none
+        does, ``arp.ar1_working`` (kept for the rest of the fit). When ``profile``, set sigma_g to the root mean
+        square of the whitened residual. Returns the largest relative change of a group's sigma_g."""
+        from ..diagnostics.goodness import FITS_LEVEL
+
         r = np.asarray(residual, dtype=float)
         old = self.sigma_g.copy()
+        level = FITS_LEVEL / max(1, self.refs.size)
         for g in range(self.refs.size):
             pieces = [r[a:b] for a, b, gg in self.runs if gg == g]
             x = np.concatenate(pieces) if pieces else np.zeros(0)
-            self.models[g], _ = arp.select(x - x.mean() if x.size else x, 1.0 / self.refs[g])
+            x = x - x.mean() if x.size else x
+            found = arp.candidates(x, 1.0 / self.refs[g])
+            if self.models[g].robust:
+                self.models[g], _ = arp.ar1_working(x, self.models[g].robust, found[0][0])
+                continue
+            tried = []
+            for m, _ in found:
+                p, lags = self.whiteness(r, g, m)
+                if not p < level:
+                    self.models[g] = m
+                    break
+                tried.append(f"{m.name} (Ljung-Box p = {p:.1e} over {lags} lags)")
+            else:
+                why = "the residuals stay correlated under " + " and ".join(tried)
+                self.models[g], _ = arp.ar1_working(x, why, found[0][0])
         if profile:
             w = self.whiten(r)
             for g in range(self.refs.size):
@@ -91,9 +123,17 @@ class RecordNoise:
                     self.sigma_g[g] = math.sqrt(ms)
         return float(np.max(np.abs(self.sigma_g / old - 1.0))) if old.size else 0.0
 
+    @property
+    def robust(self) -> bool:
+        """Whether some group's noise no candidate model whitens (its AR(1) a working model: sandwich errors)."""
+        return any(m.robust for m in self.models)
+
     def describe(self) -> list[tuple[str, str]]:
         """(rate label, model name) per group: ('100 Hz', 'AR(6)')."""
-        return [(f"{1 / r:.3g} Hz", m.name + (" (AR order at its cap)" if m.capped else ""))
+        return [(f"{1 / r:.3g} Hz", m.name + (f" as a working model ({m.robust}: AR(1)-prewhitened, Newey-West "
+                                              f"sandwich error bars, the law-fit bands under {m.best.name})"
+                                              if m.robust else
+                                              " (AR order at its cap)" if m.capped else ""))
                 for r, m in zip(self.refs, self.models)]
 
     def draw(self, rng) -> np.ndarray:
