@@ -100,10 +100,10 @@ class RecordNoise:
             pieces = [r[a:b] for a, b, gg in self.runs if gg == g]
             x = np.concatenate(pieces) if pieces else np.zeros(0)
             x = x - x.mean() if x.size else x
-            found = arp.candidates(x, 1.0 / self.refs[g])
-            if self.models[g].robust:
-                self.models[g], _ = arp.ar1_working(x, self.models[g].robust, found[0][0])
+            if self.models[g].robust:  # kept: only its coefficient follows the residuals
+                self.models[g], _ = arp.ar1_working(x, self.models[g].robust, self.models[g].best)
                 continue
+            found = arp.candidates(x, 1.0 / self.refs[g])
             tried = []
             for m, _ in found:
                 p, lags = self.whiteness(r, g, m)
@@ -122,6 +122,19 @@ class RecordNoise:
                 if math.isfinite(ms) and ms > 0:
                     self.sigma_g[g] = math.sqrt(ms)
         return float(np.max(np.abs(self.sigma_g / old - 1.0))) if old.size else 0.0
+
+    def ar1_form(self):
+        """Where every group's model is white or AR(1): (1 / marginal sigma, phi, 1 / sqrt(1 - phi^2)) per sample,
+        phi 0 at the start of each run, the weights with which ``velstep.kernel.basis_sums`` whitens exactly as
+        ``whiten`` does; None otherwise."""
+        if any(m.kind == "ARMA(1,1)" or m.order > 1 for m in self.models):
+            return None
+        phi_g = np.array([m.ar[0] if m.order else 0.0 for m in self.models])
+        phi = phi_g[self.labels]
+        inv = np.sqrt(1.0 - phi * phi) / self.sigma
+        phi = phi.copy()
+        phi[[a for a, _, _ in self.runs]] = 0.0
+        return inv, phi, 1.0 / np.sqrt(1.0 - phi * phi)
 
     @property
     def robust(self) -> bool:
