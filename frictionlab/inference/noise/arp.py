@@ -6,6 +6,10 @@ where the AR order runs to its cap, for the residuals of one sampling-rate group
   the rate (``order_cap``: tens of lags at 1 kHz, a few at 10 Hz) and stays below n / 20.
 * Where BIC's order is the cap (the AR order runs away), ARMA(1,1) (x_t = phi x_{t-1} + e_t + theta e_{t-1}),
   fitted by conditional least squares, takes its place when its BIC is lower than the capped AR's.
+* Candidates (``candidates``): BIC's AR(p) and, where its order is the cap, ARMA(1,1), best first; the record's
+  model is the first whose whitened residuals pass the Ljung-Box test (``noise.record``). Where none does, AR(1)
+  (``ar1_working``) is a working model only: the fit is AR(1)-prewhitened and its error bars are the Newey-West
+  sandwich (``velstep.result``).
 * Whitening (``whiten``): the exact innovations of a stationary AR(p) (Durbin-Levinson: sample i < p is
   predicted by the order-i predictor and scaled by the ratio of its prediction variance to the innovation
   variance), then ``scipy.signal.lfilter`` with the AR polynomial; ARMA(1,1) is filtered by (1 - phi L) /

@@ -2,7 +2,8 @@
 
 Samples are grouped by rate as for AR(1) noise (``ar1.rate_groups``); each contiguous run of a group is whitened
 on its own (the filter restarts at a change of rate). ``estimate`` chooses every group's model from a fit's
-residuals and profiles its innovation standard deviation (the maximum-likelihood value, the root mean square of
+residuals (the first candidate whose whitened residuals are white, else an AR(1) working model) and profiles its
+innovation standard deviation (the maximum-likelihood value, the root mean square of
 the whitened residuals); the fit then weights by it, and the two alternate (feasible GLS, ``velstep``).
 """
 from __future__ import annotations
