@@ -133,7 +133,8 @@ def test_noise_no_candidate_whitens_gets_an_ar1_working_model_and_whitenable_noi
     rec.estimate(_seasonal(np.random.default_rng(0), t.size))
     m = rec.models[0]
     assert rec.robust and m.name == "AR(1)" and m.best.name == "AR(12)"
-    assert "stay correlated under AR(12)" in m.robust and "working model" in rec.describe()[0][1]
+    assert m.robust.startswith("AR(12) leaves the residuals correlated (Ljung-Box p = ")
+    assert rec.describe()[0][1].startswith("AR(1) working model: AR(12) leaves")
     rec.estimate(arp.draw(np.random.default_rng(1), arp.from_coefficients((0.6, -0.2)), t.size))
     assert rec.models[0].robust  # kept for the rest of the fit once chosen
     fresh = RecordNoise.of(t, 1e-3)
@@ -170,7 +171,7 @@ def test_a_fit_whose_noise_no_model_whitens_says_so_and_its_sandwich_error_bars_
     noise = _seasonal(np.random.default_rng(7), curve.size, scale=3e-4)
     f = fl.fit(AGING, data_of(ds, curve + noise), trend=True, stiffness=True)
     (rate, what), = f.velstep.rows[0].noise
-    assert what.startswith("AR(1) as a working model") and "Newey-West sandwich" in what
+    assert what.startswith("AR(1) working model: ") and "Newey-West sandwich" in what
     assert "working model" in f.stats.likelihood_reason
     for name, value in (("a", 0.009), ("b", 0.012), ("Dc", 10e-6)):
         assert abs(f.value(name) - value) < 4 * f.params[name].stderr

@@ -105,15 +105,17 @@ class RecordNoise:
                 self.models[g], _ = arp.ar1_working(x, self.models[g].robust, self.models[g].best)
                 continue
             found = arp.candidates(x, 1.0 / self.refs[g])
-            tried = []
+            names, ps = [], []
             for m, _ in found:
                 p, lags = self.whiteness(r, g, m)
                 if not p < level:
                     self.models[g] = m
                     break
-                tried.append(f"{m.name} (Ljung-Box p = {p:.1e} over {lags} lags)")
+                names.append(m.name)
+                ps.append(f"{p:.1g}")
             else:
-                why = "the residuals stay correlated under " + " and ".join(tried)
+                verb = "leaves" if len(names) == 1 else "leave"
+                why = f"{' and '.join(names)} {verb} the residuals correlated (Ljung-Box p = {', '.join(ps)})"
                 self.models[g], _ = arp.ar1_working(x, why, found[0][0])
         if profile:
             w = self.whiten(r)
@@ -144,9 +146,8 @@ class RecordNoise:
 
     def describe(self) -> list[tuple[str, str]]:
         """(rate label, model name) per group: ('100 Hz', 'AR(6)')."""
-        return [(f"{1 / r:.3g} Hz", m.name + (f" as a working model ({m.robust}: AR(1)-prewhitened, Newey-West "
-                                              f"sandwich error bars, the law-fit bands under {m.best.name})"
-                                              if m.robust else
+        return [(f"{1 / r:.3g} Hz", m.name + (f" working model: {m.robust}; Newey-West sandwich error bars, the "
+                                              f"law-fit bands under {m.best.name}" if m.robust else
                                               " (AR order at its cap)" if m.capped else ""))
                 for r, m in zip(self.refs, self.models)]
 
