@@ -112,7 +112,7 @@ class RecordNoise:
                     self.models[g] = m
                     break
                 names.append(m.name)
-                ps.append(f"{p:.1g}")
+                ps.append(f"{p:.1g}" if p > 0 else "below 1e-300")
             else:
                 verb = "leaves" if len(names) == 1 else "leave"
                 why = f"{' and '.join(names)} {verb} the residuals correlated (Ljung-Box p = {', '.join(ps)})"
