@@ -133,13 +133,28 @@ def test_noise_no_candidate_whitens_gets_an_ar1_working_model_and_whitenable_noi
     rec.estimate(_seasonal(np.random.default_rng(0), t.size))
     m = rec.models[0]
     assert rec.robust and m.name == "AR(1)" and m.best.name == "AR(12)"
-    assert m.robust.startswith("AR(12) leaves the residuals correlated (Ljung-Box p = ")
-    assert rec.describe()[0][1].startswith("AR(1) working model: AR(12) leaves")
+    assert m.robust.startswith("AR(12), ARMA(1,1) and AR(20) leave the residuals correlated (Ljung-Box p = ")
+    assert rec.describe()[0][1].startswith("AR(1) working model: AR(12), ARMA(1,1) and AR(20) leave")
     rec.estimate(arp.draw(np.random.default_rng(1), arp.from_coefficients((0.6, -0.2)), t.size))
     assert rec.models[0].robust  # kept for the rest of the fit once chosen
     fresh = RecordNoise.of(t, 1e-3)
     fresh.estimate(arp.draw(np.random.default_rng(1), arp.from_coefficients((0.6, -0.2)), t.size))
     assert not fresh.robust and fresh.models[0].name == "AR(2)"
+
+
+def test_arma11_is_the_next_candidate_where_bics_ar_order_leaves_the_residuals_correlated():
+    from frictionlab.inference.noise.record import RecordNoise
+
+    t = np.arange(5000) / 100.0
+    chosen = []
+    for seed in range(12):
+        x = arp.draw(np.random.default_rng(seed), arp.from_coefficients((0.5,), ma=0.8), t.size)
+        first = arp.select(x, 100.0)[0]
+        rec = RecordNoise.of(t, 1.0)
+        rec.estimate(x)
+        assert not rec.robust and first.kind == "AR" and not first.capped  # BIC's order stays below the cap of 20
+        chosen.append(rec.models[0].name)
+    assert "ARMA(1,1)" in chosen and all(c == "ARMA(1,1)" or c.startswith("AR(") for c in chosen)
 
 
 def test_the_compiled_pass_whitens_an_ar1_record_exactly_as_the_filter_does():

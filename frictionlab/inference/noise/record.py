@@ -104,9 +104,9 @@ class RecordNoise:
             if self.models[g].robust:  # kept: only its coefficient follows the residuals
                 self.models[g], _ = arp.ar1_working(x, self.models[g].robust, self.models[g].best)
                 continue
-            found = arp.candidates(x, 1.0 / self.refs[g])
-            names, ps = [], []
-            for m, _ in found:
+            names, ps, first = [], [], None
+            for m, _ in arp.candidates(x, 1.0 / self.refs[g]):
+                first = first or m
                 p, lags = self.whiteness(r, g, m)
                 if not p < level:
                     self.models[g] = m
@@ -115,8 +115,9 @@ class RecordNoise:
                 ps.append(f"{p:.1g}" if p > 0 else "below 1e-300")
             else:
                 verb = "leaves" if len(names) == 1 else "leave"
-                why = f"{' and '.join(names)} {verb} the residuals correlated (Ljung-Box p = {', '.join(ps)})"
-                self.models[g], _ = arp.ar1_working(x, why, found[0][0])
+                listed = " and ".join([", ".join(names[:-1]), names[-1]] if len(names) > 1 else names)
+                why = f"{listed} {verb} the residuals correlated (Ljung-Box p = {', '.join(ps)})"
+                self.models[g], _ = arp.ar1_working(x, why, first)
         if profile:
             w = self.whiten(r)
             for g in range(self.refs.size):
