@@ -85,7 +85,7 @@ def _table_text(fit) -> str:
     for label, phi in row.phi:
         lines.append(f"φ {label}: {phi:.3f}")
     for label, model in row.noise:
-        lines += textwrap.wrap(f"noise {label}: {model}", 44, subsequent_indent="  ")
+        lines += textwrap.wrap(f"noise {label}: {model}", 34, subsequent_indent="  ")
     lines.append("")
     lines.append(f"goodness: {fit.goodness.short}")
     return "\n".join(lines)
