@@ -8,9 +8,8 @@ where the AR order runs to its cap, for the residuals of one sampling-rate group
   fitted by conditional least squares, takes its place when its BIC is lower than the capped AR's.
 * Candidates (``candidates``): BIC's choice, then ARMA(1,1) or the capped AR(p) (whichever BIC did not choose),
   then AR at the cap; the record's model is the first whose whitened residuals pass the Ljung-Box test
-  (``noise.record``). Where none does, AR(1)
-  (``ar1_working``) is a working model only: the fit is AR(1)-prewhitened and its error bars are the Newey-West
-  sandwich (``velstep.result``).
+  (``noise.record``). Where none does, AR(1) (``ar1_working``) is a working model only: the fit is
+  AR(1)-prewhitened and its error bars are the Newey-West sandwich (``velstep.result``).
 * Whitening (``whiten``): the exact innovations of a stationary AR(p) (Durbin-Levinson: sample i < p is
   predicted by the order-i predictor and scaled by the ratio of its prediction variance to the innovation
   variance), then ``scipy.signal.lfilter`` with the AR polynomial; ARMA(1,1) is filtered by (1 - phi L) /
