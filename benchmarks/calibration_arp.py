@@ -57,7 +57,7 @@ def replicate(ds, curve, model, seed: int):
     truth = {"a": t["a"], "b": t["b"], "a-b": t["a"] - t["b"], "Dc": t["Dc"], "spring.stiffness": calibration_ar1.K_TRUE}
     covered = {name: f.params[name].stderr is not None and abs(f.params[name].value - v) <= 1.959964 *
                f.params[name].stderr for name, v in truth.items()}
-    chosen = ", ".join(m for _, m in f.velstep.rows[0].noise)
+    chosen = ", ".join(m.split(":")[0].split(" (")[0] for _, m in f.velstep.rows[0].noise)  # "AR(1) working model"
     return covered, f.goodness.fits, chosen
 
 

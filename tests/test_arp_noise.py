@@ -116,3 +116,77 @@ def test_a_velocity_step_fit_chooses_the_noise_model_and_keeps_the_two_questions
     aging30 = truth(ds30, x30, v30, AGING)
     g = fl.fit("rate-state-slip", data_of(ds30, aging30 + noise[:aging30.size]), trend=True, stiffness=True).goodness
     assert g.fits is False and "Dc after step 1" in g.band
+
+
+def _seasonal(rng, n, lag=12, scale=1e-3):
+    """x_t = e_t + 0.9 e_{t-lag}: correlation at a lag of its own that no AR order up to the cap nor ARMA(1,1)
+    whitens."""
+    e = rng.standard_normal(n + lag)
+    return scale * (e[lag:] + 0.9 * e[:-lag])
+
+
+def test_noise_no_candidate_whitens_gets_an_ar1_working_model_and_whitenable_noise_keeps_its_choice():
+    from frictionlab.inference.noise.record import RecordNoise
+
+    t = np.arange(3500) / 100.0
+    rec = RecordNoise.of(t, 1e-3)
+    rec.estimate(_seasonal(np.random.default_rng(0), t.size))
+    m = rec.models[0]
+    assert rec.robust and m.name == "AR(1)" and m.best.name == "AR(12)"
+    assert m.robust.startswith("AR(12), ARMA(1,1) and AR(20) leave the residuals correlated (Ljung-Box p = ")
+    assert rec.describe()[0][1].startswith("AR(1) working model: AR(12), ARMA(1,1) and AR(20) leave")
+    rec.estimate(arp.draw(np.random.default_rng(1), arp.from_coefficients((0.6, -0.2)), t.size))
+    assert rec.models[0].robust  # kept for the rest of the fit once chosen
+    fresh = RecordNoise.of(t, 1e-3)
+    fresh.estimate(arp.draw(np.random.default_rng(1), arp.from_coefficients((0.6, -0.2)), t.size))
+    assert not fresh.robust and fresh.models[0].name == "AR(2)"
+
+
+def test_arma11_is_the_next_candidate_where_bics_ar_order_leaves_the_residuals_correlated():
+    from frictionlab.inference.noise.record import RecordNoise
+
+    t = np.arange(5000) / 100.0
+    chosen = []
+    for seed in range(12):
+        x = arp.draw(np.random.default_rng(seed), arp.from_coefficients((0.5,), ma=0.8), t.size)
+        first = arp.select(x, 100.0)[0]
+        rec = RecordNoise.of(t, 1.0)
+        rec.estimate(x)
+        assert not rec.robust and first.kind == "AR" and not first.capped  # BIC's order stays below the cap of 20
+        chosen.append(rec.models[0].name)
+    assert "ARMA(1,1)" in chosen and all(c == "ARMA(1,1)" or c.startswith("AR(") for c in chosen)
+
+
+def test_the_compiled_pass_whitens_an_ar1_record_exactly_as_the_filter_does():
+    from frictionlab.inference.noise.record import RecordNoise
+    from frictionlab.inference.velstep.kernel import basis_sums
+
+    rng = np.random.default_rng(4)
+    t = np.concatenate([np.arange(300) / 10.0, 30.0 + np.arange(1, 501) / 100.0])
+    rec = RecordNoise.of(t, 1.0)
+    rec.models = [arp.from_coefficients((0.7,)), arp.from_coefficients((-0.3,))]
+    rec.sigma_g = np.array([2e-3, 1e-3])
+    y, m, S = rng.standard_normal(t.size), rng.standard_normal(t.size), rng.standard_normal((t.size, 4))
+    Q = np.linalg.qr(rng.standard_normal((t.size, 2)))[0]
+    got = basis_sums(y, 0.1, m, S, *rec.ar1_form(), Q)
+    W = rec.whiten(np.column_stack([0.1 + m - y, S, np.ones(t.size)]) / rec.sigma[:, None])
+    w, D = W[:, 0], W[:, 1:]
+    for a, b in zip(got, (float(w @ w), D.T @ w, D.T @ D, Q.T @ w, Q.T @ D)):
+        assert np.allclose(a, b, rtol=1e-10, atol=1e-12 * np.max(np.abs(b)))
+    rec.models[1] = arp.from_coefficients((0.5, -0.2))
+    assert rec.ar1_form() is None
+
+
+def test_a_fit_whose_noise_no_model_whitens_says_so_and_its_sandwich_error_bars_cover_the_truth(tmp_path):
+    import frictionlab as fl
+    from calibration_vuong import AGING, data_of, make_dataset, truth
+
+    ds, x, v1 = make_dataset(tmp_path, 3.0)
+    curve = truth(ds, x, v1, AGING)
+    noise = _seasonal(np.random.default_rng(7), curve.size, scale=3e-4)
+    f = fl.fit(AGING, data_of(ds, curve + noise), trend=True, stiffness=True)
+    (rate, what), = f.velstep.rows[0].noise
+    assert what.startswith("AR(1) working model: ") and "Newey-West sandwich" in what
+    assert "working model" in f.stats.likelihood_reason
+    for name, value in (("a", 0.009), ("b", 0.012), ("Dc", 10e-6)):
+        assert abs(f.value(name) - value) < 4 * f.params[name].stderr

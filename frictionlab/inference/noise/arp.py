@@ -6,6 +6,10 @@ where the AR order runs to its cap, for the residuals of one sampling-rate group
   the rate (``order_cap``: tens of lags at 1 kHz, a few at 10 Hz) and stays below n / 20.
 * Where BIC's order is the cap (the AR order runs away), ARMA(1,1) (x_t = phi x_{t-1} + e_t + theta e_{t-1}),
   fitted by conditional least squares, takes its place when its BIC is lower than the capped AR's.
+* Candidates (``candidates``): BIC's choice, then ARMA(1,1) or the capped AR(p) (whichever BIC did not choose),
+  then AR at the cap; the record's model is the first whose whitened residuals pass the Ljung-Box test
+  (``noise.record``). Where none does, AR(1) (``ar1_working``) is a working model only: the fit is
+  AR(1)-prewhitened and its error bars are the Newey-West sandwich (``velstep.result``).
 * Whitening (``whiten``): the exact innovations of a stationary AR(p) (Durbin-Levinson: sample i < p is
   predicted by the order-i predictor and scaled by the ratio of its prediction variance to the innovation
   variance), then ``scipy.signal.lfilter`` with the AR polynomial; ARMA(1,1) is filtered by (1 - phi L) /
@@ -35,6 +39,8 @@ class NoiseModel:
     refl: tuple = ()  # reflection coefficients k_1..k_p (AR)
     cap: int = 0  # the largest order BIC could choose
     capped: bool = False  # BIC's AR order was the cap
+    robust: str = ""  # why this AR(1) is a working model only (no candidate whitened the residuals), '' otherwise
+    best: "NoiseModel | None" = None  # a working model's stand-in: the data's best candidate (``candidates``)
 
     @property
     def order(self) -> int:
@@ -88,28 +94,59 @@ def burg(x, pmax: int) -> tuple[list[np.ndarray], np.ndarray, np.ndarray]:
     return coefs, np.array(ks), np.array(E)
 
 
-def select(x, rate: float) -> tuple[NoiseModel, float]:
-    """The noise model of residuals x of one group sampled at ``rate`` [Hz] (module docstring) and its innovation
-    variance."""
+def candidates(x, rate: float):
+    """The noise models of residuals x of one group sampled at ``rate`` [Hz], best first, each with its innovation
+    variance (a generator: a later candidate is fitted only when asked for): BIC's choice (module docstring); then
+    ARMA(1,1) or the capped AR(p), whichever BIC did not choose; then AR at the cap."""
     x = np.asarray(x, dtype=float)
     n = x.size
     cap = order_cap(rate, n)
     if n < 10:
-        return WHITE, float(x @ x) / max(n, 1)
+        yield WHITE, float(x @ x) / max(n, 1)
+        return
     coefs, ks, E = burg(x, cap)
     E = np.maximum(E, 1e-300)
     bic = n * np.log(E) + np.arange(cap + 1) * math.log(n)
     p = int(np.argmin(bic))
-    if p == 0:
-        return attrs.evolve(WHITE, cap=cap), float(E[0])
-    model = NoiseModel("AR", tuple(coefs[p]), 0.0, tuple(ks[:p]), cap, p == cap)
-    var = float(E[p])
-    if p == cap:
-        arma = _arma11(x)
-        if arma is not None and n * math.log(arma[1]) + 2 * math.log(n) < bic[p]:
-            model = NoiseModel("ARMA(1,1)", (arma[0][0],), arma[0][1], (), cap, True)
-            var = arma[1]
-    return model, var
+
+    def ar(q):
+        return (NoiseModel("AR", tuple(coefs[q]), 0.0, tuple(ks[:q]), cap, q == cap) if q else
+                attrs.evolve(WHITE, cap=cap)), float(E[q])
+
+    def arma():
+        fitted = _arma11(x)
+        return None if fitted is None else (NoiseModel("ARMA(1,1)", (fitted[0][0],), fitted[0][1], (), cap, p == cap),
+                                            fitted[1])
+
+    if p == cap and p:
+        other = arma()
+        if other is not None and n * math.log(other[1]) + 2 * math.log(n) < bic[p]:
+            yield other
+            yield ar(p)
+            return
+        yield ar(p)
+        if other is not None:
+            yield other
+        return
+    yield ar(p)
+    other = arma()
+    if other is not None:
+        yield other
+    if cap > p:
+        yield ar(cap)
+
+
+def select(x, rate: float) -> tuple[NoiseModel, float]:
+    """The noise model of residuals x of one group sampled at ``rate`` [Hz] (the first of ``candidates``) and its
+    innovation variance."""
+    return next(candidates(x, rate))
+
+
+def ar1_working(x, why: str, best: NoiseModel) -> tuple[NoiseModel, float]:
+    """AR(1) of x by Burg's method, marked as the working model of noise that no candidate whitens (``why``;
+    ``best``: the data's best candidate, which the law-fit test keeps)."""
+    coefs, ks, E = burg(np.asarray(x, dtype=float), 1)
+    return NoiseModel("AR", tuple(coefs[1]), 0.0, tuple(ks), robust=why, best=best), float(max(E[1], 1e-300))
 
 
 def _arma11(x) -> tuple[tuple[float, float], float] | None:

@@ -2,7 +2,8 @@
 
 Samples are grouped by rate as for AR(1) noise (``ar1.rate_groups``); each contiguous run of a group is whitened
 on its own (the filter restarts at a change of rate). ``estimate`` chooses every group's model from a fit's
-residuals and profiles its innovation standard deviation (the maximum-likelihood value, the root mean square of
+residuals (the first candidate whose whitened residuals are white, else an AR(1) working model) and profiles its
+innovation standard deviation (the maximum-likelihood value, the root mean square of
 the whitened residuals); the fit then weights by it, and the two alternate (feasible GLS, ``velstep``).
 """
 from __future__ import annotations
@@ -48,12 +49,14 @@ class RecordNoise:
         """Noise coefficients fitted over the groups (AR orders, ARMA's two), their levels not counted."""
         return sum(m.n_coef for m in self.models)
 
-    def whiten(self, v) -> np.ndarray:
-        """v (samples, or samples x columns) whitened run by run with each group's model (innovation scale)."""
+    def whiten(self, v, best: bool = False) -> np.ndarray:
+        """v (samples, or samples x columns) whitened run by run with each group's model (innovation scale); with
+        ``best``, a working model's stand-in (``arp.ar1_working``) in its place."""
         v = np.asarray(v, dtype=float)
         out = np.empty_like(v)
         for a, b, g in self.runs:
-            out[a:b] = arp.whiten(v[a:b], self.models[g])
+            m = self.models[g]
+            out[a:b] = arp.whiten(v[a:b], m.best if best and m.best is not None else m)
         return out
 
     def log_det_terms(self) -> np.ndarray:
@@ -73,15 +76,48 @@ class RecordNoise:
         """The whitening's term of -2 ln L over the runs."""
         return sum(arp.log_det(self.models[g], b - a) for a, b, g in self.runs)
 
+    def whiteness(self, z, g: int, model=None) -> tuple[float, int]:
+        """(p, lags) of the Ljung-Box test that z (residuals, every sample) whitened by ``model`` (default: group g's
+        own; the filter restarts at each of the group's runs) are white over group g's samples: max(WHITE_LAGS,
+        order + 10) lags, the model's coefficients taken from the degrees of freedom; p is NaN when too short."""
+        from ..diagnostics.goodness import WHITE_LAGS, ljung_box
+
+        m = self.models[g] if model is None else model
+        pieces = [arp.whiten(z[a:b], m) for a, b, gg in self.runs if gg == g]
+        lags = max(WHITE_LAGS, m.order + 10)
+        return (ljung_box(np.concatenate(pieces), m.n_coef, lags) if pieces else math.nan), lags
+
     def estimate(self, residual, profile: bool = True) -> float:
-        """Choose each group's model from ``residual`` (model - data) and, when ``profile``, set sigma_g to the root
-        mean square of its whitened residual. Returns the largest relative change of a group's sigma_g."""
+        """Choose each group's model from ``residual`` (model - data): the first of ``arp.candidates`` whose whitened
+        residuals pass the Ljung-Box test (``whiteness``) at FITS_LEVEL, Bonferroni over the groups; where none
+        does, ``arp.ar1_working`` (kept for the rest of the fit). When ``profile``, set sigma_g to the root mean
+        square of the whitened residual. Returns the largest relative change of a group's sigma_g."""
+        from ..diagnostics.goodness import FITS_LEVEL
+
         r = np.asarray(residual, dtype=float)
         old = self.sigma_g.copy()
+        level = FITS_LEVEL / max(1, self.refs.size)
         for g in range(self.refs.size):
             pieces = [r[a:b] for a, b, gg in self.runs if gg == g]
             x = np.concatenate(pieces) if pieces else np.zeros(0)
-            self.models[g], _ = arp.select(x - x.mean() if x.size else x, 1.0 / self.refs[g])
+            x = x - x.mean() if x.size else x
+            if self.models[g].robust:  # kept: only its coefficient follows the residuals
+                self.models[g], _ = arp.ar1_working(x, self.models[g].robust, self.models[g].best)
+                continue
+            names, ps, first = [], [], None
+            for m, _ in arp.candidates(x, 1.0 / self.refs[g]):
+                first = first or m
+                p, lags = self.whiteness(r, g, m)
+                if not p < level:
+                    self.models[g] = m
+                    break
+                names.append(m.name)
+                ps.append(f"{p:.1g}" if p > 0 else "below 1e-300")
+            else:
+                verb = "leaves" if len(names) == 1 else "leave"
+                listed = " and ".join([", ".join(names[:-1]), names[-1]] if len(names) > 1 else names)
+                why = f"{listed} {verb} the residuals correlated (Ljung-Box p = {', '.join(ps)})"
+                self.models[g], _ = arp.ar1_working(x, why, first)
         if profile:
             w = self.whiten(r)
             for g in range(self.refs.size):
@@ -91,9 +127,29 @@ class RecordNoise:
                     self.sigma_g[g] = math.sqrt(ms)
         return float(np.max(np.abs(self.sigma_g / old - 1.0))) if old.size else 0.0
 
+    def ar1_form(self):
+        """Where every group's model is white or AR(1): (1 / marginal sigma, phi, 1 / sqrt(1 - phi^2)) per sample,
+        phi 0 at the start of each run, the weights with which ``velstep.kernel.basis_sums`` whitens exactly as
+        ``whiten`` does; None otherwise."""
+        if any(m.kind == "ARMA(1,1)" or m.order > 1 for m in self.models):
+            return None
+        phi_g = np.array([m.ar[0] if m.order else 0.0 for m in self.models])
+        phi = phi_g[self.labels]
+        inv = np.sqrt(1.0 - phi * phi) / self.sigma
+        phi = phi.copy()
+        phi[[a for a, _, _ in self.runs]] = 0.0
+        return inv, phi, 1.0 / np.sqrt(1.0 - phi * phi)
+
+    @property
+    def robust(self) -> bool:
+        """Whether some group's noise no candidate model whitens (its AR(1) a working model: sandwich errors)."""
+        return any(m.robust for m in self.models)
+
     def describe(self) -> list[tuple[str, str]]:
         """(rate label, model name) per group: ('100 Hz', 'AR(6)')."""
-        return [(f"{1 / r:.3g} Hz", m.name + (" (AR order at its cap)" if m.capped else ""))
+        return [(f"{1 / r:.3g} Hz", m.name + (f" working model: {m.robust}; Newey-West sandwich error bars, the "
+                                              f"law-fit bands under {m.best.name}" if m.robust else
+                                              " (AR order at its cap)" if m.capped else ""))
                 for r, m in zip(self.refs, self.models)]
 
     def draw(self, rng) -> np.ndarray:

@@ -3,7 +3,8 @@ units (``StepReport``).
 
 * Error bars: the full covariance of every parameter fitted jointly (nonlinear and linear), from the prewhitened
   Jacobian at the noise the likelihood uses, not rescaled (the noise is measured or estimated without the law,
-  as for every fit). A parameter at a bound gets no error bar; the others' are then those with it held there.
+  as for every fit). Where no candidate noise model whitens the residuals (an AR(1) working model, ``noise.arp``),
+  the Newey-West sandwich of the scores instead, and the law-fit bands under the data's best candidate. A parameter at a bound gets no error bar; the others' are then those with it held there.
 * Bounds: a parameter within AT_BOUND (relative) of a bound is reported at it, with what that means for these
   data (``BOUND_MEANING``).
 * The sign of a - b and the trend: where a trend is fitted, the result says whether the sign of a - b depends on
@@ -102,6 +103,8 @@ def build(problem, x, rounds, *, checks=True, errors=True, n_params=None, clock=
     no_effect = [problem.params[free[j]].name for j in range(len(free)) if not effect[j]]
     keep = [j for j in keep if effect[j]]
     cov, rank = _covariance(J[:, keep] if errors else J[:, :0])
+    if cov is not None and errors and any(s.arp and s.noise.robust for s in problem.series):
+        cov = _sandwich(problem, J[:, keep], pieces, cov)
     full = np.full((n_cols, n_cols), np.nan)
     if cov is not None and errors:
         full[np.ix_(keep, keep)] = cov
@@ -131,6 +134,8 @@ def build(problem, x, rounds, *, checks=True, errors=True, n_params=None, clock=
         reason += ("; correlated noise chosen by the data: AR(p) by BIC (ARMA(1,1) where the order runs to its cap) "
                    "per sampling rate, its innovation level profiled, alternated with the fit; coefficients and "
                    "levels counted as parameters; the likelihood, tests and error bars on the whitened series")
+        reason += "".join(f"; {s.target.name} at {rate}: {what}" for s in problem.series if s.arp
+                          for rate, what in s.noise.describe() if "working model" in what)
     elif n_phi:
         reason += ("; correlated noise: AR(1) per sampling rate (phi profiled, counted as a parameter), the "
                    "likelihood, tests and error bars on the prewhitened series")
@@ -204,6 +209,22 @@ def _covariance(A) -> tuple[np.ndarray | None, int]:
     return cov, rank
 
 
+def _sandwich(problem, J, pieces, bread) -> np.ndarray:
+    """The covariance where some dataset's noise no candidate model whitens (its AR(1) a working model): the
+    sandwich bread (J'J)^-1 around the sum over datasets of the Newey-West long-run covariance of the scores
+    J_t z_t (``noise.hac``, times n) where the working model is in use, J'J of their rows elsewhere."""
+    from ..noise.hac import long_run_covariance
+
+    meat = np.zeros_like(bread)
+    for s, pc in zip(problem.series, pieces):
+        Jr = J[pc["rows"]]
+        if s.arp and s.noise.robust:
+            meat += s.n * long_run_covariance(Jr * pc["z"][:, None], center=False)
+        else:
+            meat += Jr.T @ Jr
+    return bread @ meat @ bread
+
+
 def _at_bounds(problem, x) -> dict:
     """Display name -> (key, 'lower' | 'upper', what it means) for every free nonlinear parameter within AT_BOUND
     of a bound."""
@@ -242,7 +263,13 @@ def _goodness(s, p, k_each: int, J, v=None):
         from ..noise.misfit import band_test
 
         white_p, white_text = _whiteness(s, z)
-        bands = band_test(z, s.t, s.x, s.load.times[1:], v["Dc"], s.labels) if v is not None else None
+        zb = z
+        if s.noise.robust:  # the law-fit test under the data's best candidate, a working model's stand-in
+            zb = s.noise.whiten(p["r"] / s.sigma, best=True)
+            for g in range(s.refs.size):
+                sel = s.labels == g
+                zb[sel] /= math.sqrt(max(float(np.mean(zb[sel] ** 2)), 1e-300)) if sel.any() else 1.0
+        bands = band_test(zb, s.t, s.x, s.load.times[1:], v["Dc"], s.labels) if v is not None else None
         return law_fit(z, white_p, white_text, bands)
     chi = float(z @ z)
     white = ljung_box(z, s.refs.size) if s.ar1 else math.nan  # the AR(1) model says the prewhitened z are white

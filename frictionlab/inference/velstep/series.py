@@ -169,6 +169,11 @@ class Series:
     def whitened_sums(self, off: float, m, S):
         """``velstep_kernel.all_sums`` under the data's AR(p) model: the residual and the basis columns weighted,
         whitened by a linear filter (``noise.record``), and their sums (w'w, B'w, B'B, Q'w, Q'B)."""
+        fast = self.noise.ar1_form()
+        if fast is not None:  # AR(1) or white in every group: the compiled pass
+            from .kernel import basis_sums
+
+            return basis_sums(self.y_ref, off, m, S, *fast, self.Q)
         inv = self.inv_sigma
         Z = np.empty((self.n, 2 + S.shape[1]))  # the residual, then the basis (S[:, :4], 1, S[:, 4:]) / sigma
         Z[:, 0] = (off + m - self.y_ref) * inv

@@ -20,25 +20,15 @@ import math
 import attrs
 import numpy as np
 
+from ..noise.hac import long_run_covariance, nw_lags
+
 #: Two-sided level of the test.
 LEVEL = 0.05
 
 
-def nw_lags(n: int) -> int:
-    """Newey-West's rule of thumb for the Bartlett window: floor(4 (n / 100)^(2/9))."""
-    return int(4 * (n / 100.0) ** (2.0 / 9.0))
-
-
 def long_run_variance(d, lags: int | None = None) -> float:
     """The Newey-West long-run variance of d (mean removed): gamma_0 + 2 sum_j (1 - j / (L + 1)) gamma_j."""
-    d = np.asarray(d, dtype=float)
-    n = d.size
-    L = nw_lags(n) if lags is None else lags
-    e = d - d.mean()
-    s = float(e @ e) / n
-    for j in range(1, min(L, n - 1) + 1):
-        s += 2.0 * (1.0 - j / (L + 1.0)) * float(e[j:] @ e[:-j]) / n
-    return s
+    return float(long_run_covariance(d, lags)[0, 0])
 
 
 @attrs.frozen

@@ -2,6 +2,8 @@
 residuals, and the fitted parameters with their intervals in laboratory units beside them."""
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 
 from . import base
@@ -83,7 +85,7 @@ def _table_text(fit) -> str:
     for label, phi in row.phi:
         lines.append(f"φ {label}: {phi:.3f}")
     for label, model in row.noise:
-        lines.append(f"noise {label}: {model}")
+        lines += textwrap.wrap(f"noise {label}: {model}", 34, subsequent_indent="  ")
     lines.append("")
     lines.append(f"goodness: {fit.goodness.short}")
     return "\n".join(lines)
