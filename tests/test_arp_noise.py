@@ -190,3 +190,22 @@ def test_a_fit_whose_noise_no_model_whitens_says_so_and_its_sandwich_error_bars_
     assert "working model" in f.stats.likelihood_reason
     for name, value in (("a", 0.009), ("b", 0.012), ("Dc", 10e-6)):
         assert abs(f.value(name) - value) < 4 * f.params[name].stderr
+
+
+def test_nagatas_extra_column_goes_through_the_compiled_ar1_pass(tmp_path):
+    """A law with a parameter beyond a, b, Dc and k (Nagata's c) on a record whose noise the data read as AR(1):
+    the compiled pass carries the extra column, and the fit gives c = 0 the aging law's chi-square or better."""
+    import frictionlab as fl
+    from calibration_vuong import AGING, data_of, make_dataset, truth
+
+    ds, x, v1 = make_dataset(tmp_path, 3.0)
+    curve = truth(ds, x, v1, AGING)
+    e = np.random.default_rng(8).normal(0.0, 2e-4, curve.size)
+    for i in range(1, e.size):
+        e[i] += 0.6 * e[i - 1]
+    data = data_of(ds, curve + e)
+    nagata, aging = fl.fit("rate-state-nagata", data, trend=True, stiffness=True), fl.fit(AGING, data, trend=True,
+                                                                                          stiffness=True)
+    assert nagata.status == "ok" and aging.status == "ok", nagata.reason
+    assert [w for _, w in nagata.velstep.rows[0].noise] == [w for _, w in aging.velstep.rows[0].noise]
+    assert nagata.stats.chisqr <= aging.stats.chisqr * (1 + 1e-6)

@@ -171,9 +171,9 @@ class Series:
         whitened by a linear filter (``noise.record``), and their sums (w'w, B'w, B'B, Q'w, Q'B)."""
         fast = self.noise.ar1_form()
         if fast is not None:  # AR(1) or white in every group: the compiled pass
-            from .kernel import basis_sums
+            from .kernel import all_sums
 
-            return basis_sums(self.y_ref, off, m, S, *fast, self.Q)
+            return all_sums(self.y_ref, off, m, S, *fast, self.Q)
         inv = self.inv_sigma
         Z = np.empty((self.n, 2 + S.shape[1]))  # the residual, then the basis (S[:, :4], 1, S[:, 4:]) / sigma
         Z[:, 0] = (off + m - self.y_ref) * inv
