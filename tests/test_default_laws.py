@@ -1,5 +1,5 @@
 """The default laws of ``compare`` are chosen by dataset kind: the seed paper's four on impacts and inclines,
-rate-and-state (aging, slip, PRZ) on spring-slider velocity steps; named laws go to every dataset as before."""
+rate-and-state (aging, slip, PRZ, Nagata) on spring-slider velocity steps; named laws go to every dataset as before."""
 from __future__ import annotations
 
 from types import SimpleNamespace
@@ -10,7 +10,7 @@ from frictionlab.pipeline.planning import plan_fits
 from frictionlab.pipeline.settings import DEFAULT_LAWS, Settings, default_laws_by_kind
 from frictionlab.report.summary import _laws_text
 
-RS = ("rate-state-aging", "rate-state-slip", "rate-state-prz")
+RS = ("rate-state-aging", "rate-state-slip", "rate-state-prz", "rate-state-nagata")
 
 
 def test_the_default_laws_of_each_kind():

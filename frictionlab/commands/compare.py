@@ -28,7 +28,7 @@ def add_parser(sub):
 
     p = subcommand(sub, "compare", help="compare laws on datasets and write a report folder",
                    description="Fit every law to every dataset (default: the laws of each dataset's kind, the "
-                               "four mission laws on impacts and inclines and rate-and-state aging, slip and PRZ on "
+                               "four mission laws on impacts and inclines and rate-and-state aging, slip, PRZ and Nagata on "
                                "spring-sliders, on every built-in dataset and measured record present), rank them, test the paper's equivalence claim, and write report.md, "
                                "report.html, figures/, ranking.csv and results.json. Two defaults differ from "
                                "the library's fl.compare(), which runs only what it is asked for: --bootstrap "

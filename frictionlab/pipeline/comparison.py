@@ -264,7 +264,7 @@ def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None,
     ----------
     laws : sequence of str or "all", optional
         Registered names; None for the default laws of each dataset kind (Coulomb, area-rate, wear and Couette
-        on impacts and inclines; rate-and-state aging, slip and PRZ on spring-sliders); "all" for every registered
+        on impacts and inclines; rate-and-state aging, slip, PRZ and Nagata on spring-sliders); "all" for every registered
         law.
     datasets : sequence, optional
         Built-in names, names of measured records, TOML paths or Datasets; default every built-in dataset and

@@ -16,11 +16,10 @@ from ..physics.registry import available_laws, get_law
 #: question). Other registered laws (stribeck, lugre, dahl, installed plugins) join when named or with "all".
 DEFAULT_LAWS = ("coulomb", "area-rate", "wear", "couette")
 #: Dataset kinds whose default laws are others: rate-and-state friction on velocity steps of a spring-slider, the
-#: state laws aging, slip and PRZ. Nagata's law, which the velocity-step fit also serves (its c fitted with a, b,
-#: Dc), joins when named: adding it here makes the default comparison about a sixth slower in CPU. The two-state
-#: laws join when named: the velocity-step fit does not serve their b2, Dc2, and a law fitted through another
-#: model (no trend, stiffness or AR(1) noise) would be ranked against a different likelihood.
-DEFAULT_LAWS_BY_KIND = {"spring-slider": ("rate-state-aging", "rate-state-slip", "rate-state-prz")}
+#: one-state laws the velocity-step fit serves (aging, slip, PRZ, and Nagata's with its c fitted with a, b, Dc).
+#: The two-state laws join when named: the velocity-step fit does not serve their b2, Dc2, and a law fitted
+#: through another model (no trend, stiffness or data-chosen noise) would be ranked against a different likelihood.
+DEFAULT_LAWS_BY_KIND = {"spring-slider": ("rate-state-aging", "rate-state-slip", "rate-state-prz", "rate-state-nagata")}
 
 
 def select_laws(laws: Sequence[str] | None) -> tuple[str, ...]:
