@@ -35,7 +35,7 @@ from .compiled_codes import (
 )
 from .vecrk import BISECTIONS
 
-jit = numba.njit(cache=True, fastmath=False, error_model="numpy", inline="always")
+jit = numba.njit(cache=True, fastmath=False, error_model="numpy")
 
 
 @jit
