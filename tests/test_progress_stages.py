@@ -179,6 +179,32 @@ def test_the_eta_is_the_measured_rate_of_the_counts_not_of_the_moves():
         assert abs(bar.eta(done, 100, clock.t) - (100 - done) * 5.0 / 11) < 1e-9
 
 
+def test_levenberg_marquardt_is_timed_afresh_after_the_scan():
+    """A scan at 1 s an evaluation, then Levenberg-Marquardt at 0.1 s: once the fit's first start begins the rate is
+    measured on its evaluations alone (the ETA waits for three moves, then says 0.1 s a count left); later starts
+    keep it."""
+    from frictionlab.inference.fitting.progress import FitProgress
+
+    clock, out = FakeClock(), io.StringIO()
+    with Progress("fit", stream=out, tty=False, clock=clock, thread=False, every=0) as bar:
+        restarts = []
+        bar.restart_rate = lambda: (restarts.append(bar.done), Progress.restart_rate(bar))
+        fp = FitProgress(bar, "lugre on x", 1)
+        fp.stage("scanning start points", 10, total=10 + 2 * 100 + 4, other_kind=True)
+        for k in range(1, 11):
+            clock.t += 1.0
+            bar(k, 214, "scan")
+        assert abs(bar.eta(10, 214, clock.t) - 204 * 1.0) < 1e-9
+        fp.done = 10
+        fp.start(0, 2, guess=100, tail=4)
+        for k in range(11, 15):
+            clock.t += 0.1
+            bar(k, 214, "lm")
+        assert restarts == [0, 10] and abs(bar.eta(14, 214, clock.t) - 200 * 0.1) < 1e-9
+        fp.start(1, 2, guess=100, tail=4)
+        assert restarts == [0, 10]
+
+
 def test_a_delayed_progress_is_silent_for_a_quick_run_and_speaks_after_the_delay():
     quiet, slow = io.StringIO(), io.StringIO()
     with Progress("x", stream=quiet, tty=False, delay=5.0) as bar:

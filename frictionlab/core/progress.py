@@ -83,6 +83,11 @@ class Progress:
         elif first or back or (moved and done in (1, total)) or now - self.last_line >= self.every:
             self._write(self.line(done, total, label, now), now)
 
+    def restart_rate(self) -> None:
+        """Steps of another kind follow (a fit's Levenberg-Marquardt runs after its scan of start points): the rate
+        is measured afresh from the next move on, and the ETA waits for FIRST_RATES moves after it."""
+        self.marks.clear()
+
     def stage(self, name: str) -> "Progress":
         """A child counting one stage (its own count, clock, ETA and bar); close it when the stage ends."""
         child = Progress(self.desc, self.stream, self.quiet, self.every, self.tty, self.heartbeat, 0.0, self.clock,

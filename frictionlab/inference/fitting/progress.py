@@ -27,9 +27,14 @@ class FitProgress:
         self.done, self.stage_end, self.label, self.count, self.size, self._last = 0, 0, "", 0, 0, -1e9
         self.starts: list[int] = []  # evaluations of each Levenberg-Marquardt start done
 
-    def stage(self, label: str, size: int, total: int | None = None):
+    def stage(self, label: str, size: int, total: int | None = None, other_kind: bool = False):
         """A stage of about ``size`` evaluations begins; ``total``: a new overall total counted from the
-        evaluations done, else the count jumps to the estimated end of the previous stage."""
+        evaluations done, else the count jumps to the estimated end of the previous stage. ``other_kind``: its
+        evaluations cost what those before did not (a scan's against Levenberg-Marquardt's): the rate is measured
+        afresh (``restart_rate`` of the progress, where it has one)."""
+        restart = getattr(self.progress, "restart_rate", None)
+        if other_kind and restart is not None:
+            restart()
         if total is None:
             self.done = max(self.done, self.stage_end)
         else:
@@ -43,7 +48,8 @@ class FitProgress:
         if i > 0:
             self.starts.append(self.count)
         size = max(1, round(statistics.median(self.starts))) if self.starts else guess
-        self.stage(f"Levenberg-Marquardt start {i + 1} of {n}", size, total=self.done + (n - i) * size + tail)
+        self.stage(f"Levenberg-Marquardt start {i + 1} of {n}", size, total=self.done + (n - i) * size + tail,
+                   other_kind=i == 0)
 
     def tick(self):
         """One model evaluation done."""

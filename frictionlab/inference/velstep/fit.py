@@ -405,7 +405,8 @@ def _solve(problem: Problem, scan: int, n_starts: int, max_nfev):
         from ..fitting.progress import LM_EVALS
 
         size = LM_EVALS * (len(starts) + 1)
-        problem.progress.stage("velocity-step fit: local fits", size, total=problem.progress.done + size)
+        problem.progress.stage("velocity-step fit: local fits", size, total=problem.progress.done + size,
+                               other_kind=True)
     if len(starts) > 1:  # each start fitted on the search's subsample; the best one then on every sample
         found = [problem.local(x0, free, search=True, max_nfev=max_nfev) for x0 in starts]
         found = [f for f in found if f[2]]
