@@ -150,6 +150,61 @@ def test_a_fit_estimates_later_starts_from_the_ones_done():
     assert calls[-1] == (60, 60 + 2 * 50 + 4, "lugre on x: Levenberg-Marquardt start 2 of 3, 0 evaluations")
 
 
+def test_a_long_start_does_not_make_every_later_start_look_long():
+    """Later starts are estimated at the median of the starts done: one start of 100 evaluations among starts of 10
+    does not promise 40 for each start left (the mean would)."""
+    from frictionlab.inference.fitting.progress import FitProgress
+
+    calls = []
+    fp = FitProgress(lambda d, t, label: calls.append((d, t, label)), "lugre on x", 1)
+    for i, n in enumerate((10, 100, 10)):
+        fp.start(i, 5, guess=20, tail=4)
+        for _ in range(n):
+            fp.tick()
+    fp.start(3, 5, guess=20, tail=4)
+    assert calls[-1][:2] == (120, 120 + 2 * 10 + 4)
+
+
+def test_the_eta_is_the_measured_rate_of_the_counts_not_of_the_moves():
+    """Moves of many quick counts and moves of one slow count: the rate is their seconds over their counts (0.6 s a
+    count here), not the median move's (1 s a count)."""
+    clock, out = FakeClock(), io.StringIO()
+    with Progress("fit", stream=out, tty=False, clock=clock, thread=False, every=0) as bar:
+        done = 0
+        bar(done, 100, "x")
+        for step, n in [(1.0, 1)] + [(1.0, 1), (1.0, 4), (1.0, 1), (1.0, 4), (1.0, 1)]:
+            clock.t += step
+            done += n
+            bar(done, 100, "x")
+        assert abs(bar.eta(done, 100, clock.t) - (100 - done) * 5.0 / 11) < 1e-9
+
+
+def test_levenberg_marquardt_is_timed_afresh_after_the_scan():
+    """A scan at 1 s an evaluation, then Levenberg-Marquardt at 0.1 s: once the fit's first start begins the rate is
+    measured on its evaluations alone (the ETA waits for three moves, then says 0.1 s a count left); later starts
+    keep it."""
+    from frictionlab.inference.fitting.progress import FitProgress
+
+    clock, out = FakeClock(), io.StringIO()
+    with Progress("fit", stream=out, tty=False, clock=clock, thread=False, every=0) as bar:
+        restarts = []
+        bar.restart_rate = lambda: (restarts.append(bar.done), Progress.restart_rate(bar))
+        fp = FitProgress(bar, "lugre on x", 1)
+        fp.stage("scanning start points", 10, total=10 + 2 * 100 + 4, other_kind=True)
+        for k in range(1, 11):
+            clock.t += 1.0
+            bar(k, 214, "scan")
+        assert abs(bar.eta(10, 214, clock.t) - 204 * 1.0) < 1e-9
+        fp.done = 10
+        fp.start(0, 2, guess=100, tail=4)
+        for k in range(11, 15):
+            clock.t += 0.1
+            bar(k, 214, "lm")
+        assert restarts == [0, 10] and abs(bar.eta(14, 214, clock.t) - 200 * 0.1) < 1e-9
+        fp.start(1, 2, guess=100, tail=4)
+        assert restarts == [0, 10]
+
+
 def test_a_delayed_progress_is_silent_for_a_quick_run_and_speaks_after_the_delay():
     quiet, slow = io.StringIO(), io.StringIO()
     with Progress("x", stream=quiet, tty=False, delay=5.0) as bar:
@@ -180,7 +235,8 @@ def test_a_count_that_moved_gets_its_plain_line_with_eta_from_the_heartbeat():
         clock.t += 2.5
         bar.beat()
     last = out.getvalue().splitlines()[-1]
-    assert last.endswith("bench: 5/10 (50%) f; ETA 0:00:05")  # the median step: 1 s and "still working" not in out.getvalue()
+    assert last.endswith("bench: 5/10 (50%) f; ETA 0:00:04")  # 3 s for the 4 counts after the first move
+    assert "still working" not in out.getvalue()
 
 
 def test_the_eta_leaves_out_a_first_step_that_paid_for_compilation():

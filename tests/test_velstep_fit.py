@@ -31,6 +31,8 @@ def test_sdirk4_coefficients_have_order_4_and_an_order_3_embedding():
          [F(371, 1360), F(-137, 2720), F(15, 544), F(1, 4)], [F(25, 24), F(-49, 48), F(125, 16), F(-85, 12), F(1, 4)]]
     A = [r + [F(0)] * (5 - len(r)) for r in A]
     assert [float(x) for x in A[1][:1]] == [kernel.A10] and float(A[4][3]) == kernel.A43
+    assert [list(row) for row in kernel.TABLEAU] == [[float(A[i][j]) if j < i else 0.0 for j in range(4)]
+                                                      for i in range(5)]
     b, bhat = A[4], [F(59, 48), F(-17, 96), F(225, 32), F(-85, 12), F(0)]
     assert [float(x - y) for x, y in zip(b, bhat)] == pytest.approx([kernel.E0, kernel.E1, kernel.E2, kernel.E3,
                                                                       kernel.E4], abs=1e-15)
@@ -54,11 +56,11 @@ def test_kernel_jacobian_and_parameter_derivatives_match_finite_differences(law)
 
     def rates(m, psi, a=p["a"], b=p["b"], Dc=p["Dc"], k=p["k"], c=p["c"]):
         out = np.zeros(2)
-        kernel.rates(law, a, b, Dc, k, c, p["V1"], p["vlp"], m, psi, out, np.zeros((2, 2)), np.zeros((2, 5)), False)
+        kernel.rates(law, a, b, Dc, k, c, p["V1"], p["vlp"], m, psi, out, np.zeros((2, 2)), np.zeros((2, 5)))
         return out
 
     y = (0.004, -0.3)
-    kernel.rates(law, p["a"], p["b"], p["Dc"], p["k"], p["c"], p["V1"], p["vlp"], *y, f, J, Fp, True)
+    kernel.rates(law, p["a"], p["b"], p["Dc"], p["k"], p["c"], p["V1"], p["vlp"], *y, f, J, Fp)
     h = 1e-7
     for j in range(2):
         e = np.eye(2)[j] * h

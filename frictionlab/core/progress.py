@@ -22,12 +22,13 @@ import threading
 import time
 from collections import deque
 
-#: Moves of the count the ETA's rate is measured over: the last RATE_STEPS, each move's seconds a step, their median
-#: (the time to the first move, which pays for imports and compilation, never counts; a move that compiled or waited
-#: is outvoted by the others).
-RATE_STEPS = 32
+#: Moves of the count the ETA's rate is measured over: the last RATE_STEPS, their seconds over their counts (the time
+#: to the first move, which pays for imports and compilation, never counts; see ``Progress.eta``).
+RATE_STEPS = 64
 #: Moves after the first the ETA waits for: a median of three outvotes one move that compiled.
 FIRST_RATES = 3
+#: A move slower per count than OUTLIER times the median move is left out of the rate (a compilation, a stall).
+OUTLIER = 5.0
 
 
 def _clock(seconds: float) -> str:
@@ -81,6 +82,11 @@ class Progress:
             self._draw(done, total, label)
         elif first or back or (moved and done in (1, total)) or now - self.last_line >= self.every:
             self._write(self.line(done, total, label, now), now)
+
+    def restart_rate(self) -> None:
+        """Steps of another kind follow (a fit's Levenberg-Marquardt runs after its scan of start points): the rate
+        is measured afresh from the next move on, and the ETA waits for FIRST_RATES moves after it."""
+        self.marks.clear()
 
     def stage(self, name: str) -> "Progress":
         """A child counting one stage (its own count, clock, ETA and bar); close it when the stage ends."""
@@ -143,16 +149,19 @@ class Progress:
         return f"{_stamp()} {self.desc}: {self._name()}{done}/{total} ({100 * share:.0f}%) {label}; {eta}"
 
     def eta(self, done: int, total: int, now: float) -> float | None:
-        """Seconds left: the steps left times the median seconds a step of the last RATE_STEPS moves of the count;
-        None before the count has moved FIRST_RATES times after its first move. Not the mean over the whole run: the first step pays for imports
-        and compilation, and would make every later step look that slow (a fit whose first evaluation compiled for
-        a minute promised hours)."""
+        """Seconds left: the counts left times the measured rate, the seconds over the counts of the last RATE_STEPS
+        moves of the count, less any move slower per count than OUTLIER times their median; None before the count
+        has moved FIRST_RATES times after its first move. Not the mean over the whole run: the first step pays for
+        imports and compilation, and would make every later step look that slow (a fit whose first evaluation
+        compiled for a minute promised hours)."""
         marks = [m for m in self.marks if m[1] <= done]
-        rates = sorted((t1 - t0) / (d1 - d0) for (t0, d0), (t1, d1) in zip(marks, marks[1:]) if d1 > d0)
-        if len(rates) < FIRST_RATES:
+        steps = [(t1 - t0, d1 - d0) for (t0, d0), (t1, d1) in zip(marks, marks[1:]) if d1 > d0]
+        if len(steps) < FIRST_RATES:
             return None
-        mid = len(rates) // 2
-        return (total - done) * (rates[mid] if len(rates) % 2 else (rates[mid - 1] + rates[mid]) / 2)
+        per = sorted(s / n for s, n in steps)
+        typical = per[len(per) // 2]
+        kept = [(s, n) for s, n in steps if s <= OUTLIER * typical * n]
+        return (total - done) * sum(s for s, _ in kept) / sum(n for _, n in kept)
 
     def _draw(self, done: int, total: int, label: str) -> None:
         if self.bar is None:

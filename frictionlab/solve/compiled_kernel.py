@@ -35,7 +35,11 @@ from .compiled_codes import (
 )
 from .vecrk import BISECTIONS
 
-jit = numba.njit(cache=True, fastmath=False, error_model="numpy", inline="always")
+jit = numba.njit(cache=True, fastmath=False, error_model="numpy")
+#: The small helpers are inlined into the kernel by numba (they run in its innermost loops); the right-hand side,
+#: large and called from five places, is compiled once and left to LLVM (numba inlining it five times made the
+#: kernel's first compilation cost 20 CPU s instead of 13, for no gain at run time).
+inline = numba.njit(cache=True, fastmath=False, error_model="numpy", inline="always")
 
 
 @jit
@@ -80,13 +84,13 @@ def _rhs(s, z0, z1, sp, cd, tsc, fac0, fac1, fac2, ssc0, ssc1, direction):
     f2 = omega * fac2 if spin else 0.0
     return f0, f1, f2, math.isfinite(F)
 
-@jit
+@inline
 def _constants(cols, g):
     return (cols[g, MASS], cols[g, RADIUS], cols[g, INERTIA], cols[g, DRIVE], cols[g, VANISH], cols[g, A_OR_K],
             cols[g, C], cols[g, AREA_PEAK], cols[g, AREA_PHI], cols[g, AREA_TC], cols[g, AREA_CONST],
             cols[g, NORMAL_PEAK], cols[g, NORMAL_PHI], cols[g, NORMAL_TC], cols[g, NORMAL_CONST])
 
-@jit
+@inline
 def _comb(coef, K, nterm):
     """sum_j coef[j] K[j] over the nonzero coefficients, added in order (as ``vecdense.vec_dot``)."""
     a0 = a1 = a2 = 0.0
@@ -104,7 +108,7 @@ def _comb(coef, K, nterm):
             a2 += K[j, 2] * c
     return a0, a1, a2
 
-@jit
+@inline
 def _dense(Fc, nc, dop, x, h, y0, y1, y2):
     """The step's dense output at fraction x (``vecdense.Dense``: DOP853's nested x, 1 - x products, or
     RK45's polynomial times h)."""
@@ -128,7 +132,7 @@ def _dense(Fc, nc, dop, x, h, y0, y1, y2):
         a2 *= h
     return a0 + y0, a1 + y1, a2 + y2
 
-@jit
+@inline
 def _slip(z0, z1, ssc0, ssc1, r, coupled, dsc):
     """The event: slip (v - r omega with slip coupling) over its scale, times the phase's direction."""
     v = z0 * ssc0

@@ -43,13 +43,16 @@ A20, A21 = 17.0 / 50.0, -1.0 / 25.0
 A30, A31, A32 = 371.0 / 1360.0, -137.0 / 2720.0, 15.0 / 544.0
 A40, A41, A42, A43 = 25.0 / 24.0, -49.0 / 48.0, 125.0 / 16.0, -85.0 / 12.0
 E0, E1, E2, E3, E4 = 25.0 / 24.0 - 59.0 / 48.0, -49.0 / 48.0 + 17.0 / 96.0, 125.0 / 16.0 - 225.0 / 32.0, 0.0, 0.25
+#: The rows a_i0 .. a_i3 of the stage coefficients (zero past the diagonal), indexed by stage in the loops.
+TABLEAU = ((0.0, 0.0, 0.0, 0.0), (A10, 0.0, 0.0, 0.0), (A20, A21, 0.0, 0.0), (A30, A31, A32, 0.0),
+           (A40, A41, A42, A43))
 
 
 @jit
-def rates(law, a, b, Dc, k, cn, V1, vlp, m, psi, f, J, Fp, want_fp):
-    """Fill f = (dm/dt, dpsi/dt), J = d f / d(m, psi) and (want_fp) Fp = d f / d(a, b, Dc, k) at (m, psi) (cn:
-    Nagata's c; where Fp has a fifth column, d f / d c there); return the slip rate V [um/s] (inf where ln(V/V1)
-    exceeds MAX_EXPONENT or psi is beyond range)."""
+def rates(law, a, b, Dc, k, cn, V1, vlp, m, psi, f, J, Fp):
+    """Fill f = (dm/dt, dpsi/dt), J = d f / d(m, psi) and Fp = d f / d(a, b, Dc, k) at (m, psi) (cn: Nagata's c;
+    where Fp has a fifth column, d f / d c there); return the slip rate V [um/s] (inf where ln(V/V1) exceeds
+    MAX_EXPONENT or psi is beyond range)."""
     lnE = (m - b * psi) / a
     if not (lnE < MAX_EXPONENT) or not (-psi < MAX_EXPONENT) or (law == PRZ and not (psi + 2.0 * lnE < MAX_EXPONENT)):
         return math.inf
@@ -95,13 +98,12 @@ def rates(law, a, b, Dc, k, cn, V1, vlp, m, psi, f, J, Fp, want_fp):
         Fp[1, 3] = -q * (vlp - V)
         if Fp.shape[1] > 4:
             Fp[1, 4] = -f[0] / b
-    if want_fp:
-        Fp[0, 0] = -k * dVa
-        Fp[0, 1] = -k * dVb
-        Fp[0, 2] = 0.0
-        Fp[0, 3] = vlp - V
-        for c in range(4, Fp.shape[1]):
-            Fp[0, c] = 0.0
+    Fp[0, 0] = -k * dVa
+    Fp[0, 1] = -k * dVb
+    Fp[0, 2] = 0.0
+    Fp[0, 3] = vlp - V
+    for c in range(4, Fp.shape[1]):
+        Fp[0, c] = 0.0
     return V
 
 
@@ -109,25 +111,6 @@ def rates(law, a, b, Dc, k, cn, V1, vlp, m, psi, f, J, Fp, want_fp):
 def _solve2(M00, M01, M10, M11, r0, r1):
     det = M00 * M11 - M01 * M10
     return (M11 * r0 - M01 * r1) / det, (M00 * r1 - M10 * r0) / det
-
-
-@jit
-def _combine(i, h, y, K, base):
-    """base = y + h sum_{j<i} a_ij K[j] for SDIRK4's stage i (y, base: (2,) or (2, P); K: (5,) + y.shape)."""
-    yf = y.ravel()
-    bf = base.ravel()
-    Kf = K.reshape((5, yf.size))
-    for c in range(yf.size):
-        if i == 0:
-            bf[c] = yf[c]
-        elif i == 1:
-            bf[c] = yf[c] + h * (A10 * Kf[0, c])
-        elif i == 2:
-            bf[c] = yf[c] + h * (A20 * Kf[0, c] + A21 * Kf[1, c])
-        elif i == 3:
-            bf[c] = yf[c] + h * (A30 * Kf[0, c] + A31 * Kf[1, c] + A32 * Kf[2, c])
-        else:
-            bf[c] = yf[c] + h * (A40 * Kf[0, c] + A41 * Kf[1, c] + A42 * Kf[2, c] + A43 * Kf[3, c])
 
 
 @jit
@@ -163,7 +146,8 @@ def integrate(law, a, b, Dc, k, cn, V1, seg_t, seg_v, t_out, rtol, atol_m, sens,
         out_m[i_out] = 0.0
         out_psi[i_out] = 0.0
         if sens:
-            out_S[i_out, :] = 0.0
+            for c in range(P):
+                out_S[i_out, c] = 0.0
         i_out += 1
     t_end = t_out[n - 1] if n else 0.0
     accepted = 0
@@ -180,7 +164,7 @@ def integrate(law, a, b, Dc, k, cn, V1, seg_t, seg_v, t_out, rtol, atol_m, sens,
         if not t1 > t0:
             continue
         vlp = seg_v[j]
-        V = rates(law, a, b, Dc, k, cn, V1, vlp, y[0], y[1], f0, J, Fp, sens)
+        V = rates(law, a, b, Dc, k, cn, V1, vlp, y[0], y[1], f0, J, Fp)
         if sens:
             for c in range(P):
                 KS0[0, c] = J[0, 0] * S[0, c] + J[0, 1] * S[1, c] + Fp[0, c]
@@ -202,7 +186,12 @@ def integrate(law, a, b, Dc, k, cn, V1, seg_t, seg_v, t_out, rtol, atol_m, sens,
             sc1 = rtol * (1.0 + abs(y[1]))
             ok = True
             for i in range(5):
-                _combine(i, h, y, K, base)
+                row = TABLEAU[i]
+                for c in range(2):  # base = y + h sum_{l<i} a_il K[l]
+                    acc = 0.0
+                    for l in range(i):
+                        acc += row[l] * K[l, c]
+                    base[c] = y[c] + h * acc
                 if i == 0:
                     Y[0] = base[0] + h * G * f0[0]
                     Y[1] = base[1] + h * G * f0[1]
@@ -212,7 +201,7 @@ def integrate(law, a, b, Dc, k, cn, V1, seg_t, seg_v, t_out, rtol, atol_m, sens,
                 converged = False
                 for _ in range(12):
                     newton += 1
-                    V = rates(law, a, b, Dc, k, cn, V1, vlp, Y[0], Y[1], f, J, Fp, False)
+                    V = rates(law, a, b, Dc, k, cn, V1, vlp, Y[0], Y[1], f, J, Fp)
                     if not math.isfinite(V):
                         break
                     r0 = -(Y[0] - base[0] - h * G * f[0])
@@ -230,15 +219,18 @@ def integrate(law, a, b, Dc, k, cn, V1, seg_t, seg_v, t_out, rtol, atol_m, sens,
                 if not converged:
                     ok = False
                     break
-                V = rates(law, a, b, Dc, k, cn, V1, vlp, Y[0], Y[1], f, J, Fp, sens)
+                V = rates(law, a, b, Dc, k, cn, V1, vlp, Y[0], Y[1], f, J, Fp)
                 if not math.isfinite(V):
                     ok = False
                     break
                 K[i, 0] = f[0]
                 K[i, 1] = f[1]
                 if sens:
-                    Js[i] = J
-                    Fps[i] = Fp
+                    for r in range(2):
+                        Js[i, r, 0] = J[r, 0]
+                        Js[i, r, 1] = J[r, 1]
+                        for c in range(P):
+                            Fps[i, r, c] = Fp[r, c]
             if not ok:
                 rejected += 1
                 h *= 0.25
@@ -259,15 +251,20 @@ def integrate(law, a, b, Dc, k, cn, V1, seg_t, seg_v, t_out, rtol, atol_m, sens,
             t_new = t1 if last else t + h
             if sens:  # the stages' sensitivities, each with its stage's matrix
                 for i in range(5):
-                    _combine(i, h, S, KS, baseS)
-                    Ji = Js[i]
-                    M00, M01 = 1.0 - h * G * Ji[0, 0], -h * G * Ji[0, 1]
-                    M10, M11 = -h * G * Ji[1, 0], 1.0 - h * G * Ji[1, 1]
+                    row = TABLEAU[i]
+                    for r in range(2):  # baseS = S + h sum_{l<i} a_il KS[l] (after stage 4: S1's base)
+                        for c in range(P):
+                            acc = 0.0
+                            for l in range(i):
+                                acc += row[l] * KS[l, r, c]
+                            baseS[r, c] = S[r, c] + h * acc
+                    J00, J01, J10, J11 = Js[i, 0, 0], Js[i, 0, 1], Js[i, 1, 0], Js[i, 1, 1]
+                    M00, M01 = 1.0 - h * G * J00, -h * G * J01
+                    M10, M11 = -h * G * J10, 1.0 - h * G * J11
                     for c in range(P):
-                        r0 = Ji[0, 0] * baseS[0, c] + Ji[0, 1] * baseS[1, c] + Fps[i, 0, c]
-                        r1 = Ji[1, 0] * baseS[0, c] + Ji[1, 1] * baseS[1, c] + Fps[i, 1, c]
+                        r0 = J00 * baseS[0, c] + J01 * baseS[1, c] + Fps[i, 0, c]
+                        r1 = J10 * baseS[0, c] + J11 * baseS[1, c] + Fps[i, 1, c]
                         KS[i, 0, c], KS[i, 1, c] = _solve2(M00, M01, M10, M11, r0, r1)
-                _combine(4, h, S, KS, baseS)
                 for c in range(P):
                     S1[0, c] = baseS[0, c] + h * G * KS[4, 0, c]
                     S1[1, c] = baseS[1, c] + h * G * KS[4, 1, c]

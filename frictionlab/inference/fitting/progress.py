@@ -1,7 +1,8 @@
 """Progress of one fit, counted in model evaluations: the start scan, each Levenberg-Marquardt start
-and the error analysis. The first start's count is estimated (LM_EVALS per free parameter plus one),
-later ones at the mean of the starts done; a stage that needs more grows by half, so the ETA is an
-estimate that corrects itself.
+and the error analysis. The first start's count is estimated on the low side (LM_EVALS per free parameter
+plus one), later ones at the median of the starts done; a stage that needs more grows by half, so the ETA
+(``core.progress``: the counts left at the measured rate) corrects itself upwards rather than promising
+more time than the fit takes.
 
 ``FitProgress(progress, what)`` wraps a ``progress(done, total, label)`` callable (core.progress.Progress);
 the fit calls ``stage`` when a stage begins and ``tick`` after each model evaluation. Calls to
@@ -10,12 +11,14 @@ to an evaluation.
 """
 from __future__ import annotations
 
+import statistics
 import time
 
 #: seconds between two progress calls within one stage
 EVERY = 0.25
-#: estimated Levenberg-Marquardt evaluations of one start, per free parameter plus one
-LM_EVALS = 30
+#: estimated Levenberg-Marquardt evaluations of one start, per free parameter plus one (about ten iterations, each
+#: a difference-quotient Jacobian and a step; a start that needs more grows its stage)
+LM_EVALS = 10
 
 
 class FitProgress:
@@ -24,9 +27,14 @@ class FitProgress:
         self.done, self.stage_end, self.label, self.count, self.size, self._last = 0, 0, "", 0, 0, -1e9
         self.starts: list[int] = []  # evaluations of each Levenberg-Marquardt start done
 
-    def stage(self, label: str, size: int, total: int | None = None):
+    def stage(self, label: str, size: int, total: int | None = None, other_kind: bool = False):
         """A stage of about ``size`` evaluations begins; ``total``: a new overall total counted from the
-        evaluations done, else the count jumps to the estimated end of the previous stage."""
+        evaluations done, else the count jumps to the estimated end of the previous stage. ``other_kind``: its
+        evaluations cost what those before did not (a scan's against Levenberg-Marquardt's): the rate is measured
+        afresh (``restart_rate`` of the progress, where it has one)."""
+        restart = getattr(self.progress, "restart_rate", None)
+        if other_kind and restart is not None:
+            restart()
         if total is None:
             self.done = max(self.done, self.stage_end)
         else:
@@ -39,8 +47,9 @@ class FitProgress:
         is done; ``tail``: evaluations after the last start (the error analysis)."""
         if i > 0:
             self.starts.append(self.count)
-        size = max(1, round(sum(self.starts) / len(self.starts))) if self.starts else guess
-        self.stage(f"Levenberg-Marquardt start {i + 1} of {n}", size, total=self.done + (n - i) * size + tail)
+        size = max(1, round(statistics.median(self.starts))) if self.starts else guess
+        self.stage(f"Levenberg-Marquardt start {i + 1} of {n}", size, total=self.done + (n - i) * size + tail,
+                   other_kind=i == 0)
 
     def tick(self):
         """One model evaluation done."""

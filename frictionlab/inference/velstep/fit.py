@@ -386,12 +386,15 @@ def fit(law, targets, *, fixed=None, free=None, initial=None, trend=None, stiffn
         return give_up("skipped", f"{', '.join(names)}: {n_points} data points for {n_free} free parameters: a fit "
                                   f"needs at least {n_free + 1}")
     if progress is not None:
-        from ..fitting.progress import FitProgress
+        from ..fitting.progress import LM_EVALS, FitProgress
 
-        grid = GRID_DC * (GRID_K if any(p.key == "k" and p.vary for p in problem.params) else 1)
+        grid = GRID_DC * (GRID_K if any(p.key == "k" and p.vary for p in problem.params) else 1) * SEARCH_ITERS
+        local = LM_EVALS * (min(n_starts, 3) + 2)  # the starts' fits on the subsample and the full fit
         problem.progress = FitProgress(progress, f"{law.name} on {', '.join(names)}", 1)
-        problem.progress.stage("velocity-step fit: grid start and local fits", grid * (SEARCH_ITERS + 1) + 100,
-                               total=grid * (SEARCH_ITERS + 1) + 100)
+        if scan and problem.free:
+            problem.progress.stage("velocity-step fit: grid start", grid, total=grid + local)
+        else:
+            problem.progress.stage("velocity-step fit: local fit", LM_EVALS, total=LM_EVALS)
     try:
         x, cost, ok, rounds = _solve(problem, scan, n_starts, max_nfev)
     except FitTimeout:
@@ -412,6 +415,12 @@ def _solve(problem: Problem, scan: int, n_starts: int, max_nfev):
     rounds of the alternation)."""
     free = problem.free
     starts = problem.search(max(1, min(n_starts, 3))) if scan and free else [problem.x_start()]
+    if problem.progress is not None and len(starts) > 1:
+        from ..fitting.progress import LM_EVALS
+
+        size = LM_EVALS * (len(starts) + 1)
+        problem.progress.stage("velocity-step fit: local fits", size, total=problem.progress.done + size,
+                               other_kind=True)
     if len(starts) > 1:  # each start fitted on the search's subsample; the best one then on every sample
         found = [problem.local(x0, free, search=True, max_nfev=max_nfev) for x0 in starts]
         found = [f for f in found if f[2]]
