@@ -39,7 +39,8 @@ def test_the_command_line_and_the_report_say_which_laws_went_to_which_kind():
     c = SimpleNamespace(options=s, settings=s.as_dict(), laws=s.laws,
                         datasets=[SimpleNamespace(kind=k) for k in ("impact", "incline", "spring-slider")])
     assert laws_lines(c) == ["laws by dataset kind (the default): coulomb, area-rate, wear, couette on impact, "
-                             "incline; rate-state-aging, rate-state-slip, rate-state-prz, rate-state-nagata on spring-slider"]
+                             "incline; rate-state-aging, rate-state-slip, rate-state-prz, rate-state-nagata on "
+                             "spring-slider"]
     assert _laws_text(c) == ("coulomb, area-rate, wear, couette on impact, incline datasets; rate-state-aging, "
                              "rate-state-slip, rate-state-prz, rate-state-nagata on spring-slider datasets")
     named = SimpleNamespace(options=Settings(laws=("coulomb",)), settings={}, laws=("coulomb",), datasets=c.datasets)
