@@ -91,5 +91,5 @@ def test_the_default_compare_fits_the_records_with_the_laws_of_their_kind():
     for law, ds, _, _ in plan.tasks:
         fitted.setdefault(ds.name, set()).add(law)
     for name in FILES:
-        assert fitted[name] == {"rate-state-aging", "rate-state-slip", "rate-state-prz"}, name
+        assert fitted[name] == {"rate-state-aging", "rate-state-slip", "rate-state-prz", "rate-state-nagata"}, name
     assert fitted["impact-golf-v28"] == {"coulomb", "area-rate", "wear", "couette"}
