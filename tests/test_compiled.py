@@ -251,15 +251,3 @@ def test_a_numba_that_does_not_import_leaves_batches_to_numpy(monkeypatch):
     with pytest.warns(RuntimeWarning, match="numba is installed but does not import"):
         br = simulate_batch("coulomb", sc, {"mu": 0.3}, solver="DOP853")
     assert br.info["engine"] == "numpy" and not compiled.available()
-
-
-def test_the_kernels_a_comparison_runs_are_compiled_before_its_workers_fork():
-    """``pipeline.warm``: the parent compiles (or reads from the cache) the sliding-phase kernel for impact fits and
-    the quasi-static slider and the velocity-step sums (with a law's extra column) for spring-slider fits."""
-    from frictionlab.inference.velstep import kernel as sums
-    from frictionlab.pipeline.warm import warm_kernels
-    from frictionlab.solve import compiled_kernel, quasistatic_kernel
-
-    warm_kernels([("wear", "impact"), ("rate-state-nagata", "spring-slider")])
-    for dispatcher in (compiled_kernel.kernel, quasistatic_kernel.integrate, sums.basis_sums, sums.extra_sums):
-        assert dispatcher.signatures, dispatcher

@@ -164,10 +164,6 @@ def run_stages(comparison, run: Run, stages: Sequence[Stage], forced: bool = Fal
     every one given, when ``forced``), timed; returns the comparison with every stage's fields filled."""
     chosen = [s for s in stages if forced or s.wanted(run)]
     timings = dict(comparison.timings)
-    if run.client is None and run.settings.jobs > 1:  # the workers fork with the kernels compiled once, here
-        from .warm import warm_kernels
-
-        warm_kernels((getattr(law, "name", law), ds.kind) for law, ds, _, _ in run.plan.tasks)
     with executor(run.settings.jobs, run.client, "compare", warm_worker) as pool:
         run.pool = pool
         side, pending = ThreadPoolExecutor(1), []
