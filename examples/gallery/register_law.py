@@ -48,5 +48,6 @@ print(table[table.dataset == "incline-oil-a100"][["candidate", "rank", "fits", "
       .to_string(index=False))
 
 # %%
-# The new law's fit drawn as any other: velocity against time above, residuals below.
-fl.fit("exp-stribeck", "incline-oil-a100").plot()
+# The new law's fit, as the comparison made it, drawn as any other: velocity against time above, residuals below.
+fit = next(f for f in c.fits if f.law == "exp-stribeck")
+fit.plot()
