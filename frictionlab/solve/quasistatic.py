@@ -31,7 +31,7 @@ LAW_NAMES = {code: name for name, code in LAWS.items()}
 #: parameters, (mu0, a, b, Dc) and Nagata's c.
 FITTED = frozenset({"rate-state-aging", "rate-state-slip", "rate-state-prz", "rate-state-nagata"})
 #: Law parameters beyond (mu0, a, b, Dc) with a sensitivity column, by law code (after a, b, Dc, k).
-EXTRA = {3: ("c",)}
+EXTRA = {LAWS["rate-state-nagata"]: ("c",)}
 #: Reference slip rate V0 of the laws' mu0 [um/s] (frictionlab/laws/rate_state.py: 1e-6 m/s).
 V0_UM = 1.0
 #: A quasi-static slider has run away once its slip rate exceeds this multiple of the fastest load point

@@ -1,9 +1,9 @@
 """The velocity-step fit: a rate-and-state law fitted to spring-slider records as the field fits them.
 
 ``fitting.fit`` hands a fit here when the law is a built-in one of ``quasistatic.FITTED`` (aging, slip, PRZ,
-Nagata), every
-dataset is a spring-slider whose slider is quasi-static (``solve.quasistatic.applies``), the solver is 'auto'
-or 'ode' and no law parameter is fitted per dataset ('local'). The result is the usual ``FitResult``.
+Nagata), every dataset is a spring-slider whose slider is quasi-static (``solve.quasistatic.applies``), the
+solver is 'auto' or 'ode' and no law parameter is fitted per dataset ('local'). The result is the usual
+``FitResult``.
 
 Model of dataset i, in laboratory units (t in s, displacements in um):
 
@@ -14,8 +14,7 @@ velocity V1 until the first step, then through every step and hold of ``[scene.s
 displacement (the dataset's x column, else the schedule's) and x_ref its value at the first step.
 
 * Nonlinear parameters: a, b and Dc (and Nagata's c, seen as itself, within the law's bounds, 0 the aging law)
-  shared by the datasets, and the machine stiffness k_i of each: fitted by
-  default on measured data (a start: the dataset's stiffness), held at the dataset's value elsewhere, or as
+  shared by the datasets, and the machine stiffness k_i of each: fitted by default on measured data (a start: the dataset's stiffness), held at the dataset's value elsewhere, or as
   ``free={'spring.stiffness': (lo, hi)}`` says. Levenberg-Marquardt with bounds (``Problem.lm``; the laws'
   bounds for a, b, Dc) sees a / 0.01, b / 0.01, ln Dc and ln k, and the normal equations of the forward
   sensitivities, summed in one compiled pass over the samples (``velstep_kernel``).

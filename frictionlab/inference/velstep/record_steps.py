@@ -6,8 +6,7 @@ are fitted by the velocity-step fit (``velstep``) three ways, for each state law
 * per step: a, b, Dc, the machine stiffness k, mu_ss and the trend of each window, its own;
 * shared: a, b and Dc (and Nagata's c) one set for every step (k, mu_ss and the trend still each window's own:
   the stiffness the fit sees mixes the machine with the gouge layer, which compacts between steps), the transfer
-  test of
-  ``transfer.shared_fit`` (the impacts' one-parameter-set test): the likelihood-ratio statistic
+  test of ``transfer.shared_fit`` (the impacts' one-parameter-set test): the likelihood-ratio statistic
   LR = -2 ln L_shared + 2 ln L_per-step, both under one noise model (``ar1_neg2ll``: each window's residuals
   as AR(1), phi and the innovation variance profiled: the conditional Gaussian likelihood), against
   chi-square with dk = 3 (steps - 1) degrees of freedom (4 (steps - 1) with Nagata's c), and delta-AIC =

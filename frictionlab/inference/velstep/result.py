@@ -4,7 +4,8 @@ units (``StepReport``).
 * Error bars: the full covariance of every parameter fitted jointly (nonlinear and linear), from the prewhitened
   Jacobian at the noise the likelihood uses, not rescaled (the noise is measured or estimated without the law,
   as for every fit). Where no candidate noise model whitens the residuals (an AR(1) working model, ``noise.arp``),
-  the Newey-West sandwich of the scores instead, and the law-fit bands under the data's best candidate. A parameter at a bound gets no error bar; the others' are then those with it held there.
+  the Newey-West sandwich of the scores instead, and the law-fit bands under the data's best candidate. A
+  parameter at a bound gets no error bar; the others' are then those with it held there.
 * Bounds: a parameter within AT_BOUND (relative) of a bound is reported at it, with what that means for these
   data (``BOUND_MEANING``).
 * The sign of a - b and the trend: where a trend is fitted, the result says whether the sign of a - b depends on
