@@ -283,9 +283,17 @@ def end_process(rc: int) -> None:
             stream.flush()
         except Exception:  # noqa: BLE001 (a closed or broken stream: nothing more can be said)
             pass
-    if threads or children:
+    if threads or children or rc in SIGNALLED:
         os._exit(rc)
     sys.exit(rc)
+
+
+#: The exit statuses of a run ended by SIGHUP, SIGINT or SIGTERM (128 + the signal's number). Such a run has
+#: already removed its temporary output, released its locks and stopped its workers when ``end_process`` is
+#: called, so it ends there and then: CPython remembers a ^C that interrupted code run by ``exec`` of a string
+#: (a dataclass or namedtuple being made, a compiler's generated code) even when frictionlab caught it, and
+#: would then end the process by SIGINT at exit instead of with status 130.
+SIGNALLED = (129, 130, 143)
 
 
 def _children() -> list[int]:
