@@ -22,6 +22,7 @@ import numpy as np
 
 from typing import TYPE_CHECKING
 
+from ..core.blas import one_blas_thread
 from ..core.errors import DatasetError, FrictionLabError
 from ..core.files import read_toml
 from ..core.names import check_name
@@ -285,6 +286,7 @@ def check_dataset_like(value, where: str, more: tuple = ()) -> None:
         raise TypeError(f"{where}: expected {DATASET_FORMS}, got {type(value).__name__} {value!r:.60}")
 
 
+@one_blas_thread
 def load_dataset(name_or_path: str | Path) -> Dataset:
     """Load and validate a dataset.
 

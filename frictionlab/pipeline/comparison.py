@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 import attrs
 import numpy as np
 
+from ..core.blas import one_blas_thread
 from ..core.arguments import as_items
 from ..core.errors import FrictionLabError, ParameterError
 from ..inference.equivalence.discrimination import REPLICATES, EquivalenceResult
@@ -248,6 +249,7 @@ def versions() -> dict:
 
 
 @with_own_errstate
+@one_blas_thread
 def compare(laws: Sequence[str] | None = None, datasets: Sequence | None = None, solvers: Sequence[str] | None = None,
             *, free: dict | None = None, equivalence: bool = True, jobs: int = 1,
             progress: Progress | None = None, bootstrap: int = 0, seed: int = 0, bootstrap_all: bool = False,

@@ -72,6 +72,7 @@ import math
 
 import numpy as np
 
+from ...core.blas import one_blas_thread
 from ...core.errors import FrictionLabError, ParameterError
 from .decomposition import decomposition
 from .result import (  # noqa: F401  (the test's public names, defined with its result)
@@ -88,6 +89,7 @@ from ...core.fpstate import with_own_errstate
 
 # --- the test -------------------------------------------------------------------------------------
 @with_own_errstate
+@one_blas_thread
 def analyze_equivalence(fit_a: FitResult, fit_b: FitResult, replicates: int = REPLICATES, seed: int = 0,
                         executor: Executor | None = None, chunk: int | None = None,
                         timeout: float | None = None, margin: float | str = MARGIN) -> EquivalenceResult:

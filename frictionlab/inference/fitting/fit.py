@@ -39,6 +39,7 @@ from typing import TYPE_CHECKING
 import attrs
 import numpy as np
 
+from ...core.blas import one_blas_thread
 from ...core.arguments import as_items, check_type
 from ...core.errors import DatasetError, FrictionLabError, ParameterError
 from ...core.units import as_range, as_si
@@ -115,6 +116,7 @@ def scene_ranges(free: Mapping[str, object] | None, where: str) -> dict[str, tup
     return out
 
 
+@one_blas_thread
 def fit(law: str | FrictionLaw, datasets: DatasetLike | Sequence[DatasetLike], solver: str = "auto", *, free: Mapping[str, object] | None = None,
         fixed: Mapping[str, object] | None = None, local: Sequence[str] = (),
         initial: Mapping[str, object] | None = None, observable: str | None = None, derive: str | None = None,
