@@ -120,11 +120,15 @@ def extra_sums(y, off, m, S, inv_sigma, phi, gain, Q):
                 g[j] = (x[j] - f * xp[j]) * k
         else:
             w = z
-            d[:] = c
-            g[:] = x
+            for j in range(5):
+                d[j] = c[j]
+            for j in range(e):
+                g[j] = x[j]
         zp = z
-        cp[:] = c
-        xp[:] = x
+        for j in range(5):  # element by element: slice assignments tripled the compile time
+            cp[j] = c[j]
+        for j in range(e):
+            xp[j] = x[j]
         for j in range(e):
             Ew[j] += g[j] * w
             for l in range(5):
