@@ -418,10 +418,20 @@ def _make_run(settings: Settings, dss, progress, client=None) -> Run:
 
 def _import_before_fork(run: Run) -> None:
     """lmfit (and numba, where the batch engine will use it) imported once here, before the workers fork,
-    instead of once in each."""
+    instead of once in each; and the velocity-step fit's kernels compiled (or loaded from numba's cache) here
+    where the run fits a spring-slider with a rate-and-state law: on a first run each worker compiled them."""
     import lmfit  # noqa: F401
 
     if any(t[1].kind == "impact-outcome" for t in run.plan.tasks):
         from ..solve.compiled import available
 
         available()
+    from ..solve.quasistatic import EXTRA, FITTED, LAWS
+
+    sliders = {t[0] for t in run.plan.tasks if t[1].kind == "spring-slider" and t[0] in FITTED}
+    if sliders:
+        from ..inference.velstep.kernel import compile_sums
+        from ..solve.quasistatic import compile_kernel
+
+        compile_kernel()
+        compile_sums(extra=any(LAWS[name] in EXTRA for name in sliders))

@@ -201,3 +201,12 @@ def simulate(law, scene, p, t, rtol: float = 1e-10):
     return Trajectory(t=t, u=V, v=V.copy(), omega=np.zeros(t.size), theta=np.zeros(t.size), force=mu * N, N=N,
                       load=mu, solver="ode", law=law.name, info={"method": "SDIRK4", "rtol": rtol, "steps": sol.steps},
                       law_states={"theta": theta})
+
+
+def compile_kernel() -> None:
+    """Compile the slider's kernel here, or load it from numba's cache, with the one type signature ``solve``
+    calls it with (a tiny history solved with sensitivities): a pool forked after this inherits it compiled,
+    instead of each worker compiling it again."""
+    load = Load(np.array([0.0, 1.0]), np.array([1.0, 10.0]))
+    solve(LAWS["rate-state-nagata"], 0.01, 0.012, 10.0, 0.01, load, np.array([0.5, 1.5, 2.0]), sensitivities=True,
+          c=1.0)

@@ -149,3 +149,10 @@ def all_sums(y, off, m, S, inv_sigma, phi, gain, Q):
     ww, Bw, BB, Qw, QB = sums
     Ew, EB, EE, QE = extra_sums(y, off, m, S, inv_sigma, phi, gain, Q)
     return ww, np.concatenate([Bw, Ew]), np.block([[BB, EB.T], [EB, EE]]), Qw, np.hstack([QB, QE])
+
+
+def compile_sums(extra: bool) -> None:
+    """Compile ``basis_sums`` (and, with ``extra``, ``extra_sums``) here, or load them from numba's cache, with the
+    one type signature the fit calls them with (three samples): a pool forked after this inherits them compiled."""
+    n, ones = 3, np.ones(3)
+    all_sums(ones, 0.0, ones, np.ones((n, 5 if extra else 4)), ones, np.full(n, 0.5), ones, np.ones((n, 1)))
