@@ -1,6 +1,9 @@
 """A per-dataset report figure is drawn on the canvas the last figure of its kind and layout used, emptied
 (``report.figures.base.subplots``); each must come out as on a fresh canvas, byte for byte, whatever the figure
-before it showed (other data, units, titles, legends, limits, a panel switched off)."""
+before it showed (other data, units, titles, legends, limits, a panel switched off). The same in a unit 1e5
+times rpm: tests/test_report_fast_paths.py."""
+import io
+
 import attrs
 import pytest
 from _fit_helpers import TRUTH, synthetic
@@ -8,6 +11,7 @@ from _fit_helpers import TRUTH, synthetic
 from frictionlab import compare, report
 from frictionlab.io.dataset import load_dataset
 from frictionlab.report.figures import base
+from PIL import Image
 
 
 def _figures(c):
@@ -41,11 +45,15 @@ def test_each_figure_on_a_kept_canvas_is_the_figure_a_fresh_canvas_gives(figures
         fresh.append(f.draw())
     base.release()
     kinds = {f.name.split("-")[0] for f in figures}
-    assert {"fit", "force", "discrimination", "equivalence", "derive", "finding.png"} <= kinds
+    assert {"fit", "force", "ranking.png", "discrimination", "equivalence", "derive", "finding.png"} <= kinds
     assert len(emptied) >= 8  # the canvases were drawn on again
     again = [fig._suptitle.get_text() for fig in emptied if fig._suptitle is not None]  # as the last figure left it
     assert any("spin derived from rotation angle" in t for t in again)
     assert [f.name for f, a, b in zip(figures, kept, fresh) if a != b] == []
+    for data in kept:  # each a PNG Pillow reads at the figure's size
+        image = Image.open(io.BytesIO(data))
+        image.load()
+        assert image.format == "PNG" and min(image.size) > 50
 
 
 def test_the_first_screens_figure_on_a_kept_canvas_is_the_figure_a_fresh_canvas_gives(comparisons, monkeypatch):

@@ -83,12 +83,12 @@ def small_comparisons():
             compare(laws=["coulomb", "wear"], datasets=[load_dataset("impact-outcome-synthetic")]))
 
 
-@pytest.mark.parametrize("scale", [1.0, 1e5])
-def test_figures_drawn_on_kept_canvases_are_the_figures_drawn_on_fresh_ones(small_comparisons, scale, monkeypatch):
-    """Every figure of two reports (fits, force, ranking, discrimination, equivalence, first screen, outcomes;
-    spin also in a unit 1e5 times rpm: offset texts above the axes) drawn one after another on the kept canvases
+def test_figures_drawn_on_kept_canvases_are_the_figures_drawn_on_fresh_ones(small_comparisons, monkeypatch):
+    """Every figure of two reports (fits, force, ranking, discrimination, equivalence, first screen, outcomes)
+    with spin in a unit 1e5 times rpm (offset texts above the axes) drawn one after another on the kept canvases
     (``base.subplots``: each emptied and drawn on again), and each on a fresh canvas: the same PNG bytes, each a
-    PNG Pillow reads at the figure's size."""
+    PNG Pillow reads at the figure's size. In the display units: tests/test_figure_reuse.py."""
+    scale = 1e5
     import io
 
     from PIL import Image
