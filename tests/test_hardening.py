@@ -182,7 +182,7 @@ def test_compare_turns_a_runaway_fit_into_a_failed_row(monkeypatch):
     fl.register_law(_Sluggish)
     try:
         c = fl.compare(laws=["sluggish", "wear"], datasets=["incline-oil-a100"], equivalence=False,
-                       fit_timeout=0.3)
+                       fit_timeout=3.0)  # sluggish sleeps far longer; wear fits within it on a loaded machine
     finally:
         registry.unregister_law("sluggish")
     by_law = {f.law: f for f in c.fits}

@@ -1,6 +1,7 @@
 """frictionlab and laws use their dependencies through public APIs only: no private module (``scipy.integrate._ivp``),
 no private name imported from one (``from matplotlib import _api``), no private attribute read or set on what a
-dependency hands back (``font._layout``, ``axis._update_ticks = ...``), no method patched in (``types.MethodType``).
+dependency hands back (``font._layout``, ``axis._update_ticks = ...``, ``getattr(pool, "_processes")``), no method
+patched in (``types.MethodType``).
 
 The source is walked as syntax (``ast``): a private name (one leading underscore, not a dunder) read as an attribute
 counts as the project's own only where the project defines it (a function, method, class, class attribute, slot,
@@ -74,6 +75,11 @@ def violations(source: str, own: set[str] | None = None, where: str = "<text>") 
         elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr == "MethodType"
               and isinstance(node.func.value, ast.Name) and node.func.value.id == "types"):
             out.append(f"{line}: types.MethodType (a method patched in)")
+        elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+              and node.func.id in ("getattr", "setattr", "hasattr", "delattr") and len(node.args) >= 2
+              and isinstance(node.args[1], ast.Constant) and isinstance(node.args[1].value, str)
+              and _private(node.args[1].value) and node.args[1].value not in own | PUBLIC):
+            out.append(f"{line}: {node.func.id}(..., {node.args[1].value!r}) (a private attribute by name)")
     return out
 
 
@@ -91,6 +97,7 @@ PLANTED = [
     "def f(ax):\n    ax._request_autoscale_view()\n",
     "import types\ndef f(axis, g):\n    axis._update_ticks = types.MethodType(g, axis)\n",
     "def f(lines, kw):\n    lines._internal_update(kw)\n",
+    "def f(pool):\n    return getattr(pool, '_processes', None)\n",
 ]
 
 

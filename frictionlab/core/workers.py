@@ -16,7 +16,7 @@ import threading
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
-from multiprocessing import get_context
+from multiprocessing import active_children, get_context
 
 from .errors import FrictionLabError, Terminated
 
@@ -105,19 +105,20 @@ def process_pool(jobs: int, stage: str = "frictionlab"):
     # passes (the workers' and the parent's) skip it instead of touching, and so copying, every page of it
     frozen = gc.get_freeze_count()  # a caller's freeze (long_run_gc) is the caller's to undo
     gc.freeze()
+    before = {p.pid for p in active_children()}
     pool = _start(jobs, ctx)
     try:
         yield pool
     except BrokenProcessPool:
-        _stop(pool)
+        _stop(pool, _workers(before))
         raise FrictionLabError(f"{stage}: {LOST}") from None
     except BaseException:
         if pool is not None:
-            _stop(pool)
+            _stop(pool, _workers(before))
         raise
     else:
         if pool is not None:
-            workers = list(getattr(pool, "_processes", None) or ())
+            workers = [p.pid for p in _workers(before)]
             pool.shutdown(wait=True)
             _end_groups(workers)
     finally:
@@ -150,11 +151,16 @@ def _start(jobs: int, ctx) -> ProcessPoolExecutor | None:
         return None
 
 
-def _stop(pool: ProcessPoolExecutor) -> None:
-    """Cancel what is queued, terminate the workers (SIGTERM, then SIGKILL after 5 s) and reap them."""
-    procs = list((getattr(pool, "_processes", None) or {}).values())
-    manager = getattr(pool, "_executor_manager_thread", None)  # taken now: shutdown() forgets it
-    pool.shutdown(wait=False, cancel_futures=True)
+def _workers(before: set[int]) -> list:
+    """The pool's worker processes: this process's children (``multiprocessing.active_children``) that were not
+    there before the pool started (``before``: their pids)."""
+    return [p for p in active_children() if p.pid not in before]
+
+
+def _stop(pool: ProcessPoolExecutor, procs: list) -> None:
+    """Terminate the workers ``procs`` (SIGTERM, then SIGKILL after 5 s) and reap them, then shut the pool down,
+    its queued tasks cancelled: its manager thread, which sees the workers gone, ends and is waited for (else the
+    interpreter's exit hook may race it and print "OSError: Bad file descriptor" after our one-line message)."""
     for p in procs:
         if p.is_alive():
             p.terminate()
@@ -164,10 +170,7 @@ def _stop(pool: ProcessPoolExecutor) -> None:
             p.kill()
             p.join()
     _end_groups([p.pid for p in procs])
-    # let the pool's manager thread finish closing its wake-up pipe now: otherwise the interpreter's
-    # exit hook may race it and print "OSError: Bad file descriptor" after our one-line message
-    if manager is not None:
-        manager.join(5)
+    pool.shutdown(wait=True, cancel_futures=True)
 
 
 class OverBudget(Exception):
