@@ -15,8 +15,8 @@ import numpy as np
 from .params import AB_SCALE
 from .table import StepReport, StepRow
 
-#: A parameter within this distance of a bound (in its optimizer coordinate: a / 0.01, b / 0.01, ln Dc, ln k;
-#: relative for the last two) is at the bound.
+#: A parameter within this distance of a bound (in its optimizer coordinate, ``velstep.params``: a / 0.01, b / 0.01
+#: or Nagata's softplus of b, ln Dc, ln k; relative for the last two) is at the bound.
 AT_BOUND = 1e-3
 #: Residual windows after a step beyond this many standard errors count as structure the law misses.
 MISSING_Z = 4.0
