@@ -82,7 +82,8 @@ def basis_sums(y, off, m, S, inv_sigma, phi, gain, Q):
             q02 += r * d2
             q03 += r * d3
             q04 += r * d4
-            q05 += r * d5
+            if extra:
+                q05 += r * d5
             if q > 1:
                 r = Q[i, 1]
                 qw1 += r * w
@@ -91,7 +92,8 @@ def basis_sums(y, off, m, S, inv_sigma, phi, gain, Q):
                 q12 += r * d2
                 q13 += r * d3
                 q14 += r * d4
-                q15 += r * d5
+                if extra:
+                    q15 += r * d5
     nb = 6 if extra else 5
     Bw = np.array([g0, g1, g2, g3, g4, g5])[:nb].copy()
     BB = np.array([[a00, a10, a20, a30, a40, a50], [a10, a11, a21, a31, a41, a51], [a20, a21, a22, a32, a42, a52],
