@@ -10,14 +10,14 @@ numba = pytest.importorskip("numba")
 
 
 def test_the_signatures_compiled_ahead_are_the_ones_the_fits_use():
-    from frictionlab.inference.velstep.kernel import basis_sums, compile_sums, extra_sums
+    from frictionlab.inference.velstep.kernel import basis_sums, compile_sums
     from frictionlab.solve import quasistatic_kernel as kernel
     from frictionlab.solve.quasistatic import compile_kernel
 
     compile_kernel()
-    compile_sums(extra=True)
-    ahead = [tuple(f.signatures) for f in (kernel.integrate, basis_sums, extra_sums)]
+    compile_sums()
+    ahead = [tuple(f.signatures) for f in (kernel.integrate, basis_sums)]
     assert all(len(s) == 1 for s in ahead), ahead
     for law in ("rate-state-aging", "rate-state-nagata"):
         assert fl.fit(law, "spring-slider-aging").ok
-    assert [tuple(f.signatures) for f in (kernel.integrate, basis_sums, extra_sums)] == ahead
+    assert [tuple(f.signatures) for f in (kernel.integrate, basis_sums)] == ahead

@@ -426,12 +426,11 @@ def _import_before_fork(run: Run) -> None:
         from ..solve.compiled import available
 
         available()
-    from ..solve.quasistatic import EXTRA, FITTED, LAWS
+    from ..solve.quasistatic import FITTED
 
-    sliders = {t[0] for t in run.plan.tasks if t[1].kind == "spring-slider" and t[0] in FITTED}
-    if sliders:
+    if any(t[1].kind == "spring-slider" and t[0] in FITTED for t in run.plan.tasks):
         from ..inference.velstep.kernel import compile_sums
         from ..solve.quasistatic import compile_kernel
 
         compile_kernel()
-        compile_sums(extra=any(LAWS[name] in EXTRA for name in sliders))
+        compile_sums()

@@ -16,8 +16,9 @@ displacement (the dataset's x column, else the schedule's) and x_ref its value a
 * Nonlinear parameters: a, b and Dc (and Nagata's c, seen as itself, within the law's bounds, 0 the aging law)
   shared by the datasets, and the machine stiffness k_i of each: fitted by default on measured data (a start: the dataset's stiffness), held at the dataset's value elsewhere, or as
   ``free={'spring.stiffness': (lo, hi)}`` says. Levenberg-Marquardt with bounds (``Problem.lm``; the laws'
-  bounds for a, b, Dc) sees a / 0.01, b / 0.01, ln Dc and ln k, and the normal equations of the forward
-  sensitivities, summed in one compiled pass over the samples (``velstep_kernel``).
+  bounds for a, b, Dc) sees a / 0.01, b / 0.01 (Nagata's b, kept above 0: its softplus, ln b at small b,
+  ``velstep.params``), ln Dc and ln k, and the normal equations of the forward sensitivities, summed in one
+  compiled pass over the samples (``velstep_kernel``).
 * Linear parameters, by variable projection (Golub and Pereyra 1973): mu_ss,i and the trend s_i are solved by
   linear least squares inside every evaluation (the residual is projected off their columns; as those do
   not depend on the nonlinear parameters, the projected sensitivities are the exact Jacobian). The trend is
@@ -47,6 +48,7 @@ from ...core.errors import FrictionLabError, SolverError
 from ...solve import quasistatic
 from ...solve.quasistatic import UM, Load
 from ..fitting.alarm import FitTimeout
+from .params import AB_SCALE, B_KNEE, Param
 from .series import SEARCH_DENSE, SEARCH_POINTS, Series  # noqa: F401  (the fit's public names)
 
 #: Grid of the global start: points along ln Dc, and along ln k where k is fitted (its span: start / K_SPAN to
@@ -58,8 +60,6 @@ K_BOUNDS = 1e3
 SEARCH_RTOL, FIT_RTOL = 1e-5, 1e-8
 #: Largest number of fit / phi-profile alternations, and the change in phi below which they stop.
 AR1_ROUNDS, AR1_TOL = 8, 1e-3
-#: Optimizer scale of a and b (the laws' typical size).
-AB_SCALE = 0.01
 #: Columns every Jacobian column combines (``velstep_kernel``): the sensitivities to a, b, Dc and k, and a constant
 #: (then those to a law's ``quasistatic.EXTRA`` parameters).
 NBASIS = 5
@@ -75,38 +75,6 @@ def applies(law, targets, solver: str, local, free) -> bool:
         return False
     return all(tg.dataset.kind == "spring-slider" and tg.observable == "mu" and not tg.derivation
                and tg.t is not None and not quasistatic.applies(law, tg.dataset.scene) for tg in targets)
-
-
-@attrs.frozen
-class Param:
-    """A nonlinear parameter: ``x`` = value / scale ('lin') or ln(value) ('log') in laboratory units (um)."""
-
-    name: str  # display name ('a', 'Dc', 'spring.stiffness' or 'spring.stiffness[NAME]')
-    key: str  # 'a', 'b', 'Dc', 'k' or an extra law parameter ('c')
-    target: int  # the dataset of a stiffness, -1 for a shared law parameter
-    transform: str  # 'lin' | 'log'
-    value: float  # start, laboratory units
-    lower: float
-    upper: float
-    vary: bool
-    fixed_by: str = ""
-    scale: float = AB_SCALE  # of a 'lin' parameter
-
-    def to_x(self, v: float) -> float:
-        return v / self.scale if self.transform == "lin" else math.log(v)
-
-    def from_x(self, x: float) -> float:
-        return x * self.scale if self.transform == "lin" else math.exp(x)
-
-    def slope(self, x: float) -> float:
-        """d value / d x at x."""
-        return self.scale if self.transform == "lin" else math.exp(x)
-
-    @property
-    def bounds_x(self) -> tuple[float, float]:
-        if self.transform == "lin":
-            return self.lower / self.scale, self.upper / self.scale
-        return math.log(self.lower), math.log(self.upper)
 
 
 class Problem:
@@ -206,7 +174,8 @@ class Problem:
             if p.key == "a":
                 M[0, j], M[4, j] = AB_SCALE, held * AB_SCALE
             elif p.key == "b":
-                M[1, j], M[4, j] = AB_SCALE, -held * AB_SCALE
+                d = p.slope_at(v["b"])
+                M[1, j], M[4, j] = d, -held * d
             elif p.key == "Dc":
                 M[2, j] = v["Dc"]
             elif p.key in self.extra:
@@ -464,8 +433,9 @@ def make_problem(law, targets, fixed, free, initial, trend, stiffness, rtol, dea
         lo, hi = spec.lower / unit, spec.upper / unit
         if name == "Dc":  # an evolution longer than the record's slip after its first step is a trend, not a Dc
             lo, hi = max(lo, 1e-6), min(hi, max(_slip_after_step(tg) for tg in targets))
-        params.append(Param(name, name, -1, "log" if name == "Dc" else "lin", value / unit, lo, hi, name not in held,
-                            held.get(name, (0, ""))[1], AB_SCALE if name in ("a", "b") else spec.scale))
+        how = "log" if name == "Dc" else "softplus" if name == "b" and lo > 0 else "lin"  # ``params``
+        params.append(Param(name, name, -1, how, value / unit, lo, hi, name not in held, held.get(name, (0, ""))[1],
+                            B_KNEE if how == "softplus" else AB_SCALE if name in ("a", "b") else spec.scale))
     series = []
     multi = len(targets) > 1
     for i, tg in enumerate(targets):

@@ -12,10 +12,11 @@ import math
 import attrs
 import numpy as np
 
+from .params import AB_SCALE
 from .table import StepReport, StepRow
 
-#: A parameter within this distance of a bound (in its optimizer coordinate: a / 0.01, b / 0.01, ln Dc, ln k;
-#: relative for the last two) is at the bound.
+#: A parameter within this distance of a bound (in its optimizer coordinate, ``velstep.params``: a / 0.01, b / 0.01
+#: or Nagata's softplus of b, ln Dc, ln k; relative for the last two) is at the bound.
 AT_BOUND = 1e-3
 #: Residual windows after a step beyond this many standard errors count as structure the law misses.
 MISSING_Z = 4.0
@@ -102,26 +103,34 @@ def _strengthening(problem, x) -> str:
         return ""
     chi_now = problem.evaluate(x, problem.free)[0]
     best = None
+    below = attrs.evolve(p, lower=-p.upper, transform="lin", scale=AB_SCALE)  # b / 0.01 (a softplus stays > 0)
     try:
-        problem.params[ib] = attrs.evolve(p, lower=-p.upper)
+        problem.params[ib] = below
         problem._cache = None
-        tried = [problem.local(x0, problem.free, search=True) for x0 in starts]
+        tried = [problem.local(_with(x0, ib, below.to_x(p.from_x(x0[ib]))), problem.free, search=True)
+                 for x0 in starts]
         tried = [t for t in tried if t[2]]  # on the subsample; the best one then on every sample
         if tried:
             xr, cost, ok = problem.local(min(tried, key=lambda t: t[1])[0], problem.free, max_nfev=REFIT_EVALS)
-            best = (xr, cost) if ok else None
+            best = (problem.values(xr), cost) if ok else None
     finally:
         problem.params[ib] = p
         problem._cache = None
     if best is None:
         return ""
-    xr, cost = best
-    v = problem.values(xr)
+    v, cost = best
     drop = chi_now - 2 * cost
     if v["b"] < 0 and drop > CHI2_1_999:
         return (f"a strengthening evolution: a refit that lets b go below 0 gives b = {v['b']:.3g} (a = {v['a']:.3g}, "
                 f"Dc = {v['Dc']:.3g} um) and lowers chi-square by {drop:.4g}; the rate-and-state laws here need b >= 0")
     return ""
+
+
+def _with(x, i, xi) -> np.ndarray:
+    """A copy of the parameter vector x with x[i] = xi."""
+    out = np.array(x, dtype=float)
+    out[i] = xi
+    return out
 
 
 def _missing(problem, x, pieces, goods, v, at_bound) -> list[str]:
