@@ -26,6 +26,7 @@ EXAMPLES = ROOT / "examples" / "gallery"
 TIMEOUT = 600  # seconds one example may take on a loaded 2-core machine
 JOBS = 2  # examples run at once
 CELL = re.compile(r"^# %%.*$", re.M)
+CHILD = "--child"  # the first argument of the process run_example starts
 
 
 def split_cells(source: str) -> tuple[str, list[tuple[str, str]]]:
@@ -79,7 +80,7 @@ def run_example(script: Path, out: Path, timeout: float = TIMEOUT) -> list[dict]
     env.pop("PYTHONPATH", None)
     with tempfile.TemporaryDirectory(prefix="frictionlab-gallery-") as work:
         try:
-            done = subprocess.run([sys.executable, str(Path(__file__).resolve()), str(script.resolve()),
+            done = subprocess.run([sys.executable, str(Path(__file__).resolve()), CHILD, str(script.resolve()),
                                    str(out.resolve())], cwd=work, env=env, capture_output=True, text=True,
                                   timeout=timeout)
         except subprocess.TimeoutExpired:
@@ -163,8 +164,12 @@ def on_files(files, config):
     return files
 
 
-if __name__ == "__main__":  # the child process of run_example
-    script, out = Path(sys.argv[1]), Path(sys.argv[2])
-    out.mkdir(parents=True, exist_ok=True)
-    sys.path.insert(0, str(script.parent))
-    (out / f"{script.stem}.json").write_text(json.dumps(run_cells(script, out)), encoding="utf-8")
+if __name__ == "__main__":
+    if sys.argv[1:2] == [CHILD]:  # the child process of run_example, in its temporary folder
+        script, out = Path(sys.argv[2]), Path(sys.argv[3])
+        out.mkdir(parents=True, exist_ok=True)
+        sys.path.insert(0, str(script.parent))
+        (out / f"{script.stem}.json").write_text(json.dumps(run_cells(script, out)), encoding="utf-8")
+    else:  # one example run as the build runs it: a fresh process in a temporary folder, its figures in OUT
+        for cell in run_example(Path(sys.argv[1]), Path(sys.argv[2])):
+            print(cell["stdout"], end="")
