@@ -67,10 +67,13 @@ class Series:
         return self.t.size
 
     def _set_weights(self):
-        """What the compiled sums read of sigma and phi: 1 / sigma and the prewhitening gain 1 / sqrt(1 - phi^2)."""
+        """What the compiled sums read of sigma and phi: 1 / sigma and the prewhitening gain 1 / sqrt(1 - phi^2); with
+        the data's AR(p) model, its weights for the compiled pass where it is AR(1) or white (``ar1_form``), else
+        None. Called wherever the noise changes."""
         self.inv_sigma = 1.0 / self.sigma
         self.gain = 1.0 / np.sqrt(1.0 - self.phi ** 2)
         self.inv_sigma_search = self.inv_sigma[self.search]
+        self.ar1_weights = self.noise.ar1_form() if self.noise is not None else None
 
     def _set_projection(self):
         """The orthonormal columns of the (prewhitened) linear parameters, and the data less a first guess of their
@@ -169,11 +172,10 @@ class Series:
     def whitened_sums(self, off: float, m, S):
         """``velstep_kernel.all_sums`` under the data's AR(p) model: the residual and the basis columns weighted,
         whitened by a linear filter (``noise.record``), and their sums (w'w, B'w, B'B, Q'w, Q'B)."""
-        fast = self.noise.ar1_form()
-        if fast is not None:  # AR(1) or white in every group: the compiled pass
+        if self.ar1_weights is not None:  # AR(1) or white in every group: the compiled pass
             from .kernel import all_sums
 
-            return all_sums(self.y_ref, off, m, S, *fast, self.Q)
+            return all_sums(self.y_ref, off, m, S, *self.ar1_weights, self.Q)
         inv = self.inv_sigma
         Z = np.empty((self.n, 2 + S.shape[1]))  # the residual, then the basis (S[:, :4], 1, S[:, 4:]) / sigma
         Z[:, 0] = (off + m - self.y_ref) * inv
