@@ -25,8 +25,8 @@ from typing import TYPE_CHECKING
 import attrs
 import numpy as np
 
-from ..core.blas import one_blas_thread
 from ..core.arguments import as_items
+from ..core.blas import one_blas_thread
 from ..core.errors import FrictionLabError, ParameterError
 from ..inference.equivalence.discrimination import REPLICATES, EquivalenceResult
 from ..inference.fitting.fit import FitResult, scene_ranges
@@ -426,11 +426,10 @@ def _import_before_fork(run: Run) -> None:
         from ..solve.compiled import available
 
         available()
-    from ..solve.quasistatic import FITTED
+    from ..solve.quasistatic import FITTED, compile_kernel
 
     if any(t[1].kind == "spring-slider" and t[0] in FITTED for t in run.plan.tasks):
         from ..inference.velstep.kernel import compile_sums
-        from ..solve.quasistatic import compile_kernel
 
         compile_kernel()
         compile_sums()

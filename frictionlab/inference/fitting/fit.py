@@ -39,8 +39,8 @@ from typing import TYPE_CHECKING
 import attrs
 import numpy as np
 
-from ...core.blas import one_blas_thread
 from ...core.arguments import as_items, check_type
+from ...core.blas import one_blas_thread
 from ...core.errors import DatasetError, FrictionLabError, ParameterError
 from ...core.units import as_range, as_si
 from ...core.workers import beat
