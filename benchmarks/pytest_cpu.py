@@ -2,7 +2,7 @@
 and at the end the files and the tests that cost the most CPU. ``--durations`` gives wall time, which two
 parallel workers on two cores blur; CPU seconds add up to what the suite costs.
 
-    PYTHONPATH=benchmarks python -m pytest -p pytest_cpu [--cpu-top 30]
+    PYTHONPATH=benchmarks python -m pytest -p pytest_cpu [--cpu-top 30] [--cpu-log FILE]
 
 Each worker appends one JSON line a test to a file in a temporary folder the main process made (named to the
 workers by the environment variable PYTEST_CPU_DIR); the main process prints the summary and removes the folder.
@@ -23,6 +23,7 @@ import pytest
 
 def pytest_addoption(parser):
     parser.addoption("--cpu-top", type=int, default=30, help="tests and files listed by CPU time (pytest_cpu)")
+    parser.addoption("--cpu-log", default=None, help="also keep the JSON line of each test in this file (pytest_cpu)")
 
 
 def _cpu() -> tuple[float, float]:
@@ -58,6 +59,8 @@ def pytest_terminal_summary(terminalreporter, config):
         rows = [json.loads(line) for line in log.read_text(encoding="utf-8").splitlines() if line.strip()]
     except FileNotFoundError:
         rows = []
+    if config.getoption("cpu_log"):
+        shutil.copyfile(log, config.getoption("cpu_log"))
     shutil.rmtree(log.parent, ignore_errors=True)
     if not rows:
         return
