@@ -1,5 +1,7 @@
 """The law registry: entry points (built-in and third-party), run-time registration, errors."""
+import os
 import re
+import subprocess
 import sys
 import textwrap
 from pathlib import Path
@@ -255,3 +257,29 @@ class Twice(FrictionLaw):
         assert "twice" in capsys.readouterr().out
     finally:
         unregister_law("twice")
+
+
+def test_a_loaded_law_file_leaves_no_bytecode_beside_it(tmp_path, run_cli):
+    """``--load f.py`` reads f.py and writes nothing beside it, also where Python writes bytecode (the default:
+    PYTHONDONTWRITEBYTECODE unset), which would otherwise leave a __pycache__ folder in the user's folder."""
+    f = tmp_path / "my_quiet_laws.py"
+    f.write_text(textwrap.dedent('''
+        from frictionlab import FrictionLaw, ParamSpec, register_law
+
+
+        @register_law
+        class Quiet(FrictionLaw):
+            name = "quiet"
+            formula = "F = k u"
+            citation = "a test"
+            params = (ParamSpec("k", "N s/m", 1.0, 0.0, 10.0, 1.0, "coefficient"),)
+            requires = frozenset({"u"})
+
+            def force(self, p, c):
+                return p["k"] * c.u
+        '''))
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    done = subprocess.run([sys.executable, "-m", "frictionlab", "--load", str(f), "laws"], env=env, cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0 and "quiet" in done.stdout, done.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["my_quiet_laws.py"]

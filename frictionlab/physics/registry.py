@@ -449,10 +449,23 @@ def load_law_file(path) -> None:
         raise RegistryError(f"--load {path}: no such file") from None
     if not stat.S_ISREG(mode):
         raise RegistryError(f"--load {path}: not a regular file")
-    spec = importlib.util.spec_from_file_location(f"frictionlab_user_{p.stem}", p)
+    name = f"frictionlab_user_{p.stem}"
+    spec = importlib.util.spec_from_file_location(name, p, loader=_source_only_loader()(name, str(p)))
     if spec is None or spec.loader is None:
         raise RegistryError(f"--load {path}: cannot be imported as a Python module")
     within_load_limit(_import, spec, path, what=f"--load {path}: importing it (and checking the laws it registers)")
+
+
+def _source_only_loader():
+    """A loader of a --load file that reads its source and writes nothing: without it Python would leave a
+    __pycache__ folder beside the user's file (unless PYTHONDONTWRITEBYTECODE is set)."""
+    import importlib.machinery
+
+    class SourceOnlyLoader(importlib.machinery.SourceFileLoader):
+        def set_data(self, path, data, **kwargs):  # importlib.abc.SourceLoader's hook that writes the bytecode
+            pass
+
+    return SourceOnlyLoader
 
 
 def _import(spec, path) -> None:
