@@ -164,23 +164,22 @@ from frictionlab import FrictionLaw, ParamSpec, register_law
 
 
 @register_law
-class MainStribeck(FrictionLaw):
-    """Velocity-weakening friction, registered in the script that runs compare (its __main__)."""
+class MainDry(FrictionLaw):
+    """Dry friction, registered in the script that runs compare (its __main__)."""
 
-    name = "main-stribeck"
-    formula = "F = N (mu_k + (mu_s - mu_k) exp(-|u| / v_s)) sign(u)"
+    name = "main-dry"
+    formula = "F = mu_k N sign(u)"
     citation = "test"
-    params = (ParamSpec("mu_s", "", 0.4, 0.0, 5.0, 0.3, "static"), ParamSpec("mu_k", "", 0.2, 0.0, 5.0, 0.3, "kinetic"),
-              ParamSpec("v_s", "m/s", 0.1, 1e-6, 100.0, 0.1, "Stribeck velocity"))
+    params = (ParamSpec("mu_k", "", 0.2, 0.0, 5.0, 0.3, "kinetic"),)
     requires = frozenset({"u", "N"})
 
     def force(self, p, c):
-        return (p["mu_k"] + (p["mu_s"] - p["mu_k"]) * np.exp(-np.abs(c.u) / p["v_s"])) * c.N * np.sign(c.u)
+        return p["mu_k"] * c.N * np.sign(c.u)
 
 
 if __name__ == "__main__":
     logging.getLogger("distributed").setLevel(logging.ERROR)
-    opts = dict(laws=["main-stribeck"], datasets=["incline-dry-d10"], bootstrap=0, tolerance=(), equivalence=False)
+    opts = dict(laws=["main-dry"], datasets=["incline-dry-d10"], bootstrap=0, tolerance=(), equivalence=False)
     here = fl.compare(jobs=1, **opts)
     with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as lc, \\
             distributed.Client(lc) as client:
