@@ -93,3 +93,18 @@ def test_the_default_compare_fits_the_records_with_the_laws_of_their_kind():
     for name in FILES:
         assert fitted[name] == {"rate-state-aging", "rate-state-slip", "rate-state-prz", "rate-state-nagata"}, name
     assert fitted["impact-golf-v28"] == {"coulomb", "area-rate", "wear", "couette"}
+
+
+def test_nagatas_fit_with_c_free_is_not_beaten_by_one_with_c_held():
+    """Nagata's law nests the aging law (c = 0), and holding c is a restriction: the fit with c free must be at
+    least as good (in -2 ln L) as one with c held at 0, at its default or at its upper bound. On sepiolite-velstep3
+    the grid started from c's default alone ended at the upper bound, c = 20, 16 above the fit with c held at 2;
+    the grid from c = 0 finds that basin (``Problem.search``)."""
+    import frictionlab as fl
+
+    ds = fl.load_dataset("sepiolite-velstep3")
+    free = fl.fit("rate-state-nagata", ds)
+    for c in (0.0, 2.0, 20.0):
+        held = fl.fit("rate-state-nagata", ds, fixed={"c": c})
+        assert free.stats.neg2loglik <= held.stats.neg2loglik + 1e-3, (c, free.value("c"), free.stats.neg2loglik,
+                                                                        held.stats.neg2loglik)

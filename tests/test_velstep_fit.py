@@ -254,7 +254,7 @@ def test_the_strengthening_refit_starts_where_the_bound_held_b(tmp_path):
     data = attrs.evolve(ds, columns=dict(ds.columns, mu=y), noise={"mu": 2e-4})
     law = fl.get_law("rate-state-aging")
     problem = velstep.make_problem(law, [Target(data, "mu", y, np.full(y.size, 2e-4))], {}, {}, {}, None, None, 1e-8)
-    starts = problem.search(3)
+    (starts,) = problem.search(3)  # one group: the aging law has no extra parameter to start at its bound
     ib = next(i for i, p in enumerate(problem.params) if p.key == "b")
     assert problem.b_held and all(x[ib] == problem.params[ib].bounds_x[0] for x in problem.b_held)
     costs = [problem.evaluate(x, problem.free, search=True)[0] for x in problem.b_held]

@@ -26,7 +26,8 @@ displacement (the dataset's x column, else the schedule's) and x_ref its value a
   of every parameter fitted jointly; the law's mu0 (at V0 = 1 um/s) is mu_ss - (a - b) ln(V1 / V0).
 * Global start: a grid over ln Dc (and ln k where it is fitted), a, b (and c) fitted at each grid point on at most
   SEARCH_POINTS samples, full fits from the best distinct grid points on that subsample, and the lowest one
-  then fitted on every sample.
+  then fitted on every sample. For Nagata's law the grid runs again with c = 0 (the aging law it extends), and
+  the best of that grid gets its own full fit: the lower of the two full fits is kept.
 * Noise: the dataset's sigma (known or estimated), or, where it declares ``correlation = "ar1"``, the AR(1)
   model of ``inference.noise.ar1``: the fit and phi's profile alternate until phi settles; where it declares
   ``correlation = "arp"``, the data's AR(p) / ARMA(1,1) model per rate group (``noise.record``), chosen from the
@@ -256,11 +257,24 @@ class Problem:
                     break
         return x, 0.5 * cost, True
 
-    def search(self, n_starts: int) -> list[np.ndarray]:
-        """Starts for the full fit: the given start, and the best distinct points of a grid over ln Dc (and ln k
-        of each fitted stiffness, jointly scaled), with a and b fitted at each on the search subsample."""
+    def search(self, n_starts: int) -> list[list[np.ndarray]]:
+        """Starts for the full fit, in groups: the given start and the best distinct points of a grid over ln Dc
+        (and ln k of each fitted stiffness, jointly scaled), with a and b fitted at each on the search subsample.
+        A law with an extra parameter (Nagata's c) has a second group from the same grid with the parameter at
+        its lower bound, where the law is the one it extends (c = 0: the aging law): a basin the first grid can
+        miss, and one the subsample can misjudge, so each group gets its own full fit (``_solve``)."""
         x0 = self.x_start()
         by_key = {p.key: i for i, p in enumerate(self.params) if p.target < 0}
+        nested = [(by_key[k], self.params[by_key[k]].bounds_x[0]) for k in self.extra if self.params[by_key[k]].vary]
+        grids = [self._grid(x0, by_key)] + [self._grid(_put(x0, [i], [lo]), by_key) for i, lo in nested]
+        b_low = self.params[by_key["b"]].bounds_x[0]
+        held = sorted((c for g in grids for c in g if c[3][by_key["b"]] <= b_low), key=lambda c: c[0])
+        self.b_held = _distinct(held, n_starts) if self.params[by_key["b"]].vary else []
+        return [[x0] + _distinct(grids[0], n_starts)] + [_distinct(g, n_starts) for g in grids[1:] if g]
+
+    def _grid(self, x0, by_key) -> list[tuple]:
+        """The grid of ``search`` around x0: (cost, Dc index, k index, x) of each point whose a, b fit succeeded,
+        lowest cost first."""
         iDc = by_key["Dc"]
         ks = [i for i, p in enumerate(self.params) if p.key == "k" and p.vary]
         ab = [by_key[k] for k in ("a", "b") + self.extra if self.params[by_key[k]].vary]
@@ -278,10 +292,7 @@ class Problem:
                 if ok:
                     scored.append((cost, a_i, b_i, x))
         scored.sort(key=lambda c: c[0])
-        b_low = self.params[by_key["b"]].bounds_x[0]
-        self.b_held = (_distinct([c for c in scored if c[3][by_key["b"]] <= b_low], n_starts)
-                       if self.params[by_key["b"]].vary else [])
-        return [x0] + _distinct(scored, n_starts)
+        return scored
 
 
 def _distinct(scored, n: int) -> list[np.ndarray]:
@@ -356,7 +367,8 @@ def fit(law, targets, *, fixed=None, free=None, initial=None, trend=None, stiffn
     if progress is not None:
         from ..fitting.progress import LM_EVALS, FitProgress
 
-        grid = GRID_DC * (GRID_K if any(p.key == "k" and p.vary for p in problem.params) else 1) * SEARCH_ITERS
+        grids = 1 + sum(p.key in problem.extra and p.vary for p in problem.params)  # ``Problem.search``
+        grid = GRID_DC * (GRID_K if any(p.key == "k" and p.vary for p in problem.params) else 1) * SEARCH_ITERS * grids
         local = LM_EVALS * (min(n_starts, 3) + 2)  # the starts' fits on the subsample and the full fit
         problem.progress = FitProgress(progress, f"{law.name} on {', '.join(names)}", 1)
         if scan and problem.free:
@@ -382,20 +394,25 @@ def _solve(problem: Problem, scan: int, n_starts: int, max_nfev):
     """The search, the full fits from its starts, then the alternation with phi's profile: (x, cost, success,
     rounds of the alternation)."""
     free = problem.free
-    starts = problem.search(max(1, min(n_starts, 3))) if scan and free else [problem.x_start()]
-    if problem.progress is not None and len(starts) > 1:
+    groups = problem.search(max(1, min(n_starts, 3))) if scan and free else [[problem.x_start()]]
+    if problem.progress is not None and sum(map(len, groups)) > 1:
         from ..fitting.progress import LM_EVALS
 
-        size = LM_EVALS * (len(starts) + 1)
+        size = LM_EVALS * sum(len(g) + 1 for g in groups)
         problem.progress.stage("velocity-step fit: local fits", size, total=problem.progress.done + size,
                                other_kind=True)
-    if len(starts) > 1:  # each start fitted on the search's subsample; the best one then on every sample
-        found = [problem.local(x0, free, search=True, max_nfev=max_nfev) for x0 in starts]
-        found = [f for f in found if f[2]]
-        starts = [min(found, key=lambda f: f[1])[0]] if found else starts[:1]
-    x, cost, ok = problem.local(starts[0], free, max_nfev=max_nfev)
-    if not ok:
+    best = None
+    for starts in groups:  # per group: each start fitted on the search's subsample, the best then on every sample
+        if len(starts) > 1:
+            found = [problem.local(x0, free, search=True, max_nfev=max_nfev) for x0 in starts]
+            found = [f for f in found if f[2]]
+            starts = [min(found, key=lambda f: f[1])[0]] if found else starts[:1]
+        fitted = problem.local(starts[0], free, max_nfev=max_nfev)
+        if fitted[2] and (best is None or fitted[1] < best[1]):
+            best = fitted
+    if best is None:
         return problem.x_start(), math.inf, False, 0
+    x, cost, ok = best
     rounds = 0
     if any(s.correlated and not s.held for s in problem.series):
         for rounds in range(1, AR1_ROUNDS + 1):
