@@ -226,6 +226,23 @@ def test_a_notebook_cell_registering_a_law_can_run_again():
         unregister_law("cell-law")
 
 
+#: A law file for ``--load``: a linear law F = k u, named by ``format(cls=..., name=...)``.
+LINEAR_LAW_FILE = '''from frictionlab import FrictionLaw, ParamSpec, register_law
+
+
+@register_law
+class {cls}(FrictionLaw):
+    name = "{name}"
+    formula = "F = k u"
+    citation = "a test"
+    params = (ParamSpec("k", "N s/m", 1.0, 0.0, 10.0, 1.0, "coefficient"),)
+    requires = frozenset({{"u"}})
+
+    def force(self, p, c):
+        return p["k"] * c.u
+'''
+
+
 def test_loading_the_same_law_file_twice_is_a_note_not_an_error(tmp_path, capsys):
     """``--load f --load f`` (a notebook's cell run twice, on the command line): the second registration of
     the same module.class replaces the first with a warning; the command runs."""
@@ -235,20 +252,7 @@ def test_loading_the_same_law_file_twice_is_a_note_not_an_error(tmp_path, capsys
     from frictionlab.cli import main
 
     f = tmp_path / "my_twice_laws.py"
-    f.write_text('''from frictionlab import FrictionLaw, ParamSpec, register_law
-
-
-@register_law
-class Twice(FrictionLaw):
-    name = "twice"
-    formula = "F = k u"
-    citation = "loaded twice"
-    params = (ParamSpec("k", "N s/m", 1.0, 0.0, 10.0, 1.0, "coefficient"),)
-    requires = frozenset({"u"})
-
-    def force(self, p, c):
-        return p["k"] * c.u
-''')
+    f.write_text(LINEAR_LAW_FILE.format(cls="Twice", name="twice"))
     try:
         with _w.catch_warnings(record=True) as seen:
             _w.simplefilter("always")
@@ -259,25 +263,11 @@ class Twice(FrictionLaw):
         unregister_law("twice")
 
 
-def test_a_loaded_law_file_leaves_no_bytecode_beside_it(tmp_path, run_cli):
+def test_a_loaded_law_file_leaves_no_bytecode_beside_it(tmp_path):
     """``--load f.py`` reads f.py and writes nothing beside it, also where Python writes bytecode (the default:
     PYTHONDONTWRITEBYTECODE unset), which would otherwise leave a __pycache__ folder in the user's folder."""
     f = tmp_path / "my_quiet_laws.py"
-    f.write_text(textwrap.dedent('''
-        from frictionlab import FrictionLaw, ParamSpec, register_law
-
-
-        @register_law
-        class Quiet(FrictionLaw):
-            name = "quiet"
-            formula = "F = k u"
-            citation = "a test"
-            params = (ParamSpec("k", "N s/m", 1.0, 0.0, 10.0, 1.0, "coefficient"),)
-            requires = frozenset({"u"})
-
-            def force(self, p, c):
-                return p["k"] * c.u
-        '''))
+    f.write_text(LINEAR_LAW_FILE.format(cls="Quiet", name="quiet"))
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
     done = subprocess.run([sys.executable, "-m", "frictionlab", "--load", str(f), "laws"], env=env, cwd=tmp_path,
                           capture_output=True, text=True, timeout=300)

@@ -10,6 +10,7 @@ opposing slip at the defaults) and ``form``; any failure names the plugin.
 """
 from __future__ import annotations
 
+import importlib.machinery
 import inspect
 import math
 import numbers
@@ -450,22 +451,18 @@ def load_law_file(path) -> None:
     if not stat.S_ISREG(mode):
         raise RegistryError(f"--load {path}: not a regular file")
     name = f"frictionlab_user_{p.stem}"
-    spec = importlib.util.spec_from_file_location(name, p, loader=_source_only_loader()(name, str(p)))
+    spec = importlib.util.spec_from_file_location(name, p, loader=SourceOnlyLoader(name, str(p)))
     if spec is None or spec.loader is None:
         raise RegistryError(f"--load {path}: cannot be imported as a Python module")
     within_load_limit(_import, spec, path, what=f"--load {path}: importing it (and checking the laws it registers)")
 
 
-def _source_only_loader():
-    """A loader of a --load file that reads its source and writes nothing: without it Python would leave a
-    __pycache__ folder beside the user's file (unless PYTHONDONTWRITEBYTECODE is set)."""
-    import importlib.machinery
+class SourceOnlyLoader(importlib.machinery.SourceFileLoader):
+    """The loader of a --load file: it reads the source and writes nothing (a plain loader leaves a __pycache__
+    folder beside the user's file wherever Python writes bytecode)."""
 
-    class SourceOnlyLoader(importlib.machinery.SourceFileLoader):
-        def set_data(self, path, data, **kwargs):  # importlib.abc.SourceLoader's hook that writes the bytecode
-            pass
-
-    return SourceOnlyLoader
+    def set_data(self, path, data, **kwargs):  # importlib.abc.SourceLoader's hook that writes the bytecode
+        pass
 
 
 def _import(spec, path) -> None:

@@ -49,7 +49,7 @@ from ...core.errors import FrictionLabError, SolverError
 from ...solve import quasistatic
 from ...solve.quasistatic import UM, Load
 from ..fitting.alarm import FitTimeout
-from .params import AB_SCALE, B_KNEE, Param
+from .params import AB_SCALE, B_KNEE, Param, with_value
 from .series import SEARCH_DENSE, SEARCH_POINTS, Series  # noqa: F401  (the fit's public names)
 
 #: Grid of the global start: points along ln Dc, and along ln k where k is fitted (its span: start / K_SPAN to
@@ -266,7 +266,7 @@ class Problem:
         x0 = self.x_start()
         by_key = {p.key: i for i, p in enumerate(self.params) if p.target < 0}
         nested = [(by_key[k], self.params[by_key[k]].bounds_x[0]) for k in self.extra if self.params[by_key[k]].vary]
-        grids = [self._grid(x0, by_key)] + [self._grid(_put(x0, [i], [lo]), by_key) for i, lo in nested]
+        grids = [self._grid(x0, by_key)] + [self._grid(with_value(x0, i, lo), by_key) for i, lo in nested]
         b_low = self.params[by_key["b"]].bounds_x[0]
         held = sorted((c for g in grids for c in g if c[3][by_key["b"]] <= b_low), key=lambda c: c[0])
         self.b_held = _distinct(held, n_starts) if self.params[by_key["b"]].vary else []
@@ -313,12 +313,6 @@ def _slip_after_step(target) -> float:
     load = Load.of(target.dataset.scene.spring)
     first = load.times[1] if load.times.size > 1 else 0.0
     return float(load.displacement(target.t[-1]) - load.displacement(first))
-
-
-def _put(x0, free, z) -> np.ndarray:
-    x = np.array(x0, dtype=float)
-    x[free] = z
-    return x
 
 
 def _dc_grid(series, p: Param) -> np.ndarray:

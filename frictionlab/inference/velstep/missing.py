@@ -12,7 +12,7 @@ import math
 import attrs
 import numpy as np
 
-from .params import AB_SCALE
+from .params import AB_SCALE, with_value
 from .table import StepReport, StepRow
 
 #: A parameter within this distance of a bound (in its optimizer coordinate, ``velstep.params``: a / 0.01, b / 0.01
@@ -107,7 +107,7 @@ def _strengthening(problem, x) -> str:
     try:
         problem.params[ib] = below
         problem._cache = None
-        tried = [problem.local(_with(x0, ib, below.to_x(p.from_x(x0[ib]))), problem.free, search=True)
+        tried = [problem.local(with_value(x0, ib, below.to_x(p.from_x(x0[ib]))), problem.free, search=True)
                  for x0 in starts]
         tried = [t for t in tried if t[2]]  # on the subsample; the best one then on every sample
         if tried:
@@ -124,13 +124,6 @@ def _strengthening(problem, x) -> str:
         return (f"a strengthening evolution: a refit that lets b go below 0 gives b = {v['b']:.3g} (a = {v['a']:.3g}, "
                 f"Dc = {v['Dc']:.3g} um) and lowers chi-square by {drop:.4g}; the rate-and-state laws here need b >= 0")
     return ""
-
-
-def _with(x, i, xi) -> np.ndarray:
-    """A copy of the parameter vector x with x[i] = xi."""
-    out = np.array(x, dtype=float)
-    out[i] = xi
-    return out
 
 
 def _missing(problem, x, pieces, goods, v, at_bound) -> list[str]:

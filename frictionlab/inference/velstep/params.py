@@ -67,3 +67,10 @@ class Param:
     @property
     def bounds_x(self) -> tuple[float, float]:
         return self.to_x(self.lower), self.to_x(self.upper)
+
+
+def with_value(x, i: int, xi: float) -> np.ndarray:
+    """A copy of the optimizer's vector x with x[i] = xi."""
+    out = np.array(x, dtype=float)
+    out[i] = xi
+    return out
